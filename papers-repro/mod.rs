@@ -1,0 +1,21 @@
+//! Reproductions of the papers' results. Each writes tables (Markdown + CSV) and plots into
+//! `results/<name>/` and returns a short report for the command line to print. Run them with
+//! `ktree repro [NAME]`.
+
+pub mod default_object;
+
+use std::path::Path;
+
+/// The names accepted by [`run`], in the order `ktree repro all` runs them.
+pub const NAMES: &[&str] = &["default-object"];
+
+/// Runs one reproduction, writing into `results` (the results directory); returns a report to print.
+///
+/// # Errors
+/// A message naming what could not be computed or written.
+pub fn run(name: &str, results: &Path) -> Result<String, String> {
+    match name {
+        "default-object" => default_object::run(results),
+        _ => Err(format!("no reproduction named '{name}'")),
+    }
+}

@@ -1,0 +1,45 @@
+//! # ktree — k-trees from rays, for any dimension
+//!
+//! Bintrees (K = 1), quadtrees (K = 2), octrees (K = 3) and 4-D time-space trees (K = 4) from one
+//! const-generic code base, built by Akman & Franklin's *stacking* algorithm and checked against naive
+//! references.
+//!
+//! ```text
+//!  solids & data            1-D                 K-D
+//!  ray file ──► RaySet<K> ─► maximal rows ─► stacking ─► KTree<K> ─► stats, .ktree files
+//!               (z-runs per    (1-D trees)   (combine/split
+//!                column)                      per dim & level)
+//!  reference builders (tests): naive voxel insertion, dense pyramid ──► KTree<K>
+//! ```
+//!
+//! * [`space`]: the universe (level `L`, side `U = 2^L`), aligned cells, Morton keys.
+//! * [`rays`]: [`RaySet`], an object as sorted disjoint runs along the last axis, and maximal rows.
+//! * [`build`]: [`build::stack`] (stacking) and the reference builders.
+//! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
+//! * [`io`]: the ray text format and the `.ktree` file format.
+//!
+//! # Example
+//! ```
+//! use ktree::{build::stack, Ray, RaySet};
+//! // Akman & Franklin's Fig. 3 ray in an octree universe of level 7.
+//! let rays = RaySet::<3>::from_rays(7, [Ray::new([1, 1, 17], 93)]).unwrap();
+//! let tree = stack(&rays);
+//! tree.assert_well_formed();
+//! assert_eq!(tree.voxel_count(), 76);
+//! assert_eq!(tree.counts().full, 76); // a one-voxel-thick ray is all voxels in an octree
+//! ```
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+
+pub mod build;
+pub mod io;
+pub mod rays;
+pub mod space;
+pub mod tree;
+
+#[path = "../papers-repro/mod.rs"]
+pub mod repro;
+
+pub use rays::{Ray, RaySet};
+pub use space::{max_level, Cell, Universe, MAX_K};
+pub use tree::{KTree, LevelCounts, NodeState, Octree, Quadtree};

@@ -1,0 +1,10 @@
+//! Objects as rays: `RaySet<K>` (sorted, disjoint runs along the last axis per column) and the maximal rows
+//! of a run.
+
+mod ball;
+mod rayset;
+mod rows;
+
+pub use ball::ball_rays;
+pub use rayset::{ColumnGroups, Normal, Ray, RayError, RaySet};
+pub use rows::{maximal_rows, MaximalRows, Row};

@@ -1,0 +1,143 @@
+//! Building a level-order `KTree` from a depth-first (pre-order) stream of nodes or from full cells.
+//!
+//! In a depth-first traversal that visits children in child-code order, the nodes of each level appear in
+//! the same order as in level order. So a pre-order stream is turned into level order by appending each node
+//! to the array of its depth: no sorting, no pointers.
+
+use super::ktree::KTree;
+use super::states::{NodeState, PackedStates};
+use crate::space::{Cell, DimCheck, SpaceError, Universe};
+
+/// Collects a tree from its nodes in depth-first order (children in child-code order).
+///
+/// ```
+/// use ktree::{NodeState, tree::TreeAssembler};
+/// let mut a = TreeAssembler::<1>::new(1).unwrap();
+/// a.push(0, NodeState::Partial);
+/// a.push(1, NodeState::Full);
+/// a.push(1, NodeState::Empty);
+/// let tree = a.finish();
+/// assert!(tree.contains([0]) && !tree.contains([1]));
+/// ```
+#[derive(Debug, Clone)]
+pub struct TreeAssembler<const K: usize> {
+    universe: Universe<K>,
+    levels: Vec<PackedStates>,
+}
+
+impl<const K: usize> TreeAssembler<K> {
+    /// An assembler for a universe of level `level`.
+    ///
+    /// # Errors
+    /// [`SpaceError::LevelTooLarge`] for a level beyond [`crate::max_level`].
+    pub fn new(level: u32) -> Result<Self, SpaceError> {
+        let () = DimCheck::<K>::OK;
+        Ok(Self {
+            universe: Universe::new(level)?,
+            levels: Vec::new(),
+        })
+    }
+
+    /// Appends the next node of the depth-first traversal at `depth`.
+    #[inline]
+    pub fn push(&mut self, depth: usize, state: NodeState) {
+        while self.levels.len() <= depth {
+            self.levels.push(PackedStates::new());
+        }
+        self.levels[depth].push(state);
+    }
+
+    /// Appends `n` consecutive sibling leaves of the same state at `depth`.
+    pub fn push_many(&mut self, depth: usize, state: NodeState, n: usize) {
+        while self.levels.len() <= depth {
+            self.levels.push(PackedStates::new());
+        }
+        self.levels[depth].push_many(state, n);
+    }
+
+    /// The tree. The caller is responsible for having pushed a complete traversal; [`KTree::check`]
+    /// verifies it.
+    pub fn finish(mut self) -> KTree<K> {
+        if self.levels.is_empty() {
+            self.push(0, NodeState::Empty);
+        }
+        for l in &mut self.levels {
+            l.finish();
+        }
+        KTree::from_levels(self.universe, self.levels)
+    }
+}
+
+impl<const K: usize> KTree<K> {
+    /// The tree whose full leaves are exactly `cells`, which must be disjoint, inside `universe` and sorted
+    /// by Morton key of their origins ([`Cell::morton`]). Every ancestor of a cell is partial; all other
+    /// nodes are empty leaves. If the cells are maximal (no `2^K` sibling cells are all given), the tree is
+    /// reduced; otherwise [`KTree::check`] reports it.
+    ///
+    /// Cost: `O(cells · L)`.
+    pub fn from_sorted_cells(universe: Universe<K>, cells: &[Cell<K>]) -> KTree<K> {
+        let keys: Vec<(u64, u32)> = cells.iter().map(|c| (c.morton(), c.level)).collect();
+        Self::from_sorted_morton(universe, &keys)
+    }
+
+    /// Like [`KTree::from_sorted_cells`], with each cell given as `(Morton key of its origin, level)`.
+    pub fn from_sorted_morton(universe: Universe<K>, cells: &[(u64, u32)]) -> KTree<K> {
+        let mut out = TreeAssembler::<K> {
+            universe,
+            levels: Vec::new(),
+        };
+        emit::<K>(&mut out, universe.level(), 0, cells);
+        out.finish()
+    }
+}
+
+/// Emits, in pre-order, the subtree at `depth` that holds exactly `cells` (all inside this node).
+fn emit<const K: usize>(out: &mut TreeAssembler<K>, level: u32, depth: u32, cells: &[(u64, u32)]) {
+    match cells {
+        [] => out.push(depth as usize, NodeState::Empty),
+        [(_, l)] if *l == depth => out.push(depth as usize, NodeState::Full),
+        _ => {
+            out.push(depth as usize, NodeState::Partial);
+            // The child code of a key at this depth is its K-bit digit number (level - depth - 1).
+            let shift = (level - depth - 1) as usize * K;
+            let digit = |key: u64| ((key >> shift) as usize) & ((1 << K) - 1);
+            let mut rest = cells;
+            for code in 0..(1usize << K) {
+                let n = if rest.len() < 16 {
+                    rest.iter().take_while(|c| digit(c.0) == code).count()
+                } else {
+                    rest.partition_point(|c| digit(c.0) <= code)
+                };
+                let (mine, tail) = rest.split_at(n);
+                emit::<K>(out, level, depth + 1, mine);
+                rest = tail;
+            }
+            debug_assert!(rest.is_empty(), "cells not sorted or outside the node");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cells_assemble_into_the_expected_quadtree() {
+        let u = Universe::<2>::new(2).unwrap();
+        let mut cells = vec![u.cell([0, 0], 1).unwrap(), u.cell([3, 3], 2).unwrap()];
+        cells.sort_by_key(|c| c.morton());
+        let t = KTree::from_sorted_cells(u, &cells);
+        t.assert_well_formed();
+        assert_eq!(t.node_count(), 1 + 4 + 4);
+        assert_eq!(t.voxel_count(), 5);
+        assert_eq!(t.full_cells(), cells);
+    }
+
+    #[test]
+    fn non_maximal_cells_are_caught_by_check() {
+        let u = Universe::<1>::new(1).unwrap();
+        let cells = [u.cell([0], 1).unwrap(), u.cell([1], 1).unwrap()];
+        let t = KTree::from_sorted_cells(u, &cells);
+        assert!(t.check().is_err());
+    }
+}

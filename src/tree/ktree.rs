@@ -1,0 +1,397 @@
+//! `KTree<K>`: a compact, pointer-free, navigable k-tree in level order.
+
+use super::states::{NodeState, PackedStates};
+use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
+
+/// Node counts of one level (or of a whole tree): Meagher's complexity metric.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, serde::Serialize)]
+pub struct LevelCounts {
+    /// The level (depth, 0 = root); for a whole-tree total, the universe level.
+    pub level: u32,
+    /// Full nodes.
+    pub full: u64,
+    /// Empty nodes.
+    pub empty: u64,
+    /// Partial nodes.
+    pub partial: u64,
+}
+
+impl LevelCounts {
+    /// All nodes.
+    pub fn nodes(&self) -> u64 {
+        self.full + self.empty + self.partial
+    }
+}
+
+/// A k-tree over a `K`-dimensional universe of level `L`, stored in level order: level `d` is a packed array
+/// of 2-bit node states ([`NodeState`]); the children of the `i`-th partial node of level `d` are the nodes
+/// `2^K·i … 2^K·i + 2^K − 1` of level `d + 1`, in child-code order (see [`crate::space`]). Navigation needs
+/// only a rank over partial nodes, kept per level (2.25 bits a node in all).
+///
+/// Trees built by this crate are *reduced* (no partial node has children all full or all empty) and so
+/// minimal and canonical: two trees of the same object are equal node for node, and `==` compares objects.
+///
+/// ```
+/// use ktree::{KTree, NodeState};
+/// // A 4×4 quadtree universe with the lower-left 2×2 quadrant full.
+/// let mut dense = vec![false; 16];
+/// for (x, y) in [(0, 0), (1, 0), (0, 1), (1, 1)] { dense[x + 4 * y] = true; }
+/// let tree = KTree::<2>::from_dense(2, &dense).unwrap();
+/// assert_eq!(tree.root_state(), NodeState::Partial);
+/// assert_eq!(tree.node_count(), 5);
+/// assert!(tree.contains([1, 1]) && !tree.contains([2, 1]));
+/// assert_eq!(tree.to_dense().unwrap(), dense);
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct KTree<const K: usize> {
+    universe: Universe<K>,
+    levels: Vec<PackedStates>,
+}
+
+/// A bintree (K = 1).
+pub type Bintree = KTree<1>;
+/// A quadtree (K = 2).
+pub type Quadtree = KTree<2>;
+/// An octree (K = 3).
+pub type Octree = KTree<3>;
+/// A 4-D (e.g. time-space) tree (K = 4).
+pub type Tree4 = KTree<4>;
+
+/// A node of a tree, as seen while navigating: its position in level order and its cell.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NodeRef<const K: usize> {
+    /// Index of the node within its level.
+    pub index: usize,
+    /// The node's cell (its level is the node's depth).
+    pub cell: Cell<K>,
+    /// The node's state.
+    pub state: NodeState,
+}
+
+impl<const K: usize> KTree<K> {
+    /// The number of children of a partial node, `2^K`.
+    pub const FANOUT: usize = 1 << K;
+
+    /// The tree of the empty object (one empty root).
+    ///
+    /// # Errors
+    /// [`SpaceError::LevelTooLarge`] for a level beyond [`crate::max_level`].
+    pub fn empty(level: u32) -> Result<Self, SpaceError> {
+        Self::uniform(level, NodeState::Empty)
+    }
+
+    /// The tree of the whole universe (one full root).
+    ///
+    /// # Errors
+    /// As [`KTree::empty`].
+    pub fn full(level: u32) -> Result<Self, SpaceError> {
+        Self::uniform(level, NodeState::Full)
+    }
+
+    fn uniform(level: u32, state: NodeState) -> Result<Self, SpaceError> {
+        let () = DimCheck::<K>::OK;
+        let universe = Universe::new(level)?;
+        let mut root = PackedStates::with_capacity(1);
+        root.push(state);
+        root.finish();
+        Ok(Self {
+            universe,
+            levels: vec![root],
+        })
+    }
+
+    /// Assembles a tree from its levels. The caller guarantees the structure (see [`KTree::check`]).
+    pub(crate) fn from_levels(universe: Universe<K>, levels: Vec<PackedStates>) -> Self {
+        Self { universe, levels }
+    }
+
+    /// The universe.
+    pub fn universe(&self) -> Universe<K> {
+        self.universe
+    }
+
+    /// The universe level `L`.
+    pub fn level(&self) -> u32 {
+        self.universe.level()
+    }
+
+    /// The number of stored levels (the depth of the deepest node plus one).
+    pub fn depth_count(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// The packed states of level `depth`.
+    pub fn level_states(&self, depth: usize) -> &PackedStates {
+        &self.levels[depth]
+    }
+
+    /// The root's state.
+    pub fn root_state(&self) -> NodeState {
+        self.levels[0].get(0)
+    }
+
+    /// The state of node `index` at `depth`.
+    pub fn state(&self, depth: usize, index: usize) -> NodeState {
+        self.levels[depth].get(index)
+    }
+
+    /// The level-order index of the first child of the partial node `index` at `depth`
+    /// (its children are this index and the next `2^K − 1`, at `depth + 1`).
+    #[inline]
+    pub fn first_child(&self, depth: usize, index: usize) -> usize {
+        debug_assert_eq!(self.levels[depth].get(index), NodeState::Partial);
+        self.levels[depth].partial_rank(index) << K
+    }
+
+    /// The total number of nodes.
+    pub fn node_count(&self) -> u64 {
+        self.levels.iter().map(|l| l.len() as u64).sum()
+    }
+
+    /// Node counts per level, from the root (level 0) down to the deepest stored level.
+    pub fn counts_per_level(&self) -> Vec<LevelCounts> {
+        self.levels
+            .iter()
+            .enumerate()
+            .map(|(depth, l)| {
+                let partial = l.partial_count() as u64;
+                let full = l.full_count() as u64;
+                LevelCounts {
+                    level: depth as u32,
+                    full,
+                    partial,
+                    empty: l.len() as u64 - full - partial,
+                }
+            })
+            .collect()
+    }
+
+    /// Total node counts over all levels (`level` holds the universe level).
+    pub fn counts(&self) -> LevelCounts {
+        let mut total = LevelCounts {
+            level: self.level(),
+            ..Default::default()
+        };
+        for c in self.counts_per_level() {
+            total.full += c.full;
+            total.empty += c.empty;
+            total.partial += c.partial;
+        }
+        total
+    }
+
+    /// Bytes needed at Meagher's 2 bits a node.
+    pub fn bytes_at_two_bits(&self) -> u64 {
+        self.node_count().div_ceil(4)
+    }
+
+    /// Bytes of memory held by the tree (packed states and rank indexes).
+    pub fn heap_bytes(&self) -> usize {
+        self.levels.iter().map(PackedStates::heap_bytes).sum::<usize>()
+            + self.levels.capacity() * std::mem::size_of::<PackedStates>()
+    }
+
+    /// The root node.
+    pub fn root(&self) -> NodeRef<K> {
+        NodeRef {
+            index: 0,
+            cell: self.universe.root(),
+            state: self.root_state(),
+        }
+    }
+
+    /// The children of a partial node, in child-code order (empty for a leaf).
+    pub fn children(&self, node: &NodeRef<K>) -> impl Iterator<Item = NodeRef<K>> + '_ {
+        let (first, count) = if node.state == NodeState::Partial {
+            (
+                self.first_child(node.cell.level as usize, node.index),
+                Self::FANOUT,
+            )
+        } else {
+            (0, 0)
+        };
+        let depth = node.cell.level as usize + 1;
+        let cell = node.cell;
+        (0..count).map(move |code| NodeRef {
+            index: first + code,
+            cell: cell.child(code),
+            state: self.levels[depth].get(first + code),
+        })
+    }
+
+    /// Whether the voxel `point` is inside the object (point query, `O(L)`). Points outside the universe are
+    /// outside the object.
+    pub fn contains(&self, point: [u32; K]) -> bool {
+        if self.universe.check_point(point).is_err() {
+            return false;
+        }
+        let level = self.level();
+        let mut index = 0usize;
+        for depth in 0..self.levels.len() {
+            match self.levels[depth].get(index) {
+                NodeState::Empty => return false,
+                NodeState::Full => return true,
+                NodeState::Partial => {
+                    let bit = level - 1 - depth as u32;
+                    let mut code = 0usize;
+                    for (axis, &c) in point.iter().enumerate() {
+                        code |= ((c >> bit & 1) as usize) << axis;
+                    }
+                    index = self.first_child(depth, index) + code;
+                }
+            }
+        }
+        unreachable!("a well-formed tree ends in leaves")
+    }
+
+    /// Visits every leaf (empty and full) in Morton (depth-first) order.
+    pub fn for_each_leaf(&self, mut visit: impl FnMut(Cell<K>, NodeState)) {
+        let mut stack = vec![(self.universe.root(), 0usize)];
+        while let Some((cell, index)) = stack.pop() {
+            let depth = cell.level as usize;
+            match self.levels[depth].get(index) {
+                NodeState::Partial => {
+                    let first = self.first_child(depth, index);
+                    for code in (0..Self::FANOUT).rev() {
+                        stack.push((cell.child(code), first + code));
+                    }
+                }
+                state => visit(cell, state),
+            }
+        }
+    }
+
+    /// All leaves with their states, in Morton order.
+    pub fn leaves(&self) -> Vec<(Cell<K>, NodeState)> {
+        let mut out = Vec::new();
+        self.for_each_leaf(|c, s| out.push((c, s)));
+        out
+    }
+
+    /// The full leaves in Morton order: the linear tree (Gargantini) of the object.
+    pub fn full_cells(&self) -> Vec<Cell<K>> {
+        let mut out = Vec::new();
+        self.for_each_leaf(|c, s| {
+            if s == NodeState::Full {
+                out.push(c)
+            }
+        });
+        out
+    }
+
+    /// The number of voxels inside the object.
+    pub fn voxel_count(&self) -> u128 {
+        let mut n = 0u128;
+        self.for_each_leaf(|c, s| {
+            if s == NodeState::Full {
+                n += c.volume()
+            }
+        });
+        n
+    }
+
+    /// The tree of a dense boolean array (axis 0 fastest, see [`Universe::dense_index`]), reduced.
+    ///
+    /// # Errors
+    /// [`SpaceError::LevelTooLarge`]; [`SpaceError::TooLargeForDense`] if `dense.len() != U^K` or the
+    /// universe exceeds [`DENSE_LIMIT`].
+    pub fn from_dense(level: u32, dense: &[bool]) -> Result<Self, SpaceError> {
+        crate::build::dense::DensePyramid::<K>::from_dense(level, dense).map(|p| p.to_tree())
+    }
+
+    /// The object as a dense boolean array (axis 0 fastest).
+    ///
+    /// # Errors
+    /// [`SpaceError::TooLargeForDense`] if the universe exceeds [`DENSE_LIMIT`] voxels.
+    pub fn to_dense(&self) -> Result<Vec<bool>, SpaceError> {
+        let len = self.universe.dense_len(DENSE_LIMIT)?;
+        let mut dense = vec![false; len];
+        self.for_each_leaf(|cell, state| {
+            if state == NodeState::Full {
+                fill_cell(&self.universe, &mut dense, cell);
+            }
+        });
+        Ok(dense)
+    }
+
+    /// Checks the tree's invariants: level sizes match the partial counts above, no partial node at the
+    /// universe level, the last level has no partial node, and the tree is reduced (no partial node whose
+    /// children are all full or all empty).
+    ///
+    /// # Errors
+    /// A sentence naming the first broken invariant.
+    pub fn check(&self) -> Result<(), String> {
+        let level = self.level() as usize;
+        if self.levels.is_empty() || self.levels[0].len() != 1 {
+            return Err("level 0 must hold exactly the root".into());
+        }
+        if self.levels.len() > level + 1 {
+            return Err(format!(
+                "{} levels stored for a level-{level} universe",
+                self.levels.len()
+            ));
+        }
+        for depth in 0..self.levels.len() {
+            let partial = self.levels[depth].partial_count();
+            let next = self.levels.get(depth + 1).map_or(0, |l| l.len());
+            if next != partial << K {
+                return Err(format!(
+                    "level {depth} has {partial} partial nodes but level {} has {next} nodes",
+                    depth + 1
+                ));
+            }
+            if partial > 0 && depth == level {
+                return Err(format!("partial nodes at the voxel level {depth}"));
+            }
+        }
+        for depth in 1..self.levels.len() {
+            let l = &self.levels[depth];
+            for block in 0..l.len() >> K {
+                let first = l.get(block << K);
+                if first != NodeState::Partial
+                    && (1..Self::FANOUT).all(|c| l.get((block << K) + c) == first)
+                {
+                    return Err(format!(
+                        "not reduced: the children of partial node {block} of level {} are all {first:?}",
+                        depth - 1
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Panics with a readable message unless [`KTree::check`] passes. Property tests call it after every
+    /// operation.
+    pub fn assert_well_formed(&self) {
+        if let Err(e) = self.check() {
+            panic!("malformed KTree<{K}> (level {}): {e}", self.level());
+        }
+    }
+}
+
+/// Sets every voxel of `cell` in a dense array of `universe`.
+pub(crate) fn fill_cell<const K: usize>(universe: &Universe<K>, dense: &mut [bool], cell: Cell<K>) {
+    let side = cell.side() as u32;
+    let mut offset = [0u32; K];
+    loop {
+        let mut p = cell.origin;
+        for (pi, oi) in p.iter_mut().zip(offset.iter()) {
+            *pi += oi;
+        }
+        dense[universe.dense_index(p)] = true;
+        // Odometer over the cell's voxels.
+        let mut axis = 0;
+        loop {
+            if axis == K {
+                return;
+            }
+            offset[axis] += 1;
+            if offset[axis] < side {
+                break;
+            }
+            offset[axis] = 0;
+            axis += 1;
+        }
+    }
+}

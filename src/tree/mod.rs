@@ -1,0 +1,10 @@
+//! The compact k-tree: node states, the level-order `KTree<K>`, and assembling one from a depth-first
+//! stream of nodes or from full cells.
+
+mod assemble;
+mod ktree;
+mod states;
+
+pub use assemble::TreeAssembler;
+pub use ktree::{Bintree, KTree, LevelCounts, NodeRef, Octree, Quadtree, Tree4};
+pub use states::{NodeState, PackedStates};
