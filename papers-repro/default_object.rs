@@ -42,13 +42,23 @@ pub fn run(results: &Path) -> Result<String, String> {
         ("partial", counts.partial),
         ("bytes at 2 bits/node", tree.bytes_at_two_bits()),
         ("dimension-level lists used", stats.lists_used() as u64),
-        ("dimension-level lists available", stats.lists_available() as u64),
+        (
+            "dimension-level lists available",
+            stats.lists_available() as u64,
+        ),
     ] {
         let _ = writeln!(md, "| {name} | {value} |");
     }
-    let _ = writeln!(md, "\nNodes per level:\n\n| level | full | empty | partial |\n|---:|---:|---:|---:|");
+    let _ = writeln!(
+        md,
+        "\nNodes per level:\n\n| level | full | empty | partial |\n|---:|---:|---:|---:|"
+    );
     for c in tree.counts_per_level() {
-        let _ = writeln!(md, "| {} | {} | {} | {} |", c.level, c.full, c.empty, c.partial);
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} |",
+            c.level, c.full, c.empty, c.partial
+        );
     }
     let _ = writeln!(
         md,

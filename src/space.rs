@@ -393,7 +393,9 @@ mod tests {
         for _ in 0..2000 {
             let mut p = [0u32; K];
             for c in p.iter_mut() {
-                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 *c = ((state >> 33) as u32) & ((1u64 << bits) - 1) as u32;
             }
             let key = morton_encode(p);

@@ -16,12 +16,21 @@ where
 {
     let rays = &case.rays;
     let stacked = stack(rays);
-    stacked.check().map_err(|e| TestCaseError::fail(format!("stacked tree malformed: {e}")))?;
+    stacked
+        .check()
+        .map_err(|e| TestCaseError::fail(format!("stacked tree malformed: {e}")))?;
     let naive = NaiveTree::from_rays(rays).unwrap().to_tree();
     let dense = DensePyramid::from_rays(rays).unwrap().to_tree();
-    prop_assert_eq!(stacked.counts_per_level(), naive.counts_per_level(), "per-level counts: stacking vs naive");
+    prop_assert_eq!(
+        stacked.counts_per_level(),
+        naive.counts_per_level(),
+        "per-level counts: stacking vs naive"
+    );
     prop_assert!(stacked == naive, "stacking and naive differ node for node");
-    prop_assert!(stacked == dense, "stacking and dense pyramid differ node for node");
+    prop_assert!(
+        stacked == dense,
+        "stacking and dense pyramid differ node for node"
+    );
     // Leaves cover exactly the object's voxels.
     let u = rays.universe();
     let mut covered = vec![false; u.dense_len(1 << 24).unwrap()];
@@ -48,7 +57,10 @@ where
         prop_assert_eq!(c, stacked.contains(p), "point query at {:?}", p);
     }
     // Dense round trip.
-    prop_assert_eq!(KTree::<K>::from_dense(u.level(), &covered).unwrap(), stacked);
+    prop_assert_eq!(
+        KTree::<K>::from_dense(u.level(), &covered).unwrap(),
+        stacked
+    );
     Ok(())
 }
 

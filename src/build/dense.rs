@@ -31,13 +31,7 @@ impl<const K: usize> DensePyramid<K> {
         }
         let bottom: Vec<NodeState> = dense
             .iter()
-            .map(|&b| {
-                if b {
-                    NodeState::Full
-                } else {
-                    NodeState::Empty
-                }
-            })
+            .map(|&b| if b { NodeState::Full } else { NodeState::Empty })
             .collect();
         let mut levels = vec![bottom];
         for depth in (0..level).rev() {
@@ -89,7 +83,8 @@ impl<const K: usize> DensePyramid<K> {
 
     /// The reduced `KTree` of the pyramid, by a depth-first walk from the root.
     pub fn to_tree(&self) -> KTree<K> {
-        let mut out = TreeAssembler::<K>::new(self.universe.level()).expect("level already checked");
+        let mut out =
+            TreeAssembler::<K>::new(self.universe.level()).expect("level already checked");
         self.walk(&mut out, 0, [0; K]);
         out.finish()
     }

@@ -58,7 +58,14 @@ mod tests {
     #[test]
     fn sorts_like_the_standard_library() {
         let mut x = 88172645463325252u64;
-        for (n, bits) in [(0, 5), (10, 5), (1000, 3), (5000, 20), (20000, 42), (3000, 64)] {
+        for (n, bits) in [
+            (0, 5),
+            (10, 5),
+            (1000, 3),
+            (5000, 20),
+            (20000, 42),
+            (3000, 64),
+        ] {
             let mut v: Vec<u64> = (0..n)
                 .map(|_| {
                     x ^= x << 13;

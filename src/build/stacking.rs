@@ -128,7 +128,10 @@ pub fn stack_with_stats<const K: usize>(rays: &RaySet<K>) -> (KTree<K>, Stacking
     // Sort the obels by Morton key. A cell's key is unique (cells are disjoint), so sorting the keys alone
     // and re-attaching levels through a lookup is not needed: pack (key, level) when it fits in 64 bits.
     let tree = if (K as u32) * level + 5 <= 64 {
-        let mut packed: Vec<u64> = cells.iter().map(|&(key, l)| key << 5 | u64::from(l)).collect();
+        let mut packed: Vec<u64> = cells
+            .iter()
+            .map(|&(key, l)| key << 5 | u64::from(l))
+            .collect();
         radix_sort(&mut packed, K as u32 * level + 5, &mut scratch);
         let sorted: Vec<(u64, u32)> = packed.iter().map(|&p| (p >> 5, (p & 31) as u32)).collect();
         KTree::from_sorted_morton(universe, &sorted)
@@ -311,7 +314,15 @@ mod tests {
     #[test]
     fn fig4_aligned_rows_combine_into_a_square() {
         // AF2: rows (0,0,0) … (0,3,0) of length four combine (level 1 in an 8-universe).
-        let set = rays3(3, &[([0, 0, 0], 4), ([0, 1, 0], 4), ([0, 2, 0], 4), ([0, 3, 0], 4)]);
+        let set = rays3(
+            3,
+            &[
+                ([0, 0, 0], 4),
+                ([0, 1, 0], 4),
+                ([0, 2, 0], 4),
+                ([0, 3, 0], 4),
+            ],
+        );
         let (tree, stats) = stack_with_stats(&set);
         tree.assert_well_formed();
         assert_eq!(stats.entered[0][1], 4);
@@ -323,13 +334,24 @@ mod tests {
     #[test]
     fn fig4_misaligned_rows_do_not_combine_but_their_halves_do() {
         // AF2: rows (0,1,0) … (0,4,0) cannot combine; split, the halves at y = 2, 3 combine (Fig. 6).
-        let set = rays3(3, &[([0, 1, 0], 4), ([0, 2, 0], 4), ([0, 3, 0], 4), ([0, 4, 0], 4)]);
+        let set = rays3(
+            3,
+            &[
+                ([0, 1, 0], 4),
+                ([0, 2, 0], 4),
+                ([0, 3, 0], 4),
+                ([0, 4, 0], 4),
+            ],
+        );
         let (tree, stats) = stack_with_stats(&set);
         tree.assert_well_formed();
         assert_eq!(stats.combined[0][1], 0);
         assert_eq!(stats.split[0][1], 4);
         assert_eq!(stats.entered[0][2], 8, "four rows split into eight halves");
-        assert_eq!(stats.combined[0][2], 2, "two squares of side two: y = 2..3, z = 0..1 and 2..3");
+        assert_eq!(
+            stats.combined[0][2], 2,
+            "two squares of side two: y = 2..3, z = 0..1 and 2..3"
+        );
         assert_eq!(tree.voxel_count(), 16);
     }
 
@@ -347,7 +369,10 @@ mod tests {
         assert_eq!(stats.cells, 1);
         assert_eq!(tree.full_cells()[0].side(), 4);
         // Shifted by one along x: the squares cannot combine and are split.
-        let shifted: Vec<_> = rays.iter().map(|&(s, z)| ([s[0] + 1, s[1], s[2]], z)).collect();
+        let shifted: Vec<_> = rays
+            .iter()
+            .map(|&(s, z)| ([s[0] + 1, s[1], s[2]], z))
+            .collect();
         let (_, stats) = stack_with_stats(&rays3(3, &shifted));
         assert_eq!(stats.combined[1][1], 0);
         assert_eq!(stats.split[1][1], 4);

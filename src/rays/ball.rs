@@ -20,7 +20,11 @@ use crate::space::Universe;
 ///
 /// # Errors
 /// [`RayError::Space`] for a level beyond [`crate::max_level`].
-pub fn ball_rays<const K: usize>(level: u32, centre2: [i64; K], radius2: i64) -> Result<RaySet<K>, RayError> {
+pub fn ball_rays<const K: usize>(
+    level: u32,
+    centre2: [i64; K],
+    radius2: i64,
+) -> Result<RaySet<K>, RayError> {
     let universe = Universe::<K>::new(level)?;
     let side = universe.side() as i64;
     let r2 = i128::from(radius2) * i128::from(radius2);
@@ -100,7 +104,11 @@ mod tests {
         let mut n = 0;
         for i in 0..u.voxels() as usize {
             let p = u.dense_point(i);
-            let d: i64 = p.iter().zip(centre2.iter()).map(|(&c, &c2)| (2 * c as i64 + 1 - c2).pow(2)).sum();
+            let d: i64 = p
+                .iter()
+                .zip(centre2.iter())
+                .map(|(&c, &c2)| (2 * c as i64 + 1 - c2).pow(2))
+                .sum();
             if d <= radius2 * radius2 {
                 n += 1;
                 let set = ball_rays::<K>(level, centre2, radius2).unwrap();
@@ -112,11 +120,30 @@ mod tests {
 
     #[test]
     fn ball_matches_voxel_centre_test() {
-        for (c, r) in [([8, 8, 8], 8), ([0, 0, 0], 13), ([3, 17, 9], 6), ([-4, 20, 2], 11), ([50, 50, 50], 3)] {
-            assert_eq!(ball_rays::<3>(4, c, r).unwrap().voxel_count(), brute::<3>(4, c, r), "{c:?} {r}");
+        for (c, r) in [
+            ([8, 8, 8], 8),
+            ([0, 0, 0], 13),
+            ([3, 17, 9], 6),
+            ([-4, 20, 2], 11),
+            ([50, 50, 50], 3),
+        ] {
+            assert_eq!(
+                ball_rays::<3>(4, c, r).unwrap().voxel_count(),
+                brute::<3>(4, c, r),
+                "{c:?} {r}"
+            );
         }
-        assert_eq!(ball_rays::<2>(3, [7, 9], 5).unwrap().voxel_count(), brute::<2>(3, [7, 9], 5));
-        assert_eq!(ball_rays::<1>(3, [7], 5).unwrap().voxel_count(), brute::<1>(3, [7], 5));
-        assert_eq!(ball_rays::<4>(2, [4, 3, 5, 4], 4).unwrap().voxel_count(), brute::<4>(2, [4, 3, 5, 4], 4));
+        assert_eq!(
+            ball_rays::<2>(3, [7, 9], 5).unwrap().voxel_count(),
+            brute::<2>(3, [7, 9], 5)
+        );
+        assert_eq!(
+            ball_rays::<1>(3, [7], 5).unwrap().voxel_count(),
+            brute::<1>(3, [7], 5)
+        );
+        assert_eq!(
+            ball_rays::<4>(2, [4, 3, 5, 4], 4).unwrap().voxel_count(),
+            brute::<4>(2, [4, 3, 5, 4], 4)
+        );
     }
 }

@@ -275,10 +275,7 @@ impl<const K: usize> RaySet<K> {
 
     /// The total number of voxels covered.
     pub fn voxel_count(&self) -> u128 {
-        self.runs
-            .iter()
-            .map(|&(z1, z2)| u128::from(z2 - z1))
-            .sum()
+        self.runs.iter().map(|&(z1, z2)| u128::from(z2 - z1)).sum()
     }
 
     /// The `i`-th run in sorted order.

@@ -117,8 +117,8 @@ mod tests {
                 assert_eq!(z, u64::from(z2));
                 // Maximal: no two neighbours form an aligned row of twice the length.
                 for w in rows.windows(2) {
-                    let merged = w[0].log_len == w[1].log_len
-                        && u64::from(w[0].z) % (2 * w[0].len()) == 0;
+                    let merged =
+                        w[0].log_len == w[1].log_len && u64::from(w[0].z) % (2 * w[0].len()) == 0;
                     assert!(!merged, "rows {w:?} of [{z1},{z2}) could be merged");
                 }
             }
@@ -128,12 +128,6 @@ mod tests {
     #[test]
     fn whole_universe_is_one_row() {
         let rows: Vec<Row> = maximal_rows(0, 1 << 31).collect();
-        assert_eq!(
-            rows,
-            [Row {
-                z: 0,
-                log_len: 31
-            }]
-        );
+        assert_eq!(rows, [Row { z: 0, log_len: 31 }]);
     }
 }

@@ -187,7 +187,10 @@ impl<const K: usize> KTree<K> {
 
     /// Bytes of memory held by the tree (packed states and rank indexes).
     pub fn heap_bytes(&self) -> usize {
-        self.levels.iter().map(PackedStates::heap_bytes).sum::<usize>()
+        self.levels
+            .iter()
+            .map(PackedStates::heap_bytes)
+            .sum::<usize>()
             + self.levels.capacity() * std::mem::size_of::<PackedStates>()
     }
 

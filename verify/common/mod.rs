@@ -38,11 +38,13 @@ impl<const K: usize> fmt::Debug for Case<K> {
 /// Random runs anywhere: noisy objects that exercise splitting down to voxels.
 fn scattered_runs<const K: usize>(level: u32) -> impl Strategy<Value = Vec<Ray<K>>> {
     let side = 1u32 << level;
-    let ray = (prop::array::uniform::<_, K>(0..side), 0..side, 1..=side).prop_map(move |(mut start, z1, len)| {
-        let z2 = (z1 + len).min(side);
-        start[K - 1] = z1.min(z2 - 1);
-        Ray::new(start, z2)
-    });
+    let ray = (prop::array::uniform::<_, K>(0..side), 0..side, 1..=side).prop_map(
+        move |(mut start, z1, len)| {
+            let z2 = (z1 + len).min(side);
+            start[K - 1] = z1.min(z2 - 1);
+            Ray::new(start, z2)
+        },
+    );
     prop::collection::vec(ray, 0..40)
 }
 
@@ -65,7 +67,11 @@ fn box_union_runs<const K: usize>(level: u32) -> impl Strategy<Value = Vec<Ray<K
 }
 
 /// Calls `visit` with every column (first K−1 coordinates) of the box `[lo, hi)`.
-pub fn for_each_column<const K: usize>(lo: [u32; K], hi: [u32; K], mut visit: impl FnMut([u32; K])) {
+pub fn for_each_column<const K: usize>(
+    lo: [u32; K],
+    hi: [u32; K],
+    mut visit: impl FnMut([u32; K]),
+) {
     let mut col = lo;
     loop {
         visit(col);
@@ -109,7 +115,10 @@ fn special_runs<const K: usize>(level: u32) -> impl Strategy<Value = Vec<Ray<K>>
 }
 
 fn full_runs<const K: usize>(level: u32) -> Vec<Ray<K>> {
-    RaySet::<K>::full(level).expect("small level").iter().collect()
+    RaySet::<K>::full(level)
+        .expect("small level")
+        .iter()
+        .collect()
 }
 
 /// Random ray sets for dimension K, levels 0 ..= `max_test_level(K)`.

@@ -1,0 +1,45 @@
+//! `cargo run --release --example perf -- AREA`: measures wall time (best of several runs) and peak memory
+//! (the high-water mark of resident memory of a fresh child process per case) and writes
+//! `results/performance/AREA.md`. Criterion benches (`cargo bench`) give the statistically careful
+//! timings; this program records the figures the issues ask for, regenerated rather than typed.
+//!
+//! Each area is a module with `cases()` (what to measure) and `report()` (the Markdown table).
+
+mod build;
+mod measure;
+
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    // A child process measures one case: `perf --child AREA CASE`.
+    if args.first().map(String::as_str) == Some("--child") {
+        let (area, case) = (&args[1], &args[2]);
+        return match area.as_str() {
+            "build" => measure::child(|| build::run_case(case)),
+            _ => {
+                eprintln!("perf: unknown area {area}");
+                ExitCode::FAILURE
+            }
+        };
+    }
+    let areas: Vec<&str> = if args.is_empty() {
+        vec!["build"]
+    } else {
+        args.iter().map(String::as_str).collect()
+    };
+    for area in areas {
+        let result = match area {
+            "build" => build::report(),
+            other => Err(format!("unknown area '{other}' (known: build)")),
+        };
+        match result {
+            Ok(path) => println!("wrote {path}"),
+            Err(e) => {
+                eprintln!("perf: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
