@@ -15,6 +15,7 @@
 //! * [`space`]: the universe (level `L`, side `U = 2^L`), aligned cells, Morton keys.
 //! * [`rays`]: [`RaySet`], an object as sorted disjoint runs along the last axis, and maximal rows.
 //! * [`build`]: [`build::stack`] (stacking) and the reference builders.
+//! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
 //! * [`io`]: the ray text format and the `.ktree` file format.
 //!
@@ -34,6 +35,7 @@
 pub mod build;
 pub mod io;
 pub mod rays;
+pub mod solid;
 pub mod space;
 pub mod tree;
 

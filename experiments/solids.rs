@@ -1,0 +1,2 @@
+//! Criterion benchmarks of solids to rays.
+fn main() {}

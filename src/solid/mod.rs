@@ -1,0 +1,59 @@
+//! Solids to rays: analytic quadrics (and boxes), triangle meshes and scalar volumes become [`RaySet`]s
+//! exactly, touching only the columns that meet the solid.
+//!
+//! * [`Quadric`]: `Vᵀ Ξ V ≤ 0` with named constructors (ball, ellipsoid, paraboloid, cylinder, cone,
+//!   half-space) and [`BoxSolid`]; exact integer inside tests at voxel centres (or corners).
+//! * [`mesh`]: OBJ, STL and PLY triangle meshes, inside by the winding number along each column.
+//! * [`volume`]: dense 3-D scalar volumes (raw + JSON sidecar, NIfTI) by threshold or label.
+//!
+//! Boolean operations and translation on the resulting rays are in [`crate::rays`] (`union`, …).
+
+mod boxsolid;
+mod error;
+pub mod mesh;
+mod named;
+mod quadric;
+mod rational;
+pub mod volume;
+
+pub use boxsolid::BoxSolid;
+pub use error::SolidError;
+pub use quadric::{Frame, Quadric, Sample};
+pub use rational::Rational;
+
+use crate::rays::RaySet;
+
+/// Any analytic solid: a quadric or a box.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Solid<const K: usize> {
+    /// `Vᵀ Ξ V ≤ 0`.
+    Quadric(Quadric<K>),
+    /// An axis-aligned box.
+    Box(BoxSolid<K>),
+}
+
+impl<const K: usize> Solid<K> {
+    /// The solid's voxels as rays (see [`Quadric::to_rays`]).
+    ///
+    /// # Errors
+    /// As [`Quadric::to_rays`].
+    pub fn to_rays(
+        &self,
+        level: u32,
+        sample: Sample,
+        normals: bool,
+    ) -> Result<RaySet<K>, SolidError> {
+        match self {
+            Solid::Quadric(q) => q.to_rays(level, sample, normals),
+            Solid::Box(b) => b.to_rays(level, sample, normals),
+        }
+    }
+
+    /// Whether one voxel is inside (the brute-force reference).
+    pub fn contains(&self, level: u32, sample: Sample, point: [u32; K]) -> bool {
+        match self {
+            Solid::Quadric(q) => q.contains(level, sample, point),
+            Solid::Box(b) => b.contains(level, sample, point),
+        }
+    }
+}

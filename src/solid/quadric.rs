@@ -1,0 +1,515 @@
+//! Quadric solids `Vᵀ Ξ V ≤ 0`, `V = [x₀ … x_{K−1}, 1]`, to rays, exactly (Akman & Franklin's section 5, AF10).
+//!
+//! **Which point of a voxel is tested.** The voxel `c` (covering `[c, c+1)` on each axis) is inside when its
+//! *sample point* is: its centre `c + ½` by default ([`Sample::Centre`]) or its lowest corner `c`
+//! ([`Sample::Corner`]). **Frames.** The matrix is either in voxel coordinates ([`Frame::Voxel`]: the universe is
+//! `[0, U]^K`) or in the unit cube ([`Frame::UnitCube`]: the universe is `[0, 1]^K`, as in the paper).
+//!
+//! **Exactness.** Ξ has integer entries (named solids put their rational parameters on a common denominator).
+//! A sample point is `X / W` with integers `X = 2c + 1` (centre) or `2c` (corner) and `W = 2` (voxel frame) or
+//! `2U` (unit cube); `Vᵀ Ξ V` is homogeneous, so its sign at the point is the sign of the integer
+//! `[X, W]ᵀ Ξ [X, W]`, evaluated in `i128` (sizes are checked first). Ties (`= 0`, the point on the surface) are
+//! inside.
+//!
+//! **Work.** Columns are visited by a lexicographic binary subdivision of the column box (axis 0 first) that
+//! discards a block of columns when a conservative lower bound of the form over the block is positive; a column
+//! that is visited solves its quadratic in `z` exactly: a column holds zero, one or two runs. No voxel is tested
+//! on its own.
+
+use super::{rational::gcd_i128, Rational, SolidError};
+use crate::rays::{Normal, RaySet};
+use crate::space::Universe;
+
+/// Which coordinates a quadric's matrix is written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Frame {
+    /// Voxel coordinates: the universe is `[0, U]^K`, voxel `c` covers `[c, c+1)`.
+    #[default]
+    Voxel,
+    /// The unit cube: the universe is `[0, 1]^K` whatever its level (the paper's convention).
+    UnitCube,
+}
+
+/// Which point of a voxel decides whether it is inside.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Sample {
+    /// The voxel's centre `c + ½` (default).
+    #[default]
+    Centre,
+    /// The voxel's lowest corner `c`.
+    Corner,
+}
+
+/// Largest matrix size (K + 1 for K ≤ 4).
+const N: usize = 5;
+
+/// A quadric solid `Vᵀ Ξ V ≤ 0` with an integer symmetric `(K+1)×(K+1)` matrix Ξ.
+///
+/// ```
+/// use ktree::solid::{Frame, Quadric, Rational, Sample};
+/// // The disk of radius 4 centred in an 8×8 universe.
+/// let disk = Quadric::<2>::ball([4.into(), 4.into()], 4.into(), Frame::Voxel).unwrap();
+/// let rays = disk.to_rays(3, Sample::Centre, false).unwrap();
+/// assert_eq!((rays.len(), rays.voxel_count()), (8, 52));
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Quadric<const K: usize> {
+    xi: [[i128; N]; N],
+    frame: Frame,
+}
+
+impl<const K: usize> Quadric<K> {
+    /// A quadric from its symmetric matrix, `K + 1` rows of `K + 1` integers.
+    ///
+    /// # Errors
+    /// [`SolidError::BadParameter`] if the matrix is not `(K+1)×(K+1)`, not symmetric, or zero.
+    pub fn from_matrix(rows: &[Vec<i128>], frame: Frame) -> Result<Self, SolidError> {
+        if K == 0 || K > 4 {
+            return Err(SolidError::BadParameter(format!("K = {K} is not 1…4")));
+        }
+        if rows.len() != K + 1 || rows.iter().any(|r| r.len() != K + 1) {
+            return Err(SolidError::BadParameter(format!(
+                "a quadric in {K}-D needs a {0}×{0} matrix",
+                K + 1
+            )));
+        }
+        let mut xi = [[0i128; N]; N];
+        for i in 0..=K {
+            for j in 0..=K {
+                if rows[i][j] != rows[j][i] {
+                    return Err(SolidError::BadParameter(format!(
+                        "the matrix is not symmetric: entry ({i},{j}) = {} but ({j},{i}) = {}",
+                        rows[i][j], rows[j][i]
+                    )));
+                }
+                if rows[i][j].unsigned_abs() > 1 << 100 {
+                    return Err(SolidError::BadParameter("matrix entry too large".into()));
+                }
+                xi[i][j] = rows[i][j];
+            }
+        }
+        Self::reduced(xi, frame)
+    }
+
+    /// A quadric from a symmetric matrix of rationals (scaled to integers by the common denominator).
+    ///
+    /// # Errors
+    /// As [`Quadric::from_matrix`].
+    pub fn from_rational_matrix(rows: &[Vec<Rational>], frame: Frame) -> Result<Self, SolidError> {
+        let flat: Vec<Rational> = rows.iter().flatten().copied().collect();
+        let (_, nums) = super::rational::common_denominator(&flat)?;
+        let mut it = nums.into_iter();
+        let ints: Vec<Vec<i128>> = rows
+            .iter()
+            .map(|r| r.iter().map(|_| it.next().unwrap_or(0)).collect())
+            .collect();
+        Self::from_matrix(&ints, frame)
+    }
+
+    fn reduced(mut xi: [[i128; N]; N], frame: Frame) -> Result<Self, SolidError> {
+        let g = xi.iter().flatten().fold(0, |g, &v| gcd_i128(g, v));
+        if g == 0 {
+            return Err(SolidError::BadParameter(
+                "the zero matrix is not a solid".into(),
+            ));
+        }
+        for v in xi.iter_mut().flatten() {
+            *v /= g;
+        }
+        Ok(Self { xi, frame })
+    }
+
+    /// The integer matrix (row `i`, column `j`), reduced by the gcd of its entries.
+    pub fn matrix(&self) -> Vec<Vec<i128>> {
+        (0..=K).map(|i| self.xi[i][..=K].to_vec()).collect()
+    }
+
+    /// The frame the matrix is written in.
+    pub fn frame(&self) -> Frame {
+        self.frame
+    }
+
+    /// The complement solid `Vᵀ(−Ξ)V ≤ 0` (its boundary is shared: surface points are in both).
+    pub fn negated(&self) -> Self {
+        let mut xi = self.xi;
+        for v in xi.iter_mut().flatten() {
+            *v = -*v;
+        }
+        Self {
+            xi,
+            frame: self.frame,
+        }
+    }
+
+    /// Whether the voxel `point` is inside (its sample point satisfies `Vᵀ Ξ V ≤ 0`), evaluated exactly.
+    /// This is the brute-force reference the ray generator is tested against.
+    pub fn contains(&self, level: u32, sample: Sample, point: [u32; K]) -> bool {
+        let s = i128::from(sample == Sample::Centre);
+        let mut v = [0i128; N];
+        for (x, &c) in v.iter_mut().zip(point.iter()) {
+            *x = 2 * i128::from(c) + s;
+        }
+        v[K] = self.w(level);
+        let mut q = 0i128;
+        for i in 0..=K {
+            for j in 0..=K {
+                q += self.xi[i][j] * v[i] * v[j];
+            }
+        }
+        q <= 0
+    }
+
+    fn w(&self, level: u32) -> i128 {
+        match self.frame {
+            Frame::Voxel => 2,
+            Frame::UnitCube => 2i128 << level,
+        }
+    }
+
+    /// The voxels of a universe of level `level` whose sample points lie in the solid, as rays (clipped to
+    /// the universe), with outward unit normals at the run ends from the gradient when `normals` is set
+    /// (ends cut by the universe's faces get `−z` at `z1 = 0` and `+z` at `z2 = U`).
+    ///
+    /// # Errors
+    /// [`SolidError::Space`] for a bad level; [`SolidError::TooLarge`] when the coefficients are too large
+    /// for exact `i128` evaluation at this level.
+    pub fn to_rays(
+        &self,
+        level: u32,
+        sample: Sample,
+        normals: bool,
+    ) -> Result<RaySet<K>, SolidError> {
+        let universe = Universe::<K>::new(level)?;
+        let largest = self.xi.iter().flatten().map(|v| v.abs()).max().unwrap_or(0);
+        // |Vᵀ Ξ V| ≤ (K+1)² · max|Ξ| · max|V|², with max|V| ≤ 2U + 2.
+        let vmax = 2.0 * universe.side() as f64 + 2.0;
+        if (largest as f64) * 25.0 * vmax * vmax * 4.0 >= 2f64.powi(125) {
+            return Err(SolidError::TooLarge { level, largest });
+        }
+        let side = universe.side() as i64;
+        let mut gen = Generator::<K> {
+            xi: self.xi,
+            xf: std::array::from_fn(|i| std::array::from_fn(|j| self.xi[i][j] as f64)),
+            s: i64::from(sample == Sample::Centre),
+            w: self.w(level),
+            side,
+            level,
+            columns: Vec::new(),
+            runs: Vec::new(),
+            normals: normals.then(Vec::new),
+        };
+        if K == 1 {
+            gen.column([0; K]);
+        } else {
+            gen.visit([0; K], [side - 1; K]);
+        }
+        Ok(RaySet::from_sorted_parts(
+            universe,
+            gen.columns,
+            gen.runs,
+            gen.normals,
+        ))
+    }
+}
+
+struct Generator<const K: usize> {
+    xi: [[i128; N]; N],
+    xf: [[f64; N]; N],
+    s: i64,
+    w: i128,
+    side: i64,
+    level: u32,
+    columns: Vec<u64>,
+    runs: Vec<(u32, u32)>,
+    normals: Option<Vec<[Normal<K>; 2]>>,
+}
+
+impl<const K: usize> Generator<K> {
+    /// Visits the columns `lo..=hi` (axes 0 … K−2) in lexicographic order, skipping blocks that miss the solid.
+    fn visit(&mut self, lo: [i64; K], hi: [i64; K]) {
+        if self.misses(&lo, &hi) {
+            return;
+        }
+        match (0..K - 1).find(|&a| lo[a] < hi[a]) {
+            None => self.column(lo),
+            Some(a) => {
+                let mid = lo[a] + (hi[a] - lo[a]) / 2;
+                let mut h1 = hi;
+                h1[a] = mid;
+                self.visit(lo, h1);
+                let mut l2 = lo;
+                l2[a] = mid + 1;
+                self.visit(l2, hi);
+            }
+        }
+    }
+
+    /// A conservative test that no sample point of the block (all of `z`) is inside: a lower bound of the
+    /// form over the block from its value, gradient and curvature at the block's middle.
+    fn misses(&self, lo: &[i64; K], hi: &[i64; K]) -> bool {
+        let s = self.s as f64;
+        let mut m = [0f64; N];
+        let mut h = [0f64; N];
+        for a in 0..K {
+            let (l, u) = if a == K - 1 {
+                (0, self.side - 1)
+            } else {
+                (lo[a], hi[a])
+            };
+            let (l, u) = ((2 * l) as f64 + s, (2 * u) as f64 + s);
+            m[a] = 0.5 * (l + u);
+            h[a] = 0.5 * (u - l);
+        }
+        m[K] = self.w as f64;
+        let mut value = 0.0;
+        let mut scale = 0.0;
+        let mut lower = 0.0;
+        for i in 0..=K {
+            let mut g = 0.0;
+            for j in 0..=K {
+                g += self.xf[i][j] * m[j];
+                scale += (self.xf[i][j] * m[j] * m[i]).abs();
+            }
+            value += g * m[i];
+            lower -= 2.0 * g.abs() * h[i];
+            for j in 0..=K {
+                let t = self.xf[i][j] * h[i] * h[j];
+                lower -= if i == j { (-t).max(0.0) } else { t.abs() };
+            }
+        }
+        value + lower > 1e-9 * (scale + lower.abs()) + 1.0
+    }
+
+    /// Solves one column exactly and appends its runs.
+    fn column(&mut self, col: [i64; K]) {
+        let z = K - 1;
+        let mut v = [0i128; N];
+        for a in 0..K - 1 {
+            v[a] = i128::from(2 * col[a] + self.s);
+        }
+        v[K] = self.w;
+        let az = self.xi[z][z];
+        let mut bz = 0i128;
+        let mut cz = 0i128;
+        for i in (0..=K).filter(|&i| i != z) {
+            bz += 2 * self.xi[z][i] * v[i];
+            for j in (0..=K).filter(|&j| j != z) {
+                cz += self.xi[i][j] * v[i] * v[j];
+            }
+        }
+        let s = i128::from(self.s);
+        // Z = 2z + s: q(z) = 4az z² + (4 az s + 2 bz) z + (az s² + bz s + cz).
+        let q = Quad {
+            a: 4 * az,
+            b: 4 * az * s + 2 * bz,
+            c: az * s * s + bz * s + cz,
+        };
+        let (lo, hi) = (0i64, self.side - 1);
+        let mut found = [(0i64, 0i64); 2];
+        let mut n = 0;
+        if q.a > 0 {
+            if let Some(r) = q.convex_interval(lo, hi) {
+                found[0] = r;
+                n = 1;
+            }
+        } else if q.a < 0 {
+            // Inside = [lo, hi] minus where q ≥ 1, which is where the convex −q + 1 ≤ 0.
+            let p = Quad {
+                a: -q.a,
+                b: -q.b,
+                c: 1 - q.c,
+            };
+            match p.convex_interval(lo, hi) {
+                None => {
+                    found[0] = (lo, hi);
+                    n = 1;
+                }
+                Some((pl, ph)) => {
+                    if pl > lo {
+                        found[n] = (lo, pl - 1);
+                        n += 1;
+                    }
+                    if ph < hi {
+                        found[n] = (ph + 1, hi);
+                        n += 1;
+                    }
+                }
+            }
+        } else if let Some(r) = q.linear_interval(lo, hi) {
+            found[0] = r;
+            n = 1;
+        }
+        if n == 0 {
+            return;
+        }
+        let mut point = [0u32; K];
+        for a in 0..K - 1 {
+            point[a] = col[a] as u32;
+        }
+        let key = point[..K - 1]
+            .iter()
+            .fold(0u64, |key, &c| (key << self.level) | u64::from(c));
+        for &(z1, z2) in &found[..n] {
+            self.columns.push(key);
+            self.runs.push((z1 as u32, z2 as u32 + 1));
+            if self.normals.is_some() {
+                let n1 = self.normal(&v, &q, z1, -1);
+                let n2 = self.normal(&v, &q, z2, 1);
+                if let Some(ns) = self.normals.as_mut() {
+                    ns.push([n1, n2]);
+                }
+            }
+        }
+    }
+
+    /// The outward unit normal at the end voxel `zv` of a run; `dir` is −1 at `z1`, +1 at `z2`.
+    fn normal(&self, v: &[i128; N], q: &Quad, zv: i64, dir: i64) -> Normal<K> {
+        let mut axis_z = [0f32; K];
+        axis_z[K - 1] = dir as f32;
+        let beyond = zv + dir;
+        if (beyond < 0 || beyond >= self.side) && q.at(beyond) <= 0 {
+            return axis_z; // cut by the universe's face
+        }
+        let mut p = [0f64; N];
+        for a in 0..=K {
+            p[a] = v[a] as f64;
+        }
+        p[K - 1] = (2 * zv + self.s) as f64;
+        let mut g = [0f32; K];
+        let mut len = 0f64;
+        for (i, gi) in g.iter_mut().enumerate() {
+            let d: f64 = (0..=K).map(|j| self.xf[i][j] * p[j]).sum();
+            *gi = d as f32;
+            len += d * d;
+        }
+        if len == 0.0 || !len.is_finite() {
+            return axis_z;
+        }
+        let inv = (1.0 / len.sqrt()) as f32;
+        g.map(|x| x * inv)
+    }
+}
+
+/// An integer quadratic `a z² + b z + c`.
+#[derive(Debug, Clone, Copy)]
+struct Quad {
+    a: i128,
+    b: i128,
+    c: i128,
+}
+
+impl Quad {
+    fn at(&self, z: i64) -> i128 {
+        let z = i128::from(z);
+        (self.a * z + self.b) * z + self.c
+    }
+
+    /// For `a > 0`: the integers `z` in `[lo, hi]` with `q(z) ≤ 0` (an interval), exactly.
+    fn convex_interval(&self, lo: i64, hi: i64) -> Option<(i64, i64)> {
+        // The integer minimiser over [lo, hi] is clamp(floor(−b / 2a)) or the next integer.
+        let v = (-self.b).div_euclid(2 * self.a);
+        let zm0 = i64::try_from(v.clamp(i128::from(lo), i128::from(hi))).ok()?;
+        let zm = if zm0 < hi && self.at(zm0 + 1) < self.at(zm0) {
+            zm0 + 1
+        } else {
+            zm0
+        };
+        if self.at(zm) > 0 {
+            return None;
+        }
+        let (r1, r2) = self.float_roots();
+        let inside = |z: i64| self.at(z) <= 0;
+        // Smallest z in [lo, zm] inside (inside is monotone false → true there); largest in [zm, hi].
+        let left = first_true(lo, zm, r1.ceil(), |z| inside(z));
+        let right = -first_true(-hi, -zm, -r2.floor(), |z| inside(-z));
+        Some((left, right))
+    }
+
+    /// For `a = 0`: the integers in `[lo, hi]` with `b z + c ≤ 0`.
+    fn linear_interval(&self, lo: i64, hi: i64) -> Option<(i64, i64)> {
+        let (lo128, hi128) = (i128::from(lo), i128::from(hi));
+        let (l, h) = match self.b.signum() {
+            0 => {
+                if self.c <= 0 {
+                    (lo128, hi128)
+                } else {
+                    return None;
+                }
+            }
+            1 => (lo128, (-self.c).div_euclid(self.b).min(hi128)),
+            _ => {
+                // z ≥ −c / b with b < 0: z ≥ ceil(c / −b).
+                let d = -self.b;
+                ((self.c + d - 1).div_euclid(d).max(lo128), hi128)
+            }
+        };
+        (l <= h).then(|| (l as i64, h as i64))
+    }
+
+    fn float_roots(&self) -> (f64, f64) {
+        let (a, b, c) = (self.a as f64, self.b as f64, self.c as f64);
+        let d = b * b - 4.0 * a * c;
+        if !(d >= 0.0) || !d.is_finite() {
+            let m = -b / (2.0 * a);
+            return (m, m);
+        }
+        let q = -0.5 * (b + b.signum() * d.sqrt());
+        let (x1, x2) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
+        (x1.min(x2), x1.max(x2))
+    }
+}
+
+/// The smallest `z` in `[lo, hi]` with `p(z)`, where `p` is monotone (false … true) and `p(hi)` holds; `guess`
+/// is a float estimate (any value: it is only where the search starts).
+fn first_true(lo: i64, hi: i64, guess: f64, p: impl Fn(i64) -> bool) -> i64 {
+    let g = if guess.is_finite() {
+        (guess.max(lo as f64).min(hi as f64)) as i64
+    } else {
+        hi
+    };
+    // Gallop from the guess to a bracket [a, b] with !p(a) (or a = lo − 1) and p(b).
+    let (mut a, mut b);
+    if p(g) {
+        b = g;
+        let mut step = 1i64;
+        loop {
+            let t = b - step;
+            if t < lo {
+                a = lo - 1;
+                break;
+            }
+            if p(t) {
+                b = t;
+                step *= 2;
+            } else {
+                a = t;
+                break;
+            }
+        }
+    } else {
+        a = g;
+        let mut step = 1i64;
+        loop {
+            let t = a + step;
+            if t >= hi {
+                b = hi;
+                break;
+            }
+            if p(t) {
+                b = t;
+                break;
+            }
+            a = t;
+            step *= 2;
+        }
+    }
+    while b - a > 1 {
+        let m = a + (b - a) / 2;
+        if p(m) {
+            b = m;
+        } else {
+            a = m;
+        }
+    }
+    b
+}
