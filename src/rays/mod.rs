@@ -2,9 +2,11 @@
 //! of a run.
 
 mod ball;
+mod csg;
 mod rayset;
 mod rows;
 
 pub use ball::ball_rays;
+pub use csg::CsgError;
 pub use rayset::{ColumnGroups, Normal, Ray, RayError, RaySet};
 pub use rows::{maximal_rows, MaximalRows, Row};
