@@ -1,1 +1,493 @@
-//! Triangle meshes to rays.
+//! Triangle meshes to rays: OBJ (tobj), STL ASCII and binary (stl_io) and PLY (ply-rs).
+//!
+//! **Placement.** A vertex `v` goes to voxel coordinates `s·v + t` ([`Placement`]), computed in `f64` and then
+//! rounded to the nearest multiple of 2^−16 voxel; every later step is exact integer arithmetic, so a result
+//! is reproducible bit for bit. [`Placement::fit`] scales and centres a mesh into the universe with a one-voxel
+//! margin.
+//!
+//! **Inside rule.** A voxel is inside when its centre is: the column through the centre `(x+½, y+½)` is
+//! crossed by the triangles whose projection covers it, each crossing counted `+1` where the triangle faces
+//! down (`−z`: the column enters) and `−1` where it faces up, and a centre is inside when the sum of the
+//! crossings below it is non-zero (non-zero winding rule; a centre exactly on the surface is inside).
+//! **Ties.** Whether a column passing exactly through a vertex or along an edge is covered is decided by
+//! simulation of simplicity: the column is treated as moved by an infinitesimal `(ε, ε²)`, which never lies on
+//! an edge. Every point of the plane is then covered by the same number of up- and down-facing triangles of a
+//! closed mesh, so watertight meshes never leak. Triangles whose projection has zero area are skipped (the
+//! moved column never meets them). In effect a centre on the surface is inside where the column crosses the
+//! surface there (closed along z), and where the column only touches the surface — a vertical face, a
+//! silhouette edge or vertex — the moved column decides: a box `[lo, hi]` covers the centres in
+//! `[lo, hi)` across x and y and `[lo, hi]` along z.
+//!
+//! **Open meshes.** [`MeshRays::open_edges`] counts edges not shared by exactly two triangles; the rule above
+//! is still applied, column by column, so a hole can make some columns leak (runs to the universe's face) or
+//! lose runs. Callers should warn (the CLI does).
+//!
+//! **Work:** `O(triangles + rays)` plus a radix sort of the crossings: each triangle visits only the columns
+//! in its bounding box.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use super::SolidError;
+use crate::build::radix_sort;
+use crate::rays::RaySet;
+use crate::space::Universe;
+
+/// Bits of sub-voxel precision of placed vertices.
+const FRAC: u32 = 16;
+/// Placed coordinates must lie within ±2^22 voxels (keeps every product inside `i128`).
+const LIMIT: f64 = (1u64 << 22) as f64;
+
+/// A triangle mesh: vertex positions and triangles as vertex indices.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TriangleMesh {
+    /// Vertex positions.
+    pub vertices: Vec<[f64; 3]>,
+    /// Triangles, three indices into `vertices` each, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Where a mesh goes in the universe: voxel coordinate = `scale · v + translate`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placement {
+    /// Uniform scale.
+    pub scale: f64,
+    /// Translation, in voxels.
+    pub translate: [f64; 3],
+}
+
+impl Placement {
+    /// Parses `s,tx,ty,tz`.
+    ///
+    /// # Errors
+    /// [`SolidError::BadParameter`] for anything else.
+    pub fn parse(text: &str) -> Result<Self, SolidError> {
+        let v: Vec<f64> = text
+            .split(',')
+            .map(|x| x.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| {
+                SolidError::BadParameter(format!("transform '{text}': expected s,tx,ty,tz"))
+            })?;
+        if v.len() != 4 || !v.iter().all(|x| x.is_finite()) || v[0] == 0.0 {
+            return Err(SolidError::BadParameter(format!(
+                "transform '{text}': expected four finite numbers s,tx,ty,tz with s ≠ 0"
+            )));
+        }
+        Ok(Self {
+            scale: v[0],
+            translate: [v[1], v[2], v[3]],
+        })
+    }
+
+    /// Uniform scale and centring of `mesh` into a universe of level `level`, one voxel of margin each side.
+    ///
+    /// # Errors
+    /// [`SolidError::BadParameter`] for an empty or flat mesh.
+    pub fn fit(mesh: &TriangleMesh, level: u32) -> Result<Self, SolidError> {
+        let (lo, hi) = mesh
+            .bounds()
+            .ok_or_else(|| SolidError::BadParameter("the mesh has no vertex".into()))?;
+        let extent = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+        let side = (1u64 << level) as f64;
+        if !(extent > 0.0) || side <= 2.0 {
+            return Err(SolidError::BadParameter(
+                "cannot fit: the mesh has no extent or the universe is smaller than 4 voxels"
+                    .into(),
+            ));
+        }
+        let scale = (side - 2.0) / extent;
+        let translate = std::array::from_fn(|a| side / 2.0 - scale * (lo[a] + hi[a]) / 2.0);
+        Ok(Self { scale, translate })
+    }
+
+    /// `s,tx,ty,tz` (what [`Placement::parse`] reads).
+    pub fn to_arg(&self) -> String {
+        format!(
+            "{},{},{},{}",
+            self.scale, self.translate[0], self.translate[1], self.translate[2]
+        )
+    }
+
+    /// The voxel coordinates of `v`.
+    pub fn apply(&self, v: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|a| self.scale * v[a] + self.translate[a])
+    }
+}
+
+/// The rays of a mesh and what was noticed on the way.
+#[derive(Debug, Clone)]
+pub struct MeshRays {
+    /// The voxels whose centres are inside.
+    pub rays: RaySet<3>,
+    /// Edges not shared by exactly two triangles (0 for a closed 2-manifold mesh).
+    pub open_edges: usize,
+    /// Triangles skipped because their projection along z has zero area.
+    pub vertical_triangles: usize,
+}
+
+impl TriangleMesh {
+    /// Reads a mesh, choosing the format by extension: `.obj`, `.stl` (ASCII or binary), `.ply`.
+    ///
+    /// # Errors
+    /// [`SolidError::Io`] when the file cannot be read, [`SolidError::Parse`] naming the file (and the line
+    /// where the parser tells it) otherwise.
+    pub fn read(path: &Path) -> Result<Self, SolidError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        let parse = |what: String| SolidError::Parse {
+            path: path.to_path_buf(),
+            what,
+        };
+        let io = |source| SolidError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mesh = match ext.as_str() {
+            "obj" => {
+                let file = std::fs::File::open(path).map_err(io)?;
+                let opts = tobj::LoadOptions {
+                    triangulate: true,
+                    single_index: false,
+                    ignore_points: true,
+                    ignore_lines: true,
+                    ..Default::default()
+                };
+                let (models, _) =
+                    tobj::load_obj_buf(&mut std::io::BufReader::new(file), &opts, |_| {
+                        Err(tobj::LoadError::OpenFileFailed)
+                    })
+                    .map_err(|e| parse(format!("OBJ: {e}")))?;
+                let mut mesh = Self::default();
+                for m in models {
+                    let base = mesh.vertices.len() as u32;
+                    let p = &m.mesh.positions;
+                    mesh.vertices.extend(
+                        p.chunks_exact(3)
+                            .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])]),
+                    );
+                    mesh.triangles.extend(
+                        m.mesh
+                            .indices
+                            .chunks_exact(3)
+                            .map(|t| [base + t[0], base + t[1], base + t[2]]),
+                    );
+                }
+                mesh
+            }
+            "stl" => {
+                let mut file = std::fs::File::open(path).map_err(io)?;
+                let m = stl_io::read_stl(&mut file).map_err(|e| parse(format!("STL: {e}")))?;
+                Self {
+                    vertices: m.vertices.iter().map(|v| v.0.map(f64::from)).collect(),
+                    triangles: m
+                        .faces
+                        .iter()
+                        .map(|f| f.vertices.map(|i| i as u32))
+                        .collect(),
+                }
+            }
+            "ply" => read_ply(path).map_err(parse)?,
+            _ => {
+                return Err(parse(format!(
+                    "unknown mesh format '.{ext}' (known: .obj, .stl, .ply)"
+                )))
+            }
+        };
+        mesh.validate().map_err(parse)?;
+        Ok(mesh)
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let n = self.vertices.len();
+        if let Some((i, t)) = self
+            .triangles
+            .iter()
+            .enumerate()
+            .find(|(_, t)| t.iter().any(|&v| v as usize >= n))
+        {
+            return Err(format!(
+                "triangle {i} refers to vertex {t:?} but there are {n} vertices"
+            ));
+        }
+        if let Some(i) = self
+            .vertices
+            .iter()
+            .position(|v| !v.iter().all(|x| x.is_finite()))
+        {
+            return Err(format!("vertex {i} is not finite"));
+        }
+        if self.triangles.is_empty() {
+            return Err("no triangle".into());
+        }
+        Ok(())
+    }
+
+    /// The axis-aligned bounding box `(lo, hi)`, `None` without vertices.
+    pub fn bounds(&self) -> Option<([f64; 3], [f64; 3])> {
+        let first = *self.vertices.first()?;
+        Some(self.vertices.iter().fold((first, first), |(lo, hi), v| {
+            (
+                std::array::from_fn(|a| lo[a].min(v[a])),
+                std::array::from_fn(|a| hi[a].max(v[a])),
+            )
+        }))
+    }
+
+    fn corners(&self, t: &[u32; 3]) -> [[f64; 3]; 3] {
+        t.map(|i| self.vertices[i as usize])
+    }
+
+    /// The signed volume enclosed (positive for outward orientation), by the divergence theorem.
+    pub fn signed_volume(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = self.corners(t);
+                dot(a, cross(b, c)) / 6.0
+            })
+            .sum()
+    }
+
+    /// The total surface area.
+    pub fn surface_area(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = self.corners(t);
+                let n = cross(sub(b, a), sub(c, a));
+                dot(n, n).sqrt() / 2.0
+            })
+            .sum()
+    }
+
+    /// The number of edges not shared by exactly two triangles.
+    pub fn open_edges(&self) -> usize {
+        let mut uses: HashMap<(u32, u32), u32> = HashMap::with_capacity(self.triangles.len() * 2);
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        uses.values().filter(|&&n| n != 2).count()
+    }
+
+    /// The voxels of a level-`level` octree universe whose centres are inside the placed mesh, as rays.
+    ///
+    /// # Errors
+    /// [`SolidError::Space`] for a bad level (the packing of crossings needs `L ≤ 20`);
+    /// [`SolidError::BadParameter`] when a placed vertex lies farther than 2^22 voxels from the origin.
+    pub fn to_rays(&self, level: u32, placement: &Placement) -> Result<MeshRays, SolidError> {
+        let universe = Universe::<3>::new(level)?;
+        let side = universe.side() as i64;
+        let one = 1i64 << FRAC;
+        let half = one / 2;
+        let mut fixed = Vec::with_capacity(self.vertices.len());
+        for (i, v) in self.vertices.iter().enumerate() {
+            let p = placement.apply(*v);
+            if !p.iter().all(|x| x.abs() < LIMIT) {
+                return Err(SolidError::BadParameter(format!(
+                    "vertex {i} is placed at {p:?}, more than 2^22 voxels away: check the transform"
+                )));
+            }
+            fixed.push(p.map(|x| (x * one as f64).round() as i64));
+        }
+        let col_bits = 2 * level;
+        let pos_bits = level + 1;
+        let mut events: Vec<u64> = Vec::new();
+        let mut vertical = 0;
+        // Column range whose centres (2x+1)·half lie in [lo, hi].
+        let range = |lo: i64, hi: i64| {
+            let a =
+                (lo - half).div_euclid(2 * half) + i64::from((lo - half).rem_euclid(2 * half) != 0);
+            let b = (hi - half).div_euclid(2 * half);
+            (a.max(0), b.min(side - 1))
+        };
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| fixed[i as usize]);
+            let area = orient(a, b, c);
+            if area == 0 {
+                vertical += 1;
+                continue;
+            }
+            // Counter-clockwise order in the plane; faces up (exit, −1) when the given order was ccw.
+            let (p, exit) = if area > 0 {
+                ([a, b, c], true)
+            } else {
+                ([a, c, b], false)
+            };
+            let area = area.abs();
+            let (x0, x1) = range(
+                p.iter().map(|v| v[0]).min().unwrap_or(0),
+                p.iter().map(|v| v[0]).max().unwrap_or(0),
+            );
+            let (y0, y1) = range(
+                p.iter().map(|v| v[1]).min().unwrap_or(0),
+                p.iter().map(|v| v[1]).max().unwrap_or(0),
+            );
+            for x in x0..=x1 {
+                for y in y0..=y1 {
+                    let q = [(2 * x + 1) * half, (2 * y + 1) * half, 0];
+                    let e0 = orient(p[0], p[1], q);
+                    let e1 = orient(p[1], p[2], q);
+                    let e2 = orient(p[2], p[0], q);
+                    if !(covers(e0, p[0], p[1]) && covers(e1, p[1], p[2]) && covers(e2, p[2], p[0]))
+                    {
+                        continue;
+                    }
+                    // Height at the column: (e1 z0 + e2 z1 + e0 z2) / area, in 1/2^16 voxel.
+                    let num = e1 * i128::from(p[0][2])
+                        + e2 * i128::from(p[1][2])
+                        + e0 * i128::from(p[2][2]);
+                    // Voxel index: h − ½ = (num − area·half) / (area·one).
+                    let n = num - area * i128::from(half);
+                    let d = area * i128::from(one);
+                    let pos = if exit {
+                        n.div_euclid(d) + 1
+                    } else {
+                        -((-n).div_euclid(d))
+                    };
+                    let pos = pos.clamp(0, i128::from(side)) as u64;
+                    let col = ((x as u64) << level) | y as u64;
+                    events.push((((col << pos_bits) | pos) << 1) | u64::from(!exit));
+                }
+            }
+        }
+        radix_sort(&mut events, col_bits + pos_bits + 1, &mut Vec::new());
+        let mut columns = Vec::new();
+        let mut runs = Vec::new();
+        let mut i = 0;
+        while i < events.len() {
+            let col = events[i] >> (pos_bits + 1);
+            let mut winding = 0i64;
+            let mut start = None;
+            while i < events.len() && events[i] >> (pos_bits + 1) == col {
+                let pos = (events[i] >> 1) & ((1 << pos_bits) - 1);
+                while i < events.len() && events[i] >> 1 == (col << pos_bits) | pos {
+                    winding += if events[i] & 1 == 1 { 1 } else { -1 };
+                    i += 1;
+                }
+                match (start, winding != 0) {
+                    (None, true) => start = Some(pos),
+                    (Some(s), false) => {
+                        if s < pos {
+                            columns.push(col);
+                            runs.push((s as u32, pos as u32));
+                        }
+                        start = None;
+                    }
+                    _ => {}
+                }
+            }
+            if let Some(s) = start {
+                // Only on open meshes: the column never closes; it runs to the universe's face.
+                if s < side as u64 {
+                    columns.push(col);
+                    runs.push((s as u32, side as u32));
+                }
+            }
+        }
+        Ok(MeshRays {
+            rays: RaySet::from_sorted_parts(universe, columns, runs, None),
+            open_edges: self.open_edges(),
+            vertical_triangles: vertical,
+        })
+    }
+}
+
+/// Twice the signed area of `(a, b, c)` projected on the xy-plane, exactly.
+fn orient(a: [i64; 3], b: [i64; 3], c: [i64; 3]) -> i128 {
+    i128::from(b[0] - a[0]) * i128::from(c[1] - a[1])
+        - i128::from(b[1] - a[1]) * i128::from(c[0] - a[0])
+}
+
+/// Whether the column moved by `(ε, ε²)` is on the inner side of the edge `p → q` of a ccw triangle.
+fn covers(e: i128, p: [i64; 3], q: [i64; 3]) -> bool {
+    let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+    e > 0 || (e == 0 && (dy < 0 || (dy == 0 && dx > 0)))
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn read_ply(path: &Path) -> Result<TriangleMesh, String> {
+    use ply_rs::ply::Property;
+    let mut file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
+    let ply = parser
+        .read_ply(&mut file)
+        .map_err(|e| format!("PLY: {e}"))?;
+    let scalar = |p: &Property| -> Option<f64> {
+        Some(match *p {
+            Property::Char(v) => f64::from(v),
+            Property::UChar(v) => f64::from(v),
+            Property::Short(v) => f64::from(v),
+            Property::UShort(v) => f64::from(v),
+            Property::Int(v) => f64::from(v),
+            Property::UInt(v) => f64::from(v),
+            Property::Float(v) => f64::from(v),
+            Property::Double(v) => v,
+            _ => return None,
+        })
+    };
+    let mut mesh = TriangleMesh::default();
+    let vertices = ply
+        .payload
+        .get("vertex")
+        .ok_or("PLY: no 'vertex' element")?;
+    for (i, v) in vertices.iter().enumerate() {
+        let mut p = [0.0; 3];
+        for (a, name) in ["x", "y", "z"].iter().enumerate() {
+            p[a] = v
+                .get(*name)
+                .and_then(scalar)
+                .ok_or_else(|| format!("PLY: vertex {i} has no numeric '{name}'"))?;
+        }
+        mesh.vertices.push(p);
+    }
+    let faces = ply.payload.get("face").ok_or("PLY: no 'face' element")?;
+    for (i, f) in faces.iter().enumerate() {
+        let list = f
+            .get("vertex_indices")
+            .or_else(|| f.get("vertex_index"))
+            .ok_or_else(|| format!("PLY: face {i} has no 'vertex_indices'"))?;
+        let idx: Vec<i64> = match list {
+            Property::ListChar(v) => v.iter().map(|&x| i64::from(x)).collect(),
+            Property::ListUChar(v) => v.iter().map(|&x| i64::from(x)).collect(),
+            Property::ListShort(v) => v.iter().map(|&x| i64::from(x)).collect(),
+            Property::ListUShort(v) => v.iter().map(|&x| i64::from(x)).collect(),
+            Property::ListInt(v) => v.iter().map(|&x| i64::from(x)).collect(),
+            Property::ListUInt(v) => v.iter().map(|&x| i64::from(x)).collect(),
+            _ => {
+                return Err(format!(
+                    "PLY: face {i}: vertex indices are not an integer list"
+                ))
+            }
+        };
+        if idx.len() < 3 || idx.iter().any(|&x| x < 0 || x > i64::from(u32::MAX)) {
+            return Err(format!("PLY: face {i}: bad vertex index list {idx:?}"));
+        }
+        for k in 1..idx.len() - 1 {
+            mesh.triangles
+                .push([idx[0] as u32, idx[k] as u32, idx[k + 1] as u32]);
+        }
+    }
+    Ok(mesh)
+}
