@@ -1,1 +1,294 @@
-//! Volumes to rays.
+//! Dense 3-D scalar volumes (CT, MRI) to rays by a threshold or a label.
+//!
+//! Formats: headerless raw samples with a JSON sidecar (the layout of `../shared/data/volumes`: `shape_xyz`,
+//! `dtype` one of `uint8 int8 uint16 int16 uint32 int32 float32 float64`, `endianness`, x fastest), and NIfTI-1
+//! (`.nii`, `.nii.gz`, read with the `nifti` crate; the stored values are rescaled by `scl_slope`/`scl_inter`
+//! as NIfTI prescribes). Volume voxel `(i, j, k)` becomes universe voxel `offset + (i, j, k)`, unscaled.
+//!
+//! The cost is one pass over the samples (a dense input has to be read anyway) plus the rays.
+
+use std::path::Path;
+
+use serde::Deserialize;
+
+use super::SolidError;
+use crate::rays::RaySet;
+use crate::space::Universe;
+
+/// Which samples are inside.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Select {
+    /// `value ≥ threshold`.
+    AtLeast(f64),
+    /// `value == label` (segmentation labels).
+    Label(f64),
+}
+
+impl Select {
+    fn test(&self, v: f64) -> bool {
+        match *self {
+            Select::AtLeast(t) => v >= t,
+            Select::Label(l) => v == l,
+        }
+    }
+}
+
+/// A dense scalar volume, samples x fastest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Volume {
+    /// Samples along x, y, z.
+    pub shape: [usize; 3],
+    /// The samples (converted to `f64`), `offset = x + nx·(y + ny·z)`.
+    pub values: Vec<f64>,
+    /// Voxel size in mm where known (informative only).
+    pub spacing: [f64; 3],
+}
+
+#[derive(Deserialize)]
+struct Sidecar {
+    shape_xyz: [usize; 3],
+    dtype: String,
+    #[serde(default)]
+    endianness: Option<String>,
+    #[serde(default)]
+    spacing_xyz: Option<[f64; 3]>,
+    #[serde(default)]
+    file: Option<String>,
+}
+
+/// Largest number of samples accepted (checked before allocating).
+const MAX_SAMPLES: usize = 1 << 31;
+
+impl Volume {
+    /// Reads a volume: a `.json` sidecar (or the `.raw` beside one) or a NIfTI file (`.nii`, `.nii.gz`).
+    ///
+    /// # Errors
+    /// [`SolidError::Io`] or [`SolidError::Parse`] naming the file and what is wrong.
+    pub fn read(path: &Path) -> Result<Self, SolidError> {
+        let name = path.to_string_lossy().to_ascii_lowercase();
+        if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+            Self::read_nifti(path)
+        } else if name.ends_with(".json") {
+            Self::read_raw(path)
+        } else if name.ends_with(".raw") {
+            Self::read_raw(&path.with_extension("json"))
+        } else {
+            Err(SolidError::Parse {
+                path: path.to_path_buf(),
+                what: "unknown volume format (known: .json sidecar with .raw, .nii, .nii.gz)"
+                    .into(),
+            })
+        }
+    }
+
+    /// Reads raw samples described by a JSON sidecar (the raw file is the sidecar's `file`, or the same name
+    /// with `.raw`).
+    ///
+    /// # Errors
+    /// As [`Volume::read`].
+    pub fn read_raw(json: &Path) -> Result<Self, SolidError> {
+        let parse = |p: &Path, what: String| SolidError::Parse {
+            path: p.to_path_buf(),
+            what,
+        };
+        let text = std::fs::read_to_string(json).map_err(|source| SolidError::Io {
+            path: json.to_path_buf(),
+            source,
+        })?;
+        let meta: Sidecar = serde_json::from_str(&text).map_err(|e| {
+            parse(
+                json,
+                format!("line {} column {}: {e}", e.line(), e.column()),
+            )
+        })?;
+        let raw = match &meta.file {
+            Some(f) => json.with_file_name(f),
+            None => json.with_extension("raw"),
+        };
+        let size = match meta.dtype.as_str() {
+            "uint8" | "int8" => 1,
+            "uint16" | "int16" => 2,
+            "uint32" | "int32" | "float32" => 4,
+            "float64" => 8,
+            other => return Err(parse(json, format!("unknown dtype '{other}'"))),
+        };
+        let big = match meta.endianness.as_deref() {
+            None | Some("little") => false,
+            Some("big") => true,
+            Some(other) => return Err(parse(json, format!("unknown endianness '{other}'"))),
+        };
+        let n = checked_samples(meta.shape_xyz).ok_or_else(|| {
+            parse(
+                json,
+                format!("shape {:?} is empty or too large", meta.shape_xyz),
+            )
+        })?;
+        let want = n as u64 * size as u64;
+        let got = std::fs::metadata(&raw)
+            .map_err(|source| SolidError::Io {
+                path: raw.clone(),
+                source,
+            })?
+            .len();
+        if got != want {
+            return Err(parse(
+                &raw,
+                format!(
+                    "{got} bytes, but shape {:?} of {} needs {want}",
+                    meta.shape_xyz, meta.dtype
+                ),
+            ));
+        }
+        let bytes = std::fs::read(&raw).map_err(|source| SolidError::Io {
+            path: raw.clone(),
+            source,
+        })?;
+        let values = bytes
+            .chunks_exact(size)
+            .map(|c| decode(&meta.dtype, c, big))
+            .collect();
+        Ok(Self {
+            shape: meta.shape_xyz,
+            values,
+            spacing: meta.spacing_xyz.unwrap_or([1.0; 3]),
+        })
+    }
+
+    /// Reads a NIfTI-1 file with the `nifti` crate (3-D volumes only; a 4-D file with one time point is
+    /// accepted).
+    ///
+    /// # Errors
+    /// As [`Volume::read`].
+    pub fn read_nifti(path: &Path) -> Result<Self, SolidError> {
+        use nifti::{NiftiObject, NiftiVolume, RandomAccessNiftiVolume};
+        let parse = |what: String| SolidError::Parse {
+            path: path.to_path_buf(),
+            what,
+        };
+        let obj = nifti::ReaderOptions::new()
+            .read_file(path)
+            .map_err(|e| parse(format!("NIfTI: {e}")))?;
+        let pix = obj.header().pixdim;
+        let vol = obj.into_volume();
+        let dim = vol.dim().to_vec();
+        if dim.len() < 3 || dim.len() > 4 || (dim.len() == 4 && dim[3] != 1) {
+            return Err(parse(format!(
+                "NIfTI: expected a 3-D volume, found dimensions {dim:?}"
+            )));
+        }
+        let shape = [dim[0] as usize, dim[1] as usize, dim[2] as usize];
+        let n = checked_samples(shape)
+            .ok_or_else(|| parse(format!("shape {shape:?} is empty or too large")))?;
+        let mut values = Vec::with_capacity(n);
+        let mut coords = vec![0u16; dim.len()];
+        for z in 0..dim[2] {
+            for y in 0..dim[1] {
+                for x in 0..dim[0] {
+                    coords[0] = x;
+                    coords[1] = y;
+                    coords[2] = z;
+                    values.push(
+                        vol.get_f64(&coords)
+                            .map_err(|e| parse(format!("NIfTI: {e}")))?,
+                    );
+                }
+            }
+        }
+        Ok(Self {
+            shape,
+            values,
+            spacing: [f64::from(pix[1]), f64::from(pix[2]), f64::from(pix[3])],
+        })
+    }
+
+    /// The number of selected samples.
+    pub fn count(&self, select: Select) -> usize {
+        self.values.iter().filter(|&&v| select.test(v)).count()
+    }
+
+    /// The smallest level whose universe holds the volume.
+    pub fn fitting_level(&self) -> u32 {
+        let m = self.shape.iter().copied().max().unwrap_or(1).max(1);
+        m.next_power_of_two().trailing_zeros()
+    }
+
+    /// The selected samples as rays along z, the volume's voxel `(i, j, k)` at universe voxel `offset + (i, j, k)`.
+    ///
+    /// # Errors
+    /// [`SolidError::Space`] for a bad level; [`SolidError::BadParameter`] if the volume does not fit.
+    pub fn to_rays(
+        &self,
+        level: u32,
+        offset: [u32; 3],
+        select: Select,
+    ) -> Result<RaySet<3>, SolidError> {
+        let universe = Universe::<3>::new(level)?;
+        let side = universe.side();
+        for a in 0..3 {
+            if u64::from(offset[a]) + self.shape[a] as u64 > side {
+                return Err(SolidError::BadParameter(format!(
+                    "the volume ({:?} samples at offset {offset:?}) does not fit a level-{level} universe of side {side}",
+                    self.shape
+                )));
+            }
+        }
+        let [nx, ny, nz] = self.shape;
+        let mut columns = Vec::new();
+        let mut runs = Vec::new();
+        for x in 0..nx {
+            for y in 0..ny {
+                let key =
+                    (u64::from(offset[0]) + x as u64) << level | (u64::from(offset[1]) + y as u64);
+                let mut start = None;
+                for z in 0..=nz {
+                    let inside = z < nz && select.test(self.values[x + nx * (y + ny * z)]);
+                    match (start, inside) {
+                        (None, true) => start = Some(z),
+                        (Some(s), false) => {
+                            columns.push(key);
+                            runs.push((offset[2] + s as u32, offset[2] + z as u32));
+                            start = None;
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+        Ok(RaySet::from_sorted_parts(universe, columns, runs, None))
+    }
+}
+
+fn checked_samples(shape: [usize; 3]) -> Option<usize> {
+    let n = shape.iter().try_fold(1usize, |p, &s| p.checked_mul(s))?;
+    (n > 0 && n <= MAX_SAMPLES && shape.iter().all(|&s| s <= 1 << 20)).then_some(n)
+}
+
+fn decode(dtype: &str, c: &[u8], big: bool) -> f64 {
+    macro_rules! num {
+        ($t:ty) => {{
+            let b = c.try_into().unwrap_or_default();
+            f64::from(if big {
+                <$t>::from_be_bytes(b)
+            } else {
+                <$t>::from_le_bytes(b)
+            })
+        }};
+    }
+    match dtype {
+        "uint8" => f64::from(c[0]),
+        "int8" => f64::from(c[0] as i8),
+        "uint16" => num!(u16),
+        "int16" => num!(i16),
+        "uint32" => num!(u32),
+        "int32" => num!(i32),
+        "float32" => num!(f32),
+        _ => {
+            let b = c.try_into().unwrap_or_default();
+            if big {
+                f64::from_be_bytes(b)
+            } else {
+                f64::from_le_bytes(b)
+            }
+        }
+    }
+}
