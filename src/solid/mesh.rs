@@ -90,7 +90,7 @@ impl Placement {
             .ok_or_else(|| SolidError::BadParameter("the mesh has no vertex".into()))?;
         let extent = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
         let side = (1u64 << level) as f64;
-        if !(extent > 0.0) || side <= 2.0 {
+        if extent.is_nan() || extent <= 0.0 || side <= 2.0 {
             return Err(SolidError::BadParameter(
                 "cannot fit: the mesh has no extent or the universe is smaller than 4 voxels"
                     .into(),
@@ -154,7 +154,6 @@ impl TriangleMesh {
                     single_index: false,
                     ignore_points: true,
                     ignore_lines: true,
-                    ..Default::default()
                 };
                 let (models, _) =
                     tobj::load_obj_buf(&mut std::io::BufReader::new(file), &opts, |_| {

@@ -24,6 +24,7 @@ pub use rational::Rational;
 use crate::rays::RaySet;
 
 /// Any analytic solid: a quadric or a box.
+#[allow(clippy::large_enum_variant)] // a handful of solids at a time
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Solid<const K: usize> {
     /// `Vᵀ Ξ V ≤ 0`.

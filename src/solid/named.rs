@@ -27,8 +27,8 @@ impl<const K: usize> Builder<K> {
     }
 
     fn linear(&mut self, l: &[i128]) -> Result<(), SolidError> {
-        for i in 0..K {
-            self.m[i][K] = self.m[i][K].checked_add(l[i]).ok_or_else(too_large)?;
+        for (i, &li) in l[..K].iter().enumerate() {
+            self.m[i][K] = self.m[i][K].checked_add(li).ok_or_else(too_large)?;
             self.m[K][i] = self.m[i][K];
         }
         self.m[K][K] = self.m[K][K]
@@ -97,8 +97,8 @@ impl<const K: usize> Quadric<K> {
         all.push(radius);
         let (d, p) = common_denominator(&all)?;
         let mut b = Builder::<K>::new();
-        for i in 0..K {
-            b.square(1, &offset::<K>(i, d, p[i]))?;
+        for (i, &c) in p[..K].iter().enumerate() {
+            b.square(1, &offset::<K>(i, d, c))?;
         }
         b.square(-checked(&[p[K], p[K]])?, &unit::<K>())?;
         b.finish(frame)
@@ -125,8 +125,8 @@ impl<const K: usize> Quadric<K> {
             .collect::<Result<_, _>>()?;
         let prod = checked(&sq)?;
         let mut b = Builder::<K>::new();
-        for i in 0..K {
-            b.square(prod / sq[i], &offset::<K>(i, d, p[i]))?;
+        for (i, (&c, &a2)) in p[..K].iter().zip(&sq).enumerate() {
+            b.square(prod / a2, &offset::<K>(i, d, c))?;
         }
         b.square(-prod, &unit::<K>())?;
         b.finish(frame)
@@ -152,8 +152,8 @@ impl<const K: usize> Quadric<K> {
         let (r, h) = (p[K], p[K + 1]);
         // Over D: h Σ (D x_i − a_i)² − r² (D z − a_z) ≤ 0 (both sides scaled by D³).
         let mut b = Builder::<K>::new();
-        for i in 0..K - 1 {
-            b.square(h, &offset::<K>(i, d, p[i]))?;
+        for (i, &c) in p[..K - 1].iter().enumerate() {
+            b.square(h, &offset::<K>(i, d, c))?;
         }
         let r2 = checked(&[r, r])?;
         let lin: Vec<i128> = offset::<K>(K - 1, d, p[K - 1])

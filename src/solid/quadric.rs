@@ -420,7 +420,7 @@ impl Quad {
         let (r1, r2) = self.float_roots();
         let inside = |z: i64| self.at(z) <= 0;
         // Smallest z in [lo, zm] inside (inside is monotone false → true there); largest in [zm, hi].
-        let left = first_true(lo, zm, r1.ceil(), |z| inside(z));
+        let left = first_true(lo, zm, r1.ceil(), inside);
         let right = -first_true(-hi, -zm, -r2.floor(), |z| inside(-z));
         Some((left, right))
     }
@@ -443,13 +443,13 @@ impl Quad {
                 ((self.c + d - 1).div_euclid(d).max(lo128), hi128)
             }
         };
-        (l <= h).then(|| (l as i64, h as i64))
+        (l <= h).then_some((l as i64, h as i64))
     }
 
     fn float_roots(&self) -> (f64, f64) {
         let (a, b, c) = (self.a as f64, self.b as f64, self.c as f64);
         let d = b * b - 4.0 * a * c;
-        if !(d >= 0.0) || !d.is_finite() {
+        if d.is_nan() || d < 0.0 || !d.is_finite() {
             let m = -b / (2.0 * a);
             return (m, m);
         }
