@@ -150,8 +150,9 @@ proptest! {
         for (i, &g) in got.iter().enumerate() {
             let v = u.dense_point(i);
             // Back in mesh coordinates: (v + ½ − t) / s; exact in binary for these values.
-            let d = [0, 1, 2].map(|a| (f64::from(v[a]) + 0.5 - p.translate[a]) / p.scale - centre[a]);
-            prop_assert_eq!(g, octahedron_rule(d, f64::from(r) / 2.0), "voxel {:?}", v);
+            // In voxel coordinates (exact in binary: integer scales, half-integer centres).
+            let d = [0, 1, 2].map(|a| f64::from(v[a]) + 0.5 - (p.scale * centre[a] + p.translate[a]));
+            prop_assert_eq!(g, octahedron_rule(d, p.scale * f64::from(r) / 2.0), "voxel {:?}", v);
         }
     }
 }
