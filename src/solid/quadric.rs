@@ -227,7 +227,8 @@ struct Generator<const K: usize> {
 impl<const K: usize> Generator<K> {
     /// Visits the columns `lo..=hi` (axes 0 … K−2) in lexicographic order, skipping blocks that miss the solid.
     fn visit(&mut self, lo: [i64; K], hi: [i64; K]) {
-        if self.misses(&lo, &hi) {
+        let columns: i64 = (0..K - 1).map(|a| hi[a] - lo[a] + 1).product();
+        if columns > 16 && self.misses(&lo, &hi) {
             return;
         }
         match (0..K - 1).find(|&a| lo[a] < hi[a]) {
@@ -406,6 +407,38 @@ impl Quad {
 
     /// For `a > 0`: the integers `z` in `[lo, hi]` with `q(z) ≤ 0` (an interval), exactly.
     fn convex_interval(&self, lo: i64, hi: i64) -> Option<(i64, i64)> {
+        // Clearly no real root (the float discriminant is negative beyond its rounding error): q > 0.
+        let (a, b, c) = (self.a as f64, self.b as f64, self.c as f64);
+        let d = b * b - 4.0 * a * c;
+        if d < -1e-9 * (b * b + (4.0 * a * c).abs()) - 1.0 {
+            return None;
+        }
+        let (r1, r2) = float_roots(a, b, d);
+        let inside = |z: i64| self.at(z) <= 0;
+        // Fast path: the rounded float roots, confirmed exactly (by convexity, q ≤ 0 at both ends of an
+        // interval means on all of it; an end is the boundary when its outer neighbour is outside).
+        if r1.is_finite() && r2.is_finite() && r1 <= r2 {
+            let l = (r1.ceil().max(lo as f64).min(hi as f64)) as i64;
+            let h = (r2.floor().max(lo as f64).min(hi as f64)) as i64;
+            if l <= h && inside(l) && inside(h) {
+                let left = if l == lo || !inside(l - 1) {
+                    l
+                } else {
+                    first_true(lo, l, r1.ceil(), inside)
+                };
+                let right = if h == hi || !inside(h + 1) {
+                    h
+                } else {
+                    -first_true(-hi, -h, -r2.floor(), |z| inside(-z))
+                };
+                return Some((left, right));
+            }
+        }
+        self.convex_interval_exact(lo, hi, r1, r2)
+    }
+
+    /// The general path of [`Quad::convex_interval`]: from an exact integer minimiser.
+    fn convex_interval_exact(&self, lo: i64, hi: i64, r1: f64, r2: f64) -> Option<(i64, i64)> {
         // The integer minimiser over [lo, hi] is clamp(floor(−b / 2a)) or the next integer.
         let v = (-self.b).div_euclid(2 * self.a);
         let zm0 = i64::try_from(v.clamp(i128::from(lo), i128::from(hi))).ok()?;
@@ -417,7 +450,6 @@ impl Quad {
         if self.at(zm) > 0 {
             return None;
         }
-        let (r1, r2) = self.float_roots();
         let inside = |z: i64| self.at(z) <= 0;
         // Smallest z in [lo, zm] inside (inside is monotone false → true there); largest in [zm, hi].
         let left = first_true(lo, zm, r1.ceil(), inside);
@@ -445,18 +477,17 @@ impl Quad {
         };
         (l <= h).then_some((l as i64, h as i64))
     }
+}
 
-    fn float_roots(&self) -> (f64, f64) {
-        let (a, b, c) = (self.a as f64, self.b as f64, self.c as f64);
-        let d = b * b - 4.0 * a * c;
-        if d.is_nan() || d < 0.0 || !d.is_finite() {
-            let m = -b / (2.0 * a);
-            return (m, m);
-        }
-        let q = -0.5 * (b + b.signum() * d.sqrt());
-        let (x1, x2) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
-        (x1.min(x2), x1.max(x2))
+/// Float estimates of the roots of `a z² + b z + c` (with `a > 0`, discriminant `d`), in order; the vertex
+/// twice when there is no real root.
+fn float_roots(a: f64, b: f64, d: f64) -> (f64, f64) {
+    let m = -b / (2.0 * a);
+    if d.is_nan() || d < 0.0 || !d.is_finite() {
+        return (m, m);
     }
+    let h = d.sqrt() / (2.0 * a);
+    (m - h, m + h)
 }
 
 /// The smallest `z` in `[lo, hi]` with `p(z)`, where `p` is monotone (false … true) and `p(hi)` holds; `guess`
