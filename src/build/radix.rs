@@ -33,7 +33,7 @@ pub fn radix_sort(keys: &mut Vec<u64>, bits: u32, scratch: &mut Vec<u64>) {
         for &k in keys.iter() {
             counts[((k >> shift) & mask) as usize] += 1;
         }
-        if counts.iter().any(|&c| c == n) {
+        if counts.contains(&n) {
             continue; // every key has the same digit: this pass would not move anything
         }
         let mut sum = 0;
