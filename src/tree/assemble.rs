@@ -86,30 +86,75 @@ impl<const K: usize> KTree<K> {
             universe,
             levels: Vec::new(),
         };
-        emit::<K>(&mut out, universe.level(), 0, cells);
+        emit::<K, _>(&mut out, universe.level(), 0, cells);
+        out.finish()
+    }
+
+    /// Like [`KTree::from_sorted_morton`], with each cell packed as `Morton key << 5 | level` (needs
+    /// `K·L + 5 ≤ 64`); sorting such packed values sorts the cells.
+    pub fn from_sorted_packed(universe: Universe<K>, cells: &[u64]) -> KTree<K> {
+        debug_assert!(K as u32 * universe.level() + 5 <= 64);
+        let mut out = TreeAssembler::<K> {
+            universe,
+            levels: Vec::new(),
+        };
+        emit::<K, _>(&mut out, universe.level(), 0, cells);
         out.finish()
     }
 }
 
+/// A cell as the assembler sees it: a Morton key and a level.
+trait CellKey: Copy {
+    fn key(self) -> u64;
+    fn level(self) -> u32;
+}
+
+impl CellKey for (u64, u32) {
+    #[inline]
+    fn key(self) -> u64 {
+        self.0
+    }
+    #[inline]
+    fn level(self) -> u32 {
+        self.1
+    }
+}
+
+impl CellKey for u64 {
+    #[inline]
+    fn key(self) -> u64 {
+        self >> 5
+    }
+    #[inline]
+    fn level(self) -> u32 {
+        (self & 31) as u32
+    }
+}
+
 /// Emits, in pre-order, the subtree at `depth` that holds exactly `cells` (all inside this node).
-fn emit<const K: usize>(out: &mut TreeAssembler<K>, level: u32, depth: u32, cells: &[(u64, u32)]) {
+fn emit<const K: usize, C: CellKey>(
+    out: &mut TreeAssembler<K>,
+    level: u32,
+    depth: u32,
+    cells: &[C],
+) {
     match cells {
         [] => out.push(depth as usize, NodeState::Empty),
-        [(_, l)] if *l == depth => out.push(depth as usize, NodeState::Full),
+        [c] if c.level() == depth => out.push(depth as usize, NodeState::Full),
         _ => {
             out.push(depth as usize, NodeState::Partial);
             // The child code of a key at this depth is its K-bit digit number (level - depth - 1).
             let shift = (level - depth - 1) as usize * K;
-            let digit = |key: u64| ((key >> shift) as usize) & ((1 << K) - 1);
+            let digit = |c: &C| ((c.key() >> shift) as usize) & ((1 << K) - 1);
             let mut rest = cells;
             for code in 0..(1usize << K) {
                 let n = if rest.len() < 16 {
-                    rest.iter().take_while(|c| digit(c.0) == code).count()
+                    rest.iter().take_while(|c| digit(c) == code).count()
                 } else {
-                    rest.partition_point(|c| digit(c.0) <= code)
+                    rest.partition_point(|c| digit(c) <= code)
                 };
                 let (mine, tail) = rest.split_at(n);
-                emit::<K>(out, level, depth + 1, mine);
+                emit::<K, C>(out, level, depth + 1, mine);
                 rest = tail;
             }
             debug_assert!(rest.is_empty(), "cells not sorted or outside the node");
