@@ -142,7 +142,7 @@ fn emit_leaves<const K: usize, C: CellKey>(out: &mut TreeAssembler<K>, level: u3
     let k = K as u32;
     let end = 1u128 << (k * level);
     let mut pos = 0u128;
-    let mut leaf = |out: &mut TreeAssembler<K>, at: u128, depth: u32, state: NodeState| {
+    let leaf = |out: &mut TreeAssembler<K>, at: u128, depth: u32, state: NodeState| {
         // Open the partial ancestors whose first leaf this is: depths where `at` is aligned.
         let shallowest = if at == 0 {
             0
@@ -154,7 +154,7 @@ fn emit_leaves<const K: usize, C: CellKey>(out: &mut TreeAssembler<K>, level: u3
         }
         out.push(depth as usize, state);
     };
-    let mut fill = |out: &mut TreeAssembler<K>, from: u128, to: u128| {
+    let fill = |out: &mut TreeAssembler<K>, from: u128, to: u128| {
         let mut at = from;
         while at < to {
             let by_alignment = if at == 0 {
