@@ -2,12 +2,13 @@
 //! `results/<name>/` and returns a short report for the command line to print. Run them with
 //! `ktree repro [NAME]`.
 
+pub mod akman_franklin;
 pub mod default_object;
 
 use std::path::Path;
 
 /// The names accepted by [`run`], in the order `ktree repro all` runs them.
-pub const NAMES: &[&str] = &["default-object"];
+pub const NAMES: &[&str] = &["default-object", "akman-franklin"];
 
 /// Runs one reproduction, writing into `results` (the results directory); returns a report to print.
 ///
@@ -16,6 +17,7 @@ pub const NAMES: &[&str] = &["default-object"];
 pub fn run(name: &str, results: &Path) -> Result<String, String> {
     match name {
         "default-object" => default_object::run(results),
+        "akman-franklin" => akman_franklin::run(results),
         _ => Err(format!("no reproduction named '{name}'")),
     }
 }

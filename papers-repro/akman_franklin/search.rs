@@ -171,7 +171,7 @@ impl Family {
     }
 
     /// Per column (lexicographic), the smallest measure along z and where it is reached.
-    fn column_minima(&self) -> Vec<(Q, i64)> {
+    pub fn column_minima(&self) -> Vec<(Q, i64)> {
         let u = self.side();
         let mut out = Vec::with_capacity((u * u) as usize);
         for x in 0..u {
@@ -221,7 +221,10 @@ impl Family {
                         b = mid;
                     }
                 }
-                rays.push(crate::Ray::new([x as u32, y as u32, first as u32], a as u32 + 1));
+                rays.push(crate::Ray::new(
+                    [x as u32, y as u32, first as u32],
+                    a as u32 + 1,
+                ));
             }
         }
         RaySet::from_rays(self.level, rays).expect("inside the universe")
@@ -277,7 +280,11 @@ impl Family {
 /// Finds the parameter interval of `family` with exactly `want` rays, and stacks up to `cap` of its objects.
 pub fn search(family: &Family, want: usize, cap: usize) -> Option<Hit> {
     let column_minima = family.column_minima();
-    let mut minima: Vec<Q> = column_minima.iter().map(|m| m.0).filter(|q| q.den > 0).collect();
+    let mut minima: Vec<Q> = column_minima
+        .iter()
+        .map(|m| m.0)
+        .filter(|q| q.den > 0)
+        .collect();
     if minima.len() < want || want == 0 {
         return None;
     }
@@ -314,7 +321,10 @@ pub fn search(family: &Family, want: usize, cap: usize) -> Option<Hit> {
         let rays = family.rays(&column_minima, t);
         assert_eq!(rays.len(), want, "the search's ray count");
         if let Some(q) = family.quadric_rays(t) {
-            assert_eq!(q, rays, "the quadric pipeline and the exact measure disagree");
+            assert_eq!(
+                q, rays,
+                "the quadric pipeline and the exact measure disagree"
+            );
         }
         let c = stack(&rays).counts();
         stacked.push((t, c.full, c.empty, c.partial, rays.voxel_count()));
