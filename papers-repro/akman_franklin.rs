@@ -60,39 +60,37 @@ const CAP: usize = 24;
 
 fn families(claim: &str) -> Vec<Family> {
     let mut out = Vec::new();
-    let (shape, placements, levels): (
-        Shape,
-        Vec<(&'static str, fn(i64) -> [i64; 3])>,
-        std::ops::RangeInclusive<u32>,
-    ) = match claim {
-        "AF5" => (
-            Shape::Ball,
-            vec![
-                ("centre at a universe corner", |_| [0, 0, 0]),
-                ("centre at the corner voxel's centre", |_| [1, 1, 1]),
-            ],
-            5..=7,
-        ),
-        "AF6" => (
-            Shape::Paraboloid,
-            vec![
-                ("apex at the centre of the bottom face", |u| [u, u, 0]),
-                ("apex at a bottom corner", |_| [0, 0, 0]),
-            ],
-            5..=7,
-        ),
-        _ => (
-            Shape::Ball,
-            vec![
-                ("centred in the universe", |u| [u, u, u]),
-                ("centred on the voxel at the universe's middle", |u| {
-                    [u + 1, u + 1, u + 1]
-                }),
-                ("centre at a universe corner", |_| [0, 0, 0]),
-            ],
-            6..=8,
-        ),
-    };
+    type Placements = Vec<(&'static str, fn(i64) -> [i64; 3])>;
+    let (shape, placements, levels): (Shape, Placements, std::ops::RangeInclusive<u32>) =
+        match claim {
+            "AF5" => (
+                Shape::Ball,
+                vec![
+                    ("centre at a universe corner", |_| [0, 0, 0]),
+                    ("centre at the corner voxel's centre", |_| [1, 1, 1]),
+                ],
+                5..=7,
+            ),
+            "AF6" => (
+                Shape::Paraboloid,
+                vec![
+                    ("apex at the centre of the bottom face", |u| [u, u, 0]),
+                    ("apex at a bottom corner", |_| [0, 0, 0]),
+                ],
+                5..=7,
+            ),
+            _ => (
+                Shape::Ball,
+                vec![
+                    ("centred in the universe", |u| [u, u, u]),
+                    ("centred on the voxel at the universe's middle", |u| {
+                        [u + 1, u + 1, u + 1]
+                    }),
+                    ("centre at a universe corner", |_| [0, 0, 0]),
+                ],
+                6..=8,
+            ),
+        };
     for level in levels {
         for &(placement, centre) in &placements {
             for convention in Convention::ALL {
@@ -290,7 +288,7 @@ pub fn run(results: &Path) -> Result<String, String> {
             );
             for (i, &n) in nodes.iter().enumerate() {
                 let d = n.abs_diff(p.obels);
-                if best.as_ref().is_none_or(|b| d < b.0) {
+                if best.as_ref().map_or(true, |b| d < b.0) {
                     best = Some((d, hit.clone(), i));
                 }
             }

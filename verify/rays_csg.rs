@@ -16,12 +16,8 @@ fn max_level(k: usize) -> u32 {
 /// Random runs plus random boxes (so that columns share runs, touch and nest).
 fn runs<const K: usize>(level: u32) -> impl Strategy<Value = Vec<Ray<K>>> {
     let side = 1u32 << level;
-    let ray =
-        (prop::array::uniform::<_, K>(0..side), 1..=side).prop_map(move |(mut start, len)| {
-            let z1 = start[K - 1];
-            start[K - 1] = z1;
-            Ray::new(start, (z1 + len).min(side))
-        });
+    let ray = (prop::array::uniform::<_, K>(0..side), 1..=side)
+        .prop_map(move |(start, len)| Ray::new(start, (start[K - 1] + len).min(side)));
     let boxes = prop::collection::vec(prop::array::uniform::<_, K>((0..side, 1..=side)), 0..3)
         .prop_map(move |bs| {
             let mut out = Vec::new();

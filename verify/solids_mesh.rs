@@ -129,7 +129,7 @@ fn ties_follow_the_documented_rule() {
     // A box with faces through voxel centres: half-open [lo, hi) across x and y (vertical faces are
     // silhouettes: the moved column decides), closed along z.
     let got = rays_dense(&cube([1.5, 2.5, 0.5], [5.5, 3.5, 15.5]), level, &ID);
-    assert_eq!(got.iter().filter(|&&b| b).count(), 4 * 1 * 16);
+    assert_eq!(got.iter().filter(|&&b| b).count(), 4 * 16); // 4 × 1 × 16
     assert!(
         got[u.dense_index([1, 2, 0])]
             && got[u.dense_index([4, 2, 15])]
