@@ -6,8 +6,10 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod build;
+mod rays;
 mod repro;
 mod stats;
+mod voxelize;
 
 /// k-trees (bintrees, quadtrees, octrees, 4-D trees) from rays by stacking.
 #[derive(Debug, Parser)]
@@ -25,6 +27,10 @@ enum Command {
     Stats(stats::Args),
     /// Regenerate the paper reproductions into results/ (all of them by default).
     Repro(repro::Args),
+    /// An analytic solid (ball, ellipsoid, paraboloid, cylinder, cone, half-space, box, quadric) to rays.
+    Rays(rays::Args),
+    /// A triangle mesh (OBJ, STL, PLY) or a volume (raw + JSON, NIfTI) to rays or a .ktree.
+    Voxelize(voxelize::Args),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +39,8 @@ fn main() -> ExitCode {
         Command::Build(args) => build::run(args),
         Command::Stats(args) => stats::run(args),
         Command::Repro(args) => repro::run(args),
+        Command::Rays(args) => rays::run(args),
+        Command::Voxelize(args) => voxelize::run(args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
