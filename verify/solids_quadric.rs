@@ -200,3 +200,22 @@ fn bad_parameters_are_errors() {
     .unwrap();
     assert!(big.to_rays(20, Sample::Centre, false).is_err());
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// Parameters with large denominators give matrices too large for the 64-bit fast path: the 128-bit
+    /// path must agree with the brute force too.
+    #[test]
+    fn large_coefficients_k3(c in prop::array::uniform3(-3_000_000i64..20_000_000), r in 1_000_000i64..12_000_000,
+                             k in 0usize..3, s in sample()) {
+        let d = 1_000_003;
+        let centre = c.map(|x| Rational::new(x, d).unwrap());
+        let radius = Rational::new(r, d).unwrap();
+        let q = match k {
+            0 => Quadric::<3>::ball(centre, radius, Frame::Voxel),
+            1 => Quadric::<3>::cone(2, centre, radius, Rational::new(r / 2 + 1, d).unwrap(), Frame::Voxel),
+            _ => Quadric::<3>::paraboloid(centre, radius, Rational::new(3 * r, d).unwrap(), Frame::Voxel),
+        };
+        agrees(&Solid::Quadric(q.unwrap()), 4, s)?;
+    }
+}

@@ -306,40 +306,20 @@ impl<const K: usize> Generator<K> {
             c: az * s * s + bz * s + cz,
         };
         let (lo, hi) = (0i64, self.side - 1);
-        let mut found = [(0i64, 0i64); 2];
-        let mut n = 0;
-        if q.a > 0 {
-            if let Some(r) = q.convex_interval(lo, hi) {
-                found[0] = r;
-                n = 1;
+        // Small coefficients (the usual case) are solved in i64: |q(z)| < 2^62 for |z| ≤ 2^21 + 1.
+        let fits = q.a.unsigned_abs() < 1 << 16
+            && q.b.unsigned_abs() < 1 << 37
+            && q.c.unsigned_abs() < 1 << 60;
+        let (found, n) = if fits {
+            Quad64 {
+                a: q.a as i64,
+                b: q.b as i64,
+                c: q.c as i64,
             }
-        } else if q.a < 0 {
-            // Inside = [lo, hi] minus where q ≥ 1, which is where the convex −q + 1 ≤ 0.
-            let p = Quad {
-                a: -q.a,
-                b: -q.b,
-                c: 1 - q.c,
-            };
-            match p.convex_interval(lo, hi) {
-                None => {
-                    found[0] = (lo, hi);
-                    n = 1;
-                }
-                Some((pl, ph)) => {
-                    if pl > lo {
-                        found[n] = (lo, pl - 1);
-                        n += 1;
-                    }
-                    if ph < hi {
-                        found[n] = (ph + 1, hi);
-                        n += 1;
-                    }
-                }
-            }
-        } else if let Some(r) = q.linear_interval(lo, hi) {
-            found[0] = r;
-            n = 1;
-        }
+            .runs(lo, hi)
+        } else {
+            q.runs(lo, hi)
+        };
         if n == 0 {
             return;
         }
@@ -391,93 +371,145 @@ impl<const K: usize> Generator<K> {
     }
 }
 
-/// An integer quadratic `a z² + b z + c`.
-#[derive(Debug, Clone, Copy)]
-struct Quad {
-    a: i128,
-    b: i128,
-    c: i128,
-}
-
-impl Quad {
-    fn at(&self, z: i64) -> i128 {
-        let z = i128::from(z);
-        (self.a * z + self.b) * z + self.c
-    }
-
-    /// For `a > 0`: the integers `z` in `[lo, hi]` with `q(z) ≤ 0` (an interval), exactly.
-    fn convex_interval(&self, lo: i64, hi: i64) -> Option<(i64, i64)> {
-        // Clearly no real root (the float discriminant is negative beyond its rounding error): q > 0.
-        let (a, b, c) = (self.a as f64, self.b as f64, self.c as f64);
-        let d = b * b - 4.0 * a * c;
-        if d < -1e-9 * (b * b + (4.0 * a * c).abs()) - 1.0 {
-            return None;
+macro_rules! quadratic {
+    ($name:ident, $t:ty) => {
+        /// An integer quadratic `a z² + b z + c`.
+        #[derive(Debug, Clone, Copy)]
+        struct $name {
+            a: $t,
+            b: $t,
+            c: $t,
         }
-        let (r1, r2) = float_roots(a, b, d);
-        let inside = |z: i64| self.at(z) <= 0;
-        // Fast path: the rounded float roots, confirmed exactly (by convexity, q ≤ 0 at both ends of an
-        // interval means on all of it; an end is the boundary when its outer neighbour is outside).
-        if r1.is_finite() && r2.is_finite() && r1 <= r2 {
-            let l = (r1.ceil().max(lo as f64).min(hi as f64)) as i64;
-            let h = (r2.floor().max(lo as f64).min(hi as f64)) as i64;
-            if l <= h && inside(l) && inside(h) {
-                let left = if l == lo || !inside(l - 1) {
-                    l
-                } else {
-                    first_true(lo, l, r1.ceil(), inside)
-                };
-                let right = if h == hi || !inside(h + 1) {
-                    h
-                } else {
-                    -first_true(-hi, -h, -r2.floor(), |z| inside(-z))
-                };
-                return Some((left, right));
+
+        impl $name {
+            fn at(&self, z: i64) -> $t {
+                let z = z as $t;
+                (self.a * z + self.b) * z + self.c
             }
-        }
-        self.convex_interval_exact(lo, hi, r1, r2)
-    }
 
-    /// The general path of [`Quad::convex_interval`]: from an exact integer minimiser.
-    fn convex_interval_exact(&self, lo: i64, hi: i64, r1: f64, r2: f64) -> Option<(i64, i64)> {
-        // The integer minimiser over [lo, hi] is clamp(floor(−b / 2a)) or the next integer.
-        let v = (-self.b).div_euclid(2 * self.a);
-        let zm0 = i64::try_from(v.clamp(i128::from(lo), i128::from(hi))).ok()?;
-        let zm = if zm0 < hi && self.at(zm0 + 1) < self.at(zm0) {
-            zm0 + 1
-        } else {
-            zm0
-        };
-        if self.at(zm) > 0 {
-            return None;
-        }
-        let inside = |z: i64| self.at(z) <= 0;
-        // Smallest z in [lo, zm] inside (inside is monotone false → true there); largest in [zm, hi].
-        let left = first_true(lo, zm, r1.ceil(), inside);
-        let right = -first_true(-hi, -zm, -r2.floor(), |z| inside(-z));
-        Some((left, right))
-    }
-
-    /// For `a = 0`: the integers in `[lo, hi]` with `b z + c ≤ 0`.
-    fn linear_interval(&self, lo: i64, hi: i64) -> Option<(i64, i64)> {
-        let (lo128, hi128) = (i128::from(lo), i128::from(hi));
-        let (l, h) = match self.b.signum() {
-            0 => {
-                if self.c <= 0 {
-                    (lo128, hi128)
-                } else {
+            /// For `a > 0`: the integers `z` in `[lo, hi]` with `q(z) ≤ 0` (an interval), exactly.
+            fn convex_interval(&self, lo: i64, hi: i64) -> Option<(i64, i64)> {
+                // Clearly no real root (the float discriminant is negative beyond its rounding error): q > 0.
+                let (a, b, c) = (self.a as f64, self.b as f64, self.c as f64);
+                let d = b * b - 4.0 * a * c;
+                if d < -1e-9 * (b * b + (4.0 * a * c).abs()) - 1.0 {
                     return None;
                 }
+                let (r1, r2) = float_roots(a, b, d);
+                let inside = |z: i64| self.at(z) <= 0;
+                // Fast path: the rounded float roots, confirmed exactly (by convexity, q ≤ 0 at both ends of an
+                // interval means on all of it; an end is the boundary when its outer neighbour is outside).
+                if r1.is_finite() && r2.is_finite() && r1 <= r2 {
+                    let l = (r1.ceil().max(lo as f64).min(hi as f64)) as i64;
+                    let h = (r2.floor().max(lo as f64).min(hi as f64)) as i64;
+                    if l <= h && inside(l) && inside(h) {
+                        let left = if l == lo || !inside(l - 1) {
+                            l
+                        } else {
+                            first_true(lo, l, r1.ceil(), inside)
+                        };
+                        let right = if h == hi || !inside(h + 1) {
+                            h
+                        } else {
+                            -first_true(-hi, -h, -r2.floor(), |z| inside(-z))
+                        };
+                        return Some((left, right));
+                    }
+                }
+                self.convex_interval_exact(lo, hi, r1, r2)
             }
-            1 => (lo128, (-self.c).div_euclid(self.b).min(hi128)),
-            _ => {
-                // z ≥ −c / b with b < 0: z ≥ ceil(c / −b).
-                let d = -self.b;
-                ((self.c + d - 1).div_euclid(d).max(lo128), hi128)
+
+            /// The general path of [`Quad::convex_interval`]: from an exact integer minimiser.
+            fn convex_interval_exact(
+                &self,
+                lo: i64,
+                hi: i64,
+                r1: f64,
+                r2: f64,
+            ) -> Option<(i64, i64)> {
+                // The integer minimiser over [lo, hi] is clamp(floor(−b / 2a)) or the next integer.
+                let v = (-self.b).div_euclid(2 * self.a);
+                let zm0 = i64::try_from(v.clamp(lo as $t, hi as $t)).ok()?;
+                let zm = if zm0 < hi && self.at(zm0 + 1) < self.at(zm0) {
+                    zm0 + 1
+                } else {
+                    zm0
+                };
+                if self.at(zm) > 0 {
+                    return None;
+                }
+                let inside = |z: i64| self.at(z) <= 0;
+                // Smallest z in [lo, zm] inside (inside is monotone false → true there); largest in [zm, hi].
+                let left = first_true(lo, zm, r1.ceil(), inside);
+                let right = -first_true(-hi, -zm, -r2.floor(), |z| inside(-z));
+                Some((left, right))
             }
-        };
-        (l <= h).then_some((l as i64, h as i64))
-    }
+
+            /// For `a = 0`: the integers in `[lo, hi]` with `b z + c ≤ 0`.
+            fn linear_interval(&self, lo: i64, hi: i64) -> Option<(i64, i64)> {
+                let (lo128, hi128) = (lo as $t, hi as $t);
+                let (l, h) = match self.b.signum() {
+                    0 => {
+                        if self.c <= 0 {
+                            (lo128, hi128)
+                        } else {
+                            return None;
+                        }
+                    }
+                    1 => (lo128, (-self.c).div_euclid(self.b).min(hi128)),
+                    _ => {
+                        // z ≥ −c / b with b < 0: z ≥ ceil(c / −b).
+                        let d = -self.b;
+                        ((self.c + d - 1).div_euclid(d).max(lo128), hi128)
+                    }
+                };
+                (l <= h).then_some((l as i64, h as i64))
+            }
+
+            /// The runs (at most two) of integers `z` in `[lo, hi]` with `q(z) ≤ 0`.
+            fn runs(&self, lo: i64, hi: i64) -> ([(i64, i64); 2], usize) {
+                let mut found = [(0i64, 0i64); 2];
+                let mut n = 0;
+                if self.a > 0 {
+                    if let Some(r) = self.convex_interval(lo, hi) {
+                        found[0] = r;
+                        n = 1;
+                    }
+                } else if self.a < 0 {
+                    // Inside = [lo, hi] minus where q ≥ 1, which is where the convex −q + 1 ≤ 0.
+                    let p = Self {
+                        a: -self.a,
+                        b: -self.b,
+                        c: 1 - self.c,
+                    };
+                    match p.convex_interval(lo, hi) {
+                        None => {
+                            found[0] = (lo, hi);
+                            n = 1;
+                        }
+                        Some((pl, ph)) => {
+                            if pl > lo {
+                                found[n] = (lo, pl - 1);
+                                n += 1;
+                            }
+                            if ph < hi {
+                                found[n] = (ph + 1, hi);
+                                n += 1;
+                            }
+                        }
+                    }
+                } else if let Some(r) = self.linear_interval(lo, hi) {
+                    found[0] = r;
+                    n = 1;
+                }
+                (found, n)
+            }
+        }
+    };
 }
+
+quadratic!(Quad, i128);
+quadratic!(Quad64, i64);
 
 /// Float estimates of the roots of `a z² + b z + c` (with `a > 0`, discriminant `d`), in order; the vertex
 /// twice when there is no real root.
