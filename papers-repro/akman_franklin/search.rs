@@ -337,3 +337,63 @@ pub fn search(family: &Family, want: usize, cap: usize) -> Option<Hit> {
         stacked,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AF5 search at L = 5 finds the 1/8 sphere with exactly 833 rays, built alike through the exact
+    /// measure and the quadric module, and its tree counts are what stacking gives.
+    #[test]
+    fn af5_hit_at_level_5() {
+        let f = Family {
+            shape: Shape::Ball,
+            placement: "corner",
+            centre2: [0, 0, 0],
+            level: 5,
+            convention: Convention::Centre,
+        };
+        let hit = search(&f, 833, 8).expect("a hit");
+        assert!(hit.from.le(hit.to) && !hit.to.le(hit.from));
+        let t = hit.stacked[0].0;
+        let rays = f.rays(&f.column_minima(), t);
+        assert_eq!(rays.len(), 833);
+        assert_eq!(f.quadric_rays(t).expect("centre convention"), rays);
+        // Fewer rays just below the interval, more at its end.
+        let below = Q {
+            num: hit.from.num - 1,
+            den: 1,
+        };
+        assert!(f.rays(&f.column_minima(), below).len() < 833);
+        assert!(f.rays(&f.column_minima(), hit.to).len() > 833);
+        let c = stack(&rays).counts();
+        assert_eq!(
+            (c.full, c.empty, c.partial),
+            (hit.stacked[0].1, hit.stacked[0].2, hit.stacked[0].3)
+        );
+    }
+
+    #[test]
+    fn paraboloid_measures_match_the_quadric() {
+        for convention in [Convention::Centre, Convention::Corner] {
+            let f = Family {
+                shape: Shape::Paraboloid,
+                placement: "centre",
+                centre2: [16, 16, 0],
+                level: 4,
+                convention,
+            };
+            for t in [
+                Q { num: 7, den: 1 },
+                Q { num: 31, den: 3 },
+                Q { num: 2, den: 5 },
+            ] {
+                assert_eq!(
+                    f.quadric_rays(t).unwrap(),
+                    f.rays(&f.column_minima(), t),
+                    "{convention:?} {t:?}"
+                );
+            }
+        }
+    }
+}
