@@ -484,7 +484,7 @@ pub fn run(results: &Path) -> Result<String, String> {
 
     // AF12 / M1: nodes against boundary size.
     let mut af12_csv = String::from("k,level,radius,boundary,nodes\n");
-    let mut af12_md = String::from("# AF12 / M1: node count against boundary size\n\nBalls of radius 2U/5 centred in the universe (voxel centres), over a range of levels; boundary = perimeter 2πr (K = 2), surface 4πr² (K = 3), hypersurface 2π²r³ (K = 4), in voxel units. Least-squares line nodes = a·boundary + b.\n\n| K | levels | a (nodes per boundary unit) | b | R² |\n|---:|---|---:|---:|---:|\n");
+    let mut af12_md = String::from("# AF12 / M1: node count against boundary size\n\nBalls of radius 2U/5 centred in the universe (voxel centres), over a range of levels; boundary = perimeter 2πr (K = 2), surface 4πr² (K = 3), hypersurface 2π²r³ (K = 4), in voxel units. Least-squares line nodes = a·boundary + b (R² of that line); α is the slope on log-log axes over the upper half of the levels (nodes ∝ boundary^α; 1 means proportional, which the line's R² alone would not show since the largest points dominate it).\n\n| K | levels | a (nodes per boundary unit) | b | R² | α |\n|---:|---|---:|---:|---:|---:|\n");
     let mut r2s = Vec::new();
     for (k, levels) in [(2usize, 4..=11u32), (3, 3..=9), (4, 2..=6)] {
         let mut pts = Vec::new();
@@ -511,9 +511,12 @@ pub fn run(results: &Path) -> Result<String, String> {
         }
         let (a, b, r2) = fit(&pts);
         r2s.push(r2);
+        // The exponent of a power law nodes ∝ boundary^α (slope on log-log axes): 1 means proportional.
+        let logs: Vec<(f64, f64)> = pts.iter().map(|&(x, y)| (x.ln(), y.ln())).collect();
+        let (alpha, _, _) = fit(&logs[logs.len() / 2..]);
         let _ = writeln!(
             af12_md,
-            "| {k} | {}…{} | {a:.4} | {b:.1} | {r2:.6} |",
+            "| {k} | {}…{} | {a:.4} | {b:.1} | {r2:.6} | {alpha:.4} |",
             levels.start(),
             levels.end()
         );
@@ -536,7 +539,11 @@ pub fn run(results: &Path) -> Result<String, String> {
                     colour: 0,
                 },
                 Series {
-                    name: format!("fit {a:.3}·x + {b:.0}"),
+                    name: format!(
+                        "fit {a:.3}·x {} {:.0}",
+                        if b < 0.0 { "−" } else { "+" },
+                        b.abs()
+                    ),
                     points: vec![(0.0, b), (x1, a * x1 + b)],
                     line: true,
                     colour: 1,
