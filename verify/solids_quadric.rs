@@ -219,3 +219,22 @@ proptest! {
         agrees(&Solid::Quadric(q.unwrap()), 4, s)?;
     }
 }
+
+/// The general quadric ball and the core's direct ball generator (`rays::ball_rays`) agree.
+#[test]
+fn quadric_ball_equals_the_direct_generator() {
+    for (c2, r2, level) in [
+        ([16i64, 16, 16], 16i64, 4u32),
+        ([3, 40, 17], 23, 5),
+        ([-5, 9, 31], 30, 5),
+        ([64, 64, 64], 64, 6),
+    ] {
+        let centre = c2.map(|c| Rational::new(c, 2).unwrap());
+        let q = Quadric::<3>::ball(centre, Rational::new(r2, 2).unwrap(), Frame::Voxel).unwrap();
+        assert_eq!(
+            q.to_rays(level, Sample::Centre, false).unwrap(),
+            ktree::rays::ball_rays::<3>(level, c2, r2).unwrap(),
+            "{c2:?} {r2}"
+        );
+    }
+}

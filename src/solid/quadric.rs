@@ -13,8 +13,10 @@
 //!
 //! **Work.** Columns are visited by a lexicographic binary subdivision of the column box (axis 0 first) that
 //! discards a block of columns when a conservative lower bound of the form over the block is positive; a column
-//! that is visited solves its quadratic in `z` exactly: a column holds zero, one or two runs. No voxel is tested
-//! on its own.
+//! that is visited solves its quadratic in `z` exactly: a column holds zero, one or two runs. Blocks of at most
+//! 16 columns are not tested as a whole, so the columns visited are those meeting the solid plus a thin band
+//! around its projection. No voxel is tested on its own. The general version of the core's direct ball
+//! generator [`crate::rays::ball_rays`], which gives the same rays for a ball.
 
 use super::{rational::gcd_i128, Rational, SolidError};
 use crate::rays::{Normal, RaySet};
