@@ -17,6 +17,8 @@
 //! * [`build`]: [`build::stack`] (stacking) and the reference builders.
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
 //! * [`io`]: the ray text format and the `.ktree` file format.
+//! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
+//!   mass properties, complexity.
 //!
 //! # Example
 //! ```
@@ -33,6 +35,7 @@
 
 pub mod build;
 pub mod io;
+pub mod ops;
 pub mod rays;
 pub mod space;
 pub mod tree;
