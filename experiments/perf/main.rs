@@ -7,6 +7,7 @@
 
 mod build;
 mod measure;
+mod ops;
 
 use std::process::ExitCode;
 
@@ -17,6 +18,7 @@ fn main() -> ExitCode {
         let (area, case) = (&args[1], &args[2]);
         return match area.as_str() {
             "build" => measure::child(|| build::run_case(case)),
+            "ops" => measure::child(|| ops::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -31,7 +33,8 @@ fn main() -> ExitCode {
     for area in areas {
         let result = match area {
             "build" => build::report(),
-            other => Err(format!("unknown area '{other}' (known: build)")),
+            "ops" => ops::report(),
+            other => Err(format!("unknown area '{other}' (known: build, ops)")),
         };
         match result {
             Ok(path) => println!("wrote {path}"),
