@@ -33,7 +33,11 @@ pub fn cuboid(level: u32, lo: [u32; 3], hi: [u32; 3]) -> KTree<3> {
 fn sphere_and_box(level: u32) -> KTree<3> {
     let s = 1u32 << level;
     let ball = sphere(level, [0.5, 0.5, 0.5], 1.0 / 3.0);
-    let slab = cuboid(level, [s / 8, s * 3 / 8, s / 4], [s * 7 / 8, s * 5 / 8, s * 3 / 4]);
+    let slab = cuboid(
+        level,
+        [s / 8, s * 3 / 8, s / 4],
+        [s * 7 / 8, s * 5 / 8, s * 3 / 4],
+    );
     ops::union(&ball, &slab).expect("same level")
 }
 
@@ -62,8 +66,15 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
                 .find(|o| o.name() == what)
                 .expect("known op");
             let (a, b) = two_spheres(level);
-            facts.push(("input_nodes".into(), (a.node_count() + b.node_count()).to_string()));
-            best_of(repeats, || ops::boolean(&a, &b, op).unwrap(), |t| keep(t, &mut out_nodes))
+            facts.push((
+                "input_nodes".into(),
+                (a.node_count() + b.node_count()).to_string(),
+            ));
+            best_of(
+                repeats,
+                || ops::boolean(&a, &b, op).unwrap(),
+                |t| keep(t, &mut out_nodes),
+            )
         }
         "complement" => {
             let (a, _) = two_spheres(level);
@@ -75,24 +86,41 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             // Disjoint pair: no early exit, the worst case.
             let far = ops::translate(&b, [1 << (level - 1), 0, 0]);
             let small = ops::intersection(&a, &ops::complement(&far)).unwrap();
-            facts.push(("input_nodes".into(), (small.node_count() + far.node_count()).to_string()));
+            facts.push((
+                "input_nodes".into(),
+                (small.node_count() + far.node_count()).to_string(),
+            ));
             best_of(repeats, || ops::interferes(&small, &far).unwrap(), |_| {})
         }
         "rotate90" => {
             let (a, _) = two_spheres(level);
-            let q = AxisMap::<3>::quarter_turn(0, 1).unwrap().compose(&AxisMap::reflection(2).unwrap());
+            let q = AxisMap::<3>::quarter_turn(0, 1)
+                .unwrap()
+                .compose(&AxisMap::reflection(2).unwrap());
             facts.push(("input_nodes".into(), a.node_count().to_string()));
-            best_of(repeats, || ops::rotate_axes(&a, &q), |t| keep(t, &mut out_nodes))
+            best_of(
+                repeats,
+                || ops::rotate_axes(&a, &q),
+                |t| keep(t, &mut out_nodes),
+            )
         }
         "translate" => {
             let (_, b) = two_spheres(level);
             facts.push(("input_nodes".into(), b.node_count().to_string()));
-            best_of(1, || ops::translate(&b, [3, -5, 7]), |t| keep(t, &mut out_nodes))
+            best_of(
+                1,
+                || ops::translate(&b, [3, -5, 7]),
+                |t| keep(t, &mut out_nodes),
+            )
         }
         "scale" => {
             let (_, b) = two_spheres(level);
             facts.push(("input_nodes".into(), b.node_count().to_string()));
-            best_of(1, || ops::scale(&b, 2, 3).unwrap(), |t| keep(t, &mut out_nodes))
+            best_of(
+                1,
+                || ops::scale(&b, 2, 3).unwrap(),
+                |t| keep(t, &mut out_nodes),
+            )
         }
         "affine" => {
             let a = sphere_and_box(level);
@@ -101,7 +129,11 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             let m = Affine::rotation_about(0, 1, 30.0, c)
                 .unwrap()
                 .after(&Affine::rotation_about(1, 2, 20.0, c).unwrap());
-            best_of(1, || ops::transform(&a, &m).unwrap(), |t| keep(t, &mut out_nodes))
+            best_of(
+                1,
+                || ops::transform(&a, &m).unwrap(),
+                |t| keep(t, &mut out_nodes),
+            )
         }
         "mass" => {
             let (a, _) = two_spheres(level);
@@ -132,11 +164,23 @@ const CASES: &[(&str, u32, &str)] = &[
     ("diff", 10, "same pair"),
     ("xor", 10, "same pair"),
     ("complement", 10, "sphere r = U/2"),
-    ("interferes", 10, "sphere vs a disjoint sphere part (no early exit)"),
-    ("rotate90", 10, "sphere r = U/2, quarter turn + reflection by reordering"),
+    (
+        "interferes",
+        10,
+        "sphere vs a disjoint sphere part (no early exit)",
+    ),
+    (
+        "rotate90",
+        10,
+        "sphere r = U/2, quarter turn + reflection by reordering",
+    ),
     ("translate", 10, "sphere r = 0.45 U by (3, −5, 7), overlays"),
     ("scale", 10, "sphere r = 0.45 U by 2/3, overlays"),
-    ("affine", 9, "sphere-and-box, rotation 30° about z after 20° about x, overlays"),
+    (
+        "affine",
+        9,
+        "sphere-and-box, rotation 30° about z after 20° about x, overlays",
+    ),
     ("mass", 10, "sphere r = U/2: volume, centroid, inertia"),
     ("progressive", 10, "sphere r = U/2: progressive mass to 1 %"),
 ];

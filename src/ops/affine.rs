@@ -15,6 +15,8 @@
 //! halving; `f64` is the same idea with a 53-bit mantissa. To keep decisions exact regardless, cell boxes
 //! are widened by a bound on the rounding error and single voxels are decided by the very function the
 //! reference uses.
+// Matrix and per-axis code reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
 
 use super::overlay::{resample, Preimage};
 use super::OpsError;

@@ -1,6 +1,8 @@
 //! Meagher's complexity metric (§5, claim M9): the number of nodes, one value per level, and its
 //! normalisations — over placements of the object at sub-cell offsets, and over a set of rotations (or any
 //! maps): the node count as a function of the placement, with its minimum, mean and maximum.
+// Matrix and per-axis code reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
 
 use super::affine::{transform, Affine};
 use super::translate::translate;

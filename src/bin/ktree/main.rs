@@ -6,8 +6,12 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod build;
+mod collide;
+mod mass;
+mod op;
 mod repro;
 mod stats;
+mod transform;
 
 /// k-trees (bintrees, quadtrees, octrees, 4-D trees) from rays by stacking.
 #[derive(Debug, Parser)]
@@ -23,6 +27,14 @@ enum Command {
     Build(build::Args),
     /// Print node counts (K, L, rays, full, empty, partial, nodes, per level) of a tree or a ray file.
     Stats(stats::Args),
+    /// Boolean operation on tree files: union, intersect, diff, xor (two inputs) or not (one).
+    Op(op::Args),
+    /// Translate, rotate, scale or apply a matrix to a tree file.
+    Transform(transform::Args),
+    /// Interference detection: do two tree files overlap, where, and (with --time-axis) when first.
+    Collide(collide::Args),
+    /// Volume, centroid, second moments; with --tolerance, Meagher's progressive bounds.
+    Mass(mass::Args),
     /// Regenerate the paper reproductions into results/ (all of them by default).
     Repro(repro::Args),
 }
@@ -32,6 +44,10 @@ fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Build(args) => build::run(args),
         Command::Stats(args) => stats::run(args),
+        Command::Op(args) => op::run(args),
+        Command::Transform(args) => transform::run(args),
+        Command::Collide(args) => collide::run(args),
+        Command::Mass(args) => mass::run(args),
         Command::Repro(args) => repro::run(args),
     };
     match outcome {
