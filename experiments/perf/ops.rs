@@ -207,7 +207,10 @@ pub fn report() -> Result<String, String> {
         let input: f64 = m.fact("input_nodes").parse().unwrap_or(f64::NAN);
         let output: f64 = m.fact("output_nodes").parse().unwrap_or(0.0);
         let (out_nodes, out_rate) = if output > 0.0 {
-            (m.fact("output_nodes").to_string(), format!("{:.1}", output / m.seconds / 1e6))
+            (
+                m.fact("output_nodes").to_string(),
+                format!("{:.1}", output / m.seconds / 1e6),
+            )
         } else {
             ("— (not a tree)".to_string(), "—".to_string())
         };
