@@ -113,6 +113,46 @@ fn check_first_contact<const K: usize>(a: &Obj<K>, b: &Obj<K>) -> Result<(), Tes
     Ok(())
 }
 
+/// Minimum separation against all pairs of voxel centres.
+fn check_separation<const K: usize>(a: &Obj<K>, b: &Obj<K>) -> Result<(), TestCaseError> {
+    let (da, db) = (a.dense(), b.dense());
+    let u = a.universe();
+    let pa: Vec<[u32; K]> = (0..da.len())
+        .filter(|&i| da[i])
+        .map(|i| u.dense_point(i))
+        .collect();
+    let pb: Vec<[u32; K]> = (0..db.len())
+        .filter(|&i| db[i])
+        .map(|i| u.dense_point(i))
+        .collect();
+    let mut best: Option<i64> = None;
+    for p in &pa {
+        for q in &pb {
+            let d: i64 = (0..K)
+                .map(|k| (i64::from(p[k]) - i64::from(q[k])).pow(2))
+                .sum();
+            best = Some(best.map_or(d, |b| b.min(d)));
+        }
+    }
+    let got = ops::min_separation(&a.tree(), &b.tree()).unwrap();
+    prop_assert_eq!(got, best.map(|d| (d as f64).sqrt()));
+    Ok(())
+}
+
+fn small_pair<const K: usize>() -> impl Strategy<Value = (Obj<K>, Obj<K>)> {
+    pair::<K>().prop_filter("few voxels for the all-pairs reference", |(a, _)| {
+        a.level <= 4
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+    #[test] fn separation_k1((a, b) in small_pair::<1>()) { check_separation(&a, &b)?; }
+    #[test] fn separation_k2((a, b) in small_pair::<2>()) { check_separation(&a, &b)?; }
+    #[test] fn separation_k3((a, b) in small_pair::<3>()) { check_separation(&a, &b)?; }
+    #[test] fn separation_k4((a, b) in small_pair::<4>()) { check_separation(&a, &b)?; }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
     #[test] fn mass_k1(a in object::<1>()) { check_mass(&a)?; }

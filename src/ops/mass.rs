@@ -149,7 +149,7 @@ pub struct ProgressiveMass<const K: usize> {
 ///
 /// ```
 /// use ktree::{build::stack, rays::ball_rays, ops::{mass_progressive, mass_properties}};
-/// let tree = stack(&ball_rays::<3>(6, [64, 64, 64], 60).unwrap());
+/// let tree = stack(&ball_rays::<3>(8, [256, 256, 256], 240).unwrap());
 /// let p = mass_progressive(&tree, 0.05);
 /// let exact = mass_properties(&tree).volume as f64;
 /// assert!(p.met && (p.estimate - exact).abs() <= 0.05 * exact);

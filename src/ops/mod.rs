@@ -26,6 +26,7 @@ mod mass;
 pub mod overlay;
 mod rotate;
 mod scale;
+mod separation;
 mod translate;
 
 pub use affine::{transform, Affine};
@@ -40,4 +41,5 @@ pub use interference::{first_contact, interferes, overlap_cells};
 pub use mass::{mass_progressive, mass_properties, LevelBounds, MassProperties, ProgressiveMass};
 pub use rotate::{rotate_axes, AxisMap};
 pub use scale::{grow, scale, zoom};
+pub use separation::min_separation;
 pub use translate::{fine_shift, translate, translate_fine};

@@ -1,4 +1,5 @@
-//! `ktree collide A B [--time-axis N] [--json]`: interference detection between two `.ktree` files.
+//! `ktree collide A B [--time-axis N] [--json]`: interference detection between two `.ktree` files, with
+//! the minimum separation when they do not overlap.
 
 use std::path::PathBuf;
 
@@ -32,6 +33,8 @@ struct Report {
     overlap_cells: usize,
     overlap_voxels: u128,
     first_contact: Option<u32>,
+    /// Smallest distance between voxel centres of the two objects (voxels); null if one is empty.
+    min_separation: Option<f64>,
 }
 
 fn report<const K: usize>(
@@ -45,7 +48,13 @@ fn report<const K: usize>(
         Some(axis) => ops::first_contact(a, b, axis).map_err(|e| e.to_string())?,
         None => None,
     };
+    let min_separation = if collide {
+        Some(0.0)
+    } else {
+        ops::min_separation(a, b).map_err(|e| e.to_string())?
+    };
     Ok(Report {
+        min_separation,
         collide,
         overlap_cells: overlap.full_cells().len(),
         overlap_voxels: overlap.voxel_count(),
@@ -67,6 +76,10 @@ pub fn run(args: Args) -> Result<(), String> {
     println!("collide        {}", if r.collide { "yes" } else { "no" });
     println!("overlap cells  {}", r.overlap_cells);
     println!("overlap voxels {}", r.overlap_voxels);
+    match r.min_separation {
+        Some(d) => println!("separation     {d} (between voxel centres)"),
+        None => println!("separation     - (an object is empty)"),
+    }
     if let Some(axis) = args.time_axis {
         match r.first_contact {
             Some(t) => println!("first contact  {t} (axis {axis})"),
