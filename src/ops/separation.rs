@@ -26,13 +26,7 @@ fn gap2<const K: usize>(a: &Cell<K>, b: &Cell<K>) -> u128 {
             u64::from(b.origin[i]),
             u64::from(b.origin[i]) + b.side() - 1,
         );
-        let g = if b0 > a1 {
-            b0 - a1
-        } else if a0 > b1 {
-            a0 - b1
-        } else {
-            0
-        };
+        let g = b0.saturating_sub(a1).max(a0.saturating_sub(b1));
         d += u128::from(g) * u128::from(g);
     }
     d
