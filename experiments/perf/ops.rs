@@ -240,9 +240,10 @@ pub fn report() -> Result<String, String> {
          output nodes per second (every output node is written once) is the conservative rate. The \
          complement flips 32 packed nodes per machine word and touches no structure. \
          `interferes` on a disjoint pair visits every overlapping pair of partial nodes (no early exit); \
-         on overlapping objects it stops at the first shared voxel. Translation and scaling use the general \
-         overlay engine (a node's overlay is refined per child), so they are slower per node than the \
-         Booleans."
+         on overlapping objects it stops at the first shared voxel. Translation uses Meagher's fixed overlay of 2^3 \
+         obels per target node (64 slot updates per node); scaling and affine maps use the general overlay \
+         engine (a target's overlay refined per child, cell boxes per node), so they are slower per node \
+         than the Booleans."
     );
     let path = results_path("ops");
     ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;

@@ -1,5 +1,5 @@
-//! The overlay engine shared by translation, scaling by other factors than powers of two, and arbitrary
-//! affine maps (Meagher §6: "overlays").
+//! The overlay engine shared by scaling by other factors than powers of two and arbitrary affine maps
+//! (Meagher §6: "overlays"; translation has its own fixed `2^K`-obel overlay in [`super::translate`]).
 //!
 //! The output tree is generated top-down. For each target cell the engine knows the source voxels the
 //! cell's voxel centres map back to — a box given by the map ([`Preimage::cell_box`], conservative: it may

@@ -1,28 +1,110 @@
 //! Translation by an integer vector with Meagher's overlays (§6 "Translation", claim M3), and by a vector
 //! given at a finer level.
 //!
-//! Each target obel is decided from the source obels of its own level that cover it — at most `2^K` of
-//! them, Meagher's overlay — refined level by level where they are partial; parts moved outside the
-//! universe are cut off (the "void"). Integer-only: additions, comparisons and shifts.
+//! Each target obel is decided from the source obels of its own level that cover it — exactly `2^K` of
+//! them, Meagher's overlay (Fig. 2–3): slot `c` of the overlay is the source cell `base + c` where `base`
+//! is the source cell holding the target's preimage corner. If every overlay obel the target meets is
+//! empty (or in the void beyond the universe) the target is empty; if all are full it is full; otherwise
+//! each of its `2^K` children gets its own overlay, made of children of the parent's overlay obels (or of
+//! the same leaves). Parts moved outside the universe are cut off. Integer-only: additions, comparisons,
+//! masks and shifts. The output is reduced (children are decided before they are pushed).
 
-use super::overlay::{resample, Preimage};
-use crate::tree::KTree;
+use super::emit::{collapse, Levels};
+use crate::tree::{KTree, NodeState};
 
-/// The preimage of an integer translation by `t`: target voxel `q` comes from source voxel `q − t`.
-struct Shift<const K: usize> {
-    t: [i64; K],
+/// One overlay obel: a source node (depth, index) or a leaf standing for all its descendants.
+#[derive(Clone, Copy)]
+enum Slot {
+    Leaf(NodeState),
+    Node(usize, usize),
 }
 
-impl<const K: usize> Preimage<K> for Shift<K> {
-    fn voxel(&self, q: [u32; K]) -> [i64; K] {
-        std::array::from_fn(|i| i64::from(q[i]) - self.t[i])
+struct Mover<'a, const K: usize> {
+    src: &'a KTree<K>,
+    t: [i64; K],
+    level: u32,
+    out: Levels,
+}
+
+impl<const K: usize> Mover<'_, K> {
+    fn state(&self, slot: Slot) -> NodeState {
+        match slot {
+            Slot::Leaf(s) => s,
+            Slot::Node(d, i) => self.src.state(d, i),
+        }
     }
 
-    fn cell_box(&self, origin: [u32; K], side: u64) -> [(i64, i64); K] {
-        std::array::from_fn(|i| {
-            let lo = i64::from(origin[i]) - self.t[i];
-            (lo, lo + side as i64 - 1)
-        })
+    /// Decides the target cell at `depth` with origin `origin`, given its overlay.
+    fn node(&mut self, depth: u32, origin: [i64; K], overlay: &[Slot; 16]) -> NodeState {
+        let log = self.level - depth;
+        // Offsets of the target's preimage inside the base cell, per axis.
+        let mask = (1i64 << log) - 1;
+        let mut meets_upper = 0usize; // bit i: the target reaches into the upper overlay obel on axis i
+        for i in 0..K {
+            if (origin[i] - self.t[i]) & mask != 0 {
+                meets_upper |= 1 << i;
+            }
+        }
+        let (mut empty, mut full, mut partial) = (false, false, false);
+        for (code, &slot) in overlay.iter().enumerate().take(1 << K) {
+            if code & !meets_upper != 0 {
+                continue;
+            }
+            match self.state(slot) {
+                NodeState::Empty => empty = true,
+                NodeState::Full => full = true,
+                NodeState::Partial => partial = true,
+            }
+        }
+        if !partial && !(empty && full) {
+            return if full {
+                NodeState::Full
+            } else {
+                NodeState::Empty
+            };
+        }
+        // Each overlay obel resolved once: a leaf, or the index of its first child one level down.
+        let mut resolved = [Slot::Leaf(NodeState::Empty); 16];
+        for (code, &slot) in overlay.iter().enumerate().take(1 << K) {
+            resolved[code] = match slot {
+                Slot::Leaf(s) => Slot::Leaf(s),
+                Slot::Node(d, i) => match self.src.state(d, i) {
+                    NodeState::Partial => Slot::Node(d + 1, self.src.first_child(d, i)),
+                    s => Slot::Leaf(s),
+                },
+            };
+        }
+        let half = 1i64 << (log - 1);
+        // X_i: the preimage corner in units of the children's side.
+        let x: [i64; K] = std::array::from_fn(|i| (origin[i] - self.t[i]) >> (log - 1));
+        let mut kids = [NodeState::Empty; 16];
+        for (c, kid) in kids.iter_mut().enumerate().take(1 << K) {
+            let child_origin: [i64; K] =
+                std::array::from_fn(|i| origin[i] + ((c >> i) as i64 & 1) * half);
+            let mut sub = [Slot::Leaf(NodeState::Empty); 16];
+            for (code, slot) in sub.iter_mut().enumerate().take(1 << K) {
+                let mut parent = 0usize;
+                let mut within = 0usize;
+                for i in 0..K {
+                    let cell = x[i] + ((c >> i) & 1) as i64 + ((code >> i) & 1) as i64;
+                    parent |= (((cell >> 1) - (x[i] >> 1)) as usize) << i;
+                    within |= ((cell & 1) as usize) << i;
+                }
+                *slot = match resolved[parent] {
+                    Slot::Node(d, first) => Slot::Node(d, first + within),
+                    leaf => leaf,
+                };
+            }
+            *kid = self.node(depth + 1, child_origin, &sub);
+        }
+        let kids = &kids[..1 << K];
+        match collapse(kids) {
+            Some(s) => s,
+            None => {
+                self.out.push_block(depth as usize + 1, kids);
+                NodeState::Partial
+            }
+        }
     }
 }
 
@@ -43,7 +125,23 @@ pub fn translate<const K: usize>(tree: &KTree<K>, t: [i64; K]) -> KTree<K> {
     if t.iter().any(|&v| v.abs() >= side) {
         return KTree::empty(tree.level()).expect("the tree's own level is valid");
     }
-    resample(tree, &Shift { t })
+    let level = tree.level();
+    let mut m = Mover {
+        src: tree,
+        t,
+        level,
+        out: Levels::new(level as usize + 1),
+    };
+    // The root's overlay: the source root sits in the slot whose cell index is 0 on every axis.
+    let base: [i64; K] = std::array::from_fn(|i| (-t[i]).div_euclid(side));
+    let mut overlay = [Slot::Leaf(NodeState::Empty); 16];
+    for (code, slot) in overlay.iter_mut().enumerate().take(1 << K) {
+        if (0..K).all(|i| base[i] + ((code >> i) & 1) as i64 == 0) {
+            *slot = Slot::Node(0, 0);
+        }
+    }
+    let root = m.node(0, [0; K], &overlay);
+    m.out.finish(tree.universe(), root)
 }
 
 /// The whole-voxel shift used for an offset of `t / 2^sub_level` voxels: the target voxel whose centre,
