@@ -40,8 +40,8 @@ impl<const K: usize> Mover<'_, K> {
         // Offsets of the target's preimage inside the base cell, per axis.
         let mask = (1i64 << log) - 1;
         let mut meets_upper = 0usize; // bit i: the target reaches into the upper overlay obel on axis i
-        for i in 0..K {
-            if (origin[i] - self.t[i]) & mask != 0 {
+        for (i, (&o, &t)) in origin.iter().zip(&self.t).enumerate() {
+            if (o - t) & mask != 0 {
                 meets_upper |= 1 << i;
             }
         }
@@ -56,7 +56,7 @@ impl<const K: usize> Mover<'_, K> {
                 NodeState::Partial => partial = true,
             }
         }
-        if !partial && !(empty && full) {
+        if !(partial || empty && full) {
             return if full {
                 NodeState::Full
             } else {
