@@ -85,9 +85,9 @@ impl<const K: usize> Mover<'_, K> {
             for (code, slot) in sub.iter_mut().enumerate().take(1 << K) {
                 let mut parent = 0usize;
                 let mut within = 0usize;
-                for i in 0..K {
-                    let cell = x[i] + ((c >> i) & 1) as i64 + ((code >> i) & 1) as i64;
-                    parent |= (((cell >> 1) - (x[i] >> 1)) as usize) << i;
+                for (i, &xi) in x.iter().enumerate() {
+                    let cell = xi + ((c >> i) & 1) as i64 + ((code >> i) & 1) as i64;
+                    parent |= (((cell >> 1) - (xi >> 1)) as usize) << i;
                     within |= ((cell & 1) as usize) << i;
                 }
                 *slot = match resolved[parent] {
