@@ -196,6 +196,26 @@ fn complexity_over_translations_counts_each_placement() {
 }
 
 #[test]
+fn placements_rebuild_the_object_at_each_offset() {
+    // A ball at the 2^3 half-voxel placements of its centre.
+    let n = ops::over_placements::<3, ops::OpsError>(2, |o| {
+        let c = [
+            20 + i64::from(o[0]),
+            20 + i64::from(o[1]),
+            20 + i64::from(o[2]),
+        ];
+        Ok(ktree::build::stack(
+            &ktree::rays::ball_rays::<3>(5, c, 13).expect("valid level"),
+        ))
+    })
+    .unwrap();
+    assert_eq!(n.counts.len(), 8);
+    let direct = ktree::build::stack(&ktree::rays::ball_rays::<3>(5, [21, 20, 21], 13).unwrap());
+    assert_eq!(n.counts[0b101], direct.node_count());
+    assert!(n.min <= n.max);
+}
+
+#[test]
 fn four_d_space_time_collision_matches_stepping_through_time() {
     // Two balls moving towards each other in a 16³ universe over 16 time steps, as 4-D trees (x, y, z, t).
     let level = 4;

@@ -210,15 +210,32 @@ pub fn complexity(out: &Out) -> Result<String, String> {
         md,
         "### Complexity metric and its normalisations (M9)\n\nUniverse 128³. Node count over the 4³ = 64 \
          placements at offsets 0…3 voxels per axis (after translating the object to touch the origin's faces), \
-         and over rotations about z by 0°, 5°, …, 90° about the universe's centre.\n\n| object | per-level \
-         counts (nodes at levels 0, 1, …) | placements min / mean / max | rotations min / mean / max |\n|---|---|---|---|"
+         over the 2³ sub-voxel placements (the solid re-digitized with its centre moved by half voxels), and \
+         over rotations about z by 0°, 5°, …, 90° about the universe's centre.\n\n| object | per-level \
+         counts (nodes at levels 0, 1, …) | whole-voxel placements min / mean / max | half-voxel placements \
+         min / mean / max | rotations min / mean / max |\n|---|---|---|---|---|"
     );
     let mut csv = String::from("object,angle_degrees,nodes\n");
     let mut series = Vec::new();
-    for (name, t) in [
-        ("sphere, radius 20", &sphere),
-        ("cube 24³, axis-aligned", &cube),
-    ] {
+    let bad = |m: String| ops::OpsError::BadParameter { reason: m };
+    let sphere_at = |o: [u32; 3]| -> Result<KTree<3>, ops::OpsError> {
+        let c = o.map(|v| 128 + i64::from(v));
+        Ok(stack(&ball_rays::<3>(l, c, 40).map_err(|x| bad(x.to_string()))?))
+    };
+    // The cube's voxels: centres (doubled) in [100 + o, 148 + o].
+    let cube_at = |o: [u32; 3]| -> Result<KTree<3>, ops::OpsError> {
+        let lo = o.map(|v| (100 + v) / 2);
+        let hi = o.map(|v| (148 + v - 1) / 2 + 1);
+        cuboid(l, lo, hi).map_err(bad)
+    };
+    let sub = [
+        ops::over_placements(2, sphere_at).map_err(e)?,
+        ops::over_placements(2, cube_at).map_err(e)?,
+    ];
+    for (k, (name, t)) in [("sphere, radius 20", &sphere), ("cube 24³, axis-aligned", &cube)]
+        .into_iter()
+        .enumerate()
+    {
         let per_level: Vec<String> = ops::complexity(t)
             .iter()
             .map(|c| c.nodes().to_string())
@@ -227,11 +244,14 @@ pub fn complexity(out: &Out) -> Result<String, String> {
         let rot = ops::over_maps(t, &maps).map_err(e)?;
         let _ = writeln!(
             md,
-            "| {name} | {} | {} / {:.0} / {} | {} / {:.0} / {} |",
+            "| {name} | {} | {} / {:.0} / {} | {} / {:.0} / {} | {} / {:.0} / {} |",
             per_level.join(", "),
             tr.min,
             tr.mean,
             tr.max,
+            sub[k].min,
+            sub[k].mean,
+            sub[k].max,
             rot.min,
             rot.mean,
             rot.max

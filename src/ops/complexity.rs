@@ -106,6 +106,35 @@ pub fn over_translations<const K: usize>(
     Ok(Normalised::from_counts(counts, clipped))
 }
 
+/// Node counts of an object built afresh at each sub-voxel placement: `build(offset)` is called for every
+/// offset in `[0, steps)^K` (axis 0 fastest), in whatever unit the builder uses — e.g. half voxels for
+/// [`crate::rays::ball_rays`]'s doubled coordinates, giving Meagher's `2^K` placements with `steps = 2`.
+/// Unlike [`over_translations`], this re-digitizes the solid, so it measures the metric's dependence on
+/// the object's exact position, not only on whole-voxel shifts.
+///
+/// # Errors
+/// The first error `build` returns; [`OpsError::BadParameter`] beyond 65 536 placements.
+pub fn over_placements<const K: usize, E: From<OpsError>>(
+    steps: u32,
+    mut build: impl FnMut([u32; K]) -> Result<KTree<K>, E>,
+) -> Result<Normalised, E> {
+    let n = u64::from(steps).pow(K as u32);
+    if n > 1 << 16 {
+        return Err(OpsError::BadParameter {
+            reason: format!("{steps}^{K} placements is too many (at most 2^16)"),
+        }
+        .into());
+    }
+    let mut counts = Vec::with_capacity(n as usize);
+    for i in 0..n {
+        let offset: [u32; K] = std::array::from_fn(|a| {
+            ((i / u64::from(steps).pow(a as u32)) % u64::from(steps)) as u32
+        });
+        counts.push(build(offset)?.node_count());
+    }
+    Ok(Normalised::from_counts(counts, 0))
+}
+
 /// Node counts of the object under each map (e.g. rotations at uniformly spread angles): the other
 /// normalisation Meagher proposes.
 ///

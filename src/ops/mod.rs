@@ -34,7 +34,8 @@ pub use boolean::{
     boolean, complement, difference, intersection, symmetric_difference, union, BoolOp,
 };
 pub use complexity::{
-    bounding_box, complexity, normalise_to_origin, over_maps, over_translations, Normalised,
+    bounding_box, complexity, normalise_to_origin, over_maps, over_placements, over_translations,
+    Normalised,
 };
 pub use error::OpsError;
 pub use interference::{first_contact, interferes, overlap_cells};
