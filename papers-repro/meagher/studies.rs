@@ -220,7 +220,9 @@ pub fn complexity(out: &Out) -> Result<String, String> {
     let bad = |m: String| ops::OpsError::BadParameter { reason: m };
     let sphere_at = |o: [u32; 3]| -> Result<KTree<3>, ops::OpsError> {
         let c = o.map(|v| 128 + i64::from(v));
-        Ok(stack(&ball_rays::<3>(l, c, 40).map_err(|x| bad(x.to_string()))?))
+        Ok(stack(
+            &ball_rays::<3>(l, c, 40).map_err(|x| bad(x.to_string()))?,
+        ))
     };
     // The cube's voxels: centres (doubled) in [100 + o, 148 + o].
     let cube_at = |o: [u32; 3]| -> Result<KTree<3>, ops::OpsError> {
@@ -232,9 +234,12 @@ pub fn complexity(out: &Out) -> Result<String, String> {
         ops::over_placements(2, sphere_at).map_err(e)?,
         ops::over_placements(2, cube_at).map_err(e)?,
     ];
-    for (k, (name, t)) in [("sphere, radius 20", &sphere), ("cube 24³, axis-aligned", &cube)]
-        .into_iter()
-        .enumerate()
+    for (k, (name, t)) in [
+        ("sphere, radius 20", &sphere),
+        ("cube 24³, axis-aligned", &cube),
+    ]
+    .into_iter()
+    .enumerate()
     {
         let per_level: Vec<String> = ops::complexity(t)
             .iter()

@@ -122,7 +122,7 @@ pub fn translate<const K: usize>(tree: &KTree<K>, t: [i64; K]) -> KTree<K> {
     if t.iter().all(|&v| v == 0) {
         return tree.clone();
     }
-    if t.iter().any(|&v| v.abs() >= side) {
+    if t.iter().any(|&v| v.unsigned_abs() >= side as u64) {
         return KTree::empty(tree.level()).expect("the tree's own level is valid");
     }
     let level = tree.level();
@@ -157,8 +157,9 @@ pub fn translate<const K: usize>(tree: &KTree<K>, t: [i64; K]) -> KTree<K> {
 /// ```
 pub fn fine_shift(t: i64, sub_level: u32) -> i64 {
     // Source voxel of target q: floor(q + ½ − t/2^s) = q + floor((2^s − 2t) / 2^(s+1)).
-    let s = 1i64 << sub_level;
-    -(s - 2 * t).div_euclid(2 * s)
+    let s = 1i128 << sub_level.min(120); // beyond 2^120 every i64 offset rounds to 0 or −1 alike
+    let shift = -(s - 2 * i128::from(t)).div_euclid(2 * s);
+    shift.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
 }
 
 /// Translates by a vector given at a finer level: `t[i] / 2^sub_level` voxels on axis `i`, applied as the
