@@ -12,12 +12,30 @@
 use super::emit::{collapse, Levels};
 use crate::tree::{KTree, NodeState};
 
-/// One overlay obel: a source node (depth, index) or a leaf standing for all its descendants.
-#[derive(Clone, Copy)]
-enum Slot {
-    Leaf(NodeState),
-    Node(usize, usize),
-}
+/// One overlay obel: the index of a source node at the target's depth (overlays stay on the target's
+/// level), or one of two markers for a leaf standing in for all its descendants.
+type Slot = usize;
+const EMPTY: Slot = usize::MAX;
+const FULL: Slot = usize::MAX - 1;
+
+/// `TERN[m]` = the bits of `m` read as base-3 digits (bit `i` → `3^i`); `TERN[1 << K]` = `3^K`.
+const TERN: [usize; 17] = {
+    let mut t = [0usize; 17];
+    let mut m = 0;
+    while m < 17 {
+        let (mut v, mut p, mut b) = (0, 1, 0);
+        while b < 5 {
+            if m >> b & 1 == 1 {
+                v += p;
+            }
+            p *= 3;
+            b += 1;
+        }
+        t[m] = v;
+        m += 1;
+    }
+    t
+};
 
 struct Mover<'a, const K: usize> {
     src: &'a KTree<K>,
@@ -27,10 +45,11 @@ struct Mover<'a, const K: usize> {
 }
 
 impl<const K: usize> Mover<'_, K> {
-    fn state(&self, slot: Slot) -> NodeState {
+    fn state(&self, depth: u32, slot: Slot) -> NodeState {
         match slot {
-            Slot::Leaf(s) => s,
-            Slot::Node(d, i) => self.src.state(d, i),
+            EMPTY => NodeState::Empty,
+            FULL => NodeState::Full,
+            i => self.src.state(depth as usize, i),
         }
     }
 
@@ -50,7 +69,7 @@ impl<const K: usize> Mover<'_, K> {
             if code & !meets_upper != 0 {
                 continue;
             }
-            match self.state(slot) {
+            match self.state(depth, slot) {
                 NodeState::Empty => empty = true,
                 NodeState::Full => full = true,
                 NodeState::Partial => partial = true,
@@ -64,36 +83,39 @@ impl<const K: usize> Mover<'_, K> {
             };
         }
         // Each overlay obel resolved once: a leaf, or the index of its first child one level down.
-        let mut resolved = [Slot::Leaf(NodeState::Empty); 16];
+        let mut resolved = [EMPTY; 16];
         for (code, &slot) in overlay.iter().enumerate().take(1 << K) {
-            resolved[code] = match slot {
-                Slot::Leaf(s) => Slot::Leaf(s),
-                Slot::Node(d, i) => match self.src.state(d, i) {
-                    NodeState::Partial => Slot::Node(d + 1, self.src.first_child(d, i)),
-                    s => Slot::Leaf(s),
-                },
+            resolved[code] = match self.state(depth, slot) {
+                NodeState::Partial => self.src.first_child(depth as usize, slot),
+                NodeState::Full => FULL,
+                NodeState::Empty => EMPTY,
             };
         }
         let half = 1i64 << (log - 1);
-        // X_i: the preimage corner in units of the children's side.
+        // X_i: the preimage corner in units of the children's side. All children's overlay obels lie in
+        // the 3^K grid of cells X + g (g_i = 0, 1, 2): resolve each grid cell once.
         let x: [i64; K] = std::array::from_fn(|i| (origin[i] - self.t[i]) >> (log - 1));
+        let mut grid = [EMPTY; 81];
+        for (g, cell_slot) in grid.iter_mut().enumerate().take(TERN[1 << K]) {
+            let (mut parent, mut within, mut rest) = (0usize, 0usize, g);
+            for (i, &xi) in x.iter().enumerate() {
+                let cell = xi + (rest % 3) as i64;
+                rest /= 3;
+                parent |= (((cell >> 1) - (xi >> 1)) as usize) << i;
+                within |= ((cell & 1) as usize) << i;
+            }
+            *cell_slot = match resolved[parent] {
+                leaf @ (EMPTY | FULL) => leaf,
+                first => first + within,
+            };
+        }
         let mut kids = [NodeState::Empty; 16];
         for (c, kid) in kids.iter_mut().enumerate().take(1 << K) {
             let child_origin: [i64; K] =
                 std::array::from_fn(|i| origin[i] + ((c >> i) as i64 & 1) * half);
-            let mut sub = [Slot::Leaf(NodeState::Empty); 16];
+            let mut sub = [EMPTY; 16];
             for (code, slot) in sub.iter_mut().enumerate().take(1 << K) {
-                let mut parent = 0usize;
-                let mut within = 0usize;
-                for (i, &xi) in x.iter().enumerate() {
-                    let cell = xi + ((c >> i) & 1) as i64 + ((code >> i) & 1) as i64;
-                    parent |= (((cell >> 1) - (xi >> 1)) as usize) << i;
-                    within |= ((cell & 1) as usize) << i;
-                }
-                *slot = match resolved[parent] {
-                    Slot::Node(d, first) => Slot::Node(d, first + within),
-                    leaf => leaf,
-                };
+                *slot = grid[TERN[c] + TERN[code]];
             }
             *kid = self.node(depth + 1, child_origin, &sub);
         }
@@ -134,10 +156,10 @@ pub fn translate<const K: usize>(tree: &KTree<K>, t: [i64; K]) -> KTree<K> {
     };
     // The root's overlay: the source root sits in the slot whose cell index is 0 on every axis.
     let base: [i64; K] = std::array::from_fn(|i| (-t[i]).div_euclid(side));
-    let mut overlay = [Slot::Leaf(NodeState::Empty); 16];
+    let mut overlay = [EMPTY; 16];
     for (code, slot) in overlay.iter_mut().enumerate().take(1 << K) {
         if (0..K).all(|i| base[i] + ((code >> i) & 1) as i64 == 0) {
-            *slot = Slot::Node(0, 0);
+            *slot = 0;
         }
     }
     let root = m.node(0, [0; K], &overlay);
