@@ -6,6 +6,17 @@
 //! that produces level order directly; none expands the object to voxels. Which ones are integer-only
 //! (Meagher's M8) is said in [`affine`]'s docs: all but the arbitrary affine map.
 //!
+//! | operation | functions | method | cost |
+//! |---|---|---|---|
+//! | Booleans (M2) | [`boolean`], [`union`], [`intersection`], [`difference`], [`symmetric_difference`], [`complement`] | simultaneous depth-first traversal; complement on packed words | linear in the nodes reached |
+//! | translation (M3) | [`translate`], [`translate_fine`] | fixed overlay of `2^K` obels per target node | linear in the output nodes |
+//! | scaling (M4) | [`grow`], [`zoom`] (by `2^n` through the root), [`scale`] (rational, overlays) | root levels; overlay engine | `O(n·2^K)` + copy; output-sensitive |
+//! | rotations, reflections (M5) | [`rotate_axes`] with any [`AxisMap`] (`K!·2^K` of them) | child reordering | linear |
+//! | arbitrary rotation, any affine map (M5, M6) | [`transform`] with an [`Affine`] | overlay engine, voxel-exact | output-sensitive |
+//! | interference (M14) | [`interferes`], [`overlap_cells`], [`first_contact`], [`min_separation`] | simultaneous traversal, early exit; branch and bound | at most linear |
+//! | mass (M10) | [`mass_properties`], [`mass_progressive`] | exact integer moment sums; level-by-level bounds | linear; stops early |
+//! | complexity (M9) | [`complexity`], [`over_translations`], [`over_placements`], [`over_maps`], [`bounding_box`], [`normalise_to_origin`] | node counts | one operation per placement |
+//!
 //! ```
 //! use ktree::{build::stack, rays::ball_rays, ops};
 //! let a = stack(&ball_rays::<3>(5, [24, 32, 32], 20).unwrap());
