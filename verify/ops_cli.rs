@@ -91,6 +91,13 @@ fn op_transform_collide_mass_agree_with_the_library() {
     assert!(ok, "{err}");
     assert_eq!(load3(&pc), ops::translate(&a, [2, 0, 0]));
 
+    // A projective matrix: Meagher's perspective deformation along z.
+    let p = ops::Projective::<3>::perspective(5, 2, 40.0).unwrap();
+    let text = "40,0,16,0,0,40,16,0,0,0,72,0,0,0,1,40";
+    let (ok, _, err) = ktree(&["transform", s(&pa), "--matrix", text, "--out", s(&pc)]);
+    assert!(ok, "{err}");
+    assert_eq!(load3(&pc), ops::transform_projective(&a, &p).unwrap());
+
     let (ok, out, _) = ktree(&["collide", s(&pa), s(&pb), "--json"]);
     assert!(ok);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();

@@ -135,6 +135,44 @@ fn check_rotation<const K: usize>(
     same(&out, a.level, &expect)
 }
 
+fn check_projective<const K: usize>(a: &Obj<K>, e: Vec<f64>) -> Result<(), TestCaseError> {
+    let (tree, dense) = (a.tree(), a.dense());
+    let u = (1u64 << a.level) as f64;
+    let n = K + 1;
+    let mut m = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            let id = if i == j { 1.0 } else { 0.0 };
+            m[i * n + j] = id
+                + if i == K && j < K {
+                    e[i * n + j] * 0.2 / u // mild projective row
+                } else if j == K && i < K {
+                    e[i * n + j] * u / 4.0
+                } else if i < K && j < K {
+                    e[i * n + j] * 0.5
+                } else {
+                    0.0
+                };
+        }
+    }
+    let p = ops::Projective::<K>::from_homogeneous(&m).unwrap();
+    let Ok(out) = ops::transform_projective(&tree, &p) else {
+        return Ok(()); // singular or sends part of the universe to infinity: rejected, fine
+    };
+    let inv = p.inverse().unwrap();
+    let expect = resample_dense::<K>(a.level, &dense, |q: [u32; K]| {
+        inv.source_voxel(q).unwrap_or([-1; K])
+    });
+    same(&out, a.level, &expect)?;
+    // An affine matrix through the projective path agrees with the affine path.
+    let r = Affine::rotation_about(0, K - 1, 37.0, Affine::<K>::universe_centre(a.level)).unwrap();
+    prop_assert_eq!(
+        ops::transform_projective(&tree, &ops::Projective::from_affine(&r)).unwrap(),
+        ops::transform(&tree, &r).unwrap()
+    );
+    Ok(())
+}
+
 fn check_scale<const K: usize>(a: &Obj<K>, num: u32, den: u32) -> Result<(), TestCaseError> {
     let (tree, dense) = (a.tree(), a.dense());
     let out = ops::scale(&tree, num, den).unwrap();
@@ -193,6 +231,10 @@ proptest! {
     #[test] fn rotation_k3(a in object::<3>(), d in -180f64..180.0, s in -3f64..3.0) { check_rotation(&a, d, s)?; }
     #[test] fn rotation_k4(a in object::<4>(), d in -180f64..180.0, s in -3f64..3.0) { check_rotation(&a, d, s)?; }
 
+    #[test] fn projective_k2(a in object::<2>(), e in prop::collection::vec(-1f64..1.0, 9)) { check_projective(&a, e)?; }
+    #[test] fn projective_k3(a in object::<3>(), e in prop::collection::vec(-1f64..1.0, 16)) { check_projective(&a, e)?; }
+    #[test] fn projective_k4(a in object::<4>(), e in prop::collection::vec(-1f64..1.0, 25)) { check_projective(&a, e)?; }
+
     #[test] fn scale_k1(a in object::<1>(), n in 1u32..6, d in 1u32..6) { check_scale(&a, n, d)?; }
     #[test] fn scale_k2(a in object::<2>(), n in 1u32..6, d in 1u32..6) { check_scale(&a, n, d)?; }
     #[test] fn scale_k3(a in object::<3>(), n in 1u32..6, d in 1u32..6) { check_scale(&a, n, d)?; }
@@ -226,6 +268,35 @@ fn hyperoctahedral_group_has_k_factorial_two_to_the_k_elements_and_is_closed() {
     group_laws::<2>();
     group_laws::<3>();
     group_laws::<4>();
+}
+
+#[test]
+fn perspective_shrinks_far_things_more_than_near_ones() {
+    // Two equal boxes side by side in x, one near (small z) and one far (large z).
+    let l = 6;
+    let u = Universe::<3>::new(l).unwrap();
+    let dense: Vec<bool> = (0..1usize << 18)
+        .map(|i| {
+            let p = u.dense_point(i);
+            let across = (24..40).contains(&p[0]) && (24..40).contains(&p[1]);
+            across && ((2..10).contains(&p[2]) || (50..58).contains(&p[2]))
+        })
+        .collect();
+    let t = KTree::<3>::from_dense(l, &dense).unwrap();
+    let p = ops::Projective::<3>::perspective(l, 2, 32.0).unwrap();
+    let out = ops::transform_projective(&t, &p).unwrap();
+    out.assert_well_formed();
+    let width = |zs: std::ops::Range<u32>| {
+        let xs: Vec<u32> = (0..1usize << 18)
+            .filter(|&i| out.contains(u.dense_point(i)) && zs.contains(&u.dense_point(i)[2]))
+            .map(|i| u.dense_point(i)[0])
+            .collect();
+        xs.iter().max().unwrap() - xs.iter().min().unwrap() + 1
+    };
+    let (near, far) = (width(0..32), width(32..64));
+    assert!(far < near, "near {near}, far {far}");
+    // Meagher's Y' = Y·d/(z + d): the far box (z ≈ 54) is shrunk to about 32/86 of 16.
+    assert!((4..=8).contains(&far), "far width {far}");
 }
 
 #[test]

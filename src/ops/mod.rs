@@ -13,6 +13,7 @@
 //! | scaling (M4) | [`grow`], [`zoom`] (by `2^n` through the root), [`scale`] (rational, overlays) | root levels; overlay engine | `O(n·2^K)` + copy; output-sensitive |
 //! | rotations, reflections (M5) | [`rotate_axes`] with any [`AxisMap`] (`K!·2^K` of them) | child reordering | linear |
 //! | arbitrary rotation, any affine map (M5, M6) | [`transform`] with an [`Affine`] | overlay engine, voxel-exact | output-sensitive |
+//! | perspective deformation (M6) | [`transform_projective`] with a [`Projective`] map, e.g. [`Projective::perspective`] | overlay engine, voxel-exact | output-sensitive |
 //! | interference (M14) | [`interferes`], [`overlap_cells`], [`first_contact`], [`min_separation`] | simultaneous traversal, early exit; branch and bound | at most linear |
 //! | mass (M10) | [`mass_properties`], [`mass_progressive`] | exact integer moment sums; level-by-level bounds | linear; stops early |
 //! | complexity (M9) | [`complexity`], [`over_translations`], [`over_placements`], [`over_maps`], [`bounding_box`], [`normalise_to_origin`] | node counts | one operation per placement |
@@ -35,6 +36,7 @@ mod error;
 mod interference;
 mod mass;
 pub mod overlay;
+mod perspective;
 mod rotate;
 mod scale;
 mod separation;
@@ -51,6 +53,7 @@ pub use complexity::{
 pub use error::OpsError;
 pub use interference::{first_contact, interferes, overlap_cells};
 pub use mass::{mass_progressive, mass_properties, LevelBounds, MassProperties, ProgressiveMass};
+pub use perspective::{transform_projective, Projective};
 pub use rotate::{rotate_axes, AxisMap};
 pub use scale::{grow, scale, zoom};
 pub use separation::min_separation;

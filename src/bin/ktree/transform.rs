@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 
-use ktree::ops::{self, Affine, AxisMap};
+use ktree::ops::{self, Affine, AxisMap, Projective};
 use ktree::KTree;
 
 use crate::op::{read, write};
@@ -28,7 +28,8 @@ pub struct Args {
     /// Uniform scale about the universe's origin corner: `P/Q` (exact) or a decimal number.
     #[arg(long)]
     scale: Option<String>,
-    /// A homogeneous (K+1)×(K+1) matrix, row-major, comma-separated, acting on column vectors [x; 1].
+    /// A homogeneous (K+1)×(K+1) matrix, row-major, comma-separated, acting on column vectors [x; 1]. A last
+    /// row other than 0 … 0 1 makes it projective (e.g. Meagher's perspective deformation).
     #[arg(long, allow_hyphen_values = true)]
     matrix: Option<String>,
     /// The tree file to write.
@@ -133,13 +134,22 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
         }
         None => None,
     };
-    let matrix = match &args.matrix {
+    // A matrix whose last row is not 0 … 0 1 is projective (e.g. a perspective deformation).
+    let (matrix, projective) = match &args.matrix {
         Some(m) => {
-            Some(Affine::<K>::from_homogeneous(&numbers("matrix", m)?).map_err(|e| e.to_string())?)
+            let v = numbers("matrix", m)?;
+            match Affine::<K>::from_homogeneous(&v) {
+                Ok(a) => (Some(a), None),
+                Err(_) => (
+                    None,
+                    Some(Projective::<K>::from_homogeneous(&v).map_err(|e| e.to_string())?),
+                ),
+            }
         }
-        None => None,
+        None => (None, None),
     };
     let exact = matrix.is_none()
+        && projective.is_none()
         && !matches!(scale_ratio, Some(None))
         && rotate.iter().all(|r| r.2 % 90.0 == 0.0)
         && translate
@@ -178,6 +188,10 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     }
     if let Some(x) = matrix {
         m = x.after(&m);
+    }
+    if let Some(p) = projective {
+        let all = p.after(&Projective::from_affine(&m));
+        return ops::transform_projective(tree, &all).map_err(|e| e.to_string());
     }
     ops::transform(tree, &m).map_err(|e| e.to_string())
 }
