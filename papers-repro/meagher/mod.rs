@@ -58,7 +58,7 @@ pub fn run(results: &Path) -> Result<String, String> {
          | M3 translation by overlays | checks, (d) | reproduced |\n\
          | M4 scaling through the root; other factors by overlays | checks; `ops::scale` | reproduced |\n\
          | M5 rotations/reflections by reordering; arbitrary angles by overlays | checks, (d) | reproduced (all 48 in 3-D; K!·2^K in any K) |\n\
-         | M6 concatenated matrices in one pass | checks | reproduced; perspective deformation not done |\n\
+         | M6 concatenated matrices in one pass; perspective by deformation | checks | reproduced |\n\
          | M7 hidden-surface display | (f) | not here: the display issue |\n\
          | M8 no floating point | checks | partly: all but arbitrary rotations/matrices are integer-only |\n\
          | M9 complexity metric | complexity | reproduced |\n\

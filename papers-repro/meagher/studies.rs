@@ -404,6 +404,28 @@ pub fn checks() -> Result<String, String> {
             obj.voxel_count()
         ),
     );
+    // M6, perspective: two equal cubes, near and far, deformed; their widths against Y' = Y·d/(z + d).
+    let l = 7;
+    let near = cuboid(l, [48, 48, 8], [80, 80, 24])?;
+    let far = cuboid(l, [48, 48, 100], [80, 80, 116])?;
+    let d = 64.0;
+    let p = ops::Projective::<3>::perspective(l, 2, d).map_err(e)?;
+    let width = |t: &KTree<3>| -> Result<u32, String> {
+        let out = ops::transform_projective(t, &p).map_err(e)?;
+        let bx = ops::bounding_box(&out).ok_or("a deformed cube vanished")?;
+        Ok(bx[0].1 - bx[0].0 + 1)
+    };
+    let (wn, wf) = (width(&near)?, width(&far)?);
+    let (en, ef) = (32.0 * d / (8.0 + d), 32.0 * d / (100.0 + d));
+    check(
+        "M6 (perspective)",
+        "two 32-voxel cubes at depths 8–24 and 100–116, deformed for a viewer 64 voxels before z = 0; width across",
+        wf < wn && (f64::from(wn) - en).abs() <= 1.5 && (f64::from(wf) - ef).abs() <= 1.5,
+        format!(
+            "(near {wn} voxels, far {wf}; Meagher's Y' = Y·d/(z + d) at the cubes' front faces, their widest \
+             part, gives {en:.1} and {ef:.1})"
+        ),
+    );
     let _ = writeln!(
         md,
         "| M8 | which operations are integer-only | Booleans, complement, reordering, translation, scaling by \
