@@ -152,3 +152,38 @@ fn bad_input_gives_a_one_line_error() {
     }
     assert!(!out.exists(), "no output written on error");
 }
+
+#[test]
+fn other_dimensions_work_through_the_cli() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = stack(&ball_rays::<2>(6, [50, 60], 30).unwrap());
+    let b = stack(&ball_rays::<2>(6, [70, 60], 24).unwrap());
+    let (pa, pb, pc) = (
+        dir.path().join("a.ktree"),
+        dir.path().join("b.ktree"),
+        dir.path().join("c.ktree"),
+    );
+    write_ktree_file(&pa, &a).unwrap();
+    write_ktree_file(&pb, &b).unwrap();
+    let load2 = |p: &Path| read_ktree_file(p).unwrap().into_dim::<2>().unwrap();
+    let (ok, _, err) = ktree(&["op", "diff", s(&pa), s(&pb), "--out", s(&pc)]);
+    assert!(ok, "{err}");
+    assert_eq!(load2(&pc), ops::difference(&a, &b).unwrap());
+    let (ok, _, err) = ktree(&["transform", s(&pa), "--rotate", "0-1:90", "--out", s(&pc)]);
+    assert!(ok, "{err}");
+    assert_eq!(
+        load2(&pc),
+        ops::rotate_axes(&a, &AxisMap::quarter_turn(0, 1).unwrap())
+    );
+    let (ok, _, err) = ktree(&["transform", s(&pa), "--rotate", "z:30", "--out", s(&pc)]);
+    assert!(!ok && err.contains("axis"), "named axes are for 3-D: {err}");
+    // A 4-D tree's mass.
+    let t4 = stack(&ball_rays::<4>(3, [8, 8, 8, 8], 6).unwrap());
+    let p4 = dir.path().join("t4.ktree");
+    write_ktree_file(&p4, &t4).unwrap();
+    let (ok, out, _) = ktree(&["mass", s(&p4), "--json"]);
+    assert!(ok);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["k"], 4);
+    assert_eq!(v["volume"].as_u64().unwrap() as u128, t4.voxel_count());
+}
