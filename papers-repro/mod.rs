@@ -4,11 +4,12 @@
 
 pub mod akman_franklin;
 pub mod default_object;
+pub mod meagher;
 
 use std::path::Path;
 
 /// The names accepted by [`run`], in the order `ktree repro all` runs them.
-pub const NAMES: &[&str] = &["default-object", "akman-franklin"];
+pub const NAMES: &[&str] = &["default-object", "akman-franklin", "meagher"];
 
 /// Runs one reproduction, writing into `results` (the results directory); returns a report to print.
 ///
@@ -18,6 +19,7 @@ pub fn run(name: &str, results: &Path) -> Result<String, String> {
     match name {
         "default-object" => default_object::run(results),
         "akman-franklin" => akman_franklin::run(results),
+        "meagher" => meagher::run(results),
         _ => Err(format!("no reproduction named '{name}'")),
     }
 }

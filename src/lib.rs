@@ -18,6 +18,8 @@
 //! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
 //! * [`io`]: the ray text format and the `.ktree` file format.
+//! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
+//!   mass properties, complexity.
 //!
 //! # Example
 //! ```
@@ -34,6 +36,7 @@
 
 pub mod build;
 pub mod io;
+pub mod ops;
 pub mod rays;
 pub mod solid;
 pub mod space;

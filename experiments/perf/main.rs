@@ -8,6 +8,7 @@
 mod build;
 mod measure;
 mod solids;
+mod ops;
 
 use std::process::ExitCode;
 
@@ -19,6 +20,7 @@ fn main() -> ExitCode {
         return match area.as_str() {
             "build" => measure::child(|| build::run_case(case)),
             "solids" => measure::child(|| solids::run_case(case)),
+            "ops" => measure::child(|| ops::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -34,7 +36,8 @@ fn main() -> ExitCode {
         let result = match area {
             "build" => build::report(),
             "solids" => solids::report(),
-            other => Err(format!("unknown area '{other}' (known: build)")),
+            "ops" => ops::report(),
+            other => Err(format!("unknown area '{other}' (known: build, solids, ops, display)")),
         };
         match result {
             Ok(path) => println!("wrote {path}"),

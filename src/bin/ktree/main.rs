@@ -10,6 +10,10 @@ mod rays;
 mod repro;
 mod stats;
 mod voxelize;
+mod collide;
+mod mass;
+mod op;
+mod transform;
 
 /// k-trees (bintrees, quadtrees, octrees, 4-D trees) from rays by stacking.
 #[derive(Debug, Parser)]
@@ -25,6 +29,14 @@ enum Command {
     Build(build::Args),
     /// Print node counts (K, L, rays, full, empty, partial, nodes, per level) of a tree or a ray file.
     Stats(stats::Args),
+    /// Boolean operation on tree files: union, intersect, diff, xor (two inputs) or not (one).
+    Op(op::Args),
+    /// Translate, rotate, scale or apply a matrix to a tree file.
+    Transform(transform::Args),
+    /// Interference detection: do two tree files overlap, where, and (with --time-axis) when first.
+    Collide(collide::Args),
+    /// Volume, centroid, second moments; with --tolerance, Meagher's progressive bounds.
+    Mass(mass::Args),
     /// Regenerate the paper reproductions into results/ (all of them by default).
     Repro(repro::Args),
     /// An analytic solid (ball, ellipsoid, paraboloid, cylinder, cone, half-space, box, quadric) to rays.
@@ -38,6 +50,10 @@ fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Build(args) => build::run(args),
         Command::Stats(args) => stats::run(args),
+        Command::Op(args) => op::run(args),
+        Command::Transform(args) => transform::run(args),
+        Command::Collide(args) => collide::run(args),
+        Command::Mass(args) => mass::run(args),
         Command::Repro(args) => repro::run(args),
         Command::Rays(args) => rays::run(args),
         Command::Voxelize(args) => voxelize::run(args),

@@ -1,0 +1,122 @@
+//! `ktree mass A [--tolerance t] [--json]`: volume, centroid and second moments of a `.ktree` file; with
+//! `--tolerance`, Meagher's progressive bounds level by level, stopping when the tolerance is met.
+
+use std::path::PathBuf;
+
+use ktree::ops;
+use ktree::KTree;
+use serde::Serialize;
+
+use crate::op::read;
+
+/// Arguments of `ktree mass`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The tree file.
+    tree: PathBuf,
+    /// Relative tolerance for the progressive computation: stop at the first level where
+    /// `upper − lower ≤ t · (upper + lower)/2`.
+    #[arg(long)]
+    tolerance: Option<f64>,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Debug, Serialize)]
+struct Level {
+    level: u32,
+    lower: u128,
+    upper: u128,
+    nodes_touched: u64,
+}
+
+#[derive(Debug, Serialize)]
+struct Report {
+    k: usize,
+    volume: u128,
+    centroid: Vec<f64>,
+    central_moments: Vec<Vec<f64>>,
+    inertia_tensor: Vec<Vec<f64>>,
+    nodes: u64,
+    progressive: Option<Vec<Level>>,
+    estimate: Option<f64>,
+}
+
+fn report<const K: usize>(t: &KTree<K>, tolerance: Option<f64>) -> Report {
+    let m = ops::mass_properties(t);
+    let progressive = tolerance.map(|tol| ops::mass_progressive(t, tol));
+    Report {
+        k: K,
+        volume: m.volume,
+        centroid: m.centroid.to_vec(),
+        central_moments: m.central_moments.iter().map(|r| r.to_vec()).collect(),
+        inertia_tensor: m.inertia_tensor().iter().map(|r| r.to_vec()).collect(),
+        nodes: t.node_count(),
+        estimate: progressive.as_ref().map(|p| p.estimate),
+        progressive: progressive.map(|p| {
+            p.levels
+                .iter()
+                .map(|l| Level {
+                    level: l.level,
+                    lower: l.lower,
+                    upper: l.upper,
+                    nodes_touched: l.nodes_touched,
+                })
+                .collect()
+        }),
+    }
+}
+
+/// Prints the mass properties.
+pub fn run(args: Args) -> Result<(), String> {
+    if let Some(t) = args.tolerance {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(format!("--tolerance must be a number ≥ 0, got {t}"));
+        }
+    }
+    let tree = read(&args.tree)?;
+    let r = ktree::with_dim!(&tree, AnyTree, t => report(t, args.tolerance));
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
+        );
+        return Ok(());
+    }
+    if let Some(levels) = &r.progressive {
+        println!("level        lower        upper  nodes touched");
+        for l in levels {
+            println!(
+                "{:>5} {:>12} {:>12} {:>14}",
+                l.level, l.lower, l.upper, l.nodes_touched
+            );
+        }
+        println!(
+            "estimate {:.1} (exact {}), {} of {} nodes touched",
+            r.estimate.unwrap_or(f64::NAN),
+            r.volume,
+            levels.last().map_or(0, |l| l.nodes_touched),
+            r.nodes
+        );
+        return Ok(());
+    }
+    println!("K         {}", r.k);
+    println!("volume    {} voxels", r.volume);
+    println!("centroid  {:?}", r.centroid);
+    let name = if r.k == 3 { "inertia   " } else { "moments   " };
+    let rows = if r.k == 3 {
+        &r.inertia_tensor
+    } else {
+        &r.central_moments
+    };
+    for (i, row) in rows.iter().enumerate() {
+        let cells: Vec<String> = row.iter().map(|v| format!("{v:.6e}")).collect();
+        println!(
+            "{}{}",
+            if i == 0 { name } else { "          " },
+            cells.join("  ")
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,90 @@
+//! `ktree op union|intersect|diff|xor A B --out C` and `ktree op not A --out B`: Boolean operations on
+//! `.ktree` files.
+
+use std::path::{Path, PathBuf};
+
+use ktree::io::{read_ktree_file, write_ktree_file, AnyTree};
+use ktree::ops::{self, BoolOp};
+use ktree::KTree;
+
+/// Arguments of `ktree op`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The operation: union, intersect, diff (A minus B), xor, or not (complement of A).
+    #[arg(value_parser = ["union", "intersect", "diff", "xor", "not"])]
+    operation: String,
+    /// The input tree files: two for union/intersect/diff/xor, one for not.
+    #[arg(required = true, num_args = 1..=2)]
+    inputs: Vec<PathBuf>,
+    /// The tree file to write.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Reads a tree file, with the path in any error.
+pub fn read(path: &Path) -> Result<AnyTree, String> {
+    read_ktree_file(path).map_err(|e| e.to_string())
+}
+
+/// Writes a tree file and prints a one-line summary.
+pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> Result<(), String> {
+    write_ktree_file(path, tree).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    let c = tree.counts();
+    println!(
+        "{}: K = {K}, L = {}, {} nodes ({} full, {} empty, {} partial), {} voxels",
+        path.display(),
+        tree.level(),
+        c.nodes(),
+        c.full,
+        c.empty,
+        c.partial,
+        tree.voxel_count()
+    );
+    Ok(())
+}
+
+/// Pairs two trees of the same dimension, or explains the mismatch.
+macro_rules! with_pair {
+    ($a:expr, $b:expr, $names:expr, ($x:ident, $y:ident) => $body:expr) => {
+        match ($a, $b) {
+            (AnyTree::K1($x), AnyTree::K1($y)) => $body,
+            (AnyTree::K2($x), AnyTree::K2($y)) => $body,
+            (AnyTree::K3($x), AnyTree::K3($y)) => $body,
+            (AnyTree::K4($x), AnyTree::K4($y)) => $body,
+            (x, y) => Err(format!(
+                "{} is a K = {} tree but {} is K = {}: both must have the same dimension",
+                $names.0.display(),
+                x.k(),
+                $names.1.display(),
+                y.k()
+            )),
+        }
+    };
+}
+pub(crate) use with_pair;
+
+/// Runs the operation and writes the result.
+pub fn run(args: Args) -> Result<(), String> {
+    if args.operation == "not" {
+        let [a] = args.inputs.as_slice() else {
+            return Err("`ktree op not` takes exactly one input tree".into());
+        };
+        let tree = read(a)?;
+        return ktree::with_dim!(&tree, AnyTree, t => write(&args.out, &ops::complement(t)));
+    }
+    let [a, b] = args.inputs.as_slice() else {
+        return Err(format!(
+            "`ktree op {}` takes exactly two input trees",
+            args.operation
+        ));
+    };
+    let op = BoolOp::ALL
+        .into_iter()
+        .find(|o| o.name() == args.operation)
+        .ok_or_else(|| format!("unknown operation {}", args.operation))?;
+    let (ta, tb) = (read(a)?, read(b)?);
+    with_pair!(&ta, &tb, (a, b), (x, y) => {
+        let out = ops::boolean(x, y, op).map_err(|e| format!("{} and {}: {e}", a.display(), b.display()))?;
+        write(&args.out, &out)
+    })
+}

@@ -1,0 +1,172 @@
+//! The overlay engine shared by scaling by other factors than powers of two and arbitrary affine maps
+//! (Meagher §6: "overlays"; translation has its own fixed `2^K`-obel overlay in [`super::translate`]).
+//!
+//! The output tree is generated top-down. For each target cell the engine knows the source voxels the
+//! cell's voxel centres map back to — a box given by the map ([`Preimage::cell_box`], conservative: it may
+//! be larger, never smaller) — and carries down from the parent the *overlay*: the few source nodes that
+//! meet the box, refined until they are no larger than the box. If every overlay obel meeting the box is
+//! empty (or outside the universe — Meagher's void) the target is empty; if all are full it is full;
+//! otherwise the target is partial and its `2^K` children are decided the same way, each refining its
+//! parent's overlay. At the voxel level the decision is exact: the voxel's centre is mapped back
+//! ([`Preimage::voxel`]) and the source voxel containing it looked up. So the output equals the brute-force
+//! resampling of every voxel centre, while the work follows the output's nodes, not its voxels.
+//!
+//! Children are decided before they are pushed, so the output is reduced.
+
+use super::emit::{collapse, leaf, Levels};
+use crate::space::Cell;
+use crate::tree::{KTree, NodeState};
+
+/// How target voxels map back into the source universe.
+pub trait Preimage<const K: usize> {
+    /// The source voxel whose cell contains the preimage of the centre of target voxel `q` (coordinates
+    /// may lie outside the source universe: those voxels are empty).
+    fn voxel(&self, q: [u32; K]) -> [i64; K];
+
+    /// Inclusive bounds `(lo, hi)` per axis of source voxels containing the preimages of all voxel centres
+    /// of the target cell at `origin` with side `side`. May be conservative (larger).
+    fn cell_box(&self, origin: [u32; K], side: u64) -> [(i64, i64); K];
+}
+
+#[derive(Clone, Copy)]
+struct Entry<const K: usize> {
+    depth: usize,
+    index: usize,
+    cell: Cell<K>,
+}
+
+struct Engine<'a, const K: usize, P> {
+    src: &'a KTree<K>,
+    map: &'a P,
+    side: i64,
+    out: Levels,
+    overlay: Vec<Entry<K>>,
+}
+
+fn meets<const K: usize>(cell: &Cell<K>, bx: &[(i64, i64); K]) -> bool {
+    let side = cell.side() as i64;
+    (0..K).all(|i| {
+        let o = i64::from(cell.origin[i]);
+        o <= bx[i].1 && o + side > bx[i].0
+    })
+}
+
+impl<const K: usize, P: Preimage<K>> Engine<'_, K, P> {
+    /// Adds `e` (meeting `bx`) to the overlay, partial nodes refined to nodes no larger than `extent`;
+    /// leaves set `seen` (`[empty, full]`); returns the number of partial nodes added.
+    fn refine(
+        &mut self,
+        e: Entry<K>,
+        bx: &[(i64, i64); K],
+        extent: i64,
+        seen: &mut [bool; 2],
+    ) -> usize {
+        match self.src.state(e.depth, e.index) {
+            NodeState::Empty => {
+                seen[0] = true;
+                self.overlay.push(e);
+                0
+            }
+            NodeState::Full => {
+                seen[1] = true;
+                self.overlay.push(e);
+                0
+            }
+            NodeState::Partial => {
+                if (e.cell.side() as i64) <= extent {
+                    self.overlay.push(e);
+                    return 1;
+                }
+                let mut partial = 0;
+                let first = self.src.first_child(e.depth, e.index);
+                for c in 0..1usize << K {
+                    let cell = e.cell.child(c);
+                    if meets(&cell, bx) {
+                        let child = Entry {
+                            depth: e.depth + 1,
+                            index: first + c,
+                            cell,
+                        };
+                        partial += self.refine(child, bx, extent, seen);
+                    }
+                }
+                partial
+            }
+        }
+    }
+
+    fn lookup(&self, p: [i64; K]) -> bool {
+        if p.iter().any(|&c| c < 0 || c >= self.side) {
+            return false;
+        }
+        self.src.contains(p.map(|c| c as u32))
+    }
+
+    /// Decides target cell `cell` given its parent's overlay `parent` (a range of `self.overlay`).
+    fn node(&mut self, cell: Cell<K>, parent: std::ops::Range<usize>) -> NodeState {
+        if cell.log_side == 0 {
+            return leaf(self.lookup(self.map.voxel(cell.origin)));
+        }
+        let mut bx = self.map.cell_box(cell.origin, cell.side());
+        let mut seen = [false; 2];
+        for b in bx.iter_mut() {
+            if b.0 < 0 || b.1 >= self.side {
+                seen[0] = true; // part of the preimage is in the void
+            }
+            b.0 = b.0.max(0);
+            b.1 = b.1.min(self.side - 1);
+            if b.0 > b.1 {
+                return NodeState::Empty;
+            }
+        }
+        let extent = bx.iter().map(|b| b.1 - b.0 + 1).max().unwrap_or(1);
+        let start = self.overlay.len();
+        let mut partial = 0;
+        for k in parent {
+            let e = self.overlay[k];
+            if meets(&e.cell, &bx) {
+                partial += self.refine(e, &bx, extent, &mut seen);
+            }
+        }
+        let end = self.overlay.len();
+        if partial == 0 {
+            match seen {
+                [_, false] => return NodeState::Empty,
+                [false, true] => return NodeState::Full,
+                _ => {}
+            }
+        }
+        let mut kids = [NodeState::Empty; 16];
+        for (c, kid) in kids.iter_mut().enumerate().take(1 << K) {
+            *kid = self.node(cell.child(c), start..end);
+        }
+        self.overlay.truncate(start);
+        let kids = &kids[..1 << K];
+        match collapse(kids) {
+            Some(s) => s,
+            None => {
+                self.out.push_block(cell.level as usize + 1, kids);
+                NodeState::Partial
+            }
+        }
+    }
+}
+
+/// Resamples `src` through `map` into a tree of the same universe: target voxel `q` is full iff the source
+/// voxel `map.voxel(q)` is inside the universe and full. The output is reduced.
+pub fn resample<const K: usize, P: Preimage<K>>(src: &KTree<K>, map: &P) -> KTree<K> {
+    let universe = src.universe();
+    let mut engine = Engine {
+        src,
+        map,
+        side: universe.side() as i64,
+        out: Levels::new(universe.level() as usize + 1),
+        overlay: vec![Entry {
+            depth: 0,
+            index: 0,
+            cell: universe.root(),
+        }],
+    };
+    let root = engine.node(universe.root(), 0..1);
+    engine.out.finish(universe, root)
+}

@@ -1,0 +1,226 @@
+//! Rotations by quarter turns and reflections of the whole universe — the hyperoctahedral group of
+//! `K!·2^K` elements — by reordering children (Meagher §6 "Rotation", claim M5). Integer-only; the cost is
+//! one visit per node and the output has exactly the input's node counts per level.
+//!
+//! An element is an [`AxisMap`]: output axis `i` takes input axis `perm[i]`, mirrored if `flip[i]`. On
+//! voxels: `p'[i] = p[perm[i]]`, or `U − 1 − p[perm[i]]` when flipped — a rotation or reflection about the
+//! universe's centre. On a tree it is a fixed permutation of the `2^K` child codes applied at every node.
+
+use super::emit::Levels;
+use super::OpsError;
+use crate::tree::{KTree, NodeState};
+
+/// An element of the hyperoctahedral group in `K` dimensions: a signed permutation of the axes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct AxisMap<const K: usize> {
+    perm: [usize; K],
+    flip: [bool; K],
+}
+
+impl<const K: usize> AxisMap<K> {
+    /// The identity.
+    pub fn identity() -> Self {
+        Self {
+            perm: std::array::from_fn(|i| i),
+            flip: [false; K],
+        }
+    }
+
+    /// The map with output axis `i` taken from input axis `perm[i]`, mirrored when `flip[i]`.
+    ///
+    /// # Errors
+    /// [`OpsError::BadParameter`] if `perm` is not a permutation of `0 … K−1`.
+    pub fn new(perm: [usize; K], flip: [bool; K]) -> Result<Self, OpsError> {
+        let mut seen = [false; K];
+        for &p in &perm {
+            if p >= K || seen[p] {
+                return Err(OpsError::BadParameter {
+                    reason: format!("{perm:?} is not a permutation of the axes 0..{K}"),
+                });
+            }
+            seen[p] = true;
+        }
+        Ok(Self { perm, flip })
+    }
+
+    /// The reflection across the mid-plane perpendicular to `axis`.
+    ///
+    /// # Errors
+    /// [`OpsError::BadParameter`] if `axis ≥ K`.
+    pub fn reflection(axis: usize) -> Result<Self, OpsError> {
+        if axis >= K {
+            return Err(OpsError::BadParameter {
+                reason: format!("axis {axis} is not below K = {K}"),
+            });
+        }
+        let mut m = Self::identity();
+        m.flip[axis] = true;
+        Ok(m)
+    }
+
+    /// The quarter turn about the universe's centre in the plane of axes `from` and `to`, turning the
+    /// positive `from` direction into the positive `to` direction (for `from = 0, to = 1` in 3-D: +90° about z).
+    ///
+    /// # Errors
+    /// [`OpsError::BadParameter`] if an axis is `≥ K` or `from == to`.
+    pub fn quarter_turn(from: usize, to: usize) -> Result<Self, OpsError> {
+        if from >= K || to >= K || from == to {
+            return Err(OpsError::BadParameter {
+                reason: format!(
+                    "a quarter turn needs two different axes below K = {K}, got {from} and {to}"
+                ),
+            });
+        }
+        // (x_from, x_to) → (−x_to, x_from) about the centre: out[to] = in[from], out[from] = U−1−in[to].
+        let mut m = Self::identity();
+        m.perm[to] = from;
+        m.perm[from] = to;
+        m.flip[from] = true;
+        Ok(m)
+    }
+
+    /// Output axis `i` takes input axis `perm()[i]`.
+    pub fn perm(&self) -> [usize; K] {
+        self.perm
+    }
+
+    /// Whether output axis `i` is mirrored.
+    pub fn flip(&self) -> [bool; K] {
+        self.flip
+    }
+
+    /// Applies the map to a voxel of a universe of side `side`.
+    pub fn map_point(&self, p: [u32; K], side: u32) -> [u32; K] {
+        std::array::from_fn(|i| {
+            let v = p[self.perm[i]];
+            if self.flip[i] {
+                side - 1 - v
+            } else {
+                v
+            }
+        })
+    }
+
+    /// `self ∘ other`: first `other`, then `self`.
+    pub fn compose(&self, other: &Self) -> Self {
+        // out[i] = f_i(mid[perm[i]]), mid[j] = g_j(in[other.perm[j]]).
+        Self {
+            perm: std::array::from_fn(|i| other.perm[self.perm[i]]),
+            flip: std::array::from_fn(|i| self.flip[i] != other.flip[self.perm[i]]),
+        }
+    }
+
+    /// The inverse element.
+    pub fn inverse(&self) -> Self {
+        let mut perm = [0; K];
+        let mut flip = [false; K];
+        for i in 0..K {
+            perm[self.perm[i]] = i;
+            flip[self.perm[i]] = self.flip[i];
+        }
+        Self { perm, flip }
+    }
+
+    /// Whether the map is a proper rotation (determinant +1) rather than a reflection.
+    pub fn is_rotation(&self) -> bool {
+        let mut inversions = 0;
+        for i in 0..K {
+            for j in i + 1..K {
+                if self.perm[i] > self.perm[j] {
+                    inversions += 1;
+                }
+            }
+        }
+        let flips = self.flip.iter().filter(|&&f| f).count();
+        (inversions + flips) % 2 == 0
+    }
+
+    /// All `K!·2^K` elements of the group.
+    pub fn all() -> Vec<Self> {
+        let mut perms = Vec::new();
+        permutations::<K>(&mut [0; K], 0, &mut [false; K], &mut perms);
+        let mut out = Vec::new();
+        for perm in perms {
+            for bits in 0..1usize << K {
+                out.push(Self {
+                    perm,
+                    flip: std::array::from_fn(|i| bits >> i & 1 == 1),
+                });
+            }
+        }
+        out
+    }
+
+    /// For each output child code, the source child code it comes from.
+    fn child_table(&self) -> [usize; 16] {
+        let mut table = [0usize; 16];
+        for (out_code, src) in table.iter_mut().enumerate().take(1 << K) {
+            let mut code = 0;
+            for i in 0..K {
+                let bit = (out_code >> i & 1 == 1) != self.flip[i];
+                if bit {
+                    code |= 1 << self.perm[i];
+                }
+            }
+            *src = code;
+        }
+        table
+    }
+}
+
+fn permutations<const K: usize>(
+    cur: &mut [usize; K],
+    at: usize,
+    used: &mut [bool; K],
+    out: &mut Vec<[usize; K]>,
+) {
+    if at == K {
+        out.push(*cur);
+        return;
+    }
+    for v in 0..K {
+        if !used[v] {
+            used[v] = true;
+            cur[at] = v;
+            permutations(cur, at + 1, used, out);
+            used[v] = false;
+        }
+    }
+}
+
+/// Rotates or reflects the whole object about the universe's centre by an element of the hyperoctahedral
+/// group, by reordering children. Linear in the nodes; the output has the input's counts per level.
+///
+/// ```
+/// use ktree::{KTree, ops::{rotate_axes, AxisMap}};
+/// // 2×2 quadtree with the voxel (1, 0) set; a quarter turn x → y moves it to (1, 1).
+/// let a = KTree::<2>::from_dense(1, &[false, true, false, false]).unwrap();
+/// let r = rotate_axes(&a, &AxisMap::quarter_turn(0, 1).unwrap());
+/// assert!(r.contains([1, 1]));
+/// ```
+pub fn rotate_axes<const K: usize>(tree: &KTree<K>, map: &AxisMap<K>) -> KTree<K> {
+    let table = map.child_table();
+    let mut out = Levels::new(tree.depth_count());
+    let root = reorder(tree, &mut out, &table, 0, 0);
+    out.finish(tree.universe(), root)
+}
+
+fn reorder<const K: usize>(
+    tree: &KTree<K>,
+    out: &mut Levels,
+    table: &[usize; 16],
+    depth: usize,
+    index: usize,
+) -> NodeState {
+    let s = tree.state(depth, index);
+    if s != NodeState::Partial {
+        return s;
+    }
+    let first = tree.first_child(depth, index);
+    let mut kids = [NodeState::Empty; 16];
+    for (c, kid) in kids.iter_mut().enumerate().take(1 << K) {
+        *kid = reorder(tree, out, table, depth + 1, first + table[c]);
+    }
+    out.push_block(depth + 1, &kids[..1 << K]);
+    NodeState::Partial
+}
