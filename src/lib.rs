@@ -17,6 +17,7 @@
 //! * [`build`]: [`build::stack`] (stacking) and the reference builders.
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
 //! * [`io`]: the ray text format and the `.ktree` file format.
+//! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
 //!
 //! # Example
 //! ```
@@ -32,6 +33,7 @@
 #![forbid(unsafe_code)]
 
 pub mod build;
+pub mod display;
 pub mod io;
 pub mod rays;
 pub mod space;
