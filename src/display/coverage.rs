@@ -80,7 +80,13 @@ impl Coverage {
     /// Calls `hit(x)` for every uncovered pixel of row `y` in `[x0, x1]`, in order, and covers the pixels
     /// for which it returns `true`. Returns how many were covered.
     #[inline]
-    pub fn cover_where(&mut self, y: u32, x0: u32, x1: u32, mut hit: impl FnMut(u32) -> bool) -> u32 {
+    pub fn cover_where(
+        &mut self,
+        y: u32,
+        x0: u32,
+        x1: u32,
+        mut hit: impl FnMut(u32) -> bool,
+    ) -> u32 {
         if self.row_uncovered[y as usize] == 0 {
             return 0;
         }
@@ -165,7 +171,9 @@ mod tests {
                 seen.push(x);
                 true
             });
-            let want: Vec<u32> = (x0..=x1).filter(|&x| !plain[(2 * w + x) as usize]).collect();
+            let want: Vec<u32> = (x0..=x1)
+                .filter(|&x| !plain[(2 * w + x) as usize])
+                .collect();
             assert_eq!(seen, want);
         }
         let n = plain.iter().filter(|&&p| !p).count() as u64;

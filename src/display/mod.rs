@@ -12,12 +12,18 @@
 pub mod camera;
 pub mod coverage;
 mod error;
+pub mod hidden;
+pub mod lines;
+pub mod neighbours;
 pub mod order;
 pub mod png;
 pub mod raster;
+pub mod svg;
 
 pub use camera::{default_camera, object_bounds, Camera, Projection, ISO_TOWARD_EYE};
 pub use coverage::Coverage;
 pub use error::{check_size, DisplayError, MAX_IMAGE_SIDE};
+pub use hidden::HiddenLineMethod;
+pub use lines::{line_drawing, nudged_view_dir, Edge3, LineDrawing, LineStats};
 pub use order::{near_child, ordered_full_cells, walk_ordered, Order, Viewer, Walk};
 pub use raster::{render, render_zbuffer, RenderOptions, RenderStats, Rendered};

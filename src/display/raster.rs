@@ -110,7 +110,12 @@ impl Rendered {
 /// Exact ray–box test. Returns `(t_near, t_far, axis entered)` when the ray's line passes through the open
 /// box with a chord of positive length.
 #[inline]
-pub(crate) fn slab(o: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> Option<(f64, f64, usize)> {
+pub(crate) fn slab(
+    o: [f64; 3],
+    d: [f64; 3],
+    lo: [f64; 3],
+    hi: [f64; 3],
+) -> Option<(f64, f64, usize)> {
     let mut tn = f64::NEG_INFINITY;
     let mut tf = f64::INFINITY;
     let mut axis = 0;
@@ -221,7 +226,8 @@ impl Screen {
                     }
                     None => {
                         // A corner at or behind the eye plane: the cell may cover anything.
-                        (xmin, xmax, ymin, ymax) = (0.0, f64::from(self.width), 0.0, f64::from(self.height));
+                        (xmin, xmax, ymin, ymax) =
+                            (0.0, f64::from(self.width), 0.0, f64::from(self.height));
                         break;
                     }
                 }
@@ -232,13 +238,22 @@ impl Screen {
             let c = [lo[0] + h, lo[1] + h, lo[2] + h];
             let cx = v3::dot(self.ax, c) + self.bx;
             let cy = v3::dot(self.ay, c) + self.by;
-            (cx - self.ex * s, cx + self.ex * s, cy - self.ey * s, cy + self.ey * s)
+            (
+                cx - self.ex * s,
+                cx + self.ex * s,
+                cy - self.ey * s,
+                cy + self.ey * s,
+            )
         };
         const MARGIN: f64 = 1e-7;
         let x0 = (xmin - 0.5 - MARGIN).ceil().max(0.0);
-        let x1 = (xmax - 0.5 + MARGIN).floor().min(f64::from(self.width) - 1.0);
+        let x1 = (xmax - 0.5 + MARGIN)
+            .floor()
+            .min(f64::from(self.width) - 1.0);
         let y0 = (ymin - 0.5 - MARGIN).ceil().max(0.0);
-        let y1 = (ymax - 0.5 + MARGIN).floor().min(f64::from(self.height) - 1.0);
+        let y1 = (ymax - 0.5 + MARGIN)
+            .floor()
+            .min(f64::from(self.height) - 1.0);
         (x0 <= x1 && y0 <= y1).then(|| Rect {
             x0: x0 as u32,
             x1: x1 as u32,
@@ -249,7 +264,13 @@ impl Screen {
 
     /// The hit of pixel `(x, y)`'s ray with the box of `cell`: `(depth, axis entered, ray)`.
     #[inline]
-    fn hit(&self, x: u32, y: u32, lo: [f64; 3], hi: [f64; 3]) -> Option<(f64, usize, [f64; 3], [f64; 3])> {
+    fn hit(
+        &self,
+        x: u32,
+        y: u32,
+        lo: [f64; 3],
+        hi: [f64; 3],
+    ) -> Option<(f64, usize, [f64; 3], [f64; 3])> {
         let (o, d) = self.rays.ray(x, y);
         let (tn, _, axis) = slab(o, d, lo, hi)?;
         if self.rays.perspective && tn <= 0.0 {
@@ -268,7 +289,11 @@ fn cell_box(cell: &Cell<3>) -> ([f64; 3], [f64; 3]) {
 /// The light direction (towards the light) for a camera: above and to the left of the eye.
 fn light_for(camera: &Camera) -> [f64; 3] {
     let f = camera.frame();
-    let l = v3::add_scaled(v3::add_scaled([-0.6 * f.f[0], -0.6 * f.f[1], -0.6 * f.f[2]], 0.8, f.u), -0.45, f.r);
+    let l = v3::add_scaled(
+        v3::add_scaled([-0.6 * f.f[0], -0.6 * f.f[1], -0.6 * f.f[2]], 0.8, f.u),
+        -0.45,
+        f.r,
+    );
     v3::normalize(l).expect("non-zero light")
 }
 
@@ -369,7 +394,9 @@ pub fn render(
         if state == NodeState::Empty {
             continue;
         }
-        let Some(r) = screen.rect(&cell) else { continue };
+        let Some(r) = screen.rect(&cell) else {
+            continue;
+        };
         if cov.rect_covered(r.x0, r.x1, r.y0, r.y1) {
             stats.culled += 1;
             continue;
