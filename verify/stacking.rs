@@ -79,3 +79,66 @@ proptest! {
     #[test]
     fn stacking_equals_references_k4(case in ray_sets::<4>()) { stacking_agrees(&case)?; }
 }
+
+/// Small objects placed anywhere in universes of the largest level for each K: stacking (whose keys fill
+/// all 64 bits there) still equals naive insertion, and point queries agree with the rays.
+fn extreme_level_agrees<const K: usize>(seed: u64) -> Result<(), TestCaseError>
+where
+    Dim<K>: Fanout,
+{
+    let level = ktree::max_level(K);
+    let side = 1u64 << level;
+    let mut x = seed | 1;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let mut rays = Vec::new();
+    for _ in 0..6 {
+        // A few short runs near a random point, sometimes on the universe's far faces.
+        let mut start = [0u32; K];
+        for c in start.iter_mut() {
+            *c = match next() % 3 {
+                0 => 0,
+                1 => (side - 1 - next() % 3) as u32,
+                _ => (next() % side) as u32,
+            };
+        }
+        let z1 = u64::from(start[K - 1]);
+        let z2 = (z1 + 1 + next() % 5).min(side);
+        rays.push(ktree::Ray::new(start, z2 as u32));
+    }
+    let set = ktree::RaySet::from_rays(level, rays).unwrap();
+    let stacked = stack(&set);
+    stacked
+        .check()
+        .map_err(|e| TestCaseError::fail(format!("malformed: {e}")))?;
+    let naive = NaiveTree::from_rays(&set).unwrap().to_tree();
+    prop_assert!(
+        stacked == naive,
+        "stacking and naive differ at level {}",
+        level
+    );
+    prop_assert_eq!(stacked.voxel_count(), set.voxel_count());
+    for ray in set.iter() {
+        prop_assert!(stacked.contains(ray.start));
+        let mut after = ray.start;
+        after[K - 1] = ray.z2;
+        prop_assert_eq!(stacked.contains(after), set.contains(after));
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    #[test]
+    fn stacking_at_the_largest_levels(seed in any::<u64>()) {
+        extreme_level_agrees::<1>(seed)?;
+        extreme_level_agrees::<2>(seed)?;
+        extreme_level_agrees::<3>(seed)?;
+        extreme_level_agrees::<4>(seed)?;
+    }
+}

@@ -88,13 +88,29 @@ pub fn stack<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
 
 /// Like [`stack`], also returning what went through the dimension-level lists.
 pub fn stack_with_stats<const K: usize>(rays: &RaySet<K>) -> (KTree<K>, StackingStats) {
+    stack_impl(rays, RowPath::Auto)
+}
+
+/// How stage 1 (rows → squares) is run; both give the same tree (a unit test holds them equal).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RowPath {
+    /// The merging row path when its packed keys fit 64 bits (`2L + 5 ≤ 64`), else the generic one.
+    Auto,
+    /// Always the generic path (every list radix-sorted); tests compare it with the merging path.
+    #[cfg_attr(not(test), allow(dead_code))]
+    Generic,
+}
+
+fn stack_impl<const K: usize>(rays: &RaySet<K>, path: RowPath) -> (KTree<K>, StackingStats) {
     let universe = rays.universe();
     let level = universe.level();
     let lists = (level + 1) as usize;
     let mut stacker = Stacker::<K> {
         universe,
         stages: (1..K).map(|d| Stage::new(K, d, level)).collect(),
+        packed_cells: K as u32 * level + 5 <= 64,
         cells: Vec::new(),
+        wide_cells: Vec::new(),
         stats: StackingStats {
             k: K,
             level,
@@ -106,38 +122,41 @@ pub fn stack_with_stats<const K: usize>(rays: &RaySet<K>) -> (KTree<K>, Stacking
         },
         held: 0,
         scratch: Vec::new(),
+        combined_buf: Vec::new(),
     };
-    for (i, &(z1, z2)) in rays.runs().iter().enumerate() {
-        let mut origin = rays.column_of_key(rays.column_keys()[i]);
-        for row in maximal_rows(z1, z2) {
-            stacker.stats.maximal_rows += 1;
-            origin[K - 1] = row.z;
-            stacker.feed(1, level - row.log_len, origin);
+    if K >= 2 && path == RowPath::Auto && 2 * level + 5 <= 64 {
+        stacker.rows_by_merging(rays);
+    } else {
+        for (i, &(z1, z2)) in rays.runs().iter().enumerate() {
+            let mut origin = rays.column_of_key(rays.column_keys()[i]);
+            for row in maximal_rows(z1, z2) {
+                stacker.stats.maximal_rows += 1;
+                origin[K - 1] = row.z;
+                stacker.feed(1, level - row.log_len, origin);
+            }
         }
     }
     for d in 1..K {
         stacker.flush(d);
     }
     let Stacker {
+        packed_cells,
         mut cells,
+        mut wide_cells,
         mut stats,
         mut scratch,
         ..
     } = stacker;
-    stats.cells = cells.len() as u64;
-    // Sort the obels by Morton key. A cell's key is unique (cells are disjoint), so sorting the keys alone
-    // and re-attaching levels through a lookup is not needed: pack (key, level) when it fits in 64 bits.
-    let tree = if (K as u32) * level + 5 <= 64 {
-        let mut packed: Vec<u64> = cells
-            .iter()
-            .map(|&(key, l)| key << 5 | u64::from(l))
-            .collect();
-        radix_sort(&mut packed, K as u32 * level + 5, &mut scratch);
-        let sorted: Vec<(u64, u32)> = packed.iter().map(|&p| (p >> 5, (p & 31) as u32)).collect();
-        KTree::from_sorted_morton(universe, &sorted)
+    // Sort the obels by Morton key (unique: cells are disjoint) and assemble the level-order tree.
+    let tree = if packed_cells {
+        stats.cells = cells.len() as u64;
+        radix_sort(&mut cells, K as u32 * level + 5, &mut scratch);
+        drop(scratch);
+        KTree::from_sorted_packed(universe, &cells)
     } else {
-        cells.sort_unstable();
-        KTree::from_sorted_morton(universe, &cells)
+        stats.cells = wide_cells.len() as u64;
+        wide_cells.sort_unstable();
+        KTree::from_sorted_morton(universe, &wide_cells)
     };
     (tree, stats)
 }
@@ -147,12 +166,18 @@ struct Stacker<const K: usize> {
     universe: Universe<K>,
     /// `stages[D − 1]`.
     stages: Vec<Stage>,
-    /// Output cells as (Morton key, level).
-    cells: Vec<(u64, u32)>,
+    /// Whether output cells fit `Morton key << 5 | level` in 64 bits (`K·L + 5 ≤ 64`).
+    packed_cells: bool,
+    /// Output cells, packed.
+    cells: Vec<u64>,
+    /// Output cells as (Morton key, level) when they do not fit packed.
+    wide_cells: Vec<(u64, u32)>,
     stats: StackingStats,
     /// Items currently held in lists.
     held: u64,
     scratch: Vec<u64>,
+    /// Items combined during a flush — (stage key without prefix, level) — fed onward after the scan.
+    combined_buf: Vec<(u64, u32)>,
 }
 
 /// One dimension's lists ι(D, 0 … L) for the current prefix group.
@@ -165,15 +190,37 @@ struct Stage {
     prefix: Option<u64>,
     /// `lists[l]`: local keys of the items at level `l`.
     lists: Vec<Vec<u64>>,
+    /// `half_offsets[l]`: the `2^D` key offsets that split an item of level `l` into its halves.
+    half_offsets: Vec<Vec<u64>>,
 }
 
 impl Stage {
     fn new(k: usize, d: usize, level: u32) -> Self {
+        let axis = k - 1 - d;
+        // In a local key the field of axis e (a < e < K) sits at bit (K − e)·L.
+        let half_offsets = (0..=level)
+            .map(|l| {
+                let sh = level - l;
+                if sh == 0 {
+                    return Vec::new();
+                }
+                let half = 1u64 << (sh - 1);
+                (0..1usize << d)
+                    .map(|m| {
+                        (0..d)
+                            .filter(|j| m >> j & 1 == 1)
+                            .map(|j| half << ((k - (axis + 1 + j)) as u32 * level))
+                            .sum()
+                    })
+                    .collect()
+            })
+            .collect();
         Self {
-            axis: k - 1 - d,
+            axis,
             local_bits: (d as u32 + 1) * level,
             prefix: None,
             lists: vec![Vec::new(); level as usize + 1],
+            half_offsets,
         }
     }
 }
@@ -205,10 +252,20 @@ impl<const K: usize> Stacker<K> {
         origin
     }
 
+    fn hold(&mut self, n: u64) {
+        self.held += n;
+        self.stats.peak_items = self.stats.peak_items.max(self.held);
+    }
+
     /// Puts an item of dimension `d` (1 ≤ d ≤ K) at `level` into its list (or, for `d = K`, the output).
     fn feed(&mut self, d: usize, level: u32, origin: [u32; K]) {
         if d == K {
-            self.cells.push((morton_encode(origin), level));
+            let key = morton_encode(origin);
+            if self.packed_cells {
+                self.cells.push(key << 5 | u64::from(level));
+            } else {
+                self.wide_cells.push((key, level));
+            }
             return;
         }
         let (axis, local_bits, current) = {
@@ -226,8 +283,7 @@ impl<const K: usize> Stacker<K> {
         stage.prefix = Some(prefix);
         stage.lists[level as usize].push(key & local_mask);
         self.stats.entered[d - 1][level as usize] += 1;
-        self.held += 1;
-        self.stats.peak_items = self.stats.peak_items.max(self.held);
+        self.hold(1);
     }
 
     /// Runs combine/split over all levels of stage `d`'s current prefix group.
@@ -236,69 +292,231 @@ impl<const K: usize> Stacker<K> {
             return;
         };
         let top = self.universe.level();
-        let axis = self.stages[d - 1].axis;
         let local_bits = self.stages[d - 1].local_bits;
-        let prefix_bits = prefix.checked_shl(local_bits).unwrap_or(0);
-        for l in 0..=top {
-            let mut list = std::mem::take(&mut self.stages[d - 1].lists[l as usize]);
+        let mut list = Vec::new();
+        for l in 0..=top as usize {
+            std::mem::swap(&mut list, &mut self.stages[d - 1].lists[l]);
             if list.is_empty() {
                 continue;
             }
             self.held -= list.len() as u64;
-            radix_sort(&mut list, local_bits, &mut self.scratch);
-            let sh = top - l;
-            let side = 1usize << sh;
-            // Offsets that split an item into its 2^D halves along axes a+1 … K−1. In a local key the
-            // field of axis e sits at bit (K − e)·L.
-            let half_offsets: Vec<u64> = if sh > 0 {
-                let half = 1u64 << (sh - 1);
-                (0..1usize << d)
-                    .map(|m| {
-                        (0..d)
-                            .filter(|j| m >> j & 1 == 1)
-                            .map(|j| half << ((K - (axis + 1 + j)) as u32 * top))
-                            .sum()
-                    })
-                    .collect()
-            } else {
-                Vec::new()
-            };
-            let mut split_items = Vec::new();
-            let mut i = 0;
-            while i < list.len() {
-                let group = list[i] >> sh;
-                let mut j = i + 1;
-                while j < list.len() && list[j] >> sh == group {
-                    j += 1;
-                }
-                if j - i == side {
-                    self.stats.combined[d - 1][l as usize] += 1;
-                    let origin = self.unpack(axis, prefix_bits | group << sh);
-                    self.feed(d + 1, l, origin);
-                } else {
-                    self.stats.split[d - 1][l as usize] += (j - i) as u64;
-                    for &key in &list[i..j] {
-                        split_items.extend(half_offsets.iter().map(|&o| key + o));
-                    }
-                }
-                i = j;
+            let sh = top - l as u32;
+            // At the voxel level every item combines on its own: no need to sort.
+            if sh > 0 {
+                radix_sort(&mut list, local_bits, &mut self.scratch);
             }
-            if !split_items.is_empty() {
-                let n = split_items.len() as u64;
-                self.stats.entered[d - 1][l as usize + 1] += n;
-                self.held += n;
-                self.stats.peak_items = self.stats.peak_items.max(self.held);
-                self.stages[d - 1].lists[l as usize + 1].extend_from_slice(&split_items);
-            }
-            // Give the buffer back for reuse.
+            let mut combined = std::mem::take(&mut self.combined_buf);
+            let stage = &mut self.stages[d - 1];
+            let next = stage.lists.get_mut(l + 1);
+            let split = combine_or_split(&list, sh, &stage.half_offsets[l], next, |key| {
+                combined.push((key, l as u32))
+            });
             list.clear();
-            let slot = &mut self.stages[d - 1].lists[l as usize];
-            if slot.capacity() < list.capacity() {
-                *slot = list;
+            self.stats.split[d - 1][l] += split;
+            self.stats.combined[d - 1][l] += combined.len() as u64;
+            if split > 0 {
+                let n = split << d;
+                self.stats.entered[d - 1][l + 1] += n;
+                self.hold(n);
             }
+            self.pass_on(d, prefix, &mut combined);
+            self.combined_buf = combined;
         }
-        // The prefix group is done; a combined item may have started the next stage's group, so flushing
-        // that stage is left to the caller's order (prefixes of stage d+1 are coarser).
+    }
+
+    /// Feeds the items combined by stage `d` (local keys of its current `prefix`) to stage `d + 1`.
+    fn pass_on(&mut self, d: usize, prefix: u64, combined: &mut Vec<(u64, u32)>) {
+        let axis = self.stages[d - 1].axis;
+        let prefix_bits = prefix
+            .checked_shl(self.stages[d - 1].local_bits)
+            .unwrap_or(0);
+        for (key, l) in combined.drain(..) {
+            let origin = self.unpack(axis, prefix_bits | key);
+            self.feed(d + 1, l, origin);
+        }
+    }
+
+    /// Stage 1 without sorting every list: the rows of one slice (a fixed prefix) are sorted once by
+    /// (level, z, y); at each level the list is the merge of that level's fresh rows with the two halves of
+    /// the rows split at the level above — each of the three is already sorted, since adding the same offset
+    /// to sorted keys keeps them sorted. Same lists, same combine/split, linear work per level.
+    fn rows_by_merging(&mut self, rays: &RaySet<K>) {
+        let top = self.universe.level();
+        let y_mask = (1u64 << top) - 1;
+        let level_shift = 2 * top;
+        let local_mask = (1u64 << level_shift) - 1;
+        let keys = rays.column_keys();
+        let runs = rays.runs();
+        let mut fresh = Vec::new();
+        let mut list = Vec::new();
+        let (mut cur_low, mut cur_high) = (Vec::new(), Vec::new());
+        let (mut next_low, mut next_high) = (Vec::new(), Vec::new());
+        let mut combined = Vec::new();
+        let mut start = 0;
+        while start < runs.len() {
+            let prefix = keys[start] >> top;
+            let mut end = start;
+            fresh.clear();
+            while end < runs.len() && keys[end] >> top == prefix {
+                let y = keys[end] & y_mask;
+                let (z1, z2) = runs[end];
+                for row in maximal_rows(z1, z2) {
+                    let l = u64::from(top - row.log_len);
+                    fresh.push(l << level_shift | u64::from(row.z) << top | y);
+                }
+                end += 1;
+            }
+            self.stats.maximal_rows += fresh.len() as u64;
+            self.hold(fresh.len() as u64);
+            radix_sort(&mut fresh, level_shift + 5, &mut self.scratch);
+            let mut at = 0;
+            cur_low.clear();
+            cur_high.clear();
+            for l in 0..=top as usize {
+                let from = at;
+                while at < fresh.len() && (fresh[at] >> level_shift) as usize == l {
+                    at += 1;
+                }
+                // cur_low and cur_high hold the halves split from level l − 1, each sorted; merge them
+                // with this level's fresh rows.
+                list.clear();
+                if l == top as usize {
+                    // Voxel level: everything combines on its own, order does not matter.
+                    list.extend(fresh[from..at].iter().map(|&v| v & local_mask));
+                    list.extend_from_slice(&cur_low);
+                    list.extend_from_slice(&cur_high);
+                } else {
+                    merge3(&fresh[from..at], local_mask, &cur_low, &cur_high, &mut list);
+                }
+                if list.is_empty() {
+                    continue;
+                }
+                self.held -= list.len() as u64;
+                self.stats.entered[0][l] += list.len() as u64;
+                let sh = top - l as u32;
+                next_low.clear();
+                next_high.clear();
+                let half = if sh > 0 {
+                    [0, (1u64 << (sh - 1)) << top]
+                } else {
+                    [0, 0]
+                };
+                let split =
+                    combine_or_split_rows(&list, sh, half, &mut next_low, &mut next_high, |key| {
+                        combined.push((key, l as u32))
+                    });
+                self.stats.split[0][l] += split;
+                self.stats.combined[0][l] += combined.len() as u64;
+                self.hold(2 * split);
+                std::mem::swap(&mut cur_low, &mut next_low);
+                std::mem::swap(&mut cur_high, &mut next_high);
+                self.pass_on_rows(prefix, &mut combined);
+            }
+            start = end;
+        }
+    }
+
+    /// Feeds squares combined by the row stage (local keys `z << L | y` of slice `prefix`) to stage 2.
+    fn pass_on_rows(&mut self, prefix: u64, combined: &mut Vec<(u64, u32)>) {
+        let top = self.universe.level();
+        let prefix_bits = prefix << (2 * top);
+        for (key, l) in combined.drain(..) {
+            let origin = self.unpack(K - 2, prefix_bits | key);
+            self.feed(2, l, origin);
+        }
+    }
+}
+
+/// Scans a sorted list of local keys at shift `sh` (side `2^sh`): each run of keys equal above bit `sh`
+/// with exactly `2^sh` members combines (`on_combined` gets the run's first key with the low `sh` bits
+/// cleared); every member of any other run is split into `key + o` for each half offset `o`, appended to
+/// `next`. Returns the number of items split.
+fn combine_or_split(
+    list: &[u64],
+    sh: u32,
+    half_offsets: &[u64],
+    next: Option<&mut Vec<u64>>,
+    mut on_combined: impl FnMut(u64),
+) -> u64 {
+    let side = 1usize << sh;
+    let mut split = 0;
+    let mut next = next;
+    let mut i = 0;
+    while i < list.len() {
+        let group = list[i] >> sh;
+        let mut j = i + 1;
+        while j < list.len() && list[j] >> sh == group {
+            j += 1;
+        }
+        if j - i == side {
+            on_combined(group << sh);
+        } else {
+            let next = next
+                .as_deref_mut()
+                .expect("items split only above the voxel level");
+            for &key in &list[i..j] {
+                next.extend(half_offsets.iter().map(|&o| key + o));
+            }
+            split += (j - i) as u64;
+        }
+        i = j;
+    }
+    split
+}
+
+/// [`combine_or_split`] for rows, keeping the two halves in two sorted sequences: low halves (`+ half[0]`)
+/// to `lows`, high halves (`+ half[1]`) to `highs`.
+fn combine_or_split_rows(
+    list: &[u64],
+    sh: u32,
+    half: [u64; 2],
+    lows: &mut Vec<u64>,
+    highs: &mut Vec<u64>,
+    mut on_combined: impl FnMut(u64),
+) -> u64 {
+    let side = 1usize << sh;
+    let mut split = 0;
+    let mut i = 0;
+    while i < list.len() {
+        let group = list[i] >> sh;
+        let mut j = i + 1;
+        while j < list.len() && list[j] >> sh == group {
+            j += 1;
+        }
+        if j - i == side {
+            on_combined(group << sh);
+        } else {
+            for &key in &list[i..j] {
+                lows.push(key + half[0]);
+                highs.push(key + half[1]);
+            }
+            split += (j - i) as u64;
+        }
+        i = j;
+    }
+    split
+}
+
+/// Merges three sorted sequences into `out`: `fresh` (keys masked by `mask`) and the two halves `lows`,
+/// `highs`. Keys are below 2^62, so `u64::MAX` marks an exhausted sequence.
+fn merge3(fresh: &[u64], mask: u64, lows: &[u64], highs: &[u64], out: &mut Vec<u64>) {
+    let (mut i, mut j, mut k) = (0, 0, 0);
+    let total = fresh.len() + lows.len() + highs.len();
+    out.reserve(total);
+    for _ in 0..total {
+        let f = fresh.get(i).map_or(u64::MAX, |&v| v & mask);
+        let a = lows.get(j).copied().unwrap_or(u64::MAX);
+        let b = highs.get(k).copied().unwrap_or(u64::MAX);
+        if f <= a && f <= b {
+            out.push(f);
+            i += 1;
+        } else if a <= b {
+            out.push(a);
+            j += 1;
+        } else {
+            out.push(b);
+            k += 1;
+        }
     }
 }
 
@@ -376,6 +594,36 @@ mod tests {
         let (_, stats) = stack_with_stats(&rays3(3, &shifted));
         assert_eq!(stats.combined[1][1], 0);
         assert_eq!(stats.split[1][1], 4);
+    }
+
+    #[test]
+    fn merging_row_path_equals_generic_path() {
+        let mut x = 0x2545F4914F6CDD1Du64;
+        for level in 0..=6u32 {
+            let side = 1u32 << level;
+            for _ in 0..20 {
+                let rays: Vec<Ray<3>> = (0..30)
+                    .map(|_| {
+                        x ^= x << 13;
+                        x ^= x >> 7;
+                        x ^= x << 17;
+                        let c = (x % u64::from(side)) as u32;
+                        let y = ((x >> 10) % u64::from(side)) as u32;
+                        let z1 = ((x >> 20) % u64::from(side)) as u32;
+                        let z2 = z1 + 1 + ((x >> 30) % u64::from(side - z1)) as u32;
+                        Ray::new([c / 2, y, z1], z2)
+                    })
+                    .collect();
+                let set = RaySet::from_rays(level, rays).unwrap();
+                let (a, sa) = stack_impl(&set, RowPath::Auto);
+                let (b, sb) = stack_impl(&set, RowPath::Generic);
+                assert_eq!(a, b);
+                assert_eq!(
+                    (sa.entered, sa.combined, sa.split),
+                    (sb.entered, sb.combined, sb.split)
+                );
+            }
+        }
     }
 
     #[test]

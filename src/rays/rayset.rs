@@ -220,7 +220,7 @@ impl<const K: usize> RaySet<K> {
             entries.push((set.column_key(ray.start), z1, z2, normals));
         }
         // Sort by column, then z1. Stable sorts are not needed: equal (column, z1) runs are merged anyway.
-        entries.sort_unstable_by(|a, b| (a.0, a.1, a.2).cmp(&(b.0, b.1, b.2)));
+        entries.sort_unstable_by_key(|e| (e.0, e.1, e.2));
         let keep_normals = with_normals == Some(true);
         let mut normals_out = Vec::new();
         for (column, z1, z2, normals) in entries {

@@ -86,35 +86,95 @@ impl<const K: usize> KTree<K> {
             universe,
             levels: Vec::new(),
         };
-        emit::<K>(&mut out, universe.level(), 0, cells);
+        emit_leaves::<K, _>(&mut out, universe.level(), cells);
+        out.finish()
+    }
+
+    /// Like [`KTree::from_sorted_morton`], with each cell packed as `Morton key << 5 | level` (needs
+    /// `K·L + 5 ≤ 64`); sorting such packed values sorts the cells.
+    pub fn from_sorted_packed(universe: Universe<K>, cells: &[u64]) -> KTree<K> {
+        debug_assert!(K as u32 * universe.level() + 5 <= 64);
+        let mut out = TreeAssembler::<K> {
+            universe,
+            levels: Vec::new(),
+        };
+        emit_leaves::<K, _>(&mut out, universe.level(), cells);
         out.finish()
     }
 }
 
-/// Emits, in pre-order, the subtree at `depth` that holds exactly `cells` (all inside this node).
-fn emit<const K: usize>(out: &mut TreeAssembler<K>, level: u32, depth: u32, cells: &[(u64, u32)]) {
-    match cells {
-        [] => out.push(depth as usize, NodeState::Empty),
-        [(_, l)] if *l == depth => out.push(depth as usize, NodeState::Full),
-        _ => {
-            out.push(depth as usize, NodeState::Partial);
-            // The child code of a key at this depth is its K-bit digit number (level - depth - 1).
-            let shift = (level - depth - 1) as usize * K;
-            let digit = |key: u64| ((key >> shift) as usize) & ((1 << K) - 1);
-            let mut rest = cells;
-            for code in 0..(1usize << K) {
-                let n = if rest.len() < 16 {
-                    rest.iter().take_while(|c| digit(c.0) == code).count()
-                } else {
-                    rest.partition_point(|c| digit(c.0) <= code)
-                };
-                let (mine, tail) = rest.split_at(n);
-                emit::<K>(out, level, depth + 1, mine);
-                rest = tail;
-            }
-            debug_assert!(rest.is_empty(), "cells not sorted or outside the node");
-        }
+/// A cell as the assembler sees it: a Morton key and a level.
+trait CellKey: Copy {
+    fn key(self) -> u64;
+    fn level(self) -> u32;
+}
+
+impl CellKey for (u64, u32) {
+    #[inline]
+    fn key(self) -> u64 {
+        self.0
     }
+    #[inline]
+    fn level(self) -> u32 {
+        self.1
+    }
+}
+
+impl CellKey for u64 {
+    #[inline]
+    fn key(self) -> u64 {
+        self >> 5
+    }
+    #[inline]
+    fn level(self) -> u32 {
+        (self & 31) as u32
+    }
+}
+
+/// Emits the pre-order traversal of the tree whose full leaves are `cells` (sorted, disjoint), in one pass.
+///
+/// The leaves of a k-tree tile the Morton order of its voxels with aligned blocks of `2^(K·j)` voxels. Walking
+/// the cells in order, each gap before a cell is filled with the largest aligned empty blocks that fit (like
+/// the maximal rows of a run, in Morton space), and before each leaf the partial nodes it is the first
+/// descendant of are opened: those at the depths where the leaf's position is aligned to the node's size.
+/// Cost: `O(nodes)`.
+fn emit_leaves<const K: usize, C: CellKey>(out: &mut TreeAssembler<K>, level: u32, cells: &[C]) {
+    let k = K as u32;
+    let end = 1u128 << (k * level);
+    let mut pos = 0u128;
+    let leaf = |out: &mut TreeAssembler<K>, at: u128, depth: u32, state: NodeState| {
+        // Open the partial ancestors whose first leaf this is: depths where `at` is aligned.
+        let shallowest = if at == 0 {
+            0
+        } else {
+            level - (at.trailing_zeros() / k).min(level)
+        };
+        for d in shallowest..depth {
+            out.push(d as usize, NodeState::Partial);
+        }
+        out.push(depth as usize, state);
+    };
+    let fill = |out: &mut TreeAssembler<K>, from: u128, to: u128| {
+        let mut at = from;
+        while at < to {
+            let by_alignment = if at == 0 {
+                level
+            } else {
+                (at.trailing_zeros() / k).min(level)
+            };
+            let by_room = (127 - (to - at).leading_zeros()) / k;
+            let j = by_alignment.min(by_room);
+            leaf(out, at, level - j, NodeState::Empty);
+            at += 1u128 << (k * j);
+        }
+    };
+    for c in cells {
+        let at = u128::from(c.key());
+        fill(out, pos, at);
+        leaf(out, at, c.level(), NodeState::Full);
+        pos = at + (1u128 << (k * (level - c.level())));
+    }
+    fill(out, pos, end);
 }
 
 #[cfg(test)]

@@ -95,7 +95,10 @@ impl PackedStates {
 
     /// Builds the rank index; must be called once all nodes are pushed.
     pub fn finish(&mut self) {
+        self.words.shrink_to_fit();
         self.block_rank.clear();
+        self.block_rank
+            .reserve_exact(self.words.len().div_ceil(WORDS_PER_BLOCK) + 1);
         let mut total = 0u64;
         for block in self.words.chunks(WORDS_PER_BLOCK) {
             self.block_rank.push(total);

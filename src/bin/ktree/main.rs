@@ -5,7 +5,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod build;
 mod repro;
+mod stats;
 
 /// k-trees (bintrees, quadtrees, octrees, 4-D trees) from rays by stacking.
 #[derive(Debug, Parser)]
@@ -17,6 +19,10 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Stack a ray file into a .ktree file.
+    Build(build::Args),
+    /// Print node counts (K, L, rays, full, empty, partial, nodes, per level) of a tree or a ray file.
+    Stats(stats::Args),
     /// Regenerate the paper reproductions into results/ (all of them by default).
     Repro(repro::Args),
 }
@@ -24,6 +30,8 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
+        Command::Build(args) => build::run(args),
+        Command::Stats(args) => stats::run(args),
         Command::Repro(args) => repro::run(args),
     };
     match outcome {

@@ -1,0 +1,38 @@
+//! `ktree build --rays FILE --out FILE.ktree`: stack a ray file into a tree file.
+
+use std::path::PathBuf;
+
+use ktree::io::{read_rays_file, write_ktree_file};
+
+/// Arguments of `ktree build`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The ray file (text format: `# ktree rays v1`, then `K L`, then one run per line).
+    #[arg(long)]
+    rays: PathBuf,
+    /// The tree file to write (written to a temporary file, then renamed).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Reads the rays, stacks them, writes the tree, and prints a one-line summary.
+pub fn run(args: Args) -> Result<(), String> {
+    let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
+    let tree = rays.stack();
+    let write = ktree::with_dim!(&tree, AnyTree, t => write_ktree_file(&args.out, t));
+    write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
+    let c = tree.counts();
+    println!(
+        "{}: K = {}, L = {}, {} rays -> {} nodes ({} full, {} empty, {} partial), {} bytes at 2 bits/node",
+        args.out.display(),
+        tree.k(),
+        tree.level(),
+        rays.len(),
+        c.nodes(),
+        c.full,
+        c.empty,
+        c.partial,
+        tree.bytes_at_two_bits()
+    );
+    Ok(())
+}

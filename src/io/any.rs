@@ -1,0 +1,158 @@
+//! Trees and ray sets whose dimension is known only at run time (read from a file).
+
+use crate::rays::RaySet;
+use crate::tree::{KTree, LevelCounts};
+
+/// A [`KTree`] of any supported dimension, as read from a file whose header names `K`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum AnyTree {
+    /// A bintree.
+    K1(KTree<1>),
+    /// A quadtree.
+    K2(KTree<2>),
+    /// An octree.
+    K3(KTree<3>),
+    /// A 4-D tree.
+    K4(KTree<4>),
+}
+
+/// A [`RaySet`] of any supported dimension, as read from a ray file whose header names `K`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnyRaySet {
+    /// Rays of a bintree universe.
+    K1(RaySet<1>),
+    /// Rays of a quadtree universe.
+    K2(RaySet<2>),
+    /// Rays of an octree universe.
+    K3(RaySet<3>),
+    /// Rays of a 4-D universe.
+    K4(RaySet<4>),
+}
+
+/// Runs an expression on the typed value inside an [`AnyTree`] or [`AnyRaySet`]:
+/// `with_dim!(any, AnyTree, t => t.node_count())`. The expression is compiled once per `K`.
+#[macro_export]
+macro_rules! with_dim {
+    ($value:expr, $kind:ident, $name:ident => $body:expr) => {
+        match $value {
+            $crate::io::$kind::K1($name) => $body,
+            $crate::io::$kind::K2($name) => $body,
+            $crate::io::$kind::K3($name) => $body,
+            $crate::io::$kind::K4($name) => $body,
+        }
+    };
+}
+
+impl AnyTree {
+    /// The dimension `K`.
+    pub fn k(&self) -> usize {
+        match self {
+            Self::K1(_) => 1,
+            Self::K2(_) => 2,
+            Self::K3(_) => 3,
+            Self::K4(_) => 4,
+        }
+    }
+
+    /// The universe level `L`.
+    pub fn level(&self) -> u32 {
+        with_dim!(self, AnyTree, t => t.level())
+    }
+
+    /// Node counts per level.
+    pub fn counts_per_level(&self) -> Vec<LevelCounts> {
+        with_dim!(self, AnyTree, t => t.counts_per_level())
+    }
+
+    /// Total node counts.
+    pub fn counts(&self) -> LevelCounts {
+        with_dim!(self, AnyTree, t => t.counts())
+    }
+
+    /// Bytes at 2 bits a node.
+    pub fn bytes_at_two_bits(&self) -> u64 {
+        with_dim!(self, AnyTree, t => t.bytes_at_two_bits())
+    }
+}
+
+impl AnyRaySet {
+    /// The dimension `K`.
+    pub fn k(&self) -> usize {
+        match self {
+            Self::K1(_) => 1,
+            Self::K2(_) => 2,
+            Self::K3(_) => 3,
+            Self::K4(_) => 4,
+        }
+    }
+
+    /// The universe level `L`.
+    pub fn level(&self) -> u32 {
+        with_dim!(self, AnyRaySet, r => r.level())
+    }
+
+    /// The number of runs.
+    pub fn len(&self) -> usize {
+        with_dim!(self, AnyRaySet, r => r.len())
+    }
+
+    /// Whether there is no run.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Builds the tree by stacking.
+    pub fn stack(&self) -> AnyTree {
+        match self {
+            Self::K1(r) => AnyTree::K1(crate::build::stack(r)),
+            Self::K2(r) => AnyTree::K2(crate::build::stack(r)),
+            Self::K3(r) => AnyTree::K3(crate::build::stack(r)),
+            Self::K4(r) => AnyTree::K4(crate::build::stack(r)),
+        }
+    }
+}
+
+impl<const K: usize> From<KTree<K>> for AnyTree {
+    fn from(tree: KTree<K>) -> Self {
+        // Each arm converts only when K matches; `KTree<K>` and `KTree<1>` are the same type then.
+        let any: Box<dyn std::any::Any> = Box::new(tree);
+        let any = match any.downcast::<KTree<1>>() {
+            Ok(t) => return Self::K1(*t),
+            Err(a) => a,
+        };
+        let any = match any.downcast::<KTree<2>>() {
+            Ok(t) => return Self::K2(*t),
+            Err(a) => a,
+        };
+        let any = match any.downcast::<KTree<3>>() {
+            Ok(t) => return Self::K3(*t),
+            Err(a) => a,
+        };
+        match any.downcast::<KTree<4>>() {
+            Ok(t) => Self::K4(*t),
+            Err(_) => unreachable!("K is checked to be 1..=4 when a KTree is made"),
+        }
+    }
+}
+
+impl<const K: usize> From<RaySet<K>> for AnyRaySet {
+    fn from(rays: RaySet<K>) -> Self {
+        let any: Box<dyn std::any::Any> = Box::new(rays);
+        let any = match any.downcast::<RaySet<1>>() {
+            Ok(r) => return Self::K1(*r),
+            Err(a) => a,
+        };
+        let any = match any.downcast::<RaySet<2>>() {
+            Ok(r) => return Self::K2(*r),
+            Err(a) => a,
+        };
+        let any = match any.downcast::<RaySet<3>>() {
+            Ok(r) => return Self::K3(*r),
+            Err(a) => a,
+        };
+        match any.downcast::<RaySet<4>>() {
+            Ok(r) => Self::K4(*r),
+            Err(_) => unreachable!("K is checked to be 1..=4 when a RaySet is made"),
+        }
+    }
+}

@@ -1,0 +1,426 @@
+//! The `.ktree` file: a tree in level order at Meagher's 2 bits a node.
+//!
+//! | offset | size | content |
+//! |---|---|---|
+//! | 0 | 6 | magic `KTREE\0` |
+//! | 6 | 2 | format version, `u16` little-endian (= 1) |
+//! | 8 | 1 | `K` (1…4) |
+//! | 9 | 1 | `L` (0…[`crate::max_level`]`(K)`) |
+//! | 10 | 2 | reserved, 0 |
+//! | 12 | 4 | `D`, the number of stored levels (`u32` LE) |
+//! | 16 | 8·D | nodes per level, `u64` LE each |
+//! | 16 + 8·D | 24 | full, empty, partial node totals, `u64` LE each |
+//! | 40 + 8·D | ⌈N/4⌉ | node states, 2 bits each (`00` empty, `01` full, `10` partial), level order, node `i` in bits `2·(i mod 4)` of byte `i / 4`; unused bits 0 |
+//! | end − 4 | 4 | CRC-32 (IEEE) of everything before, `u32` LE |
+//!
+//! Reading checks the magic, version, K and L, that the level sizes agree with the partial counts above
+//! them and with the file's length *before* allocating, the checksum, the totals, and the tree's invariants
+//! (reduced, no partial voxels). Any mismatch is an error naming the file and the byte offset.
+
+use std::fmt;
+use std::io::Write;
+use std::path::Path;
+
+use thiserror::Error;
+
+use super::any::AnyTree;
+use crate::space::{max_level, Universe, MAX_K};
+use crate::tree::{KTree, NodeState, PackedStates};
+
+/// The magic bytes at the start of a `.ktree` file.
+pub const MAGIC: &[u8; 6] = b"KTREE\0";
+/// The format version written.
+pub const VERSION: u16 = 1;
+
+/// What was wrong with a `.ktree` file.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum KtreeFileErrorKind {
+    /// Not a `.ktree` file.
+    #[error("not a .ktree file (bad magic)")]
+    BadMagic,
+    /// Written by a newer version of ktree.
+    #[error("format version {0} is not supported (this ktree reads version {VERSION})")]
+    Version(u16),
+    /// `K` or `L` out of range.
+    #[error("bad header: {0}")]
+    Header(String),
+    /// The file ends early or has extra bytes.
+    #[error("file is {found} bytes but the header describes {expected}: truncated or padded")]
+    Length {
+        /// Bytes the header implies.
+        expected: u64,
+        /// Bytes present.
+        found: u64,
+    },
+    /// The checksum does not match: the file is corrupted.
+    #[error(
+        "checksum mismatch (stored {stored:08x}, computed {computed:08x}): the file is corrupted"
+    )]
+    Checksum {
+        /// Stored CRC.
+        stored: u32,
+        /// Computed CRC.
+        computed: u32,
+    },
+    /// The node states are inconsistent.
+    #[error("bad tree: {0}")]
+    Tree(String),
+    /// The tree has another dimension than the caller asked for.
+    #[error("the file holds a K = {found} tree, K = {expected} was expected")]
+    Dimension {
+        /// K asked for.
+        expected: usize,
+        /// K in the file.
+        found: usize,
+    },
+    /// The file could not be read.
+    #[error("cannot read: {0}")]
+    Io(String),
+}
+
+/// An error reading a `.ktree` file, with the file and the byte offset.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct KtreeFileError {
+    /// The file (or a name for the input).
+    pub file: String,
+    /// Byte offset where the problem was found.
+    pub offset: u64,
+    /// What was wrong.
+    pub kind: KtreeFileErrorKind,
+}
+
+impl fmt::Display for KtreeFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: byte {}: {}", self.file, self.offset, self.kind)
+    }
+}
+
+impl std::error::Error for KtreeFileError {}
+
+/// Writes a tree in the `.ktree` format.
+///
+/// ```
+/// use ktree::{io, KTree};
+/// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
+/// let mut bytes = Vec::new();
+/// io::write_ktree(&mut bytes, &tree).unwrap();
+/// assert_eq!(io::read_ktree::<2>(&bytes, "mem").unwrap(), tree);
+/// bytes[20] ^= 1; // corrupt a byte
+/// assert!(io::read_ktree::<2>(&bytes, "mem").is_err());
+/// ```
+///
+/// # Errors
+/// Any I/O error.
+pub fn write_ktree<const K: usize>(mut w: impl Write, tree: &KTree<K>) -> std::io::Result<()> {
+    let mut bytes = Vec::with_capacity(64 + tree.bytes_at_two_bits() as usize);
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&VERSION.to_le_bytes());
+    bytes.push(K as u8);
+    bytes.push(tree.level() as u8);
+    bytes.extend_from_slice(&[0, 0]);
+    bytes.extend_from_slice(&(tree.depth_count() as u32).to_le_bytes());
+    for d in 0..tree.depth_count() {
+        bytes.extend_from_slice(&(tree.level_states(d).len() as u64).to_le_bytes());
+    }
+    let c = tree.counts();
+    for v in [c.full, c.empty, c.partial] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    // Node states, continuing across levels.
+    let mut acc = 0u8;
+    let mut n = 0usize;
+    for d in 0..tree.depth_count() {
+        let level = tree.level_states(d);
+        for i in 0..level.len() {
+            acc |= (level.get(i) as u8) << (2 * (n % 4));
+            n += 1;
+            if n % 4 == 0 {
+                bytes.push(acc);
+                acc = 0;
+            }
+        }
+    }
+    if n % 4 != 0 {
+        bytes.push(acc);
+    }
+    let crc = crc32fast::hash(&bytes);
+    bytes.extend_from_slice(&crc.to_le_bytes());
+    w.write_all(&bytes)
+}
+
+/// Writes a `.ktree` file atomically (temporary file, then rename).
+///
+/// # Errors
+/// Any I/O error, naming the path.
+pub fn write_ktree_file<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
+    super::write_atomic_with(path, |w| write_ktree(w, tree))
+}
+
+/// Reads a `.ktree` file's bytes, expecting dimension `K`.
+///
+/// # Errors
+/// [`KtreeFileError`] for any inconsistency, or [`KtreeFileErrorKind::Dimension`] if the file's `K` differs.
+pub fn read_ktree<const K: usize>(bytes: &[u8], file: &str) -> Result<KTree<K>, KtreeFileError> {
+    let any = read_ktree_any(bytes, file)?;
+    let found = any.k();
+    any.into_dim::<K>().map_err(|_| KtreeFileError {
+        file: file.to_string(),
+        offset: 8,
+        kind: KtreeFileErrorKind::Dimension { expected: K, found },
+    })
+}
+
+/// Reads a `.ktree` file from disk, of whatever dimension it holds.
+///
+/// # Errors
+/// As [`read_ktree_any`]; an unreadable file is [`KtreeFileErrorKind::Io`].
+pub fn read_ktree_file(path: &Path) -> Result<AnyTree, KtreeFileError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| KtreeFileError {
+        file: name.clone(),
+        offset: 0,
+        kind: KtreeFileErrorKind::Io(e.to_string()),
+    })?;
+    read_ktree_any(&bytes, &name)
+}
+
+/// Reads a `.ktree` file's bytes, of whatever dimension they hold.
+///
+/// # Errors
+/// [`KtreeFileError`] naming the byte offset of the first inconsistency.
+pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileError> {
+    let fail = |offset: usize, kind| KtreeFileError {
+        file: file.to_string(),
+        offset: offset as u64,
+        kind,
+    };
+    let truncated = |offset: usize| {
+        fail(
+            offset,
+            KtreeFileErrorKind::Length {
+                expected: offset as u64 + 1,
+                found: bytes.len() as u64,
+            },
+        )
+    };
+    let u64_at = |at: usize| -> Result<u64, KtreeFileError> {
+        bytes
+            .get(at..at + 8)
+            .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")))
+            .ok_or_else(|| truncated(at))
+    };
+    if bytes.len() < 6 || &bytes[..6] != MAGIC {
+        return Err(fail(0, KtreeFileErrorKind::BadMagic));
+    }
+    if bytes.len() < 16 {
+        return Err(truncated(bytes.len()));
+    }
+    let version = u16::from_le_bytes([bytes[6], bytes[7]]);
+    if version != VERSION {
+        return Err(fail(6, KtreeFileErrorKind::Version(version)));
+    }
+    let k = bytes[8] as usize;
+    if !(1..=MAX_K).contains(&k) {
+        return Err(fail(
+            8,
+            KtreeFileErrorKind::Header(format!("K = {k} is not 1 to {MAX_K}")),
+        ));
+    }
+    let level = u32::from(bytes[9]);
+    if level > max_level(k) {
+        return Err(fail(
+            9,
+            KtreeFileErrorKind::Header(format!("L = {level} exceeds {} for K = {k}", max_level(k))),
+        ));
+    }
+    if bytes[10] != 0 || bytes[11] != 0 {
+        return Err(fail(
+            10,
+            KtreeFileErrorKind::Header("reserved bytes are not 0".into()),
+        ));
+    }
+    let depth = u32::from_le_bytes(bytes[12..16].try_into().expect("4 bytes")) as usize;
+    if depth == 0 || depth > level as usize + 1 {
+        return Err(fail(
+            12,
+            KtreeFileErrorKind::Header(format!(
+                "{depth} levels stored for a level-{level} universe"
+            )),
+        ));
+    }
+    let mut sizes = Vec::with_capacity(depth);
+    for d in 0..depth {
+        sizes.push(u64_at(16 + 8 * d)?);
+    }
+    let totals_at = 16 + 8 * depth;
+    let totals = [
+        u64_at(totals_at)?,
+        u64_at(totals_at + 8)?,
+        u64_at(totals_at + 16)?,
+    ];
+    let body_at = totals_at + 24;
+    // Check the sizes against the file length before allocating anything proportional to them.
+    let nodes = sizes.iter().try_fold(0u64, |a, &s| a.checked_add(s));
+    let expected = nodes.and_then(|n| n.div_ceil(4).checked_add(body_at as u64 + 4));
+    match expected {
+        Some(e) if e == bytes.len() as u64 => {}
+        Some(e) => {
+            return Err(fail(
+                bytes.len().min(e as usize),
+                KtreeFileErrorKind::Length {
+                    expected: e,
+                    found: bytes.len() as u64,
+                },
+            ))
+        }
+        None => {
+            return Err(fail(
+                16,
+                KtreeFileErrorKind::Header("node counts overflow".into()),
+            ))
+        }
+    }
+    let nodes = nodes.expect("checked above") as usize;
+    let crc_at = bytes.len() - 4;
+    let stored = u32::from_le_bytes(bytes[crc_at..].try_into().expect("4 bytes"));
+    let computed = crc32fast::hash(&bytes[..crc_at]);
+    if stored != computed {
+        return Err(fail(
+            crc_at,
+            KtreeFileErrorKind::Checksum { stored, computed },
+        ));
+    }
+    // Decode states level by level.
+    let body = &bytes[body_at..crc_at];
+    let mut levels = Vec::with_capacity(depth);
+    let mut n = 0usize;
+    let mut counts = [0u64; 3];
+    for (d, &size) in sizes.iter().enumerate() {
+        let mut level_states = PackedStates::with_capacity(size as usize);
+        for _ in 0..size {
+            let code = (body[n / 4] >> (2 * (n % 4))) & 3;
+            let Some(state) = NodeState::from_code(code) else {
+                return Err(fail(
+                    body_at + n / 4,
+                    KtreeFileErrorKind::Tree(format!(
+                        "node {n} (level {d}) has the unused code 11"
+                    )),
+                ));
+            };
+            counts[state as usize] += 1;
+            level_states.push(state);
+            n += 1;
+        }
+        level_states.finish();
+        levels.push(level_states);
+    }
+    if nodes % 4 != 0 && body[nodes / 4] >> (2 * (nodes % 4)) != 0 {
+        return Err(fail(
+            body_at + nodes / 4,
+            KtreeFileErrorKind::Tree("padding bits after the last node are not 0".into()),
+        ));
+    }
+    let [full, empty, partial] = [counts[1], counts[0], counts[2]];
+    if [full, empty, partial] != totals {
+        return Err(fail(
+            totals_at,
+            KtreeFileErrorKind::Tree(format!(
+                "header totals (full, empty, partial) = {totals:?} but the nodes give {:?}",
+                [full, empty, partial]
+            )),
+        ));
+    }
+    let tree = match k {
+        1 => AnyTree::K1(assemble::<1>(level, levels)),
+        2 => AnyTree::K2(assemble::<2>(level, levels)),
+        3 => AnyTree::K3(assemble::<3>(level, levels)),
+        _ => AnyTree::K4(assemble::<4>(level, levels)),
+    };
+    let check = crate::with_dim!(&tree, AnyTree, t => t.check());
+    check.map_err(|e| fail(body_at, KtreeFileErrorKind::Tree(e)))?;
+    Ok(tree)
+}
+
+fn assemble<const K: usize>(level: u32, levels: Vec<PackedStates>) -> KTree<K> {
+    KTree::from_levels(Universe::new(level).expect("level checked"), levels)
+}
+
+impl AnyTree {
+    /// The tree as `KTree<K>`, or `self` back if it has another dimension.
+    ///
+    /// # Errors
+    /// `Err(self)` when the dimension differs.
+    pub fn into_dim<const K: usize>(self) -> Result<KTree<K>, Self> {
+        let boxed: Box<dyn std::any::Any> = match self {
+            AnyTree::K1(t) if K == 1 => Box::new(t),
+            AnyTree::K2(t) if K == 2 => Box::new(t),
+            AnyTree::K3(t) if K == 3 => Box::new(t),
+            AnyTree::K4(t) if K == 4 => Box::new(t),
+            other => return Err(other),
+        };
+        Ok(*boxed.downcast::<KTree<K>>().expect("K matched above"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::build::stack;
+    use crate::rays::ball_rays;
+
+    fn sample() -> Vec<u8> {
+        let tree = stack(&ball_rays::<3>(4, [10, 12, 14], 9).unwrap());
+        let mut bytes = Vec::new();
+        write_ktree(&mut bytes, &tree).unwrap();
+        bytes
+    }
+
+    #[test]
+    fn truncation_padding_and_every_single_bit_flip_are_rejected() {
+        let bytes = sample();
+        assert!(read_ktree::<3>(&bytes, "s").is_ok());
+        for cut in [0, 5, 15, 30, bytes.len() - 1] {
+            assert!(
+                read_ktree::<3>(&bytes[..cut], "s").is_err(),
+                "truncated at {cut}"
+            );
+        }
+        let mut padded = bytes.clone();
+        padded.push(0);
+        assert!(matches!(
+            read_ktree::<3>(&padded, "s").unwrap_err().kind,
+            KtreeFileErrorKind::Length { .. }
+        ));
+        for i in 0..bytes.len() {
+            for bit in 0..8 {
+                let mut bad = bytes.clone();
+                bad[i] ^= 1 << bit;
+                assert!(
+                    read_ktree::<3>(&bad, "s").is_err(),
+                    "flip of bit {bit} of byte {i} accepted"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn wrong_dimension_and_huge_sizes_are_clear_errors() {
+        let bytes = sample();
+        let e = read_ktree::<2>(&bytes, "s").unwrap_err();
+        assert_eq!(
+            e.kind,
+            KtreeFileErrorKind::Dimension {
+                expected: 2,
+                found: 3
+            }
+        );
+        // A header claiming 2^60 nodes is rejected by length before any allocation.
+        let mut huge = bytes.clone();
+        huge[16 + 8..16 + 16].copy_from_slice(&(1u64 << 60).to_le_bytes());
+        assert!(matches!(
+            read_ktree::<3>(&huge, "s").unwrap_err().kind,
+            KtreeFileErrorKind::Length { .. }
+        ));
+    }
+}

@@ -1,0 +1,383 @@
+//! The ray text format, for users and for checking from outside the project:
+//!
+//! ```text
+//! # ktree rays v1          <- lines starting with # are comments (blank lines are skipped too)
+//! K L                      <- first other line: dimension and level
+//! c_0 ... c_{K-2} z1 z2    <- one run per line: the column's K−1 coordinates, then z1 z2 (covers z1 <= z < z2)
+//! ```
+//!
+//! Extension (added, optional): a run line may carry `2·K` more numbers, the surface normal at `z1` then the
+//! normal at `z2`; then every run line of the file must. Overlapping or touching runs of one column are
+//! merged as [`RaySet::from_rays`] documents.
+
+use std::fmt;
+use std::io::{BufRead, Write};
+use std::path::Path;
+
+use thiserror::Error;
+
+use super::any::AnyRaySet;
+use crate::rays::{Normal, Ray, RayError, RaySet};
+use crate::space::{max_level, MAX_K};
+
+/// What was wrong with a ray file.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum RaysTextErrorKind {
+    /// The file has no header line (it is empty or only comments).
+    #[error("empty file: expected a header line `K L`")]
+    Empty,
+    /// The header is not two numbers.
+    #[error("header must be `K L` (two whole numbers), found {0:?}")]
+    BadHeader(String),
+    /// `K` is not 1…4.
+    #[error("K = {0} is not supported (1 to {MAX_K})")]
+    BadDimension(u64),
+    /// `L` is beyond [`max_level`] for `K`.
+    #[error("level {level} is too large for K = {k} (at most {max})")]
+    LevelTooLarge {
+        /// The dimension.
+        k: usize,
+        /// The level.
+        level: u64,
+        /// The largest level for `k`.
+        max: u32,
+    },
+    /// A run line has the wrong number of fields.
+    #[error(
+        "expected {expected} numbers (K−1 column coordinates, z1, z2{normals}), found {found}"
+    )]
+    FieldCount {
+        /// Fields expected.
+        expected: usize,
+        /// Fields found.
+        found: usize,
+        /// A note about optional normals.
+        normals: &'static str,
+    },
+    /// A field is not a number.
+    #[error("field {field} ({text:?}) is not a {what}")]
+    NotANumber {
+        /// 1-based field number.
+        field: usize,
+        /// The text.
+        text: String,
+        /// "whole number" or "number".
+        what: &'static str,
+    },
+    /// A coordinate or run end lies outside the universe, or the run is empty or reversed.
+    #[error("{0}")]
+    BadRun(String),
+    /// The file could not be read.
+    #[error("cannot read: {0}")]
+    Io(String),
+}
+
+/// An error in a ray file, with where it happened.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RaysTextError {
+    /// The file (or a name for the input).
+    pub file: String,
+    /// The 1-based line, 0 when the error is about the whole file.
+    pub line: usize,
+    /// What was wrong.
+    pub kind: RaysTextErrorKind,
+}
+
+impl fmt::Display for RaysTextError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line > 0 {
+            write!(f, "{}:{}: {}", self.file, self.line, self.kind)
+        } else {
+            write!(f, "{}: {}", self.file, self.kind)
+        }
+    }
+}
+
+impl std::error::Error for RaysTextError {}
+
+/// Reads a ray file into a ray set of the dimension its header names.
+///
+/// ```
+/// use ktree::io::{read_rays, AnyRaySet};
+/// let text = "# ktree rays v1\n2 3\n1 0 4\n1 3 6\n";
+/// let AnyRaySet::K2(rays) = read_rays(text.as_bytes(), "example").unwrap() else { panic!() };
+/// assert_eq!(rays.len(), 1); // [0,4) and [3,6) merged
+/// let err = read_rays("2 3\n1 5 4\n".as_bytes(), "bad.rays").unwrap_err();
+/// assert_eq!(err.to_string(), "bad.rays:2: ray 0: run [5, 4) is empty or reversed (need z1 < z2)");
+/// ```
+///
+/// # Errors
+/// [`RaysTextError`] naming the file and line of the first problem.
+pub fn read_rays(reader: impl BufRead, file: &str) -> Result<AnyRaySet, RaysTextError> {
+    let mut lines = NumberedLines {
+        reader,
+        line: 0,
+        buf: String::new(),
+        file,
+    };
+    let Some(header) = lines.next_content()? else {
+        return Err(lines.error(0, RaysTextErrorKind::Empty));
+    };
+    let line = lines.line;
+    let fields: Vec<&str> = header.split_ascii_whitespace().collect();
+    let parsed: Option<Vec<u64>> = fields.iter().map(|f| f.parse().ok()).collect();
+    let (k, level) = match parsed.as_deref() {
+        Some(&[k, level]) => (k, level),
+        _ => return Err(lines.error(line, RaysTextErrorKind::BadHeader(header.clone()))),
+    };
+    if !(1..=MAX_K as u64).contains(&k) {
+        return Err(lines.error(line, RaysTextErrorKind::BadDimension(k)));
+    }
+    let k = k as usize;
+    if level > u64::from(max_level(k)) {
+        return Err(lines.error(
+            line,
+            RaysTextErrorKind::LevelTooLarge {
+                k,
+                level,
+                max: max_level(k),
+            },
+        ));
+    }
+    let level = level as u32;
+    match k {
+        1 => read_body::<1, _>(lines, level).map(AnyRaySet::K1),
+        2 => read_body::<2, _>(lines, level).map(AnyRaySet::K2),
+        3 => read_body::<3, _>(lines, level).map(AnyRaySet::K3),
+        _ => read_body::<4, _>(lines, level).map(AnyRaySet::K4),
+    }
+}
+
+/// Reads a ray file from disk.
+///
+/// # Errors
+/// As [`read_rays`]; a file that cannot be opened is [`RaysTextErrorKind::Io`].
+pub fn read_rays_file(path: &Path) -> Result<AnyRaySet, RaysTextError> {
+    let name = path.display().to_string();
+    let file = std::fs::File::open(path).map_err(|e| RaysTextError {
+        file: name.clone(),
+        line: 0,
+        kind: RaysTextErrorKind::Io(e.to_string()),
+    })?;
+    read_rays(std::io::BufReader::new(file), &name)
+}
+
+/// Writes a ray set in the text format (with normals when the set carries them).
+///
+/// # Errors
+/// Any I/O error.
+pub fn write_rays<const K: usize>(mut w: impl Write, rays: &RaySet<K>) -> std::io::Result<()> {
+    writeln!(w, "# ktree rays v1")?;
+    if rays.has_normals() {
+        writeln!(
+            w,
+            "# columns: c_0..c_{{K-2}} z1 z2, normal at z1 (K numbers), normal at z2 (K numbers)"
+        )?;
+    }
+    writeln!(w, "{K} {}", rays.level())?;
+    let mut line = String::new();
+    for (i, ray) in rays.iter().enumerate() {
+        use fmt::Write as _;
+        line.clear();
+        for c in &ray.start[..K - 1] {
+            let _ = write!(line, "{c} ");
+        }
+        let _ = write!(line, "{} {}", ray.z1(), ray.z2);
+        if let Some(normals) = rays.normals(i) {
+            for v in normals.iter().flatten() {
+                let _ = write!(line, " {v}");
+            }
+        }
+        writeln!(w, "{line}")?;
+    }
+    Ok(())
+}
+
+/// Writes a ray file atomically (temporary file, then rename).
+///
+/// # Errors
+/// Any I/O error, naming the path.
+pub fn write_rays_file<const K: usize>(path: &Path, rays: &RaySet<K>) -> std::io::Result<()> {
+    super::write_atomic_with(path, |w| write_rays(w, rays))
+}
+
+struct NumberedLines<'a, R> {
+    reader: R,
+    line: usize,
+    buf: String,
+    file: &'a str,
+}
+
+impl<R: BufRead> NumberedLines<'_, R> {
+    fn error(&self, line: usize, kind: RaysTextErrorKind) -> RaysTextError {
+        RaysTextError {
+            file: self.file.to_string(),
+            line,
+            kind,
+        }
+    }
+
+    /// The next line that is not blank or a comment, trimmed.
+    fn next_content(&mut self) -> Result<Option<String>, RaysTextError> {
+        loop {
+            self.buf.clear();
+            let n = self
+                .reader
+                .read_line(&mut self.buf)
+                .map_err(|e| self.error(self.line + 1, RaysTextErrorKind::Io(e.to_string())))?;
+            if n == 0 {
+                return Ok(None);
+            }
+            self.line += 1;
+            let t = self.buf.trim();
+            if !t.is_empty() && !t.starts_with('#') {
+                return Ok(Some(t.to_string()));
+            }
+        }
+    }
+}
+
+fn read_body<const K: usize, R: BufRead>(
+    mut lines: NumberedLines<'_, R>,
+    level: u32,
+) -> Result<RaySet<K>, RaysTextError> {
+    let plain = K + 1;
+    let with_normals = plain + 2 * K;
+    let mut rays: Vec<Ray<K>> = Vec::new();
+    let mut normals: Vec<[Normal<K>; 2]> = Vec::new();
+    let mut line_of: Vec<usize> = Vec::new();
+    let mut has_normals: Option<bool> = None;
+    while let Some(text) = lines.next_content()? {
+        let line = lines.line;
+        let fields: Vec<&str> = text.split_ascii_whitespace().collect();
+        let expect_normals = *has_normals.get_or_insert(fields.len() == with_normals);
+        let expected = if expect_normals { with_normals } else { plain };
+        if fields.len() != expected {
+            let normals = if expect_normals {
+                ", then 2·K normal components"
+            } else {
+                ""
+            };
+            return Err(lines.error(
+                line,
+                RaysTextErrorKind::FieldCount {
+                    expected,
+                    found: fields.len(),
+                    normals,
+                },
+            ));
+        }
+        let mut start = [0u32; K];
+        let mut z2 = 0u32;
+        for (i, f) in fields[..plain].iter().enumerate() {
+            let v: u32 = f.parse().map_err(|_| {
+                lines.error(
+                    line,
+                    RaysTextErrorKind::NotANumber {
+                        field: i + 1,
+                        text: f.to_string(),
+                        what: "whole number",
+                    },
+                )
+            })?;
+            if i < K {
+                start[i] = v;
+            } else {
+                z2 = v;
+            }
+        }
+        rays.push(Ray::new(start, z2));
+        line_of.push(line);
+        if expect_normals {
+            let mut n = [[0f32; K]; 2];
+            for (i, f) in fields[plain..].iter().enumerate() {
+                n[i / K][i % K] = f.parse().map_err(|_| {
+                    lines.error(
+                        line,
+                        RaysTextErrorKind::NotANumber {
+                            field: plain + i + 1,
+                            text: f.to_string(),
+                            what: "number",
+                        },
+                    )
+                })?;
+            }
+            normals.push(n);
+        }
+    }
+    let result = if has_normals == Some(true) {
+        RaySet::from_rays_with_normals(level, rays.into_iter().zip(normals))
+    } else {
+        RaySet::from_rays(level, rays)
+    };
+    result.map_err(|e| {
+        let line = match &e {
+            RayError::ColumnOutside { index, .. }
+            | RayError::RunOutside { index, .. }
+            | RayError::EmptyRun { index, .. } => line_of[*index],
+            _ => 0,
+        };
+        lines.error(line, RaysTextErrorKind::BadRun(e.to_string()))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> RaysTextError {
+        read_rays(text.as_bytes(), "t.rays").unwrap_err()
+    }
+
+    #[test]
+    fn bad_input_names_the_line() {
+        assert_eq!(err("").kind, RaysTextErrorKind::Empty);
+        assert_eq!(err("# only a comment\n\n").kind, RaysTextErrorKind::Empty);
+        assert!(matches!(err("3\n").kind, RaysTextErrorKind::BadHeader(_)));
+        assert!(matches!(err("x 3\n").kind, RaysTextErrorKind::BadHeader(_)));
+        assert_eq!(err("5 3\n").kind, RaysTextErrorKind::BadDimension(5));
+        assert!(matches!(
+            err("3 22\n").kind,
+            RaysTextErrorKind::LevelTooLarge { .. }
+        ));
+        let e = err("# c\n3 4\n1 2 3 4\n1 2 3\n");
+        assert_eq!(
+            (e.line, e.kind.clone()),
+            (
+                4,
+                RaysTextErrorKind::FieldCount {
+                    expected: 4,
+                    found: 3,
+                    normals: ""
+                }
+            )
+        );
+        let e = err("3 4\n1 2 x 4\n");
+        assert_eq!(e.line, 2);
+        assert!(matches!(
+            e.kind,
+            RaysTextErrorKind::NotANumber { field: 3, .. }
+        ));
+        let e = err("3 4\n1 2 3 4\n1 16 3 4\n");
+        assert_eq!(e.line, 3);
+        assert!(e.to_string().starts_with("t.rays:3: "), "{e}");
+        assert_eq!(err("3 4\n1 2 3 17\n").line, 2);
+        assert_eq!(err("3 4\n1 2 -3 7\n").line, 2);
+        assert_eq!(err("1 4\n5 5\n").line, 2);
+    }
+
+    #[test]
+    fn round_trip_with_and_without_normals() {
+        let rays =
+            RaySet::<3>::from_rays(4, [Ray::new([1, 2, 3], 9), Ray::new([0, 15, 0], 16)]).unwrap();
+        let mut buf = Vec::new();
+        write_rays(&mut buf, &rays).unwrap();
+        assert_eq!(read_rays(&buf[..], "x").unwrap(), AnyRaySet::K3(rays));
+        let n = [[0.0, -1.0], [0.25, 1.0]];
+        let rays = RaySet::<2>::from_rays_with_normals(3, [(Ray::new([1, 2], 5), n)]).unwrap();
+        let mut buf = Vec::new();
+        write_rays(&mut buf, &rays).unwrap();
+        assert_eq!(read_rays(&buf[..], "x").unwrap(), AnyRaySet::K2(rays));
+    }
+}
