@@ -16,8 +16,10 @@ pub mod hidden;
 pub mod lines;
 pub mod neighbours;
 pub mod order;
+pub mod plane;
 pub mod png;
 pub mod raster;
+pub mod slices;
 pub mod svg;
 
 pub use camera::{default_camera, object_bounds, Camera, Projection, ISO_TOWARD_EYE};
