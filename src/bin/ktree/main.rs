@@ -6,6 +6,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod build;
+mod lines;
+mod render;
 mod repro;
 mod stats;
 
@@ -23,6 +25,10 @@ enum Command {
     Build(build::Args),
     /// Print node counts (K, L, rays, full, empty, partial, nodes, per level) of a tree or a ray file.
     Stats(stats::Args),
+    /// Draw a hidden-surface image of a tree (octree; quadtree picture; 4-D strip of time slices) as PNG.
+    Render(render::Args),
+    /// Draw an octree as lines with hidden lines removed (SVG or PNG).
+    Lines(lines::Args),
     /// Regenerate the paper reproductions into results/ (all of them by default).
     Repro(repro::Args),
 }
@@ -32,6 +38,8 @@ fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Build(args) => build::run(args),
         Command::Stats(args) => stats::run(args),
+        Command::Render(args) => render::run(args),
+        Command::Lines(args) => lines::run(args),
         Command::Repro(args) => repro::run(args),
     };
     match outcome {
