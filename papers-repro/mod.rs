@@ -3,11 +3,12 @@
 //! `ktree repro [NAME]`.
 
 pub mod default_object;
+pub mod veenstra_ahuja;
 
 use std::path::Path;
 
 /// The names accepted by [`run`], in the order `ktree repro all` runs them.
-pub const NAMES: &[&str] = &["default-object"];
+pub const NAMES: &[&str] = &["default-object", "veenstra-ahuja"];
 
 /// Runs one reproduction, writing into `results` (the results directory); returns a report to print.
 ///
@@ -16,6 +17,7 @@ pub const NAMES: &[&str] = &["default-object"];
 pub fn run(name: &str, results: &Path) -> Result<String, String> {
     match name {
         "default-object" => default_object::run(results),
+        "veenstra-ahuja" => veenstra_ahuja::run(results),
         _ => Err(format!("no reproduction named '{name}'")),
     }
 }

@@ -349,5 +349,33 @@ pub fn default_camera(
 ) -> Result<Camera, DisplayError> {
     let side = tree.universe().side() as f64;
     let (lo, hi) = object_bounds(tree).unwrap_or(([0.0; 3], [side; 3]));
-    Camera::framing(lo, hi, toward_eye, fov_y_degrees, width, height)
+    let mut camera = Camera::framing(lo, hi, toward_eye, fov_y_degrees, width, height)?;
+    if let Projection::Orthographic { height: box_height } = camera.projection {
+        // Tighter: fit the projected corners of the full leaves rather than of the bounding box.
+        let Frame { r, u, .. } = camera.frame();
+        let (mut ex, mut ey) = (0.0f64, 0.0f64);
+        tree.for_each_leaf(|cell, state| {
+            if state != NodeState::Full {
+                return;
+            }
+            let s = cell.side() as f64;
+            let o = cell.origin.map(f64::from);
+            for c in 0..8 {
+                let p = [
+                    o[0] + if c & 1 == 0 { 0.0 } else { s },
+                    o[1] + if c & 2 == 0 { 0.0 } else { s },
+                    o[2] + if c & 4 == 0 { 0.0 } else { s },
+                ];
+                let v = v3::sub(p, camera.target);
+                ex = ex.max(v3::dot(v, r).abs());
+                ey = ey.max(v3::dot(v, u).abs());
+            }
+        });
+        let aspect = f64::from(width) / f64::from(height);
+        let fitted = (2.0 * ey).max(2.0 * ex / aspect).max(1.0) * 1.05;
+        camera.projection = Projection::Orthographic {
+            height: fitted.min(box_height),
+        };
+    }
+    Ok(camera)
 }

@@ -289,11 +289,8 @@ fn cell_box(cell: &Cell<3>) -> ([f64; 3], [f64; 3]) {
 /// The light direction (towards the light) for a camera: above and to the left of the eye.
 fn light_for(camera: &Camera) -> [f64; 3] {
     let f = camera.frame();
-    let l = v3::add_scaled(
-        v3::add_scaled([-0.6 * f.f[0], -0.6 * f.f[1], -0.6 * f.f[2]], 0.8, f.u),
-        -0.45,
-        f.r,
-    );
+    let back = [-f.f[0], -f.f[1], -f.f[2]];
+    let l = v3::add_scaled(v3::add_scaled(back, 0.6, f.u), -0.25, f.r);
     v3::normalize(l).expect("non-zero light")
 }
 
