@@ -2,6 +2,8 @@
 //! edge of the object (no cracks) and is not hidden (a brute-force ray cast through all full voxels
 //! decides), every robustly visible edge of the object is drawn, touching collinear pieces are one line,
 //! and the paper's pairwise hidden-line method and the bucketed one give the same drawing.
+// Geometry over axes reads clearest with indices.
+#![allow(clippy::needless_range_loop)]
 
 use ktree::display::{line_drawing, HiddenLineMethod, LineDrawing};
 use ktree::KTree;
@@ -181,7 +183,7 @@ fn check_drawing(dense: &[bool], d: &LineDrawing) -> Result<(), TestCaseError> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(48))]
+    #![proptest_config(ProptestConfig::with_cases(128))]
 
     #[test]
     fn drawn_lines_are_visible_edges_and_visible_edges_are_drawn(dense in objects(), dir in toward()) {

@@ -1,5 +1,7 @@
 //! The front-to-back raster renderer against a brute-force z-buffer of all full leaves: the same visible
 //! leaf at every pixel (up to exact depth ties), orthographic and perspective, on random trees.
+// Geometry over axes reads clearest with indices.
+#![allow(clippy::needless_range_loop)]
 
 mod common;
 

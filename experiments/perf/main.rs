@@ -6,6 +6,7 @@
 //! Each area is a module with `cases()` (what to measure) and `report()` (the Markdown table).
 
 mod build;
+mod display;
 mod measure;
 
 use std::process::ExitCode;
@@ -17,6 +18,7 @@ fn main() -> ExitCode {
         let (area, case) = (&args[1], &args[2]);
         return match area.as_str() {
             "build" => measure::child(|| build::run_case(case)),
+            "display" => measure::child(|| display::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -31,7 +33,8 @@ fn main() -> ExitCode {
     for area in areas {
         let result = match area {
             "build" => build::report(),
-            other => Err(format!("unknown area '{other}' (known: build)")),
+            "display" => display::report(),
+            other => Err(format!("unknown area '{other}' (known: build, display)")),
         };
         match result {
             Ok(path) => println!("wrote {path}"),

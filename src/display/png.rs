@@ -85,9 +85,9 @@ impl Canvas {
         }
         let i = 3 * (y as usize * self.width as usize + x as usize);
         let a = a.clamp(0.0, 1.0);
-        for k in 0..3 {
-            let old = f64::from(self.rgb[i + k]);
-            self.rgb[i + k] = (old + (f64::from(colour[k]) - old) * a).round() as u8;
+        for (dst, &c) in self.rgb[i..i + 3].iter_mut().zip(&colour) {
+            let old = f64::from(*dst);
+            *dst = (old + (f64::from(c) - old) * a).round() as u8;
         }
     }
 

@@ -254,7 +254,7 @@ impl Screen {
         let y1 = (ymax - 0.5 + MARGIN)
             .floor()
             .min(f64::from(self.height) - 1.0);
-        (x0 <= x1 && y0 <= y1).then(|| Rect {
+        (x0 <= x1 && y0 <= y1).then_some(Rect {
             x0: x0 as u32,
             x1: x1 as u32,
             y0: y0 as u32,
