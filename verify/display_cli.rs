@@ -106,6 +106,31 @@ fn render_and_lines_write_pictures() {
         "{err}"
     );
 
+    // Shading with the normals of a ray file (every run pointing up: a flat-looking but valid picture).
+    let flat = ktree::RaySet::<3>::from_rays_with_normals(
+        4,
+        ball_rays::<3>(4, [16, 16, 16], 14)
+            .unwrap()
+            .iter()
+            .map(|r| (r, [[0.0, 0.0, -1.0], [0.0, 0.0, 1.0]])),
+    )
+    .unwrap();
+    ktree::io::write_rays_file(&p("ball.rays"), &flat).unwrap();
+    let (ok, _, err) = ktree(&[
+        "render",
+        &s(p("ball.ktree")),
+        "--rays",
+        &s(p("ball.rays")),
+        "--size",
+        "32x32",
+        "--out",
+        &s(p("n.png")),
+    ]);
+    assert!(ok && is_png(&p("n.png")), "{err}");
+    assert_ne!(
+        std::fs::read(p("n.png")).unwrap(),
+        std::fs::read(p("e.png")).unwrap()
+    );
     let (ok, out, err) = ktree(&["lines", &s(p("ball.ktree")), "--out", &s(p("l.svg"))]);
     assert!(ok, "{err}");
     assert!(out.contains("lines"));

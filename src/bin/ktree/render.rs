@@ -9,7 +9,7 @@ use ktree::display::{
     default_camera, object_bounds, plane, png, render, slices, Camera, Projection, RenderOptions,
     ISO_TOWARD_EYE,
 };
-use ktree::io::{read_ktree_file, AnyTree};
+use ktree::io::{read_ktree_file, read_rays_file, AnyRaySet, AnyTree};
 
 /// Arguments of `ktree render`.
 #[derive(Debug, clap::Args)]
@@ -50,6 +50,9 @@ pub struct Args {
     /// 4-D trees: also write each frame as FRAMES_DIR/frame_NNN.png (an animated sequence).
     #[arg(long, value_name = "DIR")]
     frames_dir: Option<PathBuf>,
+    /// Shade with the surface normals carried by this ray file (the rays the octree was built from).
+    #[arg(long, value_name = "FILE")]
+    rays: Option<PathBuf>,
     /// Show a progress bar.
     #[arg(long)]
     progress: bool,
@@ -175,7 +178,33 @@ pub fn run(args: Args) -> Result<(), String> {
                 depth: args.depth.is_some(),
                 ..Default::default()
             };
-            let image = render(&tree, &camera, &options, None, Some(&mut tick))
+            let rays = match &args.rays {
+                None => None,
+                Some(path) => match read_rays_file(path).map_err(|e| e.to_string())? {
+                    AnyRaySet::K3(r) if r.level() != tree.level() => {
+                        return Err(format!(
+                            "{}: level {} does not match the tree's level {}",
+                            path.display(),
+                            r.level(),
+                            tree.level()
+                        ))
+                    }
+                    AnyRaySet::K3(r) if r.has_normals() => Some(r),
+                    AnyRaySet::K3(_) => {
+                        return Err(format!(
+                            "{}: the rays carry no normals to shade with",
+                            path.display()
+                        ))
+                    }
+                    _ => {
+                        return Err(format!(
+                            "{}: normals for an octree need a K = 3 ray file",
+                            path.display()
+                        ))
+                    }
+                },
+            };
+            let image = render(&tree, &camera, &options, rays.as_ref(), Some(&mut tick))
                 .map_err(|e| e.to_string())?;
             png::write_rgb_png(&out, w, h, &image.rgb).map_err(|e| e.to_string())?;
             if let (Some(path), Some(grey)) = (&args.depth, image.depth_grey()) {
