@@ -164,6 +164,22 @@ pub fn run(results: &Path) -> Result<String, String> {
     )
     .map_err(err)?;
 
+    // Beyond the paper: a quadtree as a picture of its cells, and a 4-D tree as a strip of time slices.
+    let disk = stack(&crate::rays::ball_rays::<2>(5, [32, 32], 27).map_err(|e| e.to_string())?);
+    crate::display::plane::quadtree_canvas(&disk, 512)
+        .and_then(|c| c.write_png(&dir.join("quadtree_disk.png")))
+        .map_err(err)?;
+    w(
+        &dir,
+        "quadtree_disk.svg",
+        crate::display::plane::quadtree_svg(&disk, 512).as_bytes(),
+    )?;
+    let moving = stack(&objects::moving_ball(5)?);
+    let (strip, _) = crate::display::slices::time_strip(&moving, 3, 6, 160).map_err(err)?;
+    strip
+        .write_png(&dir.join("strip_4d_moving_ball.png"))
+        .map_err(err)?;
+
     // Fig. 12: time against nodes, both methods.
     let mut timings = Vec::new();
     let mut cases: Vec<(&objects::Shape, u32)> = Vec::new();
@@ -348,7 +364,10 @@ fn readme(
          objects, so ours differ in shape and size; the figures show the same kinds of drawing.\n\n\
          A sphere at level {BIG_LEVEL}: `sphere_l7_normals.png` shaded with the exact surface normals the \
          rays carry (Akman & Franklin keep n1, n2 per ray for display), `sphere_l7_faces.png` by face \
-         orientation, `sphere_l7_depth.png` the depth image, `sphere_l7_perspective.png` a 35° perspective view.\n",
+         orientation, `sphere_l7_depth.png` the depth image, `sphere_l7_perspective.png` a 35° perspective view.\n\n\
+         Beyond the paper (issue 5, item 5): `quadtree_disk.png` / `.svg`, a level-5 quadtree of a disc drawn \
+         with its cells; `strip_4d_moving_ball.png`, a level-5 4-D tree (a ball moving along x as time, the \
+         fourth axis, passes) shown as six time slices rendered with one camera.\n",
         1u32 << FIG_LEVEL,
         ISO_TOWARD_EYE
     );

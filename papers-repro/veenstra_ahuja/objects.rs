@@ -220,3 +220,39 @@ pub fn sphere_with_normals(level: u32) -> Result<(RaySet<3>, Octree), String> {
     let tree = stack(&rays);
     Ok((rays, tree))
 }
+
+/// A 4-D object: a ball of radius U/5 moving along x from U/4 to 3U/4 (and rising along z) while time,
+/// the fourth axis, goes from 0 to U. Rays run along time: each voxel's run is when the ball covers it.
+pub fn moving_ball(level: u32) -> Result<RaySet<4>, String> {
+    let side = 1u32 << level;
+    let u = f64::from(side);
+    let mut runs = Vec::new();
+    for x in 0..side {
+        for y in 0..side {
+            for z in 0..side {
+                let mut start: Option<u32> = None;
+                for t in 0..=side {
+                    let inside = t < side && {
+                        let s = (f64::from(t) + 0.5) / u;
+                        let c = [u * (0.25 + 0.5 * s), u * 0.5, u * (0.35 + 0.3 * s)];
+                        let d: f64 = [x, y, z]
+                            .iter()
+                            .zip(c)
+                            .map(|(&v, c)| (f64::from(v) + 0.5 - c).powi(2))
+                            .sum();
+                        d <= (u / 5.0).powi(2)
+                    };
+                    match (inside, start) {
+                        (true, None) => start = Some(t),
+                        (false, Some(t1)) => {
+                            runs.push(Ray::new([x, y, z, t1], t));
+                            start = None;
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+    }
+    RaySet::from_rays(level, runs).map_err(|e| e.to_string())
+}
