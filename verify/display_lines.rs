@@ -270,3 +270,56 @@ fn a_zero_direction_is_an_error() {
     let top = line_drawing(&tree, [0.0, 0.0, 1.0], HiddenLineMethod::Bucketed, None).unwrap();
     assert!(top.lines.len() >= 4);
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// The pointer-free neighbour search agrees with the dense array: surrounded leaves, and the occupancy
+    /// read along every edge of every full leaf from the three cells around it.
+    #[test]
+    fn neighbour_search_matches_the_dense_array(dense in objects()) {
+        use ktree::display::neighbours::{edge_occupancy, is_surrounded, shifted};
+        let tree = KTree::<3>::from_dense(LEVEL, &dense).unwrap();
+        let side = SIDE as u64;
+        for cell in tree.full_cells() {
+            let s = cell.side() as i64;
+            let o = cell.origin.map(i64::from);
+            // Surrounded: every voxel just outside each face is full (and no face is on the boundary).
+            let mut want = true;
+            for axis in 0..3 {
+                for upper in [false, true] {
+                    let (b, c) = match axis { 0 => (1, 2), 1 => (0, 2), _ => (0, 1) };
+                    for i in 0..s {
+                        for j in 0..s {
+                            let mut p = o;
+                            p[axis] = if upper { o[axis] + s } else { o[axis] - 1 };
+                            p[b] += i;
+                            p[c] += j;
+                            want &= full(&dense, p);
+                        }
+                    }
+                }
+            }
+            prop_assert_eq!(is_surrounded(&tree, &cell), want, "cell {:?}", cell);
+            // Edge occupancy of the diagonal neighbour along one edge per axis.
+            for axis in 0..3usize {
+                let (b, c) = match axis { 0 => (1, 2), 1 => (0, 2), _ => (0, 1) };
+                let region = shifted(&cell, &[(b, true), (c, true)], side);
+                let runs = edge_occupancy(&tree, region.as_ref(), s as u32, axis, (b, false), (c, false));
+                let mut covered = 0u32;
+                for &(start, end, is_full) in &runs {
+                    prop_assert_eq!(start, covered);
+                    covered = end;
+                    for u in start..end {
+                        let mut p = o;
+                        p[axis] += i64::from(u);
+                        p[b] += s;
+                        p[c] += s;
+                        prop_assert_eq!(full(&dense, p), is_full, "edge of {:?} along {} at {}", cell, axis, u);
+                    }
+                }
+                prop_assert_eq!(covered, s as u32);
+            }
+        }
+    }
+}
