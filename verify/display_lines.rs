@@ -44,7 +44,14 @@ fn full(dense: &[bool], p: [i64; 3]) -> bool {
 }
 
 fn toward() -> impl Strategy<Value = [f64; 3]> {
-    prop::array::uniform3(prop_oneof![-1.0..-0.15f64, 0.15..1.0f64])
+    prop_oneof![
+        4 => prop::array::uniform3(prop_oneof![-1.0..-0.15f64, 0.15..1.0f64]),
+        // Exact axis and diagonal views (the direction is nudged off the axes).
+        1 => prop::sample::select(vec![
+            [0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0],
+            [1.0, 1.0, 1.0], [1.0, -1.0, 0.0], [0.0, 1.0, 1.0],
+        ]),
+    ]
 }
 
 /// The chord of the ray `p + t·v` through the box `[lo − grow, lo + 1 + grow]^3` intersected with
