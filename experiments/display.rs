@@ -74,5 +74,11 @@ fn lines(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, raster, lines);
+criterion_group! {
+    name = benches;
+    // Criterion's plots need a font registered with plotters (ab_glyph); without one it panics. The
+    // numbers are what matters here.
+    config = Criterion::default().without_plots();
+    targets = raster, lines
+}
 criterion_main!(benches);
