@@ -8,7 +8,8 @@ mod common;
 use common::ray_sets;
 use ktree::build::stack;
 use ktree::display::{
-    default_camera, render, render_zbuffer, Camera, DisplayError, Projection, RenderOptions,
+    default_camera, render, render_back_to_front, render_zbuffer, Camera, DisplayError, Projection,
+    RenderOptions,
 };
 use ktree::rays::ball_rays;
 use ktree::{Ray, RaySet};
@@ -55,6 +56,20 @@ proptest! {
             }
         }
         prop_assert_eq!(fast.stats.painted, reference.stats.painted);
+        // The painter's order (back to front, later leaves overwrite) gives the same leaves.
+        let painter = render_back_to_front(&tree, &camera, &options).unwrap();
+        let pc = painter.cells.as_ref().unwrap();
+        let pd = painter.depth.as_ref().unwrap();
+        for p in 0..(w * h) as usize {
+            match (pc[p], rc[p]) {
+                (None, None) => {}
+                (Some(a), Some(b)) => prop_assert!(
+                    a == b || (pd[p] - rd[p]).abs() <= 1e-5 * rd[p].abs().max(1.0),
+                    "pixel {}: painter sees {:?} at {}, z-buffer {:?} at {}", p, a, pd[p], b, rd[p]
+                ),
+                (a, b) => prop_assert!(false, "pixel {}: painter {:?}, z-buffer {:?}", p, a, b),
+            }
+        }
     }
 }
 

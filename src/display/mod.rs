@@ -28,4 +28,6 @@ pub use error::{check_size, DisplayError, MAX_IMAGE_SIDE};
 pub use hidden::HiddenLineMethod;
 pub use lines::{line_drawing, nudged_view_dir, Edge3, LineDrawing, LineStats};
 pub use order::{near_child, ordered_full_cells, walk_ordered, Order, Viewer, Walk};
-pub use raster::{render, render_zbuffer, RenderOptions, RenderStats, Rendered};
+pub use raster::{
+    render, render_back_to_front, render_zbuffer, RenderOptions, RenderStats, Rendered,
+};

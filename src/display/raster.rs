@@ -473,6 +473,76 @@ pub fn render(
     })
 }
 
+/// Meagher's other order (M7): the painter's algorithm. Leaves are visited back to front and every hit
+/// pixel is painted, later leaves overwriting earlier ones; no depth is compared and nothing is culled,
+/// so it costs a visit of every full leaf. Same picture as [`render`] (face shading).
+///
+/// # Errors
+/// As [`render`].
+pub fn render_back_to_front(
+    tree: &Octree,
+    camera: &Camera,
+    options: &RenderOptions,
+) -> Result<Rendered, DisplayError> {
+    use super::order::{walk_ordered, Order, Viewer, Walk};
+    let screen = Screen::new(camera, options.width, options.height)?;
+    let (w, h) = (options.width, options.height);
+    let pixels = w as usize * h as usize;
+    let mut rgb = Vec::with_capacity(pixels * 3);
+    for _ in 0..pixels {
+        rgb.extend_from_slice(&options.background);
+    }
+    let mut depth = options.depth.then(|| vec![f32::INFINITY; pixels]);
+    let mut cells = options.cells.then(|| vec![None; pixels]);
+    let mut hit_any = vec![false; pixels];
+    let light = light_for(camera);
+    let mut stats = RenderStats::default();
+    let viewer = if camera.is_perspective() {
+        Viewer::Eye(camera.eye)
+    } else {
+        Viewer::Direction(camera.frame().f)
+    };
+    walk_ordered(tree, viewer, Order::BackToFront, |node| {
+        stats.nodes_visited += 1;
+        if node.state != NodeState::Full {
+            return Walk::Descend;
+        }
+        let Some(r) = screen.rect(&node.cell) else {
+            return Walk::Descend;
+        };
+        stats.leaves_drawn += 1;
+        let (lo, hi) = cell_box(&node.cell);
+        for y in r.y0..=r.y1 {
+            for x in r.x0..=r.x1 {
+                stats.pixel_tests += 1;
+                if let Some((t, axis, _, d)) = screen.hit(x, y, lo, hi) {
+                    let i = y as usize * w as usize + x as usize;
+                    let mut n = [0.0; 3];
+                    n[axis] = if d[axis] > 0.0 { -1.0 } else { 1.0 };
+                    rgb[3 * i..3 * i + 3].copy_from_slice(&shade(n, light, options.colour));
+                    hit_any[i] = true;
+                    if let Some(dep) = depth.as_mut() {
+                        dep[i] = t as f32;
+                    }
+                    if let Some(cs) = cells.as_mut() {
+                        cs[i] = Some(node.cell);
+                    }
+                }
+            }
+        }
+        Walk::Descend
+    });
+    stats.painted = hit_any.iter().filter(|&&b| b).count() as u64;
+    Ok(Rendered {
+        width: w,
+        height: h,
+        rgb,
+        depth,
+        cells,
+        stats,
+    })
+}
+
 /// The brute-force reference: a z-buffer over *all* full leaves in Morton order, keeping for each pixel the
 /// leaf with the smallest entry depth (ties: the first). Shading is by face orientation. `O(leaves · pixels
 /// per leaf)`; for tests and small trees.
