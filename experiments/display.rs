@@ -1,4 +1,5 @@
-//! Criterion benchmarks of display: the front-to-back raster renderer against the brute-force z-buffer
+//! Criterion benchmarks of display: the front-to-back raster renderer against the painter's order and the
+//! brute-force z-buffer
 //! (balls at L = 6 … 8, 256 × 256), and line drawings with the pairwise and the bucketed hidden-line
 //! methods (balls at L = 4 … 6). Each benchmark first checks that the fast result equals the reference.
 //!
@@ -8,8 +9,8 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use ktree::build::stack;
 use ktree::display::{
-    default_camera, line_drawing, render, render_zbuffer, HiddenLineMethod, RenderOptions,
-    ISO_TOWARD_EYE,
+    default_camera, line_drawing, render, render_back_to_front, render_zbuffer, HiddenLineMethod,
+    RenderOptions, ISO_TOWARD_EYE,
 };
 use ktree::rays::ball_rays;
 use ktree::Octree;
@@ -40,6 +41,14 @@ fn raster(c: &mut Criterion) {
         group.throughput(Throughput::Elements(tree.node_count()));
         group.bench_with_input(BenchmarkId::new("front-to-back", level), &tree, |b, t| {
             b.iter(|| render(t, &camera, &options, None, None).expect("render"))
+        });
+        let painter = render_back_to_front(&tree, &camera, &options).expect("render");
+        assert_eq!(
+            fast.stats.painted, painter.stats.painted,
+            "raster and painter disagree"
+        );
+        group.bench_with_input(BenchmarkId::new("back-to-front", level), &tree, |b, t| {
+            b.iter(|| render_back_to_front(t, &camera, &options).expect("render"))
         });
         group.bench_with_input(BenchmarkId::new("z-buffer", level), &tree, |b, t| {
             b.iter(|| render_zbuffer(t, &camera, &options).expect("render"))

@@ -3,7 +3,8 @@
 //!
 //! * [`order`]: front-to-back / back-to-front traversal for any view.
 //! * [`camera`]: orthographic and perspective cameras, default framing.
-//! * [`raster`] + [`coverage`]: the front-to-back renderer with a screen coverage mask.
+//! * [`raster`] + [`coverage`]: the front-to-back renderer with a screen coverage mask (and the painter's
+//!   back-to-front order, and a brute-force z-buffer reference).
 //! * [`neighbours`]: face neighbours in the compact tree, without pointers.
 //! * [`lines`]: line drawings — visible edges with cracks, hidden lines and dots removed ([`hidden`] holds
 //!   the paper's pairwise hidden-line step and a faster bucketed one).
