@@ -160,6 +160,7 @@ fn bad_input_is_a_one_line_error() {
     for args in [
         vec!["render", b.as_str(), "--size", "0x10"],
         vec!["render", b.as_str(), "--size", "big"],
+        vec!["render", b.as_str(), "--size", "16000x16000"],
         vec!["render", b.as_str(), "--camera", "sideways"],
         vec!["render", b.as_str(), "--camera", "0,0,0"],
         vec!["render", b.as_str(), "--perspective", "200"],

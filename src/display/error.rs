@@ -6,8 +6,9 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum DisplayError {
-    /// The image size is zero or too large. Use a width and height from 1 to [`MAX_IMAGE_SIDE`].
-    #[error("image size {width}x{height} is not allowed (each side 1..={max})", max = MAX_IMAGE_SIDE)]
+    /// The image size is zero or too large. Use a width and height from 1 to [`MAX_IMAGE_SIDE`], at most
+    /// [`MAX_PIXELS`] pixels in all.
+    #[error("image size {width}x{height} is not allowed (each side 1..={max}, at most {pixels} pixels)", max = MAX_IMAGE_SIDE, pixels = MAX_PIXELS)]
     BadSize {
         /// Requested width.
         width: u32,
@@ -47,12 +48,21 @@ pub enum DisplayError {
 /// The largest image side accepted, in pixels.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 
+/// The largest number of pixels in one image (2^26: about 200 MB of RGB).
+pub const MAX_PIXELS: u64 = 1 << 26;
+
 /// Checks an image size.
 ///
 /// # Errors
-/// [`DisplayError::BadSize`] when a side is 0 or exceeds [`MAX_IMAGE_SIDE`].
+/// [`DisplayError::BadSize`] when a side is 0 or exceeds [`MAX_IMAGE_SIDE`], or the image has more than
+/// [`MAX_PIXELS`] pixels.
 pub fn check_size(width: u32, height: u32) -> Result<(), DisplayError> {
-    if width == 0 || height == 0 || width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
+    if width == 0
+        || height == 0
+        || width > MAX_IMAGE_SIDE
+        || height > MAX_IMAGE_SIDE
+        || u64::from(width) * u64::from(height) > MAX_PIXELS
+    {
         return Err(DisplayError::BadSize { width, height });
     }
     Ok(())
