@@ -131,7 +131,13 @@ fn render_and_lines_write_pictures() {
         std::fs::read(p("n.png")).unwrap(),
         std::fs::read(p("e.png")).unwrap()
     );
-    let (ok, out, err) = ktree(&["lines", &s(p("ball.ktree")), "--out", &s(p("l.svg"))]);
+    let (ok, out, err) = ktree(&[
+        "lines",
+        &s(p("ball.ktree")),
+        "--out",
+        &s(p("l.svg")),
+        "--progress",
+    ]);
     assert!(ok, "{err}");
     assert!(out.contains("lines"));
     let svg = std::fs::read_to_string(p("l.svg")).unwrap();
