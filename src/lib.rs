@@ -20,6 +20,7 @@
 //! * [`io`]: the ray text format and the `.ktree` file format.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
+//! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
 //!
 //! # Example
 //! ```
@@ -35,6 +36,7 @@
 #![forbid(unsafe_code)]
 
 pub mod build;
+pub mod display;
 pub mod io;
 pub mod ops;
 pub mod rays;

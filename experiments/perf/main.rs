@@ -6,9 +6,10 @@
 //! Each area is a module with `cases()` (what to measure) and `report()` (the Markdown table).
 
 mod build;
+mod display;
 mod measure;
-mod solids;
 mod ops;
+mod solids;
 
 use std::process::ExitCode;
 
@@ -21,6 +22,7 @@ fn main() -> ExitCode {
             "build" => measure::child(|| build::run_case(case)),
             "solids" => measure::child(|| solids::run_case(case)),
             "ops" => measure::child(|| ops::run_case(case)),
+            "display" => measure::child(|| display::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -37,7 +39,10 @@ fn main() -> ExitCode {
             "build" => build::report(),
             "solids" => solids::report(),
             "ops" => ops::report(),
-            other => Err(format!("unknown area '{other}' (known: build, solids, ops, display)")),
+            "display" => display::report(),
+            other => Err(format!(
+                "unknown area '{other}' (known: build, solids, ops, display)"
+            )),
         };
         match result {
             Ok(path) => println!("wrote {path}"),

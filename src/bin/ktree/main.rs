@@ -6,14 +6,16 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod build;
-mod rays;
-mod repro;
-mod stats;
-mod voxelize;
 mod collide;
+mod lines;
 mod mass;
 mod op;
+mod rays;
+mod render;
+mod repro;
+mod stats;
 mod transform;
+mod voxelize;
 
 /// k-trees (bintrees, quadtrees, octrees, 4-D trees) from rays by stacking.
 #[derive(Debug, Parser)]
@@ -37,6 +39,10 @@ enum Command {
     Collide(collide::Args),
     /// Volume, centroid, second moments; with --tolerance, Meagher's progressive bounds.
     Mass(mass::Args),
+    /// Draw a hidden-surface image of a tree (octree; quadtree picture; 4-D strip of time slices) as PNG.
+    Render(render::Args),
+    /// Draw an octree as lines with hidden lines removed (SVG or PNG).
+    Lines(lines::Args),
     /// Regenerate the paper reproductions into results/ (all of them by default).
     Repro(repro::Args),
     /// An analytic solid (ball, ellipsoid, paraboloid, cylinder, cone, half-space, box, quadric) to rays.
@@ -54,6 +60,8 @@ fn main() -> ExitCode {
         Command::Transform(args) => transform::run(args),
         Command::Collide(args) => collide::run(args),
         Command::Mass(args) => mass::run(args),
+        Command::Render(args) => render::run(args),
+        Command::Lines(args) => lines::run(args),
         Command::Repro(args) => repro::run(args),
         Command::Rays(args) => rays::run(args),
         Command::Voxelize(args) => voxelize::run(args),

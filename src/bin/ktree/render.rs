@@ -1,0 +1,258 @@
+//! `ktree render FILE.ktree [--camera VIEW] [--perspective FOV] [--size WxH] [--out img.png]`: a
+//! hidden-surface image of an octree; a quadtree is drawn as a picture of its cells, a 4-D tree as a strip
+//! of time slices.
+
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use ktree::display::{
+    default_camera, object_bounds, plane, png, render, slices, Camera, Projection, RenderOptions,
+    ISO_TOWARD_EYE,
+};
+use ktree::io::{read_ktree_file, read_rays_file, AnyRaySet, AnyTree};
+
+/// Arguments of `ktree render`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// A `.ktree` file (K = 3: hidden-surface image; K = 2: picture of the cells; K = 4: strip of slices).
+    file: PathBuf,
+    /// Where the camera looks from: iso, top, bottom, front, back, left, right, or a direction X,Y,Z from
+    /// the object towards the eye. The camera frames the object.
+    #[arg(long, default_value = "iso")]
+    camera: String,
+    /// Perspective projection with this vertical field of view in degrees (default: orthographic).
+    #[arg(long, value_name = "FOV")]
+    perspective: Option<f64>,
+    /// Put the eye at this point X,Y,Z (voxel coordinates) instead of framing automatically.
+    #[arg(long, value_name = "X,Y,Z")]
+    eye: Option<String>,
+    /// The point looked at with --eye (default: the object's centre).
+    #[arg(long, value_name = "X,Y,Z")]
+    target: Option<String>,
+    /// The up direction (default: z, or y when looking along z).
+    #[arg(long, value_name = "X,Y,Z")]
+    up: Option<String>,
+    /// Image size in pixels (for a 4-D tree: the size of each frame).
+    #[arg(long, default_value = "800x800", value_name = "WxH")]
+    size: String,
+    /// Output PNG (default: the input's name with .png).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Also write the depth image (near = light) to this PNG.
+    #[arg(long, value_name = "PNG")]
+    depth: Option<PathBuf>,
+    /// 4-D trees: the axis sliced (time).
+    #[arg(long, default_value_t = 3)]
+    time_axis: usize,
+    /// 4-D trees: the number of frames in the strip.
+    #[arg(long, default_value_t = 6)]
+    frames: usize,
+    /// 4-D trees: also write each frame as FRAMES_DIR/frame_NNN.png (an animated sequence).
+    #[arg(long, value_name = "DIR")]
+    frames_dir: Option<PathBuf>,
+    /// Shade with the surface normals carried by this ray file (the rays the octree was built from).
+    #[arg(long, value_name = "FILE")]
+    rays: Option<PathBuf>,
+    /// Show a progress bar.
+    #[arg(long)]
+    progress: bool,
+}
+
+/// Parses `WxH`.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("size '{s}' must be WIDTHxHEIGHT, e.g. 800x600"))?;
+    let p = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("size '{s}' must be WIDTHxHEIGHT with whole numbers"))
+    };
+    let (w, h) = (p(w)?, p(h)?);
+    ktree::display::check_size(w, h).map_err(|e| e.to_string())?;
+    Ok((w, h))
+}
+
+/// Parses `X,Y,Z`.
+pub fn parse_vec3(s: &str, what: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let bad = || format!("{what} '{s}' must be three numbers X,Y,Z");
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let mut v = [0.0f64; 3];
+    for (x, p) in v.iter_mut().zip(parts) {
+        *x = p.trim().parse().map_err(|_| bad())?;
+        if !x.is_finite() {
+            return Err(bad());
+        }
+    }
+    Ok(v)
+}
+
+/// A named view or a direction `X,Y,Z`, from the object towards the eye.
+pub fn parse_view(s: &str) -> Result<[f64; 3], String> {
+    Ok(match s {
+        "iso" => ISO_TOWARD_EYE,
+        "top" => [0.0, 0.0, 1.0],
+        "bottom" => [0.0, 0.0, -1.0],
+        "front" => [0.0, -1.0, 0.0],
+        "back" => [0.0, 1.0, 0.0],
+        "right" => [1.0, 0.0, 0.0],
+        "left" => [-1.0, 0.0, 0.0],
+        other => {
+            let v = parse_vec3(other, "view").map_err(|_| {
+                format!(
+                    "view '{other}' must be iso, top, bottom, front, back, left, right or X,Y,Z"
+                )
+            })?;
+            if v.iter().all(|&x| x == 0.0) {
+                return Err("the view direction must not be zero".into());
+            }
+            v
+        }
+    })
+}
+
+/// A progress bar that the library's callbacks can drive, or none.
+pub fn progress_bar(enabled: bool, what: &str) -> Option<ProgressBar> {
+    enabled.then(|| {
+        let bar = ProgressBar::new(1);
+        bar.set_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {percent}% {elapsed}")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_message(what.to_string());
+        bar
+    })
+}
+
+fn default_out(file: &Path) -> PathBuf {
+    file.with_extension("png")
+}
+
+/// Renders the file.
+pub fn run(args: Args) -> Result<(), String> {
+    let (w, h) = parse_size(&args.size)?;
+    let tree = read_ktree_file(&args.file).map_err(|e| e.to_string())?;
+    let out = args.out.clone().unwrap_or_else(|| default_out(&args.file));
+    let bar = progress_bar(args.progress, "render");
+    let mut tick = |done: u64, total: u64| {
+        if let Some(b) = &bar {
+            b.set_length(total.max(1));
+            b.set_position(done);
+        }
+    };
+    match tree {
+        AnyTree::K3(tree) => {
+            let toward = parse_view(&args.camera)?;
+            let mut camera =
+                default_camera(&tree, toward, args.perspective, w, h).map_err(|e| e.to_string())?;
+            if let Some(eye) = &args.eye {
+                camera.eye = parse_vec3(eye, "eye")?;
+                let side = tree.universe().side() as f64;
+                let (lo, hi) = object_bounds(&tree).unwrap_or(([0.0; 3], [side; 3]));
+                camera.target = match &args.target {
+                    Some(t) => parse_vec3(t, "target")?,
+                    None => [0, 1, 2].map(|i| (lo[i] + hi[i]) / 2.0),
+                };
+                if let Projection::Orthographic { .. } = camera.projection {
+                    let diag = ((hi[0] - lo[0]).powi(2)
+                        + (hi[1] - lo[1]).powi(2)
+                        + (hi[2] - lo[2]).powi(2))
+                    .sqrt();
+                    camera.projection = Projection::Orthographic {
+                        height: diag.max(1.0) * 1.05,
+                    };
+                }
+            }
+            if let Some(up) = &args.up {
+                camera.up = parse_vec3(up, "up")?;
+            }
+            let camera: Camera = camera;
+            camera.check().map_err(|e| e.to_string())?;
+            let options = RenderOptions {
+                width: w,
+                height: h,
+                depth: args.depth.is_some(),
+                ..Default::default()
+            };
+            let rays = match &args.rays {
+                None => None,
+                Some(path) => match read_rays_file(path).map_err(|e| e.to_string())? {
+                    AnyRaySet::K3(r) if r.level() != tree.level() => {
+                        return Err(format!(
+                            "{}: level {} does not match the tree's level {}",
+                            path.display(),
+                            r.level(),
+                            tree.level()
+                        ))
+                    }
+                    AnyRaySet::K3(r) if r.has_normals() => Some(r),
+                    AnyRaySet::K3(_) => {
+                        return Err(format!(
+                            "{}: the rays carry no normals to shade with",
+                            path.display()
+                        ))
+                    }
+                    _ => {
+                        return Err(format!(
+                            "{}: normals for an octree need a K = 3 ray file",
+                            path.display()
+                        ))
+                    }
+                },
+            };
+            let image = render(&tree, &camera, &options, rays.as_ref(), Some(&mut tick))
+                .map_err(|e| e.to_string())?;
+            png::write_rgb_png(&out, w, h, &image.rgb).map_err(|e| e.to_string())?;
+            if let (Some(path), Some(grey)) = (&args.depth, image.depth_grey()) {
+                png::write_grey_png(path, w, h, &grey).map_err(|e| e.to_string())?;
+            }
+            if let Some(b) = &bar {
+                b.finish_and_clear();
+            }
+            println!(
+                "wrote {} ({w}x{h}, {} pixels of the object, {} nodes visited, {} culled)",
+                out.display(),
+                image.stats.painted,
+                image.stats.nodes_visited,
+                image.stats.culled
+            );
+        }
+        AnyTree::K2(tree) => {
+            let canvas = plane::quadtree_canvas(&tree, w.min(h)).map_err(|e| e.to_string())?;
+            canvas.write_png(&out).map_err(|e| e.to_string())?;
+            println!(
+                "wrote {} (quadtree, {} leaves)",
+                out.display(),
+                tree.leaves().len()
+            );
+        }
+        AnyTree::K4(tree) => {
+            let (strip, frames) = slices::time_strip(&tree, args.time_axis, args.frames, h)
+                .map_err(|e| e.to_string())?;
+            strip.write_png(&out).map_err(|e| e.to_string())?;
+            if let Some(dir) = &args.frames_dir {
+                for (i, (_, frame)) in frames.iter().enumerate() {
+                    let path = dir.join(format!("frame_{i:03}.png"));
+                    png::write_rgb_png(&path, frame.width, frame.height, &frame.rgb)
+                        .map_err(|e| e.to_string())?;
+                }
+            }
+            let positions: Vec<String> = frames.iter().map(|(p, _)| p.to_string()).collect();
+            println!(
+                "wrote {} ({} frames of the slices at {} on axis {})",
+                out.display(),
+                frames.len(),
+                positions.join(", "),
+                args.time_axis
+            );
+        }
+        AnyTree::K1(_) => {
+            return Err("a bintree (K = 1) has no picture; render needs K = 2, 3 or 4".into())
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,34 @@
+//! Display: hidden-surface images (Meagher's ordered traversal, M7) and line drawings with hidden lines
+//! removed (Veenstra & Ahuja, V1–V8), plus pictures of quadtrees and 4-D trees.
+//!
+//! * [`order`]: front-to-back / back-to-front traversal for any view.
+//! * [`camera`]: orthographic and perspective cameras, default framing.
+//! * [`raster`] + [`coverage`]: the front-to-back renderer with a screen coverage mask (and the painter's
+//!   back-to-front order, and a brute-force z-buffer reference).
+//! * [`neighbours`]: face neighbours in the compact tree, without pointers.
+//! * [`lines`]: line drawings — visible edges with cracks, hidden lines and dots removed ([`hidden`] holds
+//!   the paper's pairwise hidden-line step and a faster bucketed one).
+//! * [`svg`], [`png`]: writers; [`plane`]: 2-D quadtree images; [`slices`]: 4-D trees as strips of frames.
+
+pub mod camera;
+pub mod coverage;
+mod error;
+pub mod hidden;
+pub mod lines;
+pub mod neighbours;
+pub mod order;
+pub mod plane;
+pub mod png;
+pub mod raster;
+pub mod slices;
+pub mod svg;
+
+pub use camera::{default_camera, object_bounds, Camera, Projection, ISO_TOWARD_EYE};
+pub use coverage::Coverage;
+pub use error::{check_size, DisplayError, MAX_IMAGE_SIDE, MAX_PIXELS};
+pub use hidden::HiddenLineMethod;
+pub use lines::{line_drawing, nudged_view_dir, Edge3, LineDrawing, LineStats};
+pub use order::{near_child, ordered_full_cells, walk_ordered, Order, Viewer, Walk};
+pub use raster::{
+    render, render_back_to_front, render_zbuffer, RenderOptions, RenderStats, Rendered,
+};

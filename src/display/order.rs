@@ -1,0 +1,141 @@
+//! Traversal order for a view (Meagher's M7, Veenstra & Ahuja's V2): children are visited in an order fixed
+//! by the viewer's octant, so that a node that can occlude another is visited first (front to back) or last
+//! (back to front). No searching or sorting.
+//!
+//! For a parallel view along `dir`, the *near* child on axis `i` is the lower half when `dir[i] > 0` (the
+//! viewer sits at −∞ on that axis) and the upper half otherwise. Visiting the children `near ^ 0, near ^ 1,
+//! …, near ^ (2^K − 1)` is front to back: a ray only moves away from the viewer on every axis, so it can
+//! pass from child `near ^ a` into child `near ^ b` only if the bits of `a` are a subset of the bits of `b`,
+//! hence `a < b`. For a perspective view the near child is chosen per node from the eye's side of the node's
+//! centre on each axis; the same argument holds inside each node.
+
+use crate::space::Cell;
+use crate::tree::{KTree, NodeRef, NodeState};
+
+/// Which way a traversal goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Order {
+    /// Occluders before what they occlude (painting never overwrites).
+    FrontToBack,
+    /// Occluded before occluders (the painter's algorithm: later cells overwrite earlier ones).
+    BackToFront,
+}
+
+/// Where the viewer is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Viewer<const K: usize> {
+    /// A parallel (orthographic) view looking along this direction (from the viewer into the scene), in
+    /// voxel coordinates.
+    Direction([f64; K]),
+    /// A perspective view from this eye point, in voxel coordinates.
+    Eye([f64; K]),
+}
+
+/// What a visitor wants after seeing a node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Walk {
+    /// Visit the node's children (if it has any).
+    Descend,
+    /// Skip the node's subtree.
+    Skip,
+}
+
+/// The near child code for a parallel view along `dir`: bit `i` set when the viewer is on the upper side of
+/// axis `i` (`dir[i] < 0`).
+///
+/// ```
+/// use ktree::display::near_child;
+/// assert_eq!(near_child([1.0, -1.0, -0.5]), 0b110);
+/// ```
+pub fn near_child<const K: usize>(dir: [f64; K]) -> usize {
+    dir.iter()
+        .enumerate()
+        .fold(0, |code, (i, &d)| code | (usize::from(d < 0.0) << i))
+}
+
+/// The near child of `cell` for a perspective eye: bit `i` set when the eye is at or above the cell's centre
+/// on axis `i`.
+pub fn near_child_from_eye<const K: usize>(cell: &Cell<K>, eye: [f64; K]) -> usize {
+    let half = cell.side() as f64 / 2.0;
+    cell.origin
+        .iter()
+        .zip(eye.iter())
+        .enumerate()
+        .fold(0, |code, (i, (&o, &e))| {
+            code | (usize::from(e >= f64::from(o) + half) << i)
+        })
+}
+
+/// The `j`-th child code to visit (`j = 0 … 2^K − 1`) given the near child and the order.
+#[inline]
+pub fn child_at<const K: usize>(near: usize, j: usize, order: Order) -> usize {
+    match order {
+        Order::FrontToBack => near ^ j,
+        Order::BackToFront => near ^ ((1 << K) - 1 - j),
+    }
+}
+
+/// Visits the nodes of `tree` in pre-order with children in view order; `visit` sees every node (partial
+/// nodes before their children) and may skip a subtree.
+///
+/// ```
+/// use ktree::display::{walk_ordered, Order, Viewer, Walk};
+/// use ktree::{rays::ball_rays, build::stack};
+/// let tree = stack(&ball_rays::<3>(4, [16, 16, 16], 14).unwrap());
+/// let mut full = 0;
+/// walk_ordered(&tree, Viewer::Direction([1.0, 0.5, -0.2]), Order::FrontToBack, |n| {
+///     full += usize::from(n.state == ktree::NodeState::Full);
+///     Walk::Descend
+/// });
+/// assert_eq!(full, tree.full_cells().len());
+/// ```
+pub fn walk_ordered<const K: usize>(
+    tree: &KTree<K>,
+    viewer: Viewer<K>,
+    order: Order,
+    mut visit: impl FnMut(&NodeRef<K>) -> Walk,
+) {
+    let fixed_near = match viewer {
+        Viewer::Direction(d) => Some(near_child(d)),
+        Viewer::Eye(_) => None,
+    };
+    let mut stack = vec![tree.root()];
+    let fanout = 1usize << K;
+    while let Some(node) = stack.pop() {
+        if visit(&node) == Walk::Skip || node.state != NodeState::Partial {
+            continue;
+        }
+        let near = match (fixed_near, viewer) {
+            (Some(n), _) => n,
+            (None, Viewer::Eye(e)) => near_child_from_eye(&node.cell, e),
+            (None, Viewer::Direction(_)) => unreachable!("direction views have a fixed near child"),
+        };
+        let depth = node.cell.level as usize;
+        let first = tree.first_child(depth, node.index);
+        // Push in reverse so that the first child in view order is popped first.
+        for j in (0..fanout).rev() {
+            let code = child_at::<K>(near, j, order);
+            stack.push(NodeRef {
+                index: first + code,
+                cell: node.cell.child(code),
+                state: tree.state(depth + 1, first + code),
+            });
+        }
+    }
+}
+
+/// The full leaves of `tree` in view order.
+pub fn ordered_full_cells<const K: usize>(
+    tree: &KTree<K>,
+    viewer: Viewer<K>,
+    order: Order,
+) -> Vec<Cell<K>> {
+    let mut out = Vec::new();
+    walk_ordered(tree, viewer, order, |n| {
+        if n.state == NodeState::Full {
+            out.push(n.cell);
+        }
+        Walk::Descend
+    });
+    out
+}

@@ -1,0 +1,193 @@
+//! 4-D trees shown as 3-D frames: the slice of a time-space tree at one position along an axis (time is
+//! the last axis by convention) is an octree; a strip of frames at evenly spaced times, rendered with one
+//! camera, shows the motion.
+
+use super::camera::{Camera, ISO_TOWARD_EYE};
+use super::error::DisplayError;
+use super::png::Canvas;
+use super::raster::{render, RenderOptions, Rendered};
+use crate::space::{Cell, Universe};
+use crate::tree::{KTree, NodeState, Octree, Tree4};
+
+/// The octree of the 4-D tree's slice at `position` along `axis` (the remaining axes keep their order).
+///
+/// ```
+/// use ktree::{build::stack, rays::ball_rays, display::slices::slice_4d};
+/// let ball4 = stack(&ball_rays::<4>(3, [8, 8, 8, 8], 8).unwrap());
+/// let middle = slice_4d(&ball4, 3, 4).unwrap();
+/// middle.assert_well_formed();
+/// assert!(middle.voxel_count() > 0);
+/// ```
+///
+/// # Errors
+/// [`DisplayError::SliceOutside`] if `axis > 3` or the position is outside the universe.
+pub fn slice_4d(tree: &Tree4, axis: usize, position: u32) -> Result<Octree, DisplayError> {
+    let side = tree.universe().side();
+    if axis > 3 || u64::from(position) >= side {
+        return Err(DisplayError::SliceOutside {
+            axis,
+            position: position.into(),
+            side,
+        });
+    }
+    let universe = Universe::<3>::new(tree.level()).expect("a 4-D level is a valid 3-D level");
+    let drop_axis = |o: [u32; 4]| -> [u32; 3] {
+        let mut out = [0u32; 3];
+        let mut j = 0;
+        for (i, &c) in o.iter().enumerate() {
+            if i != axis {
+                out[j] = c;
+                j += 1;
+            }
+        }
+        out
+    };
+    let mut cells: Vec<Cell<3>> = Vec::new();
+    let mut stack = vec![tree.root()];
+    while let Some(node) = stack.pop() {
+        let o = node.cell.origin[axis];
+        if position < o || u64::from(position - o) >= node.cell.side() {
+            continue;
+        }
+        match node.state {
+            NodeState::Empty => {}
+            NodeState::Full => cells.push(Cell {
+                origin: drop_axis(node.cell.origin),
+                level: node.cell.level,
+                log_side: node.cell.log_side,
+            }),
+            NodeState::Partial => stack.extend(tree.children(&node)),
+        }
+    }
+    cells.sort_unstable_by_key(|c| c.morton());
+    Ok(KTree::from_sorted_cells(universe, &merge_siblings(cells)))
+}
+
+/// Replaces every complete group of 8 sibling cells by their parent, repeatedly, so that the cells are
+/// maximal and the tree built from them is reduced. `cells` must be disjoint and sorted by Morton key.
+fn merge_siblings(cells: Vec<Cell<3>>) -> Vec<Cell<3>> {
+    let mut out: Vec<Cell<3>> = Vec::with_capacity(cells.len());
+    for cell in cells {
+        out.push(cell);
+        loop {
+            let n = out.len();
+            if n < 8 {
+                break;
+            }
+            let first = out[n - 8];
+            if first.level == 0 {
+                break;
+            }
+            let parent_side = first.side() * 2;
+            let aligned = first
+                .origin
+                .iter()
+                .all(|&c| u64::from(c) % parent_side == 0);
+            let complete = aligned
+                && (0..8).all(|code| {
+                    let c = out[n - 8 + code];
+                    c.level == first.level && c.origin == first_child_origin(&first, code)
+                });
+            if !complete {
+                break;
+            }
+            out.truncate(n - 8);
+            out.push(Cell {
+                origin: first.origin,
+                level: first.level - 1,
+                log_side: first.log_side + 1,
+            });
+        }
+    }
+    out
+}
+
+fn first_child_origin(first: &Cell<3>, code: usize) -> [u32; 3] {
+    let s = first.side() as u32;
+    let mut o = first.origin;
+    for (axis, c) in o.iter_mut().enumerate() {
+        if code >> axis & 1 == 1 {
+            *c += s;
+        }
+    }
+    o
+}
+
+/// A strip of `frames` hidden-surface renderings of the 4-D tree's slices at evenly spaced positions along
+/// `axis` (the middles of `frames` equal parts of the universe), each `frame_size` pixels square, seen
+/// from `ISO_TOWARD_EYE` with one camera framing the whole motion. Returns the strip and the frames with
+/// their slice positions (to write as an animated sequence of PNGs).
+///
+/// # Errors
+/// [`DisplayError::NoFrames`], [`DisplayError::SliceOutside`], [`DisplayError::BadSize`].
+pub fn time_strip(
+    tree: &Tree4,
+    axis: usize,
+    frames: usize,
+    frame_size: u32,
+) -> Result<(Canvas, Vec<(u32, Rendered)>), DisplayError> {
+    if frames == 0 {
+        return Err(DisplayError::NoFrames);
+    }
+    if axis > 3 {
+        return Err(DisplayError::SliceOutside {
+            axis,
+            position: 0,
+            side: tree.universe().side(),
+        });
+    }
+    let strip_width = u32::try_from(frames)
+        .ok()
+        .and_then(|f| f.checked_mul(frame_size + 4))
+        .ok_or(DisplayError::BadSize {
+            width: u32::MAX,
+            height: frame_size,
+        })?;
+    let mut canvas = Canvas::new(strip_width, frame_size, [255, 255, 255])?;
+    let side = tree.universe().side();
+    let (lo, hi) = super::camera::object_bounds(tree).unwrap_or(([0.0; 4], [side as f64; 4]));
+    let keep = |v: [f64; 4]| -> [f64; 3] {
+        let mut out = [0.0; 3];
+        let mut j = 0;
+        for (i, &c) in v.iter().enumerate() {
+            if i != axis {
+                out[j] = c;
+                j += 1;
+            }
+        }
+        out
+    };
+    let camera = Camera::framing(
+        keep(lo),
+        keep(hi),
+        ISO_TOWARD_EYE,
+        None,
+        frame_size,
+        frame_size,
+    )?;
+    let options = RenderOptions {
+        width: frame_size,
+        height: frame_size,
+        ..Default::default()
+    };
+    let mut out = Vec::with_capacity(frames);
+    for f in 0..frames {
+        let position = ((2 * f as u64 + 1) * side / (2 * frames as u64)).min(side - 1) as u32;
+        let slice = slice_4d(tree, axis, position)?;
+        let image = render(&slice, &camera, &options, None, None)?;
+        let x0 = f as u32 * (frame_size + 4);
+        for y in 0..frame_size {
+            let src = 3 * (y * frame_size) as usize;
+            let dst = 3 * (y * strip_width + x0) as usize;
+            canvas.rgb[dst..dst + 3 * frame_size as usize]
+                .copy_from_slice(&image.rgb[src..src + 3 * frame_size as usize]);
+        }
+        for y in 0..frame_size {
+            for dx in frame_size..frame_size + 4 {
+                canvas.blend(i64::from(x0 + dx), i64::from(y), [200, 200, 200], 1.0);
+            }
+        }
+        out.push((position, image));
+    }
+    Ok((canvas, out))
+}
