@@ -174,7 +174,10 @@ impl<const K: usize> RaySet<K> {
             }
             for i in range {
                 let (z1, z2) = self.runs()[i];
-                let (a, b) = (i64::from(z1).saturating_add(offset[K - 1]), i64::from(z2).saturating_add(offset[K - 1]));
+                let (a, b) = (
+                    i64::from(z1).saturating_add(offset[K - 1]),
+                    i64::from(z2).saturating_add(offset[K - 1]),
+                );
                 let (c1, c2) = (a.max(0), b.min(side));
                 if c1 >= c2 {
                     continue;
