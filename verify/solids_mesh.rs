@@ -282,6 +282,13 @@ fn formats_read_alike() {
     assert!(TriangleMesh::read(&dir.path().join("none.stl")).is_err());
     assert!(TriangleMesh::read(&dir.path().join("m.xyz")).is_err());
     assert!(Placement::parse("1,2,3").is_err() && Placement::parse("2,0,0,0").is_ok());
+    // Levels beyond what the crossing packing holds, and placements far outside, are errors.
+    assert!(mesh.to_rays(21, &ID).is_err());
+    let far = Placement {
+        scale: 1e9,
+        translate: [0.0; 3],
+    };
+    assert!(mesh.to_rays(4, &far).is_err());
 }
 
 #[test]

@@ -199,6 +199,22 @@ fn bad_parameters_are_errors() {
     )
     .unwrap();
     assert!(big.to_rays(20, Sample::Centre, false).is_err());
+    // Too many rays: an error, not an exhausted memory.
+    let h = Rational::int(1 << 5);
+    let ball = Quadric::<4>::ball([h; 4], h, Frame::Voxel).unwrap();
+    let n = ball.to_rays(6, Sample::Centre, false).unwrap().len();
+    assert!(ball.to_rays_limited(6, Sample::Centre, false, n).is_ok());
+    assert!(matches!(
+        ball.to_rays_limited(6, Sample::Centre, false, n - 1),
+        Err(ktree::solid::SolidError::TooManyRays { .. })
+    ));
+    let b = BoxSolid::<4>::new(
+        [Rational::int(0); 4],
+        [Rational::int(1 << 16); 4],
+        Frame::Voxel,
+    )
+    .unwrap();
+    assert!(b.to_rays(16, Sample::Centre, false).is_err());
 }
 
 proptest! {

@@ -103,6 +103,25 @@ pub struct Hit {
     pub objects: usize,
     /// Obel counts `(full, empty, partial)` and voxel counts of the objects stacked (all, or an even sample).
     pub stacked: Vec<(Q, u64, u64, u64, u128)>,
+    /// Per stacked object, its node counts per level.
+    pub per_level: Vec<Vec<crate::LevelCounts>>,
+}
+
+/// The counts `(full, partial)` of `per_level`'s tree if no full node above tree level `m` were merged
+/// (each such node expanded into a complete subtree down to level `m`); empty nodes are unchanged.
+pub fn unmerged_above(per_level: &[crate::LevelCounts], m: u32) -> (u64, u64) {
+    let (mut full, mut partial) = (0u64, 0u64);
+    for c in per_level {
+        partial += c.partial;
+        if c.level < m {
+            let fan = 8u64.pow(m - c.level);
+            full += c.full * fan;
+            partial += c.full * (fan - 1) / 7;
+        } else {
+            full += c.full;
+        }
+    }
+    (full, partial)
 }
 
 fn axis_range(conv: Convention, v: i64, c: i64) -> (i64, i64) {
@@ -317,6 +336,7 @@ pub fn search(family: &Family, want: usize, cap: usize) -> Option<Hit> {
             .collect()
     };
     let mut stacked = Vec::new();
+    let mut per_level = Vec::new();
     for t in picks {
         let rays = family.rays(&column_minima, t);
         assert_eq!(rays.len(), want, "the search's ray count");
@@ -326,8 +346,10 @@ pub fn search(family: &Family, want: usize, cap: usize) -> Option<Hit> {
                 "the quadric pipeline and the exact measure disagree"
             );
         }
-        let c = stack(&rays).counts();
+        let tree = stack(&rays);
+        let c = tree.counts();
         stacked.push((t, c.full, c.empty, c.partial, rays.voxel_count()));
+        per_level.push(tree.counts_per_level());
     }
     Some(Hit {
         family: family.clone(),
@@ -335,6 +357,7 @@ pub fn search(family: &Family, want: usize, cap: usize) -> Option<Hit> {
         to,
         objects: values.len(),
         stacked,
+        per_level,
     })
 }
 

@@ -165,7 +165,7 @@ impl<const K: usize> RaySet<K> {
             let mut new_key = 0u64;
             let mut inside = true;
             for a in 0..K - 1 {
-                let c = i64::from(col[a]) + offset[a];
+                let c = i64::from(col[a]).saturating_add(offset[a]);
                 inside &= (0..side).contains(&c);
                 new_key = (new_key << level) | (c.max(0) as u64);
             }
@@ -174,7 +174,10 @@ impl<const K: usize> RaySet<K> {
             }
             for i in range {
                 let (z1, z2) = self.runs()[i];
-                let (a, b) = (i64::from(z1) + offset[K - 1], i64::from(z2) + offset[K - 1]);
+                let (a, b) = (
+                    i64::from(z1).saturating_add(offset[K - 1]),
+                    i64::from(z2).saturating_add(offset[K - 1]),
+                );
                 let (c1, c2) = (a.max(0), b.min(side));
                 if c1 >= c2 {
                     continue;

@@ -89,6 +89,16 @@ impl<const K: usize> BoxSolid<K> {
         for x in r.iter_mut() {
             *x = (x.0.max(0), x.1.min(side - 1));
         }
+        let count = r[..K - 1]
+            .iter()
+            .map(|&(l, h)| (h - l + 1).max(0) as u128)
+            .product::<u128>();
+        if count > super::MAX_RAYS as u128 {
+            return Err(SolidError::TooManyRays {
+                level,
+                limit: super::MAX_RAYS,
+            });
+        }
         let mut columns = Vec::new();
         let mut runs = Vec::new();
         if r.iter().all(|&(l, h)| l <= h) {

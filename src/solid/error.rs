@@ -37,6 +37,14 @@ pub enum SolidError {
         /// The largest matrix entry.
         largest: i128,
     },
+    /// The result would hold more runs than [`crate::solid::MAX_RAYS`].
+    #[error("the solid has more than {limit} rays at level {level}: use a smaller level")]
+    TooManyRays {
+        /// The level asked for.
+        level: u32,
+        /// The limit.
+        limit: usize,
+    },
     /// A file could not be read.
     #[error("{path}: {source}")]
     Io {

@@ -35,6 +35,8 @@ use crate::space::Universe;
 
 /// Bits of sub-voxel precision of placed vertices.
 const FRAC: u32 = 16;
+/// The largest level for meshes: a crossing is packed as column (2L bits), position (L + 1) and sign (1).
+pub const MAX_LEVEL: u32 = 20;
 /// Placed coordinates must lie within ±2^22 voxels (keeps every product inside `i128`).
 const LIMIT: f64 = (1u64 << 22) as f64;
 
@@ -278,10 +280,15 @@ impl TriangleMesh {
     /// The voxels of a level-`level` octree universe whose centres are inside the placed mesh, as rays.
     ///
     /// # Errors
-    /// [`SolidError::Space`] for a bad level (the packing of crossings needs `L ≤ 20`);
+    /// [`SolidError::Space`] for a bad level, [`SolidError::BadParameter`] above [`MAX_LEVEL`];
     /// [`SolidError::BadParameter`] when a placed vertex lies farther than 2^22 voxels from the origin.
     pub fn to_rays(&self, level: u32, placement: &Placement) -> Result<MeshRays, SolidError> {
         let universe = Universe::<3>::new(level)?;
+        if level > MAX_LEVEL {
+            return Err(SolidError::BadParameter(format!(
+                "meshes are voxelized up to level {MAX_LEVEL} (crossings are packed in 64 bits), not {level}"
+            )));
+        }
         let side = universe.side() as i64;
         let one = 1i64 << FRAC;
         let half = one / 2;

@@ -23,6 +23,10 @@ pub use rational::Rational;
 
 use crate::rays::RaySet;
 
+/// The most runs a quadric or a box generates (about 1.5 GiB of rays); beyond it the generator stops with
+/// [`SolidError::TooManyRays`] instead of exhausting memory.
+pub const MAX_RAYS: usize = 1 << 27;
+
 /// Any analytic solid: a quadric or a box.
 #[allow(clippy::large_enum_variant)] // a handful of solids at a time
 #[derive(Debug, Clone, PartialEq, Eq)]

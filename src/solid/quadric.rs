@@ -181,6 +181,20 @@ impl<const K: usize> Quadric<K> {
         sample: Sample,
         normals: bool,
     ) -> Result<RaySet<K>, SolidError> {
+        self.to_rays_limited(level, sample, normals, super::MAX_RAYS)
+    }
+
+    /// [`Quadric::to_rays`] stopping with [`SolidError::TooManyRays`] once more than `max_rays` runs are made.
+    ///
+    /// # Errors
+    /// As [`Quadric::to_rays`].
+    pub fn to_rays_limited(
+        &self,
+        level: u32,
+        sample: Sample,
+        normals: bool,
+        max_rays: usize,
+    ) -> Result<RaySet<K>, SolidError> {
         let universe = Universe::<K>::new(level)?;
         let largest = self.xi.iter().flatten().map(|v| v.abs()).max().unwrap_or(0);
         // |Vᵀ Ξ V| ≤ (K+1)² · max|Ξ| · max|V|², with max|V| ≤ 2U + 2.
@@ -199,11 +213,18 @@ impl<const K: usize> Quadric<K> {
             columns: Vec::new(),
             runs: Vec::new(),
             normals: normals.then(Vec::new),
+            max_rays,
         };
         if K == 1 {
             gen.column([0; K]);
         } else {
             gen.visit([0; K], [side - 1; K]);
+        }
+        if gen.runs.len() > max_rays {
+            return Err(SolidError::TooManyRays {
+                level,
+                limit: max_rays,
+            });
         }
         Ok(RaySet::from_sorted_parts(
             universe,
@@ -224,11 +245,15 @@ struct Generator<const K: usize> {
     columns: Vec<u64>,
     runs: Vec<(u32, u32)>,
     normals: Option<Vec<[Normal<K>; 2]>>,
+    max_rays: usize,
 }
 
 impl<const K: usize> Generator<K> {
     /// Visits the columns `lo..=hi` (axes 0 … K−2) in lexicographic order, skipping blocks that miss the solid.
     fn visit(&mut self, lo: [i64; K], hi: [i64; K]) {
+        if self.runs.len() > self.max_rays {
+            return; // reported by the caller
+        }
         let columns: i64 = (0..K - 1).map(|a| hi[a] - lo[a] + 1).product();
         if columns > 16 && self.misses(&lo, &hi) {
             return;
