@@ -135,6 +135,19 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
                 |t| keep(t, &mut out_nodes),
             )
         }
+        "affine-fixed" => {
+            let a = sphere_and_box(level);
+            facts.push(("input_nodes".into(), a.node_count().to_string()));
+            let c = Affine::<3>::universe_centre(level);
+            let m = Affine::rotation_about(0, 1, 30.0, c)
+                .unwrap()
+                .after(&Affine::rotation_about(1, 2, 20.0, c).unwrap());
+            best_of(
+                1,
+                || ops::transform_fixed(&a, &m, 32).unwrap(),
+                |t| keep(t, &mut out_nodes),
+            )
+        }
         "mass" => {
             let (a, _) = two_spheres(level);
             facts.push(("input_nodes".into(), a.node_count().to_string()));
@@ -180,6 +193,11 @@ const CASES: &[(&str, u32, &str)] = &[
         "affine",
         9,
         "sphere-and-box, rotation 30° about z after 20° about x, overlays",
+    ),
+    (
+        "affine-fixed",
+        9,
+        "same, integer additions and shifts (32-bit fixed point)",
     ),
     ("mass", 10, "sphere r = U/2: volume, centroid, inertia"),
     ("progressive", 10, "sphere r = U/2: progressive mass to 1 %"),
