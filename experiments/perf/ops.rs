@@ -213,8 +213,12 @@ pub fn report() -> Result<String, String> {
          by stacking (an L = 10 sphere of radius U/2 has about 7.5 million nodes); each output tree is \
          checked well-formed (reduced). Times: best of 3 (one run for the overlay operations) in a fresh \
          process per case; peak memory is that process's high-water resident set, including building the \
-         inputs. Rate = input nodes / time.\n\nMachine: {}.\n",
-        machine_line()
+         inputs. Rate = input nodes / time.\n\nMachine: {}. Load average (1, 5, 15 min) when the report \
+         started: {} — the machine is shared with other jobs, and under load the times grow.\n",
+        machine_line(),
+        std::fs::read_to_string("/proc/loadavg")
+            .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(", "))
+            .unwrap_or_else(|_| "unknown".into())
     );
     let _ = writeln!(
         md,
