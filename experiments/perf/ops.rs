@@ -92,6 +92,23 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             ));
             best_of(repeats, || ops::interferes(&small, &far).unwrap(), |_| {})
         }
+        "separation" => {
+            let (a, b) = two_spheres(level);
+            let far = ops::translate(&b, [1 << (level - 1), 0, 0]);
+            let small = ops::intersection(&a, &ops::complement(&far)).unwrap();
+            facts.push((
+                "input_nodes".into(),
+                (small.node_count() + far.node_count()).to_string(),
+            ));
+            let mut d = 0.0;
+            let s = best_of(
+                repeats,
+                || ops::min_separation(&small, &far).unwrap(),
+                |r| d = r.unwrap_or(f64::NAN),
+            );
+            facts.push(("separation".into(), d.to_string()));
+            s
+        }
         "rotate90" => {
             let (a, _) = two_spheres(level);
             let q = AxisMap::<3>::quarter_turn(0, 1)
