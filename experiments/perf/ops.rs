@@ -279,8 +279,10 @@ pub fn report() -> Result<String, String> {
          output nodes per second (every output node is written once) is the conservative rate. The \
          complement flips 32 packed nodes per machine word and touches no structure. \
          `interferes` on a disjoint pair visits every overlapping pair of partial nodes (no early exit); \
-         on overlapping objects it stops at the first shared voxel. Translation uses Meagher's fixed overlay of 2^3 \
-         obels per target node (64 slot updates per node); scaling and affine maps use the general overlay \
+         on overlapping objects it stops at the first shared voxel. `separation` is the worst case for the \
+         branch and bound: the two objects touch along a large curved surface (distance 1), so every pair of \
+         nodes near it is expanded. Translation uses Meagher's fixed overlay of 2^3 obels per target node \
+         (children's overlays from one 3^3 grid of resolved obels); scaling and affine maps use the general overlay \
          engine (a target's overlay refined per child, cell boxes per node), so they are slower per node \
          than the Booleans."
     );
