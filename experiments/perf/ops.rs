@@ -200,6 +200,11 @@ const CASES: &[(&str, u32, &str)] = &[
         "sphere vs a disjoint sphere part (no early exit)",
     ),
     (
+        "separation",
+        10,
+        "minimum separation of two touching objects (branch and bound)",
+    ),
+    (
         "rotate90",
         10,
         "sphere r = U/2, quarter turn + reflection by reordering",
