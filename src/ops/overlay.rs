@@ -125,17 +125,36 @@ impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
         }
     }
 
-    fn lookup(&self, p: [i64; K]) -> bool {
+    /// Whether source voxel `p` is full, starting from the overlay entry (in `near`) that holds it — a
+    /// few levels above the voxel — rather than from the root.
+    fn lookup(&self, p: [i64; K], near: std::ops::Range<usize>) -> bool {
         if p.iter().any(|&c| c < 0 || c >= self.side) {
             return false;
         }
-        self.src.contains(p.map(|c| c as u32))
+        let p = p.map(|c| c as u32);
+        let Some(e) = near.map(|k| self.overlay[k]).find(|e| e.cell.contains(p)) else {
+            return self.src.contains(p);
+        };
+        let (mut depth, mut index, mut cell) = (e.depth, e.index, e.cell);
+        loop {
+            match self.src.state(depth, index) {
+                NodeState::Empty => return false,
+                NodeState::Full => return true,
+                NodeState::Partial => {
+                    let bit = cell.log_side - 1;
+                    let code = (0..K).fold(0, |code, a| code | (((p[a] >> bit) & 1) as usize) << a);
+                    index = self.src.first_child(depth, index) + code;
+                    depth += 1;
+                    cell = cell.child(code);
+                }
+            }
+        }
     }
 
     /// Decides target cell `cell` given its parent's overlay `parent` (a range of `self.overlay`).
     fn node(&mut self, cell: Cell<K>, ctx: P::Ctx, parent: std::ops::Range<usize>) -> NodeState {
         if cell.log_side == 0 {
-            return leaf(self.lookup(self.map.voxel(&ctx, cell.origin)));
+            return leaf(self.lookup(self.map.voxel(&ctx, cell.origin), parent));
         }
         let mut bx = self.map.cell_box(&ctx, cell.origin, cell.side());
         let mut seen = [false; 2];
