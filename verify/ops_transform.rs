@@ -116,6 +116,29 @@ fn check_affine<const K: usize>(a: &Obj<K>, entries: Vec<f64>) -> Result<(), Tes
     same(&out, a.level, &expect)
 }
 
+fn check_fixed<const K: usize>(a: &Obj<K>, entries: Vec<f64>) -> Result<(), TestCaseError> {
+    let (tree, dense) = (a.tree(), a.dense());
+    let side = (1u64 << a.level) as f64;
+    let mut m = Affine::<K>::identity();
+    for i in 0..K {
+        for j in 0..K {
+            m.a[i][j] = entries[i * K + j] + if i == j { 1.0 } else { 0.0 };
+        }
+        m.b[i] = entries[K * K + i] * side;
+    }
+    let Ok(map) = ops::FixedAffine::new(&m, 32) else {
+        return Ok(());
+    };
+    let out = ops::transform_fixed(&tree, &m, 32).unwrap();
+    let expect = resample_dense::<K>(a.level, &dense, |q: [u32; K]| map.source_voxel(q));
+    same(&out, a.level, &expect)?;
+    // Coarse fixed point (8 bits) is still exact with respect to its own rounded matrix.
+    let coarse = ops::FixedAffine::new(&m, 8).unwrap();
+    let out8 = ops::transform_fixed(&tree, &m, 8).unwrap();
+    let expect8 = resample_dense::<K>(a.level, &dense, |q: [u32; K]| coarse.source_voxel(q));
+    same(&out8, a.level, &expect8)
+}
+
 fn check_rotation<const K: usize>(
     a: &Obj<K>,
     degrees: f64,
@@ -226,6 +249,11 @@ proptest! {
     #[test] fn affine_k2(a in object::<2>(), e in prop::collection::vec(-0.9f64..0.9, 6)) { check_affine(&a, e)?; }
     #[test] fn affine_k3(a in object::<3>(), e in prop::collection::vec(-0.9f64..0.9, 12)) { check_affine(&a, e)?; }
     #[test] fn affine_k4(a in object::<4>(), e in prop::collection::vec(-0.9f64..0.9, 20)) { check_affine(&a, e)?; }
+
+    #[test] fn fixed_k1(a in object::<1>(), e in prop::collection::vec(-0.9f64..0.9, 2)) { check_fixed(&a, e)?; }
+    #[test] fn fixed_k2(a in object::<2>(), e in prop::collection::vec(-0.9f64..0.9, 6)) { check_fixed(&a, e)?; }
+    #[test] fn fixed_k3(a in object::<3>(), e in prop::collection::vec(-0.9f64..0.9, 12)) { check_fixed(&a, e)?; }
+    #[test] fn fixed_k4(a in object::<4>(), e in prop::collection::vec(-0.9f64..0.9, 20)) { check_fixed(&a, e)?; }
 
     #[test] fn rotation_k2(a in object::<2>(), d in -180f64..180.0, s in -3f64..3.0) { check_rotation(&a, d, s)?; }
     #[test] fn rotation_k3(a in object::<3>(), d in -180f64..180.0, s in -3f64..3.0) { check_rotation(&a, d, s)?; }

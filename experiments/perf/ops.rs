@@ -92,6 +92,23 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             ));
             best_of(repeats, || ops::interferes(&small, &far).unwrap(), |_| {})
         }
+        "separation" => {
+            let (a, b) = two_spheres(level);
+            let far = ops::translate(&b, [1 << (level - 1), 0, 0]);
+            let small = ops::intersection(&a, &ops::complement(&far)).unwrap();
+            facts.push((
+                "input_nodes".into(),
+                (small.node_count() + far.node_count()).to_string(),
+            ));
+            let mut d = 0.0;
+            let s = best_of(
+                repeats,
+                || ops::min_separation(&small, &far).unwrap(),
+                |r| d = r.unwrap_or(f64::NAN),
+            );
+            facts.push(("separation".into(), d.to_string()));
+            s
+        }
         "rotate90" => {
             let (a, _) = two_spheres(level);
             let q = AxisMap::<3>::quarter_turn(0, 1)
@@ -135,6 +152,19 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
                 |t| keep(t, &mut out_nodes),
             )
         }
+        "affine-fixed" => {
+            let a = sphere_and_box(level);
+            facts.push(("input_nodes".into(), a.node_count().to_string()));
+            let c = Affine::<3>::universe_centre(level);
+            let m = Affine::rotation_about(0, 1, 30.0, c)
+                .unwrap()
+                .after(&Affine::rotation_about(1, 2, 20.0, c).unwrap());
+            best_of(
+                1,
+                || ops::transform_fixed(&a, &m, 32).unwrap(),
+                |t| keep(t, &mut out_nodes),
+            )
+        }
         "mass" => {
             let (a, _) = two_spheres(level);
             facts.push(("input_nodes".into(), a.node_count().to_string()));
@@ -170,6 +200,11 @@ const CASES: &[(&str, u32, &str)] = &[
         "sphere vs a disjoint sphere part (no early exit)",
     ),
     (
+        "separation",
+        10,
+        "minimum separation of two touching objects (branch and bound)",
+    ),
+    (
         "rotate90",
         10,
         "sphere r = U/2, quarter turn + reflection by reordering",
@@ -180,6 +215,11 @@ const CASES: &[(&str, u32, &str)] = &[
         "affine",
         9,
         "sphere-and-box, rotation 30° about z after 20° about x, overlays",
+    ),
+    (
+        "affine-fixed",
+        9,
+        "same, integer additions and shifts (32-bit fixed point)",
     ),
     ("mass", 10, "sphere r = U/2: volume, centroid, inertia"),
     ("progressive", 10, "sphere r = U/2: progressive mass to 1 %"),
@@ -195,8 +235,12 @@ pub fn report() -> Result<String, String> {
          by stacking (an L = 10 sphere of radius U/2 has about 7.5 million nodes); each output tree is \
          checked well-formed (reduced). Times: best of 3 (one run for the overlay operations) in a fresh \
          process per case; peak memory is that process's high-water resident set, including building the \
-         inputs. Rate = input nodes / time.\n\nMachine: {}.\n",
-        machine_line()
+         inputs. Rate = input nodes / time.\n\nMachine: {}. Load average (1, 5, 15 min) when the report \
+         started: {} — the machine is shared with other jobs, and under load the times grow.\n",
+        machine_line(),
+        std::fs::read_to_string("/proc/loadavg")
+            .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(", "))
+            .unwrap_or_else(|_| "unknown".into())
     );
     let _ = writeln!(
         md,
@@ -240,8 +284,10 @@ pub fn report() -> Result<String, String> {
          output nodes per second (every output node is written once) is the conservative rate. The \
          complement flips 32 packed nodes per machine word and touches no structure. \
          `interferes` on a disjoint pair visits every overlapping pair of partial nodes (no early exit); \
-         on overlapping objects it stops at the first shared voxel. Translation uses Meagher's fixed overlay of 2^3 \
-         obels per target node (64 slot updates per node); scaling and affine maps use the general overlay \
+         on overlapping objects it stops at the first shared voxel. `separation` is the worst case for the \
+         branch and bound: the two objects touch along a large curved surface (distance 1), so every pair of \
+         nodes near it is expanded. Translation uses Meagher's fixed overlay of 2^3 obels per target node \
+         (children's overlays from one 3^3 grid of resolved obels); scaling and affine maps use the general overlay \
          engine (a target's overlay refined per child, cell boxes per node), so they are slower per node \
          than the Booleans."
     );

@@ -60,7 +60,7 @@ pub fn run(results: &Path) -> Result<String, String> {
          | M5 rotations/reflections by reordering; arbitrary angles by overlays | checks, (d) | reproduced (all 48 in 3-D; K!·2^K in any K) |\n\
          | M6 concatenated matrices in one pass; perspective by deformation | checks | reproduced |\n\
          | M7 hidden-surface display | (f) | not here: the display issue |\n\
-         | M8 no floating point | checks | partly: all but arbitrary rotations/matrices are integer-only |\n\
+         | M8 no floating point | checks | reproduced: arbitrary rotations too, in fixed point (`ops::transform_fixed`); `f64` versions kept beside |\n\
          | M9 complexity metric | complexity | reproduced |\n\
          | M10 progressive mass | progressive mass | reproduced |\n\
          | M11 five objects of ≈ 1 200 nodes | (b) | reproduced with tuned sizes |\n\

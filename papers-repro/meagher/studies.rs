@@ -143,7 +143,8 @@ pub fn timing(out: &Out, max_level: u32) -> Result<String, String> {
         "intersection",
         "rotate 90° (reorder)",
         "translate (overlay)",
-        "rotate 30° (affine)",
+        "rotate 30° (affine, f64)",
+        "rotate 30° (fixed point: adds, shifts)",
     ];
     let mut series: Vec<Vec<(f64, f64)>> = vec![Vec::new(); names.len()];
     let mut csv = String::from("operation,level,input_nodes,seconds\n");
@@ -166,6 +167,13 @@ pub fn timing(out: &Out, max_level: u32) -> Result<String, String> {
             (
                 n,
                 best(1, || ops::transform(&a, &m).map(|t| t.node_count())).0,
+            ),
+            (
+                n,
+                best(1, || {
+                    ops::transform_fixed(&a, &m, 32).map(|t| t.node_count())
+                })
+                .0,
             ),
         ];
         for (i, &(nodes, s)) in runs.iter().enumerate() {
@@ -440,13 +448,23 @@ pub fn checks() -> Result<String, String> {
              part, gives {en:.1} and {ef:.1})"
         ),
     );
-    let _ = writeln!(
-        md,
-        "| M8 | which operations are integer-only | Booleans, complement, reordering, translation, scaling by \
-         powers of two and by rational factors, interference, mass: integers only (additions, comparisons, \
-         shifts; mass also multiplies to sum moments exactly). Arbitrary rotations and matrices use `f64` with \
-         exact voxel-level decisions (see `ops::affine`). Multiplications are not avoided: on current CPUs they \
-         cost what additions do. |"
+    // M8: the arbitrary rotation with integer additions and shifts only, against the f64 version.
+    let fixed = ops::transform_fixed(&obj, &t.after(&r30.after(&r30)), 32).map_err(e)?;
+    let fixed_vs_float = ops::symmetric_difference(&fixed, &one)
+        .map_err(e)?
+        .voxel_count();
+    check(
+        "M8",
+        "the same one-pass map with the inverse rounded to 32-bit fixed point, then only additions and shifts \
+         per cell (`ops::transform_fixed`), against the `f64` version",
+        fixed_vs_float <= obj.voxel_count() / 1000,
+        format!(
+            "(they differ in {fixed_vs_float} voxels: rounding the matrix to 2^−32 can only change decisions that \
+             close to a voxel boundary. Booleans, complement, \
+             reordering, translation, scaling and interference are integer-only too; mass multiplies to sum \
+             moments exactly; `ops::transform` and the perspective use `f64`. Integer multiplication is not \
+             avoided everywhere: on current CPUs it costs what an addition does)"
+        ),
     );
     Ok(md)
 }

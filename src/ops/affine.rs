@@ -9,12 +9,13 @@
 //!
 //! **Integer-only or not (M8).** Booleans, complement, child reordering ([`super::rotate_axes`]),
 //! translation, scaling by powers of two and by rational factors, interference and mass use only integer
-//! additions, comparisons and shifts (mass also multiplies, to sum moments exactly). This module uses
-//! floating point: an arbitrary angle's cosine is irrational, so a matrix of them cannot be held exactly in
-//! integers of bounded size. Meagher keeps the edge equations' offsets as fixed-point numbers updated by
-//! halving; `f64` is the same idea with a 53-bit mantissa. To keep decisions exact regardless, cell boxes
+//! arithmetic (mass also multiplies, to sum moments exactly). This module uses floating point (`f64`): an
+//! arbitrary angle's cosine is irrational, so the matrix cannot be held exactly in integers; cell boxes
 //! are widened by a bound on the rounding error and single voxels are decided by the very function the
-//! reference uses.
+//! reference uses, so decisions stay exact with respect to that function. For Meagher's integer-only
+//! version — the inverse rounded once to fixed point, then only additions and shifts while descending —
+//! see [`super::transform_fixed`].
+
 // Matrix and per-axis code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 

@@ -4,7 +4,8 @@
 //!
 //! Every operation reads [`KTree`](crate::KTree)s and writes a new, *reduced* tree in one depth-first pass
 //! that produces level order directly; none expands the object to voxels. Which ones are integer-only
-//! (Meagher's M8) is said in [`affine`]'s docs: all but the arbitrary affine map.
+//! (Meagher's M8) is said in [`affine`]'s docs: all but [`transform`] and [`transform_projective`], which
+//! use `f64`; [`transform_fixed`] does the affine maps with integer additions and shifts.
 //!
 //! | operation | functions | method | cost |
 //! |---|---|---|---|
@@ -13,6 +14,7 @@
 //! | scaling (M4) | [`grow`], [`zoom`] (by `2^n` through the root), [`scale`] (rational, overlays) | root levels; overlay engine | `O(n·2^K)` + copy; output-sensitive |
 //! | rotations, reflections (M5) | [`rotate_axes`] with any [`AxisMap`] (`K!·2^K` of them) | child reordering | linear |
 //! | arbitrary rotation, any affine map (M5, M6) | [`transform`] with an [`Affine`] | overlay engine, voxel-exact | output-sensitive |
+//! | the same with integer additions and shifts only (M5, M8) | [`transform_fixed`] | overlay engine, fixed-point cell images updated incrementally | output-sensitive |
 //! | perspective deformation (M6) | [`transform_projective`] with a [`Projective`] map, e.g. [`Projective::perspective`] | overlay engine, voxel-exact | output-sensitive |
 //! | interference (M14) | [`interferes`], [`overlap_cells`], [`first_contact`], [`min_separation`] | simultaneous traversal, early exit; branch and bound | at most linear |
 //! | mass (M10) | [`mass_properties`], [`mass_progressive`] | exact integer moment sums; level-by-level bounds | linear; stops early |
@@ -33,6 +35,7 @@ mod boolean;
 mod complexity;
 mod emit;
 mod error;
+mod fixed;
 mod interference;
 mod mass;
 pub mod overlay;
@@ -51,6 +54,7 @@ pub use complexity::{
     Normalised,
 };
 pub use error::OpsError;
+pub use fixed::{transform_fixed, FixedAffine};
 pub use interference::{first_contact, interferes, overlap_cells};
 pub use mass::{mass_progressive, mass_properties, LevelBounds, MassProperties, ProgressiveMass};
 pub use perspective::{transform_projective, Projective};

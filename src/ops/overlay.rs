@@ -28,6 +28,36 @@ pub trait Preimage<const K: usize> {
     fn cell_box(&self, origin: [u32; K], side: u64) -> [(i64, i64); K];
 }
 
+/// A preimage computed incrementally down the tree: each target cell carries a context derived from its
+/// parent's (e.g. the fixed-point image of its first voxel centre, updated by additions and shifts).
+pub trait IncrementalPreimage<const K: usize> {
+    /// What a target cell carries.
+    type Ctx: Copy;
+    /// The root cell's context.
+    fn root(&self) -> Self::Ctx;
+    /// The context of child `code` of a cell of side `2^log_side` with context `ctx`.
+    fn child(&self, ctx: &Self::Ctx, code: usize, log_side: u32) -> Self::Ctx;
+    /// As [`Preimage::voxel`], for the voxel whose context is `ctx`.
+    fn voxel(&self, ctx: &Self::Ctx, q: [u32; K]) -> [i64; K];
+    /// As [`Preimage::cell_box`], for the cell whose context is `ctx`.
+    fn cell_box(&self, ctx: &Self::Ctx, origin: [u32; K], side: u64) -> [(i64, i64); K];
+}
+
+/// Any [`Preimage`] as an [`IncrementalPreimage`] with no context.
+struct Stateless<'a, P>(&'a P);
+
+impl<const K: usize, P: Preimage<K>> IncrementalPreimage<K> for Stateless<'_, P> {
+    type Ctx = ();
+    fn root(&self) {}
+    fn child(&self, _: &(), _: usize, _: u32) {}
+    fn voxel(&self, _: &(), q: [u32; K]) -> [i64; K] {
+        self.0.voxel(q)
+    }
+    fn cell_box(&self, _: &(), origin: [u32; K], side: u64) -> [(i64, i64); K] {
+        self.0.cell_box(origin, side)
+    }
+}
+
 #[derive(Clone, Copy)]
 struct Entry<const K: usize> {
     depth: usize,
@@ -51,7 +81,7 @@ fn meets<const K: usize>(cell: &Cell<K>, bx: &[(i64, i64); K]) -> bool {
     })
 }
 
-impl<const K: usize, P: Preimage<K>> Engine<'_, K, P> {
+impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
     /// Adds `e` (meeting `bx`) to the overlay, partial nodes refined to nodes no larger than `extent`;
     /// leaves set `seen` (`[empty, full]`); returns the number of partial nodes added.
     fn refine(
@@ -95,19 +125,38 @@ impl<const K: usize, P: Preimage<K>> Engine<'_, K, P> {
         }
     }
 
-    fn lookup(&self, p: [i64; K]) -> bool {
+    /// Whether source voxel `p` is full, starting from the overlay entry (in `near`) that holds it — a
+    /// few levels above the voxel — rather than from the root.
+    fn lookup(&self, p: [i64; K], near: std::ops::Range<usize>) -> bool {
         if p.iter().any(|&c| c < 0 || c >= self.side) {
             return false;
         }
-        self.src.contains(p.map(|c| c as u32))
+        let p = p.map(|c| c as u32);
+        let Some(e) = near.map(|k| self.overlay[k]).find(|e| e.cell.contains(p)) else {
+            return self.src.contains(p);
+        };
+        let (mut depth, mut index, mut cell) = (e.depth, e.index, e.cell);
+        loop {
+            match self.src.state(depth, index) {
+                NodeState::Empty => return false,
+                NodeState::Full => return true,
+                NodeState::Partial => {
+                    let bit = cell.log_side - 1;
+                    let code = (0..K).fold(0, |code, a| code | (((p[a] >> bit) & 1) as usize) << a);
+                    index = self.src.first_child(depth, index) + code;
+                    depth += 1;
+                    cell = cell.child(code);
+                }
+            }
+        }
     }
 
     /// Decides target cell `cell` given its parent's overlay `parent` (a range of `self.overlay`).
-    fn node(&mut self, cell: Cell<K>, parent: std::ops::Range<usize>) -> NodeState {
+    fn node(&mut self, cell: Cell<K>, ctx: P::Ctx, parent: std::ops::Range<usize>) -> NodeState {
         if cell.log_side == 0 {
-            return leaf(self.lookup(self.map.voxel(cell.origin)));
+            return leaf(self.lookup(self.map.voxel(&ctx, cell.origin), parent));
         }
-        let mut bx = self.map.cell_box(cell.origin, cell.side());
+        let mut bx = self.map.cell_box(&ctx, cell.origin, cell.side());
         let mut seen = [false; 2];
         for b in bx.iter_mut() {
             if b.0 < 0 || b.1 >= self.side {
@@ -138,7 +187,8 @@ impl<const K: usize, P: Preimage<K>> Engine<'_, K, P> {
         }
         let mut kids = [NodeState::Empty; 16];
         for (c, kid) in kids.iter_mut().enumerate().take(1 << K) {
-            *kid = self.node(cell.child(c), start..end);
+            let child_ctx = self.map.child(&ctx, c, cell.log_side);
+            *kid = self.node(cell.child(c), child_ctx, start..end);
         }
         self.overlay.truncate(start);
         let kids = &kids[..1 << K];
@@ -155,6 +205,14 @@ impl<const K: usize, P: Preimage<K>> Engine<'_, K, P> {
 /// Resamples `src` through `map` into a tree of the same universe: target voxel `q` is full iff the source
 /// voxel `map.voxel(q)` is inside the universe and full. The output is reduced.
 pub fn resample<const K: usize, P: Preimage<K>>(src: &KTree<K>, map: &P) -> KTree<K> {
+    resample_incremental(src, &Stateless(map))
+}
+
+/// Like [`resample`], for a map evaluated incrementally from cell to child.
+pub fn resample_incremental<const K: usize, P: IncrementalPreimage<K>>(
+    src: &KTree<K>,
+    map: &P,
+) -> KTree<K> {
     let universe = src.universe();
     let mut engine = Engine {
         src,
@@ -167,6 +225,7 @@ pub fn resample<const K: usize, P: Preimage<K>>(src: &KTree<K>, map: &P) -> KTre
             cell: universe.root(),
         }],
     };
-    let root = engine.node(universe.root(), 0..1);
+    let root_ctx = map.root();
+    let root = engine.node(universe.root(), root_ctx, 0..1);
     engine.out.finish(universe, root)
 }
