@@ -53,6 +53,7 @@ fn render_and_lines_write_pictures() {
         &s(p("a.png")),
         "--depth",
         &s(p("d.png")),
+        "--progress",
     ]);
     assert!(ok, "{err}");
     assert!(out.contains("wrote") && is_png(&p("a.png")) && is_png(&p("d.png")));

@@ -350,32 +350,54 @@ pub fn default_camera(
     let side = tree.universe().side() as f64;
     let (lo, hi) = object_bounds(tree).unwrap_or(([0.0; 3], [side; 3]));
     let mut camera = Camera::framing(lo, hi, toward_eye, fov_y_degrees, width, height)?;
-    if let Projection::Orthographic { height: box_height } = camera.projection {
-        // Tighter: fit the projected corners of the full leaves rather than of the bounding box.
-        let Frame { r, u, .. } = camera.frame();
-        let (mut ex, mut ey) = (0.0f64, 0.0f64);
-        tree.for_each_leaf(|cell, state| {
-            if state != NodeState::Full {
-                return;
+    // Tighter: fit the projected corners of the full leaves rather than the bounding box (or sphere).
+    let Frame { f, r, u } = camera.frame();
+    let toward = [-f[0], -f[1], -f[2]];
+    let aspect = f64::from(width) / f64::from(height);
+    let (mut ex, mut ey, mut distance) = (0.0f64, 0.0f64, 0.0f64);
+    let (tan_v, tan_h) = match camera.projection {
+        Projection::Perspective { fov_y_degrees } => {
+            let t = (fov_y_degrees.to_radians() / 2.0).tan();
+            (t, t * aspect)
+        }
+        Projection::Orthographic { .. } => (1.0, 1.0),
+    };
+    tree.for_each_leaf(|cell, state| {
+        if state != NodeState::Full {
+            return;
+        }
+        let s = cell.side() as f64;
+        let o = cell.origin.map(f64::from);
+        for c in 0..8 {
+            let p = [
+                o[0] + if c & 1 == 0 { 0.0 } else { s },
+                o[1] + if c & 2 == 0 { 0.0 } else { s },
+                o[2] + if c & 4 == 0 { 0.0 } else { s },
+            ];
+            let v = v3::sub(p, camera.target);
+            let (x, y) = (v3::dot(v, r).abs(), v3::dot(v, u).abs());
+            ex = ex.max(x);
+            ey = ey.max(y);
+            let along = v3::dot(v, toward);
+            distance = distance.max(along + x / tan_h).max(along + y / tan_v);
+        }
+    });
+    match camera.projection {
+        Projection::Orthographic { height: box_height } => {
+            let fitted = (2.0 * ey).max(2.0 * ex / aspect).max(1.0) * 1.05;
+            camera.projection = Projection::Orthographic {
+                height: fitted.min(box_height),
+            };
+        }
+        Projection::Perspective { .. } => {
+            // Keep the eye where it was if that is already closer; never inside the object's box.
+            let current = v3::norm(v3::sub(camera.eye, camera.target));
+            let radius = v3::norm(v3::sub(hi, lo)) / 2.0;
+            let fitted = (distance * 1.05).max(radius * 1.05).max(1.0);
+            if fitted < current {
+                camera.eye = v3::add_scaled(camera.target, fitted, toward);
             }
-            let s = cell.side() as f64;
-            let o = cell.origin.map(f64::from);
-            for c in 0..8 {
-                let p = [
-                    o[0] + if c & 1 == 0 { 0.0 } else { s },
-                    o[1] + if c & 2 == 0 { 0.0 } else { s },
-                    o[2] + if c & 4 == 0 { 0.0 } else { s },
-                ];
-                let v = v3::sub(p, camera.target);
-                ex = ex.max(v3::dot(v, r).abs());
-                ey = ey.max(v3::dot(v, u).abs());
-            }
-        });
-        let aspect = f64::from(width) / f64::from(height);
-        let fitted = (2.0 * ey).max(2.0 * ex / aspect).max(1.0) * 1.05;
-        camera.projection = Projection::Orthographic {
-            height: fitted.min(box_height),
-        };
+        }
     }
     Ok(camera)
 }

@@ -156,6 +156,10 @@ struct Screen {
     /// Half-extent of the screen rectangle of a unit cube.
     ex: f64,
     ey: f64,
+    /// Perspective: the camera frame and the screen scale per unit of depth.
+    frame: super::camera::Frame,
+    persp_sx: f64,
+    persp_sy: f64,
 }
 
 /// An inclusive pixel rectangle.
@@ -189,7 +193,22 @@ impl Screen {
         }
         let ex = ax.iter().map(|a| a.abs()).sum::<f64>() / 2.0;
         let ey = ay.iter().map(|a| a.abs()).sum::<f64>() / 2.0;
+        let frame = camera.frame();
+        let (persp_sx, persp_sy) = match camera.projection {
+            super::camera::Projection::Perspective { fov_y_degrees } => {
+                let half_h = (fov_y_degrees.to_radians() / 2.0).tan();
+                let half_w = half_h * f64::from(width) / f64::from(height);
+                (
+                    f64::from(width) / (2.0 * half_w),
+                    f64::from(height) / (2.0 * half_h),
+                )
+            }
+            super::camera::Projection::Orthographic { .. } => (0.0, 0.0),
+        };
         Ok(Self {
+            frame,
+            persp_sx,
+            persp_sy,
             width,
             height,
             camera: *camera,
@@ -217,8 +236,16 @@ impl Screen {
                     lo[1] + if c & 2 == 0 { 0.0 } else { s },
                     lo[2] + if c & 4 == 0 { 0.0 } else { s },
                 ];
-                match self.camera.project(p, self.width, self.height) {
-                    Some((x, y, _)) => {
+                let v = v3::sub(p, self.camera.eye);
+                let z = v3::dot(v, self.frame.f);
+                let projected = (z > 1e-9).then(|| {
+                    (
+                        f64::from(self.width) / 2.0 + v3::dot(v, self.frame.r) / z * self.persp_sx,
+                        f64::from(self.height) / 2.0 - v3::dot(v, self.frame.u) / z * self.persp_sy,
+                    )
+                });
+                match projected {
+                    Some((x, y)) => {
                         xmin = xmin.min(x);
                         xmax = xmax.max(x);
                         ymin = ymin.min(y);
@@ -570,7 +597,11 @@ pub fn render_zbuffer(
         if state != NodeState::Full {
             return;
         }
-        let Some(r) = screen.rect(&cell) else { return };
+        // The reference's own rectangle: all 8 corners through the public projection (independent of
+        // the renderer's incremental one); a corner behind the eye means the whole screen.
+        let Some(r) = reference_rect(camera, &cell, w, h) else {
+            return;
+        };
         stats.leaves_drawn += 1;
         let (lo, hi) = cell_box(&cell);
         for y in r.y0..=r.y1 {
@@ -597,5 +628,49 @@ pub fn render_zbuffer(
         depth: Some(depth.iter().map(|&d| d as f32).collect()),
         cells: Some(cells),
         stats,
+    })
+}
+
+/// The pixels whose centres may see `cell`, from its 8 corners projected by [`Camera::project`].
+fn reference_rect(camera: &Camera, cell: &Cell<3>, w: u32, h: u32) -> Option<Rect> {
+    let (lo, hi) = cell_box(cell);
+    let (mut xmin, mut xmax, mut ymin, mut ymax) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for c in 0..8 {
+        let p = [
+            if c & 1 == 0 { lo[0] } else { hi[0] },
+            if c & 2 == 0 { lo[1] } else { hi[1] },
+            if c & 4 == 0 { lo[2] } else { hi[2] },
+        ];
+        match camera.project(p, w, h) {
+            Some((x, y, _)) => {
+                xmin = xmin.min(x);
+                xmax = xmax.max(x);
+                ymin = ymin.min(y);
+                ymax = ymax.max(y);
+            }
+            None => {
+                return Some(Rect {
+                    x0: 0,
+                    x1: w - 1,
+                    y0: 0,
+                    y1: h - 1,
+                })
+            }
+        }
+    }
+    let x0 = (xmin - 0.5 - 1e-6).ceil().max(0.0);
+    let x1 = (xmax - 0.5 + 1e-6).floor().min(f64::from(w) - 1.0);
+    let y0 = (ymin - 0.5 - 1e-6).ceil().max(0.0);
+    let y1 = (ymax - 0.5 + 1e-6).floor().min(f64::from(h) - 1.0);
+    (x0 <= x1 && y0 <= y1).then_some(Rect {
+        x0: x0 as u32,
+        x1: x1 as u32,
+        y0: y0 as u32,
+        y1: y1 as u32,
     })
 }
