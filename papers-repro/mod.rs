@@ -30,3 +30,12 @@ pub fn run(name: &str, results: &Path) -> Result<String, String> {
         _ => Err(format!("no reproduction named '{name}'")),
     }
 }
+
+/// The process's peak resident memory (VmHWM in `/proc/self/status`), in bytes; `None` where the system does
+/// not report it. Used by reproductions and performance reports to record peak memory.
+pub fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}

@@ -1,20 +1,11 @@
 //! The `ktree` binary end to end: build and stats on ray files, the JSON keys users' scripts rely on, and a
 //! one-line error with a non-zero exit on bad input.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
 
-fn ktree(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_ktree"))
-        .args(args)
-        .output()
-        .expect("run ktree");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::ktree;
+
+use std::path::Path;
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
     let p = dir.join(name);

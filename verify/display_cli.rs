@@ -1,23 +1,13 @@
 //! `ktree render` and `ktree lines` end to end: PNG and SVG files appear for octrees, quadtrees and 4-D
 //! trees; bad input gives a one-line error and a non-zero exit.
 
-use std::process::Command;
+mod common;
+
+use common::ktree;
 
 use ktree::build::stack;
 use ktree::io::write_ktree_file;
 use ktree::rays::ball_rays;
-
-fn ktree(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_ktree"))
-        .args(args)
-        .output()
-        .expect("run ktree");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn is_png(path: &std::path::Path) -> bool {
     std::fs::read(path).is_ok_and(|b| b.starts_with(b"\x89PNG"))

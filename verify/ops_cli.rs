@@ -1,26 +1,17 @@
 //! The operations' command-line interface: `ktree op`, `ktree transform`, `ktree collide`, `ktree mass`
 //! on `.ktree` files, checked against the library, and clear errors on bad input.
 
+mod common;
+
+use common::ktree;
+
 use std::path::Path;
-use std::process::Command;
 
 use ktree::build::stack;
 use ktree::io::{read_ktree_file, write_ktree_file};
 use ktree::ops::{self, Affine, AxisMap};
 use ktree::rays::ball_rays;
 use ktree::KTree;
-
-fn ktree(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_ktree"))
-        .args(args)
-        .output()
-        .expect("run ktree");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn load3(path: &Path) -> KTree<3> {
     read_ktree_file(path).unwrap().into_dim::<3>().unwrap()

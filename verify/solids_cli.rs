@@ -1,23 +1,14 @@
 //! `ktree rays` and `ktree voxelize` from the outside: files written equal the library's result; bad input
 //! exits non-zero with a one-line message.
 
+mod common;
+
+use common::ktree;
+
 use std::path::PathBuf;
-use std::process::Command;
 
 use ktree::io::{read_ktree_file, read_rays_file, AnyRaySet};
 use ktree::solid::{Frame, Quadric, Rational, Sample};
-
-fn ktree(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_ktree"))
-        .args(args)
-        .output()
-        .expect("runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 #[test]
 fn rays_writes_the_library_result() {

@@ -28,7 +28,7 @@ pub fn child(case: impl FnOnce() -> Result<(f64, Vec<(String, String)>), String>
     match case() {
         Ok((seconds, facts)) => {
             println!("seconds={seconds}");
-            println!("peak_bytes={}", peak_rss_bytes());
+            println!("peak_bytes={}", ktree::repro::peak_rss_bytes().unwrap_or(0));
             for (k, v) in facts {
                 println!("{k}={v}");
             }
@@ -65,19 +65,6 @@ pub fn run_child(area: &str, case: &str) -> Result<Measured, String> {
         }
     }
     Ok(m)
-}
-
-/// The process's peak resident set size (VmHWM from /proc/self/status), 0 where unavailable.
-pub fn peak_rss_bytes() -> u64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|kb| kb.parse::<u64>().ok())
-        })
-        .map_or(0, |kb| kb * 1024)
 }
 
 /// Best wall time of `repeats` runs of `work` (each run's result is passed to `keep` to stay observable).

@@ -307,10 +307,19 @@ impl<const K: usize> Stacker<K> {
             }
             let mut combined = std::mem::take(&mut self.combined_buf);
             let stage = &mut self.stages[d - 1];
-            let next = stage.lists.get_mut(l + 1);
-            let split = combine_or_split(&list, sh, &stage.half_offsets[l], next, |key| {
-                combined.push((key, l as u32))
-            });
+            let offsets = &stage.half_offsets[l];
+            let mut next = stage.lists.get_mut(l + 1);
+            let split = combine_or_split(
+                &list,
+                sh,
+                |key| combined.push((key, l as u32)),
+                |key| {
+                    let next = next
+                        .as_deref_mut()
+                        .expect("items split only above the voxel level");
+                    next.extend(offsets.iter().map(|&o| key + o));
+                },
+            );
             list.clear();
             self.stats.split[d - 1][l] += split;
             self.stats.combined[d - 1][l] += combined.len() as u64;
@@ -401,10 +410,15 @@ impl<const K: usize> Stacker<K> {
                 } else {
                     [0, 0]
                 };
-                let split =
-                    combine_or_split_rows(&list, sh, half, &mut next_low, &mut next_high, |key| {
-                        combined.push((key, l as u32))
-                    });
+                let split = combine_or_split(
+                    &list,
+                    sh,
+                    |key| combined.push((key, l as u32)),
+                    |key| {
+                        next_low.push(key + half[0]);
+                        next_high.push(key + half[1]);
+                    },
+                );
                 self.stats.split[0][l] += split;
                 self.stats.combined[0][l] += combined.len() as u64;
                 self.hold(2 * split);
@@ -429,50 +443,13 @@ impl<const K: usize> Stacker<K> {
 
 /// Scans a sorted list of local keys at shift `sh` (side `2^sh`): each run of keys equal above bit `sh`
 /// with exactly `2^sh` members combines (`on_combined` gets the run's first key with the low `sh` bits
-/// cleared); every member of any other run is split into `key + o` for each half offset `o`, appended to
-/// `next`. Returns the number of items split.
+/// cleared); every member of any other run is split (`on_split` gets its key). Returns the number of items
+/// split.
 fn combine_or_split(
     list: &[u64],
     sh: u32,
-    half_offsets: &[u64],
-    next: Option<&mut Vec<u64>>,
     mut on_combined: impl FnMut(u64),
-) -> u64 {
-    let side = 1usize << sh;
-    let mut split = 0;
-    let mut next = next;
-    let mut i = 0;
-    while i < list.len() {
-        let group = list[i] >> sh;
-        let mut j = i + 1;
-        while j < list.len() && list[j] >> sh == group {
-            j += 1;
-        }
-        if j - i == side {
-            on_combined(group << sh);
-        } else {
-            let next = next
-                .as_deref_mut()
-                .expect("items split only above the voxel level");
-            for &key in &list[i..j] {
-                next.extend(half_offsets.iter().map(|&o| key + o));
-            }
-            split += (j - i) as u64;
-        }
-        i = j;
-    }
-    split
-}
-
-/// [`combine_or_split`] for rows, keeping the two halves in two sorted sequences: low halves (`+ half[0]`)
-/// to `lows`, high halves (`+ half[1]`) to `highs`.
-fn combine_or_split_rows(
-    list: &[u64],
-    sh: u32,
-    half: [u64; 2],
-    lows: &mut Vec<u64>,
-    highs: &mut Vec<u64>,
-    mut on_combined: impl FnMut(u64),
+    mut on_split: impl FnMut(u64),
 ) -> u64 {
     let side = 1usize << sh;
     let mut split = 0;
@@ -486,10 +463,7 @@ fn combine_or_split_rows(
         if j - i == side {
             on_combined(group << sh);
         } else {
-            for &key in &list[i..j] {
-                lows.push(key + half[0]);
-                highs.push(key + half[1]);
-            }
+            list[i..j].iter().for_each(|&key| on_split(key));
             split += (j - i) as u64;
         }
         i = j;

@@ -112,47 +112,32 @@ impl AnyRaySet {
     }
 }
 
-impl<const K: usize> From<KTree<K>> for AnyTree {
-    fn from(tree: KTree<K>) -> Self {
-        // Each arm converts only when K matches; `KTree<K>` and `KTree<1>` are the same type then.
-        let any: Box<dyn std::any::Any> = Box::new(tree);
-        let any = match any.downcast::<KTree<1>>() {
-            Ok(t) => return Self::K1(*t),
-            Err(a) => a,
-        };
-        let any = match any.downcast::<KTree<2>>() {
-            Ok(t) => return Self::K2(*t),
-            Err(a) => a,
-        };
-        let any = match any.downcast::<KTree<3>>() {
-            Ok(t) => return Self::K3(*t),
-            Err(a) => a,
-        };
-        match any.downcast::<KTree<4>>() {
-            Ok(t) => Self::K4(*t),
-            Err(_) => unreachable!("K is checked to be 1..=4 when a KTree is made"),
+/// `From<$typed<K>>` for an enum of the four dimensions, by downcasting to the one `K` that matches.
+macro_rules! from_typed {
+    ($typed:ident, $any:ident) => {
+        impl<const K: usize> From<$typed<K>> for $any {
+            fn from(value: $typed<K>) -> Self {
+                let boxed: Box<dyn std::any::Any> = Box::new(value);
+                let boxed = match boxed.downcast::<$typed<1>>() {
+                    Ok(v) => return Self::K1(*v),
+                    Err(b) => b,
+                };
+                let boxed = match boxed.downcast::<$typed<2>>() {
+                    Ok(v) => return Self::K2(*v),
+                    Err(b) => b,
+                };
+                let boxed = match boxed.downcast::<$typed<3>>() {
+                    Ok(v) => return Self::K3(*v),
+                    Err(b) => b,
+                };
+                match boxed.downcast::<$typed<4>>() {
+                    Ok(v) => Self::K4(*v),
+                    Err(_) => unreachable!("K is checked to be 1..=4 when the value is made"),
+                }
+            }
         }
-    }
+    };
 }
 
-impl<const K: usize> From<RaySet<K>> for AnyRaySet {
-    fn from(rays: RaySet<K>) -> Self {
-        let any: Box<dyn std::any::Any> = Box::new(rays);
-        let any = match any.downcast::<RaySet<1>>() {
-            Ok(r) => return Self::K1(*r),
-            Err(a) => a,
-        };
-        let any = match any.downcast::<RaySet<2>>() {
-            Ok(r) => return Self::K2(*r),
-            Err(a) => a,
-        };
-        let any = match any.downcast::<RaySet<3>>() {
-            Ok(r) => return Self::K3(*r),
-            Err(a) => a,
-        };
-        match any.downcast::<RaySet<4>>() {
-            Ok(r) => Self::K4(*r),
-            Err(_) => unreachable!("K is checked to be 1..=4 when a RaySet is made"),
-        }
-    }
-}
+from_typed!(KTree, AnyTree);
+from_typed!(RaySet, AnyRaySet);

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use std::fmt;
+use std::process::Command;
 
 use ktree::{Ray, RaySet};
 use proptest::prelude::*;
@@ -133,4 +134,17 @@ pub fn ray_sets<const K: usize>() -> impl Strategy<Value = Case<K>> {
             rays: RaySet::from_rays(level, runs).expect("generated runs are valid"),
         })
     })
+}
+
+/// Runs the `ktree` binary built for this test run: (success, stdout, stderr).
+pub fn ktree(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_ktree"))
+        .args(args)
+        .output()
+        .expect("run ktree");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
