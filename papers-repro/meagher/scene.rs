@@ -50,8 +50,9 @@ fn row(md: &mut String, csv: &mut String, name: &str, paper: &str, tree: &KTree<
     );
 }
 
-/// The milling scene: table of node counts, the channel, timings.
-pub fn milling(out: &Out) -> Result<String, String> {
+/// The milling scene: table of node counts, the channel, timings; returns the README section and the
+/// machined scene (workpiece after the cut, clamp and the tool at the path's end) as one tree.
+pub fn milling(out: &Out) -> Result<(String, KTree<3>), String> {
     let l = MILL_LEVEL;
     let workpiece = cuboid(l, [32, 64, 0], [224, 192, 64])?;
     // Clamp: two jaws gripping the workpiece's ends and a bar across them, not aligned to large cells.
@@ -186,7 +187,12 @@ pub fn milling(out: &Out) -> Result<String, String> {
         total.div_ceil(4)
     );
     out.write("milling.csv", &csv)?;
-    Ok(md)
+    let mut scene = ops::union(&machined, &clamp).map_err(|e| e.to_string())?;
+    for part in [&end.bit, &end.shaft, &end.holder] {
+        scene = ops::union(&scene, part).map_err(|e| e.to_string())?;
+    }
+    scene.assert_well_formed();
+    Ok((md, scene))
 }
 
 /// Bisection on an integer size parameter so that `count(size)` is as close as possible to `target`,

@@ -438,10 +438,10 @@ fn readme(
     );
     let _ = writeln!(
         md,
-        "## Not here yet\n\nMeagher's milling scene (M12: top, front, side, orthographic and perspective views) \
-         depends on the Meagher reproduction being built by another helper (its tree Booleans and scene); \
-         once it exists, its views are `ktree render` calls with `--camera top|front|right|iso` and \
-         `--perspective FOV` on its trees, and will be added here."
+        "## Meagher's milling scene\n\nThe views of Meagher's milling scene (M12: top, front, side, orthographic \
+         and perspective hidden-surface views, and a line drawing with hidden lines removed by the method \
+         above) are made by the Meagher reproduction: see `results/meagher/README.md`, section (f), and \
+         `results/meagher/views_*.png`, `results/meagher/views_lines.svg`."
     );
     md
 }
