@@ -68,7 +68,8 @@ pub fn milling(out: &Out) -> Result<(String, KTree<3>), String> {
          [32, 224) × [64, 192) × [0, 64). Clamp: two jaws [20, 32) and [224, 236) × [84, 172) × [0, 76). Tool \
          at x = {}, y = 128: bit = cylinder of radius 12 for 48 ≤ z < 100 ∪ ball of radius 12 centred at \
          z = 48 (a ball-end mill); shaft = cylinder of radius 8 for 100 ≤ z < 160; holder = box 48 × 48 × 64. \
-         All by exact voxel-centre tests, with small private ray generators (`papers-repro/meagher/solids.rs`) that will be replaced by the solids module (issue 3: quadrics and CSG on rays) once it lands. Dimensions are \
+         All by exact voxel-centre tests with the library's solids (`ktree::solid`: `BoxSolid`, `Quadric::ball`, \
+         `Quadric::cylinder` cut by a box with CSG on rays), then tree Booleans (`ktree::ops`). Dimensions are \
          ours — the paper gives only counts — and were *not* tuned to match them.\n",
         PATH.0
     );
