@@ -5,7 +5,7 @@
 //! Run with `ktree repro meagher`.
 
 mod ct;
-mod plot;
+pub(crate) mod plot;
 mod scene;
 mod solids;
 mod studies;

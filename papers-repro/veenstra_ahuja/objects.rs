@@ -62,18 +62,23 @@ fn polytope_rays(planes: &[([i64; 3], Rational)], level: u32) -> Result<RaySet<3
     Ok(rays)
 }
 
+/// The part of `rays` with 0.1 ≤ z ≤ 0.9 (CSG on rays with a slab), as a tree.
+fn upright(rays: &RaySet<3>, level: u32) -> Result<Octree, String> {
+    let slab = box_rays(
+        [q(0, 1), q(0, 1), q(1, 10)],
+        [q(1, 1), q(1, 1), q(9, 10)],
+        level,
+    )?;
+    Ok(stack(&rays.intersection(&slab).map_err(text)?))
+}
+
 /// Cylinder x² + y² ≤ 0.4² around the vertical axis through the centre, 0.1 ≤ z ≤ 0.9.
 fn cylinder(level: u32) -> Result<Octree, String> {
     let tube = quadric_rays(
         Quadric::cylinder(2, [q(1, 2), q(1, 2), q(0, 1)], q(2, 5), Frame::UnitCube),
         level,
     )?;
-    let slab = box_rays(
-        [q(0, 1), q(0, 1), q(1, 10)],
-        [q(1, 1), q(1, 1), q(9, 10)],
-        level,
-    )?;
-    Ok(stack(&tube.intersection(&slab).map_err(text)?))
+    upright(&tube, level)
 }
 
 /// Cone with apex at z = 0.9 on the vertical axis and radius 0.42 at z = 0.1 (one nappe, cut at z = 0.1).
@@ -88,12 +93,7 @@ fn cone(level: u32) -> Result<Octree, String> {
         ),
         level,
     )?;
-    let slab = box_rays(
-        [q(0, 1), q(0, 1), q(1, 10)],
-        [q(1, 1), q(1, 1), q(9, 10)],
-        level,
-    )?;
-    Ok(stack(&nappes.intersection(&slab).map_err(text)?))
+    upright(&nappes, level)
 }
 
 fn sphere_quadric() -> Result<Quadric<3>, crate::solid::SolidError> {
