@@ -60,3 +60,46 @@ pub fn cylinder(
     let slab = rays_of_box(level, lo, hi)?;
     Ok(stack(&tube.intersection(&slab).map_err(|e| e.to_string())?))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each voxel of a level-5 universe against the shapes' definitions in doubled integer coordinates.
+    #[test]
+    fn shapes_match_their_definitions() {
+        let level = 5;
+        let side = 1i64 << level;
+        let centre2 = [33, 30, 31];
+        let boxed = cuboid(level, [3, 7, 0], [20, 9, 31]).unwrap();
+        let round = ball(level, centre2, 21).unwrap();
+        let tubes: Vec<KTree<3>> = (0..3)
+            .map(|axis| cylinder(level, axis, centre2, 17, (4, 27)).unwrap())
+            .collect();
+        let dense = |t: &KTree<3>| t.to_dense().unwrap();
+        let (b, r) = (dense(&boxed), dense(&round));
+        let t: Vec<Vec<bool>> = tubes.iter().map(dense).collect();
+        let off = |c: i64, c2: i64| (2 * c + 1 - c2).pow(2);
+        for z in 0..side {
+            for y in 0..side {
+                for x in 0..side {
+                    let p = [x, y, z];
+                    let i = (x + side * (y + side * z)) as usize;
+                    let in_box =
+                        (3..20).contains(&x) && (7..9).contains(&y) && (0..31).contains(&z);
+                    assert_eq!(b[i], in_box, "box at {p:?}");
+                    let d: i64 = (0..3).map(|a| off(p[a], centre2[a])).sum();
+                    assert_eq!(r[i], d <= 21 * 21, "ball at {p:?}");
+                    for (axis, tube) in t.iter().enumerate() {
+                        let d: i64 = (0..3)
+                            .filter(|&a| a != axis)
+                            .map(|a| off(p[a], centre2[a]))
+                            .sum();
+                        let want = d <= 17 * 17 && (4..27).contains(&p[axis]);
+                        assert_eq!(tube[i], want, "cylinder along {axis} at {p:?}");
+                    }
+                }
+            }
+        }
+    }
+}

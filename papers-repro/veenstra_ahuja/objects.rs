@@ -353,3 +353,96 @@ pub fn moving_ball(level: u32) -> Result<RaySet<4>, String> {
         .to_rays(level, Sample::Centre, false)
         .map_err(text)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shapes as floating-point inside tests at voxel centres on the unit cube (the reference the
+    /// library-built objects must match voxel for voxel).
+    fn reference(name: &str, p: [f64; 3]) -> bool {
+        let (x, y, z) = (p[0] - 0.5, p[1] - 0.5, p[2] - 0.5);
+        match name {
+            "cylinder" => x * x + y * y <= 0.16 && (0.1..=0.9).contains(&p[2]),
+            "cone" => {
+                let r = 0.42 * (0.9 - p[2]) / 0.8;
+                p[2] >= 0.1 && r > 0.0 && x * x + y * y <= r * r
+            }
+            "sphere" => x * x + y * y + z * z <= 0.45 * 0.45,
+            "pyramid" => {
+                let half = 0.42 * (0.88 - p[2]) / 0.78;
+                p[2] >= 0.1 && x.abs() <= half && y.abs() <= half
+            }
+            "self_occluding" => {
+                ((x * x + y * y).sqrt() - 0.3).powi(2) + z * z <= 0.11 * 0.11
+                    || (x.abs() <= 0.06 && z.abs() <= 0.06 && y.abs() <= 0.46)
+            }
+            "diamond" => x.abs() + y.abs() + z.abs() <= 0.46,
+            "coffee_cup" => {
+                let pixel = |image: &[&str; 16], across: f64, up: f64| {
+                    let col = ((across * 16.0).floor() as usize).min(15);
+                    let row = 15 - ((up * 16.0).floor() as usize).min(15);
+                    image[row].as_bytes()[col] == b'#'
+                };
+                pixel(&CUP_FRONT, p[0], p[2])
+                    && pixel(&CUP_SIDE, p[1], p[2])
+                    && pixel(&CUP_TOP, p[0], p[1])
+            }
+            _ => panic!("unknown shape {name}"),
+        }
+    }
+
+    #[test]
+    fn library_objects_match_the_inside_tests() {
+        for level in [4, 5] {
+            let side = 1usize << level;
+            let unit = |v: usize| (v as f64 + 0.5) / side as f64;
+            for shape in shapes() {
+                let dense = shape_tree(&shape, level).unwrap().to_dense().unwrap();
+                let mut inside = 0;
+                for z in 0..side {
+                    for y in 0..side {
+                        for x in 0..side {
+                            let want = reference(shape.name, [unit(x), unit(y), unit(z)]);
+                            let got = dense[x + side * (y + side * z)];
+                            assert_eq!(
+                                got, want,
+                                "{} at L = {level}, voxel {x},{y},{z}",
+                                shape.name
+                            );
+                            inside += usize::from(got);
+                        }
+                    }
+                }
+                assert!(inside > 0, "{} is empty at L = {level}", shape.name);
+            }
+        }
+    }
+
+    #[test]
+    fn moving_ball_matches_its_definition() {
+        let level = 3;
+        let side = 1u32 << level;
+        let u = f64::from(side);
+        let rays = moving_ball(level).unwrap();
+        let mut count = 0u128;
+        for x in 0..side {
+            for y in 0..side {
+                for z in 0..side {
+                    for t in 0..side {
+                        let s = (f64::from(t) + 0.5) / u;
+                        let c = [u * (0.25 + 0.5 * s), u * 0.5, u * (0.35 + 0.3 * s)];
+                        let d: f64 = [x, y, z]
+                            .iter()
+                            .zip(c)
+                            .map(|(&v, c)| (f64::from(v) + 0.5 - c).powi(2))
+                            .sum();
+                        count += u128::from(d <= (u / 5.0).powi(2));
+                    }
+                }
+            }
+        }
+        assert!(count > 0);
+        assert_eq!(rays.voxel_count(), count);
+    }
+}
