@@ -5,10 +5,11 @@
 //! Run with `ktree repro meagher`.
 
 mod ct;
-mod plot;
+pub(crate) mod plot;
 mod scene;
 mod solids;
 mod studies;
+mod views;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -59,7 +60,7 @@ pub fn run(results: &Path) -> Result<String, String> {
          | M4 scaling through the root; other factors by overlays | checks; `ops::scale` | reproduced |\n\
          | M5 rotations/reflections by reordering; arbitrary angles by overlays | checks, (d) | reproduced (all 48 in 3-D; K!·2^K in any K) |\n\
          | M6 concatenated matrices in one pass; perspective by deformation | checks | reproduced |\n\
-         | M7 hidden-surface display | (f) | not here: the display issue |\n\
+         | M7 hidden-surface display | (f) | reproduced: top, front, side, isometric and perspective views of the milling scene, and a line drawing |\n\
          | M8 no floating point | checks | reproduced: arbitrary rotations too, in fixed point (`ops::transform_fixed`); `f64` versions kept beside |\n\
          | M9 complexity metric | complexity | reproduced |\n\
          | M10 progressive mass | progressive mass | reproduced |\n\
@@ -68,9 +69,17 @@ pub fn run(results: &Path) -> Result<String, String> {
          | M13 CT skull | (e) | reproduced on a 64³ real volume (smaller than the paper's) |\n\
          | M14 N-D interference | space-time | reproduced in 4-D |\n"
     );
+    let milled: std::cell::RefCell<Option<crate::tree::KTree<3>>> = std::cell::RefCell::new(None);
     type Part<'a> = Box<dyn Fn() -> Result<String, String> + 'a>;
     let parts: Vec<(&str, Part)> = vec![
-        ("milling scene", Box::new(|| scene::milling(&out))),
+        (
+            "milling scene",
+            Box::new(|| {
+                let (md, tree) = scene::milling(&out)?;
+                *milled.borrow_mut() = Some(tree);
+                Ok(md)
+            }),
+        ),
         ("five objects", Box::new(|| scene::five_objects(&out))),
         ("surface area", Box::new(|| studies::surface_area(&out))),
         (
@@ -81,11 +90,17 @@ pub fn run(results: &Path) -> Result<String, String> {
         (
             "views",
             Box::new(|| {
-                Ok("### (f) Views of the scene (Fig. 11–13, M7)\n\nNot yet: views (top, front, side, \
-                    orthographic, perspective) need the display module, which another issue is adding in \
-                    parallel. Once it lands, this reproduction will render the milling scene before and after \
-                    machining.\n"
-                    .to_string())
+                let scene = milled.borrow();
+                let scene = scene.as_ref().ok_or("the milling scene was not built")?;
+                views::views(
+                    &out,
+                    scene,
+                    &format!(
+                        "The machined scene of (a) — the workpiece with its channel, the clamp, and the tool \
+                         (bit, shaft, holder) at the path's end x = {} — as one tree (their union by `ops::union`)",
+                        scene::PATH.1
+                    ),
+                )
             }),
         ),
         ("complexity", Box::new(|| studies::complexity(&out))),

@@ -1,48 +1,46 @@
-//! Small private ray generators for the reproduction's scenes — boxes and cylinders along an axis, with
-//! exact voxel-centre tests in doubled (half-voxel) integer coordinates, like [`crate::rays::ball_rays`].
-//! They will be replaced by the solids module (general quadrics and CSG on rays, issue 3).
+//! The reproduction's shapes from the library's exact solids (`ktree::solid`): boxes, balls and finite
+//! cylinders, in the voxel frame sampled at voxel centres, stacked into octrees. Finite cylinders are the
+//! library's infinite quadric cylinder cut by a box, by CSG on rays (`RaySet::intersection`).
 
 use crate::build::stack;
-use crate::rays::{ball_rays, Ray, RaySet};
+use crate::rays::RaySet;
+use crate::solid::{BoxSolid, Frame, Quadric, Rational, Sample};
 use crate::tree::KTree;
+
+fn half(v: i64) -> Rational {
+    Rational::new(v, 2).expect("non-zero denominator")
+}
+
+fn rays_of_box(level: u32, lo: [u32; 3], hi: [u32; 3]) -> Result<RaySet<3>, String> {
+    // Centres c + ½ in the closed box [lo, hi − ½]: exactly the voxels lo ≤ c < hi.
+    let b = BoxSolid::<3>::new(
+        lo.map(|v| Rational::int(i64::from(v))),
+        hi.map(|v| half(2 * i64::from(v) - 1)),
+        Frame::Voxel,
+    )
+    .map_err(|e| e.to_string())?;
+    b.to_rays(level, Sample::Centre, false)
+        .map_err(|e| e.to_string())
+}
 
 /// The box `[lo, hi)` (voxels) as an octree.
 pub fn cuboid(level: u32, lo: [u32; 3], hi: [u32; 3]) -> Result<KTree<3>, String> {
-    let mut rays = Vec::new();
-    for x in lo[0]..hi[0] {
-        for y in lo[1]..hi[1] {
-            rays.push(Ray::new([x, y, lo[2]], hi[2]));
-        }
-    }
-    Ok(stack(
-        &RaySet::from_rays(level, rays).map_err(|e| e.to_string())?,
-    ))
+    Ok(stack(&rays_of_box(level, lo, hi)?))
 }
 
-/// The ball with centre `centre2` and radius `radius2` in doubled coordinates.
+/// The closed ball with centre `centre2 / 2` and radius `radius2 / 2` (voxel units; voxel centres tested).
 pub fn ball(level: u32, centre2: [i64; 3], radius2: i64) -> Result<KTree<3>, String> {
+    let q = Quadric::<3>::ball(centre2.map(half), half(radius2), Frame::Voxel)
+        .map_err(|e| e.to_string())?;
     Ok(stack(
-        &ball_rays::<3>(level, centre2, radius2).map_err(|e| e.to_string())?,
+        &q.to_rays(level, Sample::Centre, false)
+            .map_err(|e| e.to_string())?,
     ))
 }
 
-fn isqrt(n: i64) -> i64 {
-    if n <= 0 {
-        return 0;
-    }
-    let mut s = (n as f64).sqrt() as i64;
-    while s * s > n {
-        s -= 1;
-    }
-    while (s + 1) * (s + 1) <= n {
-        s += 1;
-    }
-    s
-}
-
-/// The cylinder along `axis` (0, 1, 2) whose voxels have centres within `radius2` (doubled) of the axis
-/// line through `centre2` (doubled; the coordinate along `axis` is ignored) and whose coordinate along
-/// `axis` lies in `[from, to)`.
+/// The cylinder along `axis` (0, 1, 2) whose voxels have centres within `radius2 / 2` of the axis line
+/// through `centre2 / 2` (the coordinate along `axis` is ignored) and whose coordinate along `axis` lies
+/// in `[from, to)`.
 pub fn cylinder(
     level: u32,
     axis: usize,
@@ -50,48 +48,58 @@ pub fn cylinder(
     radius2: i64,
     (from, to): (u32, u32),
 ) -> Result<KTree<3>, String> {
-    let side = 1i64 << level;
-    let r2 = radius2 * radius2;
-    let off = |c: i64, c2: i64| (2 * c + 1 - c2).pow(2);
-    let mut rays = Vec::new();
-    for x in 0..side {
-        for y in 0..side {
-            let (z1, z2) = match axis {
-                2 => {
-                    if off(x, centre2[0]) + off(y, centre2[1]) > r2 {
-                        continue;
+    let q = Quadric::<3>::cylinder(axis, centre2.map(half), half(radius2), Frame::Voxel)
+        .map_err(|e| e.to_string())?;
+    let tube = q
+        .to_rays(level, Sample::Centre, false)
+        .map_err(|e| e.to_string())?;
+    let side = 1u32 << level;
+    let (mut lo, mut hi) = ([0; 3], [side; 3]);
+    lo[axis] = from;
+    hi[axis] = to;
+    let slab = rays_of_box(level, lo, hi)?;
+    Ok(stack(&tube.intersection(&slab).map_err(|e| e.to_string())?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each voxel of a level-5 universe against the shapes' definitions in doubled integer coordinates.
+    #[test]
+    fn shapes_match_their_definitions() {
+        let level = 5;
+        let side = 1i64 << level;
+        let centre2 = [33, 30, 31];
+        let boxed = cuboid(level, [3, 7, 0], [20, 9, 31]).unwrap();
+        let round = ball(level, centre2, 21).unwrap();
+        let tubes: Vec<KTree<3>> = (0..3)
+            .map(|axis| cylinder(level, axis, centre2, 17, (4, 27)).unwrap())
+            .collect();
+        let dense = |t: &KTree<3>| t.to_dense().unwrap();
+        let (b, r) = (dense(&boxed), dense(&round));
+        let t: Vec<Vec<bool>> = tubes.iter().map(dense).collect();
+        let off = |c: i64, c2: i64| (2 * c + 1 - c2).pow(2);
+        for z in 0..side {
+            for y in 0..side {
+                for x in 0..side {
+                    let p = [x, y, z];
+                    let i = (x + side * (y + side * z)) as usize;
+                    let in_box =
+                        (3..20).contains(&x) && (7..9).contains(&y) && (0..31).contains(&z);
+                    assert_eq!(b[i], in_box, "box at {p:?}");
+                    let d: i64 = (0..3).map(|a| off(p[a], centre2[a])).sum();
+                    assert_eq!(r[i], d <= 21 * 21, "ball at {p:?}");
+                    for (axis, tube) in t.iter().enumerate() {
+                        let d: i64 = (0..3)
+                            .filter(|&a| a != axis)
+                            .map(|a| off(p[a], centre2[a]))
+                            .sum();
+                        let want = d <= 17 * 17 && (4..27).contains(&p[axis]);
+                        assert_eq!(tube[i], want, "cylinder along {axis} at {p:?}");
                     }
-                    (i64::from(from), i64::from(to))
                 }
-                _ => {
-                    // The along-axis coordinate is x (axis 0) or y (axis 1); the other is in the disk.
-                    let (along, other, oc2) = if axis == 0 {
-                        (x, y, centre2[1])
-                    } else {
-                        (y, x, centre2[0])
-                    };
-                    if along < i64::from(from) || along >= i64::from(to) {
-                        continue;
-                    }
-                    let used = off(other, oc2);
-                    if used > r2 {
-                        continue;
-                    }
-                    let s = isqrt(r2 - used);
-                    let cz = centre2[2];
-                    (
-                        (cz - s).div_euclid(2).max(0),
-                        (cz + s - 1).div_euclid(2).min(side - 1) + 1,
-                    )
-                }
-            };
-            let (z1, z2) = (z1.max(0), z2.min(side));
-            if z1 < z2 {
-                rays.push(Ray::new([x as u32, y as u32, z1 as u32], z2 as u32));
             }
         }
     }
-    Ok(stack(
-        &RaySet::from_rays(level, rays).map_err(|e| e.to_string())?,
-    ))
 }

@@ -82,7 +82,7 @@ pub fn run(results: &Path) -> Result<String, String> {
         "| Fig. | object | L | nodes | full leaves | surrounded (skipped, V5) | graphics nodes (V8) | edge pieces | segments after merging | visible pieces | lines after joining (V4) | files |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"
     );
     for shape in &shapes {
-        let tree = stack(&objects::shape_rays(shape, FIG_LEVEL)?);
+        let tree = objects::shape_tree(shape, FIG_LEVEL)?;
         tree.check()?;
         let d =
             line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed, None).map_err(err)?;
@@ -190,7 +190,7 @@ pub fn run(results: &Path) -> Result<String, String> {
     }
     cases.push((&shapes[2], BIG_LEVEL));
     for (shape, level) in cases {
-        let tree: Octree = stack(&objects::shape_rays(shape, level)?);
+        let tree: Octree = objects::shape_tree(shape, level)?;
         let (t_b, fast) = timed(3, || {
             line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed, None).map_err(err)
         })?;
@@ -357,10 +357,15 @@ fn readme(
          view (direction {:?} from the object towards the viewer) with cracks, hidden lines and dots removed \
          (`.svg`: vector lines; `.png`: the same lines rasterised), and as a hidden-surface image \
          (`_render.png`, shading by face orientation).\n\n{figures}\n\
-         The objects come from small private generators in `papers-repro/veenstra_ahuja/objects.rs` (exact \
-         voxel-centre tests turned into rays and stacked; the coffee cup is the intersection of three 16×16 \
-         silhouettes drawn in the code, extruded). They will be replaced by the solids (quadrics, CSG) and \
-         tree Boolean modules being built alongside. The coffee cup is exactly its 16×16 silhouettes extruded, so its \
+         The objects are built with the library (`papers-repro/veenstra_ahuja/objects.rs`), all by exact \
+         tests at voxel centres in the unit-cube frame: the cylinder, cone and sphere are `ktree::solid` \
+         quadrics (cylinder and cone cut by a box with CSG on rays), the pyramid and the diamond (an \
+         octahedron) intersections of half-spaces, the self-occluding object a torus (a quartic, the one \
+         shape with a private inside test) united with a box by a tree Boolean, and the coffee cup the tree \
+         intersection (`ops::intersection`) of three 16×16 silhouettes drawn in the code, each extruded as a \
+         union of boxes. They replace earlier private floating-point inside tests with the same shapes; every \
+         node count above and in Fig. 12 is unchanged by the switch (no voxel centre lies on a surface, so \
+         the closed solids and the old tests agree). The coffee cup is exactly its 16×16 silhouettes extruded, so its \
          octree stops at depth 4 at any level (the same 785 nodes at L = 4, 5 and 6 in Fig. 12). The paper's objects came from silhouette images of real \
          objects, so ours differ in shape and size; the figures show the same kinds of drawing.\n\n\
          A sphere at level {BIG_LEVEL}: `sphere_l7_normals.png` shaded with the exact surface normals the \
@@ -438,10 +443,10 @@ fn readme(
     );
     let _ = writeln!(
         md,
-        "## Not here yet\n\nMeagher's milling scene (M12: top, front, side, orthographic and perspective views) \
-         depends on the Meagher reproduction being built by another helper (its tree Booleans and scene); \
-         once it exists, its views are `ktree render` calls with `--camera top|front|right|iso` and \
-         `--perspective FOV` on its trees, and will be added here."
+        "## Meagher's milling scene\n\nThe views of Meagher's milling scene (M12: top, front, side, orthographic \
+         and perspective hidden-surface views, and a line drawing with hidden lines removed by the method \
+         above) are made by the Meagher reproduction: see `results/meagher/README.md`, section (f), and \
+         `results/meagher/views_*.png`, `results/meagher/views_lines.svg`."
     );
     md
 }

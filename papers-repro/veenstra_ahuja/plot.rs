@@ -1,31 +1,12 @@
 //! Fig. 12's plot: line-drawing time against the number of octree nodes, both hidden-line methods, as
 //! SVG and PNG (plotters). Text needs a font; the first common system font found is registered at run
-//! time, and without one the plot is skipped (the CSV and table still hold the numbers).
-
-use std::sync::OnceLock;
+//! time (shared with the Meagher reproduction's plots), and without one the plot is skipped (the CSV and table still hold the numbers).
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-const FONTS: &[&str] = &[
-    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/TTF/DejaVuSans.ttf",
-    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
-];
-
-/// Registers a system font once; `false` if none is available.
-pub fn font_available() -> bool {
-    static OK: OnceLock<bool> = OnceLock::new();
-    *OK.get_or_init(|| {
-        FONTS.iter().any(|path| {
-            std::fs::read(path).is_ok_and(|bytes| {
-                let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-                plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_ok()
-            })
-        })
-    })
-}
+/// The font registration is the Meagher reproduction's (one list of system fonts for both).
+pub use crate::repro::meagher::plot::font_available;
 
 /// The two series: (nodes, seconds) for the pairwise and the bucketed method.
 pub struct Fig12<'a> {
