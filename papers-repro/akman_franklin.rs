@@ -10,12 +10,13 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
+use super::common::{fit_line, font_available, LineFit};
 use crate::build::{stack, stack_with_stats, DensePyramid, NaiveTree};
 use crate::io::write_atomic;
 use crate::rays::{maximal_rows, RaySet};
 use crate::solid::{Frame, Quadric, Rational, Sample};
 use crate::Ray;
-use plots::{fit, png_has_text, Plot, Series};
+use plots::{Plot, Series};
 use search::{search, Convention, Family, Hit, Shape};
 
 /// A paper object: claim, name, rays, obels, (full, empty, partial) when given, CPU seconds on the Prime 750.
@@ -533,11 +534,15 @@ pub fn run(results: &Path) -> Result<String, String> {
             pts.push((boundary, nodes as f64));
             let _ = writeln!(af12_csv, "{k},{level},{rf},{boundary:.3},{nodes}");
         }
-        let (a, b, r2) = fit(&pts);
+        let LineFit {
+            slope: a,
+            intercept: b,
+            r2,
+        } = fit_line(&pts);
         r2s.push(r2);
         // The exponent of a power law nodes ∝ boundary^α (slope on log-log axes): 1 means proportional.
         let logs: Vec<(f64, f64)> = pts.iter().map(|&(x, y)| (x.ln(), y.ln())).collect();
-        let (alpha, _, _) = fit(&logs[logs.len() / 2..]);
+        let alpha = fit_line(&logs[logs.len() / 2..]).slope;
         let _ = writeln!(
             af12_md,
             "| {k} | {}…{} | {a:.4} | {b:.1} | {r2:.6} | {alpha:.4} |",
@@ -702,8 +707,8 @@ pub fn run(results: &Path) -> Result<String, String> {
          over a thousand variants spread over a few thousand node counts, a handful of coincidences is expected.\n\n## Notes\n\n\
          * Plots: the SVGs and PNGs {} text labels ({}).\n\
          * Time: this run took {:.1} s.\n",
-        if png_has_text() { "carry" } else { "have no" },
-        if png_has_text() { "DejaVu Sans from the system's fonts-dejavu-core" } else { "no system font found" },
+        if font_available() { "carry" } else { "have no" },
+        if font_available() { "DejaVu Sans from the system's fonts-dejavu-core" } else { "no system font found" },
         started.elapsed().as_secs_f64()
     );
     write("README.md", &md)?;

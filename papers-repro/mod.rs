@@ -3,6 +3,7 @@
 //! `ktree repro [NAME]`.
 
 pub mod akman_franklin;
+pub mod common;
 pub mod default_object;
 pub mod meagher;
 pub mod veenstra_ahuja;

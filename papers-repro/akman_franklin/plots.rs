@@ -4,25 +4,9 @@
 //! it the plots are drawn without any text and the report says so.
 
 use std::path::Path;
-use std::sync::OnceLock;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-
-const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-
-/// Whether PNGs get text (a font could be registered).
-pub fn png_has_text() -> bool {
-    static OK: OnceLock<bool> = OnceLock::new();
-    *OK.get_or_init(|| match std::fs::read(FONT) {
-        Ok(bytes) => {
-            // plotters keeps registered fonts for the life of the process.
-            let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-            plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_ok()
-        }
-        Err(_) => false,
-    })
-}
 
 /// One series: a name, points, and whether to join them with a line.
 pub struct Series {
@@ -162,13 +146,13 @@ impl Plot {
         let mut text = String::new();
         {
             let root = SVGBackend::with_string(&mut text, (900, 600)).into_drawing_area();
-            self.draw(root, png_has_text())?;
+            self.draw(root, crate::repro::common::font_available())?;
         }
         crate::io::write_atomic(&svg, text.as_bytes()).map_err(|e| e.to_string())?;
         let mut pixels = vec![0u8; 900 * 600 * 3];
         {
             let root = BitMapBackend::with_buffer(&mut pixels, (900, 600)).into_drawing_area();
-            self.draw(root, png_has_text())?;
+            self.draw(root, crate::repro::common::font_available())?;
         }
         let img = image::RgbImage::from_raw(900, 600, pixels).ok_or("bad image buffer")?;
         let mut bytes = Vec::new();
@@ -180,27 +164,4 @@ impl Plot {
         crate::io::write_atomic(&png, &bytes).map_err(|e| e.to_string())?;
         Ok(())
     }
-}
-
-/// Least-squares line `y = a x + b` and its R².
-pub fn fit(points: &[(f64, f64)]) -> (f64, f64, f64) {
-    let n = points.len() as f64;
-    let (sx, sy) = points
-        .iter()
-        .fold((0.0, 0.0), |(a, b), &(x, y)| (a + x, b + y));
-    let (mx, my) = (sx / n, sy / n);
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for &(x, y) in points {
-        sxx += (x - mx) * (x - mx);
-        sxy += (x - mx) * (y - my);
-        syy += (y - my) * (y - my);
-    }
-    let a = sxy / sxx;
-    let b = my - a * mx;
-    let r2 = if syy == 0.0 {
-        1.0
-    } else {
-        sxy * sxy / (sxx * syy)
-    };
-    (a, b, r2)
 }

@@ -2,8 +2,6 @@
 //! few common system fonts found is registered at run time; without one, plots are skipped and the caller
 //! says so.
 
-use std::sync::OnceLock;
-
 use plotters::prelude::*;
 
 /// One data series.
@@ -14,29 +12,6 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Draw as a line (else as dots).
     pub line: bool,
-}
-
-const FONTS: &[&str] = &[
-    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/TTF/DejaVuSans.ttf",
-    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
-];
-
-/// Registers a system font once; false if none is available.
-pub fn font_available() -> bool {
-    static OK: OnceLock<bool> = OnceLock::new();
-    *OK.get_or_init(|| {
-        for path in FONTS {
-            if let Ok(bytes) = std::fs::read(path) {
-                let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-                if plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_ok() {
-                    return true;
-                }
-            }
-        }
-        false
-    })
 }
 
 /// Draws the series into a PNG at `path`; `log` makes both axes logarithmic.
@@ -50,7 +25,7 @@ pub fn plot(
     log: bool,
     series: &[Series],
 ) -> Result<(), String> {
-    if !font_available() {
+    if !crate::repro::common::font_available() {
         return Err("no system font found for plot text".into());
     }
     if let Some(dir) = path.parent() {
@@ -128,24 +103,4 @@ pub fn plot(
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())
-}
-
-/// Least-squares line `y = a + b·x`: returns `(a, b, r²)`.
-pub fn fit(points: &[(f64, f64)]) -> (f64, f64, f64) {
-    let n = points.len() as f64;
-    let (sx, sy) = points
-        .iter()
-        .fold((0.0, 0.0), |(a, b), &(x, y)| (a + x, b + y));
-    let (mx, my) = (sx / n, sy / n);
-    let sxx: f64 = points.iter().map(|&(x, _)| (x - mx).powi(2)).sum();
-    let sxy: f64 = points.iter().map(|&(x, y)| (x - mx) * (y - my)).sum();
-    let syy: f64 = points.iter().map(|&(_, y)| (y - my).powi(2)).sum();
-    let b = sxy / sxx;
-    let a = my - b * mx;
-    let r2 = if syy > 0.0 {
-        sxy * sxy / (sxx * syy)
-    } else {
-        1.0
-    };
-    (a, b, r2)
 }

@@ -4,12 +4,13 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use super::plot::{fit, plot, Series};
+use super::plot::{plot, Series};
 use super::solids::{ball, cuboid};
 use super::Out;
 use crate::build::stack;
 use crate::ops::{self, Affine, AxisMap};
 use crate::rays::{ball_rays, Ray, RaySet};
+use crate::repro::common::{fit_line, LineFit};
 use crate::tree::KTree;
 
 fn e(x: impl std::fmt::Display) -> String {
@@ -63,10 +64,26 @@ pub fn surface_area(out: &Out) -> Result<String, String> {
         let _ = writeln!(csv, "4-ball (K = 4),{r},{boundary:.1},{}", t.node_count());
     }
     out.write("surface_area.csv", &csv)?;
-    let (da, db, dr) = fit(&disks);
-    let (fa, fb, fr) = fit(&balls4);
-    let (sa, sb, sr) = fit(&spheres);
-    let (ca, cb, cr) = fit(&cubes);
+    let LineFit {
+        intercept: da,
+        slope: db,
+        r2: dr,
+    } = fit_line(&disks);
+    let LineFit {
+        intercept: fa,
+        slope: fb,
+        r2: fr,
+    } = fit_line(&balls4);
+    let LineFit {
+        intercept: sa,
+        slope: sb,
+        r2: sr,
+    } = fit_line(&spheres);
+    let LineFit {
+        intercept: ca,
+        slope: cb,
+        r2: cr,
+    } = fit_line(&cubes);
     let line = |pts: &[(f64, f64)], a: f64, b: f64| -> Vec<(f64, f64)> {
         pts.iter().map(|&(x, _)| (x, a + b * x)).collect()
     };
@@ -193,7 +210,7 @@ pub fn timing(out: &Out, max_level: u32) -> Result<String, String> {
     let mut plotted = Vec::new();
     for (i, s) in series.iter().enumerate() {
         let logs: Vec<(f64, f64)> = s.iter().map(|&(x, y)| (x.ln(), y.max(1e-9).ln())).collect();
-        let (_, slope, r2) = fit(&logs);
+        let LineFit { slope, r2, .. } = fit_line(&logs);
         let last = s.last().copied().unwrap_or((0.0, 0.0));
         let _ = writeln!(
             md,

@@ -6,7 +6,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 /// The font registration is the Meagher reproduction's (one list of system fonts for both).
-pub use crate::repro::meagher::plot::font_available;
+pub use crate::repro::common::font_available;
 
 /// The two series: (nodes, seconds) for the pairwise and the bucketed method.
 pub struct Fig12<'a> {
