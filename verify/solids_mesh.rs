@@ -3,25 +3,12 @@
 //! centre test (the generalised winding number by solid angles) at small levels, and their voxel volume is
 //! within the discretisation bound of the signed volume; OBJ, STL (ASCII, binary) and PLY read alike.
 
-use std::path::PathBuf;
+mod common;
 
 use ktree::build::stack;
 use ktree::solid::mesh::{Placement, TriangleMesh};
 use ktree::{KTree, Universe};
 use proptest::prelude::*;
-
-fn shared_data() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "SKIPPED: {} not found (the shared test data)",
-            dir.display()
-        );
-        None
-    }
-}
 
 /// The octahedron |x−c| + |y−c| + |z−c| ≤ r, outward oriented.
 fn octahedron(c: [f64; 3], r: f64) -> TriangleMesh {
@@ -178,7 +165,9 @@ fn winding(vertices: &[[f64; 3]], triangles: &[[u32; 3]], q: [f64; 3]) -> f64 {
 
 #[test]
 fn real_meshes_match_brute_force_and_volume() {
-    let Some(dir) = shared_data() else { return };
+    let Some(dir) = common::shared_data("meshes") else {
+        return;
+    };
     for (name, brute_level) in [
         ("bunny_npm.obj", 4),
         ("fandisk.obj", 4),

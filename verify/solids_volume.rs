@@ -1,24 +1,11 @@
 //! Volumes to rays: every selected sample becomes exactly one voxel (random volumes, raw + sidecar and
 //! NIfTI files), and the skull and brain of ../shared/data/volumes give the counts their samples give.
 
-use std::path::PathBuf;
+mod common;
 
 use ktree::build::stack;
 use ktree::solid::volume::{Select, Volume};
 use proptest::prelude::*;
-
-fn shared_volumes() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/volumes");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "SKIPPED: {} not found (the shared test data)",
-            dir.display()
-        );
-        None
-    }
-}
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
@@ -56,7 +43,9 @@ proptest! {
 
 #[test]
 fn shared_volumes_give_their_counts() {
-    let Some(dir) = shared_volumes() else { return };
+    let Some(dir) = common::shared_data("volumes") else {
+        return;
+    };
     let skull = Volume::read(&dir.join("skull_grey.json")).unwrap();
     assert_eq!(skull.shape, [64, 64, 64]);
     // The source's own example uses the iso-value 2.9, stored ×10 000.

@@ -148,3 +148,20 @@ pub fn ktree(args: &[&str]) -> (bool, String, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// The folder `../shared/data/<sub>` beside the project (the real meshes and volumes), or `None` after a
+/// visible "SKIPPED" message when it is absent.
+pub fn shared_data(sub: &str) -> Option<std::path::PathBuf> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data")
+        .join(sub);
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "SKIPPED: {} not found (the shared test data)",
+            dir.display()
+        );
+        None
+    }
+}
