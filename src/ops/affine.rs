@@ -112,21 +112,8 @@ impl<const K: usize> Affine<K> {
     /// [`OpsError::BadMatrix`] for a wrong entry count, a non-finite entry or a last row other than
     /// `0 … 0 1` (perspective maps are not affine).
     pub fn from_homogeneous(m: &[f64]) -> Result<Self, OpsError> {
+        check_homogeneous(K, m)?;
         let n = K + 1;
-        if m.len() != n * n {
-            return Err(OpsError::BadMatrix {
-                reason: format!(
-                    "{} entries given, a {n}×{n} matrix needs {}",
-                    m.len(),
-                    n * n
-                ),
-            });
-        }
-        if m.iter().any(|v| !v.is_finite()) {
-            return Err(OpsError::BadMatrix {
-                reason: "an entry is not a finite number".into(),
-            });
-        }
         let last = &m[K * n..];
         if last[..K].iter().any(|&v| v != 0.0) || last[K] != 1.0 {
             return Err(OpsError::BadMatrix {
@@ -249,4 +236,24 @@ pub fn transform<const K: usize>(tree: &KTree<K>, m: &Affine<K>) -> Result<KTree
         1e-9 + 64.0 * f64::EPSILON * magnitude
     });
     Ok(resample(tree, &Inverse { map: inv, slack }))
+}
+
+/// Checks that `m` holds the `(k+1)²` finite entries of a homogeneous matrix.
+pub(crate) fn check_homogeneous(k: usize, m: &[f64]) -> Result<(), OpsError> {
+    let n = k + 1;
+    if m.len() != n * n {
+        return Err(OpsError::BadMatrix {
+            reason: format!(
+                "{} entries given, a {n}×{n} matrix needs {}",
+                m.len(),
+                n * n
+            ),
+        });
+    }
+    if m.iter().any(|v| !v.is_finite()) {
+        return Err(OpsError::BadMatrix {
+            reason: "an entry is not a finite number".into(),
+        });
+    }
+    Ok(())
 }

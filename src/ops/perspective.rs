@@ -30,21 +30,7 @@ impl<const K: usize> Projective<K> {
     /// # Errors
     /// [`OpsError::BadMatrix`] for a wrong entry count or a non-finite entry.
     pub fn from_homogeneous(m: &[f64]) -> Result<Self, OpsError> {
-        let n = K + 1;
-        if m.len() != n * n {
-            return Err(OpsError::BadMatrix {
-                reason: format!(
-                    "{} entries given, a {n}×{n} matrix needs {}",
-                    m.len(),
-                    n * n
-                ),
-            });
-        }
-        if m.iter().any(|v| !v.is_finite()) {
-            return Err(OpsError::BadMatrix {
-                reason: "an entry is not a finite number".into(),
-            });
-        }
+        super::affine::check_homogeneous(K, m)?;
         Ok(Self { m: m.to_vec() })
     }
 
