@@ -268,20 +268,23 @@ impl<const K: usize> Stacker<K> {
             }
             return;
         }
-        let (axis, local_bits, current) = {
-            let stage = &self.stages[d - 1];
-            (stage.axis, stage.local_bits, stage.prefix)
-        };
-        let key = self.pack(axis, origin);
+        let stage = &self.stages[d - 1];
+        let local_bits = stage.local_bits;
+        let key = self.pack(stage.axis, origin);
         // For a 64-bit local key the prefix is empty (K·L = 64 happens only for K = 4, L = 16).
         let prefix = key.checked_shr(local_bits).unwrap_or(0);
-        if current.is_some_and(|p| p != prefix) {
+        let local_mask = u64::MAX.checked_shr(64 - local_bits).unwrap_or(0);
+        self.feed_local(d, level, prefix, key & local_mask);
+    }
+
+    /// Puts an item of dimension `d < K`, given as its stage's prefix and local key, into its list.
+    fn feed_local(&mut self, d: usize, level: u32, prefix: u64, local: u64) {
+        if self.stages[d - 1].prefix.is_some_and(|p| p != prefix) {
             self.flush(d);
         }
-        let local_mask = u64::MAX.checked_shr(64 - local_bits).unwrap_or(0);
         let stage = &mut self.stages[d - 1];
         stage.prefix = Some(prefix);
-        stage.lists[level as usize].push(key & local_mask);
+        stage.lists[level as usize].push(local);
         self.stats.entered[d - 1][level as usize] += 1;
         self.hold(1);
     }
@@ -433,10 +436,22 @@ impl<const K: usize> Stacker<K> {
     /// Feeds squares combined by the row stage (local keys `z << L | y` of slice `prefix`) to stage 2.
     fn pass_on_rows(&mut self, prefix: u64, combined: &mut Vec<(u64, u32)>) {
         let top = self.universe.level();
-        let prefix_bits = prefix << (2 * top);
+        if K == 2 {
+            // Squares are the output cells.
+            for (key, l) in combined.drain(..) {
+                let origin = self.unpack(0, key);
+                self.feed(2, l, origin);
+            }
+            return;
+        }
+        // Stage 2 combines along axis K − 3, the last coordinate of the slice prefix; its local key is
+        // (c_{K−2}, c_{K−1}, c_{K−3}) and its prefix the slice prefix without c_{K−3}.
+        let mask = (1u64 << top) - 1;
+        let (stage_prefix, c) = (prefix >> top, prefix & mask);
         for (key, l) in combined.drain(..) {
-            let origin = self.unpack(K - 2, prefix_bits | key);
-            self.feed(2, l, origin);
+            let (z, y) = (key >> top, key & mask);
+            let local = y << (2 * top) | z << top | c;
+            self.feed_local(2, l, stage_prefix, local);
         }
     }
 }
