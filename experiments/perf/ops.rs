@@ -142,10 +142,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         "affine" => {
             let a = sphere_and_box(level);
             facts.push(("input_nodes".into(), a.node_count().to_string()));
-            let c = Affine::<3>::universe_centre(level);
-            let m = Affine::rotation_about(0, 1, 30.0, c)
-                .unwrap()
-                .after(&Affine::rotation_about(1, 2, 20.0, c).unwrap());
+            let m = rotation_30_20(level);
             best_of(
                 1,
                 || ops::transform(&a, &m).unwrap(),
@@ -155,10 +152,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         "affine-fixed" => {
             let a = sphere_and_box(level);
             facts.push(("input_nodes".into(), a.node_count().to_string()));
-            let c = Affine::<3>::universe_centre(level);
-            let m = Affine::rotation_about(0, 1, 30.0, c)
-                .unwrap()
-                .after(&Affine::rotation_about(1, 2, 20.0, c).unwrap());
+            let m = rotation_30_20(level);
             best_of(
                 1,
                 || ops::transform_fixed(&a, &m, 32).unwrap(),
@@ -294,4 +288,13 @@ pub fn report() -> Result<String, String> {
     let path = results_path("ops");
     ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
+}
+
+/// The arbitrary rotation the affine cases use: 30° in the x-y plane after 20° in the y-z plane, about the
+/// universe's centre.
+fn rotation_30_20(level: u32) -> Affine<3> {
+    let c = Affine::<3>::universe_centre(level);
+    Affine::rotation_about(0, 1, 30.0, c)
+        .expect("valid plane")
+        .after(&Affine::rotation_about(1, 2, 20.0, c).expect("valid plane"))
 }

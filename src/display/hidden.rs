@@ -251,31 +251,22 @@ pub(crate) fn remove_hidden(
         ];
         (a, b, bbox)
     };
-    match method {
-        HiddenLineMethod::Pairwise => {
-            for (i, seg) in segments.iter().enumerate() {
-                let (a, b, _) = ends(seg);
-                hidden.clear();
-                for cube in &projs[..seg.owner as usize] {
-                    tests += 1;
-                    if let Some(h) = clip(hex, cube, a, b) {
-                        hidden.push(h);
-                    }
-                }
-                visible_parts(seg, &mut hidden, &mut out);
-                if i % 4096 == 4095 {
-                    if let Some(p) = progress.as_mut() {
-                        p(i as u64 + 1, total);
-                    }
-                }
+    // The pairwise method tests every cube in front of a segment; the bucketed one only the cubes in the
+    // screen-grid buckets the segment's box touches. Both keep the same occluders in the same order.
+    let grid = (method == HiddenLineMethod::Bucketed).then(|| Grid::new(&projs));
+    let mut seen = vec![u32::MAX; if grid.is_some() { projs.len() } else { 0 }];
+    for (i, seg) in segments.iter().enumerate() {
+        let (a, b, bbox) = ends(seg);
+        hidden.clear();
+        let mut test = |cube: &CubeProj| {
+            tests += 1;
+            if let Some(h) = clip(hex, cube, a, b) {
+                hidden.push(h);
             }
-        }
-        HiddenLineMethod::Bucketed => {
-            let grid = Grid::new(&projs);
-            let mut seen = vec![u32::MAX; projs.len()];
-            for (i, seg) in segments.iter().enumerate() {
-                let (a, b, bbox) = ends(seg);
-                hidden.clear();
+        };
+        match &grid {
+            None => projs[..seg.owner as usize].iter().for_each(&mut test),
+            Some(grid) => {
                 let (gx0, gy0, gx1, gy1) = grid.range(&bbox);
                 for gy in gy0..=gy1 {
                     for gx in gx0..=gx1 {
@@ -288,22 +279,18 @@ pub(crate) fn remove_hidden(
                             }
                             seen[j as usize] = i as u32;
                             let cube = &projs[j as usize];
-                            if !boxes_meet(&cube.bbox, &bbox) {
-                                continue;
-                            }
-                            tests += 1;
-                            if let Some(h) = clip(hex, cube, a, b) {
-                                hidden.push(h);
+                            if boxes_meet(&cube.bbox, &bbox) {
+                                test(cube);
                             }
                         }
                     }
                 }
-                visible_parts(seg, &mut hidden, &mut out);
-                if i % 4096 == 4095 {
-                    if let Some(p) = progress.as_mut() {
-                        p(i as u64 + 1, total);
-                    }
-                }
+            }
+        }
+        visible_parts(seg, &mut hidden, &mut out);
+        if i % 4096 == 4095 {
+            if let Some(p) = progress.as_mut() {
+                p(i as u64 + 1, total);
             }
         }
     }
