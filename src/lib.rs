@@ -14,7 +14,8 @@
 //!
 //! * [`space`]: the universe (level `L`, side `U = 2^L`), aligned cells, Morton keys.
 //! * [`rays`]: [`RaySet`], an object as sorted disjoint runs along the last axis, and maximal rows.
-//! * [`build`]: [`build::stack`] (stacking) and the reference builders.
+//! * [`stacking`]: [`stacking::stack`], Akman & Franklin's stacking.
+//! * [`reference`]: the reference builders the tests compare against (naive insertion, dense pyramid).
 //! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
 //! * [`io`]: the ray text format and the `.ktree` file format.
@@ -24,7 +25,7 @@
 //!
 //! # Example
 //! ```
-//! use ktree::{build::stack, Ray, RaySet};
+//! use ktree::{stacking::stack, Ray, RaySet};
 //! // Akman & Franklin's Fig. 3 ray in an octree universe of level 7.
 //! let rays = RaySet::<3>::from_rays(7, [Ray::new([1, 1, 17], 93)]).unwrap();
 //! let tree = stack(&rays);
@@ -35,17 +36,15 @@
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 
-pub mod build;
 pub mod display;
 pub mod io;
 pub mod ops;
 pub mod rays;
+pub mod reference;
 pub mod solid;
 pub mod space;
+pub mod stacking;
 pub mod tree;
-
-#[path = "../papers-repro/mod.rs"]
-pub mod repro;
 
 pub use rays::{Ray, RaySet};
 pub use space::{max_level, Cell, Universe, MAX_K};

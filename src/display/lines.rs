@@ -73,7 +73,8 @@ pub(crate) fn other_axes(axis: usize) -> [usize; 2] {
 }
 
 /// Counters of one line drawing (the paper's quantities and ours).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LineStats {
     /// Nodes in the tree.
     pub nodes: u64,

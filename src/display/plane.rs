@@ -16,7 +16,7 @@ const GRID: [u8; 3] = [150, 150, 150];
 /// detail stays readable).
 ///
 /// ```
-/// use ktree::{build::stack, rays::ball_rays, display::plane::quadtree_canvas};
+/// use ktree::{stacking::stack, rays::ball_rays, display::plane::quadtree_canvas};
 /// let disk = stack(&ball_rays::<2>(5, [32, 32], 26).unwrap());
 /// let canvas = quadtree_canvas(&disk, 128).unwrap();
 /// assert_eq!(canvas.rgb.len(), 3 * 128 * 128);

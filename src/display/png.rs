@@ -1,9 +1,11 @@
 //! PNG output through the `image` crate, written atomically.
 
+#[cfg(feature = "png")]
 use std::path::Path;
 
 use super::error::DisplayError;
 
+#[cfg(feature = "png")]
 fn write_err(path: &Path, e: impl std::fmt::Display) -> DisplayError {
     DisplayError::Write {
         path: path.display().to_string(),
@@ -11,6 +13,7 @@ fn write_err(path: &Path, e: impl std::fmt::Display) -> DisplayError {
     }
 }
 
+#[cfg(feature = "png")]
 /// Encodes RGB bytes (`3 · width · height`, row-major from the top) as PNG.
 ///
 /// # Errors
@@ -28,6 +31,7 @@ pub fn encode_rgb_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, Di
     Ok(out)
 }
 
+#[cfg(feature = "png")]
 /// Writes RGB bytes as a PNG file (atomically).
 ///
 /// # Errors
@@ -37,6 +41,7 @@ pub fn write_rgb_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result
     crate::io::write_atomic(path, &bytes).map_err(|e| write_err(path, e))
 }
 
+#[cfg(feature = "png")]
 /// Writes grey levels (`width · height` bytes) as a PNG file (atomically).
 ///
 /// # Errors
@@ -145,6 +150,7 @@ impl Canvas {
         }
     }
 
+    #[cfg(feature = "png")]
     /// Writes the canvas as a PNG file (atomically).
     ///
     /// # Errors

@@ -369,7 +369,7 @@ fn ray_normal(rays: &RaySet<3>, v: [u32; 3], axis: usize, dir: [f64; 3]) -> Opti
 ///
 /// ```
 /// use ktree::display::{default_camera, render, RenderOptions, ISO_TOWARD_EYE};
-/// use ktree::{build::stack, rays::ball_rays};
+/// use ktree::{stacking::stack, rays::ball_rays};
 /// let tree = stack(&ball_rays::<3>(5, [32, 32, 32], 28).unwrap());
 /// let options = RenderOptions { width: 64, height: 64, ..Default::default() };
 /// let camera = default_camera(&tree, ISO_TOWARD_EYE, None, 64, 64).unwrap();

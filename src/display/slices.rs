@@ -12,7 +12,7 @@ use crate::tree::{KTree, NodeState, Octree, Tree4};
 /// The octree of the 4-D tree's slice at `position` along `axis` (the remaining axes keep their order).
 ///
 /// ```
-/// use ktree::{build::stack, rays::ball_rays, display::slices::slice_4d};
+/// use ktree::{stacking::stack, rays::ball_rays, display::slices::slice_4d};
 /// let ball4 = stack(&ball_rays::<4>(3, [8, 8, 8, 8], 8).unwrap());
 /// let middle = slice_4d(&ball4, 3, 4).unwrap();
 /// middle.assert_well_formed();

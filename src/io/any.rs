@@ -104,10 +104,10 @@ impl AnyRaySet {
     /// Builds the tree by stacking.
     pub fn stack(&self) -> AnyTree {
         match self {
-            Self::K1(r) => AnyTree::K1(crate::build::stack(r)),
-            Self::K2(r) => AnyTree::K2(crate::build::stack(r)),
-            Self::K3(r) => AnyTree::K3(crate::build::stack(r)),
-            Self::K4(r) => AnyTree::K4(crate::build::stack(r)),
+            Self::K1(r) => AnyTree::K1(crate::stacking::stack(r)),
+            Self::K2(r) => AnyTree::K2(crate::stacking::stack(r)),
+            Self::K3(r) => AnyTree::K3(crate::stacking::stack(r)),
+            Self::K4(r) => AnyTree::K4(crate::stacking::stack(r)),
         }
     }
 }

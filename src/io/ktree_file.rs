@@ -366,8 +366,8 @@ impl AnyTree {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::build::stack;
     use crate::rays::ball_rays;
+    use crate::stacking::stack;
 
     fn sample() -> Vec<u8> {
         let tree = stack(&ball_rays::<3>(4, [10, 12, 14], 9).unwrap());

@@ -15,7 +15,8 @@ pub fn complexity<const K: usize>(tree: &KTree<K>) -> Vec<LevelCounts> {
 }
 
 /// Node counts of an object over a family of placements.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Normalised {
     /// For each placement (in the order given or enumerated), the total node count: the metric as a
     /// function of the placement.

@@ -113,7 +113,8 @@ pub fn mass_properties<const K: usize>(tree: &KTree<K>) -> MassProperties<K> {
 }
 
 /// Bounds after one level of the progressive computation.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LevelBounds<const K: usize> {
     /// The depth reached (0 = root).
     pub level: u32,
@@ -124,7 +125,7 @@ pub struct LevelBounds<const K: usize> {
     /// Nodes visited so far.
     pub nodes_touched: u64,
     /// Per axis, an interval holding the centroid (`[−∞, ∞]` while the lower bound is 0).
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub centroid_bounds: [(f64, f64); K],
 }
 
@@ -148,7 +149,7 @@ pub struct ProgressiveMass<const K: usize> {
 /// estimate), reporting how many nodes were touched. With tolerance 0 it visits every node and is exact.
 ///
 /// ```
-/// use ktree::{build::stack, rays::ball_rays, ops::{mass_progressive, mass_properties}};
+/// use ktree::{stacking::stack, rays::ball_rays, ops::{mass_progressive, mass_properties}};
 /// let tree = stack(&ball_rays::<3>(8, [256, 256, 256], 240).unwrap());
 /// let p = mass_progressive(&tree, 0.05);
 /// let exact = mass_properties(&tree).volume as f64;

@@ -21,7 +21,7 @@
 //! | complexity (M9) | [`complexity`], [`over_translations`], [`over_placements`], [`over_maps`], [`bounding_box`], [`normalise_to_origin`] | node counts | one operation per placement |
 //!
 //! ```
-//! use ktree::{build::stack, rays::ball_rays, ops};
+//! use ktree::{stacking::stack, rays::ball_rays, ops};
 //! let a = stack(&ball_rays::<3>(5, [24, 32, 32], 20).unwrap());
 //! let b = stack(&ball_rays::<3>(5, [40, 32, 32], 20).unwrap());
 //! let lens = ops::intersection(&a, &b).unwrap();

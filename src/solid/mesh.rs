@@ -29,9 +29,9 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use super::SolidError;
-use crate::build::radix_sort;
 use crate::rays::RaySet;
 use crate::space::Universe;
+use crate::stacking::radix_sort;
 
 /// Bits of sub-voxel precision of placed vertices.
 const FRAC: u32 = 16;

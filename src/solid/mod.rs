@@ -10,10 +10,12 @@
 
 mod boxsolid;
 mod error;
+#[cfg(feature = "mesh")]
 pub mod mesh;
 mod named;
 mod quadric;
 mod rational;
+#[cfg(feature = "volume")]
 pub mod volume;
 
 pub use boxsolid::BoxSolid;

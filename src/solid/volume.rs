@@ -1,6 +1,6 @@
 //! Dense 3-D scalar volumes (CT, MRI) to rays by a threshold or a label.
 //!
-//! Formats: headerless raw samples with a JSON sidecar (the layout of `../shared/data/volumes`: `shape_xyz`,
+//! Formats: headerless raw samples with a JSON sidecar (the layout of `data/volumes`: `shape_xyz`,
 //! `dtype` one of `uint8 int8 uint16 int16 uint32 int32 float32 float64`, `endianness`, x fastest), and NIfTI-1
 //! (`.nii`, `.nii.gz`, read with the `nifti` crate; the stored values are rescaled by `scl_slope`/`scl_inter`
 //! as NIfTI prescribes). Volume voxel `(i, j, k)` becomes universe voxel `offset + (i, j, k)`, unscaled.

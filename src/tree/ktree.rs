@@ -4,7 +4,8 @@ use super::states::{NodeState, PackedStates};
 use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
 
 /// Node counts of one level (or of a whole tree): Meagher's complexity metric.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LevelCounts {
     /// The level (depth, 0 = root); for a whole-tree total, the universe level.
     pub level: u32,
@@ -299,7 +300,7 @@ impl<const K: usize> KTree<K> {
     /// [`SpaceError::LevelTooLarge`]; [`SpaceError::TooLargeForDense`] if `dense.len() != U^K` or the
     /// universe exceeds [`DENSE_LIMIT`].
     pub fn from_dense(level: u32, dense: &[bool]) -> Result<Self, SpaceError> {
-        crate::build::dense::DensePyramid::<K>::from_dense(level, dense).map(|p| p.to_tree())
+        crate::reference::dense::DensePyramid::<K>::from_dense(level, dense).map(|p| p.to_tree())
     }
 
     /// The object as a dense boolean array (axis 0 fastest).

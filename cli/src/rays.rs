@@ -1,0 +1,192 @@
+//! `ktree rays --solid NAME ... --level L --out FILE`: an analytic solid (quadric or box) to rays.
+
+use std::path::{Path, PathBuf};
+
+use ktree::io::{write_ktree_file, write_rays_file};
+use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid};
+use ktree::stacking::stack;
+use ktree::RaySet;
+
+/// Arguments of `ktree rays`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The solid: ball, ellipsoid, paraboloid, cylinder, cone, half-space, box, or quadric (with --quadric).
+    #[arg(long, default_value = "ball")]
+    solid: String,
+    /// Dimension K (1 … 4).
+    #[arg(long, short = 'k', default_value_t = 3)]
+    dim: usize,
+    /// Universe level L (side 2^L).
+    #[arg(long)]
+    level: u32,
+    /// Centre (ball, ellipsoid, cylinder) or apex (paraboloid, cone): K comma-separated numbers
+    /// (decimals or fractions, exact). Default: the universe's centre.
+    #[arg(long, alias = "centre")]
+    center: Option<String>,
+    /// Radius (ball, cylinder; paraboloid and cone: radius at --height from the apex).
+    #[arg(long)]
+    radius: Option<String>,
+    /// Semi-axes of an ellipsoid: K numbers.
+    #[arg(long)]
+    radii: Option<String>,
+    /// Height (paraboloid, cone).
+    #[arg(long)]
+    height: Option<String>,
+    /// Axis (cylinder, cone): 0 … K−1. The paraboloid always opens along the last axis.
+    #[arg(long, default_value_t = 0)]
+    axis: usize,
+    /// Half-space n·x ≤ offset: the normal n (K numbers).
+    #[arg(long)]
+    normal: Option<String>,
+    /// Half-space offset.
+    #[arg(long)]
+    offset: Option<String>,
+    /// Box lower corner (K numbers).
+    #[arg(long)]
+    lo: Option<String>,
+    /// Box upper corner (K numbers).
+    #[arg(long)]
+    hi: Option<String>,
+    /// A raw quadric matrix Ξ, (K+1)×(K+1), rows separated by ';', entries by ',' (solid: VᵀΞV ≤ 0).
+    #[arg(long)]
+    quadric: Option<String>,
+    /// Parameters are in the unit cube (the universe is [0,1]^K) instead of voxels.
+    #[arg(long)]
+    unit_cube: bool,
+    /// Test each voxel's lowest corner instead of its centre.
+    #[arg(long)]
+    corner: bool,
+    /// Output: rays in the text format, or a tree if the name ends in .ktree.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn numbers(text: &str, n: usize, what: &str) -> Result<Vec<Rational>, String> {
+    let v: Vec<Rational> = text
+        .split(',')
+        .map(|x| x.parse::<Rational>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("--{what}: {e}"))?;
+    if v.len() != n {
+        return Err(format!("--{what} needs {n} numbers, got {}", v.len()));
+    }
+    Ok(v)
+}
+
+fn one(text: &Option<String>, what: &str) -> Result<Rational, String> {
+    text.as_deref()
+        .ok_or_else(|| format!("--{what} is required for this solid"))?
+        .parse()
+        .map_err(|e| format!("--{what}: {e}"))
+}
+
+fn arr<const K: usize>(text: &Option<String>, what: &str) -> Result<Option<[Rational; K]>, String> {
+    text.as_deref()
+        .map(|t| numbers(t, K, what).map(|v| std::array::from_fn(|i| v[i])))
+        .transpose()
+}
+
+fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
+    let frame = if a.unit_cube {
+        Frame::UnitCube
+    } else {
+        Frame::Voxel
+    };
+    let middle = if a.unit_cube {
+        Rational::new(1, 2).ok_or("internal")?
+    } else {
+        Rational::int(1 << a.level.saturating_sub(1).min(62))
+    };
+    let centre = arr::<K>(&a.center, "center")?.unwrap_or([middle; K]);
+    let e = |e: ktree::solid::SolidError| e.to_string();
+    let q = match a.solid.as_str() {
+        "ball" => Quadric::ball(centre, one(&a.radius, "radius")?, frame).map_err(e)?,
+        "ellipsoid" => {
+            let radii = arr::<K>(&a.radii, "radii")?.ok_or("--radii is required for an ellipsoid")?;
+            Quadric::ellipsoid(centre, radii, frame).map_err(e)?
+        }
+        "paraboloid" => Quadric::paraboloid(centre, one(&a.radius, "radius")?, one(&a.height, "height")?, frame)
+            .map_err(e)?,
+        "cylinder" => Quadric::cylinder(a.axis, centre, one(&a.radius, "radius")?, frame).map_err(e)?,
+        "cone" => Quadric::cone(a.axis, centre, one(&a.radius, "radius")?, one(&a.height, "height")?, frame)
+            .map_err(e)?,
+        "half-space" => {
+            let n = arr::<K>(&a.normal, "normal")?.ok_or("--normal is required for a half-space")?;
+            Quadric::half_space(n, one(&a.offset, "offset")?, frame).map_err(e)?
+        }
+        "box" => {
+            let lo = arr::<K>(&a.lo, "lo")?.ok_or("--lo is required for a box")?;
+            let hi = arr::<K>(&a.hi, "hi")?.ok_or("--hi is required for a box")?;
+            return BoxSolid::new(lo, hi, frame).map(Solid::Box).map_err(e);
+        }
+        "quadric" => {
+            let text = a.quadric.as_deref().ok_or("--quadric MATRIX is required for --solid quadric")?;
+            let rows: Vec<Vec<Rational>> = text
+                .split(';')
+                .map(|r| numbers(r, K + 1, "quadric"))
+                .collect::<Result<_, _>>()?;
+            Quadric::from_rational_matrix(&rows, frame).map_err(e)?
+        }
+        other => {
+            return Err(format!(
+                "unknown solid '{other}': choose ball, ellipsoid, paraboloid, cylinder, cone, half-space, box or quadric"
+            ))
+        }
+    };
+    Ok(Solid::Quadric(q))
+}
+
+/// Writes rays as text, or stacks them into a `.ktree` file, by the output's extension; returns a summary.
+pub fn write_output<const K: usize>(rays: &RaySet<K>, out: &Path) -> Result<String, String> {
+    let is_tree = out.extension().is_some_and(|e| e == "ktree");
+    if is_tree {
+        let tree = stack(rays);
+        write_ktree_file(out, &tree).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        let c = tree.counts();
+        Ok(format!(
+            "{}: K = {K}, L = {}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
+            out.display(),
+            rays.level(),
+            rays.len(),
+            rays.voxel_count(),
+            c.nodes(),
+            c.full,
+            c.empty,
+            c.partial
+        ))
+    } else {
+        write_rays_file(out, rays).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        Ok(format!(
+            "{}: K = {K}, L = {}, {} rays, {} voxels",
+            out.display(),
+            rays.level(),
+            rays.len(),
+            rays.voxel_count()
+        ))
+    }
+}
+
+fn go<const K: usize>(a: &Args) -> Result<(), String> {
+    let s = solid::<K>(a)?;
+    let sample = if a.corner {
+        Sample::Corner
+    } else {
+        Sample::Centre
+    };
+    let rays = s
+        .to_rays(a.level, sample, false)
+        .map_err(|e| e.to_string())?;
+    println!("{}", write_output(&rays, &a.out)?);
+    Ok(())
+}
+
+/// Builds the solid's rays and writes them.
+pub fn run(args: Args) -> Result<(), String> {
+    match args.dim {
+        1 => go::<1>(&args),
+        2 => go::<2>(&args),
+        3 => go::<3>(&args),
+        4 => go::<4>(&args),
+        k => Err(format!("--dim {k}: K must be 1, 2, 3 or 4")),
+    }
+}

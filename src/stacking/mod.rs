@@ -1,0 +1,8 @@
+//! Akman & Franklin's stacking: the fast path from a [`RaySet`](crate::RaySet) to the minimal reduced
+//! [`KTree`](crate::KTree), through maximal rows and the dimension-level lists.
+
+mod radix;
+mod stack;
+
+pub use radix::radix_sort;
+pub use stack::{stack, stack_with_stats, StackingStats};
