@@ -5,6 +5,7 @@ mod ball;
 mod csg;
 mod rayset;
 mod rows;
+mod split;
 
 pub use ball::ball_rays;
 pub use csg::CsgError;

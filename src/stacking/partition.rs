@@ -1,0 +1,609 @@
+//! Morton-partitioned stacking: a tree is its top `m` levels plus, level by level, the concatenation of the
+//! subtrees of the cells of depth `m`; each subtree is stacked from its cell's rays alone.
+//!
+//! # Why it works
+//! In level order, the nodes of the subtree under a cell of depth `m` are contiguous at every level, and the
+//! subtrees of consecutive cells (Morton order) follow one another. So the level `m + j` of the tree is the
+//! concatenation, in Morton order of the cells, of the levels `j` of their subtrees; the top `m` levels
+//! follow from the cells' root states alone (a node whose `2^K` children are all full, or all empty, is a
+//! leaf: a uniform top collapses). The rays of a cell are its columns' runs clipped to the cell's range
+//! along the last axis ([`RaySet::cell_rays`]).
+//!
+//! # How it runs
+//! The columns are cut into *slabs* along axis 0 (one cell wide) and each slab into *blocks* (one cell wide
+//! along every column axis); the runs of a block are cut along the last axis into its `2^m` cells in one
+//! pass: a cell all of whose columns cross it entirely is a full leaf and a cell no run meets is an empty
+//! one — neither is stacked nor even receives its runs. Only the cells the object's boundary passes through
+//! are stacked, each in lists sized to fit in cache. Slabs are independent and run on all threads of the
+//! current rayon pool; the result does not depend on the number of threads. Levels are joined by bulk,
+//! bit-shifted copies of the 2-bit words.
+//!
+//! Sources other than a whole [`RaySet`] (solids generating their rays slab by slab) implement
+//! [`RaySource`].
+
+use std::borrow::Cow;
+use std::convert::Infallible;
+use std::ops::Range;
+
+use rayon::prelude::*;
+
+use super::stack;
+use crate::rays::RaySet;
+use crate::space::{morton_encode, Universe};
+use crate::tree::{KTree, NodeState, PackedStates};
+
+/// The runs of one slab of columns: the column keys (as [`RaySet::column_key`], non-decreasing) and the
+/// `(z1, z2)` runs, sorted as in a [`RaySet`].
+#[derive(Debug, Clone)]
+pub struct SlabRuns<'a> {
+    /// One column key per run.
+    pub keys: Cow<'a, [u64]>,
+    /// One `(z1, z2)` per run.
+    pub runs: Cow<'a, [(u32, u32)]>,
+}
+
+/// Anything that can produce the runs of a slab of columns on demand (from any thread).
+pub trait RaySource<const K: usize>: Sync {
+    /// Why producing runs can fail.
+    type Error: Send;
+
+    /// The universe of the runs.
+    fn universe(&self) -> Universe<K>;
+
+    /// The runs of the columns whose axis-0 coordinate lies in `x` (for `K = 1`, of the one column), in
+    /// [`RaySet`] order.
+    ///
+    /// # Errors
+    /// As the source defines.
+    fn slab(&self, x: Range<u32>) -> Result<SlabRuns<'_>, Self::Error>;
+
+    /// The slabs of width `2^(L − m)` (numbered along axis 0) that may hold runs, in increasing order; by
+    /// default all `2^m` of them.
+    fn occupied_slabs(&self, m: u32) -> Vec<u32> {
+        (0..1u32 << m).collect()
+    }
+}
+
+impl<const K: usize> RaySource<K> for RaySet<K> {
+    type Error = Infallible;
+
+    fn universe(&self) -> Universe<K> {
+        RaySet::universe(self)
+    }
+
+    fn occupied_slabs(&self, m: u32) -> Vec<u32> {
+        if K == 1 {
+            return vec![0];
+        }
+        let keys = self.column_keys();
+        let shift = K.saturating_sub(2) as u32 * self.level() + (self.level() - m);
+        let mut slabs = Vec::new();
+        let mut at = 0;
+        while at < keys.len() {
+            let slab = keys[at] >> shift;
+            slabs.push(slab as u32);
+            at += keys[at..].partition_point(|&k| k >> shift == slab);
+        }
+        slabs
+    }
+
+    fn slab(&self, x: Range<u32>) -> Result<SlabRuns<'_>, Infallible> {
+        let r = self.slab_range(x);
+        Ok(SlabRuns {
+            keys: Cow::Borrowed(&self.column_keys()[r.clone()]),
+            runs: Cow::Borrowed(&self.runs()[r]),
+        })
+    }
+}
+
+/// The split depth used when none is given: cells of about 2^18 voxels (side 64 for octrees), whose
+/// stacking lists fit in cache.
+pub fn default_split_depth(k: usize, level: u32) -> u32 {
+    let subtree_level = 18u32.div_ceil(k as u32);
+    level.saturating_sub(subtree_level)
+}
+
+/// Builds the tree of a ray set from the subtrees of its cells of depth `depth` (clamped to `L`), each
+/// stacked apart, on the threads of the current rayon pool. Equal, node for node, to [`stack`].
+///
+/// ```
+/// use ktree::{stacking::{stack, stack_partitioned}, Ray, RaySet};
+/// let rays = RaySet::<3>::from_rays(5, [Ray::new([1, 1, 3], 29), Ray::new([20, 7, 0], 32)]).unwrap();
+/// for depth in 0..=5 {
+///     assert_eq!(stack_partitioned(&rays, depth), stack(&rays));
+/// }
+/// ```
+pub fn stack_partitioned<const K: usize>(rays: &RaySet<K>, depth: u32) -> KTree<K> {
+    match stack_source(rays, depth) {
+        Ok(tree) => tree,
+        Err(never) => match never {},
+    }
+}
+
+/// Like [`stack_partitioned`], with the rays produced slab by slab by `source`.
+///
+/// # Errors
+/// The first error of the source (in slab order).
+pub fn stack_source<const K: usize, S: RaySource<K>>(
+    source: &S,
+    depth: u32,
+) -> Result<KTree<K>, S::Error> {
+    let universe = source.universe();
+    let level = universe.level();
+    let m = depth.min(level);
+    let slabs = if K == 1 {
+        vec![0]
+    } else {
+        source.occupied_slabs(m)
+    };
+    let pieces = slabs
+        .into_par_iter()
+        .map(|b0| stack_slab(source, m, b0))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut pieces: Vec<(u64, Piece<K>)> = pieces.into_iter().flatten().collect();
+    pieces.sort_unstable_by_key(|p| p.0);
+    Ok(join_pieces(universe, m, pieces))
+}
+
+/// A non-empty cell of depth `m`: wholly full, or a stacked subtree.
+#[derive(Debug)]
+enum Piece<const K: usize> {
+    Full,
+    Tree(KTree<K>),
+}
+
+/// Stacks the cells of slab `b0` (all of them for `K = 1`); returns the non-empty ones with their Morton
+/// index among the cells of depth `m`.
+fn stack_slab<const K: usize, S: RaySource<K>>(
+    source: &S,
+    m: u32,
+    b0: u32,
+) -> Result<Vec<(u64, Piece<K>)>, S::Error> {
+    let level = source.universe().level();
+    let t = level - m;
+    let side = 1u32 << t;
+    let slab = source.slab(b0 * side..(b0 + 1) * side)?;
+    let (keys, runs) = (&slab.keys[..], &slab.runs[..]);
+    let mut out = Vec::new();
+    if runs.is_empty() {
+        return Ok(out);
+    }
+    if K == 1 {
+        let block = Block {
+            keys: vec![0; runs.len()],
+            runs: runs.to_vec(),
+        };
+        split_block::<K>(&block, m, t, [0; K], &mut out);
+        return Ok(out);
+    }
+    // Bucket the slab's runs by block (the cell coordinates along axes 1 … K−2), keeping their order, with
+    // column keys made local to the block.
+    let mask = (1u64 << level) - 1;
+    let local_mask = u64::from(side) - 1;
+    let blocks_per_slab = 1usize << ((K - 2) as u32 * m);
+    if blocks_per_slab > runs.len().max(64) {
+        return Ok(stack_sparse_slab(keys, runs, level, m, b0));
+    }
+    let mut block_of = Vec::with_capacity(runs.len());
+    let mut counts = vec![0usize; blocks_per_slab + 1];
+    for &key in keys {
+        let mut b = 0usize;
+        for a in 1..K - 1 {
+            let c = key >> ((K - 2 - a) as u32 * level) & mask;
+            b = b << m | (c >> t) as usize;
+        }
+        block_of.push(b);
+        counts[b + 1] += 1;
+    }
+    for i in 0..blocks_per_slab {
+        counts[i + 1] += counts[i];
+    }
+    let starts = counts.clone();
+    let mut local = vec![(0u64, (0u32, 0u32)); runs.len()];
+    for (i, (&key, &run)) in keys.iter().zip(runs).enumerate() {
+        let mut lk = 0u64;
+        for a in 0..K - 1 {
+            let c = key >> ((K - 2 - a) as u32 * level) & mask;
+            lk = lk << t | (c & local_mask);
+        }
+        let at = &mut counts[block_of[i]];
+        local[*at] = (lk, run);
+        *at += 1;
+    }
+    let mut block = Block::default();
+    for b in 0..blocks_per_slab {
+        let part = &local[starts[b]..starts[b + 1]];
+        if part.is_empty() {
+            continue;
+        }
+        block.keys.clear();
+        block.runs.clear();
+        block.keys.extend(part.iter().map(|p| p.0));
+        block.runs.extend(part.iter().map(|p| p.1));
+        let mut cell = [0u32; K];
+        cell[0] = b0;
+        for a in (1..K - 1).rev() {
+            cell[a] = ((b >> ((K - 2 - a) as u32 * m)) & ((1 << m) - 1)) as u32;
+        }
+        split_block::<K>(&block, m, t, cell, &mut out);
+    }
+    Ok(out)
+}
+
+/// [`stack_slab`] for a slab with many more blocks than runs: the runs are sorted by block instead of
+/// counted into every block.
+fn stack_sparse_slab<const K: usize>(
+    keys: &[u64],
+    runs: &[(u32, u32)],
+    level: u32,
+    m: u32,
+    b0: u32,
+) -> Vec<(u64, Piece<K>)> {
+    let t = level - m;
+    let mask = (1u64 << level) - 1;
+    let local_mask = (1u64 << t) - 1;
+    // (block coordinates on axes 1 … K−2, position) sorts by block, keeping the order within a block.
+    let mut order: Vec<(u64, usize)> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, &key)| {
+            let b = (1..K - 1).fold(0u64, |b, a| {
+                b << m | (key >> ((K - 2 - a) as u32 * level) & mask) >> t
+            });
+            (b, i)
+        })
+        .collect();
+    order.sort_unstable();
+    let mut out = Vec::new();
+    let mut block = Block::default();
+    let mut at = 0;
+    while at < order.len() {
+        let b = order[at].0;
+        block.keys.clear();
+        block.runs.clear();
+        while at < order.len() && order[at].0 == b {
+            let i = order[at].1;
+            let lk = (0..K - 1).fold(0u64, |lk, a| {
+                lk << t | (keys[i] >> ((K - 2 - a) as u32 * level) & mask & local_mask)
+            });
+            block.keys.push(lk);
+            block.runs.push(runs[i]);
+            at += 1;
+        }
+        let mut cell = [0u32; K];
+        cell[0] = b0;
+        for a in (1..K - 1).rev() {
+            cell[a] = ((b >> ((K - 2 - a) as u32 * m)) & ((1 << m) - 1)) as u32;
+        }
+        split_block::<K>(&block, m, t, cell, &mut out);
+    }
+    out
+}
+
+/// The runs of one block of columns: keys local to the block (`t` bits an axis), global `z`.
+#[derive(Debug, Default)]
+struct Block {
+    keys: Vec<u64>,
+    runs: Vec<(u32, u32)>,
+}
+
+/// Cuts a block's runs into its `2^m` cells along the last axis and stacks the mixed ones. `cell` holds the
+/// block's cell coordinates on the column axes.
+fn split_block<const K: usize>(
+    block: &Block,
+    m: u32,
+    t: u32,
+    mut cell: [u32; K],
+    out: &mut Vec<(u64, Piece<K>)>,
+) {
+    let columns = 1u64 << (t as usize * (K - 1));
+    let (full, mixed) = classify_cells(&block.runs, m, t, columns);
+    for j in full {
+        cell[K - 1] = j as u32;
+        out.push((morton_encode(cell), Piece::Full));
+    }
+    let low = (1u32 << t) - 1;
+    if mixed.is_empty() {
+        return;
+    }
+    // Hand each mixed cell its clipped runs, in order.
+    let mut parts: Vec<Block> = (0..mixed.len()).map(|_| Block::default()).collect();
+    for (&key, &(z1, z2)) in block.keys.iter().zip(&block.runs) {
+        let (a, b) = ((z1 >> t) as usize, ((z2 - 1) >> t) as usize);
+        let from = mixed.partition_point(|&j| j < a);
+        for (i, &j) in mixed[from..].iter().enumerate() {
+            if j > b {
+                break;
+            }
+            let lo = (j as u32) << t;
+            let part = &mut parts[from + i];
+            part.keys.push(key);
+            part.runs.push((z1.max(lo) - lo, z2.min(lo + low + 1) - lo));
+        }
+    }
+    let universe = Universe::<K>::new(t).expect("a cell's level is a valid level");
+    for (&j, part) in mixed.iter().zip(parts) {
+        let rays = RaySet::from_sorted_parts(universe, part.keys, part.runs, None);
+        let tree = stack(&rays);
+        cell[K - 1] = j as u32;
+        out.push((morton_encode(cell), Piece::Tree(tree)));
+    }
+}
+
+/// Sorts the `2^m` cells of a block (along the last axis) by what its runs make of them: returns the
+/// cells all of whose `columns` columns cross them entirely (full) and those some run enters, leaves or
+/// crosses without all columns doing so (mixed), each in increasing order. The other cells are empty.
+fn classify_cells(runs: &[(u32, u32)], m: u32, t: u32, columns: u64) -> (Vec<usize>, Vec<usize>) {
+    let low = (1u32 << t) - 1;
+    // Changes of the number of columns crossing a cell entirely, and the cells a run end cuts.
+    let mut changes: Vec<(usize, i64)> = Vec::with_capacity(2 * runs.len());
+    let mut cuts = Vec::new();
+    for &(z1, z2) in runs {
+        let (a, b) = ((z1 >> t) as usize, ((z2 - 1) >> t) as usize);
+        let full_from = if z1 & low == 0 { a } else { a + 1 };
+        let full_to = if z2 & low == 0 { b + 1 } else { b };
+        if full_from < full_to {
+            changes.push((full_from, 1));
+            changes.push((full_to, -1));
+        }
+        if z1 & low != 0 {
+            cuts.push(a);
+        }
+        if z2 & low != 0 {
+            cuts.push(b);
+        }
+    }
+    let (mut full, mut mixed) = (Vec::new(), Vec::new());
+    let cells = 1usize << m;
+    if cells <= 4 * runs.len() + 64 {
+        // Dense: a count per cell.
+        let mut diff = vec![0i64; cells + 1];
+        let mut cut = vec![false; cells];
+        for &(j, d) in &changes {
+            diff[j] += d;
+        }
+        for &j in &cuts {
+            cut[j] = true;
+        }
+        let mut crossing = 0i64;
+        for j in 0..cells {
+            crossing += diff[j];
+            if cut[j] || (crossing > 0 && (crossing as u64) < columns) {
+                mixed.push(j);
+            } else if crossing as u64 == columns {
+                full.push(j);
+            }
+        }
+        return (full, mixed);
+    }
+    // Sparse: sweep the sorted changes and cuts.
+    changes.sort_unstable();
+    cuts.sort_unstable();
+    cuts.dedup();
+    let mut points: Vec<usize> = changes
+        .iter()
+        .map(|c| c.0)
+        .chain(cuts.iter().copied())
+        .collect();
+    points.sort_unstable();
+    points.dedup();
+    let (mut ci, mut ki) = (0, 0);
+    let mut crossing = 0i64;
+    for (p, &from) in points.iter().enumerate() {
+        while ci < changes.len() && changes[ci].0 == from {
+            crossing += changes[ci].1;
+            ci += 1;
+        }
+        let is_cut = ki < cuts.len() && cuts[ki] == from;
+        if is_cut {
+            ki += 1;
+        }
+        // From `from` up to the next point the count is constant (and no cell is cut).
+        let to = points.get(p + 1).copied().unwrap_or(cells).min(cells);
+        if is_cut || (crossing > 0 && (crossing as u64) < columns) {
+            mixed.push(from);
+        } else if crossing > 0 && crossing as u64 == columns {
+            full.push(from);
+        }
+        if crossing > 0 && (crossing as u64) < columns {
+            mixed.extend(from + 1..to);
+        } else if crossing > 0 && crossing as u64 == columns {
+            full.extend(from + 1..to);
+        }
+    }
+    (full, mixed)
+}
+
+/// Joins subtrees of the cells of depth `depth` into the tree of `universe`: `subtrees` are given for every
+/// cell, in Morton order (`2^(K·depth)` of them), each in a universe of level `L − depth`.
+///
+/// ```
+/// use ktree::{stacking::{join_subtrees, stack}, Ray, RaySet, Universe};
+/// let rays = RaySet::<2>::from_rays(3, [Ray::new([1, 2], 7)]).unwrap();
+/// let u = Universe::<2>::new(3).unwrap();
+/// let cells: Vec<_> = (0..4).map(|code| u.root().child(code)).collect();
+/// let subtrees = cells.iter().map(|&c| stack(&rays.cell_rays(c))).collect();
+/// assert_eq!(join_subtrees(u, 1, subtrees), stack(&rays));
+/// ```
+///
+/// # Panics
+/// If the number of subtrees is not `2^(K·depth)` or a subtree's level is not `L − depth`.
+pub fn join_subtrees<const K: usize>(
+    universe: Universe<K>,
+    depth: u32,
+    subtrees: Vec<KTree<K>>,
+) -> KTree<K> {
+    assert_eq!(
+        subtrees.len() as u128,
+        1u128 << (K as u32 * depth),
+        "one subtree per cell of depth {depth}"
+    );
+    let pieces = subtrees
+        .into_iter()
+        .enumerate()
+        .filter_map(|(i, t)| {
+            assert_eq!(t.level() + depth, universe.level(), "subtree level");
+            match t.root_state() {
+                NodeState::Empty => None,
+                NodeState::Full => Some((i as u64, Piece::Full)),
+                NodeState::Partial => Some((i as u64, Piece::Tree(t))),
+            }
+        })
+        .collect();
+    join_pieces(universe, depth, pieces)
+}
+
+/// The tree from its non-empty cells of depth `m` (sorted by Morton index).
+fn join_pieces<const K: usize>(
+    universe: Universe<K>,
+    m: u32,
+    pieces: Vec<(u64, Piece<K>)>,
+) -> KTree<K> {
+    let k = K as u32;
+    // The pyramid of the non-empty nodes of depths m, m − 1, …, 0, as sorted (Morton index, state): a node
+    // whose 2^K children are all full is full, any other node with a non-empty child is partial.
+    let base: Vec<(u64, NodeState)> = pieces
+        .iter()
+        .map(|(i, p)| match p {
+            Piece::Full => (*i, NodeState::Full),
+            Piece::Tree(t) => (*i, t.root_state()),
+        })
+        .filter(|p| p.1 != NodeState::Empty)
+        .collect();
+    let mut pyramid = vec![base];
+    for _ in 0..m {
+        let below = pyramid.last().expect("the pyramid has its base");
+        let mut above: Vec<(u64, NodeState)> = Vec::new();
+        let mut at = 0;
+        while at < below.len() {
+            let parent = below[at].0 >> k;
+            let mut end = at;
+            while end < below.len() && below[end].0 >> k == parent {
+                end += 1;
+            }
+            let full = end - at == 1 << K && below[at..end].iter().all(|c| c.1 == NodeState::Full);
+            above.push((
+                parent,
+                if full {
+                    NodeState::Full
+                } else {
+                    NodeState::Partial
+                },
+            ));
+            at = end;
+        }
+        pyramid.push(above);
+    }
+    pyramid.reverse();
+    // Levels 0 … m: the root, then the children of each partial node, in order (absent ones empty).
+    let mut levels = Vec::new();
+    let mut root = PackedStates::with_capacity(1);
+    root.push(pyramid[0].first().map_or(NodeState::Empty, |r| r.1));
+    levels.push(root);
+    for d in 0..m as usize {
+        let mut next = PackedStates::new();
+        let children = &pyramid[d + 1];
+        let mut at = 0;
+        for &(i, s) in &pyramid[d] {
+            if s != NodeState::Partial {
+                continue;
+            }
+            for c in i << k..(i + 1) << k {
+                while at < children.len() && children[at].0 < c {
+                    at += 1;
+                }
+                match children.get(at) {
+                    Some(&(ci, cs)) if ci == c => next.push(cs),
+                    _ => next.push(NodeState::Empty),
+                }
+            }
+        }
+        if next.is_empty() {
+            break;
+        }
+        levels.push(next);
+    }
+    for l in &mut levels {
+        l.finish();
+    }
+    // Levels m + 1 …: the concatenation of the subtrees' levels 1 …, in Morton order.
+    let trees: Vec<&KTree<K>> = pieces
+        .iter()
+        .filter_map(|(_, p)| match p {
+            Piece::Tree(t) if t.root_state() == NodeState::Partial => Some(t),
+            _ => None,
+        })
+        .collect();
+    let deepest = trees.iter().map(|t| t.depth_count()).max().unwrap_or(0);
+    let deeper: Vec<PackedStates> = (1..deepest)
+        .into_par_iter()
+        .map(|j| {
+            let mut out = LevelWords::default();
+            for t in trees.iter().filter(|t| t.depth_count() > j) {
+                let s = t.level_states(j);
+                out.append(s.words(), s.len());
+            }
+            out.into_states()
+        })
+        .collect();
+    levels.extend(deeper);
+    KTree::from_levels(universe, levels)
+}
+
+/// A level being concatenated: 2-bit codes in words, node `i` at bits `2(i mod 32)` of word `i / 32`.
+#[derive(Debug, Default)]
+struct LevelWords {
+    words: Vec<u64>,
+    len: usize,
+}
+
+impl LevelWords {
+    /// Appends `len` nodes given as packed words (bits beyond `len` zero), shifting them into place.
+    fn append(&mut self, words: &[u64], len: usize) {
+        let offset = 2 * (self.len % 32) as u32;
+        if offset == 0 {
+            self.words.extend_from_slice(&words[..len.div_ceil(32)]);
+        } else {
+            self.words.reserve(words.len());
+            for &w in &words[..len.div_ceil(32)] {
+                let last = self.words.len() - 1;
+                self.words[last] |= w << offset;
+                self.words.push(w >> (64 - offset));
+            }
+        }
+        self.len += len;
+        self.words.truncate(self.len.div_ceil(32));
+    }
+
+    fn into_states(self) -> PackedStates {
+        PackedStates::from_words(self.words, self.len)
+            .expect("concatenated levels hold valid 2-bit codes")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn level_words_concatenate_like_pushes() {
+        let mut x = 7u64;
+        let mut expected = PackedStates::new();
+        let mut joined = LevelWords::default();
+        for n in [0usize, 1, 31, 32, 33, 5, 64, 100, 3] {
+            let mut part = PackedStates::new();
+            for _ in 0..n {
+                x = x
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let s = NodeState::from_code((x >> 33) as u8 % 3).unwrap();
+                part.push(s);
+                expected.push(s);
+            }
+            part.finish();
+            joined.append(part.words(), part.len());
+        }
+        expected.finish();
+        assert_eq!(joined.into_states(), expected);
+    }
+}

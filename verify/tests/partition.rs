@@ -1,0 +1,153 @@
+//! Morton-partitioned stacking is cross-checked, for K = 1 … 4 and every split depth, against whole-set
+//! stacking and naive voxel insertion node for node; the cell split of the rays against the rays' own
+//! point test; joining stacked subtrees against stacking the whole set; and the result against the number
+//! of threads.
+
+use ktree_verify::cases;
+
+use cases::{ray_sets, Case};
+use ktree::reference::{Dim, Fanout, NaiveTree};
+use ktree::stacking::{join_subtrees, stack, stack_partitioned};
+use ktree::{Cell, KTree};
+use proptest::prelude::*;
+
+fn partitioned_agrees<const K: usize>(case: &Case<K>) -> Result<(), TestCaseError>
+where
+    Dim<K>: Fanout,
+{
+    let rays = &case.rays;
+    let whole = stack(rays);
+    let naive = NaiveTree::from_rays(rays).unwrap().to_tree();
+    prop_assert!(whole == naive, "stacking and naive differ");
+    for depth in 0..=rays.level() {
+        let parted = stack_partitioned(rays, depth);
+        parted
+            .check()
+            .map_err(|e| TestCaseError::fail(format!("depth {depth}: malformed: {e}")))?;
+        prop_assert!(
+            parted == whole,
+            "split depth {}: partitioned and whole stacking differ",
+            depth
+        );
+    }
+    Ok(())
+}
+
+/// The cells of depth `depth` in Morton order.
+fn cells<const K: usize>(level: u32, depth: u32) -> Vec<Cell<K>> {
+    let u = ktree::Universe::<K>::new(level).unwrap();
+    let mut cells = vec![u.root()];
+    for _ in 0..depth {
+        cells = cells
+            .iter()
+            .flat_map(|c| (0..1usize << K).map(move |code| c.child(code)))
+            .collect();
+    }
+    cells
+}
+
+fn split_and_join_agree<const K: usize>(case: &Case<K>, depth: u32) -> Result<(), TestCaseError> {
+    let rays = &case.rays;
+    let depth = depth.min(rays.level());
+    let u = rays.universe();
+    let mut subtrees = Vec::new();
+    for cell in cells::<K>(rays.level(), depth) {
+        let inner = rays.cell_rays(cell);
+        prop_assert_eq!(inner.level(), rays.level() - depth);
+        // Every voxel of the cell is in the cell's rays exactly when it is in the rays.
+        let mut count = 0u128;
+        let side = cell.side() as u32;
+        cases::for_each_column([0; K], [side; K], |mut p| {
+            for z in 0..side {
+                p[K - 1] = z;
+                let global: [u32; K] = std::array::from_fn(|a| p[a] + cell.origin[a]);
+                assert_eq!(inner.contains(p), rays.contains(global), "{cell:?} {p:?}");
+                count += u128::from(rays.contains(global));
+            }
+        });
+        prop_assert_eq!(inner.voxel_count(), count);
+        subtrees.push(stack(&inner));
+    }
+    prop_assert!(
+        join_subtrees(u, depth, subtrees) == stack(rays),
+        "joined subtrees differ from stacking at depth {}",
+        depth
+    );
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+
+    #[test]
+    fn partitioned_equals_stacking_k1(case in ray_sets::<1>()) { partitioned_agrees(&case)?; }
+    #[test]
+    fn partitioned_equals_stacking_k2(case in ray_sets::<2>()) { partitioned_agrees(&case)?; }
+    #[test]
+    fn partitioned_equals_stacking_k3(case in ray_sets::<3>()) { partitioned_agrees(&case)?; }
+    #[test]
+    fn partitioned_equals_stacking_k4(case in ray_sets::<4>()) { partitioned_agrees(&case)?; }
+
+    #[test]
+    fn split_and_join_k1(case in ray_sets::<1>(), depth in 0u32..=6) { split_and_join_agree(&case, depth)?; }
+    #[test]
+    fn split_and_join_k2(case in ray_sets::<2>(), depth in 0u32..=6) { split_and_join_agree(&case, depth)?; }
+    #[test]
+    fn split_and_join_k3(case in ray_sets::<3>(), depth in 0u32..=3) { split_and_join_agree(&case, depth)?; }
+    #[test]
+    fn split_and_join_k4(case in ray_sets::<4>(), depth in 0u32..=2) { split_and_join_agree(&case, depth)?; }
+}
+
+/// Thread count does not change the tree.
+#[test]
+fn any_thread_count_gives_the_same_tree() {
+    let level = 7;
+    let u = 1i64 << level;
+    let rays = ktree::rays::ball_rays::<3>(level, [u, u, u], u - 3).unwrap();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let three = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .unwrap();
+    for depth in [1, 3, 5] {
+        let a: KTree<3> = one.install(|| stack_partitioned(&rays, depth));
+        let b = three.install(|| stack_partitioned(&rays, depth));
+        assert_eq!(a, b);
+        assert_eq!(a, stack(&rays));
+    }
+}
+
+/// Small objects in universes of the largest level for each K, split deep.
+#[test]
+fn extreme_levels_split_anywhere() {
+    fn check<const K: usize>() {
+        let level = ktree::max_level(K);
+        let side = 1u64 << level;
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let rays: Vec<ktree::Ray<K>> = (0..6)
+            .map(|_| {
+                let start: [u32; K] = std::array::from_fn(|_| (next() % side) as u32);
+                let z2 = (u64::from(start[K - 1]) + 1 + next() % 40).min(side);
+                ktree::Ray::new(start, z2 as u32)
+            })
+            .collect();
+        let set = ktree::RaySet::from_rays(level, rays).unwrap();
+        let whole = stack(&set);
+        for depth in [1, level / 2, level - 1, level] {
+            assert_eq!(stack_partitioned(&set, depth), whole, "K={K} depth {depth}");
+        }
+    }
+    check::<1>();
+    check::<2>();
+    check::<3>();
+    check::<4>();
+}
