@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use ktree::io::{read_rays_file, write_ktree_file};
+use ktree::io::read_rays_file;
 
 /// Arguments of `ktree build`.
 #[derive(Debug, clap::Args)]
@@ -19,7 +19,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<(), String> {
     let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
     let tree = rays.stack();
-    let write = ktree::with_dim!(&tree, AnyTree, t => write_ktree_file(&args.out, t));
+    let write = ktree::with_dim!(&tree, AnyTree, t => crate::tree_file::write(&args.out, t));
     write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
     let c = tree.counts();
     println!(

@@ -15,6 +15,7 @@ mod render;
 mod repro;
 mod stats;
 mod transform;
+mod tree_file;
 mod voxelize;
 
 /// k-trees (bintrees, quadtrees, octrees, 4-D trees) from rays by stacking.
@@ -23,6 +24,8 @@ mod voxelize;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    #[command(flatten)]
+    format: tree_file::FormatArgs,
 }
 
 #[derive(Debug, Subcommand)]
@@ -53,6 +56,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    tree_file::set(&cli.format);
     let outcome = match cli.command {
         Command::Build(args) => build::run(args),
         Command::Stats(args) => stats::run(args),

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::{read_ktree_file, write_ktree_file, AnyTree};
+use ktree::io::{read_ktree_file, AnyTree};
 use ktree::ops::{self, BoolOp};
 use ktree::KTree;
 
@@ -28,7 +28,8 @@ pub fn read(path: &Path) -> Result<AnyTree, String> {
 
 /// Writes a tree file and prints a one-line summary.
 pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> Result<(), String> {
-    write_ktree_file(path, tree).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    crate::tree_file::write(path, tree)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     let c = tree.counts();
     println!(
         "{}: K = {K}, L = {}, {} nodes ({} full, {} empty, {} partial), {} voxels",

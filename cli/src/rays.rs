@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::{write_ktree_file, write_rays_file};
+use ktree::io::write_rays_file;
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid};
 use ktree::stacking::stack;
 use ktree::RaySet;
@@ -141,7 +141,8 @@ pub fn write_output<const K: usize>(rays: &RaySet<K>, out: &Path) -> Result<Stri
     let is_tree = out.extension().is_some_and(|e| e == "ktree");
     if is_tree {
         let tree = stack(rays);
-        write_ktree_file(out, &tree).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        crate::tree_file::write(out, &tree)
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
         let c = tree.counts();
         Ok(format!(
             "{}: K = {K}, L = {}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",

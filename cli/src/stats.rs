@@ -1,8 +1,9 @@
 //! `ktree stats FILE.ktree | --rays FILE [--json]`: node counts of a tree or of the tree a ray file stacks to.
+//! A version 2 tree file is checked and counted through a memory map, in memory independent of its size.
 
 use std::path::PathBuf;
 
-use ktree::io::{read_ktree_file, read_rays_file, AnyTree};
+use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, VERSION_2};
 use ktree::LevelCounts;
 use serde::Serialize;
 
@@ -35,27 +36,64 @@ struct Stats {
     per_level: Vec<LevelCounts>,
 }
 
+impl Stats {
+    fn new(
+        k: usize,
+        rays: Option<u64>,
+        c: LevelCounts,
+        bytes: u64,
+        per_level: Vec<LevelCounts>,
+    ) -> Self {
+        Self {
+            k,
+            level: c.level,
+            rays,
+            full: c.full,
+            empty: c.empty,
+            partial: c.partial,
+            nodes: c.nodes(),
+            bytes_at_2_bits: bytes,
+            per_level,
+        }
+    }
+}
+
 /// Prints the statistics.
 pub fn run(args: Args) -> Result<(), String> {
-    let (tree, rays): (AnyTree, Option<u64>) = match (&args.tree, &args.rays) {
-        (Some(path), None) => (read_ktree_file(path).map_err(|e| e.to_string())?, None),
+    let stats = match (&args.tree, &args.rays) {
+        (Some(path), None) if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION_2 => {
+            let view = KtreeView::open(path).map_err(|e| e.to_string())?;
+            Stats::new(
+                view.k(),
+                None,
+                view.counts(),
+                view.bytes_at_two_bits(),
+                view.counts_per_level(),
+            )
+        }
+        (Some(path), None) => {
+            let tree = read_ktree_file(path).map_err(|e| e.to_string())?;
+            Stats::new(
+                tree.k(),
+                None,
+                tree.counts(),
+                tree.bytes_at_two_bits(),
+                tree.counts_per_level(),
+            )
+        }
         (None, Some(path)) => {
             let rays = read_rays_file(path).map_err(|e| e.to_string())?;
-            (rays.stack(), Some(rays.len() as u64))
+            let tree = rays.stack();
+            let n = Some(rays.len() as u64);
+            Stats::new(
+                tree.k(),
+                n,
+                tree.counts(),
+                tree.bytes_at_two_bits(),
+                tree.counts_per_level(),
+            )
         }
         _ => return Err("give either a .ktree file or --rays FILE".into()),
-    };
-    let c = tree.counts();
-    let stats = Stats {
-        k: tree.k(),
-        level: tree.level(),
-        rays,
-        full: c.full,
-        empty: c.empty,
-        partial: c.partial,
-        nodes: c.nodes(),
-        bytes_at_2_bits: tree.bytes_at_two_bits(),
-        per_level: tree.counts_per_level(),
     };
     if args.json {
         println!(

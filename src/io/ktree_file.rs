@@ -1,4 +1,5 @@
-//! The `.ktree` file: a tree in level order at Meagher's 2 bits a node.
+//! The `.ktree` file, version 1: a tree in level order at Meagher's 2 bits a node, in one checksummed body
+//! (version 2, with a section per level, is in `ktree_v2`; the readers here read both).
 //!
 //! | offset | size | content |
 //! |---|---|---|
@@ -29,7 +30,7 @@ use crate::tree::{KTree, NodeState, PackedStates};
 
 /// The magic bytes at the start of a `.ktree` file.
 pub const MAGIC: &[u8; 6] = b"KTREE\0";
-/// The format version written.
+/// The format version of this layout (version 2 is [`crate::io::KtreeWriter`]'s).
 pub const VERSION: u16 = 1;
 
 /// What was wrong with a `.ktree` file.
@@ -40,7 +41,7 @@ pub enum KtreeFileErrorKind {
     #[error("not a .ktree file (bad magic)")]
     BadMagic,
     /// Written by a newer version of ktree.
-    #[error("format version {0} is not supported (this ktree reads version {VERSION})")]
+    #[error("format version {0} is not supported (this ktree reads versions 1 and 2)")]
     Version(u16),
     /// `K` or `L` out of range.
     #[error("bad header: {0}")]
@@ -58,6 +59,16 @@ pub enum KtreeFileErrorKind {
         "checksum mismatch (stored {stored:08x}, computed {computed:08x}): the file is corrupted"
     )]
     Checksum {
+        /// Stored CRC.
+        stored: u32,
+        /// Computed CRC.
+        computed: u32,
+    },
+    /// The checksum of one level's section (version 2) does not match: the file is corrupted.
+    #[error("checksum mismatch in the section of level {level} (stored {stored:08x}, computed {computed:08x}): the file is corrupted")]
+    SectionChecksum {
+        /// The tree level whose section is corrupted.
+        level: usize,
         /// Stored CRC.
         stored: u32,
         /// Computed CRC.
@@ -185,7 +196,7 @@ pub fn read_ktree_file(path: &Path) -> Result<AnyTree, KtreeFileError> {
     read_ktree_any(&bytes, &name)
 }
 
-/// Reads a `.ktree` file's bytes, of whatever dimension they hold.
+/// Reads a `.ktree` file's bytes (version 1 or 2), of whatever dimension they hold.
 ///
 /// # Errors
 /// [`KtreeFileError`] naming the byte offset of the first inconsistency.
@@ -217,6 +228,9 @@ pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileErro
         return Err(truncated(bytes.len()));
     }
     let version = u16::from_le_bytes([bytes[6], bytes[7]]);
+    if version == super::ktree_v2::VERSION {
+        return super::ktree_v2::read_v2_any(bytes, file);
+    }
     if version != VERSION {
         return Err(fail(6, KtreeFileErrorKind::Version(version)));
     }

@@ -1,9 +1,13 @@
-//! Files in and out: the ray text format, the `.ktree` tree format (2 bits a node, checksummed), atomic
+//! Files in and out: the ray text format, the `.ktree` tree format (2 bits a node, checksummed; version 2 in
+//! word-aligned sections per level, streamed out and memory-mapped in), atomic
 //! writes, and trees and ray sets whose dimension is read from the file ([`AnyTree`], [`AnyRaySet`]).
 
 mod any;
 mod atomic;
 mod ktree_file;
+mod ktree_v2;
+#[allow(unsafe_code)]
+mod mmap;
 mod rays_text;
 
 pub use any::{AnyRaySet, AnyTree};
@@ -11,6 +15,10 @@ pub use atomic::{write_atomic, write_atomic_with};
 pub use ktree_file::{
     read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file, KtreeFileError,
     KtreeFileErrorKind, MAGIC, VERSION,
+};
+pub use ktree_v2::{
+    ktree_file_version, write_ktree_v2, write_ktree_v2_file, KtreeView, KtreeWriter,
+    VERSION as VERSION_2,
 };
 pub use rays_text::{
     read_rays, read_rays_file, write_rays, write_rays_file, RaysTextError, RaysTextErrorKind,
