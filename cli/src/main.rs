@@ -7,6 +7,7 @@ use clap::{Parser, Subcommand};
 
 mod build;
 mod collide;
+mod convert;
 mod lines;
 mod mass;
 mod op;
@@ -52,6 +53,8 @@ enum Command {
     Rays(rays::Args),
     /// A triangle mesh (OBJ, STL, PLY) or a volume (raw + JSON, NIfTI) to rays or a .ktree.
     Voxelize(voxelize::Args),
+    /// Convert between .ktree, .rays, .binvox, OctoMap .bt and OpenVDB .vdb (meshes and volumes as inputs).
+    Convert(convert::Args),
 }
 
 fn main() -> ExitCode {
@@ -69,6 +72,7 @@ fn main() -> ExitCode {
         Command::Repro(args) => repro::run(args),
         Command::Rays(args) => rays::run(args),
         Command::Voxelize(args) => voxelize::run(args),
+        Command::Convert(args) => convert::run(args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,8 +3,9 @@
 
 use std::path::PathBuf;
 
-use ktree::solid::mesh::{Placement, TriangleMesh};
-use ktree::solid::volume::{Select, Volume};
+use ktree::io::{voxelize, Format, ReadOptions};
+use ktree::solid::mesh::Placement;
+use ktree::solid::volume::Select;
 
 use crate::rays::write_output;
 
@@ -36,43 +37,25 @@ pub struct Args {
     out: PathBuf,
 }
 
-const MESH: [&str; 3] = ["obj", "stl", "ply"];
-
 /// Voxelizes the input and writes it.
 pub fn run(a: Args) -> Result<(), String> {
-    let ext = a
-        .input
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
-    let rays = if MESH.contains(&ext.as_str()) {
-        let level = a.level.ok_or("--level L is required for a mesh")?;
-        let mesh = TriangleMesh::read(&a.input).map_err(|e| e.to_string())?;
-        let placement = match (&a.transform, a.fit) {
-            (Some(t), _) => Placement::parse(t).map_err(|e| e.to_string())?,
-            (None, true) => {
-                let p = Placement::fit(&mesh, level).map_err(|e| e.to_string())?;
-                println!("--fit chose --transform {}", p.to_arg());
-                p
-            }
+    let mut options = ReadOptions {
+        level: a.level,
+        ..ReadOptions::default()
+    };
+    if Format::of(&a.input) == Some(Format::Mesh) {
+        if a.level.is_none() {
+            return Err("--level L is required for a mesh".into());
+        }
+        options.mesh_placement = match (&a.transform, a.fit) {
+            (Some(t), _) => Some(Placement::parse(t).map_err(|e| e.to_string())?),
+            (None, true) => None,
             (None, false) => return Err("a mesh needs --fit or --transform s,tx,ty,tz".into()),
         };
-        let r = mesh.to_rays(level, &placement).map_err(|e| e.to_string())?;
-        if r.open_edges > 0 {
-            eprintln!(
-                "warning: {}: the mesh is not closed ({} edges not shared by exactly two triangles); inside is \
-                 decided by the winding along each column, so some columns may leak or lose runs",
-                a.input.display(),
-                r.open_edges
-            );
-        }
-        r.rays
     } else {
-        let v = Volume::read(&a.input).map_err(|e| e.to_string())?;
-        let select = match (a.threshold, a.label) {
-            (Some(t), _) => Select::AtLeast(t),
-            (None, Some(l)) => Select::Label(l),
+        options.select = match (a.threshold, a.label) {
+            (Some(t), _) => Some(Select::AtLeast(t)),
+            (None, Some(l)) => Some(Select::Label(l)),
             (None, None) => return Err("a volume needs --threshold T or --label V".into()),
         };
         let off: Vec<u32> = a
@@ -89,9 +72,20 @@ pub fn run(a: Args) -> Result<(), String> {
         let off: [u32; 3] = off
             .try_into()
             .map_err(|_| format!("--offset '{}': expected three numbers", a.offset))?;
-        let level = a.level.unwrap_or_else(|| v.fitting_level());
-        v.to_rays(level, off, select).map_err(|e| e.to_string())?
-    };
-    println!("{}", write_output(&rays, &a.out)?);
+        options.offset = Some(off.map(i64::from));
+    }
+    let v = voxelize(&a.input, &options).map_err(|e| e.to_string())?;
+    if let Some(t) = &v.fitted {
+        println!("--fit chose --transform {t}");
+    }
+    if v.open_edges > 0 {
+        eprintln!(
+            "warning: {}: the mesh is not closed ({} edges not shared by exactly two triangles); inside is \
+             decided by the winding along each column, so some columns may leak or lose runs",
+            a.input.display(),
+            v.open_edges
+        );
+    }
+    println!("{}", write_output(&v.rays, &a.out)?);
     Ok(())
 }

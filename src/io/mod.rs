@@ -1,17 +1,29 @@
 //! Files in and out: the ray text format, the `.ktree` tree format (2 bits a node, checksummed; version 2 in
 //! word-aligned sections per level, streamed out and memory-mapped in), atomic
 //! writes, and trees and ray sets whose dimension is read from the file ([`AnyTree`], [`AnyRaySet`]).
+//! [`read_tree`] and [`write_tree`] choose among every format by extension, the grid formats of other tools
+//! included: binvox, OctoMap `.bt` and OpenVDB `.vdb`.
 
 mod any;
 mod atomic;
+mod binvox;
+mod formats;
+mod grid;
 mod ktree_file;
 mod ktree_v2;
 #[allow(unsafe_code)]
 mod mmap;
+mod octomap_bt;
 mod rays_text;
 
 pub use any::{AnyRaySet, AnyTree};
 pub use atomic::{write_atomic, write_atomic_with};
+pub use binvox::{read_binvox, write_binvox, BINVOX_MAX_DIM};
+pub use formats::{
+    read_tree, read_tree_placed, voxelize, write_tree, Format, IoError, ReadOptions, ReadTree,
+    Voxelized, WriteOptions,
+};
+pub use grid::{tree_rays, GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree};
 pub use ktree_file::{
     read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file, KtreeFileError,
     KtreeFileErrorKind, MAGIC, VERSION,
@@ -20,6 +32,7 @@ pub use ktree_v2::{
     ktree_file_version, write_ktree_v2, write_ktree_v2_file, KtreeView, KtreeWriter,
     VERSION as VERSION_2,
 };
+pub use octomap_bt::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
 pub use rays_text::{
     read_rays, read_rays_file, write_rays, write_rays_file, RaysTextError, RaysTextErrorKind,
 };

@@ -1,0 +1,109 @@
+//! `ktree convert IN OUT`: any format to any format, chosen by extension (`.ktree`, `.rays`, `.binvox`, `.bt`,
+//! `.vdb`; meshes and volumes as inputs).
+
+use std::path::PathBuf;
+
+use ktree::io::{read_tree_placed, write_tree, Format, ReadOptions, WriteOptions};
+use ktree::solid::mesh::Placement;
+use ktree::solid::volume::Select;
+
+/// Arguments of `ktree convert`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The input: .ktree, .rays, .binvox, .bt, .vdb, a mesh (.obj, .stl, .ply) or a volume (.json, .raw,
+    /// .nii, .nii.gz).
+    input: PathBuf,
+    /// The output: .ktree, .rays, .binvox, .bt or .vdb.
+    output: PathBuf,
+    /// Universe level (grids, volumes: default the smallest that holds the input; meshes: required).
+    #[arg(long)]
+    level: Option<u32>,
+    /// Grids and volumes: ktree voxel = grid index + offset, as x,y,z (default 0, or what moves negative
+    /// indices to 0).
+    #[arg(long, allow_hyphen_values = true)]
+    offset: Option<String>,
+    /// Grid output: grid index = ktree voxel − offset, as x,y,z (default: .vdb keeps the input's grid
+    /// indices, binvox and .bt use 0).
+    #[arg(long, allow_hyphen_values = true)]
+    out_offset: Option<String>,
+    /// Grid output: the edge of a voxel in world units (default: the input grid's, else 1).
+    #[arg(long)]
+    voxel_size: Option<f64>,
+    /// OctoMap input: how unknown cells read.
+    #[arg(long, value_parser = ["empty", "full"], default_value = "empty")]
+    unknown: String,
+    /// Mesh: voxel coordinate = s·v + t, given as s,tx,ty,tz (default: fit into the universe).
+    #[arg(long)]
+    transform: Option<String>,
+    /// Volume: samples with value ≥ this are inside.
+    #[arg(long, conflicts_with = "label")]
+    threshold: Option<f64>,
+    /// Volume: samples equal to this label are inside.
+    #[arg(long)]
+    label: Option<f64>,
+}
+
+fn parse_xyz(name: &str, text: &str) -> Result<[i64; 3], String> {
+    let v: Vec<i64> = text
+        .split(',')
+        .map(|x| x.trim().parse::<i64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("--{name} '{text}': expected x,y,z (integers)"))?;
+    v.try_into()
+        .map_err(|_| format!("--{name} '{text}': expected three integers"))
+}
+
+/// Reads the input, writes the output, prints a one-line summary.
+pub fn run(a: Args) -> Result<(), String> {
+    let options = ReadOptions {
+        level: a.level,
+        offset: a
+            .offset
+            .as_deref()
+            .map(|t| parse_xyz("offset", t))
+            .transpose()?,
+        unknown_full: a.unknown == "full",
+        mesh_placement: a
+            .transform
+            .as_deref()
+            .map(Placement::parse)
+            .transpose()
+            .map_err(|e| e.to_string())?,
+        select: match (a.threshold, a.label) {
+            (Some(t), _) => Some(Select::AtLeast(t)),
+            (None, Some(l)) => Some(Select::Label(l)),
+            (None, None) => None,
+        },
+    };
+    let read = read_tree_placed(&a.input, &options).map_err(|e| e.to_string())?;
+    for r in &read.remarks {
+        eprintln!("note: {}: {r}", a.input.display());
+    }
+    let out_offset = match (&a.out_offset, Format::of(&a.output), read.placement) {
+        (Some(t), _, _) => parse_xyz("out-offset", t)?,
+        (None, Some(Format::Vdb), Some(p)) => p.offset,
+        _ => [0; 3],
+    };
+    let mut meta = read.meta.unwrap_or_default();
+    if let Some(v) = a.voxel_size {
+        meta.voxel_size = v;
+    }
+    let write_options = WriteOptions {
+        offset: out_offset,
+        meta: Some(meta),
+    };
+    write_tree(&a.output, &read.tree, &write_options).map_err(|e| e.to_string())?;
+    let c = read.tree.counts();
+    let placed = read.placement.map_or(String::new(), |p| {
+        format!(" (grid index + {:?} = ktree voxel)", p.offset)
+    });
+    println!(
+        "{}: K = {}, L = {}, {} nodes, {} voxels{placed}",
+        a.output.display(),
+        read.tree.k(),
+        read.tree.level(),
+        c.nodes(),
+        ktree::with_dim!(&read.tree, AnyTree, t => t.voxel_count()),
+    );
+    Ok(())
+}

@@ -1,0 +1,381 @@
+//! Reading and writing a tree in any format, chosen by the file's extension: `.ktree`, `.rays` (the ray
+//! text), `.binvox`, `.bt` (OctoMap), `.vdb` (OpenVDB), and as inputs only meshes (`.obj`, `.stl`, `.ply`)
+//! and volumes (`.json` + raw, `.nii`, `.nii.gz`).
+//!
+//! Grid formats index voxels by integers: ktree voxel = grid index + offset (see [`GridPlacement`]).
+//! binvox, `.bt` and `.vdb` hold octrees only.
+
+use std::path::Path;
+
+use thiserror::Error;
+
+use super::grid::{GridFileError, GridMeta, GridPlacement, PlacedTree};
+use super::{AnyTree, KtreeFileError, RaysTextError};
+use crate::rays::RaySet;
+use crate::solid::SolidError;
+
+/// A file format known to [`read_tree`] and [`write_tree`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Format {
+    /// `.ktree`: ktree's own tree file.
+    Ktree,
+    /// `.rays`: the ray text format.
+    Rays,
+    /// `.binvox`.
+    Binvox,
+    /// `.bt`: OctoMap's binary occupancy tree.
+    OctomapBt,
+    /// `.vdb`: an OpenVDB grid.
+    Vdb,
+    /// `.obj`, `.stl`, `.ply`: a triangle mesh (input only).
+    Mesh,
+    /// `.json` (+ raw samples), `.raw`, `.nii`, `.nii.gz`: a volume (input only).
+    Volume,
+}
+
+impl Format {
+    /// The format of a path, by its extension (case-insensitive).
+    ///
+    /// ```
+    /// use ktree::io::Format;
+    /// assert_eq!(Format::of(std::path::Path::new("map.BT")), Some(Format::OctomapBt));
+    /// assert_eq!(Format::of(std::path::Path::new("head.nii.gz")), Some(Format::Volume));
+    /// assert_eq!(Format::of(std::path::Path::new("notes.txt")), None);
+    /// ```
+    pub fn of(path: &Path) -> Option<Format> {
+        let name = path.file_name()?.to_str()?.to_ascii_lowercase();
+        if name.ends_with(".nii.gz") {
+            return Some(Format::Volume);
+        }
+        Some(match name.rsplit_once('.')?.1 {
+            "ktree" => Format::Ktree,
+            "rays" => Format::Rays,
+            "binvox" => Format::Binvox,
+            "bt" => Format::OctomapBt,
+            "vdb" => Format::Vdb,
+            "obj" | "stl" | "ply" => Format::Mesh,
+            "json" | "raw" | "nii" => Format::Volume,
+            _ => return None,
+        })
+    }
+}
+
+/// How to read a file. Every field has a default that suits a file holding the whole object.
+#[derive(Debug, Clone, Default)]
+pub struct ReadOptions {
+    /// The universe level. Grids and volumes: default the smallest level that holds the grid. Meshes:
+    /// required.
+    pub level: Option<u32>,
+    /// Grids and volumes: ktree voxel = grid index + `offset`. Default: 0, except that an axis with
+    /// negative indices is shifted so that its smallest index becomes 0 (see [`GridPlacement::choose`]).
+    pub offset: Option<[i64; 3]>,
+    /// OctoMap: read unknown cells inside the universe as full (default: as empty).
+    pub unknown_full: bool,
+    /// Meshes: voxel = s·v + t. Default: the mesh scaled and centred into the universe with one voxel of
+    /// margin.
+    #[cfg(feature = "mesh")]
+    pub mesh_placement: Option<crate::solid::mesh::Placement>,
+    /// Volumes: which samples are inside (required for a volume).
+    #[cfg(feature = "volume")]
+    pub select: Option<crate::solid::volume::Select>,
+}
+
+/// How to write a file.
+#[derive(Debug, Clone, Default)]
+pub struct WriteOptions {
+    /// Grids: grid index = ktree voxel − `offset` (the inverse of [`ReadOptions::offset`]). binvox needs 0;
+    /// OctoMap needs multiples of `2^L` that keep the universe inside its keys.
+    pub offset: [i64; 3],
+    /// Grids: voxel size and world origin (binvox `translate`/`scale`, OctoMap `res`, OpenVDB's transform).
+    /// Default: unit voxels at the origin.
+    pub meta: Option<GridMeta>,
+}
+
+/// A tree read by [`read_tree_placed`], with what the reader chose or noticed.
+#[derive(Debug, Clone)]
+pub struct ReadTree {
+    /// The object.
+    pub tree: AnyTree,
+    /// Grids: where the grid was placed.
+    pub placement: Option<GridPlacement>,
+    /// Grids: their world metadata.
+    pub meta: Option<GridMeta>,
+    /// Things worth telling a user: the transform a mesh was fitted with, a mesh that is not closed.
+    pub remarks: Vec<String>,
+}
+
+/// An error reading or writing a file in any format.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum IoError {
+    /// A bad `.ktree` file.
+    #[error(transparent)]
+    Ktree(#[from] KtreeFileError),
+    /// A bad ray file.
+    #[error(transparent)]
+    Rays(#[from] RaysTextError),
+    /// A bad binvox, `.bt` or `.vdb` file.
+    #[error(transparent)]
+    Grid(#[from] GridFileError),
+    /// A mesh or volume that could not be read or voxelized.
+    #[error("{file}: {source}")]
+    Solid {
+        /// The file.
+        file: String,
+        /// The cause.
+        source: SolidError,
+    },
+    /// The format or the options do not fit the file: an unknown extension, an output-only or input-only
+    /// format, a dimension the format cannot hold, a missing option.
+    #[error("{file}: {message}")]
+    Usage {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Writing failed (the message names the file).
+    #[error("{0}")]
+    Write(std::io::Error),
+}
+
+fn usage(path: &Path, message: impl Into<String>) -> IoError {
+    IoError::Usage {
+        file: path.display().to_string(),
+        message: message.into(),
+    }
+}
+
+fn format_of(path: &Path) -> Result<Format, IoError> {
+    Format::of(path).ok_or_else(|| {
+        usage(
+            path,
+            "unknown extension: expected .ktree, .rays, .binvox, .bt, .vdb, a mesh (.obj, .stl, .ply) or a \
+             volume (.json, .raw, .nii, .nii.gz)",
+        )
+    })
+}
+
+/// Reads a tree from a file of any format, chosen by extension.
+///
+/// ```
+/// use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions, AnyTree};
+/// let dir = tempfile::tempdir().unwrap();
+/// let tree = AnyTree::K3(ktree::stacking::stack(&ktree::rays::ball_rays::<3>(4, [8, 8, 8], 6).unwrap()));
+/// for name in ["ball.ktree", "ball.rays", "ball.binvox", "ball.bt"] {
+///     let path = dir.path().join(name);
+///     write_tree(&path, &tree, &WriteOptions::default()).unwrap();
+///     assert_eq!(read_tree(&path, &ReadOptions::default()).unwrap(), tree, "{name}");
+/// }
+/// ```
+///
+/// # Errors
+/// [`IoError`]: the format's own error naming the file and the line or byte, or [`IoError::Usage`].
+pub fn read_tree(path: &Path, options: &ReadOptions) -> Result<AnyTree, IoError> {
+    read_tree_placed(path, options).map(|r| r.tree)
+}
+
+/// Like [`read_tree`], with the placement, metadata and remarks of the reading.
+///
+/// # Errors
+/// As [`read_tree`].
+pub fn read_tree_placed(path: &Path, options: &ReadOptions) -> Result<ReadTree, IoError> {
+    let name = path.display().to_string();
+    let plain = |tree: AnyTree| ReadTree {
+        tree,
+        placement: None,
+        meta: None,
+        remarks: Vec::new(),
+    };
+    let grid = |p: PlacedTree| ReadTree {
+        tree: AnyTree::K3(p.tree),
+        placement: Some(p.placement),
+        meta: Some(p.meta),
+        remarks: Vec::new(),
+    };
+    let bytes = || {
+        std::fs::read(path).map_err(|e| {
+            GridFileError::new(&name, 0, super::grid::GridFileErrorKind::Io(e.to_string()))
+        })
+    };
+    match format_of(path)? {
+        Format::Ktree => Ok(plain(super::read_ktree_file(path)?)),
+        Format::Rays => Ok(plain(super::read_rays_file(path)?.stack())),
+        Format::Binvox => Ok(grid(super::read_binvox(
+            &bytes()?,
+            &name,
+            options.offset,
+            options.level,
+        )?)),
+        Format::OctomapBt => Ok(grid(super::read_bt(
+            &bytes()?,
+            &name,
+            options.offset,
+            options.level,
+            options.unknown_full,
+        )?)),
+        Format::Vdb => Err(usage(path, "OpenVDB files are not read by this build")),
+        Format::Mesh | Format::Volume => {
+            let v = voxelize(path, options)?;
+            let mut remarks = Vec::new();
+            if let Some(t) = &v.fitted {
+                remarks.push(format!("the mesh was fitted with the transform {t}"));
+            }
+            if v.open_edges > 0 {
+                remarks.push(format!(
+                    "the mesh is not closed ({} edges not shared by exactly two triangles); inside is \
+                     decided by the winding along each column, so some columns may leak or lose runs",
+                    v.open_edges
+                ));
+            }
+            Ok(ReadTree {
+                remarks,
+                ..plain(AnyTree::K3(crate::stacking::stack(&v.rays)))
+            })
+        }
+    }
+}
+
+/// A mesh or a volume as rays, with what was chosen or noticed on the way.
+#[derive(Debug, Clone)]
+pub struct Voxelized {
+    /// The voxels inside.
+    pub rays: RaySet<3>,
+    /// Meshes placed by fitting: the transform chosen, as `s,tx,ty,tz`.
+    pub fitted: Option<String>,
+    /// Meshes: edges not shared by exactly two triangles (0 for a closed mesh).
+    pub open_edges: usize,
+}
+
+/// Voxelizes a mesh or a volume file into rays ([`Format::Mesh`], [`Format::Volume`]): a mesh needs
+/// [`ReadOptions::level`], a volume [`ReadOptions::select`]; the volume's sample `(i, j, k)` goes to voxel
+/// `offset + (i, j, k)`.
+///
+/// # Errors
+/// [`IoError::Solid`] from reading or voxelizing, [`IoError::Usage`] for another format or a missing option.
+pub fn voxelize(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
+    match format_of(path)? {
+        Format::Mesh => voxelize_mesh(path, options),
+        Format::Volume => voxelize_volume(path, options),
+        _ => Err(usage(path, "not a mesh or a volume")),
+    }
+}
+
+#[cfg(any(feature = "mesh", feature = "volume"))]
+fn solid_error(path: &Path) -> impl Fn(SolidError) -> IoError + '_ {
+    move |source| IoError::Solid {
+        file: path.display().to_string(),
+        source,
+    }
+}
+
+#[cfg(feature = "mesh")]
+fn voxelize_mesh(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
+    use crate::solid::mesh::{Placement, TriangleMesh};
+    let solid = solid_error(path);
+    let level = options
+        .level
+        .ok_or_else(|| usage(path, "a mesh needs a universe level"))?;
+    let mesh = TriangleMesh::read(path).map_err(&solid)?;
+    let (placement, fitted) = match options.mesh_placement {
+        Some(p) => (p, None),
+        None => {
+            let p = Placement::fit(&mesh, level).map_err(&solid)?;
+            (p, Some(p.to_arg()))
+        }
+    };
+    let r = mesh.to_rays(level, &placement).map_err(&solid)?;
+    Ok(Voxelized {
+        rays: r.rays,
+        fitted,
+        open_edges: r.open_edges,
+    })
+}
+
+#[cfg(not(feature = "mesh"))]
+fn voxelize_mesh(path: &Path, _: &ReadOptions) -> Result<Voxelized, IoError> {
+    Err(usage(path, "meshes are read with the `mesh` feature"))
+}
+
+#[cfg(feature = "volume")]
+fn voxelize_volume(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
+    use crate::solid::volume::Volume;
+    let solid = solid_error(path);
+    let select = options
+        .select
+        .ok_or_else(|| usage(path, "a volume needs a threshold or a label"))?;
+    let offset = options.offset.unwrap_or([0; 3]);
+    let Ok(offset) = offset
+        .map(u32::try_from)
+        .into_iter()
+        .collect::<Result<Vec<u32>, _>>()
+    else {
+        return Err(usage(path, "a volume's offset must be non-negative"));
+    };
+    let v = Volume::read(path).map_err(&solid)?;
+    let level = options.level.unwrap_or_else(|| v.fitting_level());
+    let rays = v
+        .to_rays(level, [offset[0], offset[1], offset[2]], select)
+        .map_err(&solid)?;
+    Ok(Voxelized {
+        rays,
+        fitted: None,
+        open_edges: 0,
+    })
+}
+
+#[cfg(not(feature = "volume"))]
+fn voxelize_volume(path: &Path, _: &ReadOptions) -> Result<Voxelized, IoError> {
+    Err(usage(path, "volumes are read with the `volume` feature"))
+}
+
+/// Writes a tree to a file of the format its extension names, atomically ([`super::write_atomic`]).
+///
+/// # Errors
+/// [`IoError::Usage`] for an input-only format or a tree the format cannot hold (binvox, `.bt` and `.vdb`
+/// hold octrees); [`IoError::Write`] for the file system or a placement the format cannot express.
+pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result<(), IoError> {
+    let format = format_of(path)?;
+    let meta = options.meta.unwrap_or_default();
+    let octree = || match tree {
+        AnyTree::K3(t) => Ok(t),
+        other => Err(usage(
+            path,
+            format!(
+                "this format holds octrees (K = 3), the tree has K = {}",
+                other.k()
+            ),
+        )),
+    };
+    let write = |fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
+        super::write_atomic_with(path, |w| fill(w)).map_err(IoError::Write)
+    };
+    match format {
+        Format::Ktree => crate::with_dim!(tree, AnyTree, t => super::write_ktree_file(path, t))
+            .map_err(IoError::Write),
+        Format::Rays => {
+            crate::with_dim!(tree, AnyTree, t => super::write_rays_file(path, &super::tree_rays(t)))
+                .map_err(IoError::Write)
+        }
+        Format::Binvox => {
+            let t = octree()?;
+            if options.offset != [0; 3] {
+                return Err(usage(
+                    path,
+                    "binvox grids start at index 0: write with offset 0",
+                ));
+            }
+            write(&|w| super::write_binvox(w, t, &meta))
+        }
+        Format::OctomapBt => {
+            let t = octree()?;
+            write(&|w| super::write_bt(w, t, options.offset, meta.voxel_size))
+        }
+        Format::Vdb => Err(usage(path, "OpenVDB files are not written by this build")),
+        Format::Mesh | Format::Volume => Err(usage(
+            path,
+            "meshes and volumes are inputs only: write .ktree, .rays, .binvox, .bt or .vdb",
+        )),
+    }
+}

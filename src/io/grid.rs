@@ -1,0 +1,322 @@
+//! What the grid formats (binvox, OctoMap `.bt`, OpenVDB `.vdb`) share: their error type, the placement of
+//! a grid's integer indices in a ktree universe, and the runs of a tree along z.
+//!
+//! A grid file indexes voxels by integers that may be negative (OpenVDB, OctoMap) or need not start at a
+//! power of two. ktree voxel `v` is grid index `i` with `v = i + offset`; the offset and the universe level
+//! are chosen by [`GridPlacement::choose`] unless the caller fixes them.
+
+use std::fmt;
+
+use thiserror::Error;
+
+use crate::rays::{Ray, RaySet};
+use crate::space::max_level;
+use crate::tree::{KTree, NodeState, TreeAssembler};
+
+/// What was wrong with a grid file (binvox, `.bt`, `.vdb`).
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum GridFileErrorKind {
+    /// The header is missing, malformed or names something this reader does not read.
+    #[error("bad header: {0}")]
+    Header(String),
+    /// The file ends before the data it announces.
+    #[error("the file ends early: {0}")]
+    Truncated(String),
+    /// The data contradicts itself or the header.
+    #[error("bad data: {0}")]
+    Data(String),
+    /// A valid file of a kind this reader does not support.
+    #[error("unsupported: {0}")]
+    Unsupported(String),
+    /// The grid does not fit the universe asked for (or any universe).
+    #[error("placement: {0}")]
+    GridPlacement(String),
+    /// The file could not be read.
+    #[error("cannot read: {0}")]
+    Io(String),
+}
+
+/// An error reading or writing a grid file, with the file and the byte offset where it was found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GridFileError {
+    /// The file (or a name for the input).
+    pub file: String,
+    /// Byte offset of the problem (0 for a problem with the whole file).
+    pub offset: u64,
+    /// What was wrong.
+    pub kind: GridFileErrorKind,
+}
+
+impl fmt::Display for GridFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: byte {}: {}", self.file, self.offset, self.kind)
+    }
+}
+
+impl std::error::Error for GridFileError {}
+
+impl GridFileError {
+    pub(crate) fn new(file: &str, offset: usize, kind: GridFileErrorKind) -> Self {
+        Self {
+            file: file.to_string(),
+            offset: offset as u64,
+            kind,
+        }
+    }
+}
+
+/// An axis-aligned box of grid indices: `origin` and the number of voxels along each axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct IndexBox {
+    pub origin: [i64; 3],
+    pub size: [u64; 3],
+}
+
+impl IndexBox {
+    fn hi(&self) -> [i64; 3] {
+        std::array::from_fn(|a| self.origin[a] + self.size[a] as i64)
+    }
+}
+
+/// The largest number of boxes (runs, leaves) a grid reader collects (checked as they are made).
+pub(crate) const MAX_GRID_RUNS: u64 = 1 << 27;
+
+/// The object of a grid file as boxes of grid indices: `inside` must lie in the universe, `fill` (OctoMap's
+/// unknown space read as full) is clipped to it; `known` is the region the file describes, whose bounding
+/// box chooses the universe.
+#[derive(Debug, Default)]
+pub(crate) struct GridBoxes {
+    pub inside: Vec<IndexBox>,
+    pub fill: Vec<IndexBox>,
+    pub known: Option<([i64; 3], [i64; 3])>,
+}
+
+impl GridBoxes {
+    pub fn note_known(&mut self, b: IndexBox) {
+        let hi = b.hi();
+        self.known = Some(match self.known {
+            None => (b.origin, hi),
+            Some((lo0, hi0)) => (
+                std::array::from_fn(|a| lo0[a].min(b.origin[a])),
+                std::array::from_fn(|a| hi0[a].max(hi[a])),
+            ),
+        });
+    }
+}
+
+/// Where a grid goes in a universe: ktree voxel = grid index + `offset`, in a universe of level `level`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GridPlacement {
+    /// Added to a grid index to give the ktree voxel.
+    pub offset: [i64; 3],
+    /// The universe level.
+    pub level: u32,
+}
+
+impl GridPlacement {
+    /// The placement of a grid whose known region is `known` (half-open bounds of grid indices):
+    /// `offset` if given, else 0 on every axis where no index is negative and `−min` where one is; `level`
+    /// if given, else the smallest level whose universe holds the region (0 for an empty region).
+    ///
+    /// ```
+    /// use ktree::io::GridPlacement;
+    /// let p = GridPlacement::choose(Some(([-3, 0, 5], [4, 9, 6])), None, None).unwrap();
+    /// assert_eq!(p, GridPlacement { offset: [3, 0, 0], level: 4 });
+    /// ```
+    ///
+    /// # Errors
+    /// A sentence when the region does not fit (a level beyond [`max_level`]`(3)`).
+    pub fn choose(
+        known: Option<([i64; 3], [i64; 3])>,
+        offset: Option<[i64; 3]>,
+        level: Option<u32>,
+    ) -> Result<Self, String> {
+        let offset = offset.unwrap_or_else(|| match known {
+            Some((lo, _)) => std::array::from_fn(|a| (-lo[a]).max(0)),
+            None => [0; 3],
+        });
+        let level = match level {
+            Some(l) => l,
+            None => {
+                let extent = known.map_or(1, |(_, hi)| {
+                    (0..3)
+                        .map(|a| hi[a].saturating_add(offset[a]))
+                        .max()
+                        .unwrap_or(1)
+                        .max(1)
+                });
+                let mut l = 0u32;
+                while (1i128 << l) < i128::from(extent) {
+                    l += 1;
+                }
+                l
+            }
+        };
+        if level > max_level(3) {
+            return Err(format!(
+                "the grid needs a level-{level} universe; octrees go to level {}",
+                max_level(3)
+            ));
+        }
+        Ok(Self { offset, level })
+    }
+
+    /// The ktree voxel range `[lo, hi)` of a box of grid indices, clipped to the universe; `None` if the
+    /// box misses the universe. `clip = false` asks for the whole box to lie inside.
+    fn voxels(&self, b: &IndexBox, clip: bool) -> Result<Option<VoxelBox>, String> {
+        let side = 1i64 << self.level;
+        let mut lo = [0u32; 3];
+        let mut hi = [0u32; 3];
+        for a in 0..3 {
+            let l = b.origin[a].saturating_add(self.offset[a]);
+            let h = l.saturating_add(b.size[a] as i64);
+            if !clip && (l < 0 || h > side) {
+                return Err(format!(
+                    "grid voxels {:?}..{:?} fall outside the level-{} universe at offset {:?}: choose another \
+                     offset or level",
+                    b.origin,
+                    b.hi(),
+                    self.level,
+                    self.offset
+                ));
+            }
+            let (l, h) = (l.clamp(0, side), h.clamp(0, side));
+            if l >= h {
+                return Ok(None);
+            }
+            lo[a] = l as u32;
+            hi[a] = h as u32;
+        }
+        Ok(Some((lo, hi)))
+    }
+}
+
+/// The octree of a grid's boxes placed in a universe. The boxes are disjoint (every grid format here
+/// describes each voxel once), so a cell is full exactly when the volumes of its overlaps with the boxes add
+/// up to its own: the tree is built top-down, reduced as it is made.
+pub(crate) fn place_boxes(
+    boxes: &GridBoxes,
+    placement: &GridPlacement,
+) -> Result<KTree<3>, String> {
+    let mut voxel_boxes = Vec::new();
+    for (list, clip) in [(&boxes.inside, false), (&boxes.fill, true)] {
+        for b in list {
+            if let Some(v) = placement.voxels(b, clip)? {
+                voxel_boxes.push(v);
+            }
+        }
+    }
+    let mut out = TreeAssembler::<3>::new(placement.level).map_err(|e| e.to_string())?;
+    let all: Vec<u32> = (0..voxel_boxes.len() as u32).collect();
+    build(&mut out, [0; 3], placement.level, 0, &voxel_boxes, &all);
+    Ok(out.finish())
+}
+
+type VoxelBox = ([u32; 3], [u32; 3]);
+
+fn build(
+    out: &mut TreeAssembler<3>,
+    lo: [u32; 3],
+    log_side: u32,
+    depth: usize,
+    boxes: &[VoxelBox],
+    candidates: &[u32],
+) {
+    let side = 1u64 << log_side;
+    let mut covered = 0u128;
+    let mut touching = Vec::new();
+    for &i in candidates {
+        let (blo, bhi) = boxes[i as usize];
+        let mut volume = 1u128;
+        for a in 0..3 {
+            let l = u64::from(blo[a]).max(u64::from(lo[a]));
+            let h = u64::from(bhi[a]).min(u64::from(lo[a]) + side);
+            volume *= u128::from(h.saturating_sub(l));
+        }
+        if volume > 0 {
+            covered += volume;
+            touching.push(i);
+        }
+    }
+    let cell_volume = 1u128 << (3 * log_side);
+    if covered == 0 {
+        out.push(depth, NodeState::Empty);
+    } else if covered >= cell_volume || log_side == 0 {
+        out.push(depth, NodeState::Full);
+    } else {
+        out.push(depth, NodeState::Partial);
+        let half = 1u32 << (log_side - 1);
+        for code in 0..8 {
+            let child = std::array::from_fn(|a| lo[a] + if code >> a & 1 == 1 { half } else { 0 });
+            build(out, child, log_side - 1, depth + 1, boxes, &touching);
+        }
+    }
+}
+
+/// The runs along the last axis of a tree's full voxels: the ray set that stacks back to the tree.
+///
+/// ```
+/// use ktree::{io::tree_rays, stacking::stack, rays::ball_rays};
+/// let rays = ball_rays::<3>(5, [16, 16, 16], 11).unwrap();
+/// assert_eq!(tree_rays(&stack(&rays)), rays);
+/// ```
+pub fn tree_rays<const K: usize>(tree: &KTree<K>) -> RaySet<K> {
+    let mut rays = Vec::new();
+    tree.for_each_leaf(|cell, state| {
+        if state != NodeState::Full {
+            return;
+        }
+        let side = cell.side() as u32;
+        let origin = cell.origin;
+        // Every column of the cell: an odometer over the first K − 1 axes.
+        let mut start = origin;
+        loop {
+            rays.push(Ray::new(start, origin[K - 1] + side));
+            let mut axis = 0;
+            while axis + 1 < K {
+                start[axis] += 1;
+                if start[axis] < origin[axis] + side {
+                    break;
+                }
+                start[axis] = origin[axis];
+                axis += 1;
+            }
+            if axis + 1 >= K {
+                break;
+            }
+        }
+    });
+    RaySet::from_rays(tree.level(), rays).expect("the cells of a tree lie in its universe")
+}
+
+/// Where a grid's voxels are in the world: grid index `i` covers `origin + voxel_size · [i, i + 1)` on each
+/// axis (binvox `translate` and `scale / D`, OctoMap `res`, OpenVDB's linear transform).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridMeta {
+    /// The edge length of a voxel in world units.
+    pub voxel_size: f64,
+    /// The world position of the corner of grid index (0, 0, 0).
+    pub origin: [f64; 3],
+}
+
+impl Default for GridMeta {
+    /// Unit voxels, grid index (0, 0, 0) at the world origin.
+    fn default() -> Self {
+        Self {
+            voxel_size: 1.0,
+            origin: [0.0; 3],
+        }
+    }
+}
+
+/// An octree read from a grid file, with where it was placed and the grid's world metadata.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlacedTree {
+    /// The object.
+    pub tree: KTree<3>,
+    /// ktree voxel = grid index + `placement.offset`, in a universe of level `placement.level`.
+    pub placement: GridPlacement,
+    /// The grid's world metadata.
+    pub meta: GridMeta,
+}
