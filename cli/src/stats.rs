@@ -32,6 +32,8 @@ struct Stats {
     partial: u64,
     nodes: u64,
     bytes_at_2_bits: u64,
+    /// Heap bytes of the navigable tree in memory (states and rank index).
+    memory_bytes: u64,
     per_level: Vec<LevelCounts>,
 }
 
@@ -55,6 +57,7 @@ pub fn run(args: Args) -> Result<(), String> {
         partial: c.partial,
         nodes: c.nodes(),
         bytes_at_2_bits: tree.bytes_at_two_bits(),
+        memory_bytes: tree.heap_bytes() as u64,
         per_level: tree.counts_per_level(),
     };
     if args.json {
@@ -75,6 +78,11 @@ pub fn run(args: Args) -> Result<(), String> {
     println!("partial  {}", stats.partial);
     println!("nodes    {}", stats.nodes);
     println!("bytes    {} (at 2 bits/node)", stats.bytes_at_2_bits);
+    println!(
+        "memory   {} bytes navigable in memory ({:.3} bits/node)",
+        stats.memory_bytes,
+        stats.memory_bytes as f64 * 8.0 / stats.nodes as f64
+    );
     println!("level        full       empty     partial");
     for l in &stats.per_level {
         println!(

@@ -8,17 +8,8 @@ use super::ktree::KTree;
 use super::states::{NodeState, PackedStates};
 use crate::space::{Cell, DimCheck, SpaceError, Universe};
 
-/// Collects a tree from its nodes in depth-first order (children in child-code order).
-///
-/// ```
-/// use ktree::{NodeState, tree::TreeAssembler};
-/// let mut a = TreeAssembler::<1>::new(1).unwrap();
-/// a.push(0, NodeState::Partial);
-/// a.push(1, NodeState::Full);
-/// a.push(1, NodeState::Empty);
-/// let tree = a.finish();
-/// assert!(tree.contains([0]) && !tree.contains([1]));
-/// ```
+/// Collects a tree from its nodes in depth-first order (children in child-code order). The caller
+/// guarantees a complete traversal of a reduced tree.
 #[derive(Debug, Clone)]
 pub struct TreeAssembler<const K: usize> {
     universe: Universe<K>,
@@ -45,14 +36,6 @@ impl<const K: usize> TreeAssembler<K> {
             self.levels.push(PackedStates::new());
         }
         self.levels[depth].push(state);
-    }
-
-    /// Appends `n` consecutive sibling leaves of the same state at `depth`.
-    pub fn push_many(&mut self, depth: usize, state: NodeState, n: usize) {
-        while self.levels.len() <= depth {
-            self.levels.push(PackedStates::new());
-        }
-        self.levels[depth].push_many(state, n);
     }
 
     /// The tree. The caller is responsible for having pushed a complete traversal; [`KTree::check`]
@@ -180,6 +163,17 @@ fn emit_leaves<const K: usize, C: CellKey>(out: &mut TreeAssembler<K>, level: u3
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_depth_first_stream_assembles_into_levels() {
+        let mut a = TreeAssembler::<1>::new(1).unwrap();
+        a.push(0, NodeState::Partial);
+        a.push(1, NodeState::Full);
+        a.push(1, NodeState::Empty);
+        let tree = a.finish();
+        tree.assert_well_formed();
+        assert!(tree.contains([0]) && !tree.contains([1]));
+    }
 
     #[test]
     fn cells_assemble_into_the_expected_quadtree() {

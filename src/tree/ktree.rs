@@ -1,6 +1,7 @@
 //! `KTree<K>`: a compact, pointer-free, navigable k-tree in level order.
 
 use super::states::{NodeState, PackedStates};
+use super::TreeError;
 use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
 
 /// Node counts of one level (or of a whole tree): Meagher's complexity metric.
@@ -27,7 +28,8 @@ impl LevelCounts {
 /// A k-tree over a `K`-dimensional universe of level `L`, stored in level order: level `d` is a packed array
 /// of 2-bit node states ([`NodeState`]); the children of the `i`-th partial node of level `d` are the nodes
 /// `2^K·i … 2^K·i + 2^K − 1` of level `d + 1`, in child-code order (see [`crate::space`]). Navigation needs
-/// only a rank over partial nodes, kept per level (2.25 bits a node in all).
+/// only a rank over partial nodes, kept per level: about 2.07 bits a node in all ([`KTree::heap_bytes`];
+/// see [`PackedStates`]).
 ///
 /// Trees built by this crate are *reduced* (no partial node has children all full or all empty) and so
 /// minimal and canonical: two trees of the same object are equal node for node, and `==` compares objects.
@@ -99,6 +101,28 @@ impl<const K: usize> KTree<K> {
             universe,
             levels: vec![root],
         })
+    }
+
+    /// The tree of the given levels (level 0 holds the root; see [`KTree`] for the layout), checked by
+    /// [`KTree::check`].
+    ///
+    /// ```
+    /// use ktree::{tree::PackedStates, KTree, NodeState};
+    /// // A bintree of level 1: a partial root over a full and an empty voxel.
+    /// let root = PackedStates::from_words(vec![0b10], 1).unwrap();
+    /// let voxels = PackedStates::from_words(vec![0b00_01], 2).unwrap();
+    /// let tree = KTree::<1>::from_level_states(1, vec![root.clone(), voxels]).unwrap();
+    /// assert!(tree.contains([0]) && !tree.contains([1]));
+    /// assert!(KTree::<1>::from_level_states(1, vec![root]).is_err()); // the root's children are missing
+    /// ```
+    ///
+    /// # Errors
+    /// [`TreeError::Space`] for a level beyond [`crate::max_level`], otherwise the first broken invariant.
+    pub fn from_level_states(level: u32, levels: Vec<PackedStates>) -> Result<Self, TreeError> {
+        let () = DimCheck::<K>::OK;
+        let universe = Universe::new(level)?;
+        check_levels::<K>(level, &levels)?;
+        Ok(Self { universe, levels })
     }
 
     /// Assembles a tree from its levels. The caller guarantees the structure (see [`KTree::check`]).
@@ -186,7 +210,8 @@ impl<const K: usize> KTree<K> {
         self.node_count().div_ceil(4)
     }
 
-    /// Bytes of memory held by the tree (packed states and rank indexes).
+    /// Bytes of memory held by the navigable tree: packed states and rank indexes (about 2.07 bits a node on
+    /// large trees), plus the per-level bookkeeping.
     pub fn heap_bytes(&self) -> usize {
         self.levels
             .iter()
@@ -318,51 +343,14 @@ impl<const K: usize> KTree<K> {
         Ok(dense)
     }
 
-    /// Checks the tree's invariants: level sizes match the partial counts above, no partial node at the
-    /// universe level, the last level has no partial node, and the tree is reduced (no partial node whose
-    /// children are all full or all empty).
+    /// Checks the tree's invariants: level 0 holds the root, level sizes match the partial counts above, no
+    /// partial node at the universe level, the last level has no partial node, and the tree is reduced (no
+    /// partial node whose children are all full or all empty). Cost: `O(nodes)`.
     ///
     /// # Errors
-    /// A sentence naming the first broken invariant.
-    pub fn check(&self) -> Result<(), String> {
-        let level = self.level() as usize;
-        if self.levels.is_empty() || self.levels[0].len() != 1 {
-            return Err("level 0 must hold exactly the root".into());
-        }
-        if self.levels.len() > level + 1 {
-            return Err(format!(
-                "{} levels stored for a level-{level} universe",
-                self.levels.len()
-            ));
-        }
-        for depth in 0..self.levels.len() {
-            let partial = self.levels[depth].partial_count();
-            let next = self.levels.get(depth + 1).map_or(0, |l| l.len());
-            if next != partial << K {
-                return Err(format!(
-                    "level {depth} has {partial} partial nodes but level {} has {next} nodes",
-                    depth + 1
-                ));
-            }
-            if partial > 0 && depth == level {
-                return Err(format!("partial nodes at the voxel level {depth}"));
-            }
-        }
-        for depth in 1..self.levels.len() {
-            let l = &self.levels[depth];
-            for block in 0..l.len() >> K {
-                let first = l.get(block << K);
-                if first != NodeState::Partial
-                    && (1..Self::FANOUT).all(|c| l.get((block << K) + c) == first)
-                {
-                    return Err(format!(
-                        "not reduced: the children of partial node {block} of level {} are all {first:?}",
-                        depth - 1
-                    ));
-                }
-            }
-        }
-        Ok(())
+    /// The first broken invariant.
+    pub fn check(&self) -> Result<(), TreeError> {
+        check_levels::<K>(self.level(), &self.levels)
     }
 
     /// Panics with a readable message unless [`KTree::check`] passes. Property tests call it after every
@@ -398,4 +386,48 @@ pub(crate) fn fill_cell<const K: usize>(universe: &Universe<K>, dense: &mut [boo
             axis += 1;
         }
     }
+}
+
+/// [`KTree::check`] on raw levels.
+fn check_levels<const K: usize>(level: u32, levels: &[PackedStates]) -> Result<(), TreeError> {
+    if levels.is_empty() || levels[0].len() != 1 {
+        return Err(TreeError::Root {
+            nodes: levels.first().map_or(0, PackedStates::len),
+        });
+    }
+    if levels.len() > level as usize + 1 {
+        return Err(TreeError::TooDeep {
+            levels: levels.len(),
+            level,
+        });
+    }
+    for depth in 0..levels.len() {
+        let partial = levels[depth].partial_count();
+        let next = levels.get(depth + 1).map_or(0, PackedStates::len);
+        if partial > 0 && depth == level as usize {
+            return Err(TreeError::PartialVoxel { depth });
+        }
+        if partial.checked_shl(K as u32) != Some(next) || partial > usize::MAX >> K {
+            return Err(TreeError::LevelSize {
+                depth,
+                partial,
+                next,
+            });
+        }
+    }
+    for (depth, l) in levels.iter().enumerate().skip(1) {
+        for block in 0..l.len() >> K {
+            let first = l.get(block << K);
+            if first != NodeState::Partial
+                && (1..1usize << K).all(|c| l.get((block << K) + c) == first)
+            {
+                return Err(TreeError::NotReduced {
+                    depth: depth - 1,
+                    index: block,
+                    state: first,
+                });
+            }
+        }
+    }
+    Ok(())
 }

@@ -2,9 +2,11 @@
 //! stream of nodes or from full cells.
 
 mod assemble;
+mod error;
 mod ktree;
 mod states;
 
-pub use assemble::TreeAssembler;
+pub(crate) use assemble::TreeAssembler;
+pub use error::TreeError;
 pub use ktree::{Bintree, KTree, LevelCounts, NodeRef, Octree, Quadtree, Tree4};
 pub use states::{NodeState, PackedStates};
