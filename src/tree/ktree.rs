@@ -2,6 +2,7 @@
 
 use super::states::{NodeState, PackedStates};
 use super::TreeError;
+use crate::rays::RaySet;
 use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
 
 /// Node counts of one level (or of a whole tree): Meagher's complexity metric.
@@ -44,6 +45,24 @@ impl LevelCounts {
 /// assert_eq!(tree.node_count(), 5);
 /// assert!(tree.contains([1, 1]) && !tree.contains([2, 1]));
 /// assert_eq!(tree.to_dense().unwrap(), dense);
+/// ```
+///
+/// The Boolean operations of [`crate::ops`] are also operators on `&KTree`: `|` (union), `&`
+/// (intersection), `-` (difference), `^` (symmetric difference) give a `Result`, as trees of universes of
+/// different levels do not combine (an [`crate::ops::OpsError::LevelMismatch`], not a panic); `!` is the
+/// complement.
+///
+/// ```
+/// use ktree::KTree;
+/// let a = KTree::<1>::from_dense(2, &[true, true, false, false]).unwrap();
+/// let b = KTree::<1>::from_dense(2, &[false, true, true, false]).unwrap();
+/// assert_eq!((&a | &b)?.to_dense()?, [true, true, true, false]);
+/// assert_eq!((&a & &b)?.to_dense()?, [false, true, false, false]);
+/// assert_eq!((&a - &b)?.to_dense()?, [true, false, false, false]);
+/// assert_eq!((&a ^ &b)?.to_dense()?, [true, false, true, false]);
+/// assert_eq!((!&a).to_dense()?, [false, false, true, true]);
+/// assert!((&a | &KTree::<1>::full(3)?).is_err()); // another universe
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct KTree<const K: usize> {
@@ -128,6 +147,19 @@ impl<const K: usize> KTree<K> {
     /// Assembles a tree from its levels. The caller guarantees the structure (see [`KTree::check`]).
     pub(crate) fn from_levels(universe: Universe<K>, levels: Vec<PackedStates>) -> Self {
         Self { universe, levels }
+    }
+
+    /// The tree of a ray set, by stacking ([`crate::stacking::stack`]); also `KTree::from(&rays)`.
+    ///
+    /// ```
+    /// use ktree::{KTree, Ray, RaySet};
+    /// let rays = RaySet::<2>::from_rays(3, [Ray::new([0, 0], 8)]).unwrap();
+    /// let tree = KTree::from_rays(&rays);
+    /// assert_eq!(tree.voxel_count(), 8);
+    /// assert_eq!(tree, KTree::from(&rays));
+    /// ```
+    pub fn from_rays(rays: &RaySet<K>) -> Self {
+        crate::stacking::stack(rays)
     }
 
     /// The universe.
@@ -273,39 +305,32 @@ impl<const K: usize> KTree<K> {
         unreachable!("a well-formed tree ends in leaves")
     }
 
-    /// Visits every leaf (empty and full) in Morton (depth-first) order.
+    /// Visits every leaf (empty and full) in Morton (depth-first) order: [`KTree::leaves`] as a callback.
     pub fn for_each_leaf(&self, mut visit: impl FnMut(Cell<K>, NodeState)) {
-        let mut stack = vec![(self.universe.root(), 0usize)];
-        while let Some((cell, index)) = stack.pop() {
-            let depth = cell.level as usize;
-            match self.levels[depth].get(index) {
-                NodeState::Partial => {
-                    let first = self.first_child(depth, index);
-                    for code in (0..Self::FANOUT).rev() {
-                        stack.push((cell.child(code), first + code));
-                    }
-                }
-                state => visit(cell, state),
-            }
+        for (cell, state) in self.leaves() {
+            visit(cell, state);
         }
     }
 
-    /// All leaves with their states, in Morton order.
-    pub fn leaves(&self) -> Vec<(Cell<K>, NodeState)> {
-        let mut out = Vec::new();
-        self.for_each_leaf(|c, s| out.push((c, s)));
-        out
+    /// All leaves with their states, in Morton (depth-first) order.
+    ///
+    /// ```
+    /// use ktree::{KTree, NodeState};
+    /// let tree = KTree::<1>::from_dense(2, &[true, true, false, true]).unwrap();
+    /// let states: Vec<NodeState> = tree.leaves().map(|(_, s)| s).collect();
+    /// assert_eq!(states, [NodeState::Full, NodeState::Empty, NodeState::Full]);
+    /// ```
+    pub fn leaves(&self) -> Leaves<'_, K> {
+        Leaves {
+            tree: self,
+            stack: vec![(self.universe.root(), 0)],
+        }
     }
 
     /// The full leaves in Morton order: the linear tree (Gargantini) of the object.
-    pub fn full_cells(&self) -> Vec<Cell<K>> {
-        let mut out = Vec::new();
-        self.for_each_leaf(|c, s| {
-            if s == NodeState::Full {
-                out.push(c)
-            }
-        });
-        out
+    pub fn full_cells(&self) -> impl Iterator<Item = Cell<K>> + '_ {
+        self.leaves()
+            .filter_map(|(cell, state)| (state == NodeState::Full).then_some(cell))
     }
 
     /// The number of voxels inside the object.
@@ -359,6 +384,41 @@ impl<const K: usize> KTree<K> {
         if let Err(e) = self.check() {
             panic!("malformed KTree<{K}> (level {}): {e}", self.level());
         }
+    }
+}
+
+impl<const K: usize> From<&RaySet<K>> for KTree<K> {
+    /// [`KTree::from_rays`].
+    fn from(rays: &RaySet<K>) -> Self {
+        Self::from_rays(rays)
+    }
+}
+
+/// The leaves of a tree in Morton order, with their cells: see [`KTree::leaves`].
+#[derive(Debug, Clone)]
+pub struct Leaves<'a, const K: usize> {
+    tree: &'a KTree<K>,
+    /// Nodes still to visit (cell and index in its level), the next on top.
+    stack: Vec<(Cell<K>, usize)>,
+}
+
+impl<const K: usize> Iterator for Leaves<'_, K> {
+    type Item = (Cell<K>, NodeState);
+
+    fn next(&mut self) -> Option<Self::Item> {
+        while let Some((cell, index)) = self.stack.pop() {
+            let depth = cell.level as usize;
+            match self.tree.levels[depth].get(index) {
+                NodeState::Partial => {
+                    let first = self.tree.first_child(depth, index);
+                    for code in (0..KTree::<K>::FANOUT).rev() {
+                        self.stack.push((cell.child(code), first + code));
+                    }
+                }
+                state => return Some((cell, state)),
+            }
+        }
+        None
     }
 }
 
