@@ -45,9 +45,9 @@ const LOW_BITS: u64 = 0x5555_5555_5555_5555;
 /// nodes so that the rank of a node (the partial nodes before it) is found in constant time.
 ///
 /// The rank index holds a 64-bit count every 65 536 nodes and a 16-bit count (relative to that) every 256
-/// nodes: 2 + 16/256 + 64/65 536 ≈ 2.064 bits a node in all (measured: 2.07 bits a node for octrees of a
-/// million nodes and more, see `results/performance/build.md`). A rank reads the two counts and at most
-/// eight words, counted in parallel.
+/// nodes: 2 + 16/256 + 64/65 536 ≈ 2.064 bits a node in all. Measured with the per-level bookkeeping: 2.070
+/// bits a node for an octree of 1.9 million nodes, 2.065 for 7.5 million (`results/performance/build.md`).
+/// A rank reads the two counts and at most eight words, counted in parallel.
 ///
 /// Levels are built inside the crate; outside it, [`PackedStates::from_words`] checks raw words and
 /// [`crate::KTree::from_level_states`] checks a whole tree.
