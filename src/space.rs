@@ -225,18 +225,55 @@ impl<const K: usize> Universe<K> {
 pub const DENSE_LIMIT: u128 = 1 << 30;
 
 /// An aligned cell of a universe: a cube of side `2^(L − level)` whose origin is a multiple of its side.
-/// Level 0 is the whole universe, level `L` a voxel.
+/// Level 0 is the whole universe, level `L` a voxel. Made by [`Universe::cell`] (checked) or by navigating a
+/// tree, so a cell is always aligned and inside its universe.
+///
+/// ```
+/// use ktree::Universe;
+/// let u = Universe::<2>::new(3).unwrap();
+/// let c = u.cell([4, 0], 1).unwrap();
+/// assert_eq!((c.origin(), c.level(), c.side()), ([4, 0], 1, 4));
+/// assert!(u.cell([2, 0], 1).is_err()); // not aligned
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Cell<const K: usize> {
     /// The corner with the smallest coordinates.
-    pub origin: [u32; K],
+    pub(crate) origin: [u32; K],
     /// Depth in the tree (0 = root).
-    pub level: u32,
+    pub(crate) level: u32,
     /// log2 of the side: `L − level`.
-    pub log_side: u32,
+    pub(crate) log_side: u32,
 }
 
 impl<const K: usize> Cell<K> {
+    /// The aligned cell at `level` with the given origin in `universe` (the same as [`Universe::cell`]).
+    ///
+    /// # Errors
+    /// As [`Universe::cell`].
+    pub fn new(universe: Universe<K>, origin: [u32; K], level: u32) -> Result<Self, SpaceError> {
+        universe.cell(origin, level)
+    }
+
+    /// The corner with the smallest coordinates.
+    pub fn origin(&self) -> [u32; K] {
+        self.origin
+    }
+
+    /// The depth in the tree (0 = the root, the whole universe).
+    pub fn level(&self) -> u32 {
+        self.level
+    }
+
+    /// log2 of the side: `L − level`.
+    pub fn log_side(&self) -> u32 {
+        self.log_side
+    }
+
+    /// The level `L` of the universe the cell belongs to.
+    pub fn universe_level(&self) -> u32 {
+        self.level + self.log_side
+    }
+
     /// The side length in voxels.
     pub fn side(&self) -> u64 {
         1u64 << self.log_side

@@ -56,7 +56,7 @@ fn report<const K: usize>(
     Ok(Report {
         min_separation,
         collide,
-        overlap_cells: overlap.full_cells().len(),
+        overlap_cells: overlap.full_cells().count(),
         overlap_voxels: overlap.voxel_count(),
         first_contact,
     })

@@ -227,7 +227,7 @@ pub fn run(args: Args) -> Result<(), String> {
             println!(
                 "wrote {} (quadtree, {} leaves)",
                 out.display(),
-                tree.leaves().len()
+                tree.leaves().count()
             );
         }
         AnyTree::K4(tree) => {

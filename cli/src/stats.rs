@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, VERSION_2};
+use ktree::tree::heap_bytes_for_levels;
 use ktree::LevelCounts;
 use serde::Serialize;
 
@@ -33,6 +34,8 @@ struct Stats {
     partial: u64,
     nodes: u64,
     bytes_at_2_bits: u64,
+    /// Heap bytes of the navigable tree in memory (states and rank index).
+    memory_bytes: u64,
     per_level: Vec<LevelCounts>,
 }
 
@@ -42,6 +45,7 @@ impl Stats {
         rays: Option<u64>,
         c: LevelCounts,
         bytes: u64,
+        memory_bytes: u64,
         per_level: Vec<LevelCounts>,
     ) -> Self {
         Self {
@@ -53,6 +57,7 @@ impl Stats {
             partial: c.partial,
             nodes: c.nodes(),
             bytes_at_2_bits: bytes,
+            memory_bytes,
             per_level,
         }
     }
@@ -68,6 +73,7 @@ pub fn run(args: Args) -> Result<(), String> {
                 None,
                 view.counts(),
                 view.bytes_at_two_bits(),
+                heap_bytes_for_levels(&view.counts_per_level()) as u64,
                 view.counts_per_level(),
             )
         }
@@ -78,6 +84,7 @@ pub fn run(args: Args) -> Result<(), String> {
                 None,
                 tree.counts(),
                 tree.bytes_at_two_bits(),
+                tree.heap_bytes() as u64,
                 tree.counts_per_level(),
             )
         }
@@ -90,6 +97,7 @@ pub fn run(args: Args) -> Result<(), String> {
                 n,
                 tree.counts(),
                 tree.bytes_at_two_bits(),
+                tree.heap_bytes() as u64,
                 tree.counts_per_level(),
             )
         }
@@ -113,6 +121,11 @@ pub fn run(args: Args) -> Result<(), String> {
     println!("partial  {}", stats.partial);
     println!("nodes    {}", stats.nodes);
     println!("bytes    {} (at 2 bits/node)", stats.bytes_at_2_bits);
+    println!(
+        "memory   {} bytes navigable in memory ({:.3} bits/node)",
+        stats.memory_bytes,
+        stats.memory_bytes as f64 * 8.0 / stats.nodes as f64
+    );
     println!("level        full       empty     partial");
     for l in &stats.per_level {
         println!(

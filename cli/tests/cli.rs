@@ -83,3 +83,22 @@ fn bad_input_is_one_line_and_non_zero() {
     let (ok, _, _) = ktree(&["build", "--rays", &bad, "--out", &out.display().to_string()]);
     assert!(!ok && !out.exists());
 }
+
+#[test]
+fn stats_reports_the_navigable_tree_at_under_2_1_bits_a_node() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ball9.rays");
+    let rays = ktree::rays::ball_rays::<3>(9, [512, 512, 512], 512).unwrap();
+    ktree::io::write_rays_file(&path, &rays).unwrap();
+    let (ok, out, err) = ktree(&["stats", "--rays", &path.display().to_string(), "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let nodes = v["nodes"].as_u64().unwrap();
+    let memory = v["memory_bytes"].as_u64().unwrap();
+    assert!(nodes > 1_000_000, "{nodes} nodes");
+    assert!(
+        memory * 8 <= nodes * 21 / 10 + 8 * 4096,
+        "{memory} bytes for {nodes} nodes"
+    );
+    assert!(memory >= v["bytes_at_2_bits"].as_u64().unwrap());
+}

@@ -87,7 +87,7 @@ pub fn child_at<const K: usize>(near: usize, j: usize, order: Order) -> usize {
 ///     full += usize::from(n.state == ktree::NodeState::Full);
 ///     Walk::Descend
 /// });
-/// assert_eq!(full, tree.full_cells().len());
+/// assert_eq!(full, tree.full_cells().count());
 /// ```
 pub fn walk_ordered<const K: usize>(
     tree: &KTree<K>,

@@ -73,6 +73,11 @@ impl AnyTree {
     pub fn bytes_at_two_bits(&self) -> u64 {
         with_dim!(self, AnyTree, t => t.bytes_at_two_bits())
     }
+
+    /// Bytes of memory held by the navigable tree (see [`crate::KTree::heap_bytes`]).
+    pub fn heap_bytes(&self) -> usize {
+        with_dim!(self, AnyTree, t => t.heap_bytes())
+    }
 }
 
 impl AnyRaySet {

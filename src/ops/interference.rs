@@ -43,7 +43,7 @@ fn meet<const K: usize>(a: &KTree<K>, b: &KTree<K>, depth: usize, ia: usize, ib:
 /// # Errors
 /// [`OpsError::LevelMismatch`].
 pub fn overlap_cells<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Vec<Cell<K>>, OpsError> {
-    Ok(intersection(a, b)?.full_cells())
+    Ok(intersection(a, b)?.full_cells().collect())
 }
 
 /// For trees whose axis `time_axis` is time (e.g. 4-D space-time trees `(x, y, z, t)`): the first time

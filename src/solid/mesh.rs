@@ -40,13 +40,21 @@ pub const MAX_LEVEL: u32 = 20;
 /// Placed coordinates must lie within ±2^22 voxels (keeps every product inside `i128`).
 const LIMIT: f64 = (1u64 << 22) as f64;
 
-/// A triangle mesh: vertex positions and triangles as vertex indices.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// A triangle mesh: vertex positions and triangles as vertex indices, checked when made (finite vertices,
+/// indices in range, at least one triangle).
+///
+/// ```
+/// use ktree::solid::mesh::TriangleMesh;
+/// let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let t = vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+/// let tetrahedron = TriangleMesh::new(v.clone(), t).unwrap();
+/// assert!((tetrahedron.signed_volume() - 1.0 / 6.0).abs() < 1e-12);
+/// assert!(TriangleMesh::new(v, vec![[0, 1, 4]]).is_err()); // no vertex 4
+/// ```
+#[derive(Debug, Clone, PartialEq)]
 pub struct TriangleMesh {
-    /// Vertex positions.
-    pub vertices: Vec<[f64; 3]>,
-    /// Triangles, three indices into `vertices` each, counter-clockwise seen from outside.
-    pub triangles: Vec<[u32; 3]>,
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
 }
 
 /// Where a mesh goes in the universe: voxel coordinate = `scale · v + translate`.
@@ -85,13 +93,13 @@ impl Placement {
     /// Uniform scale and centring of `mesh` into a universe of level `level`, one voxel of margin each side.
     ///
     /// # Errors
-    /// [`SolidError::BadParameter`] for an empty or flat mesh.
+    /// [`SolidError::Space`] for a bad level; [`SolidError::BadParameter`] for an empty or flat mesh.
     pub fn fit(mesh: &TriangleMesh, level: u32) -> Result<Self, SolidError> {
         let (lo, hi) = mesh
             .bounds()
             .ok_or_else(|| SolidError::BadParameter("the mesh has no vertex".into()))?;
         let extent = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
-        let side = (1u64 << level) as f64;
+        let side = Universe::<3>::new(level)?.side() as f64;
         if extent.is_nan() || extent <= 0.0 || side <= 2.0 {
             return Err(SolidError::BadParameter(
                 "cannot fit: the mesh has no extent or the universe is smaller than 4 voxels"
@@ -162,7 +170,10 @@ impl TriangleMesh {
                         Err(tobj::LoadError::OpenFileFailed)
                     })
                     .map_err(|e| parse(format!("OBJ: {e}")))?;
-                let mut mesh = Self::default();
+                let mut mesh = Self {
+                    vertices: Vec::new(),
+                    triangles: Vec::new(),
+                };
                 for m in models {
                     let base = mesh.vertices.len() as u32;
                     let p = &m.mesh.positions;
@@ -198,8 +209,32 @@ impl TriangleMesh {
                 )))
             }
         };
-        mesh.validate().map_err(parse)?;
+        Self::new(mesh.vertices, mesh.triangles).map_err(|e| parse(e.to_string()))
+    }
+
+    /// A mesh of `vertices` and `triangles` (three indices into `vertices` each, counter-clockwise seen from
+    /// outside).
+    ///
+    /// # Errors
+    /// [`SolidError::BadParameter`] when a vertex is not finite, a triangle refers to a missing vertex, or
+    /// there is no triangle.
+    pub fn new(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Result<Self, SolidError> {
+        let mesh = Self {
+            vertices,
+            triangles,
+        };
+        mesh.validate().map_err(SolidError::BadParameter)?;
         Ok(mesh)
+    }
+
+    /// The vertex positions.
+    pub fn vertices(&self) -> &[[f64; 3]] {
+        &self.vertices
+    }
+
+    /// The triangles, three indices into [`TriangleMesh::vertices`] each.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
     }
 
     fn validate(&self) -> Result<(), String> {
@@ -453,7 +488,10 @@ fn read_ply(path: &Path) -> Result<TriangleMesh, String> {
             _ => return None,
         })
     };
-    let mut mesh = TriangleMesh::default();
+    let mut mesh = TriangleMesh {
+        vertices: Vec::new(),
+        triangles: Vec::new(),
+    };
     let vertices = ply
         .payload
         .get("vertex")

@@ -33,15 +33,21 @@ impl Select {
     }
 }
 
-/// A dense scalar volume, samples x fastest.
+/// A dense scalar volume, samples x fastest; its shape and samples are checked to agree when made.
+///
+/// ```
+/// use ktree::solid::volume::{Select, Volume};
+/// let v = Volume::new([2, 1, 3], vec![0.0, 9.0, 0.0, 9.0, 9.0, 9.0], [1.0; 3]).unwrap();
+/// assert_eq!(v.count(Select::AtLeast(5.0)), 4);
+/// let rays = v.to_rays(2, [0, 0, 0], Select::AtLeast(5.0)).unwrap();
+/// assert_eq!(rays.voxel_count(), 4);
+/// assert!(Volume::new([2, 2, 2], vec![0.0; 7], [1.0; 3]).is_err());
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Volume {
-    /// Samples along x, y, z.
-    pub shape: [usize; 3],
-    /// The samples (converted to `f64`), `offset = x + nx·(y + ny·z)`.
-    pub values: Vec<f64>,
-    /// Voxel size in mm where known (informative only).
-    pub spacing: [f64; 3],
+    shape: [usize; 3],
+    values: Vec<f64>,
+    spacing: [f64; 3],
 }
 
 #[derive(Deserialize)]
@@ -199,6 +205,44 @@ impl Volume {
             values,
             spacing: [f64::from(pix[1]), f64::from(pix[2]), f64::from(pix[3])],
         })
+    }
+
+    /// A volume of `shape` samples along x, y, z, `values` x fastest (`offset = x + nx·(y + ny·z)`), voxel
+    /// size `spacing` (informative only).
+    ///
+    /// # Errors
+    /// [`SolidError::BadParameter`] when the shape is empty or beyond 2^20 samples an axis or 2^31 in all,
+    /// or `values` does not hold exactly one sample per voxel of the shape.
+    pub fn new(shape: [usize; 3], values: Vec<f64>, spacing: [f64; 3]) -> Result<Self, SolidError> {
+        let n = checked_samples(shape).ok_or_else(|| {
+            SolidError::BadParameter(format!("volume shape {shape:?} is empty or too large"))
+        })?;
+        if values.len() != n {
+            return Err(SolidError::BadParameter(format!(
+                "volume shape {shape:?} needs {n} samples, {} given",
+                values.len()
+            )));
+        }
+        Ok(Self {
+            shape,
+            values,
+            spacing,
+        })
+    }
+
+    /// Samples along x, y, z.
+    pub fn shape(&self) -> [usize; 3] {
+        self.shape
+    }
+
+    /// The samples (converted to `f64`), x fastest: `offset = x + nx·(y + ny·z)`.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// Voxel size in mm where known (informative only).
+    pub fn spacing(&self) -> [f64; 3] {
+        self.spacing
     }
 
     /// The number of selected samples.

@@ -575,7 +575,7 @@ mod tests {
         let (tree, stats) = stack_with_stats(&rays3(3, &rays));
         assert_eq!(stats.combined[1][1], 1);
         assert_eq!(stats.cells, 1);
-        assert_eq!(tree.full_cells()[0].side(), 4);
+        assert_eq!(tree.full_cells().next().unwrap().side(), 4);
         // Shifted by one along x: the squares cannot combine and are split.
         let shifted: Vec<_> = rays
             .iter()

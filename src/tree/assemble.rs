@@ -6,19 +6,11 @@
 
 use super::ktree::KTree;
 use super::states::{NodeState, PackedStates};
+use super::TreeError;
 use crate::space::{Cell, DimCheck, SpaceError, Universe};
 
-/// Collects a tree from its nodes in depth-first order (children in child-code order).
-///
-/// ```
-/// use ktree::{NodeState, tree::TreeAssembler};
-/// let mut a = TreeAssembler::<1>::new(1).unwrap();
-/// a.push(0, NodeState::Partial);
-/// a.push(1, NodeState::Full);
-/// a.push(1, NodeState::Empty);
-/// let tree = a.finish();
-/// assert!(tree.contains([0]) && !tree.contains([1]));
-/// ```
+/// Collects a tree from its nodes in depth-first order (children in child-code order). The caller
+/// guarantees a complete traversal of a reduced tree.
 #[derive(Debug, Clone)]
 pub struct TreeAssembler<const K: usize> {
     universe: Universe<K>,
@@ -47,14 +39,6 @@ impl<const K: usize> TreeAssembler<K> {
         self.levels[depth].push(state);
     }
 
-    /// Appends `n` consecutive sibling leaves of the same state at `depth`.
-    pub fn push_many(&mut self, depth: usize, state: NodeState, n: usize) {
-        while self.levels.len() <= depth {
-            self.levels.push(PackedStates::new());
-        }
-        self.levels[depth].push_many(state, n);
-    }
-
     /// The tree. The caller is responsible for having pushed a complete traversal; [`KTree::check`]
     /// verifies it.
     pub fn finish(mut self) -> KTree<K> {
@@ -69,19 +53,88 @@ impl<const K: usize> TreeAssembler<K> {
 }
 
 impl<const K: usize> KTree<K> {
+    /// The tree whose full voxels are those of `cells` (in any order, disjoint, all of `universe`).
+    /// Complete groups of `2^K` sibling cells are merged, so the tree is reduced.
+    ///
+    /// ```
+    /// use ktree::{KTree, Universe};
+    /// let u = Universe::<2>::new(2).unwrap();
+    /// let voxels = [[2, 2], [3, 2], [2, 3], [3, 3], [0, 0]].map(|p| u.cell(p, 2).unwrap());
+    /// let tree = KTree::from_cells(u, &voxels).unwrap();
+    /// assert_eq!(tree.voxel_count(), 5);
+    /// assert_eq!(tree.full_cells().count(), 2); // the four siblings are one cell
+    /// assert!(KTree::from_cells(u, &[u.root(), voxels[0]]).is_err()); // overlapping
+    /// ```
+    ///
+    /// Cost: `O(cells · log cells + nodes)`.
+    ///
+    /// # Errors
+    /// [`TreeError::CellUniverse`] for a cell of another universe, [`TreeError::CellOrder`] for overlapping
+    /// cells.
+    pub fn from_cells(universe: Universe<K>, cells: &[Cell<K>]) -> Result<KTree<K>, TreeError> {
+        let level = universe.level();
+        if let Some(index) = cells.iter().position(|c| c.universe_level() != level) {
+            return Err(TreeError::CellUniverse {
+                index,
+                expected: level,
+                found: cells[index].universe_level(),
+            });
+        }
+        let mut order: Vec<usize> = (0..cells.len()).collect();
+        order.sort_unstable_by_key(|&i| (cells[i].morton(), cells[i].level));
+        let k = K as u32;
+        let mut merged: Vec<(u64, u32)> = Vec::with_capacity(cells.len());
+        let mut end = 0u128;
+        for &i in &order {
+            let c = cells[i];
+            let at = u128::from(c.morton());
+            if at < end {
+                return Err(TreeError::CellOrder { index: i });
+            }
+            end = at + c.volume();
+            merged.push((c.morton(), c.level));
+            // Merge complete sibling groups: the last 2^K cells at one level, of one parent, in order.
+            while let Some(&(key, depth)) = merged.last() {
+                let n = merged.len();
+                if depth == 0 || n < Self::FANOUT {
+                    break;
+                }
+                let step = 1u64 << (k * (level - depth));
+                let Some(first) = key.checked_sub(step * (Self::FANOUT as u64 - 1)) else {
+                    break;
+                };
+                let parent_aligned = u128::from(first) % (u128::from(step) << k) == 0;
+                let group = &merged[n - Self::FANOUT..];
+                let complete = parent_aligned
+                    && group
+                        .iter()
+                        .enumerate()
+                        .all(|(j, &(kj, dj))| dj == depth && kj == first + step * j as u64);
+                if !complete {
+                    break;
+                }
+                merged.truncate(n - Self::FANOUT);
+                merged.push((first, depth - 1));
+            }
+        }
+        let tree = Self::from_sorted_morton(universe, &merged);
+        tree.check()?;
+        Ok(tree)
+    }
+
     /// The tree whose full leaves are exactly `cells`, which must be disjoint, inside `universe` and sorted
     /// by Morton key of their origins ([`Cell::morton`]). Every ancestor of a cell is partial; all other
     /// nodes are empty leaves. If the cells are maximal (no `2^K` sibling cells are all given), the tree is
     /// reduced; otherwise [`KTree::check`] reports it.
     ///
     /// Cost: `O(cells · L)`.
-    pub fn from_sorted_cells(universe: Universe<K>, cells: &[Cell<K>]) -> KTree<K> {
+    pub(crate) fn from_sorted_cells(universe: Universe<K>, cells: &[Cell<K>]) -> KTree<K> {
         let keys: Vec<(u64, u32)> = cells.iter().map(|c| (c.morton(), c.level)).collect();
         Self::from_sorted_morton(universe, &keys)
     }
 
     /// Like [`KTree::from_sorted_cells`], with each cell given as `(Morton key of its origin, level)`.
-    pub fn from_sorted_morton(universe: Universe<K>, cells: &[(u64, u32)]) -> KTree<K> {
+    pub(crate) fn from_sorted_morton(universe: Universe<K>, cells: &[(u64, u32)]) -> KTree<K> {
         let mut out = TreeAssembler::<K> {
             universe,
             levels: Vec::new(),
@@ -92,7 +145,7 @@ impl<const K: usize> KTree<K> {
 
     /// Like [`KTree::from_sorted_morton`], with each cell packed as `Morton key << 5 | level` (needs
     /// `K·L + 5 ≤ 64`); sorting such packed values sorts the cells.
-    pub fn from_sorted_packed(universe: Universe<K>, cells: &[u64]) -> KTree<K> {
+    pub(crate) fn from_sorted_packed(universe: Universe<K>, cells: &[u64]) -> KTree<K> {
         debug_assert!(K as u32 * universe.level() + 5 <= 64);
         let mut out = TreeAssembler::<K> {
             universe,
@@ -182,6 +235,17 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_depth_first_stream_assembles_into_levels() {
+        let mut a = TreeAssembler::<1>::new(1).unwrap();
+        a.push(0, NodeState::Partial);
+        a.push(1, NodeState::Full);
+        a.push(1, NodeState::Empty);
+        let tree = a.finish();
+        tree.assert_well_formed();
+        assert!(tree.contains([0]) && !tree.contains([1]));
+    }
+
+    #[test]
     fn cells_assemble_into_the_expected_quadtree() {
         let u = Universe::<2>::new(2).unwrap();
         let mut cells = vec![u.cell([0, 0], 1).unwrap(), u.cell([3, 3], 2).unwrap()];
@@ -190,7 +254,27 @@ mod tests {
         t.assert_well_formed();
         assert_eq!(t.node_count(), 1 + 4 + 4);
         assert_eq!(t.voxel_count(), 5);
-        assert_eq!(t.full_cells(), cells);
+        assert_eq!(t.full_cells().collect::<Vec<_>>(), cells);
+    }
+
+    #[test]
+    fn from_cells_merges_siblings_and_rejects_overlaps() {
+        let u = Universe::<1>::new(3).unwrap();
+        let c = |x, l| u.cell([x], l).unwrap();
+        let t = KTree::from_cells(u, &[c(1, 3), c(0, 3), c(2, 2), c(6, 3)]).unwrap();
+        assert_eq!(t.full_cells().collect::<Vec<_>>(), [c(0, 1), c(6, 3)]);
+        assert_eq!(
+            KTree::from_cells(u, &[c(0, 1), c(2, 3)]),
+            Err(TreeError::CellOrder { index: 1 })
+        );
+        let other = Universe::<1>::new(2).unwrap().cell([0], 1).unwrap();
+        assert!(matches!(
+            KTree::from_cells(u, &[other]),
+            Err(TreeError::CellUniverse { index: 0, .. })
+        ));
+        assert_eq!(KTree::from_cells(u, &[]).unwrap(), KTree::empty(3).unwrap());
+        let all: Vec<_> = (0..8).map(|x| c(x, 3)).collect();
+        assert_eq!(KTree::from_cells(u, &all).unwrap(), KTree::full(3).unwrap());
     }
 
     #[test]

@@ -1,6 +1,8 @@
 //! `KTree<K>`: a compact, pointer-free, navigable k-tree in level order.
 
 use super::states::{NodeState, PackedStates};
+use super::TreeError;
+use crate::rays::RaySet;
 use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
 
 /// Node counts of one level (or of a whole tree): Meagher's complexity metric.
@@ -27,7 +29,8 @@ impl LevelCounts {
 /// A k-tree over a `K`-dimensional universe of level `L`, stored in level order: level `d` is a packed array
 /// of 2-bit node states ([`NodeState`]); the children of the `i`-th partial node of level `d` are the nodes
 /// `2^K·i … 2^K·i + 2^K − 1` of level `d + 1`, in child-code order (see [`crate::space`]). Navigation needs
-/// only a rank over partial nodes, kept per level (2.25 bits a node in all).
+/// only a rank over partial nodes, kept per level: about 2.07 bits a node in all ([`KTree::heap_bytes`];
+/// see [`PackedStates`]).
 ///
 /// Trees built by this crate are *reduced* (no partial node has children all full or all empty) and so
 /// minimal and canonical: two trees of the same object are equal node for node, and `==` compares objects.
@@ -42,6 +45,24 @@ impl LevelCounts {
 /// assert_eq!(tree.node_count(), 5);
 /// assert!(tree.contains([1, 1]) && !tree.contains([2, 1]));
 /// assert_eq!(tree.to_dense().unwrap(), dense);
+/// ```
+///
+/// The Boolean operations of [`crate::ops`] are also operators on `&KTree`: `|` (union), `&`
+/// (intersection), `-` (difference), `^` (symmetric difference) give a `Result`, as trees of universes of
+/// different levels do not combine (an [`crate::ops::OpsError::LevelMismatch`], not a panic); `!` is the
+/// complement.
+///
+/// ```
+/// use ktree::KTree;
+/// let a = KTree::<1>::from_dense(2, &[true, true, false, false]).unwrap();
+/// let b = KTree::<1>::from_dense(2, &[false, true, true, false]).unwrap();
+/// assert_eq!((&a | &b)?.to_dense()?, [true, true, true, false]);
+/// assert_eq!((&a & &b)?.to_dense()?, [false, true, false, false]);
+/// assert_eq!((&a - &b)?.to_dense()?, [true, false, false, false]);
+/// assert_eq!((&a ^ &b)?.to_dense()?, [true, false, true, false]);
+/// assert_eq!((!&a).to_dense()?, [false, false, true, true]);
+/// assert!((&a | &KTree::<1>::full(3)?).is_err()); // another universe
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct KTree<const K: usize> {
@@ -101,9 +122,44 @@ impl<const K: usize> KTree<K> {
         })
     }
 
+    /// The tree of the given levels (level 0 holds the root; see [`KTree`] for the layout), checked by
+    /// [`KTree::check`].
+    ///
+    /// ```
+    /// use ktree::{tree::PackedStates, KTree, NodeState};
+    /// // A bintree of level 1: a partial root over a full and an empty voxel.
+    /// let root = PackedStates::from_words(vec![0b10], 1).unwrap();
+    /// let voxels = PackedStates::from_words(vec![0b00_01], 2).unwrap();
+    /// let tree = KTree::<1>::from_level_states(1, vec![root.clone(), voxels]).unwrap();
+    /// assert!(tree.contains([0]) && !tree.contains([1]));
+    /// assert!(KTree::<1>::from_level_states(1, vec![root]).is_err()); // the root's children are missing
+    /// ```
+    ///
+    /// # Errors
+    /// [`TreeError::Space`] for a level beyond [`crate::max_level`], otherwise the first broken invariant.
+    pub fn from_level_states(level: u32, levels: Vec<PackedStates>) -> Result<Self, TreeError> {
+        let () = DimCheck::<K>::OK;
+        let universe = Universe::new(level)?;
+        check_levels::<K>(level, &levels)?;
+        Ok(Self { universe, levels })
+    }
+
     /// Assembles a tree from its levels. The caller guarantees the structure (see [`KTree::check`]).
     pub(crate) fn from_levels(universe: Universe<K>, levels: Vec<PackedStates>) -> Self {
         Self { universe, levels }
+    }
+
+    /// The tree of a ray set, by stacking ([`crate::stacking::stack`]); also `KTree::from(&rays)`.
+    ///
+    /// ```
+    /// use ktree::{KTree, Ray, RaySet};
+    /// let rays = RaySet::<2>::from_rays(3, [Ray::new([0, 0], 8)]).unwrap();
+    /// let tree = KTree::from_rays(&rays);
+    /// assert_eq!(tree.voxel_count(), 8);
+    /// assert_eq!(tree, KTree::from(&rays));
+    /// ```
+    pub fn from_rays(rays: &RaySet<K>) -> Self {
+        crate::stacking::stack(rays)
     }
 
     /// The universe.
@@ -186,7 +242,8 @@ impl<const K: usize> KTree<K> {
         self.node_count().div_ceil(4)
     }
 
-    /// Bytes of memory held by the tree (packed states and rank indexes).
+    /// Bytes of memory held by the navigable tree: packed states and rank indexes (about 2.07 bits a node on
+    /// large trees), plus the per-level bookkeeping.
     pub fn heap_bytes(&self) -> usize {
         self.levels
             .iter()
@@ -248,39 +305,32 @@ impl<const K: usize> KTree<K> {
         unreachable!("a well-formed tree ends in leaves")
     }
 
-    /// Visits every leaf (empty and full) in Morton (depth-first) order.
+    /// Visits every leaf (empty and full) in Morton (depth-first) order: [`KTree::leaves`] as a callback.
     pub fn for_each_leaf(&self, mut visit: impl FnMut(Cell<K>, NodeState)) {
-        let mut stack = vec![(self.universe.root(), 0usize)];
-        while let Some((cell, index)) = stack.pop() {
-            let depth = cell.level as usize;
-            match self.levels[depth].get(index) {
-                NodeState::Partial => {
-                    let first = self.first_child(depth, index);
-                    for code in (0..Self::FANOUT).rev() {
-                        stack.push((cell.child(code), first + code));
-                    }
-                }
-                state => visit(cell, state),
-            }
+        for (cell, state) in self.leaves() {
+            visit(cell, state);
         }
     }
 
-    /// All leaves with their states, in Morton order.
-    pub fn leaves(&self) -> Vec<(Cell<K>, NodeState)> {
-        let mut out = Vec::new();
-        self.for_each_leaf(|c, s| out.push((c, s)));
-        out
+    /// All leaves with their states, in Morton (depth-first) order.
+    ///
+    /// ```
+    /// use ktree::{KTree, NodeState};
+    /// let tree = KTree::<1>::from_dense(2, &[true, true, false, true]).unwrap();
+    /// let states: Vec<NodeState> = tree.leaves().map(|(_, s)| s).collect();
+    /// assert_eq!(states, [NodeState::Full, NodeState::Empty, NodeState::Full]);
+    /// ```
+    pub fn leaves(&self) -> Leaves<'_, K> {
+        Leaves {
+            tree: self,
+            stack: vec![(self.universe.root(), 0)],
+        }
     }
 
     /// The full leaves in Morton order: the linear tree (Gargantini) of the object.
-    pub fn full_cells(&self) -> Vec<Cell<K>> {
-        let mut out = Vec::new();
-        self.for_each_leaf(|c, s| {
-            if s == NodeState::Full {
-                out.push(c)
-            }
-        });
-        out
+    pub fn full_cells(&self) -> impl Iterator<Item = Cell<K>> + '_ {
+        self.leaves()
+            .filter_map(|(cell, state)| (state == NodeState::Full).then_some(cell))
     }
 
     /// The number of voxels inside the object.
@@ -318,51 +368,14 @@ impl<const K: usize> KTree<K> {
         Ok(dense)
     }
 
-    /// Checks the tree's invariants: level sizes match the partial counts above, no partial node at the
-    /// universe level, the last level has no partial node, and the tree is reduced (no partial node whose
-    /// children are all full or all empty).
+    /// Checks the tree's invariants: level 0 holds the root, level sizes match the partial counts above, no
+    /// partial node at the universe level, the last level has no partial node, and the tree is reduced (no
+    /// partial node whose children are all full or all empty). Cost: `O(nodes)`.
     ///
     /// # Errors
-    /// A sentence naming the first broken invariant.
-    pub fn check(&self) -> Result<(), String> {
-        let level = self.level() as usize;
-        if self.levels.is_empty() || self.levels[0].len() != 1 {
-            return Err("level 0 must hold exactly the root".into());
-        }
-        if self.levels.len() > level + 1 {
-            return Err(format!(
-                "{} levels stored for a level-{level} universe",
-                self.levels.len()
-            ));
-        }
-        for depth in 0..self.levels.len() {
-            let partial = self.levels[depth].partial_count();
-            let next = self.levels.get(depth + 1).map_or(0, |l| l.len());
-            if next != partial << K {
-                return Err(format!(
-                    "level {depth} has {partial} partial nodes but level {} has {next} nodes",
-                    depth + 1
-                ));
-            }
-            if partial > 0 && depth == level {
-                return Err(format!("partial nodes at the voxel level {depth}"));
-            }
-        }
-        for depth in 1..self.levels.len() {
-            let l = &self.levels[depth];
-            for block in 0..l.len() >> K {
-                let first = l.get(block << K);
-                if first != NodeState::Partial
-                    && (1..Self::FANOUT).all(|c| l.get((block << K) + c) == first)
-                {
-                    return Err(format!(
-                        "not reduced: the children of partial node {block} of level {} are all {first:?}",
-                        depth - 1
-                    ));
-                }
-            }
-        }
-        Ok(())
+    /// The first broken invariant.
+    pub fn check(&self) -> Result<(), TreeError> {
+        check_levels::<K>(self.level(), &self.levels)
     }
 
     /// Panics with a readable message unless [`KTree::check`] passes. Property tests call it after every
@@ -371,6 +384,41 @@ impl<const K: usize> KTree<K> {
         if let Err(e) = self.check() {
             panic!("malformed KTree<{K}> (level {}): {e}", self.level());
         }
+    }
+}
+
+impl<const K: usize> From<&RaySet<K>> for KTree<K> {
+    /// [`KTree::from_rays`].
+    fn from(rays: &RaySet<K>) -> Self {
+        Self::from_rays(rays)
+    }
+}
+
+/// The leaves of a tree in Morton order, with their cells: see [`KTree::leaves`].
+#[derive(Debug, Clone)]
+pub struct Leaves<'a, const K: usize> {
+    tree: &'a KTree<K>,
+    /// Nodes still to visit (cell and index in its level), the next on top.
+    stack: Vec<(Cell<K>, usize)>,
+}
+
+impl<const K: usize> Iterator for Leaves<'_, K> {
+    type Item = (Cell<K>, NodeState);
+
+    fn next(&mut self) -> Option<Self::Item> {
+        while let Some((cell, index)) = self.stack.pop() {
+            let depth = cell.level as usize;
+            match self.tree.levels[depth].get(index) {
+                NodeState::Partial => {
+                    let first = self.tree.first_child(depth, index);
+                    for code in (0..KTree::<K>::FANOUT).rev() {
+                        self.stack.push((cell.child(code), first + code));
+                    }
+                }
+                state => return Some((cell, state)),
+            }
+        }
+        None
     }
 }
 
@@ -398,4 +446,64 @@ pub(crate) fn fill_cell<const K: usize>(universe: &Universe<K>, dense: &mut [boo
             axis += 1;
         }
     }
+}
+
+/// [`KTree::check`] on raw levels.
+fn check_levels<const K: usize>(level: u32, levels: &[PackedStates]) -> Result<(), TreeError> {
+    if levels.is_empty() || levels[0].len() != 1 {
+        return Err(TreeError::Root {
+            nodes: levels.first().map_or(0, PackedStates::len),
+        });
+    }
+    if levels.len() > level as usize + 1 {
+        return Err(TreeError::TooDeep {
+            levels: levels.len(),
+            level,
+        });
+    }
+    for depth in 0..levels.len() {
+        let partial = levels[depth].partial_count();
+        let next = levels.get(depth + 1).map_or(0, PackedStates::len);
+        if partial > 0 && depth == level as usize {
+            return Err(TreeError::PartialVoxel { depth });
+        }
+        if partial.checked_shl(K as u32) != Some(next) || partial > usize::MAX >> K {
+            return Err(TreeError::LevelSize {
+                depth,
+                partial,
+                next,
+            });
+        }
+    }
+    for (depth, l) in levels.iter().enumerate().skip(1) {
+        for block in 0..l.len() >> K {
+            let first = l.get(block << K);
+            if first != NodeState::Partial
+                && (1..1usize << K).all(|c| l.get((block << K) + c) == first)
+            {
+                return Err(TreeError::NotReduced {
+                    depth: depth - 1,
+                    index: block,
+                    state: first,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The bytes a navigable tree with these per-level counts holds in memory ([`KTree::heap_bytes`]), without
+/// building it — e.g. for a tree read through a memory map.
+///
+/// ```
+/// use ktree::{rays::ball_rays, stacking::stack, tree::heap_bytes_for_levels};
+/// let tree = stack(&ball_rays::<3>(6, [64, 64, 64], 50).unwrap());
+/// assert_eq!(heap_bytes_for_levels(&tree.counts_per_level()), tree.heap_bytes());
+/// ```
+pub fn heap_bytes_for_levels(per_level: &[LevelCounts]) -> usize {
+    per_level
+        .iter()
+        .map(|l| PackedStates::heap_bytes_for(l.nodes() as usize))
+        .sum::<usize>()
+        + per_level.len() * std::mem::size_of::<PackedStates>()
 }

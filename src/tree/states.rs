@@ -31,20 +31,37 @@ impl NodeState {
     }
 }
 
+use super::TreeError;
+
 const NODES_PER_WORD: usize = 32;
-const WORDS_PER_BLOCK: usize = 4;
+/// Words per rank block: 256 nodes share one 16-bit block rank.
+const WORDS_PER_BLOCK: usize = 8;
+/// Blocks per superblock: 65 536 nodes share one 64-bit superblock rank, so that a block rank (partial
+/// nodes from the superblock's start to the block's) is below 2^16.
+const BLOCKS_PER_SUPER: usize = 256;
 const LOW_BITS: u64 = 0x5555_5555_5555_5555;
 
-/// One tree level: node states at 2 bits each in `u64` words, and the number of partial nodes before each
-/// block of 4 words (128 nodes) so that the rank of a partial node is found in constant time.
+/// One tree level: node states at 2 bits each in `u64` words, and a two-tier rank index over the partial
+/// nodes so that the rank of a node (the partial nodes before it) is found in constant time.
 ///
-/// Memory: 2 bits a node plus 32 bits every 128 nodes = 2.25 bits a node.
+/// The rank index holds a 64-bit count every 65 536 nodes and a 16-bit count (relative to that) every 256
+/// nodes: 2 + 16/256 + 64/65 536 ≈ 2.064 bits a node in all. Measured with the per-level bookkeeping: 2.070
+/// bits a node for an octree of 1.9 million nodes, 2.065 for 7.5 million (`results/performance/build.md`).
+/// A rank reads the two counts and at most eight words, counted in parallel.
+///
+/// Levels are built inside the crate; outside it, [`PackedStates::from_words`] checks raw words and
+/// [`crate::KTree::from_level_states`] checks a whole tree.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
 pub struct PackedStates {
     words: Vec<u64>,
     len: usize,
-    /// `block_rank[b]` = partial nodes in words `0 .. 4·b`; one extra entry holds the total.
-    block_rank: Vec<u64>,
+    /// `super_rank[s]` = partial nodes in words `0 .. 8·256·s`.
+    super_rank: Vec<u64>,
+    /// `block_rank[b]` = partial nodes in words `8·256·(b / 256) .. 8·b`; entries for blocks
+    /// `0 ..= words.len() / 8`, so that every rank `i ≤ len` has its block.
+    block_rank: Vec<u16>,
+    /// The number of partial nodes.
+    partial: usize,
 }
 
 /// Mask with the low bit of each 2-bit slot set where the slot holds `Partial` (`10`).
@@ -59,24 +76,54 @@ fn full_mask(word: u64) -> u64 {
     word & !(word >> 1) & LOW_BITS
 }
 
+/// Partial nodes in at most 7 words, counted in parallel: each word's partial slots are summed into 4-bit
+/// fields (at most 2 a word per field, so 14 at most), then the fields' bytes are added by one multiply.
+/// Faster than a population count per word on targets without a population count instruction.
+#[inline]
+fn partials_in_few(words: &[u64]) -> u64 {
+    const NIBBLE_PAIRS: u64 = 0x3333_3333_3333_3333;
+    const NIBBLES: u64 = 0x0F0F_0F0F_0F0F_0F0F;
+    debug_assert!(words.len() < WORDS_PER_BLOCK);
+    let mut acc = 0u64;
+    for &w in words {
+        let m = partial_mask(w);
+        acc += (m & NIBBLE_PAIRS) + ((m >> 2) & NIBBLE_PAIRS);
+    }
+    let bytes = (acc & NIBBLES) + ((acc >> 4) & NIBBLES);
+    bytes.wrapping_mul(0x0101_0101_0101_0101) >> 56
+}
+
+/// Partial nodes in `words`, two words per population count.
+#[inline]
+fn partials_in(words: &[u64]) -> u64 {
+    let mut pairs = words.chunks_exact(2);
+    let mut n = 0u64;
+    for p in &mut pairs {
+        n += u64::from((partial_mask(p[0]) | partial_mask(p[1]) << 1).count_ones());
+    }
+    if let [w] = pairs.remainder() {
+        n += u64::from(partial_mask(*w).count_ones());
+    }
+    n
+}
+
 impl PackedStates {
     /// An empty level.
-    pub fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self::default()
     }
 
     /// A level with room for `n` nodes.
-    pub fn with_capacity(n: usize) -> Self {
+    pub(crate) fn with_capacity(n: usize) -> Self {
         Self {
             words: Vec::with_capacity(n.div_ceil(NODES_PER_WORD)),
-            len: 0,
-            block_rank: Vec::new(),
+            ..Self::default()
         }
     }
 
     /// Appends a node. Call [`PackedStates::finish`] after the last push.
     #[inline]
-    pub fn push(&mut self, state: NodeState) {
+    pub(crate) fn push(&mut self, state: NodeState) {
         let slot = self.len % NODES_PER_WORD;
         if slot == 0 {
             self.words.push(0);
@@ -86,50 +133,66 @@ impl PackedStates {
         self.len += 1;
     }
 
-    /// Appends `n` copies of a state.
-    pub fn push_many(&mut self, state: NodeState, n: usize) {
-        for _ in 0..n {
-            self.push(state);
-        }
-    }
-
     /// Builds the rank index; must be called once all nodes are pushed.
-    pub fn finish(&mut self) {
+    pub(crate) fn finish(&mut self) {
         self.words.shrink_to_fit();
+        let blocks = self.words.len() / WORDS_PER_BLOCK + 1;
         self.block_rank.clear();
-        self.block_rank
-            .reserve_exact(self.words.len().div_ceil(WORDS_PER_BLOCK) + 1);
+        self.block_rank.reserve_exact(blocks);
+        self.super_rank.clear();
+        self.super_rank
+            .reserve_exact(blocks.div_ceil(BLOCKS_PER_SUPER));
         let mut total = 0u64;
-        for block in self.words.chunks(WORDS_PER_BLOCK) {
-            self.block_rank.push(total);
-            total += block
-                .iter()
-                .map(|&w| u64::from(partial_mask(w).count_ones()))
-                .sum::<u64>();
+        let mut base = 0u64;
+        for b in 0..blocks {
+            if b % BLOCKS_PER_SUPER == 0 {
+                self.super_rank.push(total);
+                base = total;
+            }
+            self.block_rank.push((total - base) as u16);
+            let from = b * WORDS_PER_BLOCK;
+            let to = (from + WORDS_PER_BLOCK).min(self.words.len());
+            total += partials_in(&self.words[from..to]);
         }
-        self.block_rank.push(total);
+        self.partial = total as usize;
     }
 
     /// Builds a level from raw words (two bits a node, node `i` at bits `2(i mod 32)` of word `i / 32`).
-    /// Returns `None` if a slot holds the unused code `11` or bits beyond `len` are set.
-    pub fn from_words(words: Vec<u64>, len: usize) -> Option<Self> {
+    ///
+    /// ```
+    /// use ktree::tree::PackedStates;
+    /// let level = PackedStates::from_words(vec![0b10_01_00], 3).unwrap(); // empty, full, partial
+    /// assert_eq!(level.partial_count(), 1);
+    /// assert!(PackedStates::from_words(vec![0b11], 1).is_err());
+    /// ```
+    ///
+    /// # Errors
+    /// [`TreeError::WordCount`], [`TreeError::UnusedCode`] or [`TreeError::StrayBits`] if the word count does not fit `len`, a slot holds the unused code `11`, or bits beyond
+    /// `len` are set.
+    pub fn from_words(words: Vec<u64>, len: usize) -> Result<Self, TreeError> {
         if words.len() != len.div_ceil(NODES_PER_WORD) {
-            return None;
+            return Err(TreeError::WordCount {
+                words: words.len(),
+                len,
+            });
         }
-        if words.iter().any(|&w| (w >> 1) & w & LOW_BITS != 0) {
-            return None;
+        if let Some(w) = words.iter().position(|&w| (w >> 1) & w & LOW_BITS != 0) {
+            let slot = ((words[w] >> 1) & words[w] & LOW_BITS).trailing_zeros() as usize / 2;
+            return Err(TreeError::UnusedCode {
+                node: w * NODES_PER_WORD + slot,
+            });
         }
         let used = len % NODES_PER_WORD;
         if used != 0 && words[words.len() - 1] >> (2 * used) != 0 {
-            return None;
+            return Err(TreeError::StrayBits { len });
         }
         let mut s = Self {
             words,
             len,
-            block_rank: Vec::new(),
+            ..Self::default()
         };
         s.finish();
-        Some(s)
+        Ok(s)
     }
 
     /// The packed words.
@@ -147,7 +210,7 @@ impl PackedStates {
         self.len == 0
     }
 
-    /// The state of node `i`.
+    /// The state of node `i` (`i < len`).
     #[inline]
     pub fn get(&self, i: usize) -> NodeState {
         debug_assert!(i < self.len);
@@ -164,10 +227,10 @@ impl PackedStates {
     pub fn partial_rank(&self, i: usize) -> usize {
         let word = i / NODES_PER_WORD;
         let block = word / WORDS_PER_BLOCK;
-        let mut rank = self.block_rank[block];
-        for &w in &self.words[block * WORDS_PER_BLOCK..word] {
-            rank += u64::from(partial_mask(w).count_ones());
-        }
+        let from = block * WORDS_PER_BLOCK;
+        let mut rank = self.super_rank[block / BLOCKS_PER_SUPER]
+            + u64::from(self.block_rank[block])
+            + partials_in_few(&self.words[from..word]);
         let slot = i % NODES_PER_WORD;
         if slot > 0 {
             let below = (1u64 << (2 * slot)) - 1;
@@ -178,7 +241,7 @@ impl PackedStates {
 
     /// The number of partial nodes in the level.
     pub fn partial_count(&self) -> usize {
-        self.block_rank.last().copied().unwrap_or(0) as usize
+        self.partial
     }
 
     /// The number of full nodes in the level.
@@ -189,9 +252,16 @@ impl PackedStates {
             .sum()
     }
 
+    /// The bytes a level of `len` nodes holds once built ([`PackedStates::heap_bytes`]), without building it.
+    pub fn heap_bytes_for(len: usize) -> usize {
+        let words = len.div_ceil(NODES_PER_WORD);
+        let blocks = words / WORDS_PER_BLOCK + 1;
+        words * 8 + blocks.div_ceil(BLOCKS_PER_SUPER) * 8 + blocks * 2
+    }
+
     /// Bytes of memory held (words and rank index).
     pub fn heap_bytes(&self) -> usize {
-        self.words.capacity() * 8 + self.block_rank.capacity() * 8
+        self.words.capacity() * 8 + self.super_rank.capacity() * 8 + self.block_rank.capacity() * 2
     }
 }
 
@@ -204,7 +274,8 @@ mod tests {
         let mut plain = Vec::new();
         let mut packed = PackedStates::new();
         let mut x = 12345u32;
-        for _ in 0..1000 {
+        // Enough nodes for several superblocks.
+        for _ in 0..200_000 {
             x = x.wrapping_mul(1103515245).wrapping_add(12345);
             let s = NodeState::from_code(((x >> 16) % 3) as u8).unwrap();
             plain.push(s);
@@ -224,10 +295,27 @@ mod tests {
     }
 
     #[test]
+    fn ranks_hold_in_a_level_of_partial_nodes_only() {
+        let n = 3 * 65_536 + 77;
+        let mut packed = PackedStates::new();
+        for _ in 0..n {
+            packed.push(NodeState::Partial);
+        }
+        packed.finish();
+        for i in (0..=n).step_by(97).chain([65_535, 65_536, 65_537, n]) {
+            assert_eq!(packed.partial_rank(i), i);
+        }
+        assert_eq!(packed.partial_count(), n);
+    }
+
+    #[test]
     fn from_words_rejects_code_three_and_stray_bits() {
-        assert!(PackedStates::from_words(vec![0b11], 1).is_none());
-        assert!(PackedStates::from_words(vec![0b0100], 1).is_none());
-        assert!(PackedStates::from_words(vec![0b0110], 2).is_some());
-        assert!(PackedStates::from_words(vec![], 1).is_none());
+        assert_eq!(
+            PackedStates::from_words(vec![0b1100], 2),
+            Err(TreeError::UnusedCode { node: 1 })
+        );
+        assert!(PackedStates::from_words(vec![0b0100], 1).is_err());
+        assert!(PackedStates::from_words(vec![0b0110], 2).is_ok());
+        assert!(PackedStates::from_words(vec![], 1).is_err());
     }
 }

@@ -290,7 +290,7 @@ proptest! {
         let side = SIDE as u64;
         for cell in tree.full_cells() {
             let s = cell.side() as i64;
-            let o = cell.origin.map(i64::from);
+            let o = cell.origin().map(i64::from);
             // Surrounded: every voxel just outside each face is full (and no face is on the boundary).
             let mut want = true;
             for axis in 0..3 {

@@ -17,12 +17,12 @@ fn occludes<const K: usize>(j: &Cell<K>, i: &Cell<K>, d: [f64; K]) -> bool {
     let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
     for k in 0..K {
         let (jl, jh) = (
-            f64::from(j.origin[k]),
-            f64::from(j.origin[k]) + j.side() as f64,
+            f64::from(j.origin()[k]),
+            f64::from(j.origin()[k]) + j.side() as f64,
         );
         let (il, ih) = (
-            f64::from(i.origin[k]),
-            f64::from(i.origin[k]) + i.side() as f64,
+            f64::from(i.origin()[k]),
+            f64::from(i.origin()[k]) + i.side() as f64,
         );
         // Need lo < −t·d_k < hi with lo = jl − ih, hi = jh − il.
         let (lo, hi) = (jl - ih, jh - il);
@@ -43,7 +43,7 @@ fn occludes<const K: usize>(j: &Cell<K>, i: &Cell<K>, d: [f64; K]) -> bool {
 fn segment_hits(eye: [f64; 3], x: [f64; 3], cell: &Cell<3>) -> bool {
     let (mut t0, mut t1) = (1e-9f64, 1.0f64 - 1e-9);
     for k in 0..3 {
-        let lo = f64::from(cell.origin[k]);
+        let lo = f64::from(cell.origin()[k]);
         let hi = lo + cell.side() as f64;
         let d = x[k] - eye[k];
         if d == 0.0 {
@@ -72,7 +72,7 @@ proptest! {
         let tree = stack(&case.rays);
         tree.assert_well_formed();
         let cells = ordered_full_cells(&tree, Viewer::Direction(d), Order::FrontToBack);
-        prop_assert_eq!(cells.len(), tree.full_cells().len());
+        prop_assert_eq!(cells.len(), tree.full_cells().count());
         let n = cells.len().min(700);
         for i in 0..n {
             for j in i + 1..n {
@@ -94,12 +94,12 @@ proptest! {
     ) {
         let tree = stack(&case.rays);
         let cells = ordered_full_cells(&tree, Viewer::Eye(eye), Order::FrontToBack);
-        prop_assert_eq!(cells.len(), tree.full_cells().len());
+        prop_assert_eq!(cells.len(), tree.full_cells().count());
         let n = cells.len().min(300);
         for i in 0..n {
             let c = &cells[i];
             let s = c.side() as f64;
-            let o = c.origin.map(f64::from);
+            let o = c.origin().map(f64::from);
             for sample in 0..9 {
                 let f = |bit: usize| -> f64 { if sample == 8 { 0.5 } else if sample >> bit & 1 == 1 { 0.8 } else { 0.2 } };
                 let x = [o[0] + f(0) * s, o[1] + f(1) * s, o[2] + f(2) * s];

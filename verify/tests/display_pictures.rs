@@ -56,7 +56,7 @@ proptest! {
             }
         }
         let svg = quadtree_svg(&tree, 256);
-        prop_assert_eq!(svg.matches("<rect x=").count(), tree.leaves().len());
+        prop_assert_eq!(svg.matches("<rect x=").count(), tree.leaves().count());
     }
 }
 

@@ -97,7 +97,7 @@ fn a_ball_fills_a_disc_and_is_shaded_like_a_sphere() {
         image.stats.painted
     );
     // Culling works: far fewer leaves drawn than the ball has.
-    assert!(image.stats.leaves_drawn < tree.full_cells().len() as u64);
+    assert!(image.stats.leaves_drawn < tree.full_cells().count() as u64);
 
     // With exact sphere normals carried by the rays, the shading is smooth: many grey levels, and the
     // brightest pixel is up and to the left of the centre (the light comes from there).

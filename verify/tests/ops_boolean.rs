@@ -55,7 +55,7 @@ fn check_booleans<const K: usize>(a: &Obj<K>, b: &Obj<K>) -> Result<(), TestCase
     let overlap = da.iter().zip(&db).any(|(&x, &y)| x && y);
     prop_assert_eq!(ops::interferes(&ta, &tb).unwrap(), overlap);
     let cells = ops::overlap_cells(&ta, &tb).unwrap();
-    prop_assert_eq!(cells, i.full_cells());
+    prop_assert_eq!(cells, i.full_cells().collect::<Vec<_>>());
     Ok(())
 }
 

@@ -34,10 +34,7 @@ fn octahedron(c: [f64; 3], r: f64) -> TriangleMesh {
             }
         }
     }
-    TriangleMesh {
-        vertices,
-        triangles,
-    }
+    TriangleMesh::new(vertices, triangles).unwrap()
 }
 
 /// The box [lo, hi]³, outward oriented.
@@ -57,10 +54,7 @@ fn cube(lo: [f64; 3], hi: [f64; 3]) -> TriangleMesh {
         .iter()
         .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
         .collect();
-    TriangleMesh {
-        vertices,
-        triangles,
-    }
+    TriangleMesh::new(vertices, triangles).unwrap()
 }
 
 fn rays_dense(mesh: &TriangleMesh, level: u32, p: &Placement) -> Vec<bool> {
@@ -178,14 +172,14 @@ fn real_meshes_match_brute_force_and_volume() {
             let got = rays_dense(&mesh, brute_level, &p);
             // The brute force uses the same rounding of vertices to 1/65536 voxel as the ray generator.
             let placed: Vec<[f64; 3]> = mesh
-                .vertices
+                .vertices()
                 .iter()
                 .map(|v| p.apply(*v).map(|x| (x * 65536.0).round() / 65536.0))
                 .collect();
             let u = Universe::<3>::new(brute_level).unwrap();
             for (i, &g) in got.iter().enumerate() {
                 let v = u.dense_point(i);
-                let w = winding(&placed, &mesh.triangles, v.map(|c| f64::from(c) + 0.5));
+                let w = winding(&placed, mesh.triangles(), v.map(|c| f64::from(c) + 0.5));
                 assert!(
                     (w - w.round()).abs() < 1e-6,
                     "{name}: voxel {v:?} too close to the surface for the brute force"
@@ -217,21 +211,21 @@ fn real_meshes_match_brute_force_and_volume() {
 fn formats_read_alike() {
     let mesh = octahedron([7.5, 7.5, 7.5], 6.0);
     let dir = tempfile::tempdir().unwrap();
-    let v = &mesh.vertices;
+    let v = mesh.vertices();
     let mut obj = String::from("# octahedron\n");
     let mut stl = String::from("solid oct\n");
     let mut ply = format!(
         "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
         v.len(),
-        mesh.triangles.len()
+        mesh.triangles().len()
     );
     let mut bin = vec![0u8; 80];
-    bin.extend((mesh.triangles.len() as u32).to_le_bytes());
+    bin.extend((mesh.triangles().len() as u32).to_le_bytes());
     for p in v {
         obj += &format!("v {} {} {}\n", p[0], p[1], p[2]);
         ply += &format!("{} {} {}\n", p[0], p[1], p[2]);
     }
-    for t in &mesh.triangles {
+    for t in mesh.triangles() {
         obj += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
         ply += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
         stl += "facet normal 0 0 0\nouter loop\n";
@@ -280,8 +274,10 @@ fn formats_read_alike() {
 
 #[test]
 fn open_meshes_are_reported_and_do_not_panic() {
-    let mut mesh = octahedron([7.5, 7.5, 7.5], 5.0);
-    mesh.triangles.pop();
+    let full = octahedron([7.5, 7.5, 7.5], 5.0);
+    let mut triangles = full.triangles().to_vec();
+    triangles.pop();
+    let mesh = TriangleMesh::new(full.vertices().to_vec(), triangles).unwrap();
     let r = mesh.to_rays(4, &ID).unwrap();
     assert_eq!(r.open_edges, 3);
     stack(&r.rays).assert_well_formed();

@@ -17,7 +17,7 @@ proptest! {
         label in any::<bool>(),
     ) {
         let n = shape.iter().product::<usize>();
-        let v = Volume { shape, values: seed[..n].iter().map(|&x| f64::from(x)).collect(), spacing: [1.0; 3] };
+        let v = Volume::new(shape, seed[..n].iter().map(|&x| f64::from(x)).collect(), [1.0; 3]).unwrap();
         let select = if label { Select::Label(2.0) } else { Select::AtLeast(2.0) };
         let rays = v.to_rays(4, offset, select).unwrap();
         let mut count = 0;
@@ -28,7 +28,7 @@ proptest! {
                     let inside_vol = (0..3).all(|a| p[a] >= offset[a] && ((p[a] - offset[a]) as usize) < shape[a]);
                     let want = inside_vol && {
                         let [i, j, k] = [0, 1, 2].map(|a| (p[a] - offset[a]) as usize);
-                        let s = v.values[i + shape[0] * (j + shape[1] * k)];
+                        let s = v.values()[i + shape[0] * (j + shape[1] * k)];
                         if label { s == 2.0 } else { s >= 2.0 }
                     };
                     count += usize::from(want);
@@ -45,7 +45,7 @@ proptest! {
 fn real_volumes_give_their_counts() {
     let dir = cases::data_dir("volumes");
     let skull = Volume::read(&dir.join("skull_grey.json")).unwrap();
-    assert_eq!(skull.shape, [64, 64, 64]);
+    assert_eq!(skull.shape(), [64, 64, 64]);
     // The source's own example uses the iso-value 2.9, stored ×10 000.
     let rays = skull
         .to_rays(skull.fitting_level(), [0; 3], Select::AtLeast(29_000.0))
@@ -106,8 +106,8 @@ fn nifti_and_raw_read_alike() {
     let nii = dir.path().join("v.nii");
     std::fs::write(&nii, nifti_bytes(shape, &values, 2.0, 1.0)).unwrap();
     let a = Volume::read(&nii).unwrap();
-    assert_eq!(a.shape, [5, 3, 4]);
-    assert_eq!(a.values[7], f64::from(values[7]) * 2.0 + 1.0);
+    assert_eq!(a.shape(), [5, 3, 4]);
+    assert_eq!(a.values()[7], f64::from(values[7]) * 2.0 + 1.0);
     let json = dir.path().join("v.json");
     std::fs::write(
         &json,
@@ -120,7 +120,7 @@ fn nifti_and_raw_read_alike() {
         .collect();
     std::fs::write(dir.path().join("v.raw"), &raw).unwrap();
     let b = Volume::read(&json).unwrap();
-    assert_eq!(a.values, b.values);
+    assert_eq!(a.values(), b.values());
     let sel = Select::AtLeast(5.0);
     assert_eq!(
         a.to_rays(3, [1, 2, 3], sel).unwrap(),

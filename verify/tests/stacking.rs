@@ -46,8 +46,8 @@ where
     });
     for cell in stacked.full_cells() {
         let side = cell.side() as u32;
-        cases::for_each_column(cell.origin, cell.origin.map(|o| o + side), |mut p| {
-            for z in cell.origin[K - 1]..cell.origin[K - 1] + side {
+        cases::for_each_column(cell.origin(), cell.origin().map(|o| o + side), |mut p| {
+            for z in cell.origin()[K - 1]..cell.origin()[K - 1] + side {
                 p[K - 1] = z;
                 covered[u.dense_index(p)] = true;
             }

@@ -85,7 +85,7 @@ pub fn run_case(case: &str) -> Result<(f64, Facts), String> {
             };
             let (mesh, p) = mesh_rays(file)?;
             let s = best_of(3, || mesh.to_rays(LEVEL, &p).expect("ok").rays, &mut keep);
-            facts.push(("triangles".into(), mesh.triangles.len().to_string()));
+            facts.push(("triangles".into(), mesh.triangles().len().to_string()));
             s
         }
         "skull" => {

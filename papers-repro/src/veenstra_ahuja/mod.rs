@@ -83,7 +83,7 @@ pub fn run(results: &Path) -> Result<String, String> {
     );
     for shape in &shapes {
         let tree = objects::shape_tree(shape, FIG_LEVEL)?;
-        tree.check()?;
+        tree.check().map_err(|e| e.to_string())?;
         let d =
             line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed, None).map_err(err)?;
         let slow =

@@ -1,0 +1,93 @@
+//! What can be wrong with a tree given from outside the crate.
+
+use thiserror::Error;
+
+use super::NodeState;
+use crate::space::SpaceError;
+
+/// Why raw levels, words or cells do not make a well-formed tree.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum TreeError {
+    /// The universe level is out of range.
+    #[error(transparent)]
+    Space(#[from] SpaceError),
+    /// The number of words does not match the number of nodes.
+    #[error("{words} words cannot hold exactly {len} nodes (2 bits each, 32 a word)")]
+    WordCount {
+        /// Words given.
+        words: usize,
+        /// Nodes asked for.
+        len: usize,
+    },
+    /// A slot holds the unused code `11`.
+    #[error("node {node} has the unused code 11")]
+    UnusedCode {
+        /// The node's index in its level.
+        node: usize,
+    },
+    /// Bits beyond the last node of a level are set.
+    #[error("bits after node {len} are set")]
+    StrayBits {
+        /// The number of nodes.
+        len: usize,
+    },
+    /// Level 0 does not hold exactly one node, the root.
+    #[error("level 0 must hold exactly the root, not {nodes} nodes")]
+    Root {
+        /// Nodes at level 0.
+        nodes: usize,
+    },
+    /// More levels than the universe has.
+    #[error("{levels} levels stored for a level-{level} universe")]
+    TooDeep {
+        /// Levels given.
+        levels: usize,
+        /// The universe level.
+        level: u32,
+    },
+    /// A level's size is not `2^K` times the partial nodes above it.
+    #[error("level {depth} has {partial} partial nodes but level {} has {next} nodes", depth + 1)]
+    LevelSize {
+        /// The level above.
+        depth: usize,
+        /// Its partial nodes.
+        partial: usize,
+        /// Nodes of the level below.
+        next: usize,
+    },
+    /// A partial node at the voxel level (a voxel has no children).
+    #[error("partial nodes at the voxel level {depth}")]
+    PartialVoxel {
+        /// The level.
+        depth: usize,
+    },
+    /// A partial node whose children are all full or all empty.
+    #[error(
+        "not reduced: the children of partial node {index} of level {depth} are all {state:?}"
+    )]
+    NotReduced {
+        /// The partial node's level.
+        depth: usize,
+        /// Its index among the partial nodes of that level.
+        index: usize,
+        /// The children's common state.
+        state: NodeState,
+    },
+    /// A cell belongs to a universe of another level.
+    #[error("cell {index} belongs to a level-{found} universe, not level {expected}")]
+    CellUniverse {
+        /// The cell's position in the input.
+        index: usize,
+        /// The universe level expected.
+        expected: u32,
+        /// The cell's universe level.
+        found: u32,
+    },
+    /// Cells are not in Morton order or overlap.
+    #[error("cell {index} overlaps or precedes the cell before it in Morton order")]
+    CellOrder {
+        /// The cell's position in the input.
+        index: usize,
+    },
+}

@@ -1,0 +1,55 @@
+//! Boolean operators on trees: `&a | &b`, `&a & &b`, `&a - &b`, `&a ^ &b` and `!&a`, the operations of
+//! [`crate::ops`] under their usual symbols.
+//!
+//! Two trees combine only when their universes have the same level, so the binary operators give a
+//! `Result` (an [`OpsError::LevelMismatch`] otherwise) rather than panic; see [`KTree`] for an example.
+
+use std::ops::{BitAnd, BitOr, BitXor, Not, Sub};
+
+use super::KTree;
+use crate::ops::{self, OpsError};
+
+impl<const K: usize> BitOr for &KTree<K> {
+    type Output = Result<KTree<K>, OpsError>;
+
+    /// The union, [`ops::union`].
+    fn bitor(self, other: Self) -> Self::Output {
+        ops::union(self, other)
+    }
+}
+
+impl<const K: usize> BitAnd for &KTree<K> {
+    type Output = Result<KTree<K>, OpsError>;
+
+    /// The intersection, [`ops::intersection`].
+    fn bitand(self, other: Self) -> Self::Output {
+        ops::intersection(self, other)
+    }
+}
+
+impl<const K: usize> Sub for &KTree<K> {
+    type Output = Result<KTree<K>, OpsError>;
+
+    /// The difference, [`ops::difference`].
+    fn sub(self, other: Self) -> Self::Output {
+        ops::difference(self, other)
+    }
+}
+
+impl<const K: usize> BitXor for &KTree<K> {
+    type Output = Result<KTree<K>, OpsError>;
+
+    /// The symmetric difference, [`ops::symmetric_difference`].
+    fn bitxor(self, other: Self) -> Self::Output {
+        ops::symmetric_difference(self, other)
+    }
+}
+
+impl<const K: usize> Not for &KTree<K> {
+    type Output = KTree<K>;
+
+    /// The complement within the universe, [`ops::complement`].
+    fn not(self) -> KTree<K> {
+        ops::complement(self)
+    }
+}
