@@ -1,6 +1,6 @@
-//! The same cross-checks with quickcheck (the design card names both property-testing crates): stacking
-//! equals the dense pyramid on arbitrary small ray sets, and maximal rows tile any run with aligned,
-//! unmergeable rows.
+//! The same cross-checks with a second property-testing crate, quickcheck (its own generators and
+//! shrinking): stacking equals the dense pyramid on arbitrary small ray sets, and maximal rows tile any run
+//! with aligned, unmergeable rows.
 
 use ktree::rays::maximal_rows;
 use ktree::{reference::DensePyramid, stacking::stack};
