@@ -11,7 +11,8 @@ cases="${PROPTEST_CASES:-5000}"
 export PROPTEST_CASES="$cases"
 out=results/verification.md
 tmp="$out.tmp.$$"
-trap 'rm -f "$tmp"' EXIT
+log=$(mktemp)
+trap 'rm -f "$tmp" "$log"' EXIT
 
 # Build once, then run the test binaries themselves (from the package folder, as cargo does).
 built=$(cargo test -p ktree-verify --tests --no-run 2>&1) || { echo "$built" >&2; exit 1; }
@@ -36,13 +37,11 @@ for file in verify/tests/*.rs; do
     qc=$(grep -c '\.quickcheck(' "$file" || true)
     if [ "$qc" -gt 0 ]; then props=$qc; else props=$((tests - plain)); fi
     t0=$(date +%s)
-    if ! (cd verify && "$binary" -q) >"$tmp.log" 2>&1; then
-        cat "$tmp.log"
-        rm -f "$tmp.log"
+    if ! (cd verify && "$binary" -q) >"$log" 2>&1; then
+        cat "$log"
         echo "thorough run: $name failed" >&2
         exit 1
     fi
-    rm -f "$tmp.log"
     secs=$(($(date +%s) - t0))
     rows="$rows| \`$name\` | $tests | $props | $secs |
 "
@@ -69,5 +68,4 @@ total_time=$(($(date +%s) - start_all))
     echo "| **total** | $total_tests | $total_props | $total_time |"
 } >"$tmp"
 mv "$tmp" "$out"
-trap - EXIT
 echo "wrote $out" >&2
