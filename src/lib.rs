@@ -15,7 +15,7 @@
 //! * [`space`]: the universe (level `L`, side `U = 2^L`), aligned cells, Morton keys.
 //! * [`rays`]: [`RaySet`], an object as sorted disjoint runs along the last axis, and maximal rows.
 //! * [`stacking`]: [`stacking::stack`], Akman & Franklin's stacking.
-//! * [`reference`]: the reference builders the tests compare against (naive insertion, dense pyramid).
+//! * [`reference`](mod@reference): the reference builders the tests compare against (naive insertion, dense pyramid).
 //! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
 //! * [`io`]: the ray text format and the `.ktree` file format.

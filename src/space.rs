@@ -9,6 +9,19 @@
 //! Child numbering (used by every tree in the crate): the child code of a cell's child is a `K`-bit number
 //! whose bit `i` is set when the child is in the upper half of the parent along axis `i`. Axis `K − 1` (the
 //! last, "z") is the ray axis.
+//!
+//! ```
+//! use ktree::{max_level, Universe};
+//! // The largest octree universe: 2^21 voxels a side, 2^63 voxels, none of them allocated.
+//! let u = Universe::<3>::new(max_level(3)).unwrap();
+//! assert_eq!(u.side(), 1 << 21);
+//! assert_eq!(u.voxels(), 1u128 << 63);
+//! // Child 1 of the root is its upper half along x (bit 0 of the child code).
+//! let child = u.root().child(1);
+//! assert_eq!(child.origin, [1 << 20, 0, 0]);
+//! assert!(child.contains([(1 << 21) - 1, 5, 5]) && !child.contains([0, 5, 5]));
+//! assert!(Universe::<3>::new(22).is_err());
+//! ```
 
 use thiserror::Error;
 

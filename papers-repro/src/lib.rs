@@ -1,6 +1,7 @@
 //! Reproductions of the papers' results. Each writes tables (Markdown + CSV) and plots into
 //! `results/<name>/` and returns a short report for the command line to print. Run them with
 //! `ktree repro [NAME]`.
+#![deny(missing_docs)]
 
 pub mod akman_franklin;
 pub mod common;

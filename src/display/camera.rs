@@ -4,6 +4,17 @@
 //! World coordinates are voxel coordinates: voxel `(x, y, z)` is the unit cube `[x, x+1) × …`. The image's
 //! pixel `(px, py)` has its centre at `(px + ½, py + ½)`, `py` growing downwards; screen up is the camera's
 //! up vector.
+//!
+//! ```
+//! use ktree::display::{default_camera, ISO_TOWARD_EYE};
+//! use ktree::{rays::ball_rays, stacking::stack};
+//! let ball = stack(&ball_rays::<3>(5, [32, 32, 32], 28).unwrap());
+//! let camera = default_camera(&ball, ISO_TOWARD_EYE, None, 100, 100).unwrap();
+//! assert!(!camera.is_perspective());
+//! // The ball's centre projects to the middle of the image.
+//! let (x, y, _depth) = camera.project([16.0, 16.0, 16.0], 100, 100).unwrap();
+//! assert!((x - 50.0).abs() < 1.0 && (y - 50.0).abs() < 1.0);
+//! ```
 
 use super::error::DisplayError;
 use crate::space::Cell;

@@ -1,6 +1,17 @@
 //! The screen coverage structure of the front-to-back renderer: one bit a pixel in row spans of 64, plus
 //! a count of uncovered pixels per row and in all. A node whose screen rectangle is wholly covered is
 //! skipped with its subtree; once every pixel is covered the traversal stops.
+//!
+//! ```
+//! use ktree::display::Coverage;
+//! let mut c = Coverage::new(4, 2);
+//! assert_eq!(c.uncovered(), 8);
+//! c.cover(1, 0);
+//! c.cover(2, 0);
+//! // Rectangles are inclusive: [1, 2] × [0, 0] is covered, [0, 2] × [0, 0] is not.
+//! assert!(c.is_covered(1, 0) && c.rect_covered(1, 2, 0, 0) && !c.rect_covered(0, 2, 0, 0));
+//! assert_eq!(c.uncovered(), 6);
+//! ```
 
 /// Which pixels of a `width × height` screen have been painted.
 #[derive(Debug, Clone)]

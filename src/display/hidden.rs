@@ -13,6 +13,16 @@
 //! at origin `o` is the unit cube's hexagon scaled by `s` and moved to the projection of `o`. A segment is
 //! hidden where it lies strictly inside (by a tolerance of 10⁻⁹ of the universe's side) — a segment
 //! on the border of a hexagon stays visible.
+//!
+//! ```
+//! use ktree::display::{line_drawing, HiddenLineMethod};
+//! use ktree::{rays::ball_rays, stacking::stack};
+//! let ball = stack(&ball_rays::<3>(4, [16, 16, 16], 20).unwrap());
+//! let dir = [0.6, -1.0, 0.8];
+//! let pairwise = line_drawing(&ball, dir, HiddenLineMethod::Pairwise, None).unwrap();
+//! let bucketed = line_drawing(&ball, dir, HiddenLineMethod::Bucketed, None).unwrap();
+//! assert_eq!(pairwise.lines, bucketed.lines); // two methods, one drawing
+//! ```
 
 use super::lines::{Edge3, LineStats, Piece};
 use crate::space::Cell;

@@ -19,6 +19,17 @@
 //! The view direction is nudged by at most 10⁻⁴ on any axis it is parallel to, so that no two parallel
 //! lattice lines project onto the same line: in an exact axis view, hidden edges behind a crack would
 //! project exactly onto it and be judged visible.
+//!
+//! ```
+//! use ktree::display::{line_drawing, HiddenLineMethod};
+//! use ktree::KTree;
+//! // A single voxel seen from a general direction: a hexagon outline and three inner edges.
+//! let mut dense = vec![false; 8];
+//! dense[0] = true;
+//! let voxel = KTree::<3>::from_dense(1, &dense).unwrap();
+//! let d = line_drawing(&voxel, [1.0, -0.8, 0.6], HiddenLineMethod::Bucketed, None).unwrap();
+//! assert_eq!(d.lines.len(), 9);
+//! ```
 
 use super::camera::v3;
 use super::error::DisplayError;

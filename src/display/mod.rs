@@ -9,6 +9,15 @@
 //! * [`lines`]: line drawings — visible edges with cracks, hidden lines and dots removed ([`hidden`] holds
 //!   the paper's pairwise hidden-line step and a faster bucketed one).
 //! * [`svg`], [`png`]: writers; [`plane`]: 2-D quadtree images; [`slices`]: 4-D trees as strips of frames.
+//!
+//! ```
+//! use ktree::display::{line_drawing, HiddenLineMethod, ISO_TOWARD_EYE};
+//! use ktree::{rays::ball_rays, stacking::stack};
+//! let ball = stack(&ball_rays::<3>(4, [16, 16, 16], 20).unwrap());
+//! let drawing = line_drawing(&ball, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed, None).unwrap();
+//! assert!(!drawing.lines.is_empty());
+//! assert!(drawing.lines.iter().all(|edge| edge.u0 < edge.u1));
+//! ```
 
 pub mod camera;
 pub mod coverage;

@@ -3,6 +3,16 @@
 //! found by descending from the root to the equal-sized cell across a face — `O(L)` rank lookups — and the
 //! part of it that touches the face (or an edge) is read by descending only into the children that touch
 //! it.
+//!
+//! ```
+//! use ktree::display::neighbours::is_surrounded;
+//! use ktree::KTree;
+//! // A full 4 × 4 × 4 universe: the voxel (1, 1, 1) is surrounded, the universe's corner voxel is not.
+//! let full = KTree::<3>::full(2).unwrap();
+//! let u = full.universe();
+//! assert!(is_surrounded(&full, &u.cell([1, 1, 1], 2).unwrap()));
+//! assert!(!is_surrounded(&full, &u.cell([0, 0, 0], 2).unwrap()));
+//! ```
 
 use crate::space::Cell;
 use crate::tree::{KTree, NodeRef, NodeState};

@@ -8,6 +8,24 @@
 //! pass from child `near ^ a` into child `near ^ b` only if the bits of `a` are a subset of the bits of `b`,
 //! hence `a < b`. For a perspective view the near child is chosen per node from the eye's side of the node's
 //! centre on each axis; the same argument holds inside each node.
+//!
+//! ```
+//! use ktree::display::{walk_ordered, Order, Viewer, Walk};
+//! use ktree::KTree;
+//! // Two voxels along x; looking along −x (from the +x side), the one at x = 1 comes first front to back.
+//! let mut dense = vec![false; 8];
+//! dense[0] = true;
+//! dense[1] = true;
+//! let tree = KTree::<3>::from_dense(1, &dense).unwrap();
+//! let mut seen = Vec::new();
+//! walk_ordered(&tree, Viewer::Direction([-1.0, 0.0, 0.0]), Order::FrontToBack, |n| {
+//!     if n.state == ktree::NodeState::Full {
+//!         seen.push(n.cell.origin[0]);
+//!     }
+//!     Walk::Descend
+//! });
+//! assert_eq!(seen, [1, 0]);
+//! ```
 
 use crate::space::Cell;
 use crate::tree::{KTree, NodeRef, NodeState};

@@ -1,4 +1,11 @@
 //! 2-D quadtrees as pictures: full cells filled, every leaf's boundary drawn, so the decomposition shows.
+//!
+//! ```
+//! use ktree::{display::plane::quadtree_svg, rays::ball_rays, stacking::stack};
+//! let disk = stack(&ball_rays::<2>(4, [16, 16], 20).unwrap());
+//! let svg = quadtree_svg(&disk, 256);
+//! assert!(svg.starts_with("<svg") && svg.contains("<rect"));
+//! ```
 
 use std::fmt::Write as _;
 

@@ -1,4 +1,12 @@
 //! PNG output through the `image` crate, written atomically.
+//!
+//! ```
+//! use ktree::display::png::{encode_rgb_png, Canvas};
+//! let mut canvas = Canvas::new(8, 4, [255, 255, 255]).unwrap();
+//! canvas.fill_rect(0, 0, 4, 4, [0, 0, 0]);
+//! let png = encode_rgb_png(8, 4, &canvas.rgb).unwrap();
+//! assert_eq!(&png[1..4], b"PNG");
+//! ```
 
 #[cfg(feature = "png")]
 use std::path::Path;

@@ -1,6 +1,15 @@
 //! 4-D trees shown as 3-D frames: the slice of a time-space tree at one position along an axis (time is
 //! the last axis by convention) is an octree; a strip of frames at evenly spaced times, rendered with one
 //! camera, shows the motion.
+//!
+//! ```
+//! use ktree::{display::slices::slice_4d, rays::ball_rays, stacking::stack};
+//! // A 4-D ball; its slice at the middle of the fourth axis is a 3-D ball.
+//! let ball4 = stack(&ball_rays::<4>(3, [8, 8, 8, 8], 8).unwrap());
+//! let middle = slice_4d(&ball4, 3, 4).unwrap();
+//! assert_eq!(middle.level(), 3);
+//! assert!(middle.contains([4, 4, 4]) && !middle.contains([0, 0, 0]));
+//! ```
 
 use super::camera::{Camera, ISO_TOWARD_EYE};
 use super::error::DisplayError;

@@ -1,4 +1,12 @@
 //! SVG output: true vector lines, and filled rectangles for quadtree pictures.
+//!
+//! ```
+//! use ktree::display::svg::{bounds_of, lines_svg};
+//! let segments = [[0.0, 0.0, 2.0, 1.0], [2.0, 1.0, 3.0, -1.0]];
+//! assert_eq!(bounds_of(&segments), [0.0, -1.0, 3.0, 1.0]);
+//! let svg = lines_svg(&segments, 120, 80, 1.0);
+//! assert!(svg.starts_with("<svg") && svg.contains("<path"));
+//! ```
 
 use std::fmt::Write as _;
 use std::path::Path;

@@ -3,6 +3,19 @@
 //! writes, and trees and ray sets whose dimension is read from the file ([`AnyTree`], [`AnyRaySet`]).
 //! [`read_tree`] and [`write_tree`] choose among every format by extension, the grid formats of other tools
 //! included: binvox, OctoMap `.bt` and OpenVDB `.vdb`.
+//!
+//! ```
+//! use ktree::io::{read_ktree, read_rays, write_ktree, write_rays, AnyRaySet};
+//! use ktree::{stacking::stack, Ray, RaySet};
+//! let rays = RaySet::<3>::from_rays(4, [Ray::new([1, 1, 2], 9)]).unwrap();
+//! let mut text = Vec::new();
+//! write_rays(&mut text, &rays).unwrap();
+//! assert_eq!(read_rays(&text[..], "mem").unwrap(), AnyRaySet::K3(rays.clone()));
+//! let tree = stack(&rays);
+//! let mut bytes = Vec::new();
+//! write_ktree(&mut bytes, &tree).unwrap();
+//! assert_eq!(read_ktree::<3>(&bytes, "mem").unwrap(), tree);
+//! ```
 
 mod any;
 mod atomic;

@@ -15,6 +15,17 @@
 //! reference uses, so decisions stay exact with respect to that function. For Meagher's integer-only
 //! version — the inverse rounded once to fixed point, then only additions and shifts while descending —
 //! see [`super::transform_fixed`].
+//!
+//! ```
+//! use ktree::ops::{rotate_axes, transform, Affine, AxisMap};
+//! use ktree::{rays::ball_rays, stacking::stack};
+//! let ball = stack(&ball_rays::<2>(4, [12, 16], 10).unwrap());
+//! // A quarter turn about the universe's centre, by an affine map and by reordering children: the same tree.
+//! let m = Affine::rotation_about(0, 1, 90.0, Affine::<2>::universe_centre(4)).unwrap();
+//! let turned = transform(&ball, &m).unwrap();
+//! assert_eq!(turned, rotate_axes(&ball, &AxisMap::quarter_turn(0, 1).unwrap()));
+//! assert_eq!(turned.voxel_count(), ball.voxel_count());
+//! ```
 
 // Matrix and per-axis code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]

@@ -12,6 +12,24 @@
 //! resampling of every voxel centre, while the work follows the output's nodes, not its voxels.
 //!
 //! Children are decided before they are pushed, so the output is reduced.
+//!
+//! ```
+//! use ktree::ops::overlay::{resample, Preimage};
+//! use ktree::KTree;
+//! /// Target voxel q comes from source voxel q − 1 along the one axis: a shift by one.
+//! struct ShiftOne;
+//! impl Preimage<1> for ShiftOne {
+//!     fn voxel(&self, q: [u32; 1]) -> [i64; 1] {
+//!         [i64::from(q[0]) - 1]
+//!     }
+//!     fn cell_box(&self, origin: [u32; 1], side: u64) -> [(i64, i64); 1] {
+//!         let lo = i64::from(origin[0]) - 1;
+//!         [(lo, lo + side as i64 - 1)]
+//!     }
+//! }
+//! let a = KTree::<1>::from_dense(2, &[true, true, false, false]).unwrap();
+//! assert_eq!(resample(&a, &ShiftOne).to_dense().unwrap(), [false, true, true, false]);
+//! ```
 
 use super::emit::{collapse, leaf, Levels};
 use crate::space::Cell;

@@ -1,6 +1,15 @@
 //! Reference builder: a dense bottom-up pyramid. Level `L` is the voxel array; each coarser level holds, per
 //! cell, empty / full / partial from its `2^K` children. Simple enough to trust; `O(U^K)` time and memory, so
 //! only for small universes (tests).
+//!
+//! ```
+//! use ktree::{reference::DensePyramid, NodeState};
+//! // A 4-voxel bintree universe with voxels 0 and 1 full.
+//! let p = DensePyramid::<1>::from_dense(2, &[true, true, false, false]).unwrap();
+//! assert_eq!(p.state(0, [0]), NodeState::Partial); // the root
+//! assert_eq!(p.state(1, [0]), NodeState::Full); // its lower half
+//! assert_eq!(p.to_tree().voxel_count(), 2);
+//! ```
 
 use crate::rays::RaySet;
 use crate::space::{SpaceError, Universe, DENSE_LIMIT};

@@ -24,6 +24,17 @@
 //!
 //! **Work:** `O(triangles + rays)` plus a radix sort of the crossings: each triangle visits only the columns
 //! in its bounding box.
+//!
+//! ```
+//! use ktree::solid::mesh::{Placement, TriangleMesh};
+//! use std::path::Path;
+//! let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/meshes/bunny_npm.obj");
+//! let bunny = TriangleMesh::read(&path).unwrap();
+//! let placement = Placement::fit(&bunny, 6).unwrap(); // scaled and centred into a 64³ universe
+//! let voxels = bunny.to_rays(6, &placement).unwrap();
+//! assert_eq!(voxels.open_edges, bunny.open_edges());
+//! assert!(voxels.rays.voxel_count() > 1000);
+//! ```
 
 use std::collections::HashMap;
 use std::path::Path;

@@ -7,6 +7,16 @@
 //! * [`volume`]: dense 3-D scalar volumes (raw + JSON sidecar, NIfTI) by threshold or label.
 //!
 //! Boolean operations and translation on the resulting rays are in [`crate::rays`] (`union`, …).
+//!
+//! ```
+//! use ktree::solid::{BoxSolid, Frame, Sample};
+//! use ktree::stacking::stack;
+//! // The box [0, 4] × [0, 2] in voxel units: the voxel centres inside are x in 0..4, y in 0..2.
+//! let b = BoxSolid::<2>::new([0.into(), 0.into()], [4.into(), 2.into()], Frame::Voxel).unwrap();
+//! let rays = b.to_rays(3, Sample::Centre, false).unwrap();
+//! assert_eq!(rays.voxel_count(), 8);
+//! assert_eq!(stack(&rays).node_count(), 9); // two levels of quadrants: 1 + 4 + 4
+//! ```
 
 mod boxsolid;
 mod error;

@@ -6,6 +6,16 @@
 //! as NIfTI prescribes). Volume voxel `(i, j, k)` becomes universe voxel `offset + (i, j, k)`, unscaled.
 //!
 //! The cost is one pass over the samples (a dense input has to be read anyway) plus the rays.
+//!
+//! ```
+//! use ktree::solid::volume::{Select, Volume};
+//! use std::path::Path;
+//! let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/volumes/itk_t1_brain.json");
+//! let brain = Volume::read(&path).unwrap(); // 128 × 128 × 62 samples
+//! assert_eq!(brain.fitting_level(), 7);
+//! let rays = brain.to_rays(7, [0, 0, 0], Select::AtLeast(1.0)).unwrap();
+//! assert_eq!(rays.voxel_count(), brain.count(Select::AtLeast(1.0)) as u128);
+//! ```
 
 use std::path::Path;
 

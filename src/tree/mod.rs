@@ -1,5 +1,17 @@
 //! The compact k-tree: node states, the level-order `KTree<K>`, assembling one from a depth-first stream of
 //! nodes or from full cells, and its Boolean operators.
+//!
+//! ```
+//! use ktree::{stacking::stack, NodeState, Ray, RaySet};
+//! // The lower half (z < 4) of column x = 0 of an 8 × 8 quadtree universe.
+//! let tree = stack(&RaySet::<2>::from_rays(3, [Ray::new([0, 0], 4)]).unwrap());
+//! assert_eq!(tree.root_state(), NodeState::Partial);
+//! assert_eq!(tree.voxel_count(), 4);
+//! assert!(tree.contains([0, 3]) && !tree.contains([1, 3]));
+//! assert_eq!(tree.bytes_at_two_bits(), tree.node_count().div_ceil(4));
+//! let children: Vec<_> = tree.children(&tree.root()).map(|c| c.state).collect();
+//! assert_eq!(children.len(), 4);
+//! ```
 
 mod assemble;
 mod error;

@@ -6,7 +6,8 @@ use std::fmt;
 use ktree::{Ray, RaySet};
 use proptest::prelude::*;
 
-/// Largest level tested for each K (the bounds: L ≤ 6 for K ≤ 3, L ≤ 4 for K = 4).
+/// Largest level of the random ray sets for each K (L ≤ 6 for K ≤ 3, L ≤ 4 for K = 4): small enough for
+/// the dense references.
 pub const fn max_test_level(k: usize) -> u32 {
     if k <= 3 {
         6
@@ -18,6 +19,7 @@ pub const fn max_test_level(k: usize) -> u32 {
 /// A ray set under test, printed in the ray text format so a shrunk failure reads as a file.
 #[derive(Clone)]
 pub struct Case<const K: usize> {
+    /// The rays.
     pub rays: RaySet<K>,
 }
 

@@ -1,5 +1,12 @@
-//! Shared strategies for ktree's property tests (in `tests/`): random ray sets ([`cases`]) and random
-//! objects as dense boolean arrays ([`objects`]), both printed readably when proptest shrinks a failure.
+//! Shared strategies for ktree's property tests (in `tests/`): random ray sets ([`cases`]), random objects
+//! as dense boolean arrays ([`objects`]), sparse objects at the largest level of each K ([`sparse`]), all
+//! printed readably when proptest shrinks a failure, and the case counts every property runs
+//! ([`config()`]).
+#![deny(missing_docs)]
 
 pub mod cases;
+mod config;
 pub mod objects;
+pub mod sparse;
+
+pub use config::{config, quickcheck_tests};

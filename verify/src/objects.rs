@@ -6,7 +6,8 @@ use std::fmt;
 use ktree::{KTree, Universe};
 use proptest::prelude::*;
 
-/// Largest level tested for each K (L ≤ 5 for K ≤ 3, L ≤ 3 for K = 4).
+/// Largest level of the dense objects for each K (L ≤ 5 for K ≤ 3, L ≤ 3 for K = 4): dense arrays stay
+/// small enough to compare many cases.
 pub const fn max_level(k: usize) -> u32 {
     if k <= 3 {
         5
@@ -18,8 +19,11 @@ pub const fn max_level(k: usize) -> u32 {
 /// An object as a dense array, printed as its list of boxes and voxels so shrunk failures are readable.
 #[derive(Clone)]
 pub struct Obj<const K: usize> {
+    /// The universe's level.
     pub level: u32,
+    /// Boxes `[lo, hi)` of full voxels.
     pub boxes: Vec<([u32; K], [u32; K])>,
+    /// Single full voxels.
     pub voxels: Vec<[u32; K]>,
 }
 
@@ -34,10 +38,12 @@ impl<const K: usize> fmt::Debug for Obj<K> {
 }
 
 impl<const K: usize> Obj<K> {
+    /// The universe of the object's level.
     pub fn universe(&self) -> Universe<K> {
         Universe::new(self.level).unwrap()
     }
 
+    /// The object as a dense boolean array, in [`Universe::dense_index`] order: the reference.
     pub fn dense(&self) -> Vec<bool> {
         let u = self.universe();
         let mut d = vec![false; u.voxels() as usize];
@@ -52,6 +58,7 @@ impl<const K: usize> Obj<K> {
         d
     }
 
+    /// The object's tree, built from the dense array and checked well formed.
     pub fn tree(&self) -> KTree<K> {
         let t = KTree::from_dense(self.level, &self.dense()).unwrap();
         t.assert_well_formed();

@@ -190,7 +190,7 @@ fn check_drawing(dense: &[bool], d: &LineDrawing) -> Result<(), TestCaseError> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(128))]
+    #![proptest_config(ktree_verify::config(128))]
 
     #[test]
     fn drawn_lines_are_visible_edges_and_visible_edges_are_drawn(dense in objects(), dir in toward()) {
@@ -279,7 +279,7 @@ fn a_zero_direction_is_an_error() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(ktree_verify::config(64))]
 
     /// The pointer-free neighbour search agrees with the dense array: surrounded leaves, and the occupancy
     /// read along every edge of every full leaf from the three cells around it.

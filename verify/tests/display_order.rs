@@ -65,7 +65,7 @@ fn direction() -> impl Strategy<Value = [f64; 3]> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(96))]
+    #![proptest_config(ktree_verify::config(96))]
 
     #[test]
     fn no_later_cell_occludes_an_earlier_one(case in ray_sets::<3>(), d in direction()) {

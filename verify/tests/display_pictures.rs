@@ -13,7 +13,7 @@ use ktree::stacking::stack;
 use proptest::prelude::*;
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(ktree_verify::config(64))]
 
     #[test]
     fn slices_of_4d_trees_match_the_dense_array(case in ray_sets::<4>(), axis in 0..4usize, pos in 0..16u32) {

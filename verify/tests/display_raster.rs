@@ -20,7 +20,7 @@ fn toward() -> impl Strategy<Value = [f64; 3]> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(ktree_verify::config(64))]
 
     #[test]
     fn raster_equals_zbuffer(

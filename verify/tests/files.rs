@@ -52,7 +52,7 @@ where
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+    #![proptest_config(ktree_verify::config(128))]
 
     #[test]
     fn files_round_trip_k1(case in ray_sets::<1>(), at in any::<usize>(), bit in any::<u8>()) { round_trips(&case, at, bit)?; }

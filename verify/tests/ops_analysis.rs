@@ -146,7 +146,7 @@ fn small_pair<const K: usize>() -> impl Strategy<Value = (Obj<K>, Obj<K>)> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+    #![proptest_config(ktree_verify::config(32))]
     #[test] fn separation_k1((a, b) in small_pair::<1>()) { check_separation(&a, &b)?; }
     #[test] fn separation_k2((a, b) in small_pair::<2>()) { check_separation(&a, &b)?; }
     #[test] fn separation_k3((a, b) in small_pair::<3>()) { check_separation(&a, &b)?; }
@@ -154,7 +154,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+    #![proptest_config(ktree_verify::config(64))]
     #[test] fn mass_k1(a in object::<1>()) { check_mass(&a)?; }
     #[test] fn mass_k2(a in object::<2>()) { check_mass(&a)?; }
     #[test] fn mass_k3(a in object::<3>()) { check_mass(&a)?; }

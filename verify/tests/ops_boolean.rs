@@ -60,7 +60,7 @@ fn check_booleans<const K: usize>(a: &Obj<K>, b: &Obj<K>) -> Result<(), TestCase
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+    #![proptest_config(ktree_verify::config(128))]
     #[test]
     fn booleans_match_dense_k1((a, b) in pair::<1>()) { check_booleans(&a, &b)?; }
     #[test]

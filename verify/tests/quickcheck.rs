@@ -1,6 +1,6 @@
-//! The same cross-checks with quickcheck (the design card names both property-testing crates): stacking
-//! equals the dense pyramid on arbitrary small ray sets, and maximal rows tile any run with aligned,
-//! unmergeable rows.
+//! The same cross-checks with a second property-testing crate, quickcheck (its own generators and
+//! shrinking): stacking equals the dense pyramid on arbitrary small ray sets, and maximal rows tile any run
+//! with aligned, unmergeable rows.
 
 use ktree::rays::maximal_rows;
 use ktree::{reference::DensePyramid, stacking::stack};
@@ -62,16 +62,16 @@ fn stacking_equals_dense<const K: usize>(case: SmallRays<K>) -> bool {
 #[test]
 fn quickcheck_stacking_equals_dense_pyramid() {
     QuickCheck::new()
-        .tests(200)
+        .tests(ktree_verify::quickcheck_tests(200))
         .quickcheck(stacking_equals_dense::<1> as fn(SmallRays<1>) -> bool);
     QuickCheck::new()
-        .tests(200)
+        .tests(ktree_verify::quickcheck_tests(200))
         .quickcheck(stacking_equals_dense::<2> as fn(SmallRays<2>) -> bool);
     QuickCheck::new()
-        .tests(200)
+        .tests(ktree_verify::quickcheck_tests(200))
         .quickcheck(stacking_equals_dense::<3> as fn(SmallRays<3>) -> bool);
     QuickCheck::new()
-        .tests(100)
+        .tests(ktree_verify::quickcheck_tests(100))
         .quickcheck(stacking_equals_dense::<4> as fn(SmallRays<4>) -> bool);
 }
 
@@ -94,6 +94,6 @@ fn quickcheck_maximal_rows_tile_and_cannot_merge() {
         tiles && aligned && unmergeable && short
     }
     QuickCheck::new()
-        .tests(2000)
+        .tests(ktree_verify::quickcheck_tests(2000))
         .quickcheck(prop as fn(u32, u32) -> bool);
 }

@@ -166,7 +166,7 @@ fn agrees<const K: usize>(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(ktree_verify::config(64))]
     #[test]
     fn csg_k1((a, b, off) in pair::<1>()) { agrees(&a, &b, off)?; }
     #[test]

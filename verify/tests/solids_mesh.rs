@@ -119,7 +119,7 @@ fn ties_follow_the_documented_rule() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(32))]
+    #![proptest_config(ktree_verify::config(32))]
     /// Octahedra anywhere, on half-voxel grids (ties everywhere) and placed by a transform.
     #[test]
     fn octahedra_are_exact(c in prop::array::uniform3(-4i32..40), r in 1i32..20, s in 1i32..4) {

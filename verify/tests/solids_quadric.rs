@@ -122,7 +122,7 @@ fn named<const K: usize>() -> impl Strategy<Value = Solid<K>> {
 macro_rules! quadric_tests {
     ($k:literal, $raw:ident, $named:ident) => {
         proptest! {
-            #![proptest_config(ProptestConfig::with_cases(48))]
+            #![proptest_config(ktree_verify::config(48))]
             #[test]
             fn $raw(q in matrices::<$k>(), level in 0..=max_level($k), s in sample()) {
                 agrees(&Solid::Quadric(q), level, s)?;
@@ -218,7 +218,7 @@ fn bad_parameters_are_errors() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(24))]
+    #![proptest_config(ktree_verify::config(24))]
     /// Parameters with large denominators give matrices too large for the 64-bit fast path: the 128-bit
     /// path must agree with the brute force too.
     #[test]

@@ -8,7 +8,7 @@ use ktree::stacking::stack;
 use proptest::prelude::*;
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(ktree_verify::config(64))]
     #[test]
     fn samples_become_voxels(
         shape in prop::array::uniform3(1usize..9),

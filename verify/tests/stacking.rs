@@ -68,7 +68,7 @@ where
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+    #![proptest_config(ktree_verify::config(256))]
 
     #[test]
     fn stacking_equals_references_k1(case in ray_sets::<1>()) { stacking_agrees(&case)?; }
@@ -135,7 +135,7 @@ where
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+    #![proptest_config(ktree_verify::config(64))]
 
     #[test]
     fn stacking_at_the_largest_levels(seed in any::<u64>()) {

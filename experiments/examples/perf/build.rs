@@ -13,7 +13,7 @@ use ktree::{
 use crate::measure::{best_of, machine_line, results_path, run_child, Measured};
 
 const LEVELS: [u32; 5] = [6, 7, 8, 9, 10];
-/// Naive insertion is run up to this level (the issue's bound; it is O(voxels · L)).
+/// Naive insertion is run up to this level (it is O(voxels · L)).
 const NAIVE_MAX: u32 = 8;
 /// The dense pyramid needs U^3 bytes and more; run up to this level.
 const DENSE_MAX: u32 = 9;
@@ -127,7 +127,7 @@ pub fn report() -> Result<String, String> {
     let _ = writeln!(
         md,
         "\nThe tree in memory is the navigable tree (2-bit states and their rank index, `KTree::heap_bytes`). \
-         The bar: at L = 10 stacking well under a second on one core, aiming for 0.2 s; OpenVDB \
+         The target: at L = 10 stacking well under a second on one core, aiming for 0.2 s; OpenVDB \
          builds the same sphere from its level-set sphere in about 1.1 s on one core of this machine, and per \
          voxel in about 3 s (quoted figures, not measured here); peak memory far under 1 GiB. \
          Naive insertion is not run above L = {NAIVE_MAX} and the dense pyramid above L = {DENSE_MAX} \

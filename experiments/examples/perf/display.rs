@@ -144,7 +144,7 @@ pub fn report() -> Result<String, String> {
     }
     let _ = writeln!(
         md,
-        "\nThe bar (issue 5): about a second on one core. Measured: {ortho_s:.3} s. Front to back with the \
+        "\nThe target: about a second on one core. Measured: {ortho_s:.3} s. Front to back with the \
          screen coverage mask, only the visible shell of the ball is rasterised; hidden subtrees are culled \
          as soon as their screen rectangle is covered. The painter's order (Meagher's other variant: back to front, \
          later leaves overwrite) draws every full leaf and is shown for comparison.\n"
@@ -178,7 +178,7 @@ pub fn report() -> Result<String, String> {
     }
     let _ = writeln!(
         md,
-        "\nThe bar (issue 5): an L = 7 sphere in seconds, the faster method at least 10× faster than the \
+        "\nThe target: an L = 7 sphere in seconds, the faster method at least 10× faster than the \
          pairwise one. Measured at L = 7: pairwise {:.3} s, bucketed {:.3} s ({:.0}×). Both produce the same \
          drawing (checked by the reproduction and the tests).",
         last.0,

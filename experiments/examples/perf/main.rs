@@ -1,7 +1,7 @@
 //! `cargo run --release --example perf -- AREA`: measures wall time (best of several runs) and peak memory
 //! (the high-water mark of resident memory of a fresh child process per case) and writes
 //! `results/performance/AREA.md`. Criterion benches (`cargo bench`) give the statistically careful
-//! timings; this program records the figures the issues ask for, regenerated rather than typed.
+//! timings; this program records the figures the project tracks, regenerated rather than typed.
 //!
 //! Each area is a module with `cases()` (what to measure) and `report()` (the Markdown table).
 

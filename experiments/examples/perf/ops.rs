@@ -1,4 +1,4 @@
-//! Operations performance (issue 4): Booleans, complement and rotations by reordering on octrees of
+//! Operations performance: Booleans, complement and rotations by reordering on octrees of
 //! L = 10 voxel-centre spheres (rate in input nodes per second on one core), translation and scaling by
 //! overlays, arbitrary rotation of an L = 9 sphere-and-box object, interference and mass.
 
@@ -222,7 +222,7 @@ const CASES: &[(&str, u32, &str)] = &[
 /// Measures every case in a child process and writes `results/performance/ops.md`.
 pub fn report() -> Result<String, String> {
     let mut md = String::new();
-    let _ = writeln!(md, "# Operations on k-trees (issue 4)\n");
+    let _ = writeln!(md, "# Operations on k-trees\n");
     let _ = writeln!(
         md,
         "Regenerate with `cargo run --release --example perf -- ops`. Objects: voxel-centre spheres built \
@@ -271,7 +271,7 @@ pub fn report() -> Result<String, String> {
     }
     let _ = writeln!(
         md,
-        "\nThe bar (issue 4): Booleans and rotations by reordering at least 20 million input nodes per second \
+        "\nThe target: Booleans and rotations by reordering at least 20 million input nodes per second \
          on one core on L = 10 spheres; arbitrary rotation of an L = 9 sphere-and-box in seconds. A Boolean \
          does not visit the part of one input lying under a leaf of the other that decides the result (under \
          an empty node, for an intersection), so input nodes per second overstate the work per node visited; \

@@ -189,9 +189,9 @@ pub fn report() -> Result<String, String> {
     }
     let _ = writeln!(
         md,
-        "\nThe bar (issue 3): the ball's quadric → rays well under 0.1 s; the bunny and a 50 000-triangle mesh \
+        "\nThe target: the ball's quadric → rays well under 0.1 s; the bunny and a 50 000-triangle mesh \
          → rays under a second each; end to end faster than OpenVDB builds the same sphere (about 3 s per \
-         voxel, about 1 s from its level-set sphere on one core here — figures quoted by the issue, not \
+         voxel, about 1 s from its level-set sphere on one core here — quoted figures, not \
          measured here). `?` marks facts a case does not report."
     );
     let path = results_path("solids");

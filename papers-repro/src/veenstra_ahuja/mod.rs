@@ -22,7 +22,7 @@ use ktree::tree::Octree;
 pub const FIG_LEVEL: u32 = 5;
 /// Levels timed for Fig. 12 (every shape), plus the sphere at [`BIG_LEVEL`].
 pub const TIMED_LEVELS: [u32; 3] = [4, 5, 6];
-/// The largest sphere timed (the issue's bar: an L = 7 sphere in seconds, bucketed ≥ 10× faster).
+/// The largest sphere timed (the target: an L = 7 sphere in seconds, bucketed ≥ 10× faster).
 pub const BIG_LEVEL: u32 = 7;
 
 fn w(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {
@@ -371,7 +371,7 @@ fn readme(
          A sphere at level {BIG_LEVEL}: `sphere_l7_normals.png` shaded with the exact surface normals the \
          rays carry (Akman & Franklin keep n1, n2 per ray for display), `sphere_l7_faces.png` by face \
          orientation, `sphere_l7_depth.png` the depth image, `sphere_l7_perspective.png` a 35° perspective view.\n\n\
-         Beyond the paper (issue 5, item 5): `quadtree_disk.png` / `.svg`, a level-5 quadtree of a disc drawn \
+         Beyond the paper: `quadtree_disk.png` / `.svg`, a level-5 quadtree of a disc drawn \
          with its cells; `strip_4d_moving_ball.png`, a level-5 4-D tree (a ball moving along x as time, the \
          fourth axis, passes) shown as six time slices rendered with one camera.\n",
         1u32 << FIG_LEVEL,
@@ -426,7 +426,7 @@ fn readme(
         md,
         "| claim | paper | ours |\n|---|---|---|\n\
          | V7 time vs nodes | up to about 12 000 nodes and about 400 CPU s on a VAX; \"no simple relationship\" between time and nodes; the hidden-line step is quadratic in graphics nodes; time follows image complexity | up to 12 000 nodes the pairwise method takes at most {max_nodes_paper:.3} s here (the paper's seconds are a 1988 VAX's and are not comparable with ours; the shape of the curve is). Quadratic: {tests_note}. Across all rows, log time correlates with log nodes at {corr_nodes:.3} and with log (segments × graphics nodes) at {corr_complexity:.3}: our objects are compact shapes whose complexity grows with their size, so the paper's scatter is milder here. {complexity} |\n\
-         | better than the paper | — | the bucketed method puts the hexagons of the graphics nodes in a screen grid once and tests each segment only against earlier nodes in the buckets it meets: at L = {} (sphere, {} nodes) pairwise {:.3} s, bucketed {:.3} s, {:.0}× faster (the issue's bar: ≥ 10×), the same drawing. |\n",
+         | better than the paper | — | the bucketed method puts the hexagons of the graphics nodes in a screen grid once and tests each segment only against earlier nodes in the buckets it meets: at L = {} (sphere, {} nodes) pairwise {:.3} s, bucketed {:.3} s, {:.0}× faster (the target: ≥ 10×), the same drawing. |\n",
         big.level, big.nodes, big.t_pairwise, big.t_bucketed, big.t_pairwise / big.t_bucketed
     );
     let _ = writeln!(
