@@ -34,6 +34,9 @@ pub struct Args {
     /// Output: rays in the text format, or a tree if the name ends in .ktree.
     #[arg(long)]
     out: PathBuf,
+    /// Worker threads for stacking a tree (default: all cores). The output is the same for any number.
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 const MESH: [&str; 3] = ["obj", "stl", "ply"];
@@ -92,6 +95,6 @@ pub fn run(a: Args) -> Result<(), String> {
         let level = a.level.unwrap_or_else(|| v.fitting_level());
         v.to_rays(level, off, select).map_err(|e| e.to_string())?
     };
-    println!("{}", write_output(&rays, &a.out)?);
+    println!("{}", write_output(&rays, &a.out, a.threads)?);
     Ok(())
 }
