@@ -120,6 +120,14 @@ pub fn report() -> Result<String, String> {
          {WHOLE_MAX} and checked to give as many nodes. File: the `.ktree` written.\n\nMachine: {}.\n",
         machine_line().replace("; one thread used", "")
     );
+    // Other work on the machine takes cores from the two-thread runs: record how busy it was.
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    let load = load.split_whitespace().next().unwrap_or("?");
+    let _ = writeln!(
+        md,
+        "Load average (1 minute) when the measurements started: {load} (on {} cores).\n",
+        std::thread::available_parallelism().map_or(0, |n| n.get())
+    );
     let _ = writeln!(
         md,
         "| L | rays | nodes | 1 thread s | 2 threads s | speed-up | ns/node (1 thread) | peak MiB (1 thread) | peak MiB (2 threads) | whole-set s | whole-set peak MiB | file MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
