@@ -1,8 +1,10 @@
-//! `ktree build --rays FILE --out FILE.ktree`: stack a ray file into a tree file.
+//! `ktree build --rays FILE --out FILE.ktree [--threads N]`: stack a ray file into a tree file.
 
 use std::path::PathBuf;
 
-use ktree::io::read_rays_file;
+use ktree::io::{read_rays_file, AnyRaySet, AnyTree};
+use ktree::stacking::{default_split_depth, stack_partitioned};
+use ktree::{KTree, RaySet};
 
 /// Arguments of `ktree build`.
 #[derive(Debug, clap::Args)]
@@ -13,12 +15,40 @@ pub struct Args {
     /// The tree file to write (written to a temporary file, then renamed).
     #[arg(long)]
     out: PathBuf,
+    /// Worker threads (default: all cores). The tree is the same for any number.
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+/// Runs `work` on a pool of `threads` worker threads (all cores when `None`).
+pub fn with_threads<T: Send>(
+    threads: Option<usize>,
+    work: impl FnOnce() -> T + Send,
+) -> Result<T, String> {
+    if threads == Some(0) {
+        return Err("--threads 0: at least one thread is needed".into());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    Ok(pool.install(work))
+}
+
+/// Stacks rays cell by cell on the current thread pool (see [`ktree::stacking::stack_partitioned`]).
+pub fn stack_cells<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
+    stack_partitioned(rays, default_split_depth(K, rays.level()))
 }
 
 /// Reads the rays, stacks them, writes the tree, and prints a one-line summary.
 pub fn run(args: Args) -> Result<(), String> {
     let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
-    let tree = rays.stack();
+    let tree = with_threads(args.threads, || match &rays {
+        AnyRaySet::K1(r) => AnyTree::K1(stack_cells(r)),
+        AnyRaySet::K2(r) => AnyTree::K2(stack_cells(r)),
+        AnyRaySet::K3(r) => AnyTree::K3(stack_cells(r)),
+        AnyRaySet::K4(r) => AnyTree::K4(stack_cells(r)),
+    })?;
     let write = ktree::with_dim!(&tree, AnyTree, t => crate::tree_file::write(&args.out, t));
     write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
     let c = tree.counts();

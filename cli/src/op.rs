@@ -19,6 +19,9 @@ pub struct Args {
     /// The tree file to write.
     #[arg(long)]
     out: PathBuf,
+    /// Worker threads (default: all cores). The output is the same for any number.
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 /// Reads a tree file, with the path in any error.
@@ -64,8 +67,13 @@ macro_rules! with_pair {
 }
 pub(crate) use with_pair;
 
-/// Runs the operation and writes the result.
+/// Runs the operation and writes the result, on a pool of `--threads` worker threads.
 pub fn run(args: Args) -> Result<(), String> {
+    let threads = args.threads;
+    crate::build::with_threads(threads, || run_op(args))?
+}
+
+fn run_op(args: Args) -> Result<(), String> {
     if args.operation == "not" {
         let [a] = args.inputs.as_slice() else {
             return Err("`ktree op not` takes exactly one input tree".into());

@@ -3,9 +3,11 @@
 use std::path::{Path, PathBuf};
 
 use ktree::io::write_rays_file;
-use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid};
-use ktree::stacking::stack;
-use ktree::RaySet;
+use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSource};
+use ktree::stacking::{default_split_depth, stack_source};
+use ktree::{KTree, RaySet};
+
+use crate::build::{stack_cells, with_threads};
 
 /// Arguments of `ktree rays`.
 #[derive(Debug, clap::Args)]
@@ -59,6 +61,9 @@ pub struct Args {
     /// Output: rays in the text format, or a tree if the name ends in .ktree.
     #[arg(long)]
     out: PathBuf,
+    /// Worker threads (default: all cores). The output is the same for any number.
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 fn numbers(text: &str, n: usize, what: &str) -> Result<Vec<Rational>, String> {
@@ -137,12 +142,14 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
 }
 
 /// Writes rays as text, or stacks them into a `.ktree` file, by the output's extension; returns a summary.
-pub fn write_output<const K: usize>(rays: &RaySet<K>, out: &Path) -> Result<String, String> {
-    let is_tree = out.extension().is_some_and(|e| e == "ktree");
-    if is_tree {
-        let tree = stack(rays);
-        crate::tree_file::write(out, &tree)
-            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+pub fn write_output<const K: usize>(
+    rays: &RaySet<K>,
+    out: &Path,
+    threads: Option<usize>,
+) -> Result<String, String> {
+    if is_tree_file(out) {
+        let tree = with_threads(threads, || stack_cells(rays))?;
+        crate::tree_file::write(out, &tree).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
         let c = tree.counts();
         Ok(format!(
             "{}: K = {K}, L = {}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
@@ -167,6 +174,26 @@ pub fn write_output<const K: usize>(rays: &RaySet<K>, out: &Path) -> Result<Stri
     }
 }
 
+/// Whether an output path names a tree file (`.ktree`) rather than a ray file.
+fn is_tree_file(out: &Path) -> bool {
+    out.extension().is_some_and(|e| e == "ktree")
+}
+
+/// Prints the summary of a tree written to `out`.
+fn tree_summary<const K: usize>(out: &Path, tree: &KTree<K>) -> String {
+    let c = tree.counts();
+    format!(
+        "{}: K = {K}, L = {}, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
+        out.display(),
+        tree.level(),
+        tree.voxel_count(),
+        c.nodes(),
+        c.full,
+        c.empty,
+        c.partial
+    )
+}
+
 fn go<const K: usize>(a: &Args) -> Result<(), String> {
     let s = solid::<K>(a)?;
     let sample = if a.corner {
@@ -174,10 +201,21 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
     } else {
         Sample::Centre
     };
+    if is_tree_file(&a.out) {
+        // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
+        let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
+        let depth = default_split_depth(K, a.level);
+        let tree =
+            with_threads(a.threads, || stack_source(&source, depth))?.map_err(|e| e.to_string())?;
+        crate::tree_file::write(&a.out, &tree)
+            .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+        println!("{}", tree_summary(&a.out, &tree));
+        return Ok(());
+    }
     let rays = s
         .to_rays(a.level, sample, false)
         .map_err(|e| e.to_string())?;
-    println!("{}", write_output(&rays, &a.out)?);
+    println!("{}", write_output(&rays, &a.out, a.threads)?);
     Ok(())
 }
 

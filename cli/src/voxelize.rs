@@ -35,6 +35,9 @@ pub struct Args {
     /// Output: rays in the text format, or a tree if the name ends in .ktree.
     #[arg(long)]
     out: PathBuf,
+    /// Worker threads for stacking a tree (default: all cores). The output is the same for any number.
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 /// Voxelizes the input and writes it.
@@ -86,6 +89,6 @@ pub fn run(a: Args) -> Result<(), String> {
             v.open_edges
         );
     }
-    println!("{}", write_output(&v.rays, &a.out)?);
+    println!("{}", write_output(&v.rays, &a.out, a.threads)?);
     Ok(())
 }

@@ -353,6 +353,11 @@ impl<const K: usize> RaySet<K> {
         }
     }
 
+    /// The column keys and runs, taken apart (normals dropped).
+    pub(crate) fn into_parts(self) -> (Vec<u64>, Vec<(u32, u32)>) {
+        (self.columns, self.runs)
+    }
+
     /// Builds a set directly from sorted, validated parts. Used by crate code that generates runs in order.
     pub(crate) fn from_sorted_parts(
         universe: Universe<K>,

@@ -83,20 +83,52 @@ impl<const K: usize> BoxSolid<K> {
         sample: Sample,
         normals: bool,
     ) -> Result<RaySet<K>, SolidError> {
+        let side = Universe::<K>::new(level)?.side() as u32;
+        self.generate(level, sample, normals, super::MAX_RAYS, 0..side)
+    }
+
+    /// The rays of the columns whose axis-0 coordinate lies in `x` (for `K = 1`, of the one column), as
+    /// [`BoxSolid::to_rays`] makes them, without normals and without a cap on their number.
+    ///
+    /// # Errors
+    /// [`SolidError::Space`] for a bad level.
+    pub fn slab_rays(
+        &self,
+        level: u32,
+        sample: Sample,
+        x: std::ops::Range<u32>,
+    ) -> Result<RaySet<K>, SolidError> {
+        self.generate(level, sample, false, usize::MAX, x)
+    }
+
+    fn generate(
+        &self,
+        level: u32,
+        sample: Sample,
+        normals: bool,
+        max_rays: usize,
+        x: std::ops::Range<u32>,
+    ) -> Result<RaySet<K>, SolidError> {
         let universe = Universe::<K>::new(level)?;
         let side = universe.side() as i64;
         let mut r = self.ranges(level, sample)?;
         for x in r.iter_mut() {
             *x = (x.0.max(0), x.1.min(side - 1));
         }
+        if K > 1 {
+            r[0] = (
+                r[0].0.max(i64::from(x.start)),
+                r[0].1.min(i64::from(x.end) - 1),
+            );
+        }
         let count = r[..K - 1]
             .iter()
             .map(|&(l, h)| (h - l + 1).max(0) as u128)
             .product::<u128>();
-        if count > super::MAX_RAYS as u128 {
+        if count > max_rays as u128 {
             return Err(SolidError::TooManyRays {
                 level,
-                limit: super::MAX_RAYS,
+                limit: max_rays,
             });
         }
         let mut columns = Vec::new();

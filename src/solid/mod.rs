@@ -33,7 +33,12 @@ pub use error::SolidError;
 pub use quadric::{Frame, Quadric, Sample};
 pub use rational::Rational;
 
+use std::borrow::Cow;
+use std::ops::Range;
+
 use crate::rays::RaySet;
+use crate::space::Universe;
+use crate::stacking::{RaySource, SlabRuns};
 
 /// The most runs a quadric or a box generates (about 1.5 GiB of rays); beyond it the generator stops with
 /// [`SolidError::TooManyRays`] instead of exhausting memory.
@@ -66,11 +71,79 @@ impl<const K: usize> Solid<K> {
         }
     }
 
+    /// The rays of the columns whose axis-0 coordinate lies in `x` (see [`Quadric::slab_rays`]).
+    ///
+    /// # Errors
+    /// As [`Quadric::to_rays`].
+    pub fn slab_rays(
+        &self,
+        level: u32,
+        sample: Sample,
+        x: Range<u32>,
+    ) -> Result<RaySet<K>, SolidError> {
+        match self {
+            Solid::Quadric(q) => q.slab_rays(level, sample, x),
+            Solid::Box(b) => b.slab_rays(level, sample, x),
+        }
+    }
+
     /// Whether one voxel is inside (the brute-force reference).
     pub fn contains(&self, level: u32, sample: Sample, point: [u32; K]) -> bool {
         match self {
             Solid::Quadric(q) => q.contains(level, sample, point),
             Solid::Box(b) => b.contains(level, sample, point),
         }
+    }
+}
+
+/// A solid in a universe, producing its rays slab by slab for
+/// [`stack_source`](crate::stacking::stack_source): no whole ray set is held and no cap on the number of
+/// rays applies.
+///
+/// ```
+/// use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
+/// use ktree::stacking::{stack, stack_source};
+/// let ball = Solid::Quadric(Quadric::<3>::ball([Rational::int(16); 3], Rational::int(11), Frame::Voxel).unwrap());
+/// let source = SolidSource::new(&ball, 5, Sample::Centre).unwrap();
+/// let tree = stack_source(&source, 2).unwrap();
+/// assert_eq!(tree, stack(&ball.to_rays(5, Sample::Centre, false).unwrap()));
+/// ```
+#[derive(Debug, Clone)]
+pub struct SolidSource<'a, const K: usize> {
+    solid: &'a Solid<K>,
+    universe: Universe<K>,
+    sample: Sample,
+}
+
+impl<'a, const K: usize> SolidSource<'a, K> {
+    /// The solid's rays in a universe of level `level`.
+    ///
+    /// # Errors
+    /// [`SolidError::Space`] for a bad level.
+    pub fn new(solid: &'a Solid<K>, level: u32, sample: Sample) -> Result<Self, SolidError> {
+        Ok(Self {
+            solid,
+            universe: Universe::new(level)?,
+            sample,
+        })
+    }
+}
+
+impl<const K: usize> RaySource<K> for SolidSource<'_, K> {
+    type Error = SolidError;
+
+    fn universe(&self) -> Universe<K> {
+        self.universe
+    }
+
+    fn slab(&self, x: Range<u32>) -> Result<SlabRuns<'_>, SolidError> {
+        let (keys, runs) = self
+            .solid
+            .slab_rays(self.universe.level(), self.sample, x)?
+            .into_parts();
+        Ok(SlabRuns {
+            keys: Cow::Owned(keys),
+            runs: Cow::Owned(runs),
+        })
     }
 }

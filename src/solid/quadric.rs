@@ -195,6 +195,41 @@ impl<const K: usize> Quadric<K> {
         normals: bool,
         max_rays: usize,
     ) -> Result<RaySet<K>, SolidError> {
+        let side = Universe::<K>::new(level)?.side() as u32;
+        self.generate(level, sample, normals, max_rays, 0..side)
+    }
+
+    /// The rays of the columns whose axis-0 coordinate lies in `x` (for `K = 1`, of the one column), as
+    /// [`Quadric::to_rays`] makes them, without normals and without a cap on their number: a slab of the
+    /// universe, for building a tree slab by slab.
+    ///
+    /// ```
+    /// use ktree::solid::{Frame, Quadric, Rational, Sample};
+    /// let ball = Quadric::<3>::ball([Rational::int(8); 3], Rational::int(6), Frame::Voxel).unwrap();
+    /// let whole = ball.to_rays(4, Sample::Centre, false).unwrap();
+    /// let slab = ball.slab_rays(4, Sample::Centre, 4..8).unwrap();
+    /// assert_eq!(slab.iter().collect::<Vec<_>>(), whole.iter().filter(|r| (4..8).contains(&r.start[0])).collect::<Vec<_>>());
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Quadric::to_rays`].
+    pub fn slab_rays(
+        &self,
+        level: u32,
+        sample: Sample,
+        x: std::ops::Range<u32>,
+    ) -> Result<RaySet<K>, SolidError> {
+        self.generate(level, sample, false, usize::MAX, x)
+    }
+
+    fn generate(
+        &self,
+        level: u32,
+        sample: Sample,
+        normals: bool,
+        max_rays: usize,
+        x: std::ops::Range<u32>,
+    ) -> Result<RaySet<K>, SolidError> {
         let universe = Universe::<K>::new(level)?;
         let largest = self.xi.iter().flatten().map(|v| v.abs()).max().unwrap_or(0);
         // |Vᵀ Ξ V| ≤ (K+1)² · max|Ξ| · max|V|², with max|V| ≤ 2U + 2.
@@ -217,8 +252,11 @@ impl<const K: usize> Quadric<K> {
         };
         if K == 1 {
             gen.column([0; K]);
-        } else {
-            gen.visit([0; K], [side - 1; K]);
+        } else if x.start < x.end {
+            let (mut lo, mut hi) = ([0; K], [side - 1; K]);
+            lo[0] = i64::from(x.start);
+            hi[0] = (i64::from(x.end) - 1).min(side - 1);
+            gen.visit(lo, hi);
         }
         if gen.runs.len() > max_rays {
             return Err(SolidError::TooManyRays {

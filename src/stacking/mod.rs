@@ -1,5 +1,7 @@
 //! Akman & Franklin's stacking: the fast path from a [`RaySet`](crate::RaySet) to the minimal reduced
-//! [`KTree`](crate::KTree), through maximal rows and the dimension-level lists.
+//! [`KTree`](crate::KTree), through maximal rows and the dimension-level lists; and the same tree built
+//! cell by cell ([`stack_partitioned`], [`stack_source`]): cache-sized subtrees on all threads, joined level
+//! by level.
 //!
 //! ```
 //! use ktree::{rays::ball_rays, reference::DensePyramid, stacking::stack_with_stats};

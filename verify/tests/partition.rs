@@ -151,3 +151,53 @@ fn extreme_levels_split_anywhere() {
     check::<3>();
     check::<4>();
 }
+
+/// Solids produce their rays slab by slab: the partitioned build from a quadric or a box equals stacking
+/// its whole ray set, for every split depth.
+fn solid_agrees<const K: usize>(
+    solid: &ktree::solid::Solid<K>,
+    level: u32,
+) -> Result<(), TestCaseError> {
+    use ktree::solid::{Sample, SolidSource};
+    use ktree::stacking::stack_source;
+    let whole = stack(&solid.to_rays(level, Sample::Centre, false).unwrap());
+    let source = SolidSource::new(solid, level, Sample::Centre).unwrap();
+    for depth in 0..=level {
+        let parted = stack_source(&source, depth).unwrap();
+        prop_assert!(parted == whole, "solid at split depth {}", depth);
+    }
+    Ok(())
+}
+
+fn rational(n: i64, d: i64) -> ktree::solid::Rational {
+    ktree::solid::Rational::new(n, d).unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn solids_by_slab_k2(c in prop::array::uniform2(-8i64..72), r in 1i64..60, lo in prop::array::uniform2(-4i64..40), ext in prop::array::uniform2(1i64..40)) {
+        use ktree::solid::{BoxSolid, Frame, Quadric, Solid};
+        let ball = Quadric::<2>::ball(c.map(|v| rational(v, 2)), rational(r, 2), Frame::Voxel).unwrap();
+        solid_agrees(&Solid::Quadric(ball), 5)?;
+        let b = BoxSolid::<2>::new(lo.map(|v| rational(v, 1)), [lo[0] + ext[0], lo[1] + ext[1]].map(|v| rational(v, 1)), Frame::Voxel).unwrap();
+        solid_agrees(&Solid::Box(b), 5)?;
+    }
+
+    #[test]
+    fn solids_by_slab_k3(c in prop::array::uniform3(-8i64..72), r in 1i64..60) {
+        use ktree::solid::{Frame, Quadric, Solid};
+        let ball = Quadric::<3>::ball(c.map(|v| rational(v, 2)), rational(r, 2), Frame::Voxel).unwrap();
+        solid_agrees(&Solid::Quadric(ball), 5)?;
+    }
+
+    #[test]
+    fn solids_by_slab_k1_k4(c in -8i64..40, r in 1i64..30) {
+        use ktree::solid::{Frame, Quadric, Solid};
+        let ball = Quadric::<1>::ball([rational(c, 2)], rational(r, 2), Frame::Voxel).unwrap();
+        solid_agrees(&Solid::Quadric(ball), 4)?;
+        let ball = Quadric::<4>::ball([rational(c, 2); 4], rational(r, 2), Frame::Voxel).unwrap();
+        solid_agrees(&Solid::Quadric(ball), 3)?;
+    }
+}

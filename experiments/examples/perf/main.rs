@@ -9,6 +9,7 @@ mod build;
 mod display;
 mod measure;
 mod ops;
+mod scale;
 mod solids;
 
 use std::process::ExitCode;
@@ -23,6 +24,7 @@ fn main() -> ExitCode {
             "solids" => measure::child(|| solids::run_case(case)),
             "ops" => measure::child(|| ops::run_case(case)),
             "display" => measure::child(|| display::run_case(case)),
+            "scale" => measure::child(|| scale::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -40,8 +42,9 @@ fn main() -> ExitCode {
             "solids" => solids::report(),
             "ops" => ops::report(),
             "display" => display::report(),
+            "scale" => scale::report(),
             other => Err(format!(
-                "unknown area '{other}' (known: build, solids, ops, display)"
+                "unknown area '{other}' (known: build, solids, ops, display, scale)"
             )),
         };
         match result {
