@@ -58,7 +58,7 @@ const NODES_PER_WORD: u64 = 32;
 /// Words between two rank samples.
 const WORDS_PER_SAMPLE: u64 = 64;
 /// Bytes scanned at a time when a file's sections are checked through the map.
-const WINDOW_BYTES: usize = 8 << 20;
+const WINDOW_BYTES: usize = 1 << 20;
 const LOW_BITS: u64 = 0x5555_5555_5555_5555;
 
 #[inline]
@@ -820,7 +820,7 @@ enum Backing {
 /// iteration without loading the levels into memory.
 ///
 /// Opening checks the whole file (the checks listed with the layout in the README) by scanning it through windows of
-/// 8 MiB that are unmapped after use, so the memory a view holds does not grow with the tree; queries then
+/// 1 MiB that are unmapped after use, so the memory a view holds does not grow with the tree; queries then
 /// read only the pages they touch.
 ///
 /// ```
