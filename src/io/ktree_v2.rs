@@ -819,9 +819,9 @@ enum Backing {
 /// A read-only view of a `.ktree` version 2 file through a memory map: statistics, point queries and leaf
 /// iteration without loading the levels into memory.
 ///
-/// Opening checks the whole file (the checks listed with the layout in the README) by scanning it through windows of
-/// 1 MiB that are unmapped after use, so the memory a view holds does not grow with the tree; queries then
-/// read only the pages they touch.
+/// Opening checks the whole file (the checks listed with the layout in the README) by scanning it through
+/// windows of 1 MiB that are unmapped after use, holding besides only one level's rank samples (1/256 of
+/// the level); queries then read only the pages they touch.
 ///
 /// ```
 /// use ktree::{io, KTree};
