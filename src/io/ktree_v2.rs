@@ -58,7 +58,7 @@ const NODES_PER_WORD: u64 = 32;
 /// Words between two rank samples.
 const WORDS_PER_SAMPLE: u64 = 64;
 /// Bytes scanned at a time when a file's sections are checked through the map.
-const WINDOW_BYTES: usize = 8 << 20;
+const WINDOW_BYTES: usize = 1 << 20;
 const LOW_BITS: u64 = 0x5555_5555_5555_5555;
 
 #[inline]
@@ -819,9 +819,9 @@ enum Backing {
 /// A read-only view of a `.ktree` version 2 file through a memory map: statistics, point queries and leaf
 /// iteration without loading the levels into memory.
 ///
-/// Opening checks the whole file (the checks listed with the layout in the README) by scanning it through windows of
-/// 8 MiB that are unmapped after use, so the memory a view holds does not grow with the tree; queries then
-/// read only the pages they touch.
+/// Opening checks the whole file (the checks listed with the layout in the README) by scanning it through
+/// windows of 1 MiB that are unmapped after use, holding besides only one level's rank samples (1/256 of
+/// the level); queries then read only the pages they touch.
 ///
 /// ```
 /// use ktree::{io, KTree};
@@ -963,6 +963,24 @@ impl KtreeView {
         NodeState::from_code(code as u8)
     }
 
+    /// The error for a node that is not what the checks at opening found: the file was changed since.
+    fn changed(&self, depth: usize, index: u64) -> KtreeFileError {
+        let section = &self.layout.sections[depth.min(self.layout.sections.len() - 1)];
+        KtreeFileError {
+            file: self.name.clone(),
+            offset: section.offset + 8 * (index / NODES_PER_WORD),
+            kind: KtreeFileErrorKind::Tree(format!(
+                "node {index} of level {depth} is missing or has the code 11: the file was changed after it was opened"
+            )),
+        }
+    }
+
+    /// The state of a node the tree's shape says exists, or the error of a file changed since opening.
+    fn checked_state(&self, depth: usize, index: u64) -> Result<NodeState, KtreeFileError> {
+        self.state(depth, index)
+            .ok_or_else(|| self.changed(depth, index))
+    }
+
     /// The number of partial nodes before node `index` of level `depth` (`index` < the level's size).
     fn partial_rank(&self, depth: usize, index: u64) -> u64 {
         let s = &self.layout.sections[depth];
@@ -970,10 +988,12 @@ impl KtreeView {
         let block = word / WORDS_PER_SAMPLE;
         let mut rank = u64_at(self.bytes(), (s.samples_offset() + 8 * block) as usize);
         for j in block * WORDS_PER_SAMPLE..word {
-            rank += u64::from(partial_mask(self.word(s, j)).count_ones());
+            rank = rank.saturating_add(u64::from(partial_mask(self.word(s, j)).count_ones()));
         }
         let slot = index % NODES_PER_WORD;
-        rank + u64::from((partial_mask(self.word(s, word)) & slots_mask(slot)).count_ones())
+        rank.saturating_add(u64::from(
+            (partial_mask(self.word(s, word)) & slots_mask(slot)).count_ones(),
+        ))
     }
 
     fn dimension<const K: usize>(&self) -> Result<Universe<K>, KtreeFileError> {
@@ -1002,16 +1022,24 @@ impl KtreeView {
         }
         let mut index = 0u64;
         for depth in 0..self.depth_count() {
-            match self.state(depth, index).expect("checked file") {
+            match self.checked_state(depth, index)? {
                 NodeState::Empty => return Ok(false),
                 NodeState::Full => return Ok(true),
+                NodeState::Partial if depth + 1 >= self.depth_count() => {
+                    return Err(self.changed(depth, index))
+                }
                 NodeState::Partial => {
                     let bit = self.level() - 1 - depth as u32;
                     let code = point
                         .iter()
                         .enumerate()
                         .fold(0u64, |c, (axis, &x)| c | u64::from(x >> bit & 1) << axis);
-                    index = (self.partial_rank(depth, index) << K) + code;
+                    // Saturating: a rank sample changed underneath must not overflow (the node is then
+                    // missing, an error).
+                    index = self
+                        .partial_rank(depth, index)
+                        .saturating_mul(1 << K)
+                        .saturating_add(code);
                 }
             }
         }
@@ -1033,7 +1061,10 @@ impl KtreeView {
         let mut stack = vec![(universe.root(), 0u64)];
         while let Some((cell, index)) = stack.pop() {
             let depth = cell.level as usize;
-            match self.state(depth, index).expect("checked file") {
+            match self.checked_state(depth, index)? {
+                NodeState::Partial if depth + 1 >= self.depth_count() => {
+                    return Err(self.changed(depth, index))
+                }
                 NodeState::Partial => {
                     let first = next_child[depth + 1];
                     next_child[depth + 1] += 1 << K;
@@ -1072,12 +1103,20 @@ impl KtreeView {
             .layout
             .sections
             .iter()
-            .map(|s| {
+            .enumerate()
+            .map(|(depth, s)| {
                 let words = (0..s.words()).map(|j| self.word(s, j)).collect();
-                PackedStates::from_words(words, s.nodes as usize).expect("checked file")
+                PackedStates::from_words(words, s.nodes as usize)
+                    .ok_or_else(|| self.changed(depth, 0))
             })
-            .collect();
-        Ok(KTree::from_levels(universe, levels))
+            .collect::<Result<_, _>>()?;
+        let tree = KTree::from_levels(universe, levels);
+        tree.check().map_err(|e| KtreeFileError {
+            file: self.name.clone(),
+            offset: HEADER_BYTES as u64,
+            kind: KtreeFileErrorKind::Tree(e),
+        })?;
+        Ok(tree)
     }
 }
 
@@ -1196,6 +1235,34 @@ mod tests {
         );
         assert!(e.to_string().contains(&format!("level {last}")), "{e}");
         let _ = tree;
+    }
+
+    #[test]
+    fn a_file_changed_underneath_a_view_gives_errors_not_panics() {
+        use std::io::{Seek, SeekFrom, Write as _};
+        let (tree, bytes) = sample();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.ktree");
+        std::fs::write(&path, &bytes).unwrap();
+        let view = KtreeView::open(&path).unwrap();
+        assert!(view.is_mapped());
+        assert_eq!(view.to_tree::<3>().unwrap(), tree);
+        // Overwrite every section in place with code 11: the map shows the new bytes.
+        let directory_at = view
+            .layout
+            .sections
+            .last()
+            .map(|s| s.offset + s.bytes())
+            .unwrap();
+        let mut f = std::fs::OpenOptions::new().write(true).open(&path).unwrap();
+        f.seek(SeekFrom::Start(HEADER_BYTES as u64)).unwrap();
+        f.write_all(&vec![0xFF; directory_at as usize - HEADER_BYTES])
+            .unwrap();
+        f.sync_all().unwrap();
+        assert!(view.contains([10u32, 12, 14]).is_err());
+        assert!(view.for_each_leaf::<3>(|_, _| {}).is_err());
+        assert!(view.to_tree::<3>().is_err());
+        assert!(KtreeView::open(&path).is_err(), "reopening checks again");
     }
 
     #[test]

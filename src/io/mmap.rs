@@ -26,8 +26,9 @@ impl FileMap {
         // * bytes rewritten in place become visible through the `&[u8]`. The crate only ever copies values
         //   out of the map (`u64::from_le_bytes` on bounds-checked slices) and treats every value as
         //   untrusted data — sizes and offsets come from the directory validated when the file was opened,
-        //   node codes are matched exhaustively — so a concurrent writer yields wrong answers or an error,
-        //   never an out-of-bounds access or an invalid value of a Rust type;
+        //   node codes are matched exhaustively, a node the shape says exists but is not there is an error
+        //   (`KtreeView`'s queries) — so a concurrent writer yields wrong answers or an error, never an
+        //   out-of-bounds access, a panic or an invalid value of a Rust type;
         // * a file truncated underneath makes the kernel raise `SIGBUS` on the first access to a page past
         //   the new end, which terminates the process (it does not corrupt memory).
         // `.ktree` files are written to a temporary file and renamed over the target

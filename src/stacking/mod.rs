@@ -1,7 +1,10 @@
 //! Akman & Franklin's stacking: the fast path from a [`RaySet`](crate::RaySet) to the minimal reduced
-//! [`KTree`](crate::KTree), through maximal rows and the dimension-level lists; and the same tree built
-//! cell by cell ([`stack_partitioned`], [`stack_source`]): cache-sized subtrees on all threads, joined level
-//! by level.
+//! [`KTree`](crate::KTree), through maximal rows and the dimension-level lists — in memory ([`stack`]), with
+//! the lists as sequential disk files ([`stack_with_file_lists`]), or as a pipeline of one thread per stage
+//! ([`stack_pipelined`]); all three build the same tree from the same combine and split steps. The same
+//! tree is also built cell by cell ([`stack_partitioned`], [`stack_source`]): cache-sized subtrees on all
+//! threads, joined level by level; and in parts that run apart, as the ranks of a distributed run do
+//! ([`balanced_slabs`], [`slab_rays`], [`join_parts`]).
 //!
 //! ```
 //! use ktree::{rays::ball_rays, reference::DensePyramid, stacking::stack_with_stats};
@@ -12,12 +15,18 @@
 //! assert_eq!(tree.voxel_count(), ball.voxel_count());
 //! ```
 
+mod distribute;
 mod partition;
+mod pipeline;
 mod radix;
+mod sequential;
 mod stack;
 
+pub use distribute::{balanced_slabs, join_parts, slab_rays};
 pub use partition::{
     default_split_depth, join_subtrees, stack_partitioned, stack_source, RaySource, SlabRuns,
 };
+pub use pipeline::stack_pipelined;
 pub use radix::radix_sort;
+pub use sequential::{stack_with_file_lists, FileListStats};
 pub use stack::{stack, stack_with_stats, StackingStats};

@@ -109,9 +109,7 @@ fn stack_impl<const K: usize>(rays: &RaySet<K>, path: RowPath) -> (KTree<K>, Sta
     let mut stacker = Stacker::<K> {
         universe,
         stages: (1..K).map(|d| Stage::new(K, d, level)).collect(),
-        packed_cells: K as u32 * level + 5 <= 64,
-        cells: Vec::new(),
-        wide_cells: Vec::new(),
+        cells: Cells::new(level),
         stats: StackingStats {
             k: K,
             level,
@@ -141,25 +139,64 @@ fn stack_impl<const K: usize>(rays: &RaySet<K>, path: RowPath) -> (KTree<K>, Sta
         stacker.flush(d);
     }
     let Stacker {
-        packed_cells,
-        mut cells,
-        mut wide_cells,
+        cells,
         mut stats,
-        mut scratch,
+        scratch,
         ..
     } = stacker;
-    // Sort the obels by Morton key (unique: cells are disjoint) and assemble the level-order tree.
-    let tree = if packed_cells {
-        stats.cells = cells.len() as u64;
-        radix_sort(&mut cells, K as u32 * level + 5, &mut scratch);
-        drop(scratch);
-        KTree::from_sorted_packed(universe, &cells)
-    } else {
-        stats.cells = wide_cells.len() as u64;
-        wide_cells.sort_unstable();
-        KTree::from_sorted_morton(universe, &wide_cells)
-    };
-    (tree, stats)
+    stats.cells = cells.len();
+    (cells.into_tree(universe, scratch), stats)
+}
+
+/// The full leaves (items of dimension `K`, the "obels") collected by stacking, assembled into the tree.
+pub(super) struct Cells<const K: usize> {
+    /// Whether cells fit `Morton key << 5 | level` in 64 bits (`K·L + 5 ≤ 64`).
+    packed: bool,
+    /// The cells, packed.
+    keys: Vec<u64>,
+    /// The cells as (Morton key, level) when they do not fit packed.
+    wide: Vec<(u64, u32)>,
+    level: u32,
+}
+
+impl<const K: usize> Cells<K> {
+    pub(super) fn new(level: u32) -> Self {
+        Self {
+            packed: K as u32 * level + 5 <= 64,
+            keys: Vec::new(),
+            wide: Vec::new(),
+            level,
+        }
+    }
+
+    /// Adds the cell of `level` at `origin`.
+    #[inline]
+    pub(super) fn push(&mut self, origin: [u32; K], level: u32) {
+        let key = morton_encode(origin);
+        if self.packed {
+            self.keys.push(key << 5 | u64::from(level));
+        } else {
+            self.wide.push((key, level));
+        }
+    }
+
+    pub(super) fn len(&self) -> u64 {
+        (self.keys.len() + self.wide.len()) as u64
+    }
+
+    /// Sorts the cells by Morton key (unique: cells are disjoint) and assembles the level-order tree.
+    pub(super) fn into_tree(self, universe: Universe<K>, mut scratch: Vec<u64>) -> KTree<K> {
+        if self.packed {
+            let mut keys = self.keys;
+            radix_sort(&mut keys, K as u32 * self.level + 5, &mut scratch);
+            drop(scratch);
+            KTree::from_sorted_packed(universe, &keys)
+        } else {
+            let mut wide = self.wide;
+            wide.sort_unstable();
+            KTree::from_sorted_morton(universe, &wide)
+        }
+    }
 }
 
 /// The streaming pipeline of stages `D = 1 … K−1` and the collected output cells.
@@ -167,12 +204,8 @@ struct Stacker<const K: usize> {
     universe: Universe<K>,
     /// `stages[D − 1]`.
     stages: Vec<Stage>,
-    /// Whether output cells fit `Morton key << 5 | level` in 64 bits (`K·L + 5 ≤ 64`).
-    packed_cells: bool,
-    /// Output cells, packed.
-    cells: Vec<u64>,
-    /// Output cells as (Morton key, level) when they do not fit packed.
-    wide_cells: Vec<(u64, u32)>,
+    /// Output cells.
+    cells: Cells<K>,
     stats: StackingStats,
     /// Items currently held in lists.
     held: u64,
@@ -182,47 +215,105 @@ struct Stacker<const K: usize> {
 }
 
 /// One dimension's lists ι(D, 0 … L) for the current prefix group.
-struct Stage {
+pub(super) struct Stage {
     /// The axis this stage combines along: `K − 1 − D`.
-    axis: usize,
+    pub(super) axis: usize,
     /// Bits of a local key: the `D + 1` fields of axes `a+1 … K−1` and `a`, `L` bits each.
-    local_bits: u32,
+    pub(super) local_bits: u32,
     /// The prefix (axes `0 … a−1`) of the group being collected, if any.
-    prefix: Option<u64>,
+    pub(super) prefix: Option<u64>,
     /// `lists[l]`: local keys of the items at level `l`.
-    lists: Vec<Vec<u64>>,
+    pub(super) lists: Vec<Vec<u64>>,
     /// `half_offsets[l]`: the `2^D` key offsets that split an item of level `l` into its halves.
     half_offsets: Vec<Vec<u64>>,
 }
 
+/// For stage `D` of a `K`-tree in a level-`level` universe, `offsets[l]`: the `2^D` offsets that turn the
+/// key of an item of level `l` into the keys of its halves (fields of axes `a+1 … K−1` at bit `(K − e)·L`,
+/// in a local key as in a whole stage key).
+pub(super) fn half_offsets(k: usize, d: usize, level: u32) -> Vec<Vec<u64>> {
+    let axis = k - 1 - d;
+    (0..=level)
+        .map(|l| {
+            let sh = level - l;
+            if sh == 0 {
+                return Vec::new();
+            }
+            let half = 1u64 << (sh - 1);
+            (0..1usize << d)
+                .map(|m| {
+                    (0..d)
+                        .filter(|j| m >> j & 1 == 1)
+                        .map(|j| half << ((k - (axis + 1 + j)) as u32 * level))
+                        .sum()
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Packs an origin into the key of the stage combining along `axis`: fields (most significant first) axes
+/// `0…a−1`, axes `a+1…K−1`, then axis `a`, `level` bits each.
+#[inline]
+pub(super) fn pack_key<const K: usize>(level: u32, axis: usize, origin: [u32; K]) -> u64 {
+    let mut key = 0u64;
+    for (i, &c) in origin.iter().enumerate() {
+        if i != axis {
+            key = key << level | u64::from(c);
+        }
+    }
+    key << level | u64::from(origin[axis])
+}
+
+/// The origin of a key packed by [`pack_key`].
+#[inline]
+pub(super) fn unpack_key<const K: usize>(level: u32, axis: usize, mut key: u64) -> [u32; K] {
+    let mask = (1u64 << level) - 1;
+    let mut origin = [0u32; K];
+    origin[axis] = (key & mask) as u32;
+    key >>= level;
+    for i in (0..K).rev().filter(|&i| i != axis) {
+        origin[i] = (key & mask) as u32;
+        key >>= level;
+    }
+    origin
+}
+
 impl Stage {
-    fn new(k: usize, d: usize, level: u32) -> Self {
-        let axis = k - 1 - d;
-        // In a local key the field of axis e (a < e < K) sits at bit (K − e)·L.
-        let half_offsets = (0..=level)
-            .map(|l| {
-                let sh = level - l;
-                if sh == 0 {
-                    return Vec::new();
-                }
-                let half = 1u64 << (sh - 1);
-                (0..1usize << d)
-                    .map(|m| {
-                        (0..d)
-                            .filter(|j| m >> j & 1 == 1)
-                            .map(|j| half << ((k - (axis + 1 + j)) as u32 * level))
-                            .sum()
-                    })
-                    .collect()
-            })
-            .collect();
+    pub(super) fn new(k: usize, d: usize, level: u32) -> Self {
         Self {
-            axis,
+            axis: k - 1 - d,
             local_bits: (d as u32 + 1) * level,
             prefix: None,
             lists: vec![Vec::new(); level as usize + 1],
-            half_offsets,
+            half_offsets: half_offsets(k, d, level),
         }
+    }
+
+    /// Sorts `list`, the items of level `l` (of a universe of level `top`), and combines or splits them:
+    /// each combined group's first key goes to `on_combined`, the halves of every split item to
+    /// `self.lists[l + 1]`. Returns the number of items split.
+    pub(super) fn combine_level(
+        &mut self,
+        l: usize,
+        list: &mut Vec<u64>,
+        top: u32,
+        scratch: &mut Vec<u64>,
+        on_combined: impl FnMut(u64),
+    ) -> u64 {
+        let sh = top - l as u32;
+        // At the voxel level every item combines on its own: no need to sort.
+        if sh > 0 {
+            radix_sort(list, self.local_bits, scratch);
+        }
+        let offsets = &self.half_offsets[l];
+        let mut next = self.lists.get_mut(l + 1);
+        combine_or_split(list, sh, on_combined, |key| {
+            let next = next
+                .as_deref_mut()
+                .expect("items split only above the voxel level");
+            next.extend(offsets.iter().map(|&o| key + o));
+        })
     }
 }
 
@@ -230,27 +321,11 @@ impl<const K: usize> Stacker<K> {
     /// Packs an origin into stage `D`'s key: fields (most significant first) axes `0…a−1`, axes `a+1…K−1`,
     /// then axis `a`, `L` bits each.
     fn pack(&self, axis: usize, origin: [u32; K]) -> u64 {
-        let level = self.universe.level();
-        let mut key = 0u64;
-        for (i, &c) in origin.iter().enumerate() {
-            if i != axis {
-                key = key << level | u64::from(c);
-            }
-        }
-        key << level | u64::from(origin[axis])
+        pack_key(self.universe.level(), axis, origin)
     }
 
-    fn unpack(&self, axis: usize, mut key: u64) -> [u32; K] {
-        let level = self.universe.level();
-        let mask = (1u64 << level) - 1;
-        let mut origin = [0u32; K];
-        origin[axis] = (key & mask) as u32;
-        key >>= level;
-        for i in (0..K).rev().filter(|&i| i != axis) {
-            origin[i] = (key & mask) as u32;
-            key >>= level;
-        }
-        origin
+    fn unpack(&self, axis: usize, key: u64) -> [u32; K] {
+        unpack_key(self.universe.level(), axis, key)
     }
 
     fn hold(&mut self, n: u64) {
@@ -261,12 +336,7 @@ impl<const K: usize> Stacker<K> {
     /// Puts an item of dimension `d` (1 ≤ d ≤ K) at `level` into its list (or, for `d = K`, the output).
     fn feed(&mut self, d: usize, level: u32, origin: [u32; K]) {
         if d == K {
-            let key = morton_encode(origin);
-            if self.packed_cells {
-                self.cells.push(key << 5 | u64::from(level));
-            } else {
-                self.wide_cells.push((key, level));
-            }
+            self.cells.push(origin, level);
             return;
         }
         let stage = &self.stages[d - 1];
@@ -296,7 +366,6 @@ impl<const K: usize> Stacker<K> {
             return;
         };
         let top = self.universe.level();
-        let local_bits = self.stages[d - 1].local_bits;
         let mut list = Vec::new();
         for l in 0..=top as usize {
             std::mem::swap(&mut list, &mut self.stages[d - 1].lists[l]);
@@ -304,26 +373,11 @@ impl<const K: usize> Stacker<K> {
                 continue;
             }
             self.held -= list.len() as u64;
-            let sh = top - l as u32;
-            // At the voxel level every item combines on its own: no need to sort.
-            if sh > 0 {
-                radix_sort(&mut list, local_bits, &mut self.scratch);
-            }
             let mut combined = std::mem::take(&mut self.combined_buf);
-            let stage = &mut self.stages[d - 1];
-            let offsets = &stage.half_offsets[l];
-            let mut next = stage.lists.get_mut(l + 1);
-            let split = combine_or_split(
-                &list,
-                sh,
-                |key| combined.push((key, l as u32)),
-                |key| {
-                    let next = next
-                        .as_deref_mut()
-                        .expect("items split only above the voxel level");
-                    next.extend(offsets.iter().map(|&o| key + o));
-                },
-            );
+            let split =
+                self.stages[d - 1].combine_level(l, &mut list, top, &mut self.scratch, |key| {
+                    combined.push((key, l as u32))
+                });
             list.clear();
             self.stats.split[d - 1][l] += split;
             self.stats.combined[d - 1][l] += combined.len() as u64;
@@ -461,7 +515,7 @@ impl<const K: usize> Stacker<K> {
 /// with exactly `2^sh` members combines (`on_combined` gets the run's first key with the low `sh` bits
 /// cleared); every member of any other run is split (`on_split` gets its key). Returns the number of items
 /// split.
-fn combine_or_split(
+pub(super) fn combine_or_split(
     list: &[u64],
     sh: u32,
     mut on_combined: impl FnMut(u64),
