@@ -3,8 +3,6 @@
 use std::path::PathBuf;
 
 use ktree::io::{read_ktree_file, read_rays_file, AnyTree};
-use ktree::LevelCounts;
-use serde::Serialize;
 
 /// Arguments of `ktree stats`.
 #[derive(Debug, clap::Args)]
@@ -20,21 +18,6 @@ pub struct Args {
     json: bool,
 }
 
-/// The statistics printed, with the JSON keys users' scripts rely on.
-#[derive(Debug, Serialize)]
-struct Stats {
-    k: usize,
-    level: u32,
-    /// Runs in the ray file; `null` for a tree file.
-    rays: Option<u64>,
-    full: u64,
-    empty: u64,
-    partial: u64,
-    nodes: u64,
-    bytes_at_2_bits: u64,
-    per_level: Vec<LevelCounts>,
-}
-
 /// Prints the statistics.
 pub fn run(args: Args) -> Result<(), String> {
     let (tree, rays): (AnyTree, Option<u64>) = match (&args.tree, &args.rays) {
@@ -45,18 +28,8 @@ pub fn run(args: Args) -> Result<(), String> {
         }
         _ => return Err("give either a .ktree file or --rays FILE".into()),
     };
-    let c = tree.counts();
-    let stats = Stats {
-        k: tree.k(),
-        level: tree.level(),
-        rays,
-        full: c.full,
-        empty: c.empty,
-        partial: c.partial,
-        nodes: c.nodes(),
-        bytes_at_2_bits: tree.bytes_at_two_bits(),
-        per_level: tree.counts_per_level(),
-    };
+    // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
+    let stats = tree.stats(rays);
     if args.json {
         println!(
             "{}",

@@ -6,6 +6,7 @@ mod atomic;
 mod ktree_file;
 mod rays_text;
 
+pub use any::TreeStats;
 pub use any::{AnyRaySet, AnyTree};
 pub use atomic::{write_atomic, write_atomic_with};
 pub use ktree_file::{
