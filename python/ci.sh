@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The Python module `ktree`: installs it with `pip install ./python` into a fresh virtual environment and runs
-# its pytest suite (python/tests/) against numpy references and the command-line tool's JSON. Exits non-zero
-# on any failure, including a run that collected no test.
+# its pytest suite (python/tests/) against numpy references and the command-line tool's JSON, after checking
+# the type stubs with mypy's stubtest. Exits non-zero on any failure, including a run that collected no test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -21,7 +21,7 @@ fi
 export PATH="$venv/bin:$PATH" # maturin, for the build without isolation below
 pip=("$venv/bin/python" -m pip)
 "${pip[@]}" install --quiet --upgrade pip
-"${pip[@]}" install --quiet maturin numpy pytest
+"${pip[@]}" install --quiet maturin numpy pytest mypy
 # The module (a release build of the extension, in the workspace's target folder).
 "${pip[@]}" install --no-build-isolation ./python
 
@@ -29,8 +29,10 @@ pip=("$venv/bin/python" -m pip)
 cargo build --quiet -p ktree-cli
 export KTREE_BIN="$root/target/debug/ktree"
 
+# The installed type stubs against the installed module.
+"$venv/bin/python" -m mypy.stubtest ktree --allowlist python/stubtest-allowlist.txt
 status=0
-(cd "$root/python" && "$venv/bin/python" -m pytest -q -p no:cacheprovider tests) || status=$?
+(cd python && "$venv/bin/python" -m pytest -q -p no:cacheprovider tests) || status=$?
 if [ "$status" -eq 5 ]; then
   echo "python/ci.sh: pytest collected no test" >&2
   exit 1

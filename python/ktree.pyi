@@ -7,23 +7,24 @@ are ``ValueError`` (bad input) or ``OSError`` (files) with the library's message
 
 from fractions import Fraction
 from os import PathLike
-from typing import Any, Optional, Sequence, Tuple, TypedDict, Union
+from typing import Optional, Sequence, Tuple, TypedDict, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+__all__ = ["Tree", "__version__"]
 
 _Path = Union[str, PathLike[str]]
 _View = Union[str, Sequence[float]]
 
-class LevelCounts(TypedDict):
+class _LevelCounts(TypedDict):
     level: int
     full: int
     empty: int
     partial: int
 
-class Stats(TypedDict):
+class _Stats(TypedDict):
     k: int
     level: int
     rays: Optional[int]
@@ -32,31 +33,32 @@ class Stats(TypedDict):
     partial: int
     nodes: int
     bytes_at_2_bits: int
-    per_level: list[LevelCounts]
+    per_level: list[_LevelCounts]
 
-class ProgressiveLevel(TypedDict):
+class _ProgressiveLevel(TypedDict):
     level: int
     lower: int
     upper: int
     nodes_touched: int
 
-class Mass(TypedDict):
+class _Mass(TypedDict):
     k: int
     volume: int
     centroid: list[float]
     central_moments: list[list[float]]
     inertia_tensor: list[list[float]]
     nodes: int
-    progressive: Optional[list[ProgressiveLevel]]
+    progressive: Optional[list[_ProgressiveLevel]]
     estimate: Optional[float]
 
-class Collision(TypedDict):
+class _Collision(TypedDict):
     collide: bool
     overlap_cells: int
     overlap_voxels: int
     first_contact: Optional[int]
     min_separation: Optional[float]
 
+@final
 class Tree:
     """A k-tree of dimension K = 1...4 over a universe of side 2**level; immutable, compared by content."""
 
@@ -94,9 +96,10 @@ class Tree:
         *,
         label: Optional[float] = None,
         level: Optional[int] = None,
-        offset: Tuple[int, int, int] = (0, 0, 0),
+        offset: Optional[Tuple[int, int, int]] = None,
     ) -> Tree:
-        """The octree of a volume file (.json sidecar, .raw, .nii, .nii.gz): samples >= threshold (or == label)."""
+        """The octree of a volume file (.json sidecar, .raw, .nii, .nii.gz): samples >= threshold (or == label),
+        sample (0, 0, 0) at voxel `offset` (default (0, 0, 0))."""
     @staticmethod
     def load(path: _Path) -> Tree:
         """Reads a tree file, the format chosen by the extension."""
@@ -123,7 +126,7 @@ class Tree:
         """The voxels as maximal runs: an (n, K + 1) array as from_rays reads."""
     def contains(self, point: Sequence[int]) -> bool:
         """Whether the voxel at `point` is inside."""
-    def stats(self) -> Stats:
+    def stats(self) -> _Stats:
         """Node counts, with the keys of `ktree stats --json`."""
     def translate(self, offset: Sequence[float]) -> Tree:
         """Translated by K numbers (exact for integers)."""
@@ -133,11 +136,11 @@ class Tree:
         """Scaled about the origin corner (exact for ints and Fractions)."""
     def affine(self, matrix: npt.ArrayLike) -> Tree:
         """Mapped by a homogeneous (K + 1) x (K + 1) matrix (projective if the last row is not 0 ... 0 1)."""
-    def mass(self, tolerance: Optional[float] = None) -> Mass:
+    def mass(self, tolerance: Optional[float] = None) -> _Mass:
         """Volume, centroid and second moments, with the keys of `ktree mass --json`."""
     def interferes(self, other: Tree) -> bool:
         """Whether the objects share a voxel."""
-    def collide(self, other: Tree, time_axis: Optional[int] = None) -> Collision:
+    def collide(self, other: Tree, time_axis: Optional[int] = None) -> _Collision:
         """Interference, with the keys of `ktree collide --json`."""
     def render(
         self,
@@ -160,9 +163,13 @@ class Tree:
         method: str = "bucketed",
     ) -> str:
         """An SVG line drawing of an octree with hidden lines removed."""
-    def __or__(self, other: Tree) -> Tree: ...
-    def __and__(self, other: Tree) -> Tree: ...
-    def __sub__(self, other: Tree) -> Tree: ...
-    def __xor__(self, other: Tree) -> Tree: ...
+    def __or__(self, other: Tree, /) -> Tree: ...
+    def __and__(self, other: Tree, /) -> Tree: ...
+    def __sub__(self, other: Tree, /) -> Tree: ...
+    def __xor__(self, other: Tree, /) -> Tree: ...
+    def __ror__(self, other: Tree, /) -> Tree: ...
+    def __rand__(self, other: Tree, /) -> Tree: ...
+    def __rsub__(self, other: Tree, /) -> Tree: ...
+    def __rxor__(self, other: Tree, /) -> Tree: ...
     def __invert__(self) -> Tree: ...
-    def __eq__(self, other: Any) -> bool: ...
+    def __eq__(self, other: object, /) -> bool: ...

@@ -372,18 +372,19 @@ impl Tree {
     }
 
     /// The octree of a volume file (a .json sidecar or its .raw, .nii, .nii.gz): samples with value
-    /// `>= threshold` (or `== label`) are inside. The volume's sample (0, 0, 0) goes to voxel `offset`;
-    /// `level` defaults to the smallest that holds the volume.
+    /// `>= threshold` (or `== label`) are inside. The volume's sample (0, 0, 0) goes to voxel `offset`
+    /// (default (0, 0, 0)); `level` defaults to the smallest that holds the volume.
     #[staticmethod]
-    #[pyo3(signature = (path, threshold = None, *, label = None, level = None, offset = (0, 0, 0)))]
+    #[pyo3(signature = (path, threshold = None, *, label = None, level = None, offset = None))]
     fn from_volume(
         py: Python<'_>,
         path: PathBuf,
         threshold: Option<f64>,
         label: Option<f64>,
         level: Option<u32>,
-        offset: (u32, u32, u32),
+        offset: Option<(u32, u32, u32)>,
     ) -> PyResult<Self> {
+        let offset = offset.unwrap_or((0, 0, 0));
         let select = match (threshold, label) {
             (Some(t), None) => Select::AtLeast(t),
             (None, Some(l)) => Select::Label(l),

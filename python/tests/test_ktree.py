@@ -610,3 +610,21 @@ def test_readme_session_runs(monkeypatch, capsys):
     exec(compile(session, "README.md", "exec"), {})
     printed = capsys.readouterr().out.split()
     assert int(printed[0]) > 1 and printed[-1] == "3)"  # nodes ... (300, 400, 3)
+
+
+def test_calls_from_threads_agree_with_serial_calls(rng):
+    # Long calls release the GIL: several threads then run inside the library at once.
+    from concurrent.futures import ThreadPoolExecutor
+
+    arrays = [random_object(rng, 3, 4) for _ in range(8)]
+
+    def work(a):
+        t = ktree.Tree.from_dense(a)
+        return (t | t.rotate(90, "z")).to_dense(), t.render(width=24, height=24)
+
+    serial = [work(a) for a in arrays]
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        parallel = list(pool.map(work, arrays))
+    for (d1, i1), (d2, i2) in zip(serial, parallel):
+        np.testing.assert_array_equal(d1, d2)
+        np.testing.assert_array_equal(i1, i2)
