@@ -7,7 +7,7 @@ are ``ValueError`` (bad input) or ``OSError`` (files) with the library's message
 
 from fractions import Fraction
 from os import PathLike
-from typing import Optional, Sequence, Tuple, TypedDict, Union, final
+from typing import Any, Optional, Sequence, Tuple, TypedDict, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -105,6 +105,12 @@ class Tree:
         """Reads a tree file, the format chosen by the extension."""
     def save(self, path: _Path) -> None:
         """Writes the tree atomically, the format chosen by the extension."""
+    def to_bytes(self) -> bytes:
+        """The tree in the .ktree format (2 bits a node, with a checksum)."""
+    @staticmethod
+    def from_bytes(data: bytes) -> Tree:
+        """The tree of .ktree bytes."""
+    def __reduce__(self) -> tuple[Any, tuple[bytes]]: ...
     @property
     def k(self) -> int:
         """The dimension K."""

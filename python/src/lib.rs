@@ -21,7 +21,7 @@ use numpy::{
 };
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::{PyBytes, PyDict, PyString};
 
 mod failure;
 mod files;
@@ -411,6 +411,32 @@ impl Tree {
     /// Writes the tree (atomically: a temporary file renamed); the format is chosen by the extension.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         Ok(py.detach(|| files::write_tree(&path, &self.inner))?)
+    }
+
+    /// The tree in the `.ktree` format (2 bits a node, with a checksum), as bytes.
+    fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = py.detach(|| {
+            let mut out = Vec::new();
+            with_dim!(&self.inner, AnyTree, t => ktree::io::write_ktree(&mut out, t)).map(|()| out)
+        });
+        let bytes = bytes.map_err(Failure::value)?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    /// The tree of bytes in the `.ktree` format (as `to_bytes` gives).
+    #[staticmethod]
+    fn from_bytes(py: Python<'_>, data: &[u8]) -> PyResult<Self> {
+        let tree =
+            py.detach(|| ktree::io::read_ktree_any(data, "<bytes>").map_err(Failure::value))?;
+        Ok(Self { inner: tree })
+    }
+
+    /// Pickling: the tree is rebuilt from its `.ktree` bytes.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+        let rebuild = slf.get_type().getattr("from_bytes")?;
+        Ok((rebuild, (slf.get().to_bytes(slf.py())?,)))
     }
 
     /// The dimension K.

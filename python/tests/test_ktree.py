@@ -472,6 +472,19 @@ def test_save_load_round_trip(tmp_path, rng, k, ext):
     assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporary file left
 
 
+@pytest.mark.parametrize("k", [1, 2, 3, 4])
+def test_bytes_and_pickle_round_trip(tmp_path, rng, k):
+    import pickle
+
+    t = ktree.Tree.from_dense(random_object(rng, k, LEVELS[k]))
+    t.save(tmp_path / "t.ktree")
+    assert t.to_bytes() == (tmp_path / "t.ktree").read_bytes()
+    assert ktree.Tree.from_bytes(t.to_bytes()) == t
+    assert pickle.loads(pickle.dumps(t)) == t
+    with pytest.raises(ValueError, match="<bytes>: byte"):
+        ktree.Tree.from_bytes(t.to_bytes()[:-1])
+
+
 def test_file_errors_name_the_file(tmp_path):
     with pytest.raises(OSError):
         ktree.Tree.load(tmp_path / "missing.ktree")
