@@ -3,10 +3,8 @@
 
 use std::path::PathBuf;
 
-use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, VERSION_2};
+use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, TreeStats, VERSION_2};
 use ktree::tree::heap_bytes_for_levels;
-use ktree::LevelCounts;
-use serde::Serialize;
 
 /// Arguments of `ktree stats`.
 #[derive(Debug, clap::Args)]
@@ -22,84 +20,38 @@ pub struct Args {
     json: bool,
 }
 
-/// The statistics printed, with the JSON keys users' scripts rely on.
-#[derive(Debug, Serialize)]
-struct Stats {
-    k: usize,
-    level: u32,
-    /// Runs in the ray file; `null` for a tree file.
-    rays: Option<u64>,
-    full: u64,
-    empty: u64,
-    partial: u64,
-    nodes: u64,
-    bytes_at_2_bits: u64,
-    /// Heap bytes of the navigable tree in memory (states and rank index).
-    memory_bytes: u64,
-    per_level: Vec<LevelCounts>,
-}
-
-impl Stats {
-    fn new(
-        k: usize,
-        rays: Option<u64>,
-        c: LevelCounts,
-        bytes: u64,
-        memory_bytes: u64,
-        per_level: Vec<LevelCounts>,
-    ) -> Self {
-        Self {
-            k,
-            level: c.level,
-            rays,
-            full: c.full,
-            empty: c.empty,
-            partial: c.partial,
-            nodes: c.nodes(),
-            bytes_at_2_bits: bytes,
-            memory_bytes,
-            per_level,
-        }
+/// The statistics of a version 2 file, read through its memory map (the tree is not loaded; its memory is
+/// what the navigable tree would take).
+fn view_stats(view: &KtreeView) -> TreeStats {
+    let c = view.counts();
+    let per_level = view.counts_per_level();
+    TreeStats {
+        k: view.k(),
+        level: view.level(),
+        rays: None,
+        full: c.full,
+        empty: c.empty,
+        partial: c.partial,
+        nodes: c.nodes(),
+        bytes_at_2_bits: view.bytes_at_two_bits(),
+        memory_bytes: heap_bytes_for_levels(&per_level) as u64,
+        per_level,
     }
 }
 
 /// Prints the statistics.
 pub fn run(args: Args) -> Result<(), String> {
+    // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
     let stats = match (&args.tree, &args.rays) {
         (Some(path), None) if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION_2 => {
-            let view = KtreeView::open(path).map_err(|e| e.to_string())?;
-            Stats::new(
-                view.k(),
-                None,
-                view.counts(),
-                view.bytes_at_two_bits(),
-                heap_bytes_for_levels(&view.counts_per_level()) as u64,
-                view.counts_per_level(),
-            )
+            view_stats(&KtreeView::open(path).map_err(|e| e.to_string())?)
         }
-        (Some(path), None) => {
-            let tree = read_ktree_file(path).map_err(|e| e.to_string())?;
-            Stats::new(
-                tree.k(),
-                None,
-                tree.counts(),
-                tree.bytes_at_two_bits(),
-                tree.heap_bytes() as u64,
-                tree.counts_per_level(),
-            )
-        }
+        (Some(path), None) => read_ktree_file(path)
+            .map_err(|e| e.to_string())?
+            .stats(None),
         (None, Some(path)) => {
             let rays = read_rays_file(path).map_err(|e| e.to_string())?;
-            let tree = rays.stack();
-            let n = Some(rays.len() as u64);
-            Stats::new(
-                tree.k(),
-                n,
-                tree.counts(),
-                tree.bytes_at_two_bits(),
-                tree.heap_bytes() as u64,
-                tree.counts_per_level(),
-            )
+            rays.stack().stats(Some(rays.len() as u64))
         }
         _ => return Err("give either a .ktree file or --rays FILE".into()),
     };

@@ -3,6 +3,41 @@
 use crate::rays::RaySet;
 use crate::tree::{KTree, LevelCounts};
 
+/// The statistics of a tree: its dimension, level, node counts and size. With the `serde` feature these
+/// are the keys of `ktree stats --json`.
+///
+/// ```
+/// use ktree::{io::AnyTree, KTree};
+/// let tree = AnyTree::from(KTree::<2>::from_dense(1, &[true, false, false, false]).unwrap());
+/// let s = tree.stats(None);
+/// assert_eq!((s.k, s.level, s.nodes, s.full, s.partial), (2, 1, 5, 1, 1));
+/// assert_eq!(s.per_level.len(), 2);
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct TreeStats {
+    /// The dimension `K`.
+    pub k: usize,
+    /// The universe level `L`.
+    pub level: u32,
+    /// Runs of the ray set the tree was stacked from, where there was one.
+    pub rays: Option<u64>,
+    /// Full nodes.
+    pub full: u64,
+    /// Empty nodes.
+    pub empty: u64,
+    /// Partial nodes.
+    pub partial: u64,
+    /// All nodes.
+    pub nodes: u64,
+    /// Bytes at 2 bits a node.
+    pub bytes_at_2_bits: u64,
+    /// Heap bytes of the navigable tree in memory (states and rank index, [`crate::KTree::heap_bytes`]).
+    pub memory_bytes: u64,
+    /// Node counts per level, the root's first.
+    pub per_level: Vec<LevelCounts>,
+}
+
 /// A [`KTree`] of any supported dimension, as read from a file whose header names `K`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum AnyTree {
@@ -77,6 +112,23 @@ impl AnyTree {
     /// Bytes of memory held by the navigable tree (see [`crate::KTree::heap_bytes`]).
     pub fn heap_bytes(&self) -> usize {
         with_dim!(self, AnyTree, t => t.heap_bytes())
+    }
+
+    /// The statistics, with `rays` the number of runs the tree was stacked from (if it was).
+    pub fn stats(&self, rays: Option<u64>) -> TreeStats {
+        let c = self.counts();
+        TreeStats {
+            k: self.k(),
+            level: self.level(),
+            rays,
+            full: c.full,
+            empty: c.empty,
+            partial: c.partial,
+            nodes: c.nodes(),
+            bytes_at_2_bits: self.bytes_at_two_bits(),
+            memory_bytes: self.heap_bytes() as u64,
+            per_level: self.counts_per_level(),
+        }
     }
 }
 

@@ -29,6 +29,7 @@ mod mmap;
 mod octomap_bt;
 mod rays_text;
 
+pub use any::TreeStats;
 pub use any::{AnyRaySet, AnyTree};
 pub use atomic::{write_atomic, write_atomic_with};
 pub use binvox::{read_binvox, write_binvox, BINVOX_MAX_DIM};

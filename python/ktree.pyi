@@ -1,0 +1,181 @@
+"""k-trees (bintrees, quadtrees, octrees, 4-D trees) with numpy arrays in and out.
+
+Coordinates are ``[x, y, z, ...]`` as in the ``ktree`` command-line tool: a dense array ``a`` has
+``a[x, y, z]`` for voxel (x, y, z), and rays run along the last axis. Long calls release the GIL; errors
+are ``ValueError`` (bad input) or ``OSError`` (files) with the library's message.
+"""
+
+from fractions import Fraction
+from os import PathLike
+from typing import Any, Optional, Sequence, Tuple, TypedDict, Union, final
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+__all__ = ["Tree", "__version__"]
+
+_Path = Union[str, PathLike[str]]
+_View = Union[str, Sequence[float]]
+
+class _LevelCounts(TypedDict):
+    level: int
+    full: int
+    empty: int
+    partial: int
+
+class _Stats(TypedDict):
+    k: int
+    level: int
+    rays: Optional[int]
+    full: int
+    empty: int
+    partial: int
+    nodes: int
+    bytes_at_2_bits: int
+    per_level: list[_LevelCounts]
+
+class _ProgressiveLevel(TypedDict):
+    level: int
+    lower: int
+    upper: int
+    nodes_touched: int
+
+class _Mass(TypedDict):
+    k: int
+    volume: int
+    centroid: list[float]
+    central_moments: list[list[float]]
+    inertia_tensor: list[list[float]]
+    nodes: int
+    progressive: Optional[list[_ProgressiveLevel]]
+    estimate: Optional[float]
+
+class _Collision(TypedDict):
+    collide: bool
+    overlap_cells: int
+    overlap_voxels: int
+    first_contact: Optional[int]
+    min_separation: Optional[float]
+
+@final
+class Tree:
+    """A k-tree of dimension K = 1...4 over a universe of side 2**level; immutable, compared by content."""
+
+    @staticmethod
+    def from_dense(array: npt.ArrayLike, level: Optional[int] = None) -> Tree:
+        """The tree of a boolean array indexed [x, y, z, ...] (K = ndim), placed at the origin of a universe
+        of level `level` (default: the smallest holding the longest axis)."""
+    @staticmethod
+    def empty(k: int, level: int) -> Tree:
+        """The empty tree."""
+    @staticmethod
+    def full(k: int, level: int) -> Tree:
+        """The whole universe."""
+    @staticmethod
+    def from_rays(rays: npt.ArrayLike, level: int) -> Tree:
+        """The tree of an (n, K + 1) integer array of runs: the column's K - 1 coordinates, z1, z2
+        (covering z1 <= z < z2 on the last axis)."""
+    @staticmethod
+    def from_mesh(
+        path: _Path, level: int, transform: Optional[Tuple[float, float, float, float]] = None
+    ) -> Tree:
+        """The octree of an OBJ, STL or PLY mesh; `transform` (s, tx, ty, tz) maps v to s*v + t, default: fit."""
+    @staticmethod
+    def from_mesh_arrays(
+        vertices: npt.ArrayLike,
+        faces: npt.ArrayLike,
+        level: int,
+        transform: Optional[Tuple[float, float, float, float]] = None,
+    ) -> Tree:
+        """The octree of a mesh given as (n, 3) vertices and (m, 3) triangle indices."""
+    @staticmethod
+    def from_volume(
+        path: _Path,
+        threshold: Optional[float] = None,
+        *,
+        label: Optional[float] = None,
+        level: Optional[int] = None,
+        offset: Optional[Tuple[int, int, int]] = None,
+    ) -> Tree:
+        """The octree of a volume file (.json sidecar, .raw, .nii, .nii.gz): samples >= threshold (or == label),
+        sample (0, 0, 0) at voxel `offset` (default (0, 0, 0))."""
+    @staticmethod
+    def load(path: _Path) -> Tree:
+        """Reads a tree file, the format chosen by the extension."""
+    def save(self, path: _Path) -> None:
+        """Writes the tree atomically, the format chosen by the extension."""
+    def to_bytes(self) -> bytes:
+        """The tree in the .ktree format (2 bits a node, with a checksum)."""
+    @staticmethod
+    def from_bytes(data: bytes) -> Tree:
+        """The tree of .ktree bytes."""
+    def __reduce__(self) -> tuple[Any, tuple[bytes]]: ...
+    @property
+    def k(self) -> int:
+        """The dimension K."""
+    @property
+    def level(self) -> int:
+        """The universe level L."""
+    @property
+    def side(self) -> int:
+        """The universe's side, 2**level."""
+    @property
+    def voxel_count(self) -> int:
+        """Voxels inside the object."""
+    @property
+    def node_count(self) -> int:
+        """Nodes of the tree."""
+    def to_dense(self) -> npt.NDArray[np.bool_]:
+        """The voxels as a boolean array of shape (side,) * K indexed [x, y, z, ...]."""
+    def to_rays(self) -> npt.NDArray[np.int64]:
+        """The voxels as maximal runs: an (n, K + 1) array as from_rays reads."""
+    def contains(self, point: Sequence[int]) -> bool:
+        """Whether the voxel at `point` is inside."""
+    def stats(self) -> _Stats:
+        """Node counts, with the keys of `ktree stats --json`."""
+    def translate(self, offset: Sequence[float]) -> Tree:
+        """Translated by K numbers (exact for integers)."""
+    def rotate(self, degrees: float, axes: Union[str, Tuple[int, int], None] = None) -> Tree:
+        """Rotated about the universe's centre in the plane (i, j) (default (0, 1)) or about 'x', 'y', 'z'."""
+    def scale(self, factor: Union[int, float, Fraction]) -> Tree:
+        """Scaled about the origin corner (exact for ints and Fractions)."""
+    def affine(self, matrix: npt.ArrayLike) -> Tree:
+        """Mapped by a homogeneous (K + 1) x (K + 1) matrix (projective if the last row is not 0 ... 0 1)."""
+    def mass(self, tolerance: Optional[float] = None) -> _Mass:
+        """Volume, centroid and second moments, with the keys of `ktree mass --json`."""
+    def interferes(self, other: Tree) -> bool:
+        """Whether the objects share a voxel."""
+    def collide(self, other: Tree, time_axis: Optional[int] = None) -> _Collision:
+        """Interference, with the keys of `ktree collide --json`."""
+    def render(
+        self,
+        view: Optional[_View] = None,
+        width: int = 512,
+        height: int = 512,
+        *,
+        perspective: Optional[float] = None,
+        time_axis: int = 3,
+        frames: int = 6,
+    ) -> npt.NDArray[np.uint8]:
+        """An RGB image of shape (height, width, 3) (K = 2: the cells; K = 4: a strip of time slices)."""
+    def lines(
+        self,
+        view: Optional[_View] = None,
+        width: int = 800,
+        height: int = 800,
+        *,
+        stroke: float = 1.0,
+        method: str = "bucketed",
+    ) -> str:
+        """An SVG line drawing of an octree with hidden lines removed."""
+    def __or__(self, other: Tree, /) -> Tree: ...
+    def __and__(self, other: Tree, /) -> Tree: ...
+    def __sub__(self, other: Tree, /) -> Tree: ...
+    def __xor__(self, other: Tree, /) -> Tree: ...
+    def __ror__(self, other: Tree, /) -> Tree: ...
+    def __rand__(self, other: Tree, /) -> Tree: ...
+    def __rsub__(self, other: Tree, /) -> Tree: ...
+    def __rxor__(self, other: Tree, /) -> Tree: ...
+    def __invert__(self) -> Tree: ...
+    def __eq__(self, other: object, /) -> bool: ...

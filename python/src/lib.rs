@@ -1,0 +1,839 @@
+//! The Python module `ktree`: k-trees (K = 1…4) with numpy arrays in and out.
+//!
+//! One class, `ktree.Tree`, wraps the library's [`AnyTree`]; `K` comes from the input (an array's `ndim`, a
+//! ray array's width, a file's header). Every call that may take long releases the interpreter lock, and
+//! every error of the library becomes a Python exception (`ValueError` for bad input, `OSError` for files)
+//! with the library's message.
+
+use std::ffi::CString;
+use std::path::PathBuf;
+
+use ktree::display::{self, HiddenLineMethod, RenderOptions, ISO_TOWARD_EYE};
+use ktree::io::AnyTree;
+use ktree::ops::{self, BoolOp};
+use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::volume::{Select, Volume};
+use ktree::space::{Universe, DENSE_LIMIT};
+use ktree::{with_dim, KTree};
+use numpy::ndarray::{Array3, ArrayD, ArrayViewD, IxDyn, ShapeBuilder};
+use numpy::{
+    AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayDyn, PyArrayLike2, PyArrayLikeDyn,
+};
+use pyo3::exceptions::PyUserWarning;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyString};
+
+mod failure;
+mod files;
+mod geometry;
+mod rays;
+
+use failure::Failure;
+use geometry::Factor;
+
+/// Runs `$body` on two trees of the same dimension, or fails naming both dimensions.
+macro_rules! with_pair {
+    ($a:expr, $b:expr, ($x:ident, $y:ident) => $body:expr) => {
+        match ($a, $b) {
+            (AnyTree::K1($x), AnyTree::K1($y)) => $body,
+            (AnyTree::K2($x), AnyTree::K2($y)) => $body,
+            (AnyTree::K3($x), AnyTree::K3($y)) => $body,
+            (AnyTree::K4($x), AnyTree::K4($y)) => $body,
+            (x, y) => Err(Failure::Value(format!(
+                "a K = {} tree and a K = {} tree: both must have the same dimension",
+                x.k(),
+                y.k()
+            ))),
+        }
+    };
+}
+
+/// Runs `$body` with `K` bound as a constant, for `$k` in 1…4, or fails.
+macro_rules! with_k {
+    ($k:expr, $what:expr, K => $body:expr) => {
+        match $k {
+            1 => {
+                const K: usize = 1;
+                $body
+            }
+            2 => {
+                const K: usize = 2;
+                $body
+            }
+            3 => {
+                const K: usize = 3;
+                $body
+            }
+            4 => {
+                const K: usize = 4;
+                $body
+            }
+            k => Err(Failure::Value(format!(
+                "{}: K = {k} is not supported (1 to 4)",
+                $what
+            ))),
+        }
+    };
+}
+
+/// A k-tree of dimension K = 1…4 (bintree, quadtree, octree, 4-D tree) over a universe of side 2**level.
+///
+/// Coordinates are `[x, y, z, ...]` as in the command-line tool: a dense array `a` has `a[x, y, z]` for
+/// voxel (x, y, z), and rays run along the last axis. Trees are immutable: operations return new trees.
+/// Two trees compare equal when they hold the same object in the same universe.
+#[pyclass(frozen, name = "Tree", module = "ktree")]
+struct Tree {
+    inner: AnyTree,
+}
+
+impl Tree {
+    fn wrap(inner: impl Into<AnyTree>) -> Self {
+        Self {
+            inner: inner.into(),
+        }
+    }
+}
+
+/// The smallest level whose side holds `n` voxels.
+fn level_for(n: usize) -> u32 {
+    n.max(1).next_power_of_two().trailing_zeros()
+}
+
+/// The dense array (axis 0 fastest, as the library lays it out) of a numpy array indexed `[x, y, z, …]`,
+/// placed at the origin of a universe of level `level`.
+fn dense_of_view<const K: usize>(
+    view: &ArrayViewD<'_, bool>,
+    level: u32,
+) -> Result<Vec<bool>, Failure> {
+    let universe = Universe::<K>::new(level)?;
+    let len = universe.dense_len(DENSE_LIMIT)?;
+    let side = universe.side() as usize;
+    if let Some(n) = view.shape().iter().find(|&&n| n > side) {
+        return Err(Failure::Value(format!(
+            "an array of shape {:?} does not fit a level-{level} universe of side {side} ({n} > {side})",
+            view.shape()
+        )));
+    }
+    let mut dense = vec![false; len];
+    if view.shape().iter().all(|&n| n == side) {
+        // Reversing the axes makes axis 0 the fastest in logical order.
+        for (d, &v) in dense.iter_mut().zip(view.t().iter()) {
+            *d = v;
+        }
+    } else {
+        for (index, &v) in view.indexed_iter() {
+            if v {
+                let flat = (0..K).rev().fold(0, |acc, a| acc * side + index[a]);
+                dense[flat] = true;
+            }
+        }
+    }
+    Ok(dense)
+}
+
+/// A tree's voxels as an array indexed `[x, y, z, …]` (memory in Fortran order: axis 0 fastest).
+fn array_of_tree<const K: usize>(tree: &KTree<K>) -> Result<ArrayD<bool>, Failure> {
+    let dense = tree.to_dense()?;
+    let side = tree.universe().side() as usize;
+    ArrayD::from_shape_vec(IxDyn(&[side; K]).f(), dense).map_err(Failure::value)
+}
+
+/// A view direction from the object towards the viewer: a name or three numbers.
+fn view_direction(view: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
+    if let Ok(name) = view.cast::<PyString>() {
+        let name = name.to_str()?;
+        let v = match name {
+            "iso" => ISO_TOWARD_EYE,
+            "top" => [0.0, 0.0, 1.0],
+            "bottom" => [0.0, 0.0, -1.0],
+            "front" => [0.0, -1.0, 0.0],
+            "back" => [0.0, 1.0, 0.0],
+            "right" => [1.0, 0.0, 0.0],
+            "left" => [-1.0, 0.0, 0.0],
+            other => {
+                return Err(Failure::Value(format!(
+                    "view '{other}' must be iso, top, bottom, front, back, left, right or three numbers"
+                ))
+                .into())
+            }
+        };
+        return Ok(v);
+    }
+    let v: [f64; 3] = view.extract().map_err(|_| {
+        Failure::Value("a view is a name or three numbers (x, y, z) towards the viewer".into())
+    })?;
+    if v.iter().any(|x| !x.is_finite()) || v.iter().all(|&x| x == 0.0) {
+        return Err(
+            Failure::Value(format!("view direction {v:?} must be finite and not zero")).into(),
+        );
+    }
+    Ok(v)
+}
+
+/// The plane of a rotation: an axis name in 3-D or a pair of axes.
+fn rotation_plane(k: usize, axes: &Bound<'_, PyAny>) -> PyResult<(usize, usize)> {
+    if let Ok(name) = axes.cast::<PyString>() {
+        return match (name.to_str()?, k) {
+            ("x", 3) => Ok((1, 2)),
+            ("y", 3) => Ok((2, 0)),
+            ("z", 3) => Ok((0, 1)),
+            (other, _) => Err(Failure::Value(format!(
+                "axis '{other}': named axes x, y, z are for K = 3; give a pair of axes (i, j) for K = {k}"
+            ))
+            .into()),
+        };
+    }
+    axes.extract::<(usize, usize)>().map_err(|_| {
+        Failure::Value("axes must be a pair (i, j) (or 'x', 'y', 'z' in 3-D)".into()).into()
+    })
+}
+
+/// A mesh placement: `(s, tx, ty, tz)` (voxel = s·v + t), or fitted into the universe.
+fn placement(
+    mesh: &TriangleMesh,
+    level: u32,
+    transform: Option<[f64; 4]>,
+) -> Result<Placement, Failure> {
+    match transform {
+        Some([scale, tx, ty, tz]) => {
+            if !(scale.is_finite() && tx.is_finite() && ty.is_finite() && tz.is_finite()) {
+                return Err(Failure::Value(format!(
+                    "transform {:?} must be four finite numbers",
+                    [scale, tx, ty, tz]
+                )));
+            }
+            Ok(Placement {
+                scale,
+                translate: [tx, ty, tz],
+            })
+        }
+        None => Ok(Placement::fit(mesh, level)?),
+    }
+}
+
+/// Voxelizes a mesh, warning (as the command-line tool does) when the mesh is not closed.
+fn mesh_tree(
+    py: Python<'_>,
+    mesh: TriangleMesh,
+    level: u32,
+    transform: Option<[f64; 4]>,
+    name: &str,
+) -> PyResult<Tree> {
+    let (tree, open_edges) = py.detach(|| -> Result<_, Failure> {
+        let placed = placement(&mesh, level, transform)?;
+        let r = mesh.to_rays(level, &placed)?;
+        Ok((ktree::stacking::stack(&r.rays), r.open_edges))
+    })?;
+    if open_edges > 0 {
+        let message = format!(
+            "{name}: the mesh is not closed ({open_edges} edges not shared by exactly two triangles); inside is \
+             decided by the winding along each column, so some columns may leak or lose runs"
+        );
+        let message = CString::new(message).unwrap_or_default();
+        PyErr::warn(py, py.get_type::<PyUserWarning>().as_any(), &message, 1)?;
+    }
+    Ok(Tree::wrap(tree))
+}
+
+/// Runs a Boolean operation without the interpreter lock.
+fn boolean(py: Python<'_>, a: &Tree, b: &Tree, op: BoolOp) -> PyResult<Tree> {
+    let out = py.detach(|| {
+        with_pair!(&a.inner, &b.inner, (x, y) => ops::boolean(x, y, op).map(AnyTree::from).map_err(Failure::from))
+    })?;
+    Ok(Tree { inner: out })
+}
+
+#[pymethods]
+impl Tree {
+    /// The tree of a boolean array indexed `[x, y, z, ...]` (K = `array.ndim`, 1 to 4). The array is placed
+    /// at the origin of a universe of level `level` (default: the smallest whose side 2**level holds the
+    /// longest axis); other values than booleans are converted by numpy (non-zero is inside).
+    #[staticmethod]
+    #[pyo3(signature = (array, level = None))]
+    fn from_dense(
+        py: Python<'_>,
+        array: PyArrayLikeDyn<'_, bool, AllowTypeChange>,
+        level: Option<u32>,
+    ) -> PyResult<Self> {
+        let view = array.as_array();
+        let level =
+            level.unwrap_or_else(|| level_for(view.shape().iter().copied().max().unwrap_or(1)));
+        let tree = with_k!(view.ndim(), "from_dense: an array with that many dimensions", K => {
+            let dense = dense_of_view::<K>(&view, level)?;
+            py.detach(|| KTree::<K>::from_dense(level, &dense).map(AnyTree::from).map_err(Failure::from))
+        })?;
+        Ok(Self { inner: tree })
+    }
+
+    /// The empty tree of dimension `k` and level `level`.
+    #[staticmethod]
+    fn empty(k: usize, level: u32) -> PyResult<Self> {
+        let tree = with_k!(k, "empty", K => KTree::<K>::empty(level).map(AnyTree::from).map_err(Failure::from))?;
+        Ok(Self { inner: tree })
+    }
+
+    /// The tree of the whole universe of dimension `k` and level `level`.
+    #[staticmethod]
+    fn full(k: usize, level: u32) -> PyResult<Self> {
+        let tree = with_k!(k, "full", K => KTree::<K>::full(level).map(AnyTree::from).map_err(Failure::from))?;
+        Ok(Self { inner: tree })
+    }
+
+    /// The tree of runs along the last axis: an `(n, K + 1)` integer array whose rows are a column's `K - 1`
+    /// coordinates, then `z1` and `z2` (the run covers `z1 <= z < z2`), in a universe of level `level`.
+    /// Runs of a column that overlap or touch are merged. The tree is built by stacking.
+    #[staticmethod]
+    fn from_rays(
+        py: Python<'_>,
+        rays: PyArrayLike2<'_, i64, AllowTypeChange>,
+        level: u32,
+    ) -> PyResult<Self> {
+        let view = rays.as_array();
+        let what = format!(
+            "from_rays: an array of {} columns (K + 1 for K = 1 to 4)",
+            view.ncols()
+        );
+        let tree = with_k!(view.ncols().wrapping_sub(1), what, K => {
+            let set = rays::rays_of_array::<K>(view, level)?;
+            Ok(AnyTree::from(py.detach(|| ktree::stacking::stack(&set))))
+        })?;
+        Ok(Self { inner: tree })
+    }
+
+    /// The tree's voxels as runs along the last axis: an `(n, K + 1)` int64 array as `from_rays` reads
+    /// (maximal runs, columns in lexicographic order).
+    fn to_rays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let array = py.detach(|| with_dim!(&self.inner, AnyTree, t => rays::tree_rays(t).map(|r| rays::array_of_rays(&r))))?;
+        Ok(array.into_pyarray(py))
+    }
+
+    /// The octree of a triangle mesh file (OBJ, STL, PLY) in a universe of level `level`. `transform`
+    /// `(s, tx, ty, tz)` places vertex v at voxel s*v + t; without it the mesh is scaled and centred to fit
+    /// with one voxel of margin. Voxels whose centres are inside are in the tree. A mesh that is not closed
+    /// gives a `UserWarning`.
+    #[staticmethod]
+    #[pyo3(signature = (path, level, transform = None))]
+    fn from_mesh(
+        py: Python<'_>,
+        path: PathBuf,
+        level: u32,
+        transform: Option<[f64; 4]>,
+    ) -> PyResult<Self> {
+        let mesh = py.detach(|| TriangleMesh::read(&path).map_err(Failure::from))?;
+        mesh_tree(py, mesh, level, transform, &path.display().to_string())
+    }
+
+    /// The octree of a triangle mesh given as an `(n, 3)` float array of vertices and an `(m, 3)` integer
+    /// array of triangles (vertex indices, counter-clockwise seen from outside); otherwise as `from_mesh`.
+    #[staticmethod]
+    #[pyo3(signature = (vertices, faces, level, transform = None))]
+    fn from_mesh_arrays(
+        py: Python<'_>,
+        vertices: PyArrayLike2<'_, f64, AllowTypeChange>,
+        faces: PyArrayLike2<'_, i64, AllowTypeChange>,
+        level: u32,
+        transform: Option<[f64; 4]>,
+    ) -> PyResult<Self> {
+        let (v, f) = (vertices.as_array(), faces.as_array());
+        if v.ncols() != 3 || f.ncols() != 3 {
+            return Err(Failure::Value(format!(
+                "vertices must be (n, 3) and faces (m, 3), got {:?} and {:?}",
+                v.shape(),
+                f.shape()
+            ))
+            .into());
+        }
+        let n = v.nrows();
+        let vertices: Vec<[f64; 3]> = v.outer_iter().map(|r| [r[0], r[1], r[2]]).collect();
+        let mut triangles = Vec::with_capacity(f.nrows());
+        for (i, r) in f.outer_iter().enumerate() {
+            let mut t = [0u32; 3];
+            for (slot, &x) in t.iter_mut().zip(r.iter()) {
+                *slot = u32::try_from(x)
+                    .ok()
+                    .filter(|&x| (x as usize) < n)
+                    .ok_or_else(|| {
+                        Failure::Value(format!("face {i}: vertex index {x} is not below {n}"))
+                    })?;
+            }
+            triangles.push(t);
+        }
+        if let Some(i) = vertices
+            .iter()
+            .position(|p| p.iter().any(|x| !x.is_finite()))
+        {
+            return Err(Failure::Value(format!("vertex {i} is not finite")).into());
+        }
+        let mesh = TriangleMesh {
+            vertices,
+            triangles,
+        };
+        mesh_tree(py, mesh, level, transform, "from_mesh_arrays")
+    }
+
+    /// The octree of a volume file (a .json sidecar or its .raw, .nii, .nii.gz): samples with value
+    /// `>= threshold` (or `== label`) are inside. The volume's sample (0, 0, 0) goes to voxel `offset`
+    /// (default (0, 0, 0)); `level` defaults to the smallest that holds the volume.
+    #[staticmethod]
+    #[pyo3(signature = (path, threshold = None, *, label = None, level = None, offset = None))]
+    fn from_volume(
+        py: Python<'_>,
+        path: PathBuf,
+        threshold: Option<f64>,
+        label: Option<f64>,
+        level: Option<u32>,
+        offset: Option<(u32, u32, u32)>,
+    ) -> PyResult<Self> {
+        let offset = offset.unwrap_or((0, 0, 0));
+        let select = match (threshold, label) {
+            (Some(t), None) => Select::AtLeast(t),
+            (None, Some(l)) => Select::Label(l),
+            _ => {
+                return Err(Failure::Value("give exactly one of threshold and label".into()).into())
+            }
+        };
+        let tree = py.detach(|| -> Result<_, Failure> {
+            let v = Volume::read(&path)?;
+            let level = level.unwrap_or_else(|| v.fitting_level());
+            let rays = v.to_rays(level, [offset.0, offset.1, offset.2], select)?;
+            Ok(ktree::stacking::stack(&rays))
+        })?;
+        Ok(Self::wrap(tree))
+    }
+
+    /// Reads a tree file; the format is chosen by the extension.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let tree = py.detach(|| files::read_tree(&path))?;
+        Ok(Self { inner: tree })
+    }
+
+    /// Writes the tree (atomically: a temporary file renamed); the format is chosen by the extension.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        Ok(py.detach(|| files::write_tree(&path, &self.inner))?)
+    }
+
+    /// The tree in the `.ktree` format (2 bits a node, with a checksum), as bytes.
+    fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = py.detach(|| {
+            let mut out = Vec::new();
+            with_dim!(&self.inner, AnyTree, t => ktree::io::write_ktree(&mut out, t)).map(|()| out)
+        });
+        let bytes = bytes.map_err(Failure::value)?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    /// The tree of bytes in the `.ktree` format (as `to_bytes` gives).
+    #[staticmethod]
+    fn from_bytes(py: Python<'_>, data: &[u8]) -> PyResult<Self> {
+        let tree =
+            py.detach(|| ktree::io::read_ktree_any(data, "<bytes>").map_err(Failure::value))?;
+        Ok(Self { inner: tree })
+    }
+
+    /// Pickling: the tree is rebuilt from its `.ktree` bytes.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+        let rebuild = slf.get_type().getattr("from_bytes")?;
+        Ok((rebuild, (slf.get().to_bytes(slf.py())?,)))
+    }
+
+    /// The dimension K.
+    #[getter]
+    fn k(&self) -> usize {
+        self.inner.k()
+    }
+
+    /// The universe level L (the side is 2**L).
+    #[getter]
+    fn level(&self) -> u32 {
+        self.inner.level()
+    }
+
+    /// The universe's side, 2**level.
+    #[getter]
+    fn side(&self) -> u64 {
+        1u64 << self.inner.level()
+    }
+
+    /// The number of voxels inside the object.
+    #[getter]
+    fn voxel_count(&self, py: Python<'_>) -> u128 {
+        py.detach(|| with_dim!(&self.inner, AnyTree, t => t.voxel_count()))
+    }
+
+    /// The number of nodes.
+    #[getter]
+    fn node_count(&self) -> u64 {
+        self.inner.counts().nodes()
+    }
+
+    /// The voxels as a boolean array of shape (side,) * K, indexed `[x, y, z, ...]`.
+    fn to_dense<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<bool>>> {
+        let array = py.detach(|| with_dim!(&self.inner, AnyTree, t => array_of_tree(t)))?;
+        Ok(array.into_pyarray(py))
+    }
+
+    /// Whether the voxel at `point` (K integers) is inside.
+    fn contains(&self, point: Vec<u64>) -> PyResult<bool> {
+        let k = self.inner.k();
+        if point.len() != k {
+            return Err(Failure::Value(format!(
+                "a point of a K = {k} tree has {k} coordinates, got {}",
+                point.len()
+            ))
+            .into());
+        }
+        let side = 1u64 << self.inner.level();
+        if point.iter().any(|&c| c >= side) {
+            return Ok(false);
+        }
+        Ok(
+            with_dim!(&self.inner, AnyTree, t => t.contains(std::array::from_fn(|a| point[a] as u32))),
+        )
+    }
+
+    /// The statistics as a dict with the keys of `ktree stats --json`: k, level, rays (None), full, empty,
+    /// partial, nodes, bytes_at_2_bits, per_level (a list of dicts with level, full, empty, partial).
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let json = serde_json::to_string(&self.inner.stats(None)).map_err(Failure::value)?;
+        py.import("json")?.call_method1("loads", (json,))
+    }
+
+    /// Translated by `offset` (K numbers): exactly by whole voxels when all are integers (voxels leaving the
+    /// universe are lost), by an affine pass otherwise.
+    fn translate(&self, py: Python<'_>, offset: Vec<f64>) -> PyResult<Self> {
+        let out = py.detach(|| with_dim!(&self.inner, AnyTree, t => geometry::translate(t, &offset).map(AnyTree::from)))?;
+        Ok(Self { inner: out })
+    }
+
+    /// Rotated by `degrees` about the universe's centre, in the plane of `axes` = (i, j) (turning axis i
+    /// towards axis j; default (0, 1)) or, in 3-D, about the axis 'x', 'y' or 'z'. Multiples of 90 degrees
+    /// are exact (children reordered); other angles take an affine pass.
+    #[pyo3(signature = (degrees, axes = None))]
+    fn rotate(
+        &self,
+        py: Python<'_>,
+        degrees: f64,
+        axes: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let (from, to) = match axes {
+            Some(a) => rotation_plane(self.inner.k(), &a)?,
+            None => (0, 1),
+        };
+        let out = py.detach(|| with_dim!(&self.inner, AnyTree, t => geometry::rotate(t, degrees, from, to).map(AnyTree::from)))?;
+        Ok(Self { inner: out })
+    }
+
+    /// Scaled by `factor` about the universe's origin corner: an int or a `fractions.Fraction` p/q is exact
+    /// (p, q up to 2**20), a float takes an affine pass unless it is a whole number.
+    fn scale(&self, py: Python<'_>, factor: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let ratio = || -> PyResult<(u32, u32)> {
+            Ok((
+                factor.getattr("numerator")?.extract()?,
+                factor.getattr("denominator")?.extract()?,
+            ))
+        };
+        let factor = match ratio() {
+            Ok((p, q)) => Factor::Ratio(p, q),
+            Err(_) => {
+                let s: f64 = factor.extract()?;
+                if s.fract() == 0.0 && s >= 1.0 && s <= f64::from(u32::MAX) {
+                    Factor::Ratio(s as u32, 1)
+                } else {
+                    Factor::Real(s)
+                }
+            }
+        };
+        let out = py.detach(
+            || with_dim!(&self.inner, AnyTree, t => geometry::scale(t, factor).map(AnyTree::from)),
+        )?;
+        Ok(Self { inner: out })
+    }
+
+    /// Mapped by a homogeneous (K + 1) x (K + 1) matrix acting on column vectors [x; 1], in one overlay
+    /// pass: affine when the last row is 0 ... 0 1, projective otherwise.
+    fn affine(
+        &self,
+        py: Python<'_>,
+        matrix: PyArrayLike2<'_, f64, AllowTypeChange>,
+    ) -> PyResult<Self> {
+        let m: Vec<f64> = matrix.as_array().iter().copied().collect();
+        let n = self.inner.k() + 1;
+        if matrix.as_array().shape() != [n, n] {
+            return Err(Failure::Value(format!(
+                "a K = {} tree needs a {n} x {n} matrix, got shape {:?}",
+                self.inner.k(),
+                matrix.as_array().shape()
+            ))
+            .into());
+        }
+        let out = py.detach(
+            || with_dim!(&self.inner, AnyTree, t => geometry::matrix(t, &m).map(AnyTree::from)),
+        )?;
+        Ok(Self { inner: out })
+    }
+
+    /// Mass properties as a dict with the keys of `ktree mass --json`: k, volume (voxels), centroid (voxel
+    /// (x, y, ...) spans [x, x + 1) on each axis), central_moments and inertia_tensor (K x K lists), nodes;
+    /// with `tolerance`, also Meagher's progressive bounds (progressive: a list of dicts with level, lower,
+    /// upper, nodes_touched) and the estimate where they meet the tolerance (otherwise both None).
+    #[pyo3(signature = (tolerance = None))]
+    fn mass<'py>(&self, py: Python<'py>, tolerance: Option<f64>) -> PyResult<Bound<'py, PyDict>> {
+        if let Some(t) = tolerance {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(
+                    Failure::Value(format!("tolerance must be a number >= 0, got {t}")).into(),
+                );
+            }
+        }
+        #[allow(clippy::type_complexity)]
+        let (volume, centroid, moments, inertia, progressive): (
+            u128,
+            Vec<f64>,
+            Vec<Vec<f64>>,
+            Vec<Vec<f64>>,
+            Option<(Vec<(u32, u128, u128, u64)>, f64)>,
+        ) = py.detach(|| {
+            with_dim!(&self.inner, AnyTree, t => {
+                let m = ops::mass_properties(t);
+                let p = tolerance.map(|tol| {
+                    let p = ops::mass_progressive(t, tol);
+                    let levels = p.levels.iter().map(|l| (l.level, l.lower, l.upper, l.nodes_touched)).collect();
+                    (levels, p.estimate)
+                });
+                (
+                    m.volume,
+                    m.centroid.to_vec(),
+                    m.central_moments.iter().map(|r| r.to_vec()).collect(),
+                    m.inertia_tensor().iter().map(|r| r.to_vec()).collect(),
+                    p,
+                )
+            })
+        });
+        let d = PyDict::new(py);
+        d.set_item("k", self.inner.k())?;
+        d.set_item("volume", volume)?;
+        d.set_item("centroid", centroid)?;
+        d.set_item("central_moments", moments)?;
+        d.set_item("inertia_tensor", inertia)?;
+        d.set_item("nodes", self.inner.counts().nodes())?;
+        match progressive {
+            Some((levels, estimate)) => {
+                let list: Vec<Bound<'py, PyDict>> = levels
+                    .into_iter()
+                    .map(|(level, lower, upper, touched)| {
+                        let l = PyDict::new(py);
+                        l.set_item("level", level)?;
+                        l.set_item("lower", lower)?;
+                        l.set_item("upper", upper)?;
+                        l.set_item("nodes_touched", touched)?;
+                        Ok(l)
+                    })
+                    .collect::<PyResult<_>>()?;
+                d.set_item("progressive", list)?;
+                d.set_item("estimate", estimate)?;
+            }
+            None => {
+                d.set_item("progressive", py.None())?;
+                d.set_item("estimate", py.None())?;
+            }
+        }
+        Ok(d)
+    }
+
+    /// Whether the two objects share a voxel (same K and level).
+    fn interferes(&self, py: Python<'_>, other: &Tree) -> PyResult<bool> {
+        Ok(py.detach(|| with_pair!(&self.inner, &other.inner, (a, b) => ops::interferes(a, b).map_err(Failure::from)))?)
+    }
+
+    /// Interference as a dict with the keys of `ktree collide --json`: collide, overlap_cells,
+    /// overlap_voxels, first_contact (the first position along `time_axis` where they overlap, if given and
+    /// they do), min_separation (smallest distance between voxel centres; 0.0 when they overlap, None if one
+    /// is empty).
+    #[pyo3(signature = (other, time_axis = None))]
+    fn collide<'py>(
+        &self,
+        py: Python<'py>,
+        other: &Tree,
+        time_axis: Option<usize>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (collide, cells, voxels, first, separation) = py.detach(|| {
+            with_pair!(&self.inner, &other.inner, (a, b) => (|| -> Result<_, Failure> {
+                let collide = ops::interferes(a, b)?;
+                let overlap = ops::intersection(a, b)?;
+                let first = match time_axis {
+                    Some(axis) => ops::first_contact(a, b, axis)?,
+                    None => None,
+                };
+                let separation = if collide { Some(0.0) } else { ops::min_separation(a, b)? };
+                Ok((collide, overlap.full_cells().len(), overlap.voxel_count(), first, separation))
+            })())
+        })?;
+        let d = PyDict::new(py);
+        d.set_item("collide", collide)?;
+        d.set_item("overlap_cells", cells)?;
+        d.set_item("overlap_voxels", voxels)?;
+        d.set_item("first_contact", first)?;
+        d.set_item("min_separation", separation)?;
+        Ok(d)
+    }
+
+    /// A picture as an RGB uint8 array of shape (height, width, 3). An octree: a hidden-surface image seen
+    /// from `view` (a name: iso, top, bottom, front, back, left, right, or three numbers towards the eye),
+    /// orthographic or with a vertical field of view `perspective` in degrees, framing the object. A
+    /// quadtree: its cells, min(width, height) pixels square. A 4-D tree: a strip of `frames` slices along
+    /// `time_axis`, each `height` pixels square.
+    #[pyo3(signature = (view = None, width = 512, height = 512, *, perspective = None, time_axis = 3, frames = 6))]
+    #[allow(clippy::too_many_arguments)]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        view: Option<Bound<'py, PyAny>>,
+        width: u32,
+        height: u32,
+        perspective: Option<f64>,
+        time_axis: usize,
+        frames: usize,
+    ) -> PyResult<Bound<'py, PyArray3<u8>>> {
+        let toward = match &view {
+            Some(v) => view_direction(v)?,
+            None => ISO_TOWARD_EYE,
+        };
+        let (w, h, rgb) = py.detach(|| -> Result<_, Failure> {
+            display::check_size(width, height)?;
+            match &self.inner {
+                AnyTree::K3(t) => {
+                    let camera = display::default_camera(t, toward, perspective, width, height)?;
+                    camera.check()?;
+                    let options = RenderOptions {
+                        width,
+                        height,
+                        ..Default::default()
+                    };
+                    let image = display::render(t, &camera, &options, None, None)?;
+                    Ok((image.width, image.height, image.rgb))
+                }
+                AnyTree::K2(t) => {
+                    let c = display::plane::quadtree_canvas(t, width.min(height))?;
+                    Ok((c.width, c.height, c.rgb))
+                }
+                AnyTree::K4(t) => {
+                    let (c, _) = display::slices::time_strip(t, time_axis, frames, height)?;
+                    Ok((c.width, c.height, c.rgb))
+                }
+                AnyTree::K1(_) => Err(Failure::Value(
+                    "a bintree (K = 1) has no picture; render needs K = 2, 3 or 4".into(),
+                )),
+            }
+        })?;
+        let image =
+            Array3::from_shape_vec((h as usize, w as usize, 3), rgb).map_err(Failure::value)?;
+        Ok(image.into_pyarray(py))
+    }
+
+    /// A line drawing of an octree with hidden lines removed (Veenstra & Ahuja), seen in parallel
+    /// projection from `view` (as in `render`), as SVG text of `width` x `height` pixels. `method` is
+    /// 'bucketed' (fast) or 'pairwise' (the paper's); `stroke` is the line width.
+    #[pyo3(signature = (view = None, width = 800, height = 800, *, stroke = 1.0, method = "bucketed"))]
+    fn lines(
+        &self,
+        py: Python<'_>,
+        view: Option<Bound<'_, PyAny>>,
+        width: u32,
+        height: u32,
+        stroke: f64,
+        method: &str,
+    ) -> PyResult<String> {
+        let toward = match &view {
+            Some(v) => view_direction(v)?,
+            None => ISO_TOWARD_EYE,
+        };
+        let method = match method {
+            "bucketed" => HiddenLineMethod::Bucketed,
+            "pairwise" => HiddenLineMethod::Pairwise,
+            other => {
+                return Err(Failure::Value(format!(
+                    "method '{other}' must be 'bucketed' or 'pairwise'"
+                ))
+                .into())
+            }
+        };
+        if !(stroke.is_finite() && stroke > 0.0) {
+            return Err(
+                Failure::Value(format!("stroke must be a positive number, got {stroke}")).into(),
+            );
+        }
+        let AnyTree::K3(tree) = &self.inner else {
+            return Err(Failure::Value(format!(
+                "line drawings need an octree (K = 3), this is a K = {} tree (try render)",
+                self.inner.k()
+            ))
+            .into());
+        };
+        Ok(py.detach(|| -> Result<_, Failure> {
+            display::check_size(width, height)?;
+            let drawing = display::line_drawing(tree, toward, method, None)?;
+            Ok(display::svg::lines_svg(
+                &drawing.segments_2d(),
+                width,
+                height,
+                stroke,
+            ))
+        })?)
+    }
+
+    /// Union.
+    fn __or__(&self, py: Python<'_>, other: PyRef<'_, Tree>) -> PyResult<Self> {
+        boolean(py, self, &other, BoolOp::Union)
+    }
+
+    /// Intersection.
+    fn __and__(&self, py: Python<'_>, other: PyRef<'_, Tree>) -> PyResult<Self> {
+        boolean(py, self, &other, BoolOp::Intersection)
+    }
+
+    /// Difference: voxels of this tree not in `other`.
+    fn __sub__(&self, py: Python<'_>, other: PyRef<'_, Tree>) -> PyResult<Self> {
+        boolean(py, self, &other, BoolOp::Difference)
+    }
+
+    /// Symmetric difference.
+    fn __xor__(&self, py: Python<'_>, other: PyRef<'_, Tree>) -> PyResult<Self> {
+        boolean(py, self, &other, BoolOp::SymmetricDifference)
+    }
+
+    /// Complement within the universe.
+    fn __invert__(&self, py: Python<'_>) -> Self {
+        let out =
+            py.detach(|| with_dim!(&self.inner, AnyTree, t => AnyTree::from(ops::complement(t))));
+        Self { inner: out }
+    }
+
+    /// Same object in the same universe (trees are canonical, so this compares nodes).
+    fn __eq__(&self, other: PyRef<'_, Tree>) -> bool {
+        self.inner == other.inner
+    }
+
+    fn __repr__(&self) -> String {
+        let c = self.inner.counts();
+        format!(
+            "Tree(k={}, level={}, nodes={}, full={}, partial={})",
+            self.inner.k(),
+            self.inner.level(),
+            c.nodes(),
+            c.full,
+            c.partial
+        )
+    }
+}
+
+/// k-trees (bintrees, quadtrees, octrees, 4-D trees) with numpy arrays in and out: see `ktree.Tree`.
+#[pymodule]
+#[pyo3(name = "ktree")]
+fn ktree_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Tree>()?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,99 @@
+//! Rays as integer arrays: one row per run, the column's `K − 1` coordinates, then `z1` and `z2` (the run
+//! covers `z1 ≤ z < z2` along the last axis), as in the ray text format.
+
+use ktree::{KTree, NodeState, Ray, RaySet};
+use numpy::ndarray::{Array2, ArrayView2};
+
+use crate::failure::Failure;
+
+/// Most runs a tree is turned into before merging (checked before allocating).
+const MAX_RUNS: u128 = 1 << 27;
+
+/// The ray set of an `(n, K + 1)` array's rows in a universe of level `level`.
+pub(crate) fn rays_of_array<const K: usize>(
+    rows: ArrayView2<'_, i64>,
+    level: u32,
+) -> Result<RaySet<K>, Failure> {
+    let mut rays = Vec::with_capacity(rows.nrows());
+    for (i, row) in rows.outer_iter().enumerate() {
+        let mut v = [0u32; K];
+        let mut z2 = 0u32;
+        for (j, &x) in row.iter().enumerate() {
+            let x = u32::try_from(x).map_err(|_| {
+                Failure::Value(format!(
+                    "ray {i}: {x} in column {j} is not a coordinate (0 to 2^32 - 1)"
+                ))
+            })?;
+            match v.get_mut(j) {
+                Some(c) => *c = x,
+                None => z2 = x,
+            }
+        }
+        rays.push(Ray::new(v, z2));
+    }
+    Ok(RaySet::from_rays(level, rays)?)
+}
+
+/// The `(n, K + 1)` array of a ray set's runs, in the set's order.
+pub(crate) fn array_of_rays<const K: usize>(rays: &RaySet<K>) -> Array2<i64> {
+    let mut out = Array2::zeros((rays.len(), K + 1));
+    for (mut row, ray) in out.outer_iter_mut().zip(rays.iter()) {
+        for (j, &c) in ray.start.iter().enumerate() {
+            row[j] = i64::from(c);
+        }
+        row[K] = i64::from(ray.z2);
+    }
+    out
+}
+
+/// The runs of a tree's voxels along the last axis (each full leaf gives one run per column it covers;
+/// runs that touch are merged).
+///
+/// # Errors
+/// A `ValueError` when the leaves would give more than [`MAX_RUNS`] runs before merging.
+pub(crate) fn tree_rays<const K: usize>(tree: &KTree<K>) -> Result<RaySet<K>, Failure> {
+    let leaves: Vec<_> = tree
+        .leaves()
+        .into_iter()
+        .filter(|(_, s)| *s == NodeState::Full)
+        .map(|(c, _)| c)
+        .collect();
+    let runs: u128 = leaves
+        .iter()
+        .map(|c| u128::from(c.side()).pow(K as u32 - 1))
+        .sum();
+    if runs > MAX_RUNS {
+        return Err(Failure::Value(format!(
+            "the tree's {} full leaves make {runs} runs, more than the {MAX_RUNS} this conversion allows",
+            leaves.len()
+        )));
+    }
+    let mut rays = Vec::with_capacity(runs as usize);
+    for cell in &leaves {
+        let side = cell.side();
+        let z1 = cell.origin[K - 1];
+        let z2 = u32::try_from(u64::from(z1) + side).map_err(Failure::value)?;
+        // Every column of the cell: an odometer over the first K − 1 axes.
+        let mut offset = [0u64; K];
+        loop {
+            let mut start = cell.origin;
+            for a in 0..K - 1 {
+                start[a] += offset[a] as u32;
+            }
+            rays.push(Ray::new(start, z2));
+            let mut axis = 0;
+            while axis < K - 1 {
+                offset[axis] += 1;
+                if offset[axis] < side {
+                    break;
+                }
+                offset[axis] = 0;
+                axis += 1;
+            }
+            if axis == K - 1 {
+                break;
+            }
+        }
+    }
+    Ok(RaySet::from_rays(tree.level(), rays)?)
+}
