@@ -11,6 +11,7 @@ mod grid;
 mod ktree_file;
 mod octomap_bt;
 mod rays_text;
+mod vdb;
 
 pub use any::{AnyRaySet, AnyTree};
 pub use atomic::{write_atomic, write_atomic_with};
@@ -28,3 +29,4 @@ pub use octomap_bt::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
 pub use rays_text::{
     read_rays, read_rays_file, write_rays, write_rays_file, RaysTextError, RaysTextErrorKind,
 };
+pub use vdb::{read_vdb, write_vdb};
