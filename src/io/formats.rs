@@ -163,7 +163,7 @@ fn format_of(path: &Path) -> Result<Format, IoError> {
 /// use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions, AnyTree};
 /// let dir = tempfile::tempdir().unwrap();
 /// let tree = AnyTree::K3(ktree::stacking::stack(&ktree::rays::ball_rays::<3>(4, [8, 8, 8], 6).unwrap()));
-/// for name in ["ball.ktree", "ball.rays", "ball.binvox", "ball.bt"] {
+/// for name in ["ball.ktree", "ball.rays", "ball.binvox", "ball.bt", "ball.vdb"] {
 ///     let path = dir.path().join(name);
 ///     write_tree(&path, &tree, &WriteOptions::default()).unwrap();
 ///     assert_eq!(read_tree(&path, &ReadOptions::default()).unwrap(), tree, "{name}");
@@ -215,7 +215,12 @@ pub fn read_tree_placed(path: &Path, options: &ReadOptions) -> Result<ReadTree, 
             options.level,
             options.unknown_full,
         )?)),
-        Format::Vdb => Err(usage(path, "OpenVDB files are not read by this build")),
+        Format::Vdb => Ok(grid(super::read_vdb(
+            &bytes()?,
+            &name,
+            options.offset,
+            options.level,
+        )?)),
         Format::Mesh | Format::Volume => {
             let v = voxelize(path, options)?;
             let mut remarks = Vec::new();
@@ -372,7 +377,10 @@ pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result
             let t = octree()?;
             write(&|w| super::write_bt(w, t, options.offset, meta.voxel_size))
         }
-        Format::Vdb => Err(usage(path, "OpenVDB files are not written by this build")),
+        Format::Vdb => {
+            let t = octree()?;
+            write(&|w| super::write_vdb(w, t, options.offset, &meta))
+        }
         Format::Mesh | Format::Volume => Err(usage(
             path,
             "meshes and volumes are inputs only: write .ktree, .rays, .binvox, .bt or .vdb",

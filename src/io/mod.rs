@@ -28,6 +28,7 @@ mod ktree_v2;
 mod mmap;
 mod octomap_bt;
 mod rays_text;
+mod vdb;
 
 pub use any::TreeStats;
 pub use any::{AnyRaySet, AnyTree};
@@ -50,3 +51,4 @@ pub use octomap_bt::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
 pub use rays_text::{
     read_rays, read_rays_file, write_rays, write_rays_file, RaysTextError, RaysTextErrorKind,
 };
+pub use vdb::{read_vdb, write_vdb};
