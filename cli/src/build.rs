@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use ktree::io::read_rays_file;
+use ktree::io::{read_rays_file, AnyRaySet, AnyTree};
 
 /// Arguments of `ktree build`.
 #[derive(Debug, clap::Args)]
@@ -18,7 +18,16 @@ pub struct Args {
 /// Reads the rays, stacks them, writes the tree, and prints a one-line summary.
 pub fn run(args: Args) -> Result<(), String> {
     let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
-    let tree = rays.stack();
+    let tree = match &rays {
+        AnyRaySet::K1(r) => crate::distributed::stack(r)?.map(AnyTree::K1),
+        AnyRaySet::K2(r) => crate::distributed::stack(r)?.map(AnyTree::K2),
+        AnyRaySet::K3(r) => crate::distributed::stack(r)?.map(AnyTree::K3),
+        AnyRaySet::K4(r) => crate::distributed::stack(r)?.map(AnyTree::K4),
+    };
+    // In a run over several MPI ranks, rank 0 alone writes.
+    let Some(tree) = tree else {
+        return Ok(());
+    };
     let write = ktree::with_dim!(&tree, AnyTree, t => crate::tree_file::write(&args.out, t));
     write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
     let c = tree.counts();

@@ -4,7 +4,6 @@ use std::path::{Path, PathBuf};
 
 use ktree::io::write_rays_file;
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid};
-use ktree::stacking::stack;
 use ktree::RaySet;
 
 /// Arguments of `ktree rays`.
@@ -137,10 +136,14 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
 }
 
 /// Writes rays as text, or stacks them into a `.ktree` file, by the output's extension; returns a summary.
+/// In a run over several MPI ranks, every rank takes part in the build and rank 0 alone writes and returns
+/// the summary (the others return an empty one).
 pub fn write_output<const K: usize>(rays: &RaySet<K>, out: &Path) -> Result<String, String> {
     let is_tree = out.extension().is_some_and(|e| e == "ktree");
     if is_tree {
-        let tree = stack(rays);
+        let Some(tree) = crate::distributed::stack(rays)? else {
+            return Ok(String::new());
+        };
         crate::tree_file::write(out, &tree)
             .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
         let c = tree.counts();
@@ -155,6 +158,8 @@ pub fn write_output<const K: usize>(rays: &RaySet<K>, out: &Path) -> Result<Stri
             c.empty,
             c.partial
         ))
+    } else if !crate::distributed::ranks().is_root() {
+        Ok(String::new())
     } else {
         write_rays_file(out, rays).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
         Ok(format!(
@@ -164,6 +169,13 @@ pub fn write_output<const K: usize>(rays: &RaySet<K>, out: &Path) -> Result<Stri
             rays.len(),
             rays.voxel_count()
         ))
+    }
+}
+
+/// Prints a command's summary line, if it has one (ranks other than 0 of an MPI run have none).
+pub fn print_summary(summary: &str) {
+    if !summary.is_empty() {
+        println!("{summary}");
     }
 }
 
@@ -177,7 +189,7 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
     let rays = s
         .to_rays(a.level, sample, false)
         .map_err(|e| e.to_string())?;
-    println!("{}", write_output(&rays, &a.out)?);
+    print_summary(&write_output(&rays, &a.out)?);
     Ok(())
 }
 
