@@ -43,12 +43,17 @@ pub fn stack_cells<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
 /// Reads the rays, stacks them, writes the tree, and prints a one-line summary.
 pub fn run(args: Args) -> Result<(), String> {
     let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
-    let tree = with_threads(args.threads, || match &rays {
-        AnyRaySet::K1(r) => AnyTree::K1(stack_cells(r)),
-        AnyRaySet::K2(r) => AnyTree::K2(stack_cells(r)),
-        AnyRaySet::K3(r) => AnyTree::K3(stack_cells(r)),
-        AnyRaySet::K4(r) => AnyTree::K4(stack_cells(r)),
-    })?;
+    let threads = args.threads;
+    let tree = match &rays {
+        AnyRaySet::K1(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K1),
+        AnyRaySet::K2(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K2),
+        AnyRaySet::K3(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K3),
+        AnyRaySet::K4(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K4),
+    };
+    // In a run over several MPI ranks, rank 0 alone writes.
+    let Some(tree) = tree else {
+        return Ok(());
+    };
     let write = ktree::with_dim!(&tree, AnyTree, t => crate::tree_file::write(&args.out, t));
     write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
     let c = tree.counts();

@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 mod build;
 mod collide;
 mod convert;
+mod distributed;
 mod lines;
 mod mass;
 mod op;
@@ -59,6 +60,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let _mpi = distributed::init();
     tree_file::set(&cli.format);
     let outcome = match cli.command {
         Command::Build(args) => build::run(args),
@@ -77,7 +79,7 @@ fn main() -> ExitCode {
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("ktree: {e:#}");
+            distributed::report_failure(&e);
             ExitCode::FAILURE
         }
     }

@@ -7,7 +7,7 @@ use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSourc
 use ktree::stacking::{default_split_depth, stack_source};
 use ktree::{KTree, RaySet};
 
-use crate::build::{stack_cells, with_threads};
+use crate::build::with_threads;
 
 /// Arguments of `ktree rays`.
 #[derive(Debug, clap::Args)]
@@ -142,13 +142,17 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
 }
 
 /// Writes rays as text, or stacks them into a `.ktree` file, by the output's extension; returns a summary.
+/// In a run over several MPI ranks, every rank takes part in the build and rank 0 alone writes and returns
+/// the summary (the others return an empty one).
 pub fn write_output<const K: usize>(
     rays: &RaySet<K>,
     out: &Path,
     threads: Option<usize>,
 ) -> Result<String, String> {
     if is_tree_file(out) {
-        let tree = with_threads(threads, || stack_cells(rays))?;
+        let Some(tree) = crate::distributed::stack(rays, threads)? else {
+            return Ok(String::new());
+        };
         crate::tree_file::write(out, &tree).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
         let c = tree.counts();
         Ok(format!(
@@ -162,6 +166,8 @@ pub fn write_output<const K: usize>(
             c.empty,
             c.partial
         ))
+    } else if !crate::distributed::ranks().is_root() {
+        Ok(String::new())
     } else {
         write_rays_file(out, rays).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
         Ok(format!(
@@ -201,7 +207,7 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
     } else {
         Sample::Centre
     };
-    if is_tree_file(&a.out) {
+    if is_tree_file(&a.out) && crate::distributed::ranks().size == 1 {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
         let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
         let depth = default_split_depth(K, a.level);
@@ -215,8 +221,15 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
     let rays = s
         .to_rays(a.level, sample, false)
         .map_err(|e| e.to_string())?;
-    println!("{}", write_output(&rays, &a.out, a.threads)?);
+    print_summary(&write_output(&rays, &a.out, a.threads)?);
     Ok(())
+}
+
+/// Prints a command's summary line, if it has one (ranks other than 0 of an MPI run have none).
+pub fn print_summary(summary: &str) {
+    if !summary.is_empty() {
+        println!("{summary}");
+    }
 }
 
 /// Builds the solid's rays and writes them.

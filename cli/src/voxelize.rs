@@ -78,10 +78,12 @@ pub fn run(a: Args) -> Result<(), String> {
         options.offset = Some(off.map(i64::from));
     }
     let v = voxelize(&a.input, &options).map_err(|e| e.to_string())?;
-    if let Some(t) = &v.fitted {
+    // In a run over several MPI ranks, rank 0 alone reports.
+    let root = crate::distributed::ranks().is_root();
+    if let (Some(t), true) = (&v.fitted, root) {
         println!("--fit chose --transform {t}");
     }
-    if v.open_edges > 0 {
+    if v.open_edges > 0 && root {
         eprintln!(
             "warning: {}: the mesh is not closed ({} edges not shared by exactly two triangles); inside is \
              decided by the winding along each column, so some columns may leak or lose runs",
@@ -89,6 +91,6 @@ pub fn run(a: Args) -> Result<(), String> {
             v.open_edges
         );
     }
-    println!("{}", write_output(&v.rays, &a.out, a.threads)?);
+    crate::rays::print_summary(&write_output(&v.rays, &a.out, a.threads)?);
     Ok(())
 }
