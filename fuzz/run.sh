@@ -19,7 +19,8 @@ targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   mapfile -t targets < <(cargo fuzz list)
 fi
-cargo fuzz build -O -s "$sanitizer" >/dev/null || exit 1
+cargo fuzz build -O -s "$sanitizer" || exit 1
+host=$(rustc -vV | sed -n "s/^host: //p")
 logs=target/logs
 mkdir -p "$logs"
 rows=()
@@ -27,9 +28,11 @@ failed=0
 for t in "${targets[@]}"; do
   mkdir -p "target/corpus/$t" "corpus/$t"
   start=$(date +%s)
-  cargo fuzz run -O -s "$sanitizer" "$t" "target/corpus/$t" "corpus/$t" -- \
+  mkdir -p "artifacts/$t"
+  # The binary cargo-fuzz built above, run directly (as `cargo fuzz run` would, without rebuilding).
+  "target/$host/release/$t" -artifact_prefix="artifacts/$t/" \
     -max_total_time="$seconds" -rss_limit_mb=2048 -malloc_limit_mb=2048 -timeout=10 \
-    -print_final_stats=1 >"$logs/$t.log" 2>&1
+    -print_final_stats=1 "target/corpus/$t" "corpus/$t" >"$logs/$t.log" 2>&1
   status=$?
   took=$(( $(date +%s) - start ))
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$logs/$t.log" | grep -o '[0-9]*$' | tail -1)

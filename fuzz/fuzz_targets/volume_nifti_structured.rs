@@ -84,8 +84,10 @@ fuzz_target!(|input: Input| {
     for edit in &input.edits {
         match *edit {
             Edit::Xor { at, mask } => {
-                let at = usize::from(at) % h.len();
-                h[at] ^= mask;
+                if !h.is_empty() {
+                    let at = usize::from(at) % h.len();
+                    h[at] ^= mask;
+                }
             }
             Edit::Dim { index, value } => put16(&mut h, 40 + 2 * usize::from(index % 8), value),
             Edit::Bitpix(b) => put16(&mut h, 72, b),
