@@ -9,6 +9,7 @@
 # AddressSanitizer (default none: the library forbids unsafe code, and a plain build runs several times faster).
 # Each run starts from the committed seeds in fuzz/corpus/TARGET and keeps what it finds in
 # fuzz/target/corpus/TARGET (not committed). A crash leaves its input in fuzz/artifacts/TARGET/.
+# FUZZ_NO_REPORT=1 skips writing results/reliability.md (the CI smoke run); the exit status is 1 on any crash.
 set -uo pipefail
 cd "$(dirname "$0")"
 seconds=${1:-60}
@@ -50,6 +51,9 @@ for t in "${targets[@]}"; do
   echo "$t: ${execs:-?} executions in ${took} s, crashes: $outcome"
   rows+=("| \`$t\` | ${execs:-?} | ${took} | $outcome | ${cov:-?} | ${rss:-?} |")
 done
+if [ "${FUZZ_NO_REPORT:-0}" = 1 ]; then
+  exit $failed
+fi
 out=../results/reliability.md
 {
   echo "# Reliability: fuzzing"
