@@ -60,10 +60,14 @@ fuzz_target!(|input: Input| {
         } else {
             v.to_le_bytes()
         };
-        h[at..at + 2].copy_from_slice(&b);
+        if let Some(field) = h.get_mut(at..at + 2) {
+            field.copy_from_slice(&b);
+        }
     };
     let put32 = |h: &mut [u8], at: usize, b: [u8; 4], be: [u8; 4]| {
-        h[at..at + 4].copy_from_slice(if input.big_endian { &be } else { &b });
+        if let Some(field) = h.get_mut(at..at + 4) {
+            field.copy_from_slice(if input.big_endian { &be } else { &b });
+        }
     };
     put32(&mut h, 0, 348i32.to_le_bytes(), 348i32.to_be_bytes());
     for (i, d) in dim.iter().enumerate() {
