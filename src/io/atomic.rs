@@ -1,8 +1,16 @@
 //! Writing output files atomically: into a temporary file in the same directory, then renamed over the
 //! target, so a crash or a full disk never leaves a half-written file where a good one was.
+//!
+//! **Temporary files.** The temporary file of a write to `dir/NAME` is `dir/.NAME.XXXXXX.PID.ktree-tmp`
+//! (hidden, random `XXXXXX`, `PID` the writing process). An error removes it; a process killed mid-write
+//! cannot, so the next write to the same target removes the temporary files of `NAME` whose process no
+//! longer runs (where `/proc` tells; elsewhere they stay, recognisable by the suffix).
 
 use std::io::Write;
 use std::path::Path;
+
+/// The suffix of temporary files.
+const TEMP_SUFFIX: &str = ".ktree-tmp";
 
 /// Writes `bytes` to `path` atomically, creating the parent directory if needed.
 ///
@@ -34,7 +42,16 @@ pub fn write_atomic_with(
         _ => Path::new("."),
     };
     std::fs::create_dir_all(dir).map_err(with_path)?;
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(with_path)?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    remove_stale_temporaries(dir, &name);
+    let mut tmp = tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(&format!(".{}{TEMP_SUFFIX}", std::process::id()))
+        .tempfile_in(dir)
+        .map_err(with_path)?;
     {
         let mut w = std::io::BufWriter::new(tmp.as_file_mut());
         fill(&mut w).map_err(with_path)?;
@@ -43,4 +60,80 @@ pub fn write_atomic_with(
     tmp.as_file().sync_all().map_err(with_path)?;
     tmp.persist(path).map_err(|e| with_path(e.error))?;
     Ok(())
+}
+
+/// Removes `dir/.NAME.*.PID.ktree-tmp` files left by writers that were killed (their `PID` no longer runs).
+/// Best effort: errors are ignored, and nothing is removed where `/proc` does not list processes.
+fn remove_stale_temporaries(dir: &Path, name: &str) {
+    let proc = Path::new("/proc");
+    if !proc.join("self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let prefix = format!(".{name}.");
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let file = file.to_string_lossy();
+        let Some(rest) = file
+            .strip_prefix(&prefix)
+            .and_then(|r| r.strip_suffix(TEMP_SUFFIX))
+        else {
+            continue;
+        };
+        let Some(pid) = rest.rsplit('.').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        if !proc.join(pid.to_string()).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stale_temporaries_of_dead_writers_are_removed_on_the_next_write() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.ktree");
+        // PIDs above the kernel's maximum (4194304) never run.
+        let stale = dir.path().join(".out.ktree.abc123.4294967295.ktree-tmp");
+        let live = dir.path().join(format!(
+            ".out.ktree.abc123.{}.ktree-tmp",
+            std::process::id()
+        ));
+        let other = dir.path().join(".other.ktree.abc123.4294967295.ktree-tmp");
+        for f in [&stale, &live, &other] {
+            std::fs::write(f, b"partial").unwrap();
+        }
+        write_atomic(&target, b"new").unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        assert!(!stale.exists(), "a dead writer's temporary file stays");
+        assert!(
+            live.exists(),
+            "a running writer's temporary file was removed"
+        );
+        assert!(
+            other.exists(),
+            "another target's temporary file was removed"
+        );
+    }
+
+    #[test]
+    fn a_failed_write_leaves_the_old_file_and_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("keep.txt");
+        write_atomic(&target, b"old").unwrap();
+        let e = write_atomic_with(&target, |w| {
+            w.write_all(b"half")?;
+            Err(std::io::Error::other("disk full"))
+        })
+        .unwrap_err();
+        assert!(e.to_string().contains("keep.txt"), "{e}");
+        assert_eq!(std::fs::read(&target).unwrap(), b"old");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
 }

@@ -33,8 +33,13 @@ pub fn ball_rays<const K: usize>(
     // Column range per axis: voxels c with |2c + 1 − C| ≤ R.
     let range = |c2: i64| -> (i64, i64) {
         // ceil((c2 − R − 1) / 2) ..= floor((c2 + R − 1) / 2), clipped to the universe.
-        let lo = (c2 - radius2).div_euclid(2).max(0);
-        let hi = (c2 + radius2 - 1).div_euclid(2).min(side - 1);
+        // Saturating: a bound beyond i64 is clipped to the universe all the same.
+        let lo = c2.saturating_sub(radius2).div_euclid(2).max(0);
+        let hi = c2
+            .saturating_add(radius2)
+            .saturating_sub(1)
+            .div_euclid(2)
+            .min(side - 1);
         (lo, hi)
     };
     let ranges: Vec<(i64, i64)> = centre2.iter().map(|&c| range(c)).collect();
@@ -47,14 +52,14 @@ pub fn ball_rays<const K: usize>(
         let used: i128 = col
             .iter()
             .zip(centre2.iter())
-            .map(|(&c, &c2)| i128::from(2 * c + 1 - c2).pow(2))
+            .map(|(&c, &c2)| (i128::from(2 * c + 1) - i128::from(c2)).pow(2))
             .sum();
         if used <= r2 {
-            let s = isqrt(r2 - used) as i64;
-            let cz = centre2[K - 1];
-            // |2z + 1 − cz| ≤ s  ⇔  (cz − s − 1)/2 ≤ z ≤ (cz + s − 1)/2
+            let s = isqrt(r2 - used);
+            let cz = i128::from(centre2[K - 1]);
+            // |2z + 1 − cz| ≤ s  ⇔  (cz − s − 1)/2 ≤ z ≤ (cz + s − 1)/2 (in i128: no overflow)
             let z1 = (cz - s).div_euclid(2).max(0);
-            let z2 = (cz + s - 1).div_euclid(2).min(side - 1) + 1;
+            let z2 = (cz + s - 1).div_euclid(2).min(i128::from(side) - 1) + 1;
             if z1 < z2 {
                 let mut point = [0u32; K];
                 for (p, &c) in point.iter_mut().zip(col.iter()) {

@@ -51,6 +51,9 @@ pub const MAX_LEVEL: u32 = 20;
 /// Placed coordinates must lie within ±2^22 voxels (keeps every product inside `i128`).
 const LIMIT: f64 = (1u64 << 22) as f64;
 
+/// The mesh file extensions [`TriangleMesh::read`] knows.
+const MESH_FORMATS: [&str; 3] = ["obj", "stl", "ply"];
+
 /// A triangle mesh: vertex positions and triangles as vertex indices, checked when made (finite vertices,
 /// indices in range, at least one triangle).
 ///
@@ -154,33 +157,52 @@ impl TriangleMesh {
     /// [`SolidError::Io`] when the file cannot be read, [`SolidError::Parse`] naming the file (and the line
     /// where the parser tells it) otherwise.
     pub fn read(path: &Path) -> Result<Self, SolidError> {
-        let ext = path
+        let format = path
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase)
             .unwrap_or_default();
-        let parse = |what: String| SolidError::Parse {
-            path: path.to_path_buf(),
-            what,
-        };
-        let io = |source| SolidError::Io {
+        if !MESH_FORMATS.contains(&format.as_str()) {
+            return Self::from_bytes(&[], &format, path);
+        }
+        let bytes = std::fs::read(path).map_err(|source| SolidError::Io {
             path: path.to_path_buf(),
             source,
+        })?;
+        Self::from_bytes(&bytes, &format, path)
+    }
+
+    /// Parses a mesh held in memory; `format` is the extension without the dot (`obj`, `stl`, `ply`, any case),
+    /// `file` names the input in errors. [`TriangleMesh::read`] reads a file and calls this.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use ktree::solid::mesh::TriangleMesh;
+    /// let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    /// let mesh = TriangleMesh::from_bytes(obj, "obj", Path::new("mem.obj")).unwrap();
+    /// assert_eq!(mesh.triangles.len(), 1);
+    /// assert!(TriangleMesh::from_bytes(b"f 1 2 9\n", "obj", Path::new("bad.obj")).is_err());
+    /// ```
+    ///
+    /// # Errors
+    /// [`SolidError::Parse`] naming `file` and what is wrong.
+    pub fn from_bytes(bytes: &[u8], format: &str, file: &Path) -> Result<Self, SolidError> {
+        let parse = |what: String| SolidError::Parse {
+            path: file.to_path_buf(),
+            what,
         };
-        let mesh = match ext.as_str() {
+        let mesh = match format.to_ascii_lowercase().as_str() {
             "obj" => {
-                let file = std::fs::File::open(path).map_err(io)?;
                 let opts = tobj::LoadOptions {
                     triangulate: true,
                     single_index: false,
                     ignore_points: true,
                     ignore_lines: true,
                 };
-                let (models, _) =
-                    tobj::load_obj_buf(&mut std::io::BufReader::new(file), &opts, |_| {
-                        Err(tobj::LoadError::OpenFileFailed)
-                    })
-                    .map_err(|e| parse(format!("OBJ: {e}")))?;
+                let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &opts, |_| {
+                    Err(tobj::LoadError::OpenFileFailed)
+                })
+                .map_err(|e| parse(format!("OBJ: {e}")))?;
                 let mut mesh = Self {
                     vertices: Vec::new(),
                     triangles: Vec::new(),
@@ -202,8 +224,8 @@ impl TriangleMesh {
                 mesh
             }
             "stl" => {
-                let mut file = std::fs::File::open(path).map_err(io)?;
-                let m = stl_io::read_stl(&mut file).map_err(|e| parse(format!("STL: {e}")))?;
+                let m = stl_io::read_stl(&mut std::io::Cursor::new(bytes))
+                    .map_err(|e| parse(format!("STL: {e}")))?;
                 Self {
                     vertices: m.vertices.iter().map(|v| v.0.map(f64::from)).collect(),
                     triangles: m
@@ -213,10 +235,10 @@ impl TriangleMesh {
                         .collect(),
                 }
             }
-            "ply" => read_ply(path).map_err(parse)?,
-            _ => {
+            "ply" => read_ply(bytes).map_err(parse)?,
+            other => {
                 return Err(parse(format!(
-                    "unknown mesh format '.{ext}' (known: .obj, .stl, .ply)"
+                    "unknown mesh format '.{other}' (known: .obj, .stl, .ply)"
                 )))
             }
         };
@@ -479,12 +501,70 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-fn read_ply(path: &Path) -> Result<TriangleMesh, String> {
+/// Checks a PLY header before the `ply-rs` parser sees it: every number on a `format` or `element` line fits
+/// in a `u64` (the parser panics otherwise), every declared element has a property, and the elements declared
+/// are no more than the bytes after the header (each takes at least one), so the parser never loops or
+/// allocates beyond the input.
+fn check_ply_header(bytes: &[u8]) -> Result<(), String> {
+    let mut elements: Vec<(String, u64, usize)> = Vec::new();
+    let mut at = 0;
+    for line in bytes.split_inclusive(|&b| b == b'\n') {
+        at += line.len();
+        let text = String::from_utf8_lossy(line);
+        let mut words = text.split_ascii_whitespace();
+        let first = words.next().unwrap_or("");
+        if first == "format" || first == "element" {
+            let too_big = text
+                .split(|c: char| !c.is_ascii_digit())
+                .any(|run| !run.is_empty() && run.parse::<u64>().is_err());
+            if too_big {
+                return Err(format!(
+                    "PLY: number too large in header line '{}'",
+                    text.trim()
+                ));
+            }
+        }
+        match first {
+            "element" => {
+                let name = words.next().unwrap_or("").to_string();
+                let count = words.next().and_then(|c| c.parse().ok()).unwrap_or(0);
+                elements.push((name, count, 0));
+            }
+            "property" => {
+                if let Some(e) = elements.last_mut() {
+                    e.2 += 1;
+                }
+            }
+            "end_header" => {
+                let body = (bytes.len() - at) as u64;
+                let mut declared = 0u64;
+                for (name, count, properties) in &elements {
+                    if *count > 0 && *properties == 0 {
+                        return Err(format!(
+                            "PLY: element '{name}' has {count} entries but no property"
+                        ));
+                    }
+                    declared = declared.saturating_add(*count);
+                }
+                if declared > body {
+                    return Err(format!(
+                        "PLY: the header declares {declared} elements but only {body} bytes follow it"
+                    ));
+                }
+                return Ok(());
+            }
+            _ => {}
+        }
+    }
+    Err("PLY: no end_header line".into())
+}
+
+fn read_ply(mut bytes: &[u8]) -> Result<TriangleMesh, String> {
     use ply_rs::ply::Property;
-    let mut file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    check_ply_header(bytes)?;
     let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
     let ply = parser
-        .read_ply(&mut file)
+        .read_ply(&mut bytes)
         .map_err(|e| format!("PLY: {e}"))?;
     let scalar = |p: &Property| -> Option<f64> {
         Some(match *p {

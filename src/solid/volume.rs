@@ -73,7 +73,77 @@ struct Sidecar {
 }
 
 /// Largest number of samples accepted (checked before allocating).
-const MAX_SAMPLES: usize = 1 << 31;
+pub const MAX_SAMPLES: usize = 1 << 31;
+/// Bytes of a NIfTI-1 header.
+const NIFTI_HEADER_BYTES: u64 = 348;
+/// Largest offset of the samples in a NIfTI file (room for header extensions).
+const MAX_NIFTI_OFFSET: f32 = (1u32 << 24) as f32;
+
+/// The sample layout a raw volume's JSON sidecar describes.
+struct RawLayout {
+    meta: Sidecar,
+    samples: usize,
+    size: usize,
+    big: bool,
+}
+
+impl RawLayout {
+    fn parse(text: &[u8], json: &Path) -> Result<Self, SolidError> {
+        let parse = |what: String| SolidError::Parse {
+            path: json.to_path_buf(),
+            what,
+        };
+        let meta: Sidecar = serde_json::from_slice(text)
+            .map_err(|e| parse(format!("line {} column {}: {e}", e.line(), e.column())))?;
+        let size = match meta.dtype.as_str() {
+            "uint8" | "int8" => 1,
+            "uint16" | "int16" => 2,
+            "uint32" | "int32" | "float32" => 4,
+            "float64" => 8,
+            other => return Err(parse(format!("unknown dtype '{other}'"))),
+        };
+        let big = match meta.endianness.as_deref() {
+            None | Some("little") => false,
+            Some("big") => true,
+            Some(other) => return Err(parse(format!("unknown endianness '{other}'"))),
+        };
+        let samples = checked_samples(meta.shape_xyz)
+            .ok_or_else(|| parse(format!("shape {:?} is empty or too large", meta.shape_xyz)))?;
+        Ok(Self {
+            meta,
+            samples,
+            size,
+            big,
+        })
+    }
+
+    /// Checks the raw data's length before it is read or decoded.
+    fn check_length(&self, got: u64, raw: &Path) -> Result<(), SolidError> {
+        let want = self.samples as u64 * self.size as u64;
+        if got == want {
+            return Ok(());
+        }
+        Err(SolidError::Parse {
+            path: raw.to_path_buf(),
+            what: format!(
+                "{got} bytes, but shape {:?} of {} needs {want}",
+                self.meta.shape_xyz, self.meta.dtype
+            ),
+        })
+    }
+
+    fn decode(self, bytes: &[u8]) -> Volume {
+        let values = bytes
+            .chunks_exact(self.size)
+            .map(|c| decode(&self.meta.dtype, c, self.big))
+            .collect();
+        Volume {
+            shape: self.meta.shape_xyz,
+            values,
+            spacing: self.meta.spacing_xyz.unwrap_or([1.0; 3]),
+        }
+    }
+}
 
 impl Volume {
     /// Reads a volume: a `.json` sidecar (or the `.raw` beside one) or a NIfTI file (`.nii`, `.nii.gz`).
@@ -98,95 +168,98 @@ impl Volume {
     }
 
     /// Reads raw samples described by a JSON sidecar (the raw file is the sidecar's `file`, or the same name
-    /// with `.raw`).
+    /// with `.raw`). The raw file's length is checked against the sidecar's shape before it is read.
     ///
     /// # Errors
     /// As [`Volume::read`].
     pub fn read_raw(json: &Path) -> Result<Self, SolidError> {
-        let parse = |p: &Path, what: String| SolidError::Parse {
-            path: p.to_path_buf(),
-            what,
-        };
-        let text = std::fs::read_to_string(json).map_err(|source| SolidError::Io {
+        let text = std::fs::read(json).map_err(|source| SolidError::Io {
             path: json.to_path_buf(),
             source,
         })?;
-        let meta: Sidecar = serde_json::from_str(&text).map_err(|e| {
-            parse(
-                json,
-                format!("line {} column {}: {e}", e.line(), e.column()),
-            )
-        })?;
-        let raw = match &meta.file {
+        let layout = RawLayout::parse(&text, json)?;
+        let raw = match &layout.meta.file {
             Some(f) => json.with_file_name(f),
             None => json.with_extension("raw"),
         };
-        let size = match meta.dtype.as_str() {
-            "uint8" | "int8" => 1,
-            "uint16" | "int16" => 2,
-            "uint32" | "int32" | "float32" => 4,
-            "float64" => 8,
-            other => return Err(parse(json, format!("unknown dtype '{other}'"))),
-        };
-        let big = match meta.endianness.as_deref() {
-            None | Some("little") => false,
-            Some("big") => true,
-            Some(other) => return Err(parse(json, format!("unknown endianness '{other}'"))),
-        };
-        let n = checked_samples(meta.shape_xyz).ok_or_else(|| {
-            parse(
-                json,
-                format!("shape {:?} is empty or too large", meta.shape_xyz),
-            )
-        })?;
-        let want = n as u64 * size as u64;
         let got = std::fs::metadata(&raw)
             .map_err(|source| SolidError::Io {
                 path: raw.clone(),
                 source,
             })?
             .len();
-        if got != want {
-            return Err(parse(
-                &raw,
-                format!(
-                    "{got} bytes, but shape {:?} of {} needs {want}",
-                    meta.shape_xyz, meta.dtype
-                ),
-            ));
-        }
+        layout.check_length(got, &raw)?;
         let bytes = std::fs::read(&raw).map_err(|source| SolidError::Io {
             path: raw.clone(),
             source,
         })?;
-        let values = bytes
-            .chunks_exact(size)
-            .map(|c| decode(&meta.dtype, c, big))
-            .collect();
-        Ok(Self {
-            shape: meta.shape_xyz,
-            values,
-            spacing: meta.spacing_xyz.unwrap_or([1.0; 3]),
-        })
+        layout.check_length(bytes.len() as u64, &raw)?;
+        Ok(layout.decode(&bytes))
+    }
+
+    /// Decodes raw samples held in memory, described by the bytes of a JSON sidecar (its `file` field is
+    /// ignored); `file` names the input in errors. [`Volume::read_raw`] reads the files and calls the same
+    /// checks.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use ktree::solid::volume::Volume;
+    /// let sidecar = br#"{"shape_xyz": [2, 1, 1], "dtype": "uint16", "endianness": "big"}"#;
+    /// let v = Volume::from_raw_bytes(sidecar, &[0, 7, 1, 0], Path::new("mem.json")).unwrap();
+    /// assert_eq!(v.values, [7.0, 256.0]);
+    /// assert!(Volume::from_raw_bytes(sidecar, &[0, 7], Path::new("mem.json")).is_err());
+    /// ```
+    ///
+    /// # Errors
+    /// [`SolidError::Parse`] for a bad sidecar or a sample count that does not match its shape.
+    pub fn from_raw_bytes(sidecar: &[u8], raw: &[u8], file: &Path) -> Result<Self, SolidError> {
+        let layout = RawLayout::parse(sidecar, file)?;
+        layout.check_length(raw.len() as u64, file)?;
+        Ok(layout.decode(raw))
     }
 
     /// Reads a NIfTI-1 file with the `nifti` crate (3-D volumes only; a 4-D file with one time point is
-    /// accepted).
+    /// accepted): the file's bytes go to [`Volume::from_nifti_bytes`].
     ///
     /// # Errors
     /// As [`Volume::read`].
     pub fn read_nifti(path: &Path) -> Result<Self, SolidError> {
-        use nifti::{NiftiObject, NiftiVolume, RandomAccessNiftiVolume};
-        let parse = |what: String| SolidError::Parse {
+        let bytes = std::fs::read(path).map_err(|source| SolidError::Io {
             path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_nifti_bytes(&bytes, path)
+    }
+
+    /// Parses a single-file NIfTI-1 volume (`.nii`, or gzip-compressed `.nii.gz`, told by the gzip magic)
+    /// held in memory; `file` names the input in errors. The header's shape is checked against
+    /// [`MAX_SAMPLES`] and against the bytes present before the samples are allocated.
+    ///
+    /// # Errors
+    /// [`SolidError::Parse`] naming `file` and what is wrong.
+    pub fn from_nifti_bytes(bytes: &[u8], file: &Path) -> Result<Self, SolidError> {
+        use nifti::{NiftiObject, RandomAccessNiftiVolume};
+        use std::io::Read;
+        let parse = |what: String| SolidError::Parse {
+            path: file.to_path_buf(),
             what,
         };
-        let obj = nifti::ReaderOptions::new()
-            .read_file(path)
-            .map_err(|e| parse(format!("NIfTI: {e}")))?;
-        let pix = obj.header().pixdim;
-        let vol = obj.into_volume();
-        let dim = vol.dim().to_vec();
+        let nifti_error = |e: nifti::NiftiError| parse(format!("NIfTI: {e}"));
+        let io_error = |e: std::io::Error| parse(format!("NIfTI: {e}"));
+        // The header, then exactly the bytes it describes (never more: a compressed file is inflated only as
+        // far as the header's own claim, which is bounded by MAX_SAMPLES).
+        let mut input: Box<dyn Read + '_> = if bytes.starts_with(&[0x1f, 0x8b]) {
+            Box::new(flate2::bufread::GzDecoder::new(bytes))
+        } else {
+            Box::new(bytes)
+        };
+        let mut data = Vec::new();
+        (&mut input)
+            .take(NIFTI_HEADER_BYTES)
+            .read_to_end(&mut data)
+            .map_err(io_error)?;
+        let header = nifti::NiftiHeader::from_reader(&data[..]).map_err(nifti_error)?;
+        let dim = header.dim().map_err(nifti_error)?.to_vec();
         if dim.len() < 3 || dim.len() > 4 || (dim.len() == 4 && dim[3] != 1) {
             return Err(parse(format!(
                 "NIfTI: expected a 3-D volume, found dimensions {dim:?}"
@@ -195,6 +268,35 @@ impl Volume {
         let shape = [dim[0] as usize, dim[1] as usize, dim[2] as usize];
         let n = checked_samples(shape)
             .ok_or_else(|| parse(format!("shape {shape:?} is empty or too large")))?;
+        let datatype = header.data_type().map_err(nifti_error)?;
+        let sample = datatype.size_of() as u64;
+        if u64::from(header.bitpix.unsigned_abs()) != 8 * sample {
+            return Err(parse(format!(
+                "NIfTI: {} bits per sample do not match the data type {datatype:?}",
+                header.bitpix
+            )));
+        }
+        let offset = header.vox_offset;
+        if !(offset >= NIFTI_HEADER_BYTES as f32 + 4.0 && offset <= MAX_NIFTI_OFFSET) {
+            return Err(parse(format!(
+                "NIfTI: the samples' offset {offset} is not from 352 to {MAX_NIFTI_OFFSET}"
+            )));
+        }
+        let need = offset as u64 + n as u64 * sample;
+        (&mut input)
+            .take(need - data.len() as u64)
+            .read_to_end(&mut data)
+            .map_err(io_error)?;
+        if (data.len() as u64) < need {
+            return Err(parse(format!(
+                "NIfTI: {} bytes, but the header describes {need}: truncated",
+                data.len()
+            )));
+        }
+        let obj = nifti::InMemNiftiObject::from_reader(&data[..]).map_err(nifti_error)?;
+        drop(data);
+        let pix = obj.header().pixdim;
+        let vol = obj.into_volume();
         let mut values = Vec::with_capacity(n);
         let mut coords = vec![0u16; dim.len()];
         for z in 0..dim[2] {
@@ -203,10 +305,7 @@ impl Volume {
                     coords[0] = x;
                     coords[1] = y;
                     coords[2] = z;
-                    values.push(
-                        vol.get_f64(&coords)
-                            .map_err(|e| parse(format!("NIfTI: {e}")))?,
-                    );
+                    values.push(vol.get_f64(&coords).map_err(nifti_error)?);
                 }
             }
         }

@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Runs every fuzz target for SECONDS each (default 60), one after the other, and writes
+# results/reliability.md: executions, time, crashes, coverage and peak memory per target.
+#
+#   fuzz/run.sh [SECONDS] [TARGET...]
+#
+# Needs cargo-fuzz (`cargo install cargo-fuzz`) and a C++ compiler; the stable toolchain is enough with
+# RUSTC_BOOTSTRAP=1, which this script sets (cargo-fuzz passes -Z flags to rustc). SANITIZER=address turns on
+# AddressSanitizer (default none: the library forbids unsafe code, and a plain build runs several times faster).
+# Each run starts from the committed seeds in fuzz/corpus/TARGET and keeps what it finds in
+# fuzz/target/corpus/TARGET (not committed). A crash leaves its input in fuzz/artifacts/TARGET/.
+# FUZZ_NO_REPORT=1 skips writing results/reliability.md (the CI smoke run); the exit status is 1 on any crash.
+set -uo pipefail
+cd "$(dirname "$0")"
+seconds=${1:-60}
+shift || true
+export RUSTC_BOOTSTRAP=1
+sanitizer=${SANITIZER:-none}
+targets=("$@")
+if [ ${#targets[@]} -eq 0 ]; then
+  mapfile -t targets < <(cargo fuzz list)
+fi
+cargo fuzz build -O -s "$sanitizer" || exit 1
+host=$(rustc -vV | sed -n "s/^host: //p")
+logs=target/logs
+mkdir -p "$logs"
+rows=()
+failed=0
+for t in "${targets[@]}"; do
+  mkdir -p "target/corpus/$t" "corpus/$t"
+  start=$(date +%s)
+  mkdir -p "artifacts/$t"
+  # The binary cargo-fuzz built above, run directly (as `cargo fuzz run` would, without rebuilding).
+  "target/$host/release/$t" -artifact_prefix="artifacts/$t/" \
+    -max_total_time="$seconds" -rss_limit_mb=2048 -malloc_limit_mb=2048 -timeout=10 \
+    -print_final_stats=1 "target/corpus/$t" "corpus/$t" >"$logs/$t.log" 2>&1
+  status=$?
+  took=$(( $(date +%s) - start ))
+  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$logs/$t.log" | grep -o '[0-9]*$' | tail -1)
+  rss=$(grep -o 'stat::peak_rss_mb: *[0-9]*' "$logs/$t.log" | grep -o '[0-9]*$' | tail -1)
+  cov=$(grep -o 'cov: [0-9]* ft: [0-9]*' "$logs/$t.log" | tail -1)
+  if [ $status -eq 0 ]; then
+    outcome="none"
+  else
+    failed=1
+    # The kind of failure, and for a panic the source file's name (never a path of this machine).
+    kind=$(grep -o -m1 -E 'panicked at [^:]*|ERROR: libFuzzer: [a-z -]*|ERROR: AddressSanitizer: [a-z-]*' "$logs/$t.log" \
+      | head -1 | sed -E 's#(panicked at ).*/#\1#')
+    outcome="**${kind:-exit $status}** (see fuzz/artifacts/$t/)"
+  fi
+  echo "$t: ${execs:-?} executions in ${took} s, crashes: $outcome"
+  rows+=("| \`$t\` | ${execs:-?} | ${took} | $outcome | ${cov:-?} | ${rss:-?} |")
+done
+if [ "${FUZZ_NO_REPORT:-0}" = 1 ]; then
+  exit $failed
+fi
+out=../results/reliability.md
+{
+  echo "# Reliability: fuzzing"
+  echo
+  echo "Written by \`fuzz/run.sh $seconds\` (libFuzzer through cargo-fuzz, sanitizer: $sanitizer, \`-rss_limit_mb=2048\`,"
+  echo "\`-malloc_limit_mb=2048\`, \`-timeout=10\`), one target after the other, each starting from the committed seeds"
+  echo "in \`fuzz/corpus/\` plus what earlier runs on this machine kept in \`fuzz/target/corpus/\`. Coverage is libFuzzer's"
+  echo "count of covered edges (\`cov\`) and features (\`ft\`) at the end of the run."
+  echo
+  echo "| target | executions | seconds | crashes in this run | coverage | peak RSS (MB) |"
+  echo "|---|---:|---:|---|---|---:|"
+  printf '%s\n' "${rows[@]}"
+  echo
+  cat FINDINGS.md
+} >"$out"
+exit $failed
