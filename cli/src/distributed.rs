@@ -40,7 +40,10 @@ pub fn stack<const K: usize>(
 }
 
 /// Stacks rays in this process, cell by cell on `threads` worker threads (all cores when `None`).
-fn stack_here<const K: usize>(rays: &RaySet<K>, threads: Option<usize>) -> Result<KTree<K>, String> {
+fn stack_here<const K: usize>(
+    rays: &RaySet<K>,
+    threads: Option<usize>,
+) -> Result<KTree<K>, String> {
     crate::build::with_threads(threads, || crate::build::stack_cells(rays))
 }
 

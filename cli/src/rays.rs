@@ -153,7 +153,8 @@ pub fn write_output<const K: usize>(
         let Some(tree) = crate::distributed::stack(rays, threads)? else {
             return Ok(String::new());
         };
-        crate::tree_file::write(out, &tree).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        crate::tree_file::write(out, &tree)
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
         let c = tree.counts();
         Ok(format!(
             "{}: K = {K}, L = {}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",

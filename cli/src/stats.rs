@@ -3,7 +3,9 @@
 
 use std::path::PathBuf;
 
-use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, TreeStats, VERSION_2};
+use ktree::io::{
+    ktree_file_version, read_ktree_file, read_rays_file, KtreeView, TreeStats, VERSION_2,
+};
 use ktree::tree::heap_bytes_for_levels;
 
 /// Arguments of `ktree stats`.

@@ -309,8 +309,8 @@ fn a_vdb_written_by_ktree_opens_in_openvdb_with_the_same_voxels_and_box() {
                 tree.for_each_leaf(|c, s| {
                     if s == NodeState::Full {
                         for a in 0..3 {
-                            lo[a] = lo[a].min(c.origin[a]);
-                            hi[a] = hi[a].max(c.origin[a] + c.side() as u32 - 1);
+                            lo[a] = lo[a].min(c.origin()[a]);
+                            hi[a] = hi[a].max(c.origin()[a] + c.side() as u32 - 1);
                         }
                     }
                 });

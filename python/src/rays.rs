@@ -71,7 +71,7 @@ pub(crate) fn tree_rays<const K: usize>(tree: &KTree<K>) -> Result<RaySet<K>, Fa
     let mut rays = Vec::with_capacity(runs as usize);
     for cell in &leaves {
         let side = cell.side();
-        let z1 = cell.origin[K - 1];
+        let z1 = cell.origin()[K - 1];
         let z2 = u32::try_from(u64::from(z1) + side).map_err(Failure::value)?;
         // Every column of the cell: an odometer over the first K − 1 axes.
         let mut offset = [0u64; K];

@@ -802,7 +802,7 @@ pub(super) fn read_v2_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFile
     check.map_err(|e| KtreeFileError {
         file: file.to_string(),
         offset: HEADER_BYTES as u64,
-        kind: KtreeFileErrorKind::Tree(e),
+        kind: KtreeFileErrorKind::Tree(e.to_string()),
     })?;
     Ok(tree)
 }
@@ -1107,14 +1107,14 @@ impl KtreeView {
             .map(|(depth, s)| {
                 let words = (0..s.words()).map(|j| self.word(s, j)).collect();
                 PackedStates::from_words(words, s.nodes as usize)
-                    .ok_or_else(|| self.changed(depth, 0))
+                    .map_err(|_| self.changed(depth, 0))
             })
             .collect::<Result<_, _>>()?;
         let tree = KTree::from_levels(universe, levels);
         tree.check().map_err(|e| KtreeFileError {
             file: self.name.clone(),
             offset: HEADER_BYTES as u64,
-            kind: KtreeFileErrorKind::Tree(e),
+            kind: KtreeFileErrorKind::Tree(e.to_string()),
         })?;
         Ok(tree)
     }
@@ -1187,7 +1187,7 @@ mod tests {
         }
         let mut leaves = Vec::new();
         view.for_each_leaf::<3>(|c, s| leaves.push((c, s))).unwrap();
-        assert_eq!(leaves, tree.leaves());
+        assert_eq!(leaves, tree.leaves().collect::<Vec<_>>());
         // Each level in odd-sized pieces: the shifted appends give the same bytes.
         let mut pieces = Vec::new();
         let mut w = KtreeWriter::new(&mut pieces, 3, tree.level()).unwrap();

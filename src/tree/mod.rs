@@ -21,5 +21,7 @@ mod states;
 
 pub(crate) use assemble::TreeAssembler;
 pub use error::TreeError;
-pub use ktree::{heap_bytes_for_levels, Bintree, KTree, Leaves, LevelCounts, NodeRef, Octree, Quadtree, Tree4};
+pub use ktree::{
+    heap_bytes_for_levels, Bintree, KTree, Leaves, LevelCounts, NodeRef, Octree, Quadtree, Tree4,
+};
 pub use states::{NodeState, PackedStates};

@@ -16,7 +16,7 @@ use sparse::{boxes, point, union_volume, Boxes, Cuboid};
 /// The tree of `b`, built by stacking its rays, after checking it is well formed.
 fn tree<const K: usize>(b: &Boxes<K>) -> Result<KTree<K>, TestCaseError> {
     let t = stack(&b.rays());
-    t.check().map_err(TestCaseError::fail)?;
+    t.check().map_err(|e| TestCaseError::fail(e.to_string()))?;
     Ok(t)
 }
 
@@ -80,7 +80,8 @@ fn check_booleans<const K: usize>(
             BoolOp::SymmetricDifference => (na + nb - 2 * both, |x, y| x != y),
         };
         let out = ops::boolean(&ta, &tb, op).map_err(|e| TestCaseError::fail(e.to_string()))?;
-        out.check().map_err(TestCaseError::fail)?;
+        out.check()
+            .map_err(|e| TestCaseError::fail(e.to_string()))?;
         prop_assert_eq!(out.voxel_count(), count, "{:?}", op);
         same_at(&out, probes.iter().copied(), |q| {
             rule(a.contains(q), b.contains(q))
@@ -88,7 +89,9 @@ fn check_booleans<const K: usize>(
     }
     // The complement holds nearly the whole universe: 2^64 voxels for K = 4 need 128 bits.
     let not_a = ops::complement(&ta);
-    not_a.check().map_err(TestCaseError::fail)?;
+    not_a
+        .check()
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(not_a.voxel_count(), universe_volume::<K>(a.level) - na);
     same_at(&not_a, probes.iter().copied(), |q| !a.contains(q))?;
     prop_assert_eq!(
@@ -122,7 +125,8 @@ fn check_translate<const K: usize>(
             .collect(),
     };
     let out = ops::translate(&tree(a)?, shift);
-    out.check().map_err(TestCaseError::fail)?;
+    out.check()
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(out.voxel_count(), moved.voxel_count());
     let probes = moved.probe_points().into_iter().chain([p]);
     same_at(&out, probes, |q| moved.contains(q))?;
@@ -159,7 +163,8 @@ fn check_axis_map<const K: usize>(
             .collect(),
     };
     let out = ops::rotate_axes(&tree(a)?, &map);
-    out.check().map_err(TestCaseError::fail)?;
+    out.check()
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(out.voxel_count(), a.voxel_count());
     let probes = mapped.probe_points().into_iter().chain([p]);
     same_at(&out, probes, |q| mapped.contains(q))?;
@@ -214,7 +219,8 @@ fn check_scale<const K: usize>(
             .collect(),
     };
     let out = ops::scale(&tree(a)?, num, den).map_err(|e| TestCaseError::fail(e.to_string()))?;
-    out.check().map_err(TestCaseError::fail)?;
+    out.check()
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(out.voxel_count(), scaled.voxel_count());
     let back = |q: u64| (2 * q + 1) * u64::from(den) / (2 * u64::from(num));
     let probes = scaled.probe_points().into_iter().chain([p]);
@@ -259,7 +265,8 @@ fn check_zoom<const K: usize>(a: &Boxes<K>, path: Vec<usize>) -> Result<(), Test
             .collect(),
     };
     let out = ops::zoom(&tree(a)?, &path).map_err(|e| TestCaseError::fail(e.to_string()))?;
-    out.check().map_err(TestCaseError::fail)?;
+    out.check()
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(out.level(), level);
     prop_assert_eq!(out.voxel_count(), kept.voxel_count());
     same_at(&out, kept.probe_points(), |q| kept.contains(q))?;
@@ -314,7 +321,7 @@ fn check_interference<const K: usize>(a: &Boxes<K>, b: &Boxes<K>) -> Result<(), 
     let covered: u128 = cells.iter().map(|c| c.volume()).sum();
     prop_assert_eq!(covered, both);
     for c in &cells {
-        let corner = c.origin.map(u64::from);
+        let corner = c.origin().map(u64::from);
         prop_assert!(
             a.contains(corner) && b.contains(corner),
             "overlap cell {:?}",

@@ -60,7 +60,7 @@ fn split_and_join_agree<const K: usize>(case: &Case<K>, depth: u32) -> Result<()
         cases::for_each_column([0; K], [side; K], |mut p| {
             for z in 0..side {
                 p[K - 1] = z;
-                let global: [u32; K] = std::array::from_fn(|a| p[a] + cell.origin[a]);
+                let global: [u32; K] = std::array::from_fn(|a| p[a] + cell.origin()[a]);
                 assert_eq!(inner.contains(p), rays.contains(global), "{cell:?} {p:?}");
                 count += u128::from(rays.contains(global));
             }

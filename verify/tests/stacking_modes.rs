@@ -45,7 +45,9 @@ fn modes_agree<const K: usize>(case: &Case<K>) -> Result<(), TestCaseError> {
         pipelined == tree,
         "pipeline and memory differ node for node"
     );
-    pipelined.check().map_err(TestCaseError::fail)?;
+    pipelined
+        .check()
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert!(stack(rays) == tree);
     Ok(())
 }
