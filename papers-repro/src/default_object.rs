@@ -21,7 +21,7 @@ pub const RADIUS: i64 = 32;
 pub fn run(results: &Path) -> Result<String, String> {
     let rays = ball_rays::<3>(LEVEL, [0, 0, 0], 2 * RADIUS).map_err(|e| e.to_string())?;
     let (tree, stats) = stack_with_stats(&rays);
-    tree.check()?;
+    tree.check().map_err(|e| e.to_string())?;
     let counts = tree.counts();
     let mut md = String::new();
     let _ = writeln!(md, "# Default object: a 1/8 sphere\n");

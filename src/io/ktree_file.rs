@@ -338,7 +338,7 @@ pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileErro
         _ => AnyTree::K4(assemble::<4>(level, levels)),
     };
     let check = crate::with_dim!(&tree, AnyTree, t => t.check());
-    check.map_err(|e| fail(body_at, KtreeFileErrorKind::Tree(e)))?;
+    check.map_err(|e| fail(body_at, KtreeFileErrorKind::Tree(e.to_string())))?;
     Ok(tree)
 }
 

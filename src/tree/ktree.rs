@@ -1,5 +1,6 @@
 //! `KTree<K>`: a compact, pointer-free, navigable k-tree in level order.
 
+use super::error::TreeError;
 use super::states::{NodeState, PackedStates};
 use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
 
@@ -229,23 +230,12 @@ impl<const K: usize> KTree<K> {
         if self.universe.check_point(point).is_err() {
             return false;
         }
-        let level = self.level();
-        let mut index = 0usize;
-        for depth in 0..self.levels.len() {
-            match self.levels[depth].get(index) {
-                NodeState::Empty => return false,
-                NodeState::Full => return true,
-                NodeState::Partial => {
-                    let bit = level - 1 - depth as u32;
-                    let mut code = 0usize;
-                    for (axis, &c) in point.iter().enumerate() {
-                        code |= ((c >> bit & 1) as usize) << axis;
-                    }
-                    index = self.first_child(depth, index) + code;
-                }
-            }
-        }
-        unreachable!("a well-formed tree ends in leaves")
+        let voxel = Cell {
+            origin: point,
+            level: self.level(),
+            log_side: 0,
+        };
+        super::cursor::locate(self, self.root(), &voxel).state == NodeState::Full
     }
 
     /// Visits every leaf (empty and full) in Morton (depth-first) order.
@@ -323,29 +313,30 @@ impl<const K: usize> KTree<K> {
     /// children are all full or all empty).
     ///
     /// # Errors
-    /// A sentence naming the first broken invariant.
-    pub fn check(&self) -> Result<(), String> {
+    /// The first broken invariant, as a [`TreeError`].
+    pub fn check(&self) -> Result<(), TreeError> {
         let level = self.level() as usize;
         if self.levels.is_empty() || self.levels[0].len() != 1 {
-            return Err("level 0 must hold exactly the root".into());
+            return Err(TreeError::NoRoot);
         }
         if self.levels.len() > level + 1 {
-            return Err(format!(
-                "{} levels stored for a level-{level} universe",
-                self.levels.len()
-            ));
+            return Err(TreeError::TooManyLevels {
+                levels: self.levels.len(),
+                level: self.level(),
+            });
         }
         for depth in 0..self.levels.len() {
             let partial = self.levels[depth].partial_count();
             let next = self.levels.get(depth + 1).map_or(0, |l| l.len());
             if next != partial << K {
-                return Err(format!(
-                    "level {depth} has {partial} partial nodes but level {} has {next} nodes",
-                    depth + 1
-                ));
+                return Err(TreeError::LevelSize {
+                    depth,
+                    partial,
+                    next,
+                });
             }
             if partial > 0 && depth == level {
-                return Err(format!("partial nodes at the voxel level {depth}"));
+                return Err(TreeError::PartialAtVoxelLevel { depth });
             }
         }
         for depth in 1..self.levels.len() {
@@ -355,10 +346,11 @@ impl<const K: usize> KTree<K> {
                 if first != NodeState::Partial
                     && (1..Self::FANOUT).all(|c| l.get((block << K) + c) == first)
                 {
-                    return Err(format!(
-                        "not reduced: the children of partial node {block} of level {} are all {first:?}",
-                        depth - 1
-                    ));
+                    return Err(TreeError::NotReduced {
+                        depth: depth - 1,
+                        parent: block,
+                        state: first,
+                    });
                 }
             }
         }

@@ -2,9 +2,13 @@
 //! stream of nodes or from full cells.
 
 mod assemble;
+pub mod cursor;
+mod error;
 mod ktree;
 mod states;
 
+pub(crate) use assemble::LevelWriter;
 pub use assemble::TreeAssembler;
+pub use error::TreeError;
 pub use ktree::{Bintree, KTree, LevelCounts, NodeRef, Octree, Quadtree, Tree4};
 pub use states::{NodeState, PackedStates};

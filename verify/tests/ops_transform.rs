@@ -26,7 +26,8 @@ fn resample_dense<const K: usize>(
 }
 
 fn same<const K: usize>(out: &KTree<K>, level: u32, expect: &[bool]) -> Result<(), TestCaseError> {
-    out.check().map_err(TestCaseError::fail)?;
+    out.check()
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(out.to_dense().unwrap(), expect.to_vec());
     prop_assert_eq!(out, &KTree::from_dense(level, expect).unwrap());
     Ok(())
@@ -208,7 +209,7 @@ fn check_grow_zoom<const K: usize>(a: &Obj<K>, path: Vec<usize>) -> Result<(), T
     let tree = a.tree();
     let path: Vec<usize> = path.into_iter().map(|c| c % (1 << K)).collect();
     let g = ops::grow(&tree, &path).unwrap();
-    g.check().map_err(TestCaseError::fail)?;
+    g.check().map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(g.voxel_count(), tree.voxel_count());
     prop_assert_eq!(ops::zoom(&g, &path).unwrap(), tree.clone());
     // Every voxel lands at the cell the path names.
