@@ -12,7 +12,7 @@
 //! use ktree::tree::cursor::{walk, Visitor, Walk};
 //! use ktree::tree::NodeRef;
 //! use ktree::{KTree, NodeState};
-//! // Count the full voxels of a bintree, stopping at the first full leaf of size ≥ 2.
+//! // The side of the first full leaf of side ≥ 2, in Morton order; the walk stops there.
 //! struct FirstBig(Option<u64>);
 //! impl Visitor<1> for FirstBig {
 //!     fn visit(&mut self, node: &NodeRef<1>) -> Walk {
@@ -50,7 +50,7 @@ pub enum Walk {
 /// use ktree::tree::cursor::ChildOrder;
 /// let codes = |o: ChildOrder| o.codes().collect::<Vec<_>>();
 /// assert_eq!(codes(ChildOrder::xor::<2>(0b10)), [2, 3, 0, 1]);
-/// assert_eq!(codes(ChildOrder::lower_half_first::<2>(1)), [0, 2, 1, 3]);
+/// assert_eq!(codes(ChildOrder::lower_half_first::<2>(0)), [0, 2, 1, 3]);
 /// assert_eq!(codes(ChildOrder::half::<2>(0, true)), [1, 3]);
 /// assert_eq!(codes(ChildOrder::one(5)), [5]);
 /// ```
