@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use ktree::display::{line_drawing, png, svg, HiddenLineMethod};
+use ktree::display::{line_drawing_with_progress, png, svg, HiddenLineMethod};
 use ktree::io::{read_ktree_file, AnyTree};
 
 use crate::render::{parse_size, parse_view, progress_bar};
@@ -68,7 +68,7 @@ pub fn run(args: Args) -> Result<(), String> {
         }
     };
     let drawing =
-        line_drawing(&tree, toward, method, Some(&mut tick)).map_err(|e| e.to_string())?;
+        line_drawing_with_progress(&tree, toward, method, &mut tick).map_err(|e| e.to_string())?;
     if let Some(b) = &bar {
         b.finish_and_clear();
     }

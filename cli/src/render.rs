@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use ktree::display::{
-    default_camera, object_bounds, plane, png, render, slices, Camera, Projection, RenderOptions,
-    ISO_TOWARD_EYE,
+    default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
+    RenderOptions, ISO_TOWARD_EYE,
 };
 use ktree::io::{read_ktree_file, read_rays_file, AnyRaySet, AnyTree};
 
@@ -204,8 +204,16 @@ pub fn run(args: Args) -> Result<(), String> {
                     }
                 },
             };
-            let image = render(&tree, &camera, &options, rays.as_ref(), Some(&mut tick))
-                .map_err(|e| e.to_string())?;
+            let image = render_with_progress(
+                &tree,
+                &camera,
+                &RenderOptions {
+                    normals: rays.as_ref(),
+                    ..options
+                },
+                &mut tick,
+            )
+            .map_err(|e| e.to_string())?;
             png::write_rgb_png(&out, w, h, &image.rgb).map_err(|e| e.to_string())?;
             if let (Some(path), Some(grey)) = (&args.depth, image.depth_grey()) {
                 png::write_grey_png(path, w, h, &grey).map_err(|e| e.to_string())?;

@@ -32,7 +32,7 @@ fn raster(c: &mut Criterion) {
             depth: true,
             ..Default::default()
         };
-        let fast = render(&tree, &camera, &options, None, None).expect("render");
+        let fast = render(&tree, &camera, &options).expect("render");
         let reference = render_zbuffer(&tree, &camera, &options).expect("render");
         assert_eq!(
             fast.stats.painted, reference.stats.painted,
@@ -40,7 +40,7 @@ fn raster(c: &mut Criterion) {
         );
         group.throughput(Throughput::Elements(tree.node_count()));
         group.bench_with_input(BenchmarkId::new("front-to-back", level), &tree, |b, t| {
-            b.iter(|| render(t, &camera, &options, None, None).expect("render"))
+            b.iter(|| render(t, &camera, &options).expect("render"))
         });
         let painter = render_back_to_front(&tree, &camera, &options).expect("render");
         assert_eq!(
@@ -62,10 +62,8 @@ fn lines(c: &mut Criterion) {
     group.sample_size(10);
     for level in 4..=6u32 {
         let tree = ball(level);
-        let fast =
-            line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed, None).expect("draw");
-        let slow =
-            line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Pairwise, None).expect("draw");
+        let fast = line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed).expect("draw");
+        let slow = line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Pairwise).expect("draw");
         assert_eq!(
             fast.lines, slow.lines,
             "bucketed and pairwise drawings differ"
@@ -76,7 +74,7 @@ fn lines(c: &mut Criterion) {
             ("pairwise", HiddenLineMethod::Pairwise),
         ] {
             group.bench_with_input(BenchmarkId::new(name, level), &tree, |b, t| {
-                b.iter(|| line_drawing(t, ISO_TOWARD_EYE, method, None).expect("draw"))
+                b.iter(|| line_drawing(t, ISO_TOWARD_EYE, method).expect("draw"))
             });
         }
     }

@@ -16,7 +16,7 @@
 //! assert!((x - 50.0).abs() < 1.0 && (y - 50.0).abs() < 1.0);
 //! ```
 
-use super::error::DisplayError;
+use super::error::{CameraProblem, DisplayError};
 use crate::space::Cell;
 use crate::tree::{KTree, NodeState};
 
@@ -136,7 +136,7 @@ impl Camera {
     /// [`DisplayError::BadCamera`] if a value is not finite, eye = target, up ∥ view direction, the height
     /// is not positive or the field of view is outside (0°, 180°).
     pub fn check(&self) -> Result<(), DisplayError> {
-        let bad = |m: &str| Err(DisplayError::BadCamera(m.to_string()));
+        let bad = |p: CameraProblem| Err(DisplayError::BadCamera(p));
         if self
             .eye
             .iter()
@@ -144,27 +144,27 @@ impl Camera {
             .chain(&self.up)
             .any(|v| !v.is_finite())
         {
-            return bad("eye, target and up must be finite");
+            return bad(CameraProblem::NotFinite);
         }
         match self.projection {
             Projection::Orthographic { height } if !(height.is_finite() && height > 0.0) => {
-                return bad("orthographic height must be positive")
+                return bad(CameraProblem::BadHeight)
             }
             Projection::Perspective { fov_y_degrees: f }
                 if !(f.is_finite() && f > 0.0 && f < 180.0) =>
             {
-                return bad("field of view must be between 0 and 180 degrees")
+                return bad(CameraProblem::BadFieldOfView)
             }
             _ => {}
         }
         let Some(f) = v3::normalize(v3::sub(self.target, self.eye)) else {
-            return bad("eye and target coincide");
+            return bad(CameraProblem::EyeAtTarget);
         };
         let Some(up) = v3::normalize(self.up) else {
-            return bad("up is zero");
+            return bad(CameraProblem::ZeroUp);
         };
         if v3::norm(v3::cross(f, up)) < 1e-9 {
-            return bad("up is parallel to the view direction");
+            return bad(CameraProblem::UpAlongView);
         }
         Ok(())
     }

@@ -18,7 +18,7 @@ pub enum DisplayError {
     /// The camera is degenerate: its eye equals its target, its up vector is parallel to the view
     /// direction, or a parameter is not finite or out of range.
     #[error("bad camera: {0}")]
-    BadCamera(String),
+    BadCamera(CameraProblem),
     /// A view direction is zero or not finite.
     #[error("bad view direction {0:?}: it must be a finite, non-zero vector")]
     BadDirection(Vec<f64>),
@@ -35,14 +35,42 @@ pub enum DisplayError {
     /// A frame count of zero was asked for.
     #[error("at least one frame is needed")]
     NoFrames,
-    /// Encoding or writing an image failed.
-    #[error("cannot write {path}: {message}")]
+    /// Writing an image file failed.
+    #[error("cannot write {}: {source}", path.display())]
     Write {
         /// The file.
-        path: String,
+        path: std::path::PathBuf,
         /// What went wrong.
-        message: String,
+        source: std::io::Error,
     },
+    /// Encoding an image failed.
+    #[cfg(feature = "png")]
+    #[error("cannot encode the image: {0}")]
+    Encode(#[source] image::ImageError),
+}
+
+/// What is wrong with a camera.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum CameraProblem {
+    /// The eye, target or up vector has an infinite or NaN coordinate.
+    #[error("eye, target and up must be finite")]
+    NotFinite,
+    /// An orthographic camera's height is not positive and finite.
+    #[error("orthographic height must be positive")]
+    BadHeight,
+    /// A perspective camera's field of view is outside (0°, 180°).
+    #[error("field of view must be between 0 and 180 degrees")]
+    BadFieldOfView,
+    /// The eye and the target are the same point.
+    #[error("eye and target coincide")]
+    EyeAtTarget,
+    /// The up vector is zero.
+    #[error("up is zero")]
+    ZeroUp,
+    /// The up vector is parallel to the view direction.
+    #[error("up is parallel to the view direction")]
+    UpAlongView,
 }
 
 /// The largest image side accepted, in pixels.

@@ -386,7 +386,7 @@ pub(crate) fn join_lines(mut pieces: Vec<Edge3>) -> Vec<Edge3> {
 }
 
 /// A line drawing of the object in `tree` seen from direction `toward_eye` (from the object towards the
-/// viewer), with cracks, hidden lines and dots removed. `progress` is called with (segments done, total).
+/// viewer), with cracks, hidden lines and dots removed.
 ///
 /// ```
 /// use ktree::display::{line_drawing, HiddenLineMethod};
@@ -395,13 +395,34 @@ pub(crate) fn join_lines(mut pieces: Vec<Edge3>) -> Vec<Edge3> {
 /// let mut dense = vec![false; 64];
 /// for z in 0..2 { for y in 0..2 { for x in 0..2 { dense[x + 4 * (y + 4 * z)] = true; } } }
 /// let tree = KTree::<3>::from_dense(2, &dense).unwrap();
-/// let d = line_drawing(&tree, [1.0, -0.8, 0.6], HiddenLineMethod::Bucketed, None).unwrap();
+/// let d = line_drawing(&tree, [1.0, -0.8, 0.6], HiddenLineMethod::Bucketed).unwrap();
 /// assert_eq!(d.lines.len(), 9);
 /// ```
 ///
 /// # Errors
 /// [`DisplayError::BadDirection`] for a zero or non-finite direction.
 pub fn line_drawing(
+    tree: &Octree,
+    toward_eye: [f64; 3],
+    method: HiddenLineMethod,
+) -> Result<LineDrawing, DisplayError> {
+    draw(tree, toward_eye, method, None)
+}
+
+/// As [`line_drawing`], calling `progress` with (segments done, total).
+///
+/// # Errors
+/// As [`line_drawing`].
+pub fn line_drawing_with_progress(
+    tree: &Octree,
+    toward_eye: [f64; 3],
+    method: HiddenLineMethod,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<LineDrawing, DisplayError> {
+    draw(tree, toward_eye, method, Some(progress))
+}
+
+fn draw(
     tree: &Octree,
     toward_eye: [f64; 3],
     method: HiddenLineMethod,

@@ -2,7 +2,7 @@
 //! six neighbours with spare child pointers (V3); the level-order tree has no pointers, so a neighbour is
 //! found by descending from the root to the equal-sized cell across a face — `O(L)` rank lookups — and the
 //! part of it that touches the face (or an edge) is read by descending only into the children that touch
-//! it.
+//! it. Both are [`cursor`] walks that choose which children to visit.
 //!
 //! ```
 //! use ktree::display::neighbours::is_surrounded;
@@ -15,28 +15,13 @@
 //! ```
 
 use crate::space::Cell;
+use crate::tree::cursor::{self, ChildOrder, Visitor, Walk};
 use crate::tree::{KTree, NodeRef, NodeState};
 
 /// The node whose cell contains the aligned cell `region` and is either a leaf or `region` itself.
 /// `region` must lie inside the tree's universe.
 pub fn locate<const K: usize>(tree: &KTree<K>, region: &Cell<K>) -> NodeRef<K> {
-    let level = tree.level();
-    let mut node = tree.root();
-    while node.state == NodeState::Partial && node.cell.level < region.level {
-        let depth = node.cell.level as usize;
-        let bit = level - 1 - node.cell.level;
-        let mut code = 0usize;
-        for (axis, &c) in region.origin.iter().enumerate() {
-            code |= ((c >> bit & 1) as usize) << axis;
-        }
-        let index = tree.first_child(depth, node.index) + code;
-        node = NodeRef {
-            index,
-            cell: node.cell.child(code),
-            state: tree.state(depth + 1, index),
-        };
-    }
-    node
+    cursor::locate(tree, tree.root(), region)
 }
 
 /// The cell of the same size as `cell` across its face on `axis` (`upper`: the face at `origin + side`),
@@ -84,30 +69,28 @@ pub fn face_all_full<const K: usize>(
     axis: usize,
     upper: bool,
 ) -> bool {
-    let node = locate(tree, region);
-    match node.state {
-        NodeState::Full => true,
-        NodeState::Empty => false,
-        NodeState::Partial => face_all_full_below(tree, &node, axis, upper),
+    struct AllFull {
+        face: ChildOrder,
+        all_full: bool,
     }
-}
-
-fn face_all_full_below<const K: usize>(
-    tree: &KTree<K>,
-    node: &NodeRef<K>,
-    axis: usize,
-    upper: bool,
-) -> bool {
-    tree.children(node)
-        .filter(|c| {
-            let code_bit = (c.cell.origin[axis] > node.cell.origin[axis]) as usize;
-            code_bit == usize::from(upper)
-        })
-        .all(|c| match c.state {
-            NodeState::Full => true,
-            NodeState::Empty => false,
-            NodeState::Partial => face_all_full_below(tree, &c, axis, upper),
-        })
+    impl<const K: usize> Visitor<K> for AllFull {
+        fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+            if node.state == NodeState::Empty {
+                self.all_full = false;
+                return Walk::Stop;
+            }
+            Walk::Descend
+        }
+        fn child_order(&self, _node: &NodeRef<K>) -> ChildOrder {
+            self.face
+        }
+    }
+    let mut query = AllFull {
+        face: ChildOrder::half::<K>(axis, upper),
+        all_full: true,
+    };
+    cursor::walk_from(tree, locate(tree, region), &mut query);
+    query.all_full
 }
 
 /// Whether a full leaf is surrounded: each of its `2K` faces touches only full voxels across it (V5).
@@ -149,28 +132,35 @@ pub fn edge_occupancy(
         return out;
     }
     // Depth-first along the edge, lower half first.
-    let mut stack = vec![node];
-    while let Some(n) = stack.pop() {
-        if n.state != NodeState::Partial {
-            let start = n.cell.origin[axis] - base;
-            push(
-                start,
-                start + n.cell.side() as u32,
-                n.state == NodeState::Full,
-            );
-            continue;
+    struct Edge<F> {
+        along: ChildOrder,
+        axis: usize,
+        base: u32,
+        push: F,
+    }
+    impl<F: FnMut(u32, u32, bool)> Visitor<3> for Edge<F> {
+        fn visit(&mut self, n: &NodeRef<3>) -> Walk {
+            if n.state != NodeState::Partial {
+                let start = n.cell.origin[self.axis] - self.base;
+                (self.push)(
+                    start,
+                    start + n.cell.side() as u32,
+                    n.state == NodeState::Full,
+                );
+            }
+            Walk::Descend
         }
-        let first = tree.first_child(n.cell.level as usize, n.index);
-        for upper in [true, false] {
-            let code = (usize::from(upper) << axis)
-                | (usize::from(side_b) << b)
-                | (usize::from(side_c) << c);
-            stack.push(NodeRef {
-                index: first + code,
-                cell: n.cell.child(code),
-                state: tree.state(n.cell.level as usize + 1, first + code),
-            });
+        fn child_order(&self, _n: &NodeRef<3>) -> ChildOrder {
+            self.along
         }
     }
+    let corner = (usize::from(side_b) << b) | (usize::from(side_c) << c);
+    let mut query = Edge {
+        along: ChildOrder::from_codes([corner, corner | 1 << axis]),
+        axis,
+        base,
+        push,
+    };
+    cursor::walk_from(tree, node, &mut query);
     out
 }

@@ -28,6 +28,7 @@
 //! ```
 
 use crate::space::Cell;
+use crate::tree::cursor::{self, ChildOrder, Visitor};
 use crate::tree::{KTree, NodeRef, NodeState};
 
 /// Which way a traversal goes.
@@ -49,14 +50,7 @@ pub enum Viewer<const K: usize> {
     Eye([f64; K]),
 }
 
-/// What a visitor wants after seeing a node.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Walk {
-    /// Visit the node's children (if it has any).
-    Descend,
-    /// Skip the node's subtree.
-    Skip,
-}
+pub use crate::tree::cursor::Walk;
 
 /// The near child code for a parallel view along `dir`: bit `i` set when the viewer is on the upper side of
 /// axis `i` (`dir[i] < 0`).
@@ -94,7 +88,7 @@ pub fn child_at<const K: usize>(near: usize, j: usize, order: Order) -> usize {
 }
 
 /// Visits the nodes of `tree` in pre-order with children in view order; `visit` sees every node (partial
-/// nodes before their children) and may skip a subtree.
+/// nodes before their children) and may skip a subtree or stop. A [`cursor`] walk with a view order.
 ///
 /// ```
 /// use ktree::display::{walk_ordered, Order, Viewer, Walk};
@@ -111,33 +105,52 @@ pub fn walk_ordered<const K: usize>(
     tree: &KTree<K>,
     viewer: Viewer<K>,
     order: Order,
-    mut visit: impl FnMut(&NodeRef<K>) -> Walk,
+    visit: impl FnMut(&NodeRef<K>) -> Walk,
 ) {
-    let fixed_near = match viewer {
-        Viewer::Direction(d) => Some(near_child(d)),
-        Viewer::Eye(_) => None,
-    };
-    let mut stack = vec![tree.root()];
-    let fanout = 1usize << K;
-    while let Some(node) = stack.pop() {
-        if visit(&node) == Walk::Skip || node.state != NodeState::Partial {
-            continue;
-        }
-        let near = match (fixed_near, viewer) {
-            (Some(n), _) => n,
-            (None, Viewer::Eye(e)) => near_child_from_eye(&node.cell, e),
-            (None, Viewer::Direction(_)) => unreachable!("direction views have a fixed near child"),
+    cursor::walk(tree, &mut ViewOrder::new(viewer, order, visit));
+}
+
+/// A visitor in view order: wraps a per-node function and visits children front to back or back to front.
+pub(crate) struct ViewOrder<const K: usize, F> {
+    /// For a parallel view, the order of every node's children.
+    fixed: Option<ChildOrder>,
+    eye: [f64; K],
+    /// `0` front to back, `2^K − 1` back to front (xored onto the near child).
+    flip: usize,
+    visit: F,
+}
+
+impl<const K: usize, F> ViewOrder<K, F> {
+    /// Visits with `visit` in the order `order` for `viewer`.
+    pub(crate) fn new(viewer: Viewer<K>, order: Order, visit: F) -> Self {
+        let flip = match order {
+            Order::FrontToBack => 0,
+            Order::BackToFront => (1 << K) - 1,
         };
-        let depth = node.cell.level as usize;
-        let first = tree.first_child(depth, node.index);
-        // Push in reverse so that the first child in view order is popped first.
-        for j in (0..fanout).rev() {
-            let code = child_at::<K>(near, j, order);
-            stack.push(NodeRef {
-                index: first + code,
-                cell: node.cell.child(code),
-                state: tree.state(depth + 1, first + code),
-            });
+        let (fixed, eye) = match viewer {
+            Viewer::Direction(d) => (Some(ChildOrder::xor::<K>(near_child(d) ^ flip)), [0.0; K]),
+            Viewer::Eye(e) => (None, e),
+        };
+        Self {
+            fixed,
+            eye,
+            flip,
+            visit,
+        }
+    }
+}
+
+impl<const K: usize, F: FnMut(&NodeRef<K>) -> Walk> Visitor<K> for ViewOrder<K, F> {
+    #[inline]
+    fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+        (self.visit)(node)
+    }
+
+    #[inline]
+    fn child_order(&self, node: &NodeRef<K>) -> ChildOrder {
+        match self.fixed {
+            Some(order) => order,
+            None => ChildOrder::xor::<K>(near_child_from_eye(&node.cell, self.eye) ^ self.flip),
         }
     }
 }

@@ -14,18 +14,10 @@ use std::path::Path;
 use super::error::DisplayError;
 
 #[cfg(feature = "png")]
-fn write_err(path: &Path, e: impl std::fmt::Display) -> DisplayError {
-    DisplayError::Write {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    }
-}
-
-#[cfg(feature = "png")]
 /// Encodes RGB bytes (`3 · width · height`, row-major from the top) as PNG.
 ///
 /// # Errors
-/// [`DisplayError::BadSize`] if the buffer does not match the size; [`DisplayError::Write`] on an
+/// [`DisplayError::BadSize`] if the buffer does not match the size; [`DisplayError::Encode`] on an
 /// encoding failure.
 pub fn encode_rgb_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, DisplayError> {
     super::error::check_size(width, height)?;
@@ -35,7 +27,7 @@ pub fn encode_rgb_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, Di
     let mut out = Vec::new();
     let encoder = image::codecs::png::PngEncoder::new(&mut out);
     image::ImageEncoder::write_image(encoder, rgb, width, height, image::ExtendedColorType::Rgb8)
-        .map_err(|e| write_err(Path::new("<memory>"), e))?;
+        .map_err(DisplayError::Encode)?;
     Ok(out)
 }
 
@@ -46,7 +38,10 @@ pub fn encode_rgb_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, Di
 /// As [`encode_rgb_png`], and [`DisplayError::Write`] for I/O errors.
 pub fn write_rgb_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), DisplayError> {
     let bytes = encode_rgb_png(width, height, rgb)?;
-    crate::io::write_atomic(path, &bytes).map_err(|e| write_err(path, e))
+    crate::io::write_atomic(path, &bytes).map_err(|source| DisplayError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 #[cfg(feature = "png")]

@@ -29,14 +29,22 @@
 use super::camera::{v3, Camera, PixelRays};
 use super::coverage::Coverage;
 use super::error::{check_size, DisplayError};
-use super::order::{near_child, near_child_from_eye};
+use super::order::{walk_ordered, Order, ViewOrder, Viewer, Walk};
 use crate::rays::RaySet;
 use crate::space::Cell;
-use crate::tree::{NodeState, Octree};
+use crate::tree::cursor;
+use crate::tree::{NodeRef, NodeState, Octree};
 
-/// Image size and colours of a rendering.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct RenderOptions {
+/// Everything a rendering can be asked for besides the tree and the camera, with defaults: a 512×512
+/// image, face shading, no depth or cell images.
+///
+/// ```
+/// use ktree::display::RenderOptions;
+/// let options = RenderOptions { width: 64, height: 48, ..Default::default() };
+/// assert!(options.normals.is_none() && !options.depth);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderOptions<'a> {
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
@@ -49,9 +57,12 @@ pub struct RenderOptions {
     pub depth: bool,
     /// Keep, for each pixel, the leaf cell seen there (for tests and picking; 24 bytes a pixel).
     pub cells: bool,
+    /// The rays the tree was built from, if they carry surface normals: [`render`] then shades by them
+    /// (elsewhere, and by default, shading is by face orientation).
+    pub normals: Option<&'a RaySet<3>>,
 }
 
-impl Default for RenderOptions {
+impl Default for RenderOptions<'_> {
     fn default() -> Self {
         Self {
             width: 512,
@@ -60,6 +71,7 @@ impl Default for RenderOptions {
             background: [255, 255, 255],
             depth: false,
             cells: false,
+            normals: None,
         }
     }
 }
@@ -320,6 +332,15 @@ impl Screen {
     }
 }
 
+/// Where a camera's viewer is, for ordering the walk.
+fn viewer(camera: &Camera) -> Viewer<3> {
+    if camera.is_perspective() {
+        Viewer::Eye(camera.eye)
+    } else {
+        Viewer::Direction(camera.frame().f)
+    }
+}
+
 fn cell_box(cell: &Cell<3>) -> ([f64; 3], [f64; 3]) {
     let s = cell.side() as f64;
     let lo = cell.origin.map(f64::from);
@@ -376,9 +397,8 @@ fn ray_normal(rays: &RaySet<3>, v: [u32; 3], axis: usize, dir: [f64; 3]) -> Opti
 
 /// Renders the object in `tree` as seen by `camera`, front to back with early termination.
 ///
-/// `normals`: the rays the tree was built from, if they carry surface normals (shading then follows them;
-/// otherwise, or where a voxel is not found in the rays, shading is by face orientation). `progress` is
-/// called now and then with (pixels covered, pixels in all).
+/// Shading follows the surface normals of `options.normals` where the rays carry them (and the visible
+/// voxel is found in them), else the face orientation.
 ///
 /// ```
 /// use ktree::display::{default_camera, render, RenderOptions, ISO_TOWARD_EYE};
@@ -386,7 +406,7 @@ fn ray_normal(rays: &RaySet<3>, v: [u32; 3], axis: usize, dir: [f64; 3]) -> Opti
 /// let tree = stack(&ball_rays::<3>(5, [32, 32, 32], 28).unwrap());
 /// let options = RenderOptions { width: 64, height: 64, ..Default::default() };
 /// let camera = default_camera(&tree, ISO_TOWARD_EYE, None, 64, 64).unwrap();
-/// let image = render(&tree, &camera, &options, None, None).unwrap();
+/// let image = render(&tree, &camera, &options).unwrap();
 /// assert!(image.stats.painted > 1000); // the ball fills much of the frame
 /// ```
 ///
@@ -396,7 +416,27 @@ pub fn render(
     tree: &Octree,
     camera: &Camera,
     options: &RenderOptions,
-    normals: Option<&RaySet<3>>,
+) -> Result<Rendered, DisplayError> {
+    front_to_back(tree, camera, options, None)
+}
+
+/// As [`render`], calling `progress` now and then with (pixels covered, pixels in all).
+///
+/// # Errors
+/// As [`render`].
+pub fn render_with_progress(
+    tree: &Octree,
+    camera: &Camera,
+    options: &RenderOptions,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Rendered, DisplayError> {
+    front_to_back(tree, camera, options, Some(progress))
+}
+
+fn front_to_back(
+    tree: &Octree,
+    camera: &Camera,
+    options: &RenderOptions,
     mut progress: Option<&mut dyn FnMut(u64, u64)>,
 ) -> Result<Rendered, DisplayError> {
     let screen = Screen::new(camera, options.width, options.height)?;
@@ -408,44 +448,33 @@ pub fn render(
     }
     let mut depth = options.depth.then(|| vec![f32::INFINITY; pixels]);
     let mut cells = options.cells.then(|| vec![None; pixels]);
-    let normals = normals.filter(|r| r.has_normals() && r.level() == tree.level());
+    let normals = options
+        .normals
+        .filter(|r| r.has_normals() && r.level() == tree.level());
     let light = light_for(camera);
     let mut cov = Coverage::new(w, h);
     let mut stats = RenderStats::default();
-    let fixed_near = (!camera.is_perspective()).then(|| near_child(camera.frame().f));
-    let eye = camera.eye;
     let total = cov.uncovered();
-
-    // (index in level, cell)
-    let mut stack: Vec<(usize, Cell<3>)> = Vec::with_capacity(256);
-    stack.push((0, tree.universe().root()));
-    while let Some((index, cell)) = stack.pop() {
+    let visit = |node: &NodeRef<3>| {
         stats.nodes_visited += 1;
         if stats.nodes_visited % (1 << 16) == 0 {
             if let Some(p) = progress.as_mut() {
                 p(total - cov.uncovered(), total);
             }
         }
-        let depth_level = cell.level as usize;
-        let state = tree.state(depth_level, index);
+        let (cell, state) = (node.cell, node.state);
         if state == NodeState::Empty {
-            continue;
+            return Walk::Skip;
         }
         let Some(r) = screen.rect(&cell) else {
-            continue;
+            return Walk::Skip;
         };
         if cov.rect_covered(r.x0, r.x1, r.y0, r.y1) {
             stats.culled += 1;
-            continue;
+            return Walk::Skip;
         }
         if state == NodeState::Partial {
-            let near = fixed_near.unwrap_or_else(|| near_child_from_eye(&cell, eye));
-            let first = tree.first_child(depth_level, index);
-            for j in (0..8).rev() {
-                let code = near ^ j;
-                stack.push((first + code, cell.child(code)));
-            }
-            continue;
+            return Walk::Descend;
         }
         // A full leaf: paint the uncovered pixels its box is hit at.
         stats.leaves_drawn += 1;
@@ -497,9 +526,15 @@ pub fn render(
             stats.painted += u64::from(painted);
         }
         if cov.uncovered() == 0 {
-            break;
+            Walk::Stop
+        } else {
+            Walk::Skip
         }
-    }
+    };
+    cursor::walk(
+        tree,
+        &mut ViewOrder::new(viewer(camera), Order::FrontToBack, visit),
+    );
     if let Some(p) = progress.as_mut() {
         p(total - cov.uncovered(), total);
     }
@@ -515,7 +550,8 @@ pub fn render(
 
 /// Meagher's other order (M7): the painter's algorithm. Leaves are visited back to front and every hit
 /// pixel is painted, later leaves overwriting earlier ones; no depth is compared and nothing is culled,
-/// so it costs a visit of every full leaf. Same picture as [`render`] (face shading).
+/// so it costs a visit of every full leaf. Same picture as [`render`] (face shading; `options.normals` is
+/// not used).
 ///
 /// # Errors
 /// As [`render`].
@@ -524,7 +560,6 @@ pub fn render_back_to_front(
     camera: &Camera,
     options: &RenderOptions,
 ) -> Result<Rendered, DisplayError> {
-    use super::order::{walk_ordered, Order, Viewer, Walk};
     let screen = Screen::new(camera, options.width, options.height)?;
     let (w, h) = (options.width, options.height);
     let pixels = w as usize * h as usize;
@@ -537,12 +572,7 @@ pub fn render_back_to_front(
     let mut hit_any = vec![false; pixels];
     let light = light_for(camera);
     let mut stats = RenderStats::default();
-    let viewer = if camera.is_perspective() {
-        Viewer::Eye(camera.eye)
-    } else {
-        Viewer::Direction(camera.frame().f)
-    };
-    walk_ordered(tree, viewer, Order::BackToFront, |node| {
+    walk_ordered(tree, viewer(camera), Order::BackToFront, |node| {
         stats.nodes_visited += 1;
         if node.state != NodeState::Full {
             return Walk::Descend;
@@ -584,7 +614,8 @@ pub fn render_back_to_front(
 }
 
 /// The brute-force reference: a z-buffer over *all* full leaves in Morton order, keeping for each pixel the
-/// leaf with the smallest entry depth (ties: the first). Shading is by face orientation. `O(leaves · pixels
+/// leaf with the smallest entry depth (ties: the first). Shading is by face orientation (`options.normals` is
+/// not used). `O(leaves · pixels
 /// per leaf)`; for tests and small trees.
 ///
 /// # Errors

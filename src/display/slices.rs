@@ -183,7 +183,7 @@ pub fn time_strip(
     for f in 0..frames {
         let position = ((2 * f as u64 + 1) * side / (2 * frames as u64)).min(side - 1) as u32;
         let slice = slice_4d(tree, axis, position)?;
-        let image = render(&slice, &camera, &options, None, None)?;
+        let image = render(&slice, &camera, &options)?;
         let x0 = f as u32 * (frame_size + 4);
         for y in 0..frame_size {
             let src = 3 * (y * frame_size) as usize;

@@ -74,7 +74,7 @@ impl<const K: usize> Affine<K> {
     /// about the point `centre`. For `K = 3`, `(0, 1)` is about z, `(1, 2)` about x, `(2, 0)` about y.
     ///
     /// # Errors
-    /// [`OpsError::BadParameter`] if an axis is `≥ K` or the two are equal.
+    /// [`OpsError::BadAxisPair`] if an axis is `≥ K` or the two are equal.
     pub fn rotation_about(
         from: usize,
         to: usize,
@@ -82,11 +82,7 @@ impl<const K: usize> Affine<K> {
         centre: [f64; K],
     ) -> Result<Self, OpsError> {
         if from >= K || to >= K || from == to {
-            return Err(OpsError::BadParameter {
-                reason: format!(
-                    "a rotation needs two different axes below K = {K}, got {from} and {to}"
-                ),
-            });
+            return Err(OpsError::BadAxisPair { from, to, k: K });
         }
         let (s, c) = degrees.to_radians().sin_cos();
         let mut r = Self::identity();
@@ -120,15 +116,16 @@ impl<const K: usize> Affine<K> {
     /// (Meagher writes row vectors times the transpose; same map).
     ///
     /// # Errors
-    /// [`OpsError::BadMatrix`] for a wrong entry count, a non-finite entry or a last row other than
+    /// [`OpsError::MatrixSize`], [`OpsError::NonFiniteEntry`] or [`OpsError::NotAffine`] for a wrong entry
+    /// count, a non-finite entry or a last row other than
     /// `0 … 0 1` (perspective maps are not affine).
     pub fn from_homogeneous(m: &[f64]) -> Result<Self, OpsError> {
         check_homogeneous(K, m)?;
         let n = K + 1;
         let last = &m[K * n..];
         if last[..K].iter().any(|&v| v != 0.0) || last[K] != 1.0 {
-            return Err(OpsError::BadMatrix {
-                reason: format!("the last row must be 0 … 0 1 (an affine map), got {last:?}"),
+            return Err(OpsError::NotAffine {
+                last_row: last.to_vec(),
             });
         }
         Ok(Self {
@@ -140,7 +137,7 @@ impl<const K: usize> Affine<K> {
     /// The inverse map.
     ///
     /// # Errors
-    /// [`OpsError::BadMatrix`] if the linear part is singular (or nearly: a pivot below 1e-12).
+    /// [`OpsError::Singular`] if the linear part is singular (or nearly: a pivot below 1e-12).
     pub fn inverse(&self) -> Result<Self, OpsError> {
         // Gauss–Jordan with partial pivoting on [A | I].
         let mut a = self.a;
@@ -150,9 +147,7 @@ impl<const K: usize> Affine<K> {
                 .max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))
                 .unwrap_or(col);
             if a[pivot][col].abs() < 1e-12 {
-                return Err(OpsError::BadMatrix {
-                    reason: "the matrix is singular (it flattens the object)".into(),
-                });
+                return Err(OpsError::Singular);
             }
             a.swap(col, pivot);
             inv.swap(col, pivot);
@@ -237,7 +232,7 @@ impl<const K: usize> Preimage<K> for Inverse<K> {
 /// ```
 ///
 /// # Errors
-/// [`OpsError::BadMatrix`] if `m` is singular.
+/// [`OpsError::Singular`] if `m` is singular.
 pub fn transform<const K: usize>(tree: &KTree<K>, m: &Affine<K>) -> Result<KTree<K>, OpsError> {
     let inv = m.inverse()?;
     let side = tree.universe().side() as f64;
@@ -253,18 +248,10 @@ pub fn transform<const K: usize>(tree: &KTree<K>, m: &Affine<K>) -> Result<KTree
 pub(crate) fn check_homogeneous(k: usize, m: &[f64]) -> Result<(), OpsError> {
     let n = k + 1;
     if m.len() != n * n {
-        return Err(OpsError::BadMatrix {
-            reason: format!(
-                "{} entries given, a {n}×{n} matrix needs {}",
-                m.len(),
-                n * n
-            ),
-        });
+        return Err(OpsError::MatrixSize { given: m.len(), n });
     }
     if m.iter().any(|v| !v.is_finite()) {
-        return Err(OpsError::BadMatrix {
-            reason: "an entry is not a finite number".into(),
-        });
+        return Err(OpsError::NonFiniteEntry);
     }
     Ok(())
 }

@@ -12,8 +12,9 @@
 //! Two trees of different universe levels are an error ([`OpsError::LevelMismatch`]); trees of different
 //! dimension `K` cannot be combined at all — `KTree<2>` and `KTree<3>` are different types.
 
-use super::emit::{collapse, copy_subtree, leaf, Levels};
+use super::emit::{collapse, leaf, LevelWriter};
 use super::OpsError;
+use crate::tree::cursor::{walk_pair, PairNode, PairVisitor, Walk};
 use crate::tree::{KTree, NodeState};
 
 /// A binary Boolean operation.
@@ -67,11 +68,16 @@ enum Outcome {
     Invert,
 }
 
+/// The Boolean as a two-tree walk: a pair is decided on the spot where a leaf decides it (a leaf, a copy
+/// of the other subtree or its complement), else its children are visited and the pair is decided when
+/// it is left, from its children's states.
 struct Merge<'a, const K: usize> {
     a: &'a KTree<K>,
     b: &'a KTree<K>,
     op: BoolOp,
-    out: Levels,
+    out: LevelWriter,
+    /// `kids[d]`: the states decided so far for the children (at depth `d`) of the open pair above.
+    kids: Vec<[NodeState; 16]>,
 }
 
 impl<const K: usize> Merge<'_, K> {
@@ -95,38 +101,62 @@ impl<const K: usize> Merge<'_, K> {
         }
     }
 
-    fn node(&mut self, depth: usize, ia: usize, ib: usize) -> NodeState {
-        let sa = self.a.state(depth, ia);
-        let sb = self.b.state(depth, ib);
-        match (sa, sb) {
-            (NodeState::Partial, NodeState::Partial) => {
-                let fa = self.a.first_child(depth, ia);
-                let fb = self.b.first_child(depth, ib);
-                let mut kids = [NodeState::Empty; 16];
-                for (c, kid) in kids.iter_mut().enumerate().take(1 << K) {
-                    *kid = self.node(depth + 1, fa + c, fb + c);
-                }
-                let kids = &kids[..1 << K];
-                match collapse(kids) {
-                    Some(s) => s,
-                    None => {
-                        self.out.push_block(depth + 1, kids);
-                        NodeState::Partial
+    /// Records the result `state` of the pair at `depth` with child code `code`.
+    #[inline]
+    fn decide(&mut self, depth: usize, code: usize, state: NodeState) {
+        self.kids[depth][code] = state;
+    }
+}
+
+impl<const K: usize> PairVisitor<K> for Merge<'_, K> {
+    const ORIGINS: bool = false;
+
+    #[inline]
+    fn visit(&mut self, pair: &PairNode<K>) -> Walk {
+        let (depth, code) = (pair.cell.level as usize, pair.code);
+        let state = match (pair.a.state, pair.b.state) {
+            (NodeState::Partial, NodeState::Partial) => return Walk::Descend,
+            (NodeState::Partial, lb) => {
+                let invert = match self.outcome(lb == NodeState::Full, false) {
+                    Outcome::Leaf(s) => {
+                        self.decide(depth, code, s);
+                        return Walk::Skip;
                     }
-                }
+                    outcome => matches!(outcome, Outcome::Invert),
+                };
+                self.out
+                    .copy_subtree(self.a, depth, pair.a.index, depth, invert)
             }
-            (NodeState::Partial, lb) => match self.outcome(lb == NodeState::Full, false) {
-                Outcome::Leaf(s) => s,
-                Outcome::Copy => copy_subtree(self.a, &mut self.out, depth, ia, false),
-                Outcome::Invert => copy_subtree(self.a, &mut self.out, depth, ia, true),
-            },
-            (la, NodeState::Partial) => match self.outcome(la == NodeState::Full, true) {
-                Outcome::Leaf(s) => s,
-                Outcome::Copy => copy_subtree(self.b, &mut self.out, depth, ib, false),
-                Outcome::Invert => copy_subtree(self.b, &mut self.out, depth, ib, true),
-            },
+            (la, NodeState::Partial) => {
+                let invert = match self.outcome(la == NodeState::Full, true) {
+                    Outcome::Leaf(s) => {
+                        self.decide(depth, code, s);
+                        return Walk::Skip;
+                    }
+                    outcome => matches!(outcome, Outcome::Invert),
+                };
+                self.out
+                    .copy_subtree(self.b, depth, pair.b.index, depth, invert)
+            }
             (la, lb) => leaf(self.op.apply(la == NodeState::Full, lb == NodeState::Full)),
-        }
+        };
+        self.decide(depth, code, state);
+        Walk::Skip
+    }
+
+    #[inline]
+    fn leave(&mut self, pair: &PairNode<K>) {
+        let depth = pair.cell.level as usize;
+        let kids = self.kids[depth + 1];
+        let kids = &kids[..1 << K];
+        let state = match collapse(kids) {
+            Some(s) => s,
+            None => {
+                self.out.push_block(depth + 1, kids);
+                NodeState::Partial
+            }
+        };
+        self.decide(depth, pair.code, state);
     }
 }
 
@@ -166,10 +196,12 @@ pub fn boolean<const K: usize>(
         a,
         b,
         op,
-        out: Levels::new(depths),
+        out: LevelWriter::new(),
+        kids: vec![[NodeState::Empty; 16]; depths + 1],
     };
-    let root = m.node(0, 0, 0);
-    Ok(m.out.finish(a.universe(), root))
+    walk_pair(a, b, &mut m);
+    let root = m.kids[0][0];
+    Ok(m.out.finish_with_root(a.universe(), root))
 }
 
 /// `A ∪ B`. See [`boolean`].

@@ -80,14 +80,15 @@ pub fn normalise_to_origin<const K: usize>(tree: &KTree<K>) -> KTree<K> {
 /// fastest.
 ///
 /// # Errors
-/// [`OpsError::BadParameter`] if `2^(K·bits)` exceeds 65 536 placements.
+/// [`OpsError::TooManyPlacements`] if `2^(K·bits)` exceeds 65 536 placements.
 pub fn over_translations<const K: usize>(
     tree: &KTree<K>,
     bits: u32,
 ) -> Result<Normalised, OpsError> {
     if K as u32 * bits > 16 {
-        return Err(OpsError::BadParameter {
-            reason: format!("2^({K}·{bits}) placements is too many (at most 2^16)"),
+        return Err(OpsError::TooManyPlacements {
+            per_axis: 1u64.checked_shl(bits).unwrap_or(u64::MAX),
+            k: K,
         });
     }
     let base = normalise_to_origin(tree);
@@ -114,15 +115,16 @@ pub fn over_translations<const K: usize>(
 /// the object's exact position, not only on whole-voxel shifts.
 ///
 /// # Errors
-/// The first error `build` returns; [`OpsError::BadParameter`] beyond 65 536 placements.
+/// The first error `build` returns; [`OpsError::TooManyPlacements`] beyond 65 536 placements.
 pub fn over_placements<const K: usize, E: From<OpsError>>(
     steps: u32,
     mut build: impl FnMut([u32; K]) -> Result<KTree<K>, E>,
 ) -> Result<Normalised, E> {
     let n = u64::from(steps).pow(K as u32);
     if n > 1 << 16 {
-        return Err(OpsError::BadParameter {
-            reason: format!("{steps}^{K} placements is too many (at most 2^16)"),
+        return Err(OpsError::TooManyPlacements {
+            per_axis: steps.into(),
+            k: K,
         }
         .into());
     }
@@ -140,7 +142,7 @@ pub fn over_placements<const K: usize, E: From<OpsError>>(
 /// normalisation Meagher proposes.
 ///
 /// # Errors
-/// [`OpsError::BadMatrix`] for a singular map.
+/// [`OpsError::Singular`] for a singular map.
 pub fn over_maps<const K: usize>(
     tree: &KTree<K>,
     maps: &[Affine<K>],

@@ -33,13 +33,11 @@ impl<const K: usize> FixedAffine<K> {
     /// The fixed-point inverse of `m` (source → target) with `frac_bits` fractional bits (8 … 48).
     ///
     /// # Errors
-    /// [`OpsError::BadMatrix`] if `m` is singular or its inverse has entries too large for fixed point;
-    /// [`OpsError::BadParameter`] for `frac_bits` outside 8 … 48.
+    /// [`OpsError::Singular`] if `m` is singular, [`OpsError::FixedPointOverflow`] if its inverse has
+    /// entries too large for fixed point; [`OpsError::BadFractionBits`] for `frac_bits` outside 8 … 48.
     pub fn new(m: &Affine<K>, frac_bits: u32) -> Result<Self, OpsError> {
         if !(8..=48).contains(&frac_bits) {
-            return Err(OpsError::BadParameter {
-                reason: format!("fixed point needs 8 to 48 fractional bits, got {frac_bits}"),
-            });
+            return Err(OpsError::BadFractionBits { bits: frac_bits });
         }
         let inv = m.inverse()?;
         let limit = 2f64.powi(60);
@@ -49,17 +47,13 @@ impl<const K: usize> FixedAffine<K> {
             for j in 0..K {
                 let v = (inv.a[i][j] * 2f64.powi(frac_bits as i32 - 1)).round();
                 if v.abs() > limit {
-                    return Err(OpsError::BadMatrix {
-                        reason: "the inverse map's entries are too large for fixed point".into(),
-                    });
+                    return Err(OpsError::FixedPointOverflow);
                 }
                 h[i][j] = v as i128;
             }
             let v = (inv.b[i] * 2f64.powi(frac_bits as i32)).round();
             if v.abs() > limit * 2f64.powi(24) {
-                return Err(OpsError::BadMatrix {
-                    reason: "the inverse map's translation is too large for fixed point".into(),
-                });
+                return Err(OpsError::FixedPointOverflow);
             }
             b[i] = v as i128;
         }

@@ -7,6 +7,7 @@
 use super::boolean::{intersection, same_level};
 use super::OpsError;
 use crate::space::Cell;
+use crate::tree::cursor::{walk_pair, ChildOrder, PairNode, PairVisitor, Walk};
 use crate::tree::{KTree, NodeState};
 
 /// Whether the objects share at least one voxel (regularized: touching along a face is not interference).
@@ -23,18 +24,28 @@ use crate::tree::{KTree, NodeState};
 /// [`OpsError::LevelMismatch`] when the trees' levels differ.
 pub fn interferes<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<bool, OpsError> {
     same_level(a, b)?;
-    Ok(meet(a, b, 0, 0, 0))
+    let mut meet = Meet(false);
+    walk_pair(a, b, &mut meet);
+    Ok(meet.0)
 }
 
-fn meet<const K: usize>(a: &KTree<K>, b: &KTree<K>, depth: usize, ia: usize, ib: usize) -> bool {
-    match (a.state(depth, ia), b.state(depth, ib)) {
-        (NodeState::Empty, _) | (_, NodeState::Empty) => false,
-        (NodeState::Partial, NodeState::Partial) => {
-            let (fa, fb) = (a.first_child(depth, ia), b.first_child(depth, ib));
-            (0..1usize << K).any(|c| meet(a, b, depth + 1, fa + c, fb + c))
+/// The interference test as a two-tree walk: stops at the first pair of a full node and a non-empty one.
+struct Meet(bool);
+
+impl<const K: usize> PairVisitor<K> for Meet {
+    const ORIGINS: bool = false;
+
+    #[inline]
+    fn visit(&mut self, pair: &PairNode<K>) -> Walk {
+        match (pair.a.state, pair.b.state) {
+            (NodeState::Empty, _) | (_, NodeState::Empty) => Walk::Skip,
+            (NodeState::Partial, NodeState::Partial) => Walk::Descend,
+            // Full against anything non-empty: a reduced partial node holds at least one full voxel.
+            _ => {
+                self.0 = true;
+                Walk::Stop
+            }
         }
-        // Full against anything non-empty: a reduced partial node holds at least one full voxel.
-        _ => true,
     }
 }
 
@@ -51,7 +62,7 @@ pub fn overlap_cells<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Vec<C
 /// with the lower `time_axis` half first and stops at the first overlap, so it visits few nodes.
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`]; [`OpsError::BadParameter`] if `time_axis ≥ K`.
+/// [`OpsError::LevelMismatch`]; [`OpsError::BadAxis`] if `time_axis ≥ K`.
 pub fn first_contact<const K: usize>(
     a: &KTree<K>,
     b: &KTree<K>,
@@ -59,116 +70,45 @@ pub fn first_contact<const K: usize>(
 ) -> Result<Option<u32>, OpsError> {
     same_level(a, b)?;
     if time_axis >= K {
-        return Err(OpsError::BadParameter {
-            reason: format!("time axis {time_axis} is not below K = {K}"),
+        return Err(OpsError::BadAxis {
+            axis: time_axis,
+            k: K,
         });
     }
-    let mut best = None;
-    earliest(a, b, (0, 0), 0, a.universe().root(), time_axis, &mut best);
-    Ok(best)
-}
-
-fn earliest<const K: usize>(
-    a: &KTree<K>,
-    b: &KTree<K>,
-    (ia, ib): (usize, usize),
-    depth: usize,
-    cell: Cell<K>,
-    axis: usize,
-    best: &mut Option<u32>,
-) {
-    let t0 = cell.origin[axis];
-    if best.is_some_and(|b| b <= t0) {
-        return;
-    }
-    match (a.state(depth, ia), b.state(depth, ib)) {
-        (NodeState::Empty, _) | (_, NodeState::Empty) => {}
-        (NodeState::Full, NodeState::Full) => *best = Some(t0),
-        (sa, sb) => {
-            // Lower time half first.
-            let mut codes: Vec<usize> = (0..1usize << K).collect();
-            codes.sort_by_key(|&c| c >> axis & 1);
-            for c in codes {
-                let ca = if sa == NodeState::Partial {
-                    a.first_child(depth, ia) + c
-                } else {
-                    usize::MAX
-                };
-                let cb = if sb == NodeState::Partial {
-                    b.first_child(depth, ib) + c
-                } else {
-                    usize::MAX
-                };
-                earliest_mixed(
-                    a,
-                    b,
-                    (ca, sa),
-                    (cb, sb),
-                    depth + 1,
-                    cell.child(c),
-                    axis,
-                    best,
-                );
-            }
-        }
-    }
-}
-
-/// Like [`earliest`] where either side may be a full leaf standing in for all its descendants.
-#[allow(clippy::too_many_arguments)]
-fn earliest_mixed<const K: usize>(
-    a: &KTree<K>,
-    b: &KTree<K>,
-    (ia, sa): (usize, NodeState),
-    (ib, sb): (usize, NodeState),
-    depth: usize,
-    cell: Cell<K>,
-    axis: usize,
-    best: &mut Option<u32>,
-) {
-    if sa == NodeState::Partial && sb == NodeState::Partial {
-        return earliest(a, b, (ia, ib), depth, cell, axis, best);
-    }
-    // One side is a full leaf above this depth: the first time the other side is non-empty in `cell`.
-    let (tree, index) = if sa == NodeState::Partial {
-        (a, ia)
-    } else {
-        (b, ib)
+    let mut query = Earliest {
+        axis: time_axis,
+        order: ChildOrder::lower_half_first::<K>(time_axis),
+        best: None,
     };
-    if let Some(t) = first_time(tree, depth, index, cell, axis, *best) {
-        *best = Some(best.map_or(t, |b| b.min(t)));
-    }
+    walk_pair(a, b, &mut query);
+    Ok(query.best)
 }
 
-/// The smallest time coordinate of a full voxel in the subtree (`None` if none before `bound`).
-fn first_time<const K: usize>(
-    tree: &KTree<K>,
-    depth: usize,
-    index: usize,
-    cell: Cell<K>,
+/// The first contact as a two-tree walk, lower time half first: a pair of full nodes is a contact at the
+/// cell's first time step; pairs starting no earlier than the best contact so far are skipped.
+struct Earliest {
     axis: usize,
-    bound: Option<u32>,
-) -> Option<u32> {
-    let t0 = cell.origin[axis];
-    if bound.is_some_and(|b| b <= t0) {
-        return None;
-    }
-    match tree.state(depth, index) {
-        NodeState::Empty => None,
-        NodeState::Full => Some(t0),
-        NodeState::Partial => {
-            let first = tree.first_child(depth, index);
-            let mut best = bound;
-            let mut found = None;
-            let mut codes: Vec<usize> = (0..1usize << K).collect();
-            codes.sort_by_key(|&c| c >> axis & 1);
-            for c in codes {
-                if let Some(t) = first_time(tree, depth + 1, first + c, cell.child(c), axis, best) {
-                    best = Some(best.map_or(t, |b| b.min(t)));
-                    found = Some(found.map_or(t, |f: u32| f.min(t)));
-                }
-            }
-            found
+    order: ChildOrder,
+    best: Option<u32>,
+}
+
+impl<const K: usize> PairVisitor<K> for Earliest {
+    fn visit(&mut self, pair: &PairNode<K>) -> Walk {
+        let t0 = pair.cell.origin[self.axis];
+        if self.best.is_some_and(|b| b <= t0) {
+            return Walk::Skip;
         }
+        match (pair.a.state, pair.b.state) {
+            (NodeState::Empty, _) | (_, NodeState::Empty) => Walk::Skip,
+            (NodeState::Full, NodeState::Full) => {
+                self.best = Some(t0);
+                Walk::Skip
+            }
+            _ => Walk::Descend,
+        }
+    }
+
+    fn child_order(&self, _pair: &PairNode<K>) -> ChildOrder {
+        self.order
     }
 }

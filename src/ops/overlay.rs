@@ -31,9 +31,10 @@
 //! assert_eq!(resample(&a, &ShiftOne).to_dense().unwrap(), [false, true, true, false]);
 //! ```
 
-use super::emit::{collapse, leaf, Levels};
+use super::emit::{collapse, leaf, LevelWriter};
 use crate::space::Cell;
-use crate::tree::{KTree, NodeState};
+use crate::tree::cursor::locate;
+use crate::tree::{KTree, NodeRef, NodeState};
 
 /// How target voxels map back into the source universe.
 pub trait Preimage<const K: usize> {
@@ -87,7 +88,7 @@ struct Engine<'a, const K: usize, P> {
     src: &'a KTree<K>,
     map: &'a P,
     side: i64,
-    out: Levels,
+    out: LevelWriter,
     overlay: Vec<Entry<K>>,
 }
 
@@ -153,20 +154,17 @@ impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
         let Some(e) = near.map(|k| self.overlay[k]).find(|e| e.cell.contains(p)) else {
             return self.src.contains(p);
         };
-        let (mut depth, mut index, mut cell) = (e.depth, e.index, e.cell);
-        loop {
-            match self.src.state(depth, index) {
-                NodeState::Empty => return false,
-                NodeState::Full => return true,
-                NodeState::Partial => {
-                    let bit = cell.log_side - 1;
-                    let code = (0..K).fold(0, |code, a| code | (((p[a] >> bit) & 1) as usize) << a);
-                    index = self.src.first_child(depth, index) + code;
-                    depth += 1;
-                    cell = cell.child(code);
-                }
-            }
-        }
+        let start = NodeRef {
+            index: e.index,
+            cell: e.cell,
+            state: self.src.state(e.depth, e.index),
+        };
+        let voxel = Cell {
+            origin: p,
+            level: self.src.level(),
+            log_side: 0,
+        };
+        locate(self.src, start, &voxel).state == NodeState::Full
     }
 
     /// Decides target cell `cell` given its parent's overlay `parent` (a range of `self.overlay`).
@@ -236,7 +234,7 @@ pub fn resample_incremental<const K: usize, P: IncrementalPreimage<K>>(
         src,
         map,
         side: universe.side() as i64,
-        out: Levels::new(universe.level() as usize + 1),
+        out: LevelWriter::new(),
         overlay: vec![Entry {
             depth: 0,
             index: 0,
@@ -245,5 +243,5 @@ pub fn resample_incremental<const K: usize, P: IncrementalPreimage<K>>(
     };
     let root_ctx = map.root();
     let root = engine.node(universe.root(), root_ctx, 0..1);
-    engine.out.finish(universe, root)
+    engine.out.finish_with_root(universe, root)
 }

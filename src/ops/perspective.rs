@@ -28,7 +28,8 @@ impl<const K: usize> Projective<K> {
     /// From a homogeneous matrix in row-major order.
     ///
     /// # Errors
-    /// [`OpsError::BadMatrix`] for a wrong entry count or a non-finite entry.
+    /// [`OpsError::MatrixSize`] or [`OpsError::NonFiniteEntry`] for a wrong entry count or a non-finite
+    /// entry.
     pub fn from_homogeneous(m: &[f64]) -> Result<Self, OpsError> {
         super::affine::check_homogeneous(K, m)?;
         Ok(Self { m: m.to_vec() })
@@ -41,12 +42,14 @@ impl<const K: usize> Projective<K> {
     /// faces `0` and `U` in place and the map projective (straight lines stay straight).
     ///
     /// # Errors
-    /// [`OpsError::BadParameter`] if `depth ≥ K` or `distance` is not positive and finite.
+    /// [`OpsError::BadAxis`] if `depth ≥ K`, [`OpsError::BadDistance`] if `distance` is not positive and
+    /// finite.
     pub fn perspective(level: u32, depth: usize, distance: f64) -> Result<Self, OpsError> {
-        if depth >= K || !(distance.is_finite() && distance > 0.0) {
-            return Err(OpsError::BadParameter {
-                reason: format!("perspective needs an axis below K = {K} and a positive distance, got {depth} and {distance}"),
-            });
+        if depth >= K {
+            return Err(OpsError::BadAxis { axis: depth, k: K });
+        }
+        if !(distance.is_finite() && distance > 0.0) {
+            return Err(OpsError::BadDistance { distance });
         }
         let n = K + 1;
         let u = (1u64 << level) as f64;
@@ -106,7 +109,7 @@ impl<const K: usize> Projective<K> {
     /// The inverse map.
     ///
     /// # Errors
-    /// [`OpsError::BadMatrix`] if the matrix is singular.
+    /// [`OpsError::Singular`] if the matrix is singular.
     pub fn inverse(&self) -> Result<Self, OpsError> {
         let n = K + 1;
         let mut a = self.m.clone();
@@ -118,9 +121,7 @@ impl<const K: usize> Projective<K> {
                 .max_by(|&x, &y| a[x * n + col].abs().total_cmp(&a[y * n + col].abs()))
                 .unwrap_or(col);
             if a[pivot * n + col].abs() < 1e-12 {
-                return Err(OpsError::BadMatrix {
-                    reason: "the matrix is singular".into(),
-                });
+                return Err(OpsError::Singular);
             }
             for j in 0..n {
                 a.swap(col * n + j, pivot * n + j);
@@ -211,7 +212,8 @@ impl<const K: usize> Preimage<K> for Inverse<K> {
 /// ```
 ///
 /// # Errors
-/// [`OpsError::BadMatrix`] if the matrix is singular or its inverse's denominator changes sign (or
+/// [`OpsError::Singular`] if the matrix is singular, [`OpsError::ToInfinity`] if its inverse's
+/// denominator changes sign (or
 /// vanishes) over the universe — the map would send part of it to infinity.
 pub fn transform_projective<const K: usize>(
     tree: &KTree<K>,
@@ -224,11 +226,7 @@ pub fn transform_projective<const K: usize>(
         let c: [f64; K] = std::array::from_fn(|i| if corner >> i & 1 == 1 { u } else { 0.0 });
         let w = inv.w(c);
         if w == 0.0 || (sign != 0.0 && w.signum() != sign) {
-            return Err(OpsError::BadMatrix {
-                reason:
-                    "the map sends part of the universe to infinity (its denominator changes sign)"
-                        .into(),
-            });
+            return Err(OpsError::ToInfinity);
         }
         sign = w.signum();
     }

@@ -6,7 +6,7 @@
 //! voxels: `p'[i] = p[perm[i]]`, or `U − 1 − p[perm[i]]` when flipped — a rotation or reflection about the
 //! universe's centre. On a tree it is a fixed permutation of the `2^K` child codes applied at every node.
 
-use super::emit::Levels;
+use super::emit::LevelWriter;
 use super::OpsError;
 use crate::tree::{KTree, NodeState};
 
@@ -29,13 +29,13 @@ impl<const K: usize> AxisMap<K> {
     /// The map with output axis `i` taken from input axis `perm[i]`, mirrored when `flip[i]`.
     ///
     /// # Errors
-    /// [`OpsError::BadParameter`] if `perm` is not a permutation of `0 … K−1`.
+    /// [`OpsError::NotAPermutation`] if `perm` is not a permutation of `0 … K−1`.
     pub fn new(perm: [usize; K], flip: [bool; K]) -> Result<Self, OpsError> {
         let mut seen = [false; K];
         for &p in &perm {
             if p >= K || seen[p] {
-                return Err(OpsError::BadParameter {
-                    reason: format!("{perm:?} is not a permutation of the axes 0..{K}"),
+                return Err(OpsError::NotAPermutation {
+                    perm: perm.to_vec(),
                 });
             }
             seen[p] = true;
@@ -46,12 +46,10 @@ impl<const K: usize> AxisMap<K> {
     /// The reflection across the mid-plane perpendicular to `axis`.
     ///
     /// # Errors
-    /// [`OpsError::BadParameter`] if `axis ≥ K`.
+    /// [`OpsError::BadAxis`] if `axis ≥ K`.
     pub fn reflection(axis: usize) -> Result<Self, OpsError> {
         if axis >= K {
-            return Err(OpsError::BadParameter {
-                reason: format!("axis {axis} is not below K = {K}"),
-            });
+            return Err(OpsError::BadAxis { axis, k: K });
         }
         let mut m = Self::identity();
         m.flip[axis] = true;
@@ -62,14 +60,10 @@ impl<const K: usize> AxisMap<K> {
     /// positive `from` direction into the positive `to` direction (for `from = 0, to = 1` in 3-D: +90° about z).
     ///
     /// # Errors
-    /// [`OpsError::BadParameter`] if an axis is `≥ K` or `from == to`.
+    /// [`OpsError::BadAxisPair`] if an axis is `≥ K` or `from == to`.
     pub fn quarter_turn(from: usize, to: usize) -> Result<Self, OpsError> {
         if from >= K || to >= K || from == to {
-            return Err(OpsError::BadParameter {
-                reason: format!(
-                    "a quarter turn needs two different axes below K = {K}, got {from} and {to}"
-                ),
-            });
+            return Err(OpsError::BadAxisPair { from, to, k: K });
         }
         // (x_from, x_to) → (−x_to, x_from) about the centre: out[to] = in[from], out[from] = U−1−in[to].
         let mut m = Self::identity();
@@ -200,27 +194,38 @@ fn permutations<const K: usize>(
 /// ```
 pub fn rotate_axes<const K: usize>(tree: &KTree<K>, map: &AxisMap<K>) -> KTree<K> {
     let table = map.child_table();
-    let mut out = Levels::new(tree.depth_count());
-    let root = reorder(tree, &mut out, &table, 0, 0);
-    out.finish(tree.universe(), root)
-}
-
-fn reorder<const K: usize>(
-    tree: &KTree<K>,
-    out: &mut Levels,
-    table: &[usize; 16],
-    depth: usize,
-    index: usize,
-) -> NodeState {
-    let s = tree.state(depth, index);
-    if s != NodeState::Partial {
-        return s;
+    let fanout = 1usize << K;
+    let block_mask = (1u64 << (2 * fanout)) - 1;
+    let mut out = LevelWriter::new();
+    out.push(0, tree.root_state());
+    // Level by level: the source indices of the output's partial nodes at `depth`, in output order. Each
+    // one's children are an aligned block of `2^K` states (one piece of a word), permuted by the table.
+    let mut partials: Vec<usize> = Vec::new();
+    if tree.root_state() == NodeState::Partial {
+        partials.push(0);
     }
-    let first = tree.first_child(depth, index);
-    let mut kids = [NodeState::Empty; 16];
-    for (c, kid) in kids.iter_mut().enumerate().take(1 << K) {
-        *kid = reorder(tree, out, table, depth + 1, first + table[c]);
+    let mut depth = 0;
+    while !partials.is_empty() {
+        let words = tree.level_states(depth + 1).words();
+        let mut next = Vec::with_capacity(partials.len() * 2);
+        for &index in &partials {
+            let first = tree.first_child(depth, index);
+            let block = (words[first / 32] >> (2 * (first % 32))) & block_mask;
+            let mut kids = [NodeState::Empty; 16];
+            for (kid, &src) in kids.iter_mut().zip(&table[..fanout]) {
+                *kid = match block >> (2 * src) & 3 {
+                    0 => NodeState::Empty,
+                    1 => NodeState::Full,
+                    _ => {
+                        next.push(first + src);
+                        NodeState::Partial
+                    }
+                };
+            }
+            out.push_block(depth + 1, &kids[..fanout]);
+        }
+        partials = next;
+        depth += 1;
     }
-    out.push_block(depth + 1, &kids[..1 << K]);
-    NodeState::Partial
+    KTree::from_levels(tree.universe(), out.finish())
 }

@@ -1,11 +1,12 @@
 //! Scaling (§6 "Scaling", claim M4): by powers of two by adding or removing levels at the root (exact,
 //! touching only the top of the tree), and by other rational factors with overlays.
 
-use super::emit::{copy_subtree, Levels};
+use super::emit::LevelWriter;
 use super::overlay::{resample, Preimage};
 use super::OpsError;
 use crate::space::{max_level, Universe};
-use crate::tree::{KTree, NodeState, PackedStates};
+use crate::tree::cursor::locate;
+use crate::tree::{KTree, NodeState};
 
 fn check_path<const K: usize>(path: &[usize], level: u32) -> Result<(), OpsError> {
     if path.len() > level as usize || path.iter().any(|&c| c >= 1 << K) {
@@ -57,31 +58,25 @@ pub fn grow<const K: usize>(tree: &KTree<K>, path: &[usize]) -> Result<KTree<K>,
     if tree.root_state() == NodeState::Empty {
         return Ok(KTree::empty(level).expect("level checked"));
     }
-    let mut levels = Vec::with_capacity(n + tree.depth_count());
-    let mut root = PackedStates::with_capacity(1);
-    root.push(NodeState::Partial);
-    levels.push(root);
+    let mut out = LevelWriter::new();
+    out.push(0, NodeState::Partial);
     for (d, &code) in path.iter().enumerate() {
-        let mut l = PackedStates::with_capacity(1 << K);
         for c in 0..1usize << K {
-            l.push(if c != code {
-                NodeState::Empty
-            } else if d + 1 < n {
-                NodeState::Partial
-            } else {
-                tree.root_state()
-            });
+            out.push(
+                d + 1,
+                if c != code {
+                    NodeState::Empty
+                } else if d + 1 < n {
+                    NodeState::Partial
+                } else {
+                    tree.root_state()
+                },
+            );
         }
-        levels.push(l);
     }
     // The old root is the only partial node at depth n, so every old level keeps its indices.
-    for d in 1..tree.depth_count() {
-        levels.push(tree.level_states(d).clone());
-    }
-    for l in &mut levels {
-        l.finish();
-    }
-    Ok(KTree::from_levels(universe, levels))
+    out.copy_subtree(tree, 0, 0, n, false);
+    Ok(KTree::from_levels(universe, out.finish()))
 }
 
 /// Doubles the object `path.len()` times by removing levels at the root: the cell reached by the child
@@ -100,35 +95,19 @@ pub fn zoom<const K: usize>(tree: &KTree<K>, path: &[usize]) -> Result<KTree<K>,
     check_path::<K>(path, tree.level())?;
     let level = tree.level() - path.len() as u32;
     let universe = Universe::<K>::new(level).expect("a smaller level is valid");
-    // Walk down the path.
-    let (mut depth, mut index) = (0usize, 0usize);
-    for &code in path {
-        match tree.state(depth, index) {
-            NodeState::Partial => {
-                index = tree.first_child(depth, index) + code;
-                depth += 1;
-            }
-            leaf => return Ok(uniform(level, leaf)),
-        }
+    // Descend to the path's cell.
+    let target = path
+        .iter()
+        .fold(tree.universe().root(), |c, &code| c.child(code));
+    let node = locate(tree, tree.root(), &target);
+    if node.state != NodeState::Partial {
+        return Ok(uniform(level, node.state));
     }
-    let state = tree.state(depth, index);
-    if state != NodeState::Partial {
-        return Ok(uniform(level, state));
-    }
-    // Copy the subtree; the copy's depths are shifted up by `depth`.
-    let mut shifted = Levels::new(tree.depth_count());
-    let root = copy_subtree(tree, &mut shifted, depth, index, false);
-    let full = shifted.finish(tree.universe(), root);
-    // `full` has the subtree's levels at depths ≥ depth; drop the top ones.
-    let levels: Vec<PackedStates> = std::iter::once({
-        let mut r = PackedStates::with_capacity(1);
-        r.push(NodeState::Partial);
-        r.finish();
-        r
-    })
-    .chain((depth + 1..full.depth_count()).map(|d| full.level_states(d).clone()))
-    .collect();
-    Ok(KTree::from_levels(universe, levels))
+    // Copy the subtree, its root becoming the root.
+    let mut out = LevelWriter::new();
+    out.push(0, NodeState::Partial);
+    out.copy_subtree(tree, node.cell.level as usize, node.index, 0, false);
+    Ok(KTree::from_levels(universe, out.finish()))
 }
 
 fn uniform<const K: usize>(level: u32, state: NodeState) -> KTree<K> {
@@ -178,12 +157,10 @@ impl<const K: usize> Preimage<K> for Ratio<K> {
 /// ```
 ///
 /// # Errors
-/// [`OpsError::BadParameter`] unless `num` and `den` are both positive and at most 2^20.
+/// [`OpsError::BadScale`] unless `num` and `den` are both positive and at most 2^20.
 pub fn scale<const K: usize>(tree: &KTree<K>, num: u32, den: u32) -> Result<KTree<K>, OpsError> {
     if num == 0 || den == 0 || num > 1 << 20 || den > 1 << 20 {
-        return Err(OpsError::BadParameter {
-            reason: format!("scale factor {num}/{den}: both must be between 1 and 2^20"),
-        });
+        return Err(OpsError::BadScale { num, den });
     }
     if num == den {
         return Ok(tree.clone());

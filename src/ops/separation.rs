@@ -12,7 +12,7 @@ use std::collections::BinaryHeap;
 use super::boolean::same_level;
 use super::OpsError;
 use crate::space::Cell;
-use crate::tree::{KTree, NodeState};
+use crate::tree::{KTree, NodeRef, NodeState};
 
 /// Squared distance between the nearest voxel centres of two cells.
 fn gap2<const K: usize>(a: &Cell<K>, b: &Cell<K>) -> u128 {
@@ -46,31 +46,35 @@ fn gap2<const K: usize>(a: &Cell<K>, b: &Cell<K>) -> u128 {
 /// [`OpsError::LevelMismatch`] when the levels differ.
 pub fn min_separation<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Option<f64>, OpsError> {
     same_level(a, b)?;
-    let root = a.universe().root();
     // Heap entries: (bound, (depth, index, cell) of a, of b), smallest bound first.
     type Side<const K: usize> = (usize, usize, Cell<K>);
+    let node = |tree: &KTree<K>, s: Side<K>| NodeRef {
+        index: s.1,
+        cell: s.2,
+        state: tree.state(s.0, s.1),
+    };
+    let root = a.universe().root();
     let mut heap: BinaryHeap<Reverse<(u128, Side<K>, Side<K>)>> = BinaryHeap::new();
     heap.push(Reverse((0, (0, 0, root), (0, 0, root))));
     while let Some(Reverse((bound, sa, sb))) = heap.pop() {
-        let (state_a, state_b) = (a.state(sa.0, sa.1), b.state(sb.0, sb.1));
-        if state_a == NodeState::Empty || state_b == NodeState::Empty {
+        let (na, nb) = (node(a, sa), node(b, sb));
+        if na.state == NodeState::Empty || nb.state == NodeState::Empty {
             continue;
         }
-        if state_a == NodeState::Full && state_b == NodeState::Full {
+        if na.state == NodeState::Full && nb.state == NodeState::Full {
             return Ok(Some((bound as f64).sqrt()));
         }
         // Split the partial node with the larger cell (a if tied and partial).
-        let split_a = state_a == NodeState::Partial
-            && (state_b != NodeState::Partial || sa.2.log_side >= sb.2.log_side);
-        let (tree, side) = if split_a { (a, sa) } else { (b, sb) };
-        let first = tree.first_child(side.0, side.1);
-        for c in 0..1usize << K {
-            let child = (side.0 + 1, first + c, side.2.child(c));
-            if tree.state(child.0, child.1) == NodeState::Empty {
+        let split_a = na.state == NodeState::Partial
+            && (nb.state != NodeState::Partial || na.cell.log_side >= nb.cell.log_side);
+        let (tree, split) = if split_a { (a, &na) } else { (b, &nb) };
+        for child in tree.children(split) {
+            if child.state == NodeState::Empty {
                 continue;
             }
-            let (na, nb) = if split_a { (child, sb) } else { (sa, child) };
-            heap.push(Reverse((gap2(&na.2, &nb.2), na, nb)));
+            let side = (child.cell.level as usize, child.index, child.cell);
+            let (ca, cb) = if split_a { (side, sb) } else { (sa, side) };
+            heap.push(Reverse((gap2(&ca.2, &cb.2), ca, cb)));
         }
     }
     Ok(None)

@@ -9,7 +9,7 @@
 //! the same leaves). Parts moved outside the universe are cut off. Integer-only: additions, comparisons,
 //! masks and shifts. The output is reduced (children are decided before they are pushed).
 
-use super::emit::{collapse, Levels};
+use super::emit::{collapse, LevelWriter};
 use crate::tree::{KTree, NodeState};
 
 /// One overlay obel: the index of a source node at the target's depth (overlays stay on the target's
@@ -41,7 +41,7 @@ struct Mover<'a, const K: usize> {
     src: &'a KTree<K>,
     t: [i64; K],
     level: u32,
-    out: Levels,
+    out: LevelWriter,
 }
 
 impl<const K: usize> Mover<'_, K> {
@@ -152,7 +152,7 @@ pub fn translate<const K: usize>(tree: &KTree<K>, t: [i64; K]) -> KTree<K> {
         src: tree,
         t,
         level,
-        out: Levels::new(level as usize + 1),
+        out: LevelWriter::new(),
     };
     // The root's overlay: the source root sits in the slot whose cell index is 0 on every axis.
     let base: [i64; K] = std::array::from_fn(|i| (-t[i]).div_euclid(side));
@@ -163,7 +163,7 @@ pub fn translate<const K: usize>(tree: &KTree<K>, t: [i64; K]) -> KTree<K> {
         }
     }
     let root = m.node(0, [0; K], &overlay);
-    m.out.finish(tree.universe(), root)
+    m.out.finish_with_root(tree.universe(), root)
 }
 
 /// The whole-voxel shift used for an offset of `t / 2^sub_level` voxels: the target voxel whose centre,

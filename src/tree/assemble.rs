@@ -4,6 +4,7 @@
 //! the same order as in level order. So a pre-order stream is turned into level order by appending each node
 //! to the array of its depth: no sorting, no pointers.
 
+use super::cursor::subtree_ranges;
 use super::ktree::KTree;
 use super::states::{NodeState, PackedStates};
 use super::TreeError;
@@ -14,7 +15,7 @@ use crate::space::{Cell, DimCheck, SpaceError, Universe};
 #[derive(Debug, Clone)]
 pub struct TreeAssembler<const K: usize> {
     universe: Universe<K>,
-    levels: Vec<PackedStates>,
+    levels: LevelWriter,
 }
 
 impl<const K: usize> TreeAssembler<K> {
@@ -26,17 +27,14 @@ impl<const K: usize> TreeAssembler<K> {
         let () = DimCheck::<K>::OK;
         Ok(Self {
             universe: Universe::new(level)?,
-            levels: Vec::new(),
+            levels: LevelWriter::new(),
         })
     }
 
     /// Appends the next node of the depth-first traversal at `depth`.
     #[inline]
     pub fn push(&mut self, depth: usize, state: NodeState) {
-        while self.levels.len() <= depth {
-            self.levels.push(PackedStates::new());
-        }
-        self.levels[depth].push(state);
+        self.levels.push(depth, state);
     }
 
     /// The tree. The caller is responsible for having pushed a complete traversal; [`KTree::check`]
@@ -45,10 +43,170 @@ impl<const K: usize> TreeAssembler<K> {
         if self.levels.is_empty() {
             self.push(0, NodeState::Empty);
         }
-        for l in &mut self.levels {
-            l.finish();
+        KTree::from_levels(self.universe, self.levels.finish())
+    }
+}
+
+/// The one writer of tree levels: 2-bit states appended per level, in words, with whole blocks of
+/// siblings and whole subtrees (contiguous ranges at every level) appended as bit-shifted word copies.
+/// Writing the nodes of a depth-first traversal, each at its depth, yields level order.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct LevelWriter {
+    levels: Vec<LevelWords>,
+}
+
+/// One level being written: node `i` at bits `2(i mod 32)` of word `i / 32`.
+#[derive(Debug, Clone, Default)]
+struct LevelWords {
+    words: Vec<u64>,
+    len: usize,
+}
+
+const LOW_BITS: u64 = 0x5555_5555_5555_5555;
+
+/// The low `2·slots` bits set (`slots ≤ 32`).
+#[inline]
+fn slot_mask(slots: usize) -> u64 {
+    if slots >= 32 {
+        u64::MAX
+    } else {
+        (1u64 << (2 * slots)) - 1
+    }
+}
+
+impl LevelWords {
+    /// Appends `slots ≤ 32` states packed in the low bits of `chunk` (higher bits clear).
+    #[inline]
+    fn append(&mut self, chunk: u64, slots: usize) {
+        let offset = self.len % 32;
+        if offset == 0 {
+            self.words.push(chunk);
+        } else {
+            let last = self.words.len() - 1;
+            self.words[last] |= chunk << (2 * offset);
+            if offset + slots > 32 {
+                self.words.push(chunk >> (64 - 2 * offset));
+            }
         }
-        KTree::from_levels(self.universe, self.levels)
+        self.len += slots;
+    }
+
+    /// Appends the states `start .. start + n` of the packed `src`, leaves complemented if `invert`.
+    fn append_range(&mut self, src: &[u64], start: usize, n: usize, invert: bool) {
+        self.words.reserve(n.div_ceil(32) + 1);
+        let mut at = start;
+        let end = start + n;
+        while at < end {
+            let slots = (end - at).min(32);
+            let (w, s) = (at / 32, 2 * (at % 32));
+            let mut chunk = src[w] >> s;
+            if s > 0 && w + 1 < src.len() {
+                chunk |= src[w + 1] << (64 - s);
+            }
+            let valid = slot_mask(slots);
+            chunk &= valid;
+            if invert {
+                chunk ^= !(chunk >> 1) & LOW_BITS & valid;
+            }
+            self.append(chunk, slots);
+            at += slots;
+        }
+    }
+}
+
+impl LevelWriter {
+    /// An empty writer.
+    pub(crate) fn new() -> Self {
+        Self::default()
+    }
+
+    /// Whether nothing was written.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.levels.iter().all(|l| l.len == 0)
+    }
+
+    #[inline]
+    fn level(&mut self, depth: usize) -> &mut LevelWords {
+        if self.levels.len() <= depth {
+            self.levels.resize_with(depth + 1, LevelWords::default);
+        }
+        &mut self.levels[depth]
+    }
+
+    /// Appends a node at `depth`.
+    #[inline]
+    pub(crate) fn push(&mut self, depth: usize, state: NodeState) {
+        self.level(depth).append(state as u64, 1);
+    }
+
+    /// Appends a block of sibling states (at most 32) at `depth`.
+    #[inline]
+    pub(crate) fn push_block(&mut self, depth: usize, kids: &[NodeState]) {
+        let chunk = kids
+            .iter()
+            .enumerate()
+            .fold(0u64, |w, (i, &s)| w | (s as u64) << (2 * i));
+        self.level(depth).append(chunk, kids.len());
+    }
+
+    /// Appends the descendants of node `index` at `depth` of `tree` (not the node itself), the node's
+    /// depth written as `to_depth`, leaves complemented if `invert`; returns the node's state
+    /// (complemented if `invert` and a leaf), for the caller to write. One bit-shifted word copy per level.
+    pub(crate) fn copy_subtree<const K: usize>(
+        &mut self,
+        tree: &KTree<K>,
+        depth: usize,
+        index: usize,
+        to_depth: usize,
+        invert: bool,
+    ) -> NodeState {
+        for (d, range) in subtree_ranges(tree, depth, index) {
+            let src = tree.level_states(d);
+            self.level(d - depth + to_depth).append_range(
+                src.words(),
+                range.start,
+                range.len(),
+                invert,
+            );
+        }
+        match tree.state(depth, index) {
+            NodeState::Full if invert => NodeState::Empty,
+            NodeState::Empty if invert => NodeState::Full,
+            s => s,
+        }
+    }
+
+    /// The levels written, without trailing empty levels (at least one level).
+    pub(crate) fn finish(mut self) -> Vec<PackedStates> {
+        while self.levels.len() > 1 && self.levels.last().is_some_and(|l| l.len == 0) {
+            self.levels.pop();
+        }
+        if self.levels.is_empty() {
+            self.levels.push(LevelWords::default());
+        }
+        self.levels
+            .into_iter()
+            .map(|l| {
+                PackedStates::from_words(l.words, l.len)
+                    .expect("the writer only stores valid 2-bit codes")
+            })
+            .collect()
+    }
+
+    /// The tree with these levels below the root and `root` as its root state (level 0 is replaced):
+    /// for writers that decide each node after its children.
+    pub(crate) fn finish_with_root<const K: usize>(
+        mut self,
+        universe: Universe<K>,
+        root: NodeState,
+    ) -> KTree<K> {
+        if root != NodeState::Partial {
+            self.levels.clear();
+        }
+        let root_level = self.level(0);
+        *root_level = LevelWords::default();
+        root_level.append(root as u64, 1);
+        KTree::from_levels(universe, self.finish())
     }
 }
 
@@ -137,7 +295,7 @@ impl<const K: usize> KTree<K> {
     pub(crate) fn from_sorted_morton(universe: Universe<K>, cells: &[(u64, u32)]) -> KTree<K> {
         let mut out = TreeAssembler::<K> {
             universe,
-            levels: Vec::new(),
+            levels: LevelWriter::new(),
         };
         emit_leaves::<K, _>(&mut out, universe.level(), cells);
         out.finish()
@@ -149,7 +307,7 @@ impl<const K: usize> KTree<K> {
         debug_assert!(K as u32 * universe.level() + 5 <= 64);
         let mut out = TreeAssembler::<K> {
             universe,
-            levels: Vec::new(),
+            levels: LevelWriter::new(),
         };
         emit_leaves::<K, _>(&mut out, universe.level(), cells);
         out.finish()

@@ -286,23 +286,12 @@ impl<const K: usize> KTree<K> {
         if self.universe.check_point(point).is_err() {
             return false;
         }
-        let level = self.level();
-        let mut index = 0usize;
-        for depth in 0..self.levels.len() {
-            match self.levels[depth].get(index) {
-                NodeState::Empty => return false,
-                NodeState::Full => return true,
-                NodeState::Partial => {
-                    let bit = level - 1 - depth as u32;
-                    let mut code = 0usize;
-                    for (axis, &c) in point.iter().enumerate() {
-                        code |= ((c >> bit & 1) as usize) << axis;
-                    }
-                    index = self.first_child(depth, index) + code;
-                }
-            }
-        }
-        unreachable!("a well-formed tree ends in leaves")
+        let voxel = Cell {
+            origin: point,
+            level: self.level(),
+            log_side: 0,
+        };
+        super::cursor::locate(self, self.root(), &voxel).state == NodeState::Full
     }
 
     /// Visits every leaf (empty and full) in Morton (depth-first) order: [`KTree::leaves`] as a callback.

@@ -14,12 +14,13 @@
 //! ```
 
 mod assemble;
+pub mod cursor;
 mod error;
 mod ktree;
 mod operators;
 mod states;
 
-pub(crate) use assemble::TreeAssembler;
+pub(crate) use assemble::{LevelWriter, TreeAssembler};
 pub use error::TreeError;
 pub use ktree::{
     heap_bytes_for_levels, Bintree, KTree, Leaves, LevelCounts, NodeRef, Octree, Quadtree, Tree4,

@@ -196,9 +196,9 @@ proptest! {
     fn drawn_lines_are_visible_edges_and_visible_edges_are_drawn(dense in objects(), dir in toward()) {
         let tree = KTree::<3>::from_dense(LEVEL, &dense).unwrap();
         tree.assert_well_formed();
-        let fast = line_drawing(&tree, dir, HiddenLineMethod::Bucketed, None).unwrap();
+        let fast = line_drawing(&tree, dir, HiddenLineMethod::Bucketed).unwrap();
         check_drawing(&dense, &fast)?;
-        let slow = line_drawing(&tree, dir, HiddenLineMethod::Pairwise, None).unwrap();
+        let slow = line_drawing(&tree, dir, HiddenLineMethod::Pairwise).unwrap();
         prop_assert_eq!(fast.lines.len(), slow.lines.len());
         for (a, b) in fast.lines.iter().zip(&slow.lines) {
             prop_assert!(a.key_eq(b) && (a.u0 - b.u0).abs() < 1e-9 && (a.u1 - b.u1).abs() < 1e-9, "{:?} vs {:?}", a, b);
@@ -241,7 +241,7 @@ fn a_box_of_many_leaves_is_nine_lines() {
     let dense = dense_of(3, &[([1, 1, 3], [4, 6, 5])]);
     let tree = KTree::<3>::from_dense(3, &dense).unwrap();
     assert!(tree.counts().full > 4);
-    let d = line_drawing(&tree, [0.7, -1.0, 0.8], HiddenLineMethod::Pairwise, None).unwrap();
+    let d = line_drawing(&tree, [0.7, -1.0, 0.8], HiddenLineMethod::Pairwise).unwrap();
     assert_eq!(d.lines.len(), 9, "{:?}", d.lines);
     assert!(d.stats.edge_pieces > 9, "cracks and dots were joined");
 }
@@ -251,30 +251,24 @@ fn an_l_shape_shows_its_concave_edge() {
     // Two boxes forming an L: the concave crease between the lower slab's top and the tower's front.
     let dense = dense_of(3, &[([0, 0, 0], [4, 4, 2]), ([0, 2, 2], [4, 4, 4])]);
     let tree = KTree::<3>::from_dense(3, &dense).unwrap();
-    let d = line_drawing(&tree, [0.6, -1.0, 0.9], HiddenLineMethod::Bucketed, None).unwrap();
+    let d = line_drawing(&tree, [0.6, -1.0, 0.9], HiddenLineMethod::Bucketed).unwrap();
     let concave = d
         .lines
         .iter()
         .any(|e| e.axis == 0 && e.fixed == [2, 2] && e.u0 <= 0.0 && e.u1 >= 4.0);
     assert!(concave, "{:?}", d.lines);
     // Seen from behind-below, the crease is hidden.
-    let back = line_drawing(&tree, [-0.6, 1.0, -0.9], HiddenLineMethod::Bucketed, None).unwrap();
+    let back = line_drawing(&tree, [-0.6, 1.0, -0.9], HiddenLineMethod::Bucketed).unwrap();
     assert!(!back.lines.iter().any(|e| e.axis == 0 && e.fixed == [2, 2]));
 }
 
 #[test]
 fn a_zero_direction_is_an_error() {
     let tree = KTree::<3>::full(2).unwrap();
-    assert!(line_drawing(&tree, [0.0, 0.0, 0.0], HiddenLineMethod::Bucketed, None).is_err());
-    assert!(line_drawing(
-        &tree,
-        [f64::NAN, 0.0, 1.0],
-        HiddenLineMethod::Bucketed,
-        None
-    )
-    .is_err());
+    assert!(line_drawing(&tree, [0.0, 0.0, 0.0], HiddenLineMethod::Bucketed).is_err());
+    assert!(line_drawing(&tree, [f64::NAN, 0.0, 1.0], HiddenLineMethod::Bucketed).is_err());
     // An exact axis view works (the direction is nudged) and shows the square outline.
-    let top = line_drawing(&tree, [0.0, 0.0, 1.0], HiddenLineMethod::Bucketed, None).unwrap();
+    let top = line_drawing(&tree, [0.0, 0.0, 1.0], HiddenLineMethod::Bucketed).unwrap();
     assert!(top.lines.len() >= 4);
 }
 

@@ -37,7 +37,7 @@ proptest! {
             camera.projection = Projection::Orthographic { height: height * zoom };
         }
         let options = RenderOptions { width: w, height: h, depth: true, cells: true, ..Default::default() };
-        let fast = render(&tree, &camera, &options, None, None).unwrap();
+        let fast = render(&tree, &camera, &options).unwrap();
         let reference = render_zbuffer(&tree, &camera, &options).unwrap();
         let (fc, rc) = (fast.cells.as_ref().unwrap(), reference.cells.as_ref().unwrap());
         let (fd, rd) = (fast.depth.as_ref().unwrap(), reference.depth.as_ref().unwrap());
@@ -88,7 +88,7 @@ fn a_ball_fills_a_disc_and_is_shaded_like_a_sphere() {
         height: 256,
         ..Default::default()
     };
-    let image = render(&tree, &camera, &options, None, None).unwrap();
+    let image = render(&tree, &camera, &options).unwrap();
     let disc = std::f64::consts::PI * (30.0f64 * 4.0).powi(2);
     let ratio = image.stats.painted as f64 / disc;
     assert!(
@@ -104,7 +104,15 @@ fn a_ball_fills_a_disc_and_is_shaded_like_a_sphere() {
     let rays = sphere_rays_with_normals(6, 30.0);
     let tree2 = stack(&rays);
     assert_eq!(tree2, tree);
-    let smooth = render(&tree2, &camera, &options, Some(&rays), None).unwrap();
+    let smooth = render(
+        &tree2,
+        &camera,
+        &RenderOptions {
+            normals: Some(&rays),
+            ..options
+        },
+    )
+    .unwrap();
     let flat_levels = distinct_colours(&image.rgb);
     let smooth_levels = distinct_colours(&smooth.rgb);
     assert!(
@@ -172,7 +180,7 @@ fn bad_sizes_and_cameras_are_errors() {
         ..Default::default()
     };
     assert!(matches!(
-        render(&tree, &camera, &zero, None, None),
+        render(&tree, &camera, &zero),
         Err(DisplayError::BadSize { .. })
     ));
     let flat = Camera {
@@ -181,7 +189,7 @@ fn bad_sizes_and_cameras_are_errors() {
         ..camera
     };
     assert!(matches!(
-        render(&tree, &flat, &RenderOptions::default(), None, None),
+        render(&tree, &flat, &RenderOptions::default()),
         Err(DisplayError::BadCamera(_))
     ));
     let up = Camera {

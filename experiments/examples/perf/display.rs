@@ -51,7 +51,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         } else {
             best_of(
                 3,
-                || render(&tree, &camera, &options, None, None).expect("valid camera"),
+                || render(&tree, &camera, &options).expect("valid camera"),
                 |image| stats = Some(image.stats),
             )
         };
@@ -78,7 +78,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         let mut stats = None;
         let s = best_of(
             repeats,
-            || line_drawing(&tree, ISO_TOWARD_EYE, method, None).expect("valid view"),
+            || line_drawing(&tree, ISO_TOWARD_EYE, method).expect("valid view"),
             |d| stats = Some(d.stats),
         );
         let st = stats.expect("ran");

@@ -242,6 +242,15 @@ pub fn timing(out: &Out, max_level: u32) -> Result<String, String> {
     Ok(md)
 }
 
+/// Why building the object at one placement failed: the builder's message or the library's.
+struct PlacementError(String);
+
+impl From<ops::OpsError> for PlacementError {
+    fn from(x: ops::OpsError) -> Self {
+        Self(x.to_string())
+    }
+}
+
 /// M9: node count as a function of placement and of rotation angle, min / mean / max.
 pub fn complexity(out: &Out) -> Result<String, String> {
     let l = 7;
@@ -266,22 +275,22 @@ pub fn complexity(out: &Out) -> Result<String, String> {
     );
     let mut csv = String::from("object,angle_degrees,nodes\n");
     let mut series = Vec::new();
-    let bad = |m: String| ops::OpsError::BadParameter { reason: m };
-    let sphere_at = |o: [u32; 3]| -> Result<KTree<3>, ops::OpsError> {
+    let bad = PlacementError;
+    let sphere_at = |o: [u32; 3]| -> Result<KTree<3>, PlacementError> {
         let c = o.map(|v| 128 + i64::from(v));
         Ok(stack(
             &ball_rays::<3>(l, c, 40).map_err(|x| bad(x.to_string()))?,
         ))
     };
     // The cube's voxels: centres (doubled) in [100 + o, 148 + o].
-    let cube_at = |o: [u32; 3]| -> Result<KTree<3>, ops::OpsError> {
+    let cube_at = |o: [u32; 3]| -> Result<KTree<3>, PlacementError> {
         let lo = o.map(|v| (100 + v) / 2);
         let hi = o.map(|v| (148 + v - 1) / 2 + 1);
         cuboid(l, lo, hi).map_err(bad)
     };
     let sub = [
-        ops::over_placements(2, sphere_at).map_err(e)?,
-        ops::over_placements(2, cube_at).map_err(e)?,
+        ops::over_placements(2, sphere_at).map_err(|x| x.0)?,
+        ops::over_placements(2, cube_at).map_err(|x| x.0)?,
     ];
     for (k, (name, t)) in [
         ("sphere, radius 20", &sphere),

@@ -96,7 +96,7 @@ pub fn views(out: &Out, scene: &Octree, what: &str) -> Result<String, String> {
             ..Default::default()
         };
         let t = Instant::now();
-        let mut image = render(scene, &camera, &options, None, None).map_err(err)?;
+        let mut image = render(scene, &camera, &options).map_err(err)?;
         let secs = t.elapsed().as_secs_f64();
         if image.stats.painted == 0 {
             return Err(format!("{name}: the rendered view is empty"));
@@ -114,7 +114,7 @@ pub fn views(out: &Out, scene: &Octree, what: &str) -> Result<String, String> {
         let _ = write!(images, "![{name}]({file}) ");
     }
     let t = Instant::now();
-    let d = line_drawing(scene, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed, None).map_err(err)?;
+    let d = line_drawing(scene, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed).map_err(err)?;
     let secs = t.elapsed().as_secs_f64();
     let segs = d.segments_2d();
     if segs.is_empty() {

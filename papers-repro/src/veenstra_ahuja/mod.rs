@@ -84,10 +84,8 @@ pub fn run(results: &Path) -> Result<String, String> {
     for shape in &shapes {
         let tree = objects::shape_tree(shape, FIG_LEVEL)?;
         tree.check().map_err(|e| e.to_string())?;
-        let d =
-            line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed, None).map_err(err)?;
-        let slow =
-            line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Pairwise, None).map_err(err)?;
+        let d = line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed).map_err(err)?;
+        let slow = line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Pairwise).map_err(err)?;
         if !same_drawing(&d, &slow) {
             return Err(format!(
                 "{}: pairwise and bucketed drawings differ",
@@ -110,7 +108,7 @@ pub fn run(results: &Path) -> Result<String, String> {
             height: 400,
             ..Default::default()
         };
-        let image = render(&tree, &camera, &options, None, None).map_err(err)?;
+        let image = render(&tree, &camera, &options).map_err(err)?;
         png::write_rgb_png(
             &dir.join(format!("{base}_render.png")),
             400,
@@ -136,8 +134,16 @@ pub fn run(results: &Path) -> Result<String, String> {
         depth: true,
         ..Default::default()
     };
-    let smooth = render(&sphere7, &camera, &options, Some(&rays), None).map_err(err)?;
-    let faces = render(&sphere7, &camera, &options, None, None).map_err(err)?;
+    let smooth = render(
+        &sphere7,
+        &camera,
+        &RenderOptions {
+            normals: Some(&rays),
+            ..options
+        },
+    )
+    .map_err(err)?;
+    let faces = render(&sphere7, &camera, &options).map_err(err)?;
     png::write_rgb_png(&dir.join("sphere_l7_normals.png"), 512, 512, &smooth.rgb).map_err(err)?;
     png::write_rgb_png(&dir.join("sphere_l7_faces.png"), 512, 512, &faces.rgb).map_err(err)?;
     if let Some(grey) = faces.depth_grey() {
@@ -150,10 +156,9 @@ pub fn run(results: &Path) -> Result<String, String> {
         &RenderOptions {
             width: 512,
             height: 512,
+            normals: Some(&rays),
             ..Default::default()
         },
-        Some(&rays),
-        None,
     )
     .map_err(err)?;
     png::write_rgb_png(
@@ -192,11 +197,11 @@ pub fn run(results: &Path) -> Result<String, String> {
     for (shape, level) in cases {
         let tree: Octree = objects::shape_tree(shape, level)?;
         let (t_b, fast) = timed(3, || {
-            line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed, None).map_err(err)
+            line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed).map_err(err)
         })?;
         let runs = if level >= 6 { 1 } else { 3 };
         let (t_p, slow) = timed(runs, || {
-            line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Pairwise, None).map_err(err)
+            line_drawing(&tree, ISO_TOWARD_EYE, HiddenLineMethod::Pairwise).map_err(err)
         })?;
         if !same_drawing(&fast, &slow) {
             return Err(format!(

@@ -1,0 +1,476 @@
+//! One traversal for every query over the compact tree: a depth-first walk of one tree, or of two trees
+//! side by side, driven by a [`Visitor`] that answers per node whether to descend, skip the subtree or stop
+//! the whole walk, and that chooses which children to visit and in what order (code order, a view order,
+//! the one child towards a point).
+//!
+//! Queries are small visitors, not new descents: point location ([`locate`]) takes the walk's one step
+//! ([`child`]) towards a point; the Booleans and interference tests are [`walk_pair`] visitors; display orders are
+//! [`ChildOrder::xor`] orders. The nodes under a node are contiguous at every level, so a whole subtree is
+//! also a list of index ranges ([`subtree_ranges`]), which the level writer copies in bulk.
+//!
+//! ```
+//! use ktree::tree::cursor::{walk, Visitor, Walk};
+//! use ktree::tree::NodeRef;
+//! use ktree::{KTree, NodeState};
+//! // The side of the first full leaf of side ≥ 2, in Morton order; the walk stops there.
+//! struct FirstBig(Option<u64>);
+//! impl Visitor<1> for FirstBig {
+//!     fn visit(&mut self, node: &NodeRef<1>) -> Walk {
+//!         if node.state == NodeState::Full && node.cell.side() >= 2 {
+//!             self.0 = Some(node.cell.side());
+//!             return Walk::Stop;
+//!         }
+//!         Walk::Descend
+//!     }
+//! }
+//! let tree = KTree::<1>::from_dense(3, &[true, false, false, false, true, true, true, true]).unwrap();
+//! let mut v = FirstBig(None);
+//! assert!(walk(&tree, &mut v)); // stopped early
+//! assert_eq!(v.0, Some(4));
+//! ```
+
+use super::ktree::{KTree, NodeRef};
+use super::states::NodeState;
+use crate::space::Cell;
+
+/// What a visitor wants after seeing a node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Walk {
+    /// Visit the node's children (if it has any).
+    Descend,
+    /// Skip the node's subtree and go on with the next node.
+    Skip,
+    /// End the whole walk now.
+    Stop,
+}
+
+/// The children of a node to visit, in order: up to `2^K` child codes.
+///
+/// ```
+/// use ktree::tree::cursor::ChildOrder;
+/// let codes = |o: ChildOrder| o.codes().collect::<Vec<_>>();
+/// assert_eq!(codes(ChildOrder::xor::<2>(0b10)), [2, 3, 0, 1]);
+/// assert_eq!(codes(ChildOrder::lower_half_first::<2>(0)), [0, 2, 1, 3]);
+/// assert_eq!(codes(ChildOrder::half::<2>(0, true)), [1, 3]);
+/// assert_eq!(codes(ChildOrder::one(5)), [5]);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ChildOrder(Codes);
+
+/// The `j`-th code is `mask ^ j` (`j < len`), or read from a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Codes {
+    Xor { mask: u8, len: u8 },
+    Table { codes: [u8; 16], len: u8 },
+}
+
+impl ChildOrder {
+    /// All children in child-code (Morton) order.
+    #[inline]
+    pub fn morton<const K: usize>() -> Self {
+        Self::xor::<K>(0)
+    }
+
+    /// All children, the `j`-th being `mask ^ j`: a view order (front to back with `mask` the near
+    /// child, back to front with `mask` the far child).
+    #[inline]
+    pub fn xor<const K: usize>(mask: usize) -> Self {
+        Self(Codes::Xor {
+            mask: mask as u8,
+            len: 1 << K,
+        })
+    }
+
+    /// Only child `code`.
+    #[inline]
+    pub fn one(code: usize) -> Self {
+        Self(Codes::Xor {
+            mask: code as u8,
+            len: 1,
+        })
+    }
+
+    /// The given child codes, in the order given (at most 16, each below `2^K`).
+    pub fn from_codes(list: impl IntoIterator<Item = usize>) -> Self {
+        let mut codes = [0u8; 16];
+        let mut len = 0u8;
+        for (slot, c) in codes.iter_mut().zip(list) {
+            *slot = c as u8;
+            len += 1;
+        }
+        Self(Codes::Table { codes, len })
+    }
+
+    /// All children, those in the lower half on `axis` first, each half in code order.
+    pub fn lower_half_first<const K: usize>(axis: usize) -> Self {
+        let lower = (0..1usize << K).filter(|c| c >> axis & 1 == 0);
+        let upper = (0..1usize << K).filter(|c| c >> axis & 1 == 1);
+        Self::from_codes(lower.chain(upper))
+    }
+
+    /// The children in the lower (`upper == false`) or upper half on `axis`, in code order.
+    pub fn half<const K: usize>(axis: usize, upper: bool) -> Self {
+        Self::from_codes((0..1usize << K).filter(|c| (c >> axis & 1 == 1) == upper))
+    }
+
+    /// The number of children visited.
+    #[inline]
+    pub fn len(&self) -> usize {
+        match self.0 {
+            Codes::Xor { len, .. } | Codes::Table { len, .. } => usize::from(len),
+        }
+    }
+
+    /// Whether no child is visited.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The `j`-th child code to visit (`j < len`).
+    #[inline]
+    pub fn code(&self, j: usize) -> usize {
+        match self.0 {
+            Codes::Xor { mask, .. } => usize::from(mask) ^ j,
+            Codes::Table { codes, .. } => usize::from(codes[j]),
+        }
+    }
+
+    /// The child codes, in visiting order.
+    pub fn codes(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.len()).map(|j| self.code(j))
+    }
+}
+
+/// A query over one tree: sees each node before its children.
+pub trait Visitor<const K: usize> {
+    /// Whether the walk tracks cell origins. A visitor that never reads `cell.origin` sets this to
+    /// `false`; its nodes then carry the right level and size but their parent's origin.
+    const ORIGINS: bool = true;
+
+    /// Sees a node; says whether to visit its children, skip them, or stop.
+    fn visit(&mut self, node: &NodeRef<K>) -> Walk;
+
+    /// Called after the children of a partial node have all been visited (not when they were skipped,
+    /// nor after a stop).
+    #[inline]
+    fn leave(&mut self, _node: &NodeRef<K>) {}
+
+    /// Which children of a partial node to visit, in order (all, in code order, unless overridden).
+    #[inline]
+    fn child_order(&self, _node: &NodeRef<K>) -> ChildOrder {
+        ChildOrder::morton::<K>()
+    }
+}
+
+/// The cell of child `code`, with or without its origin (see [`Visitor::ORIGINS`]).
+#[inline(always)]
+fn step<const K: usize>(cell: &Cell<K>, code: usize, origins: bool) -> Cell<K> {
+    if origins {
+        cell.child(code)
+    } else {
+        Cell {
+            origin: cell.origin,
+            level: cell.level + 1,
+            log_side: cell.log_side - 1,
+        }
+    }
+}
+
+/// The child `code` of the partial node `node` whose first child is `first`.
+#[inline(always)]
+fn child_ref<const K: usize>(
+    tree: &KTree<K>,
+    node: &NodeRef<K>,
+    first: usize,
+    code: usize,
+    origins: bool,
+) -> NodeRef<K> {
+    NodeRef {
+        index: first + code,
+        cell: step(&node.cell, code, origins),
+        state: tree.state(node.cell.level as usize + 1, first + code),
+    }
+}
+
+/// Walks `tree` depth first from the root with `visitor`. Returns `true` if the visitor stopped the walk.
+pub fn walk<const K: usize, V: Visitor<K>>(tree: &KTree<K>, visitor: &mut V) -> bool {
+    walk_from(tree, tree.root(), visitor)
+}
+
+/// Walks the subtree of `node` (a node of `tree`) depth first with `visitor`. Returns `true` if the
+/// visitor stopped the walk.
+pub fn walk_from<const K: usize, V: Visitor<K>>(
+    tree: &KTree<K>,
+    node: NodeRef<K>,
+    visitor: &mut V,
+) -> bool {
+    visit_node(tree, &node, visitor)
+}
+
+/// Visits `node`; descends into its children if asked to and it has any. `true` when stopped.
+#[inline]
+fn visit_node<const K: usize, V: Visitor<K>>(
+    tree: &KTree<K>,
+    node: &NodeRef<K>,
+    v: &mut V,
+) -> bool {
+    match v.visit(node) {
+        Walk::Stop => true,
+        Walk::Skip => false,
+        Walk::Descend => node.state == NodeState::Partial && descend(tree, node, v),
+    }
+}
+
+/// Visits the children of the partial node `node` (already visited), then leaves it. `true` when
+/// stopped. Children are visited here, so a leaf or a skipped subtree costs no call.
+fn descend<const K: usize, V: Visitor<K>>(tree: &KTree<K>, node: &NodeRef<K>, v: &mut V) -> bool {
+    let first = tree.first_child(node.cell.level as usize, node.index);
+    let order = v.child_order(node);
+    for j in 0..order.len() {
+        let child = child_ref(tree, node, first, order.code(j), V::ORIGINS);
+        if visit_node(tree, &child, v) {
+            return true;
+        }
+    }
+    v.leave(node);
+    false
+}
+
+/// Where one tree stands in a two-tree walk: its node at the walk's cell, or the leaf above the cell that
+/// stands for every cell below it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Side {
+    /// The node's index within its level (for a leaf above the cell, within the leaf's level).
+    pub index: usize,
+    /// The node's state.
+    pub state: NodeState,
+}
+
+/// A cell of a simultaneous walk of two trees, with the node of each tree that covers it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PairNode<const K: usize> {
+    /// The cell (see [`PairVisitor::ORIGINS`] for its origin); its level is the depth of the nodes that
+    /// are at the cell.
+    pub cell: Cell<K>,
+    /// The cell's child code within its parent (0 for the root).
+    pub code: usize,
+    /// The first tree's node.
+    pub a: Side,
+    /// The second tree's node.
+    pub b: Side,
+}
+
+/// A query over two trees of the same universe, walked side by side: sees each cell where at least one
+/// tree is partial before its children. Where one tree is a leaf and the other partial, the walk goes on
+/// with the leaf standing for every cell below it.
+pub trait PairVisitor<const K: usize> {
+    /// As [`Visitor::ORIGINS`].
+    const ORIGINS: bool = true;
+
+    /// Sees a pair of nodes; says whether to visit the children, skip them, or stop.
+    fn visit(&mut self, pair: &PairNode<K>) -> Walk;
+
+    /// Called after the children of a pair have all been visited.
+    #[inline]
+    fn leave(&mut self, _pair: &PairNode<K>) {}
+
+    /// Which children to visit, in order.
+    #[inline]
+    fn child_order(&self, _pair: &PairNode<K>) -> ChildOrder {
+        ChildOrder::morton::<K>()
+    }
+}
+
+/// Walks two trees (of the same universe level) side by side from their roots. Returns `true` if the
+/// visitor stopped the walk.
+///
+/// ```
+/// use ktree::tree::cursor::{walk_pair, PairNode, PairVisitor, Walk};
+/// use ktree::{KTree, NodeState};
+/// // Do two objects share a voxel?
+/// struct Meet(bool);
+/// impl PairVisitor<1> for Meet {
+///     fn visit(&mut self, p: &PairNode<1>) -> Walk {
+///         match (p.a.state, p.b.state) {
+///             (NodeState::Empty, _) | (_, NodeState::Empty) => Walk::Skip,
+///             (NodeState::Partial, NodeState::Partial) => Walk::Descend,
+///             _ => { self.0 = true; Walk::Stop }
+///         }
+///     }
+/// }
+/// let a = KTree::<1>::from_dense(2, &[true, true, false, false]).unwrap();
+/// let b = KTree::<1>::from_dense(2, &[false, true, true, false]).unwrap();
+/// let mut m = Meet(false);
+/// walk_pair(&a, &b, &mut m);
+/// assert!(m.0);
+/// ```
+pub fn walk_pair<const K: usize, V: PairVisitor<K>>(
+    a: &KTree<K>,
+    b: &KTree<K>,
+    visitor: &mut V,
+) -> bool {
+    debug_assert_eq!(a.level(), b.level());
+    let root = PairNode {
+        cell: a.universe().root(),
+        code: 0,
+        a: Side {
+            index: 0,
+            state: a.root_state(),
+        },
+        b: Side {
+            index: 0,
+            state: b.root_state(),
+        },
+    };
+    visit_pair(a, b, &root, visitor)
+}
+
+/// The side of child `code`: the real child of a partial node, or the same leaf standing in.
+#[inline(always)]
+fn child_side<const K: usize>(
+    tree: &KTree<K>,
+    side: &Side,
+    depth: usize,
+    first: usize,
+    code: usize,
+) -> Side {
+    if side.state == NodeState::Partial {
+        Side {
+            index: first + code,
+            state: tree.state(depth, first + code),
+        }
+    } else {
+        *side
+    }
+}
+
+/// Visits `pair`; descends into its children if asked to and either side is partial. `true` when stopped.
+#[inline]
+fn visit_pair<const K: usize, V: PairVisitor<K>>(
+    a: &KTree<K>,
+    b: &KTree<K>,
+    pair: &PairNode<K>,
+    v: &mut V,
+) -> bool {
+    match v.visit(pair) {
+        Walk::Stop => true,
+        Walk::Skip => false,
+        Walk::Descend => {
+            (pair.a.state == NodeState::Partial || pair.b.state == NodeState::Partial)
+                && descend_pair(a, b, pair, v)
+        }
+    }
+}
+
+/// Visits the children of `pair` (already visited; at least one side partial), then leaves it. `true`
+/// when stopped.
+fn descend_pair<const K: usize, V: PairVisitor<K>>(
+    a: &KTree<K>,
+    b: &KTree<K>,
+    pair: &PairNode<K>,
+    v: &mut V,
+) -> bool {
+    let depth = pair.cell.level as usize;
+    let fa = if pair.a.state == NodeState::Partial {
+        a.first_child(depth, pair.a.index)
+    } else {
+        0
+    };
+    let fb = if pair.b.state == NodeState::Partial {
+        b.first_child(depth, pair.b.index)
+    } else {
+        0
+    };
+    let order = v.child_order(pair);
+    for j in 0..order.len() {
+        let code = order.code(j);
+        let child = PairNode {
+            cell: step(&pair.cell, code, V::ORIGINS),
+            code,
+            a: child_side(a, &pair.a, depth + 1, fa, code),
+            b: child_side(b, &pair.b, depth + 1, fb, code),
+        };
+        if visit_pair(a, b, &child, v) {
+            return true;
+        }
+    }
+    v.leave(pair);
+    false
+}
+
+/// The child `code` of the partial node `node` of `tree`: one step of navigation, the one every walk
+/// takes.
+///
+/// ```
+/// use ktree::tree::cursor::child;
+/// use ktree::{KTree, NodeState};
+/// let tree = KTree::<1>::from_dense(1, &[false, true]).unwrap();
+/// assert_eq!(child(&tree, &tree.root(), 1).state, NodeState::Full);
+/// ```
+#[inline]
+pub fn child<const K: usize>(tree: &KTree<K>, node: &NodeRef<K>, code: usize) -> NodeRef<K> {
+    let first = tree.first_child(node.cell.level as usize, node.index);
+    child_ref(tree, node, first, code, true)
+}
+
+/// The node of `tree` whose cell contains the aligned cell `target` and is either a leaf or `target`
+/// itself, found by descending from `start` (a node whose cell contains `target`; usually
+/// [`KTree::root`]) one child at a time, towards `target`. `O(levels descended)` rank lookups.
+///
+/// ```
+/// use ktree::tree::cursor::locate;
+/// use ktree::{KTree, NodeState};
+/// let tree = KTree::<1>::from_dense(2, &[false, true, true, true]).unwrap();
+/// let voxel = tree.universe().cell([3], 2).unwrap();
+/// let node = locate(&tree, tree.root(), &voxel);
+/// assert_eq!((node.state, node.cell.side()), (NodeState::Full, 2));
+/// ```
+pub fn locate<const K: usize>(tree: &KTree<K>, start: NodeRef<K>, target: &Cell<K>) -> NodeRef<K> {
+    debug_assert!(start.cell.level <= target.level);
+    let bit_top = tree.level().saturating_sub(1);
+    let mut node = start;
+    while node.state == NodeState::Partial && node.cell.level < target.level {
+        let bit = bit_top - node.cell.level;
+        let mut code = 0usize;
+        for (axis, &c) in target.origin.iter().enumerate() {
+            code |= ((c >> bit & 1) as usize) << axis;
+        }
+        let first = tree.first_child(node.cell.level as usize, node.index);
+        node = child_ref(tree, &node, first, code, false);
+    }
+    // The steps did not track origins: the node's cell is the target's ancestor at its level.
+    let low = ((1u64 << node.cell.log_side) - 1) as u32;
+    node.cell.origin = target.origin.map(|o| o & !low);
+    node
+}
+
+/// The ranges of node indices, level by level from `depth + 1` down, that hold the descendants of the
+/// node `index` at `depth`: `(depth, start..end)` pairs, contiguous because children blocks follow the
+/// order of their parents. Empty for a leaf.
+///
+/// ```
+/// use ktree::tree::cursor::subtree_ranges;
+/// use ktree::KTree;
+/// let tree = KTree::<1>::from_dense(2, &[true, false, true, true]).unwrap();
+/// assert_eq!(subtree_ranges(&tree, 0, 0).collect::<Vec<_>>(), [(1, 0..2), (2, 0..2)]);
+/// assert_eq!(subtree_ranges(&tree, 1, 1).count(), 0); // a full leaf
+/// ```
+pub fn subtree_ranges<const K: usize>(
+    tree: &KTree<K>,
+    depth: usize,
+    index: usize,
+) -> impl Iterator<Item = (usize, std::ops::Range<usize>)> + '_ {
+    let mut range = index..index + 1;
+    let mut d = depth;
+    std::iter::from_fn(move || {
+        if d + 1 >= tree.depth_count() || range.is_empty() {
+            return None;
+        }
+        let states = tree.level_states(d);
+        let next = (states.partial_rank(range.start) << K)..(states.partial_rank(range.end) << K);
+        d += 1;
+        range = next.clone();
+        (!next.is_empty()).then_some((d, next))
+    })
+}
