@@ -460,7 +460,6 @@ pub fn read_vdb(
     let grids = r.i32("grid count")?;
     let mut found = None;
     for _ in 0..grids.max(0) {
-        let name_at = r.at;
         let _name = r.string("grid name")?;
         let kind = r.string("grid type")?;
         let parent = r.string("instance parent")?;
@@ -468,7 +467,16 @@ pub fn read_vdb(
         r.i64("block position")?;
         let end_at = r.i64("end position")?;
         if (kind == BOOL_TREE || kind == MASK_TREE) && parent.is_empty() {
-            found = Some((name_at, if has_offsets { grid_at } else { r.at as i64 }));
+            if has_offsets && usize::try_from(end_at).map_or(true, |e| e > bytes.len()) {
+                return Err(r.fail(GridFileErrorKind::Truncated(format!(
+                    "the grid ends at byte {end_at}, the file has {}",
+                    bytes.len()
+                ))));
+            }
+            found = Some((
+                kind == BOOL_TREE,
+                if has_offsets { grid_at } else { r.at as i64 },
+            ));
             break;
         }
         if !has_offsets {
@@ -478,7 +486,7 @@ pub fn read_vdb(
             .unwrap_or(usize::MAX)
             .min(bytes.len());
     }
-    let Some((_, grid_at)) = found else {
+    let Some((is_bool, grid_at)) = found else {
         return Err(r.fail(GridFileErrorKind::Unsupported(
             "no BoolGrid or MaskGrid in the file".into(),
         )));
@@ -567,6 +575,7 @@ pub fn read_vdb(
             return Err(too_many(&r));
         }
     }
+    let mut leaves = 0usize;
     for _ in 0..children {
         let o = [
             r.i32("node origin")?,
@@ -599,6 +608,7 @@ pub fn read_vdb(
                 }
             }
             for m in ones(&lower_children) {
+                leaves += 1;
                 let leaf_lo = corner_of(lo, m, 4, 3);
                 let leaf = r.mask(LEAF_WORDS)?;
                 // Runs along z of the leaf's active voxels (z is the fastest index).
@@ -627,6 +637,12 @@ pub fn read_vdb(
             }
         }
     }
+    if is_bool {
+        // Each bool leaf's buffer: its value mask, origin and values again.
+        for _ in 0..leaves {
+            r.take(2 * 8 * LEAF_WORDS + 12, "leaf buffer")?;
+        }
+    }
     let placement = GridPlacement::choose(boxes.known, offset, level)
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;
     let tree = place_boxes(&boxes, &placement)
@@ -636,4 +652,62 @@ pub fn read_vdb(
         placement,
         meta,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rays::ball_rays;
+    use crate::stacking::stack;
+
+    #[test]
+    fn round_trip_keeps_the_universe_and_tiles_cover_whole_nodes() {
+        for (tree, offset) in [
+            (
+                stack(&ball_rays::<3>(6, [30, 25, 26], 20).unwrap()),
+                [5, -300, 0],
+            ),
+            (
+                stack(&ball_rays::<3>(9, [300, 250, 260], 200).unwrap()),
+                [0, -512, 128],
+            ),
+            (KTree::<3>::empty(2).unwrap(), [0; 3]),
+        ] {
+            let mut bytes = Vec::new();
+            write_vdb(&mut bytes, &tree, offset, &GridMeta::default()).unwrap();
+            let p = read_vdb(&bytes, "v", None, None).unwrap();
+            assert_eq!(p.tree, tree);
+            assert_eq!(p.placement.offset, offset);
+        }
+        // A full level-13 universe at offset 0 is 8 root children of tiles: no leaf at all.
+        let mut bytes = Vec::new();
+        write_vdb(
+            &mut bytes,
+            &KTree::<3>::full(13).unwrap(),
+            [0; 3],
+            &GridMeta::default(),
+        )
+        .unwrap();
+        assert!(bytes.len() < 8 * 50_000, "{} bytes", bytes.len());
+    }
+
+    #[test]
+    fn a_small_file_claiming_huge_counts_is_refused_before_allocating() {
+        let tree = stack(&ball_rays::<3>(4, [8, 8, 8], 5).unwrap());
+        let mut bytes = Vec::new();
+        write_vdb(&mut bytes, &tree, [0; 3], &GridMeta::default()).unwrap();
+        // The root child count sits right after the tile count, just before the first node origin.
+        let topo = bytes
+            .windows(9)
+            .position(|w| w == [1, 0, 0, 0, 0, 0, 0, 0, 0])
+            .unwrap();
+        let mut huge = bytes[..topo + 13].to_vec();
+        huge[topo + 9..topo + 13].copy_from_slice(&u32::MAX.to_le_bytes());
+        huge.truncate(100.max(huge.len()));
+        let e = read_vdb(&huge, "huge", None, None).unwrap_err();
+        assert!(matches!(e.kind, GridFileErrorKind::Truncated(_)), "{e}");
+        assert!(e.to_string().starts_with("huge: byte "), "{e}");
+        let e = read_vdb(b"not a vdb file at all", "x", None, None).unwrap_err();
+        assert_eq!((e.offset, e.to_string().contains("bad magic")), (0, true));
+    }
 }
