@@ -18,7 +18,7 @@
 //! assert_eq!(u.voxels(), 1u128 << 63);
 //! // Child 1 of the root is its upper half along x (bit 0 of the child code).
 //! let child = u.root().child(1);
-//! assert_eq!(child.origin, [1 << 20, 0, 0]);
+//! assert_eq!(child.origin(), [1 << 20, 0, 0]);
 //! assert!(child.contains([(1 << 21) - 1, 5, 5]) && !child.contains([0, 5, 5]));
 //! assert!(Universe::<3>::new(22).is_err());
 //! ```

@@ -19,8 +19,8 @@
 //! use ktree::{rays::ball_rays, stacking::stack};
 //! let ball = stack(&ball_rays::<3>(4, [16, 16, 16], 20).unwrap());
 //! let dir = [0.6, -1.0, 0.8];
-//! let pairwise = line_drawing(&ball, dir, HiddenLineMethod::Pairwise, None).unwrap();
-//! let bucketed = line_drawing(&ball, dir, HiddenLineMethod::Bucketed, None).unwrap();
+//! let pairwise = line_drawing(&ball, dir, HiddenLineMethod::Pairwise).unwrap();
+//! let bucketed = line_drawing(&ball, dir, HiddenLineMethod::Bucketed).unwrap();
 //! assert_eq!(pairwise.lines, bucketed.lines); // two methods, one drawing
 //! ```
 

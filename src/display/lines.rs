@@ -27,7 +27,7 @@
 //! let mut dense = vec![false; 8];
 //! dense[0] = true;
 //! let voxel = KTree::<3>::from_dense(1, &dense).unwrap();
-//! let d = line_drawing(&voxel, [1.0, -0.8, 0.6], HiddenLineMethod::Bucketed, None).unwrap();
+//! let d = line_drawing(&voxel, [1.0, -0.8, 0.6], HiddenLineMethod::Bucketed).unwrap();
 //! assert_eq!(d.lines.len(), 9);
 //! ```
 

@@ -14,7 +14,7 @@
 //! use ktree::display::{line_drawing, HiddenLineMethod, ISO_TOWARD_EYE};
 //! use ktree::{rays::ball_rays, stacking::stack};
 //! let ball = stack(&ball_rays::<3>(4, [16, 16, 16], 20).unwrap());
-//! let drawing = line_drawing(&ball, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed, None).unwrap();
+//! let drawing = line_drawing(&ball, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed).unwrap();
 //! assert!(!drawing.lines.is_empty());
 //! assert!(drawing.lines.iter().all(|edge| edge.u0 < edge.u1));
 //! ```

@@ -20,7 +20,7 @@
 //! let mut seen = Vec::new();
 //! walk_ordered(&tree, Viewer::Direction([-1.0, 0.0, 0.0]), Order::FrontToBack, |n| {
 //!     if n.state == ktree::NodeState::Full {
-//!         seen.push(n.cell.origin[0]);
+//!         seen.push(n.cell.origin()[0]);
 //!     }
 //!     Walk::Descend
 //! });

@@ -19,7 +19,7 @@
 //! let ball = stack(&ball_rays::<3>(4, [16, 16, 16], 24).unwrap());
 //! let options = RenderOptions { width: 48, height: 48, ..Default::default() };
 //! let camera = default_camera(&ball, ISO_TOWARD_EYE, None, 48, 48).unwrap();
-//! let front_to_back = render(&ball, &camera, &options, None, None).unwrap();
+//! let front_to_back = render(&ball, &camera, &options).unwrap();
 //! let zbuffer = render_zbuffer(&ball, &camera, &options).unwrap();
 //! // Front to back with a coverage mask paints exactly the pixels the brute-force reference paints.
 //! assert_eq!(front_to_back.stats.painted, zbuffer.stats.painted);

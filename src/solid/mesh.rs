@@ -180,7 +180,7 @@ impl TriangleMesh {
     /// use ktree::solid::mesh::TriangleMesh;
     /// let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     /// let mesh = TriangleMesh::from_bytes(obj, "obj", Path::new("mem.obj")).unwrap();
-    /// assert_eq!(mesh.triangles.len(), 1);
+    /// assert_eq!(mesh.triangles().len(), 1);
     /// assert!(TriangleMesh::from_bytes(b"f 1 2 9\n", "obj", Path::new("bad.obj")).is_err());
     /// ```
     ///

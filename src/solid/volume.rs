@@ -206,7 +206,7 @@ impl Volume {
     /// use ktree::solid::volume::Volume;
     /// let sidecar = br#"{"shape_xyz": [2, 1, 1], "dtype": "uint16", "endianness": "big"}"#;
     /// let v = Volume::from_raw_bytes(sidecar, &[0, 7, 1, 0], Path::new("mem.json")).unwrap();
-    /// assert_eq!(v.values, [7.0, 256.0]);
+    /// assert_eq!(v.values(), [7.0, 256.0]);
     /// assert!(Volume::from_raw_bytes(sidecar, &[0, 7], Path::new("mem.json")).is_err());
     /// ```
     ///
