@@ -364,10 +364,7 @@ impl Tree {
         {
             return Err(Failure::Value(format!("vertex {i} is not finite")).into());
         }
-        let mesh = TriangleMesh {
-            vertices,
-            triangles,
-        };
+        let mesh = TriangleMesh::new(vertices, triangles).map_err(Failure::value)?;
         mesh_tree(py, mesh, level, transform, "from_mesh_arrays")
     }
 
@@ -668,7 +665,7 @@ impl Tree {
                     None => None,
                 };
                 let separation = if collide { Some(0.0) } else { ops::min_separation(a, b)? };
-                Ok((collide, overlap.full_cells().len(), overlap.voxel_count(), first, separation))
+                Ok((collide, overlap.full_cells().count(), overlap.voxel_count(), first, separation))
             })())
         })?;
         let d = PyDict::new(py);
@@ -712,7 +709,7 @@ impl Tree {
                         height,
                         ..Default::default()
                     };
-                    let image = display::render(t, &camera, &options, None, None)?;
+                    let image = display::render(t, &camera, &options)?;
                     Ok((image.width, image.height, image.rgb))
                 }
                 AnyTree::K2(t) => {
@@ -774,7 +771,7 @@ impl Tree {
         };
         Ok(py.detach(|| -> Result<_, Failure> {
             display::check_size(width, height)?;
-            let drawing = display::line_drawing(tree, toward, method, None)?;
+            let drawing = display::line_drawing(tree, toward, method)?;
             Ok(display::svg::lines_svg(
                 &drawing.segments_2d(),
                 width,

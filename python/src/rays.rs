@@ -54,7 +54,6 @@ pub(crate) fn array_of_rays<const K: usize>(rays: &RaySet<K>) -> Array2<i64> {
 pub(crate) fn tree_rays<const K: usize>(tree: &KTree<K>) -> Result<RaySet<K>, Failure> {
     let leaves: Vec<_> = tree
         .leaves()
-        .into_iter()
         .filter(|(_, s)| *s == NodeState::Full)
         .map(|(c, _)| c)
         .collect();
@@ -76,7 +75,7 @@ pub(crate) fn tree_rays<const K: usize>(tree: &KTree<K>) -> Result<RaySet<K>, Fa
         // Every column of the cell: an odometer over the first K − 1 axes.
         let mut offset = [0u64; K];
         loop {
-            let mut start = cell.origin;
+            let mut start = cell.origin();
             for a in 0..K - 1 {
                 start[a] += offset[a] as u32;
             }

@@ -7,6 +7,7 @@
 
 mod build;
 mod display;
+mod interop;
 mod measure;
 mod ops;
 mod scale;
@@ -43,8 +44,9 @@ fn main() -> ExitCode {
             "ops" => ops::report(),
             "display" => display::report(),
             "scale" => scale::report(),
+            "interop" => interop::report(),
             other => Err(format!(
-                "unknown area '{other}' (known: build, solids, ops, display, scale)"
+                "unknown area '{other}' (known: build, solids, ops, display, scale, interop)"
             )),
         };
         match result {
