@@ -3,9 +3,11 @@
 //! stopping as soon as a requested tolerance is met.
 //!
 //! The object is the union of its full voxels as unit cubes (density 1, voxel units, origin at the
-//! universe's corner). Sums are exact integers (`u128`): for a cell of side `s` at `o`, `∫x = s(2o+s)/2`,
+//! universe's corner). Sums are exact integers (`i128`): for a cell of side `s` at `o`, `∫x = s(2o+s)/2`,
 //! `∫x² = (3o²s + 3os² + s³)/3` along one axis; they are scaled by 2, 3 and 4 to stay integral and turned
-//! into `f64` only at the end.
+//! into `f64` only at the end. The second moments are summed about a corner of one of the object's own
+//! voxels, so that a small object far from the origin keeps its central moments exact to `f64` precision
+//! (summed about the origin, they would cancel).
 
 use crate::space::Cell;
 use crate::tree::{KTree, NodeState};
@@ -35,19 +37,26 @@ impl<const K: usize> MassProperties<K> {
     }
 }
 
-/// Exact integer moment sums of a set of cells.
+/// Exact integer moment sums of a set of cells, in coordinates relative to a reference point.
 #[derive(Debug, Clone, Copy)]
 struct Sums<const K: usize> {
+    /// The point the moments are taken about.
+    reference: [u32; K],
     volume: u128,
-    /// `2 ∫ x_a`.
-    first2: [u128; K],
-    /// `3 ∫ x_a²` on the diagonal, `4 ∫ x_a x_b` off it.
-    second: [[u128; K]; K],
+    /// `2 ∫ (x_a − r_a)`.
+    first2: [i128; K],
+    /// `3 ∫ (x_a − r_a)²` on the diagonal, `4 ∫ (x_a − r_a)(x_b − r_b)` off it.
+    second: [[i128; K]; K],
 }
 
 impl<const K: usize> Sums<K> {
     fn new() -> Self {
+        Self::about([0; K])
+    }
+
+    fn about(reference: [u32; K]) -> Self {
         Self {
+            reference,
             volume: 0,
             first2: [0; K],
             second: [[0; K]; K],
@@ -55,14 +64,16 @@ impl<const K: usize> Sums<K> {
     }
 
     fn add(&mut self, cell: &Cell<K>) {
-        let s = u128::from(cell.side());
+        let s = i128::from(cell.side());
         let v = cell.volume();
         self.volume += v;
-        let face = v / s; // s^(K−1)
-        let lin: [u128; K] = cell.origin.map(|o| s * (2 * u128::from(o) + s)); // 2 ∫ x over one axis
+        let face = v as i128 / s; // s^(K−1)
+        let origin: [i128; K] =
+            std::array::from_fn(|a| i128::from(cell.origin[a]) - i128::from(self.reference[a]));
+        let lin: [i128; K] = origin.map(|o| s * (2 * o + s)); // 2 ∫ x over one axis
         for a in 0..K {
             self.first2[a] += face * lin[a];
-            let o = u128::from(cell.origin[a]);
+            let o = origin[a];
             self.second[a][a] += face * (3 * o * o * s + 3 * o * s * s + s * s * s);
             for b in a + 1..K {
                 let m = face / s * lin[a] * lin[b]; // s^(K−2) · (2∫x_a)(2∫x_b)
@@ -72,8 +83,9 @@ impl<const K: usize> Sums<K> {
         }
     }
 
+    /// `∫ x_a` about the origin.
     fn first_moment(&self, a: usize) -> f64 {
-        self.first2[a] as f64 / 2.0
+        f64::from(self.reference[a]) * self.volume as f64 + self.first2[a] as f64 / 2.0
     }
 }
 
@@ -87,7 +99,12 @@ impl<const K: usize> Sums<K> {
 /// assert_eq!(m.centroid, [1.0, 0.5]);
 /// ```
 pub fn mass_properties<const K: usize>(tree: &KTree<K>) -> MassProperties<K> {
-    let mut sums = Sums::<K>::new();
+    // Moments about the corner of the first full voxel keep a small object far from the origin exact.
+    let reference = tree
+        .leaves()
+        .find(|(_, state)| *state == NodeState::Full)
+        .map_or([0; K], |(cell, _)| cell.origin);
+    let mut sums = Sums::<K>::about(reference);
     tree.for_each_leaf(|cell, state| {
         if state == NodeState::Full {
             sums.add(&cell);
@@ -95,6 +112,8 @@ pub fn mass_properties<const K: usize>(tree: &KTree<K>) -> MassProperties<K> {
     });
     let v = sums.volume as f64;
     let centroid: [f64; K] = std::array::from_fn(|a| sums.first_moment(a) / v);
+    // The centroid relative to the reference point.
+    let relative: [f64; K] = std::array::from_fn(|a| sums.first2[a] as f64 / (2.0 * v));
     let central_moments = std::array::from_fn(|a| {
         std::array::from_fn(|b| {
             let raw = if a == b {
@@ -102,7 +121,7 @@ pub fn mass_properties<const K: usize>(tree: &KTree<K>) -> MassProperties<K> {
             } else {
                 sums.second[a][b] as f64 / 4.0
             };
-            raw - v * centroid[a] * centroid[b]
+            raw - v * relative[a] * relative[b]
         })
     });
     MassProperties {

@@ -287,6 +287,15 @@ fn check_mass<const K: usize>(a: &Boxes<K>) -> Result<(), TestCaseError> {
             m.centroid[axis],
             expect
         );
+        // Every voxel contributes at least its own 1/12 about its centre, whatever the object's shape.
+        let least = volume as f64 / 12.0;
+        prop_assert!(
+            m.central_moments[axis][axis] >= least * (1.0 - 1e-9),
+            "central moment axis {}: {} < {}",
+            axis,
+            m.central_moments[axis][axis],
+            least
+        );
     }
     Ok(())
 }

@@ -66,3 +66,29 @@ fn ball_with_extreme_centre_and_radius_matches_the_definition() {
         }
     }
 }
+
+/// A small box far from the origin in a level-31 quadtree: its central second moments are the box's own,
+/// `V·w²/12` per axis (they used to cancel to a negative number when summed about the origin).
+#[test]
+fn central_moments_of_a_small_far_box_are_exact() {
+    let (lo, hi) = ([6_030_483u32, 499_419_628], [6_030_496u32, 499_419_638]);
+    let rays = ktree::RaySet::<2>::from_rays(
+        31,
+        (lo[0]..hi[0]).map(|x| ktree::Ray::new([x, lo[1]], hi[1])),
+    )
+    .unwrap();
+    let m = ktree::ops::mass_properties(&ktree::stacking::stack(&rays));
+    let v = m.volume as f64;
+    for axis in 0..2 {
+        let w = f64::from(hi[axis] - lo[axis]);
+        let want = v * w * w / 12.0;
+        let got = m.central_moments[axis][axis];
+        assert!(
+            (got - want).abs() <= 1e-6 * want,
+            "axis {axis}: {got} vs {want}"
+        );
+        let centre = f64::from(lo[axis]) + w / 2.0;
+        assert!((m.centroid[axis] - centre).abs() < 1e-6);
+    }
+    assert!(m.central_moments[0][1].abs() <= 1e-6 * v);
+}
