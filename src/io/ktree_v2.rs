@@ -927,16 +927,7 @@ impl KtreeView {
 
     /// Total node counts (`level` holds the universe level), as [`KTree::counts`].
     pub fn counts(&self) -> LevelCounts {
-        let mut total = LevelCounts {
-            level: self.level(),
-            ..Default::default()
-        };
-        for c in self.counts_per_level() {
-            total.full += c.full;
-            total.empty += c.empty;
-            total.partial += c.partial;
-        }
-        total
+        LevelCounts::total(self.level(), &self.counts_per_level())
     }
 
     /// The total number of nodes.

@@ -20,6 +20,22 @@ pub struct LevelCounts {
 }
 
 impl LevelCounts {
+    /// The sum of per-level counts, labelled with the universe level `level`.
+    pub fn total(level: u32, per_level: &[LevelCounts]) -> LevelCounts {
+        per_level.iter().fold(
+            LevelCounts {
+                level,
+                ..Default::default()
+            },
+            |t, c| LevelCounts {
+                level,
+                full: t.full + c.full,
+                empty: t.empty + c.empty,
+                partial: t.partial + c.partial,
+            },
+        )
+    }
+
     /// All nodes.
     pub fn nodes(&self) -> u64 {
         self.full + self.empty + self.partial
@@ -225,16 +241,7 @@ impl<const K: usize> KTree<K> {
 
     /// Total node counts over all levels (`level` holds the universe level).
     pub fn counts(&self) -> LevelCounts {
-        let mut total = LevelCounts {
-            level: self.level(),
-            ..Default::default()
-        };
-        for c in self.counts_per_level() {
-            total.full += c.full;
-            total.empty += c.empty;
-            total.partial += c.partial;
-        }
-        total
+        LevelCounts::total(self.level(), &self.counts_per_level())
     }
 
     /// Bytes needed at Meagher's 2 bits a node.
