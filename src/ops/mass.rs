@@ -5,11 +5,12 @@
 //! The object is the union of its full voxels as unit cubes (density 1, voxel units, origin at the
 //! universe's corner). Sums are exact integers (`i128`): for a cell of side `s` at `o`, `∫x = s(2o+s)/2`,
 //! `∫x² = (3o²s + 3os² + s³)/3` along one axis; they are scaled by 2, 3 and 4 to stay integral and turned
-//! into `f64` only at the end. The second moments are summed about a corner of one of the object's own
-//! voxels, so that a small object far from the origin keeps its central moments exact to `f64` precision
-//! (summed about the origin, they would cancel).
+//! into `f64` only at the end. One pass over the leaves sums, per depth, the count of full leaves, their
+//! origins and their origins' products (additions and 64-bit products only); the moments of each depth's
+//! cells follow from those sums. The second moments are taken about the voxel holding the centroid, so
+//! that a small object far from the origin keeps its central moments exact to `f64` precision (summed
+//! about the origin, they would cancel).
 
-use crate::space::Cell;
 use crate::tree::{KTree, NodeState};
 
 /// Exact volume, centroid and second moments of an object.
@@ -37,11 +38,47 @@ impl<const K: usize> MassProperties<K> {
     }
 }
 
+/// Sums over cells of one size, in the voxel coordinates of their origins: the count, `Σ o_a` and
+/// `Σ o_a·o_b`. Exact: a coordinate is below 2^31, so a product fits a `u64`, and the sums over all cells of
+/// one depth stay below 2^124 within the universe limits.
+#[derive(Debug, Clone, Copy)]
+struct SizeSums<const K: usize> {
+    count: u64,
+    origins: [u128; K],
+    /// `products[a][b]` for `a ≤ b`.
+    products: [[u128; K]; K],
+}
+
+impl<const K: usize> SizeSums<K> {
+    fn new() -> Self {
+        Self {
+            count: 0,
+            origins: [0; K],
+            products: [[0; K]; K],
+        }
+    }
+
+    #[inline]
+    fn add(&mut self, origin: [u32; K]) {
+        self.count += 1;
+        for a in 0..K {
+            let oa = u64::from(origin[a]);
+            self.origins[a] += u128::from(oa);
+            for b in a..K {
+                self.products[a][b] += u128::from(oa * u64::from(origin[b]));
+            }
+        }
+    }
+}
+
 /// Exact integer moment sums of a set of cells, in coordinates relative to a reference point.
+///
+/// The sums are computed in wrapping `i128` arithmetic: every final sum is an integral over the object that
+/// fits an `i128` (at most `4·U^(K+2) ≤ 2^126`), so wrapping intermediate steps cancel out exactly.
 #[derive(Debug, Clone, Copy)]
 struct Sums<const K: usize> {
     /// The point the moments are taken about.
-    reference: [u32; K],
+    reference: [i128; K],
     volume: u128,
     /// `2 ∫ (x_a − r_a)`.
     first2: [i128; K],
@@ -50,11 +87,7 @@ struct Sums<const K: usize> {
 }
 
 impl<const K: usize> Sums<K> {
-    fn new() -> Self {
-        Self::about([0; K])
-    }
-
-    fn about(reference: [u32; K]) -> Self {
+    fn about(reference: [i128; K]) -> Self {
         Self {
             reference,
             volume: 0,
@@ -63,33 +96,60 @@ impl<const K: usize> Sums<K> {
         }
     }
 
-    fn add(&mut self, cell: &Cell<K>) {
-        let s = i128::from(cell.side());
-        let v = cell.volume();
-        self.volume += v;
-        let face = v as i128 / s; // s^(K−1)
-        let origin: [i128; K] =
-            std::array::from_fn(|a| i128::from(cell.origin[a]) - i128::from(self.reference[a]));
-        let lin: [i128; K] = origin.map(|o| s * (2 * o + s)); // 2 ∫ x over one axis
+    /// Adds cells of side `2^log_side` summed in `cells`. For one cell of side `s` at `o` (relative to the
+    /// reference), along one axis `2∫x = s(2o + s)` and `3∫x² = 3o²s + 3os² + s³`, times `s^(K−1)`.
+    fn add(&mut self, log_side: u32, cells: &SizeSums<K>) {
+        if cells.count == 0 {
+            return;
+        }
+        let n = i128::from(cells.count);
+        let s = 1i128 << log_side;
+        let volume = 1i128 << (log_side as usize * K); // s^K
+        self.volume += (volume as u128) * cells.count as u128;
+        let r = self.reference;
+        // Σ (o_a − r_a), and Σ (o_a − r_a)(o_b − r_b).
+        let sum: [i128; K] =
+            std::array::from_fn(|a| (cells.origins[a] as i128).wrapping_sub(n.wrapping_mul(r[a])));
+        let product = |a: usize, b: usize| -> i128 {
+            let (lo, hi) = (a.min(b), a.max(b));
+            (cells.products[lo][hi] as i128)
+                .wrapping_sub(r[b].wrapping_mul(cells.origins[a] as i128))
+                .wrapping_sub(r[a].wrapping_mul(cells.origins[b] as i128))
+                .wrapping_add(n.wrapping_mul(r[a]).wrapping_mul(r[b]))
+        };
+        let ns2 = n.wrapping_mul(s * s);
         for a in 0..K {
-            self.first2[a] += face * lin[a];
-            let o = origin[a];
-            self.second[a][a] += face * (3 * o * o * s + 3 * o * s * s + s * s * s);
+            let first = sum[a].wrapping_mul(2).wrapping_add(n.wrapping_mul(s));
+            self.first2[a] = self.first2[a].wrapping_add(volume.wrapping_mul(first));
+            let diagonal = product(a, a)
+                .wrapping_mul(3)
+                .wrapping_add(sum[a].wrapping_mul(3 * s))
+                .wrapping_add(ns2);
+            self.second[a][a] = self.second[a][a].wrapping_add(volume.wrapping_mul(diagonal));
             for b in a + 1..K {
-                let m = face / s * lin[a] * lin[b]; // s^(K−2) · (2∫x_a)(2∫x_b)
-                self.second[a][b] += m;
-                self.second[b][a] += m;
+                let off = product(a, b)
+                    .wrapping_mul(4)
+                    .wrapping_add(sum[a].wrapping_mul(2 * s))
+                    .wrapping_add(sum[b].wrapping_mul(2 * s))
+                    .wrapping_add(ns2);
+                let m = volume.wrapping_mul(off);
+                self.second[a][b] = self.second[a][b].wrapping_add(m);
+                self.second[b][a] = self.second[b][a].wrapping_add(m);
             }
         }
     }
 
     /// `∫ x_a` about the origin.
     fn first_moment(&self, a: usize) -> f64 {
-        f64::from(self.reference[a]) * self.volume as f64 + self.first2[a] as f64 / 2.0
+        self.reference[a] as f64 * self.volume as f64 + self.first2[a] as f64 / 2.0
     }
 }
 
 /// Volume, centroid and central second moments, exactly from the full leaves (cost linear in the nodes).
+///
+/// The full leaves are summed per depth in one pass; the second moments are then taken about the voxel
+/// holding the centroid, so that a small object far from the origin keeps its central moments exact to
+/// `f64` precision (summed about the origin, they would cancel).
 ///
 /// ```
 /// use ktree::{KTree, ops::mass_properties};
@@ -99,17 +159,30 @@ impl<const K: usize> Sums<K> {
 /// assert_eq!(m.centroid, [1.0, 0.5]);
 /// ```
 pub fn mass_properties<const K: usize>(tree: &KTree<K>) -> MassProperties<K> {
-    // Moments about the corner of the first full voxel keep a small object far from the origin exact.
-    let reference = tree
-        .leaves()
-        .find(|(_, state)| *state == NodeState::Full)
-        .map_or([0; K], |(cell, _)| cell.origin);
-    let mut sums = Sums::<K>::about(reference);
+    let mut per_depth = vec![SizeSums::<K>::new(); tree.depth_count()];
     tree.for_each_leaf(|cell, state| {
         if state == NodeState::Full {
-            sums.add(&cell);
+            per_depth[cell.level as usize].add(cell.origin);
         }
     });
+    let level = tree.level();
+    let sum_about = |reference: [i128; K]| {
+        let mut sums = Sums::<K>::about(reference);
+        for (depth, cells) in per_depth.iter().enumerate() {
+            sums.add(level - depth as u32, cells);
+        }
+        sums
+    };
+    // First about the origin, for the centroid; then about the voxel holding the centroid.
+    let rough = sum_about([0; K]);
+    let reference: [i128; K] = std::array::from_fn(|a| {
+        if rough.volume == 0 {
+            0
+        } else {
+            (rough.first2[a] as u128 / (2 * rough.volume)) as i128
+        }
+    });
+    let sums = sum_about(reference);
     let v = sums.volume as f64;
     let centroid: [f64; K] = std::array::from_fn(|a| sums.first_moment(a) / v);
     // The centroid relative to the reference point.
@@ -176,25 +249,31 @@ pub struct ProgressiveMass<const K: usize> {
 /// assert!(p.levels.last().unwrap().nodes_touched < p.total_nodes);
 /// ```
 pub fn mass_progressive<const K: usize>(tree: &KTree<K>, tolerance: f64) -> ProgressiveMass<K> {
-    let mut full = Sums::<K>::new();
-    let mut frontier = vec![(0usize, tree.universe().root())];
+    let level = tree.level();
+    let mut full = Sums::<K>::about([0; K]);
+    // The partial nodes of the current depth, in index order: the `j`-th one's children are `j·2^K ..`.
+    let mut frontier = vec![tree.universe().root()];
     let mut touched = 1u64;
     let mut levels = Vec::new();
     let mut depth = 0usize;
     // The root itself.
     match tree.root_state() {
         NodeState::Full => {
-            full.add(&tree.universe().root());
+            let mut root = SizeSums::new();
+            root.add([0; K]);
+            full.add(level, &root);
             frontier.clear();
         }
         NodeState::Empty => frontier.clear(),
         NodeState::Partial => {}
     }
     loop {
-        let mut partial = Sums::<K>::new();
-        for (_, cell) in &frontier {
-            partial.add(cell);
+        let mut frontier_cells = SizeSums::new();
+        for cell in &frontier {
+            frontier_cells.add(cell.origin);
         }
+        let mut partial = Sums::<K>::about([0; K]);
+        partial.add(level - depth as u32, &frontier_cells);
         let (lower, upper) = (full.volume, full.volume + partial.volume);
         let centroid_bounds = std::array::from_fn(|a| {
             if lower == 0 {
@@ -224,18 +303,20 @@ pub fn mass_progressive<const K: usize>(tree: &KTree<K>, tolerance: f64) -> Prog
             };
         }
         let mut next = Vec::with_capacity(frontier.len() << K);
-        for &(index, cell) in &frontier {
-            let first = tree.first_child(depth, index);
+        let mut full_children = SizeSums::new();
+        for (j, cell) in frontier.iter().enumerate() {
+            let first = j << K;
             for c in 0..1usize << K {
                 touched += 1;
                 let child = cell.child(c);
                 match tree.state(depth + 1, first + c) {
-                    NodeState::Full => full.add(&child),
-                    NodeState::Partial => next.push((first + c, child)),
+                    NodeState::Full => full_children.add(child.origin),
+                    NodeState::Partial => next.push(child),
                     NodeState::Empty => {}
                 }
             }
         }
+        full.add(level - depth as u32 - 1, &full_children);
         frontier = next;
         depth += 1;
     }

@@ -320,6 +320,7 @@ impl<const K: usize> KTree<K> {
         Leaves {
             tree: self,
             stack: vec![(self.universe.root(), 0)],
+            next_first: vec![0; self.depth_count()],
         }
     }
 
@@ -396,6 +397,9 @@ pub struct Leaves<'a, const K: usize> {
     tree: &'a KTree<K>,
     /// Nodes still to visit (cell and index in its level), the next on top.
     stack: Vec<(Cell<K>, usize)>,
+    /// Per depth, the first child of the next partial node met there. A depth-first walk meets the partial
+    /// nodes of each depth in index order, so their children blocks follow one another: no rank lookup.
+    next_first: Vec<usize>,
 }
 
 impl<const K: usize> Iterator for Leaves<'_, K> {
@@ -406,7 +410,9 @@ impl<const K: usize> Iterator for Leaves<'_, K> {
             let depth = cell.level as usize;
             match self.tree.levels[depth].get(index) {
                 NodeState::Partial => {
-                    let first = self.tree.first_child(depth, index);
+                    let first = self.next_first[depth];
+                    debug_assert_eq!(first, self.tree.first_child(depth, index));
+                    self.next_first[depth] += KTree::<K>::FANOUT;
                     for code in (0..KTree::<K>::FANOUT).rev() {
                         self.stack.push((cell.child(code), first + code));
                     }

@@ -47,7 +47,7 @@ const LOW_BITS: u64 = 0x5555_5555_5555_5555;
 /// The rank index holds a 64-bit count every 65 536 nodes and a 16-bit count (relative to that) every 256
 /// nodes: 2 + 16/256 + 64/65 536 ≈ 2.064 bits a node in all. Measured with the per-level bookkeeping: 2.070
 /// bits a node for an octree of 1.9 million nodes, 2.065 for 7.5 million (`results/performance/build.md`).
-/// A rank reads the two counts and at most eight words, counted in parallel.
+/// A rank reads two counts and at most four words besides the node's own, counting from the nearer end of its block.
 ///
 /// Levels are built inside the crate; outside it, [`PackedStates::from_words`] checks raw words and
 /// [`crate::KTree::from_level_states`] checks a whole tree.
@@ -65,7 +65,7 @@ pub struct PackedStates {
 }
 
 /// Mask with the low bit of each 2-bit slot set where the slot holds `Partial` (`10`).
-#[inline]
+#[inline(always)]
 fn partial_mask(word: u64) -> u64 {
     (word >> 1) & !word & LOW_BITS
 }
@@ -79,7 +79,7 @@ fn full_mask(word: u64) -> u64 {
 /// Partial nodes in at most 7 words, counted in parallel: each word's partial slots are summed into 4-bit
 /// fields (at most 2 a word per field, so 14 at most), then the fields' bytes are added by one multiply.
 /// Faster than a population count per word on targets without a population count instruction.
-#[inline]
+#[inline(always)]
 fn partials_in_few(words: &[u64]) -> u64 {
     const NIBBLE_PAIRS: u64 = 0x3333_3333_3333_3333;
     const NIBBLES: u64 = 0x0F0F_0F0F_0F0F_0F0F;
@@ -223,20 +223,34 @@ impl PackedStates {
     }
 
     /// The number of partial nodes before node `i` (`i ≤ len`).
-    #[inline]
+    ///
+    /// Counts from the nearer end of the node's block: at most four words besides the node's own.
+    #[inline(always)]
     pub fn partial_rank(&self, i: usize) -> usize {
         let word = i / NODES_PER_WORD;
         let block = word / WORDS_PER_BLOCK;
         let from = block * WORDS_PER_BLOCK;
-        let mut rank = self.super_rank[block / BLOCKS_PER_SUPER]
-            + u64::from(self.block_rank[block])
-            + partials_in_few(&self.words[from..word]);
-        let slot = i % NODES_PER_WORD;
-        if slot > 0 {
-            let below = (1u64 << (2 * slot)) - 1;
-            rank += u64::from((partial_mask(self.words[word]) & below).count_ones());
-        }
+        let to = from + WORDS_PER_BLOCK;
+        let below = (1u64 << (2 * (i % NODES_PER_WORD))) - 1;
+        let rank = if word - from < WORDS_PER_BLOCK / 2 || to > self.words.len() {
+            let mut rank = self.block_start(block) + partials_in_few(&self.words[from..word]);
+            if below != 0 {
+                rank += u64::from((partial_mask(self.words[word]) & below).count_ones());
+            }
+            rank
+        } else {
+            // The block is complete: its end's rank less the partial nodes from `i` to that end.
+            self.block_start(block + 1)
+                - partials_in_few(&self.words[word + 1..to])
+                - u64::from((partial_mask(self.words[word]) & !below).count_ones())
+        };
         rank as usize
+    }
+
+    /// The partial nodes in the words before block `block`.
+    #[inline(always)]
+    fn block_start(&self, block: usize) -> u64 {
+        self.super_rank[block / BLOCKS_PER_SUPER] + u64::from(self.block_rank[block])
     }
 
     /// The number of partial nodes in the level.
