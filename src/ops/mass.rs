@@ -64,8 +64,8 @@ impl<const K: usize> SizeSums<K> {
         for a in 0..K {
             let oa = u64::from(origin[a]);
             self.origins[a] += u128::from(oa);
-            for b in a..K {
-                self.products[a][b] += u128::from(oa * u64::from(origin[b]));
+            for (product, &ob) in self.products[a].iter_mut().zip(&origin).skip(a) {
+                *product += u128::from(oa * u64::from(ob));
             }
         }
     }
