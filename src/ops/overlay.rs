@@ -33,7 +33,7 @@
 
 use super::emit::{collapse, leaf, LevelWriter};
 use crate::space::Cell;
-use crate::tree::cursor::locate;
+use crate::tree::cursor::voxel_state;
 use crate::tree::{KTree, NodeRef, NodeState};
 
 /// How target voxels map back into the source universe.
@@ -159,12 +159,7 @@ impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
             cell: e.cell,
             state: self.src.state(e.depth, e.index),
         };
-        let voxel = Cell {
-            origin: p,
-            level: self.src.level(),
-            log_side: 0,
-        };
-        locate(self.src, start, &voxel).state == NodeState::Full
+        voxel_state(self.src, &start, p) == NodeState::Full
     }
 
     /// Decides target cell `cell` given its parent's overlay `parent` (a range of `self.overlay`).

@@ -326,22 +326,28 @@ pub fn walk_pair<const K: usize, V: PairVisitor<K>>(
     visit_pair(a, b, &root, visitor)
 }
 
-/// The side of child `code`: the real child of a partial node, or the same leaf standing in.
+/// The side of child `code`: the real child of a partial node (whose children's codes are `codes`, the
+/// first at index `first`), or the same leaf standing in.
 #[inline(always)]
-fn child_side<const K: usize>(
-    tree: &KTree<K>,
-    side: &Side,
-    depth: usize,
-    first: usize,
-    code: usize,
-) -> Side {
+fn child_side(side: &Side, first: usize, codes: u32, code: usize) -> Side {
     if side.state == NodeState::Partial {
         Side {
             index: first + code,
-            state: tree.state(depth, first + code),
+            state: NodeState::from_bits(codes >> (2 * code)),
         }
     } else {
         *side
+    }
+}
+
+/// The first child of `side` and its children's codes (zeros for a leaf).
+#[inline(always)]
+fn children_of<const K: usize>(tree: &KTree<K>, side: &Side, depth: usize) -> (usize, u32) {
+    if side.state == NodeState::Partial {
+        let first = tree.first_child(depth, side.index);
+        (first, tree.level_states(depth + 1).block_codes(first, K))
+    } else {
+        (0, 0)
     }
 }
 
@@ -372,24 +378,16 @@ fn descend_pair<const K: usize, V: PairVisitor<K>>(
     v: &mut V,
 ) -> bool {
     let depth = pair.cell.level as usize;
-    let fa = if pair.a.state == NodeState::Partial {
-        a.first_child(depth, pair.a.index)
-    } else {
-        0
-    };
-    let fb = if pair.b.state == NodeState::Partial {
-        b.first_child(depth, pair.b.index)
-    } else {
-        0
-    };
+    let (fa, codes_a) = children_of(a, &pair.a, depth);
+    let (fb, codes_b) = children_of(b, &pair.b, depth);
     let order = v.child_order(pair);
     for j in 0..order.len() {
         let code = order.code(j);
         let child = PairNode {
             cell: step(&pair.cell, code, V::ORIGINS),
             code,
-            a: child_side(a, &pair.a, depth + 1, fa, code),
-            b: child_side(b, &pair.b, depth + 1, fb, code),
+            a: child_side(&pair.a, fa, codes_a, code),
+            b: child_side(&pair.b, fb, codes_b, code),
         };
         if visit_pair(a, b, &child, v) {
             return true;
@@ -426,6 +424,7 @@ pub fn child<const K: usize>(tree: &KTree<K>, node: &NodeRef<K>, code: usize) ->
 /// let node = locate(&tree, tree.root(), &voxel);
 /// assert_eq!((node.state, node.cell.side()), (NodeState::Full, 2));
 /// ```
+#[inline]
 pub fn locate<const K: usize>(tree: &KTree<K>, start: NodeRef<K>, target: &Cell<K>) -> NodeRef<K> {
     debug_assert!(start.cell.level <= target.level);
     let bit_top = tree.level().saturating_sub(1);
@@ -443,6 +442,36 @@ pub fn locate<const K: usize>(tree: &KTree<K>, start: NodeRef<K>, target: &Cell<
     let low = ((1u64 << node.cell.log_side) - 1) as u32;
     node.cell.origin = target.origin.map(|o| o & !low);
     node
+}
+
+/// The state of the voxel `point` (inside `start`'s cell): [`locate`] for one voxel when only its state is
+/// wanted, descending from `start` without tracking cells.
+///
+/// ```
+/// use ktree::tree::cursor::voxel_state;
+/// use ktree::{KTree, NodeState};
+/// let tree = KTree::<1>::from_dense(2, &[false, true, true, true]).unwrap();
+/// assert_eq!(voxel_state(&tree, &tree.root(), [0]), NodeState::Empty);
+/// assert_eq!(voxel_state(&tree, &tree.root(), [3]), NodeState::Full);
+/// ```
+#[inline(always)]
+pub fn voxel_state<const K: usize>(
+    tree: &KTree<K>,
+    start: &NodeRef<K>,
+    point: [u32; K],
+) -> NodeState {
+    let (mut depth, mut index) = (start.cell.level as usize, start.index);
+    let (mut state, mut log_side) = (start.state, start.cell.log_side);
+    while state == NodeState::Partial {
+        log_side -= 1;
+        let code = (0..K).fold(0, |code, a| {
+            code | ((point[a] >> log_side & 1) as usize) << a
+        });
+        index = tree.first_child(depth, index) + code;
+        depth += 1;
+        state = tree.state(depth, index);
+    }
+    state
 }
 
 /// The ranges of node indices, level by level from `depth + 1` down, that hold the descendants of the

@@ -293,12 +293,7 @@ impl<const K: usize> KTree<K> {
         if self.universe.check_point(point).is_err() {
             return false;
         }
-        let voxel = Cell {
-            origin: point,
-            level: self.level(),
-            log_side: 0,
-        };
-        super::cursor::locate(self, self.root(), &voxel).state == NodeState::Full
+        super::cursor::voxel_state(self, &self.root(), point) == NodeState::Full
     }
 
     /// Visits every leaf (empty and full) in Morton (depth-first) order: [`KTree::leaves`] as a callback.

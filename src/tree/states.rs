@@ -25,6 +25,17 @@ impl NodeState {
         }
     }
 
+    /// The state of the low two bits of `bits`, reading the unused code `11` as partial (levels never
+    /// hold it: they are checked when built).
+    #[inline(always)]
+    pub(crate) fn from_bits(bits: u32) -> Self {
+        match bits & 3 {
+            0 => Self::Empty,
+            1 => Self::Full,
+            _ => Self::Partial,
+        }
+    }
+
     /// Whether the node is a leaf (empty or full).
     pub fn is_leaf(self) -> bool {
         self != Self::Partial
@@ -76,19 +87,20 @@ fn full_mask(word: u64) -> u64 {
     word & !(word >> 1) & LOW_BITS
 }
 
-/// Partial nodes in at most 7 words, counted in parallel: each word's partial slots are summed into 4-bit
-/// fields (at most 2 a word per field, so 14 at most), then the fields' bytes are added by one multiply.
-/// Faster than a population count per word on targets without a population count instruction.
+/// Adds the partial slots of `word` into 4-bit fields of `acc` (at most 2 a word per field): up to seven
+/// words can be summed before [`nibble_total`] reads the sum.
 #[inline(always)]
-fn partials_in_few(words: &[u64]) -> u64 {
+fn nibble_add(acc: u64, word: u64) -> u64 {
     const NIBBLE_PAIRS: u64 = 0x3333_3333_3333_3333;
+    let m = partial_mask(word);
+    acc + (m & NIBBLE_PAIRS) + ((m >> 2) & NIBBLE_PAIRS)
+}
+
+/// The sum of the 4-bit fields of `acc`, added bytewise by one multiply. Faster than a population count per
+/// word on targets without a population count instruction.
+#[inline(always)]
+fn nibble_total(acc: u64) -> u64 {
     const NIBBLES: u64 = 0x0F0F_0F0F_0F0F_0F0F;
-    debug_assert!(words.len() < WORDS_PER_BLOCK);
-    let mut acc = 0u64;
-    for &w in words {
-        let m = partial_mask(w);
-        acc += (m & NIBBLE_PAIRS) + ((m >> 2) & NIBBLE_PAIRS);
-    }
     let bytes = (acc & NIBBLES) + ((acc >> 4) & NIBBLES);
     bytes.wrapping_mul(0x0101_0101_0101_0101) >> 56
 }
@@ -214,37 +226,69 @@ impl PackedStates {
     #[inline]
     pub fn get(&self, i: usize) -> NodeState {
         debug_assert!(i < self.len);
-        let code = (self.words[i / NODES_PER_WORD] >> (2 * (i % NODES_PER_WORD))) & 3;
-        match code {
-            0 => NodeState::Empty,
-            1 => NodeState::Full,
-            _ => NodeState::Partial,
-        }
+        NodeState::from_bits((self.words[i / NODES_PER_WORD] >> (2 * (i % NODES_PER_WORD))) as u32)
+    }
+
+    /// The 2-bit codes of the `2^k` nodes from `first` (a multiple of `2^k`, `k ≤ 4`), node `first + c` at
+    /// bits `2c`: a block of children read with one load (it never straddles a word).
+    #[inline(always)]
+    pub(crate) fn block_codes(&self, first: usize, k: usize) -> u32 {
+        debug_assert!(k <= 4 && first % (1 << k) == 0 && first + (1 << k) <= self.len);
+        let codes = self.words[first / NODES_PER_WORD] >> (2 * (first % NODES_PER_WORD));
+        (codes & ((1u64 << (2 << k)) - 1)) as u32
     }
 
     /// The number of partial nodes before node `i` (`i ≤ len`).
     ///
-    /// Counts from the nearer end of the node's block: at most four words besides the node's own.
+    /// Counts from the nearer end of the node's block: four words masked and counted in parallel, without
+    /// branches on the data.
     #[inline(always)]
     pub fn partial_rank(&self, i: usize) -> usize {
         let word = i / NODES_PER_WORD;
         let block = word / WORDS_PER_BLOCK;
         let from = block * WORDS_PER_BLOCK;
-        let to = from + WORDS_PER_BLOCK;
         let below = (1u64 << (2 * (i % NODES_PER_WORD))) - 1;
-        let rank = if word - from < WORDS_PER_BLOCK / 2 || to > self.words.len() {
-            let mut rank = self.block_start(block) + partials_in_few(&self.words[from..word]);
-            if below != 0 {
-                rank += u64::from((partial_mask(self.words[word]) & below).count_ones());
-            }
-            rank
+        let Some(words) = self.words.get(from..from + WORDS_PER_BLOCK) else {
+            return self.rank_in_last_block(i);
+        };
+        // The lower half counts forwards from the block's start, the upper half backwards from its end.
+        let upper = word - from >= WORDS_PER_BLOCK / 2;
+        let half = if upper { WORDS_PER_BLOCK / 2 } else { 0 };
+        let own = if upper { !below } else { below };
+        let mut acc = 0;
+        for (at, &w) in (from + half..).zip(&words[half..half + WORDS_PER_BLOCK / 2]) {
+            let mask = if at == word {
+                own
+            } else if (at < word) != upper {
+                u64::MAX
+            } else {
+                0
+            };
+            acc = nibble_add(acc, w & mask);
+        }
+        let count = nibble_total(acc);
+        let rank = if upper {
+            self.block_start(block + 1) - count
         } else {
-            // The block is complete: its end's rank less the partial nodes from `i` to that end.
-            self.block_start(block + 1)
-                - partials_in_few(&self.words[word + 1..to])
-                - u64::from((partial_mask(self.words[word]) & !below).count_ones())
+            self.block_start(block) + count
         };
         rank as usize
+    }
+
+    /// [`PackedStates::partial_rank`] in the level's last, incomplete block: counted forwards.
+    #[inline(never)]
+    fn rank_in_last_block(&self, i: usize) -> usize {
+        let word = i / NODES_PER_WORD;
+        let block = word / WORDS_PER_BLOCK;
+        let mut acc = 0;
+        for &w in &self.words[block * WORDS_PER_BLOCK..word] {
+            acc = nibble_add(acc, w);
+        }
+        let below = (1u64 << (2 * (i % NODES_PER_WORD))) - 1;
+        if below != 0 {
+            acc = nibble_add(acc, self.words[word] & below);
+        }
+        (self.block_start(block) + nibble_total(acc)) as usize
     }
 
     /// The partial nodes in the words before block `block`.
