@@ -268,8 +268,7 @@ pub fn complement<const K: usize>(a: &KTree<K>) -> KTree<K> {
                     word ^ (!(word >> 1) & LOW & valid)
                 })
                 .collect();
-            crate::tree::PackedStates::from_words(words, n)
-                .expect("complementing keeps every 2-bit code valid")
+            l.with_same_partials(words)
         })
         .collect();
     KTree::from_levels(a.universe(), levels)

@@ -352,7 +352,7 @@ fn children_of<const K: usize>(tree: &KTree<K>, side: &Side, depth: usize) -> (u
 }
 
 /// Visits `pair`; descends into its children if asked to and either side is partial. `true` when stopped.
-#[inline]
+#[inline(always)]
 fn visit_pair<const K: usize, V: PairVisitor<K>>(
     a: &KTree<K>,
     b: &KTree<K>,

@@ -207,6 +207,24 @@ impl PackedStates {
         Ok(s)
     }
 
+    /// A level with the same partial nodes as this one and other leaves (`words`, e.g. the leaves
+    /// complemented): the rank index is copied, not rebuilt.
+    pub(crate) fn with_same_partials(&self, words: Vec<u64>) -> Self {
+        debug_assert!(
+            words.len() == self.words.len()
+                && words.iter().zip(&self.words).all(|(&new, &old)| {
+                    partial_mask(new) == partial_mask(old) && (new >> 1) & new & LOW_BITS == 0
+                })
+        );
+        Self {
+            words,
+            len: self.len,
+            super_rank: self.super_rank.clone(),
+            block_rank: self.block_rank.clone(),
+            partial: self.partial,
+        }
+    }
+
     /// The packed words.
     pub fn words(&self) -> &[u64] {
         &self.words
