@@ -209,7 +209,7 @@ pub fn walk_from<const K: usize, V: Visitor<K>>(
 }
 
 /// Visits `node`; descends into its children if asked to and it has any. `true` when stopped.
-#[inline]
+#[inline(always)]
 fn visit_node<const K: usize, V: Visitor<K>>(
     tree: &KTree<K>,
     node: &NodeRef<K>,
@@ -225,10 +225,17 @@ fn visit_node<const K: usize, V: Visitor<K>>(
 /// Visits the children of the partial node `node` (already visited), then leaves it. `true` when
 /// stopped. Children are visited here, so a leaf or a skipped subtree costs no call.
 fn descend<const K: usize, V: Visitor<K>>(tree: &KTree<K>, node: &NodeRef<K>, v: &mut V) -> bool {
-    let first = tree.first_child(node.cell.level as usize, node.index);
+    let depth = node.cell.level as usize;
+    let first = tree.first_child(depth, node.index);
+    let codes = tree.level_states(depth + 1).block_codes(first, K);
     let order = v.child_order(node);
     for j in 0..order.len() {
-        let child = child_ref(tree, node, first, order.code(j), V::ORIGINS);
+        let code = order.code(j);
+        let child = NodeRef {
+            index: first + code,
+            cell: step(&node.cell, code, V::ORIGINS),
+            state: NodeState::from_bits(codes >> (2 * code)),
+        };
         if visit_node(tree, &child, v) {
             return true;
         }
