@@ -47,19 +47,19 @@ pub fn ball_rays<const K: usize>(
         return RaySet::from_rays(level, []);
     }
     let mut col: Vec<i64> = ranges[..K - 1].iter().map(|r| r.0).collect();
+    // The squared distance from the centre along each column axis, updated as the column moves.
+    let term = |axis: usize, c: i64| (i128::from(2 * c + 1) - i128::from(centre2[axis])).pow(2);
+    let mut terms: Vec<i128> = col.iter().enumerate().map(|(a, &c)| term(a, c)).collect();
     let empty = RaySet::<K>::empty(level)?;
     loop {
-        let used: i128 = col
-            .iter()
-            .zip(centre2.iter())
-            .map(|(&c, &c2)| (i128::from(2 * c + 1) - i128::from(c2)).pow(2))
-            .sum();
+        let used: i128 = terms.iter().sum();
         if used <= r2 {
             let s = isqrt(r2 - used);
             let cz = i128::from(centre2[K - 1]);
-            // |2z + 1 − cz| ≤ s  ⇔  (cz − s − 1)/2 ≤ z ≤ (cz + s − 1)/2 (in i128: no overflow)
-            let z1 = (cz - s).div_euclid(2).max(0);
-            let z2 = (cz + s - 1).div_euclid(2).min(i128::from(side) - 1) + 1;
+            // |2z + 1 − cz| ≤ s  ⇔  (cz − s − 1)/2 ≤ z ≤ (cz + s − 1)/2 (in i128: no overflow; an
+            // arithmetic shift is the floor of a halving)
+            let z1 = ((cz - s) >> 1).max(0);
+            let z2 = ((cz + s - 1) >> 1).min(i128::from(side) - 1) + 1;
             if z1 < z2 {
                 let mut point = [0u32; K];
                 for (p, &c) in point.iter_mut().zip(col.iter()) {
@@ -78,9 +78,11 @@ pub fn ball_rays<const K: usize>(
             axis -= 1;
             col[axis] += 1;
             if col[axis] <= ranges[axis].1 {
+                terms[axis] = term(axis, col[axis]);
                 break;
             }
             col[axis] = ranges[axis].0;
+            terms[axis] = term(axis, col[axis]);
         }
     }
 }
@@ -89,6 +91,9 @@ pub fn ball_rays<const K: usize>(
 pub(crate) fn isqrt(n: i128) -> i128 {
     if n <= 0 {
         return 0;
+    }
+    if let Ok(small) = u64::try_from(n) {
+        return i128::from(isqrt_u64(small));
     }
     let mut s = (n as f64).sqrt() as i128;
     while s * s > n {
@@ -100,9 +105,37 @@ pub(crate) fn isqrt(n: i128) -> i128 {
     s
 }
 
+/// `floor(sqrt(n))` in 64-bit arithmetic.
+fn isqrt_u64(n: u64) -> u64 {
+    let mut s = (n as f64).sqrt() as u64;
+    while s.checked_mul(s).map_or(true, |sq| sq > n) {
+        s -= 1;
+    }
+    while (s + 1).checked_mul(s + 1).is_some_and(|sq| sq <= n) {
+        s += 1;
+    }
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn isqrt_is_the_floor_of_the_square_root_around_squares() {
+        let roots = (0..2000i128)
+            .chain((1i128 << 31) - 3..(1 << 31) + 3)
+            .chain((1i128 << 32) - 3..(1 << 32) + 3);
+        for k in roots.chain((1i128 << 40)..(1 << 40) + 3) {
+            for n in [k * k - 1, k * k, k * k + 1] {
+                let s = isqrt(n);
+                assert!(
+                    n < 0 || (s * s <= n && (s + 1) * (s + 1) > n),
+                    "isqrt({n}) = {s}"
+                );
+            }
+        }
+    }
 
     fn brute<const K: usize>(level: u32, centre2: [i64; K], radius2: i64) -> u128 {
         let u = Universe::<K>::new(level).unwrap();
