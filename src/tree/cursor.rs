@@ -55,14 +55,16 @@ pub enum Walk {
 /// assert_eq!(codes(ChildOrder::one(5)), [5]);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ChildOrder(Codes);
-
-/// The `j`-th code is `mask ^ j` (`j < len`), or read from a table.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Codes {
-    Xor { mask: u8, len: u8 },
-    Table { codes: [u8; 16], len: u8 },
+pub struct ChildOrder {
+    /// Byte `j` is the `j`-th code: read without a branch.
+    codes: u128,
+    len: u8,
 }
+
+/// Byte `j` holds `j`.
+const IDENTITY: u128 = 0x0F0E_0D0C_0B0A_0908_0706_0504_0302_0100;
+/// Every byte holds 1.
+const ONES: u128 = 0x0101_0101_0101_0101_0101_0101_0101_0101;
 
 impl ChildOrder {
     /// All children in child-code (Morton) order.
@@ -75,30 +77,30 @@ impl ChildOrder {
     /// child, back to front with `mask` the far child).
     #[inline]
     pub fn xor<const K: usize>(mask: usize) -> Self {
-        Self(Codes::Xor {
-            mask: mask as u8,
+        Self {
+            codes: IDENTITY ^ (mask as u8 as u128 * ONES),
             len: 1 << K,
-        })
+        }
     }
 
     /// Only child `code`.
     #[inline]
     pub fn one(code: usize) -> Self {
-        Self(Codes::Xor {
-            mask: code as u8,
+        Self {
+            codes: code as u8 as u128,
             len: 1,
-        })
+        }
     }
 
     /// The given child codes, in the order given (at most 16, each below `2^K`).
     pub fn from_codes(list: impl IntoIterator<Item = usize>) -> Self {
-        let mut codes = [0u8; 16];
+        let mut codes = 0u128;
         let mut len = 0u8;
-        for (slot, c) in codes.iter_mut().zip(list) {
-            *slot = c as u8;
+        for c in list.into_iter().take(16) {
+            codes |= (c as u8 as u128) << (8 * len);
             len += 1;
         }
-        Self(Codes::Table { codes, len })
+        Self { codes, len }
     }
 
     /// All children, those in the lower half on `axis` first, each half in code order.
@@ -116,9 +118,7 @@ impl ChildOrder {
     /// The number of children visited.
     #[inline]
     pub fn len(&self) -> usize {
-        match self.0 {
-            Codes::Xor { len, .. } | Codes::Table { len, .. } => usize::from(len),
-        }
+        usize::from(self.len)
     }
 
     /// Whether no child is visited.
@@ -130,10 +130,7 @@ impl ChildOrder {
     /// The `j`-th child code to visit (`j < len`).
     #[inline]
     pub fn code(&self, j: usize) -> usize {
-        match self.0 {
-            Codes::Xor { mask, .. } => usize::from(mask) ^ j,
-            Codes::Table { codes, .. } => usize::from(codes[j]),
-        }
+        (self.codes >> (8 * j) & 0xFF) as usize
     }
 
     /// The child codes, in visiting order.
@@ -203,44 +200,41 @@ pub fn walk<const K: usize, V: Visitor<K>>(tree: &KTree<K>, visitor: &mut V) -> 
 pub fn walk_from<const K: usize, V: Visitor<K>>(
     tree: &KTree<K>,
     node: NodeRef<K>,
-    visitor: &mut V,
-) -> bool {
-    visit_node(tree, &node, visitor)
-}
-
-/// Visits `node`; descends into its children if asked to and it has any. `true` when stopped.
-#[inline(always)]
-fn visit_node<const K: usize, V: Visitor<K>>(
-    tree: &KTree<K>,
-    node: &NodeRef<K>,
     v: &mut V,
 ) -> bool {
-    match v.visit(node) {
-        Walk::Stop => true,
-        Walk::Skip => false,
-        Walk::Descend => node.state == NodeState::Partial && descend(tree, node, v),
-    }
-}
-
-/// Visits the children of the partial node `node` (already visited), then leaves it. `true` when
-/// stopped. Children are visited here, so a leaf or a skipped subtree costs no call.
-fn descend<const K: usize, V: Visitor<K>>(tree: &KTree<K>, node: &NodeRef<K>, v: &mut V) -> bool {
-    let depth = node.cell.level as usize;
-    let first = tree.first_child(depth, node.index);
-    let codes = tree.level_states(depth + 1).block_codes(first, K);
-    let order = v.child_order(node);
-    for j in 0..order.len() {
-        let code = order.code(j);
-        let child = NodeRef {
-            index: first + code,
-            cell: step(&node.cell, code, V::ORIGINS),
-            state: NodeState::from_bits(codes >> (2 * code)),
-        };
-        if visit_node(tree, &child, v) {
-            return true;
+    // Depth first with an explicit stack: a node to visit, or a partial node to leave once the entries
+    // above it (its children's) are done.
+    let mut stack: Vec<(NodeRef<K>, bool)> = Vec::with_capacity(16 * (tree.depth_count() + 1));
+    stack.push((node, false));
+    while let Some((node, leaving)) = stack.pop() {
+        if leaving {
+            v.leave(&node);
+            continue;
+        }
+        match v.visit(&node) {
+            Walk::Stop => return true,
+            Walk::Skip => continue,
+            Walk::Descend if node.state != NodeState::Partial => continue,
+            Walk::Descend => {}
+        }
+        let depth = node.cell.level as usize;
+        let first = tree.first_child(depth, node.index);
+        let codes = tree.level_states(depth + 1).block_codes(first, K);
+        let order = v.child_order(&node);
+        stack.push((node, true));
+        // Pushed last to first: the first child in order is on top.
+        for j in (0..order.len()).rev() {
+            let code = order.code(j);
+            stack.push((
+                NodeRef {
+                    index: first + code,
+                    cell: step(&node.cell, code, V::ORIGINS),
+                    state: NodeState::from_bits(codes >> (2 * code)),
+                },
+                false,
+            ));
         }
     }
-    v.leave(node);
     false
 }
 

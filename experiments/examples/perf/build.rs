@@ -12,11 +12,11 @@ use ktree::{
 
 use crate::measure::{best_of, machine_line, results_path, run_child, Measured};
 
-const LEVELS: [u32; 5] = [6, 7, 8, 9, 10];
+pub const LEVELS: [u32; 5] = [6, 7, 8, 9, 10];
 /// Naive insertion is run up to this level (it is O(voxels · L)).
-const NAIVE_MAX: u32 = 8;
+pub const NAIVE_MAX: u32 = 8;
 /// The dense pyramid needs U^3 bytes and more; run up to this level.
-const DENSE_MAX: u32 = 9;
+pub const DENSE_MAX: u32 = 9;
 
 fn sphere(level: u32) -> RaySet<3> {
     let u = 1i64 << level;

@@ -15,7 +15,16 @@ use crate::measure::{best_of, machine_line, results_path, run_child, Measured};
 
 const RASTER_LEVEL: u32 = 10;
 const RASTER_SIZE: u32 = 1024;
-const LINE_LEVELS: [u32; 3] = [5, 6, 7];
+/// The hidden-surface cases: `raster-KIND` and what it draws.
+pub const RASTER_CASES: [(&str, &str); 3] = [
+    ("ortho", "orthographic, default view"),
+    ("persp", "perspective 40°, default view"),
+    (
+        "painter",
+        "orthographic, back-to-front painter (no culling; 1 run)",
+    ),
+];
+pub const LINE_LEVELS: [u32; 3] = [5, 6, 7];
 
 fn ball(level: u32) -> Octree {
     let u = 1i64 << level;
@@ -118,14 +127,7 @@ pub fn report() -> Result<String, String> {
          |---|---:|---:|---:|---:|---:|---:|---:|"
     );
     let mut ortho_s = 0.0;
-    for (kind, label) in [
-        ("ortho", "orthographic, default view"),
-        ("persp", "perspective 40°, default view"),
-        (
-            "painter",
-            "orthographic, back-to-front painter (no culling; 1 run)",
-        ),
-    ] {
+    for (kind, label) in RASTER_CASES {
         let m: Measured = run_child("display", &format!("raster-{kind}"))?;
         if kind == "ortho" {
             ortho_s = m.seconds;

@@ -3,9 +3,12 @@
 //! `results/performance/AREA.md`. Criterion benches (`cargo bench`) give the statistically careful
 //! timings; this program records the figures the project tracks, regenerated rather than typed.
 //!
-//! Each area is a module with `cases()` (what to measure) and `report()` (the Markdown table).
+//! Each area is a module with `run_case()` (one case, in a child) and `report()` (the Markdown table).
+//! `perf compare BEFORE LABEL [ROUNDS]` times every case against a perf example built from an earlier
+//! commit (see `compare.rs`).
 
 mod build;
+mod compare;
 mod display;
 mod interop;
 mod measure;
@@ -28,6 +31,18 @@ fn main() -> ExitCode {
             "scale" => measure::child(|| scale::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
+                ExitCode::FAILURE
+            }
+        };
+    }
+    if args.first().map(String::as_str) == Some("compare") {
+        return match compare::report(&args[1..]) {
+            Ok(path) => {
+                println!("wrote {path}");
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("perf: {e}");
                 ExitCode::FAILURE
             }
         };

@@ -44,6 +44,12 @@ pub fn child(case: impl FnOnce() -> Result<(f64, Vec<(String, String)>), String>
 /// Parent side: runs `perf --child AREA CASE` and parses its report.
 pub fn run_child(area: &str, case: &str) -> Result<Measured, String> {
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    run_child_of(&exe, area, case)
+}
+
+/// Runs `EXE --child AREA CASE` (this program, or a perf example built from another commit) and parses
+/// its report.
+pub fn run_child_of(exe: &std::path::Path, area: &str, case: &str) -> Result<Measured, String> {
     let out = Command::new(exe)
         .args(["--child", area, case])
         .output()

@@ -182,7 +182,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
     Ok((seconds, facts))
 }
 
-const CASES: &[(&str, u32, &str)] = &[
+pub const CASES: &[(&str, u32, &str)] = &[
     ("union", 10, "two spheres (r = U/2 and 0.45 U, offset)"),
     ("intersect", 10, "same pair"),
     ("diff", 10, "same pair"),

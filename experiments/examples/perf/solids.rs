@@ -141,6 +141,28 @@ pub fn run_case(case: &str) -> Result<(f64, Facts), String> {
     Ok((seconds, facts))
 }
 
+/// The cases: name and what it measures.
+pub const CASES: [(&str, &str); 9] = [
+    (
+        "quadric-ball",
+        "ball of radius U/2 centred, quadric → rays (exact, centre test)",
+    ),
+    (
+        "quadric-ball-normals",
+        "same, with unit normals at run ends",
+    ),
+    (
+        "direct-ball",
+        "same ball by the core's direct generator `rays::ball_rays`",
+    ),
+    ("bunny", "Stanford bunny (npm) mesh → rays"),
+    ("armadillo", "armadillo mesh (52 000 triangles) → rays"),
+    ("skull", "CT skull 64³ volume ≥ 29 000 → rays (L = 6)"),
+    ("csg", "box minus cylinder, difference of two ray sets"),
+    ("e2e-ball", "ball: quadric → rays → tree (stacking)"),
+    ("e2e-bunny", "bunny: mesh → rays → tree (stacking)"),
+];
+
 /// Measures every case in a child process and writes `results/performance/solids.md`.
 pub fn report() -> Result<String, String> {
     let mut md = String::new();
@@ -154,27 +176,8 @@ pub fn report() -> Result<String, String> {
         machine_line()
     );
     let _ = writeln!(md, "| case | what | seconds | rays | voxels | triangles | nodes | peak MiB |\n|---|---|---:|---:|---:|---:|---:|---:|");
-    let cases = [
-        (
-            "quadric-ball",
-            "ball of radius U/2 centred, quadric → rays (exact, centre test)",
-        ),
-        (
-            "quadric-ball-normals",
-            "same, with unit normals at run ends",
-        ),
-        (
-            "direct-ball",
-            "same ball by the core's direct generator `rays::ball_rays`",
-        ),
-        ("bunny", "Stanford bunny (npm) mesh → rays"),
-        ("armadillo", "armadillo mesh (52 000 triangles) → rays"),
-        ("skull", "CT skull 64³ volume ≥ 29 000 → rays (L = 6)"),
-        ("csg", "box minus cylinder, difference of two ray sets"),
-        ("e2e-ball", "ball: quadric → rays → tree (stacking)"),
-        ("e2e-bunny", "bunny: mesh → rays → tree (stacking)"),
-    ];
-    for (case, what) in cases {
+
+    for (case, what) in CASES {
         let m = run_child("solids", case)?;
         let _ = writeln!(
             md,
