@@ -15,6 +15,7 @@
 //! assert_eq!(tree.voxel_count(), ball.voxel_count());
 //! ```
 
+mod bitmap;
 mod distribute;
 mod partition;
 mod pipeline;
@@ -22,6 +23,7 @@ mod radix;
 mod sequential;
 mod stack;
 
+pub use bitmap::{stack_bitmap, MAX_BITMAP_VOXELS};
 pub use distribute::{balanced_slabs, join_parts, slab_rays};
 pub use partition::{
     default_split_depth, join_subtrees, stack_partitioned, stack_source, RaySource, SlabRuns,

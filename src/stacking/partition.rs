@@ -27,7 +27,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::stack;
+use super::stack_bitmap;
 use crate::rays::RaySet;
 use crate::space::{morton_encode, Universe};
 use crate::tree::{KTree, NodeState, PackedStates};
@@ -324,7 +324,7 @@ fn split_block<const K: usize>(
     let universe = Universe::<K>::new(t).expect("a cell's level is a valid level");
     for (&j, part) in mixed.iter().zip(parts) {
         let rays = RaySet::from_sorted_parts(universe, part.keys, part.runs, None);
-        let tree = stack(&rays);
+        let tree = stack_bitmap(&rays);
         cell[K - 1] = j as u32;
         out.push((morton_encode(cell), Piece::Tree(tree)));
     }

@@ -1,11 +1,14 @@
 //! The other ways of running stacking build the tree of the in-memory stacker, K = 1 … 4: with the
 //! dimension-level lists as sequential disk files (same tree, same traffic through every list, never more
-//! than three files open) and as a pipeline of one thread per stage.
+//! than three files open), as a pipeline of one thread per stage, and through a bitmap pyramid (the way
+//! the cells of a partitioned build are stacked).
 
 use ktree_verify::cases;
 
 use cases::{ray_sets, Case};
-use ktree::stacking::{stack, stack_pipelined, stack_with_file_lists, stack_with_stats};
+use ktree::stacking::{
+    stack, stack_bitmap, stack_pipelined, stack_with_file_lists, stack_with_stats,
+};
 use proptest::prelude::*;
 
 fn modes_agree<const K: usize>(case: &Case<K>) -> Result<(), TestCaseError> {
@@ -49,6 +52,10 @@ fn modes_agree<const K: usize>(case: &Case<K>) -> Result<(), TestCaseError> {
         .check()
         .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert!(stack(rays) == tree);
+    prop_assert!(
+        stack_bitmap(rays) == tree,
+        "bitmap pyramid and stacking differ node for node"
+    );
     Ok(())
 }
 
