@@ -92,3 +92,32 @@ fn central_moments_of_a_small_far_box_are_exact() {
     }
     assert!(m.central_moments[0][1].abs() <= 1e-6 * v);
 }
+
+/// `binvox_structured`: `write_binvox` wrote `translate` and `scale` in plain digits, 301 of them for
+/// `1e300`, and its own reader rejects header lines longer than 256 bytes; the numbers now take an exponent
+/// where the digits would be long, and read back exactly.
+#[test]
+fn binvox_with_huge_or_tiny_metadata_reads_back() {
+    use ktree::io::{read_binvox, write_binvox, GridMeta};
+    let tree =
+        ktree::KTree::<3>::from_dense(1, &[true, false, false, true, false, true, true, false])
+            .unwrap();
+    for meta in [
+        GridMeta {
+            voxel_size: 1e-300,
+            origin: [1e300, -1.5e-300, f64::MAX],
+        },
+        GridMeta {
+            voxel_size: 1e300,
+            origin: [-f64::MAX, 5e-324, 0.1],
+        },
+    ] {
+        let mut bytes = Vec::new();
+        write_binvox(&mut bytes, &tree, &meta).unwrap();
+        let back = read_binvox(&bytes, "meta.binvox", None, None).unwrap();
+        assert_eq!(back.tree, tree);
+        assert_eq!(back.meta.origin, meta.origin);
+        assert_eq!(back.meta.voxel_size, meta.voxel_size * 2.0 / 2.0);
+    }
+}
+
