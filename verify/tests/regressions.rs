@@ -121,3 +121,28 @@ fn binvox_with_huge_or_tiny_metadata_reads_back() {
     }
 }
 
+/// `octomap_bt_structured`: a `.bt` file of 90 bytes — a free voxel at key x = 1 and an occupied cube of
+/// side 2^14 — read at the default placement (offset 32767 on x) puts the cube off its alignment, and its
+/// octree would have billions of nodes (the reader ran out of memory). Grid readers now stop at 2^20 +
+/// 2^10 nodes a byte of the file with a placement error; at an aligned offset the file reads.
+#[test]
+fn bt_cube_off_its_alignment_is_a_placement_error_not_unbounded_memory() {
+    use ktree::io::{read_bt, GridFileErrorKind, BT_HEADER};
+    let mut file = format!("{BT_HEADER}\nid OcTree\nsize 18\nres 1\ndata\n").into_bytes();
+    file.extend_from_slice(&[0b11, 0]); // root: child 0 has children
+    file.extend_from_slice(&[0b10_11, 0]); // depth 1: child 0 has children, child 1 (x + 2^14) occupied
+    for _ in 2..15 {
+        file.extend_from_slice(&[0b11, 0]); // depths 2…14: child 0 has children
+    }
+    file.extend_from_slice(&[0b01_00, 0]); // depth 15: voxel child 1 (key x = 1) free
+    for (level, unknown_full) in [(None, false), (Some(21), true)] {
+        let e = read_bt(&file, "cut.bt", None, level, unknown_full).unwrap_err();
+        assert!(
+            matches!(&e.kind, GridFileErrorKind::GridPlacement(m) if m.contains("nodes")),
+            "{e}"
+        );
+    }
+    let aligned = read_bt(&file, "cut.bt", Some([32768; 3]), Some(16), false).unwrap();
+    assert_eq!(aligned.tree.voxel_count(), 1 << 42);
+    assert!(aligned.tree.node_count() < 1000);
+}
