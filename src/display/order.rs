@@ -141,6 +141,8 @@ impl<const K: usize, F> ViewOrder<K, F> {
 }
 
 impl<const K: usize, F: FnMut(&NodeRef<K>) -> Walk> Visitor<K> for ViewOrder<K, F> {
+    const LEAVES: bool = false;
+
     #[inline]
     fn visit(&mut self, node: &NodeRef<K>) -> Walk {
         (self.visit)(node)

@@ -56,15 +56,15 @@ pub enum Walk {
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ChildOrder {
-    /// Byte `j` is the `j`-th code: read without a branch.
-    codes: u128,
+    /// Bits `4j .. 4j + 4` hold the `j`-th code: read without a branch.
+    codes: u64,
     len: u8,
 }
 
-/// Byte `j` holds `j`.
-const IDENTITY: u128 = 0x0F0E_0D0C_0B0A_0908_0706_0504_0302_0100;
-/// Every byte holds 1.
-const ONES: u128 = 0x0101_0101_0101_0101_0101_0101_0101_0101;
+/// Code `j` is `j`.
+const IDENTITY: u64 = 0xFEDC_BA98_7654_3210;
+/// Every code is 1.
+const ONES: u64 = 0x1111_1111_1111_1111;
 
 impl ChildOrder {
     /// All children in child-code (Morton) order.
@@ -78,7 +78,7 @@ impl ChildOrder {
     #[inline]
     pub fn xor<const K: usize>(mask: usize) -> Self {
         Self {
-            codes: IDENTITY ^ (mask as u8 as u128 * ONES),
+            codes: IDENTITY ^ ((mask as u64 & 0xF) * ONES),
             len: 1 << K,
         }
     }
@@ -87,17 +87,17 @@ impl ChildOrder {
     #[inline]
     pub fn one(code: usize) -> Self {
         Self {
-            codes: code as u8 as u128,
+            codes: code as u64 & 0xF,
             len: 1,
         }
     }
 
     /// The given child codes, in the order given (at most 16, each below `2^K`).
     pub fn from_codes(list: impl IntoIterator<Item = usize>) -> Self {
-        let mut codes = 0u128;
+        let mut codes = 0u64;
         let mut len = 0u8;
         for c in list.into_iter().take(16) {
-            codes |= (c as u8 as u128) << (8 * len);
+            codes |= (c as u64 & 0xF) << (4 * len);
             len += 1;
         }
         Self { codes, len }
@@ -130,7 +130,7 @@ impl ChildOrder {
     /// The `j`-th child code to visit (`j < len`).
     #[inline]
     pub fn code(&self, j: usize) -> usize {
-        (self.codes >> (8 * j) & 0xFF) as usize
+        (self.codes >> (4 * j) & 0xF) as usize
     }
 
     /// The child codes, in visiting order.
@@ -144,6 +144,10 @@ pub trait Visitor<const K: usize> {
     /// Whether the walk tracks cell origins. A visitor that never reads `cell.origin` sets this to
     /// `false`; its nodes then carry the right level and size but their parent's origin.
     const ORIGINS: bool = true;
+
+    /// Whether the walk calls [`Visitor::leave`]. A visitor that does not override it may set this to
+    /// `false` and save the walk the bookkeeping.
+    const LEAVES: bool = true;
 
     /// Sees a node; says whether to visit its children, skip them, or stop.
     fn visit(&mut self, node: &NodeRef<K>) -> Walk;
@@ -221,7 +225,9 @@ pub fn walk_from<const K: usize, V: Visitor<K>>(
         let first = tree.first_child(depth, node.index);
         let codes = tree.level_states(depth + 1).block_codes(first, K);
         let order = v.child_order(&node);
-        stack.push((node, true));
+        if V::LEAVES {
+            stack.push((node, true));
+        }
         // Pushed last to first: the first child in order is on top.
         for j in (0..order.len()).rev() {
             let code = order.code(j);
