@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::write_rays_file;
+use ktree::io::{write_atomic_with, write_rays_file, write_rays_source};
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSource};
 use ktree::stacking::{default_split_depth, stack_source};
 use ktree::{LevelCounts, RaySet};
@@ -241,6 +241,35 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
             tree.counts_per_level()
         };
         println!("{}", tree_summary::<K>(&a.out, a.level, &counts));
+        return Ok(());
+    }
+    if crate::distributed::ranks().size == 1 {
+        // A ray file, written slab by slab: one slab's runs held at a time, no cap on their number.
+        let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
+        let bar = crate::render::progress_bar(a.build.progress, "writing slabs");
+        let progress = |done: u64, total: u64| {
+            if let Some(bar) = &bar {
+                bar.set_length(total);
+                bar.set_position(done);
+            }
+        };
+        let mut written = (0, 0);
+        let depth = default_split_depth(K, a.level);
+        write_atomic_with(&a.out, |w| {
+            written = write_rays_source(w, &source, depth, &progress)?;
+            Ok(())
+        })
+        .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+        if let Some(bar) = bar {
+            bar.finish_and_clear();
+        }
+        println!(
+            "{}: K = {K}, L = {}, {} rays, {} voxels",
+            a.out.display(),
+            a.level,
+            written.0,
+            written.1
+        );
         return Ok(());
     }
     let rays = s

@@ -231,6 +231,50 @@ fn rays_and_voxelize_build_out_of_core_with_progress() {
     );
 }
 
+/// `ktree rays` writes a ray file slab by slab: the file is the whole set's, so building it gives the tree
+/// `ktree rays` writes directly; at L = 12 a quadric's ray count passes no cap.
+#[test]
+fn ray_files_are_written_slab_by_slab() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    let solid = [
+        "--solid",
+        "ellipsoid",
+        "--radii",
+        "30,21.5,17",
+        "--level",
+        "6",
+    ];
+    for out in [p("e.rays"), p("e.ktree")] {
+        let mut args = vec!["rays"];
+        args.extend(solid);
+        args.extend(["--out", &out, "--progress"]);
+        let (ok, _, err) = ktree(&args);
+        assert!(ok, "{err}");
+    }
+    let whole = {
+        use ktree::solid::{Frame, Quadric, Rational, Sample, Solid};
+        let r = |n, d| Rational::new(n, d).unwrap();
+        let q =
+            Quadric::<3>::ellipsoid([r(32, 1); 3], [r(30, 1), r(43, 2), r(17, 1)], Frame::Voxel)
+                .unwrap();
+        let mut text = Vec::new();
+        ktree::io::write_rays(
+            &mut text,
+            &Solid::Quadric(q).to_rays(6, Sample::Centre, false).unwrap(),
+        )
+        .unwrap();
+        text
+    };
+    assert_eq!(std::fs::read(p("e.rays")).unwrap(), whole);
+    let (ok, _, err) = ktree(&["build", "--rays", &p("e.rays"), "--out", &p("f.ktree")]);
+    assert!(ok, "{err}");
+    assert_eq!(
+        std::fs::read(p("f.ktree")).unwrap(),
+        std::fs::read(p("e.ktree")).unwrap()
+    );
+}
+
 #[test]
 fn op_checks_its_budget() {
     let dir = tempfile::tempdir().unwrap();
