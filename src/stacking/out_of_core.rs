@@ -16,7 +16,8 @@
 //! # Memory
 //! The budget ([`OutOfCore::max_memory`]) is kept by accounting, not by measuring the process:
 //! [`RUN_BYTES`] bytes per run of each slab being stacked (its copies and the subtrees made from it, until
-//! they are spilled), [`CELL_BYTES`] per non-empty cell of depth `m`, [`SUBTREE_BYTES`] plus 8 per level for
+//! they are spilled), the states of the cells of depth `m` (2 bits a cell, all of them, up to `2^28` cells;
+//! above, [`CELL_BYTES`] per non-empty cell), [`SUBTREE_BYTES`] plus 8 per level for
 //! each stacked cell, and the I/O buffers ([`BUFFER_BYTES`] per spill file and two more). The first slab
 //! runs alone; then rounds of up to as many slabs as the rayon pool has threads run at once, as many as
 //! the largest slab seen so far allows in what is left of the budget; a slab whose rays turn out not to fit
@@ -53,16 +54,21 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use super::partition::{slab_pieces, top_levels, Piece, RaySource};
+use super::partition::{slab_pieces, top_levels, top_levels_dense, Piece, RaySource};
 use crate::io::{write_atomic_with, KtreeWriter};
-use crate::tree::{LevelCounts, NodeState};
+use crate::tree::{LevelCounts, NodeState, PackedStates};
 
 /// Bytes accounted for each run of a slab being stacked: the runs and their copies while they are cut
 /// into cells, and the subtrees made from them until they are spilled.
 pub const RUN_BYTES: u64 = 64;
-/// Bytes accounted for each non-empty cell of depth `m` (its Morton index and state, and its share of the
-/// top levels made from them at the end).
+/// Bytes accounted for each non-empty cell of depth `m` when they are listed (more than `2^28` cells): its
+/// Morton index and state, and its share of the top levels made from them at the end. Up to `2^28` cells
+/// are kept densely instead, at 2 bits each, accounted three times over (the pyramid and the top levels).
 pub const CELL_BYTES: u64 = 24;
+/// The cells of depth `m` are kept densely, two bits each, when there are at most `2^DENSE_BITS` of them
+/// (64 MiB); above, as a sorted list of the non-empty ones.
+const DENSE_BITS: u32 = 28;
+
 /// Bytes accounted for each stacked cell, besides 8 per level of its subtree (its place in the index and
 /// in the order the levels are written in).
 pub const SUBTREE_BYTES: u64 = 24;
@@ -203,6 +209,60 @@ struct SubtreeIndex {
     counts: Vec<u64>,
 }
 
+/// The states of the non-empty cells of depth `m`.
+enum CellStates {
+    /// All `2^(K·m)` cells, two bits each in Morton order (`00` for the empty ones).
+    Dense(Vec<u64>),
+    /// The non-empty cells as (Morton index, state).
+    Sparse(Vec<(u64, NodeState)>),
+}
+
+impl CellStates {
+    fn new(k: u32, m: u32) -> Self {
+        if k * m <= DENSE_BITS {
+            Self::Dense(vec![0; (1usize << (k * m)).div_ceil(32)])
+        } else {
+            Self::Sparse(Vec::new())
+        }
+    }
+
+    fn set(&mut self, index: u64, state: NodeState) {
+        match self {
+            Self::Dense(words) => {
+                words[(index / 32) as usize] |= (state as u64) << (2 * (index % 32))
+            }
+            Self::Sparse(cells) => cells.push((index, state)),
+        }
+    }
+
+    /// The bytes accounted for the cells once `more` further non-empty cells are added.
+    fn bytes_with(&self, more: usize) -> u64 {
+        match self {
+            Self::Dense(words) => 3 * 8 * words.len() as u64,
+            Self::Sparse(cells) => (cells.len() + more) as u64 * CELL_BYTES,
+        }
+    }
+
+    fn bytes(&self) -> u64 {
+        self.bytes_with(0)
+    }
+
+    /// The top levels `0 … m` of the tree.
+    fn into_top_levels(self, k: u32, m: u32) -> Vec<PackedStates> {
+        match self {
+            Self::Dense(words) => {
+                let base = PackedStates::from_words(words, 1usize << (k * m))
+                    .expect("cells hold the codes of node states");
+                top_levels_dense(k, m, base)
+            }
+            Self::Sparse(mut cells) => {
+                cells.sort_unstable();
+                top_levels(k, m, cells)
+            }
+        }
+    }
+}
+
 /// The memory accounting of a build.
 struct Budget {
     max: u64,
@@ -213,8 +273,8 @@ struct Budget {
 
 impl Budget {
     /// The memory held between slabs: cells, index, buffers.
-    fn fixed(&self, cells: usize, subtrees: usize) -> u64 {
-        cells as u64 * CELL_BYTES
+    fn fixed(&self, cell_bytes: u64, subtrees: usize) -> u64 {
+        cell_bytes
             + subtrees as u64 * (SUBTREE_BYTES + 8 * (self.t + 1))
             + (self.t + 2) * BUFFER_BYTES
     }
@@ -267,7 +327,7 @@ where
         t: u64::from(t),
         peak: 0,
     };
-    let mut cells: Vec<(u64, NodeState)> = Vec::new();
+    let mut cells = CellStates::new(K as u32, m);
     let mut index = SubtreeIndex::default();
     let threads = rayon::current_num_threads().max(1);
     let total = slabs.len() as u64;
@@ -283,7 +343,7 @@ where
     let mut window = 1;
     while !queue.is_empty() {
         let round: Vec<u32> = queue.drain(..window.min(queue.len())).collect();
-        let fixed = budget.fixed(cells.len(), index.mortons.len());
+        let fixed = budget.fixed(cells.bytes(), index.mortons.len());
         let in_flight = AtomicU64::new(0);
         let outcomes = round
             .par_iter()
@@ -332,7 +392,7 @@ where
                 &budget,
                 m,
                 &set_aside,
-                cells.len(),
+                &cells,
                 index.mortons.len(),
                 largest,
             )?;
@@ -351,10 +411,10 @@ where
         });
         let free = budget
             .max
-            .saturating_sub(budget.fixed(cells.len(), index.mortons.len()));
+            .saturating_sub(budget.fixed(cells.bytes(), index.mortons.len()));
         window = (free / largest.max(1)).clamp(1, threads as u64) as usize;
     }
-    let end = budget.fixed(cells.len(), index.mortons.len());
+    let end = budget.fixed(cells.bytes(), index.mortons.len());
     if end > budget.max {
         return Err(OutOfCoreError::BudgetTooSmall {
             budget: budget.max,
@@ -433,14 +493,14 @@ fn open_spill<E>(
 /// Records a non-empty cell of depth `m`, spilling the levels below its root if it is partial.
 fn spill_piece<const K: usize, E>(
     spill: &mut Spill,
-    cells: &mut Vec<(u64, NodeState)>,
+    cells: &mut CellStates,
     index: &mut SubtreeIndex,
     morton: u64,
     piece: Piece<K>,
 ) -> Result<(), OutOfCoreError<E>> {
     let tree = match piece {
         Piece::Full => {
-            cells.push((morton, NodeState::Full));
+            cells.set(morton, NodeState::Full);
             return Ok(());
         }
         Piece::Tree(tree) => tree,
@@ -449,10 +509,10 @@ fn spill_piece<const K: usize, E>(
     match tree.root_state() {
         NodeState::Empty => return Ok(()),
         NodeState::Full => {
-            cells.push((morton, NodeState::Full));
+            cells.set(morton, NodeState::Full);
             return Ok(());
         }
-        NodeState::Partial => cells.push((morton, NodeState::Partial)),
+        NodeState::Partial => cells.set(morton, NodeState::Partial),
     }
     index.mortons.push(morton);
     for j in 1..=spill.files.len() {
@@ -485,7 +545,7 @@ fn survey<const K: usize, S>(
     budget: &Budget,
     m: u32,
     rest: &[u32],
-    mut cells: usize,
+    cells: &CellStates,
     mut subtrees: usize,
     mut largest: u64,
 ) -> Result<u64, OutOfCoreError<S::Error>>
@@ -494,19 +554,20 @@ where
 {
     let level = source.universe().level();
     let side = 1u32 << (level - m);
+    let mut more = 0;
     for &b0 in rest {
         let slab = source
             .slab(b0 * side..(b0 + 1) * side)
             .map_err(OutOfCoreError::Source)?;
         largest = largest.max(slab.runs.len() as u64 * RUN_BYTES);
         for (_, piece) in slab_pieces::<K>(&slab, level, m, b0, false) {
-            cells += 1;
+            more += 1;
             if matches!(piece, Piece::Unstacked) {
                 subtrees += 1;
             }
         }
     }
-    Ok(budget.fixed(cells, subtrees) + largest)
+    Ok(budget.fixed(cells.bytes_with(more), subtrees) + largest)
 }
 
 /// Writes the output: the top levels from the cells' states, then each level below as the subtrees'
@@ -515,7 +576,7 @@ fn write_levels<const K: usize, E>(
     out: &Path,
     level: u32,
     m: u32,
-    mut cells: Vec<(u64, NodeState)>,
+    cells: CellStates,
     index: &SubtreeIndex,
     spill: Spill,
     progress: &(dyn Fn(Progress) + Sync),
@@ -535,8 +596,7 @@ fn write_levels<const K: usize, E>(
         })?;
         readers.push((path, file));
     }
-    cells.sort_unstable();
-    let top = top_levels(K as u32, m, cells);
+    let top = cells.into_top_levels(K as u32, m);
     let n = index.mortons.len();
     // The stacked cells in Morton order, and the deepest subtree level.
     let mut order: Vec<usize> = (0..n).collect();

@@ -582,6 +582,59 @@ pub(super) fn top_levels(k: u32, m: u32, base: Vec<(u64, NodeState)>) -> Vec<Pac
     levels
 }
 
+/// [`top_levels`] from the states of all `2^(k·m)` cells of depth `m`, in Morton order (absent cells
+/// empty): the same levels.
+pub(super) fn top_levels_dense(k: u32, m: u32, base: PackedStates) -> Vec<PackedStates> {
+    // The pyramid of all nodes of depths m, m − 1, …, 0.
+    let mut pyramid = vec![base];
+    for _ in 0..m {
+        let below = pyramid.last().expect("the pyramid has its base");
+        let mut above = PackedStates::with_capacity(below.len() >> k);
+        for p in 0..below.len() >> k {
+            let (mut full, mut empty) = (true, true);
+            for c in p << k..(p + 1) << k {
+                match below.get(c) {
+                    NodeState::Full => empty = false,
+                    NodeState::Partial => (full, empty) = (false, false),
+                    NodeState::Empty => full = false,
+                }
+            }
+            above.push(if full {
+                NodeState::Full
+            } else if empty {
+                NodeState::Empty
+            } else {
+                NodeState::Partial
+            });
+        }
+        pyramid.push(above);
+    }
+    pyramid.reverse();
+    // Levels 0 … m: the root, then the children of each partial node, in order.
+    let mut levels = Vec::new();
+    let mut root = PackedStates::with_capacity(1);
+    root.push(pyramid[0].get(0));
+    levels.push(root);
+    for d in 0..m as usize {
+        let mut next = PackedStates::new();
+        for p in 0..pyramid[d].len() {
+            if pyramid[d].get(p) == NodeState::Partial {
+                for c in p << k..(p + 1) << k {
+                    next.push(pyramid[d + 1].get(c));
+                }
+            }
+        }
+        if next.is_empty() {
+            break;
+        }
+        levels.push(next);
+    }
+    for l in &mut levels {
+        l.finish();
+    }
+    levels
+}
+
 /// A level being concatenated: 2-bit codes in words, node `i` at bits `2(i mod 32)` of word `i / 32`.
 #[derive(Debug, Default)]
 struct LevelWords {
