@@ -5,8 +5,8 @@
 //! The cells of depth `m` are stacked slab by slab exactly as in [`stack_source`](super::stack_source),
 //! but no finished subtree is kept: the levels `1, 2, …` of each partial cell's subtree are appended to
 //! one temporary *spill file* per level (word-aligned, in the order the slabs finish), and only a small
-//! index (the cell's Morton index and its node count per level) and the states of the non-empty cells of
-//! depth `m` stay in memory. At the end the file is written level by level through a [`KtreeWriter`]: the
+//! index (the cell's Morton index and its node count per level) and the states of the cells of depth `m`
+//! (see *Memory*) stay in memory. At the end the file is written level by level through a [`KtreeWriter`]: the
 //! top levels `0 … m` (from the cells' states; a uniform top collapses), then each level `m + j` as the
 //! concatenation, in Morton order of the cells, of the subtrees' levels `j` read back from spill file `j`
 //! (the writer shifts each piece into place). The file goes to a temporary file renamed over the target
