@@ -1,10 +1,11 @@
-//! `ktree build --rays FILE --out FILE.ktree [--threads N]`: stack a ray file into a tree file.
+//! `ktree build --rays FILE --out FILE.ktree [--threads N] [--max-memory SIZE] [--temp-dir DIR]
+//! [--progress]`: stack a ray file into a tree file (out of core: see [`crate::memory`]).
 
 use std::path::PathBuf;
 
 use ktree::io::{read_rays_file, AnyRaySet, AnyTree};
 use ktree::stacking::{default_split_depth, stack_partitioned};
-use ktree::{KTree, RaySet};
+use ktree::{KTree, LevelCounts, RaySet};
 
 /// Arguments of `ktree build`.
 #[derive(Debug, clap::Args)]
@@ -18,6 +19,8 @@ pub struct Args {
     /// Worker threads (default: all cores). The tree is the same for any number.
     #[arg(long)]
     threads: Option<usize>,
+    #[command(flatten)]
+    build: crate::memory::BuildArgs,
 }
 
 /// Runs `work` on a pool of `threads` worker threads (all cores when `None`).
@@ -43,6 +46,11 @@ pub fn stack_cells<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
 /// Reads the rays, stacks them, writes the tree, and prints a one-line summary.
 pub fn run(args: Args) -> Result<(), String> {
     let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
+    if crate::memory::out_of_core() {
+        let summary = ktree::with_dim!(&rays, AnyRaySet, r => build_out_of_core(r, &args))?;
+        println!("{summary}");
+        return Ok(());
+    }
     let threads = args.threads;
     let tree = match &rays {
         AnyRaySet::K1(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K1),
@@ -58,16 +66,55 @@ pub fn run(args: Args) -> Result<(), String> {
     write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
     let c = tree.counts();
     println!(
-        "{}: K = {}, L = {}, {} rays -> {} nodes ({} full, {} empty, {} partial), {} bytes at 2 bits/node",
-        args.out.display(),
-        tree.k(),
-        tree.level(),
+        "{}",
+        summary(
+            &args.out,
+            tree.k(),
+            tree.level(),
+            rays.len(),
+            c,
+            tree.bytes_at_two_bits()
+        )
+    );
+    Ok(())
+}
+
+/// Stacks the rays straight into the output, out of core; returns the summary.
+fn build_out_of_core<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<String, String> {
+    let what = format!("the rays of {}", args.rays.display());
+    let budget = args
+        .build
+        .budget
+        .left_after(&what, crate::memory::ray_bytes(rays))?;
+    let report = with_threads(args.threads, || {
+        crate::memory::build_to_file(rays, &args.out, &args.build, budget)
+    })??;
+    let c = LevelCounts::total(rays.level(), &report.counts_per_level);
+    Ok(summary(
+        &args.out,
+        K,
+        rays.level(),
         rays.len(),
+        c,
+        c.nodes().div_ceil(4),
+    ))
+}
+
+/// The one-line summary of a build.
+fn summary(
+    out: &std::path::Path,
+    k: usize,
+    level: u32,
+    rays: usize,
+    c: LevelCounts,
+    bytes: u64,
+) -> String {
+    format!(
+        "{}: K = {k}, L = {level}, {rays} rays -> {} nodes ({} full, {} empty, {} partial), {bytes} bytes at 2 bits/node",
+        out.display(),
         c.nodes(),
         c.full,
         c.empty,
         c.partial,
-        tree.bytes_at_two_bits()
-    );
-    Ok(())
+    )
 }

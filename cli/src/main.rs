@@ -11,6 +11,7 @@ mod convert;
 mod distributed;
 mod lines;
 mod mass;
+mod memory;
 mod op;
 mod rays;
 mod render;

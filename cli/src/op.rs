@@ -22,6 +22,8 @@ pub struct Args {
     /// Worker threads (default: all cores). The output is the same for any number.
     #[arg(long)]
     threads: Option<usize>,
+    #[command(flatten)]
+    budget: crate::memory::BudgetArgs,
 }
 
 /// Reads a tree file, with the path in any error.
@@ -67,6 +69,31 @@ macro_rules! with_pair {
 }
 pub(crate) use with_pair;
 
+/// Checks that the operation fits in the budget: it holds its input trees (about as large in memory as in
+/// their files) and a result at most as large as them together.
+fn check_budget(args: &Args) -> Result<(), String> {
+    let mut files = 0u64;
+    for input in &args.inputs {
+        files += std::fs::metadata(input)
+            .map_err(|e| format!("{}: {e}", input.display()))?
+            .len();
+    }
+    let names: Vec<String> = args
+        .inputs
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    args.budget
+        .left_after(
+            &format!(
+                "the trees of {} and the result (held in memory)",
+                names.join(" and ")
+            ),
+            files.saturating_mul(2),
+        )
+        .map(drop)
+}
+
 /// Runs the operation and writes the result, on a pool of `--threads` worker threads.
 pub fn run(args: Args) -> Result<(), String> {
     let threads = args.threads;
@@ -74,6 +101,7 @@ pub fn run(args: Args) -> Result<(), String> {
 }
 
 fn run_op(args: Args) -> Result<(), String> {
+    check_budget(&args)?;
     if args.operation == "not" {
         let [a] = args.inputs.as_slice() else {
             return Err("`ktree op not` takes exactly one input tree".into());

@@ -2,12 +2,13 @@
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::write_rays_file;
+use ktree::io::{write_atomic_with, write_rays_file, write_rays_source};
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSource};
 use ktree::stacking::{default_split_depth, stack_source};
-use ktree::{KTree, RaySet};
+use ktree::{LevelCounts, RaySet};
 
 use crate::build::with_threads;
+use crate::memory::BuildArgs;
 
 /// Arguments of `ktree rays`.
 #[derive(Debug, clap::Args)]
@@ -64,6 +65,8 @@ pub struct Args {
     /// Worker threads (default: all cores). The output is the same for any number.
     #[arg(long)]
     threads: Option<usize>,
+    #[command(flatten)]
+    build: crate::memory::BuildArgs,
 }
 
 fn numbers(text: &str, n: usize, what: &str) -> Result<Vec<Rational>, String> {
@@ -142,20 +145,33 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
 }
 
 /// Writes rays as text, or stacks them into a `.ktree` file, by the output's extension; returns a summary.
-/// In a run over several MPI ranks, every rank takes part in the build and rank 0 alone writes and returns
-/// the summary (the others return an empty one).
+/// A tree is built out of core in the budget of `build` less what the rays hold (see [`crate::memory`]),
+/// except in a run over several MPI ranks or for format version 1: there every rank takes part in the
+/// build in memory and rank 0 alone writes and returns the summary (the others return an empty one).
 pub fn write_output<const K: usize>(
     rays: &RaySet<K>,
     out: &Path,
     threads: Option<usize>,
+    build: &BuildArgs,
 ) -> Result<String, String> {
     if is_tree_file(out) {
-        let Some(tree) = crate::distributed::stack(rays, threads)? else {
-            return Ok(String::new());
+        let counts = if crate::memory::out_of_core() {
+            let budget = build
+                .budget
+                .left_after("the rays", crate::memory::ray_bytes(rays))?;
+            with_threads(threads, || {
+                crate::memory::build_to_file(rays, out, build, budget)
+            })??
+            .counts_per_level
+        } else {
+            let Some(tree) = crate::distributed::stack(rays, threads)? else {
+                return Ok(String::new());
+            };
+            crate::tree_file::write(out, &tree)
+                .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+            tree.counts_per_level()
         };
-        crate::tree_file::write(out, &tree)
-            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
-        let c = tree.counts();
+        let c = LevelCounts::total(rays.level(), &counts);
         Ok(format!(
             "{}: K = {K}, L = {}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
             out.display(),
@@ -186,14 +202,13 @@ fn is_tree_file(out: &Path) -> bool {
     out.extension().is_some_and(|e| e == "ktree")
 }
 
-/// Prints the summary of a tree written to `out`.
-fn tree_summary<const K: usize>(out: &Path, tree: &KTree<K>) -> String {
-    let c = tree.counts();
+/// The summary of a tree written to `out`, from its counts per level.
+fn tree_summary<const K: usize>(out: &Path, level: u32, counts: &[LevelCounts]) -> String {
+    let c = LevelCounts::total(level, counts);
     format!(
-        "{}: K = {K}, L = {}, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
+        "{}: K = {K}, L = {level}, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
         out.display(),
-        tree.level(),
-        tree.voxel_count(),
+        crate::memory::voxels::<K>(level, counts),
         c.nodes(),
         c.full,
         c.empty,
@@ -211,18 +226,56 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
     if is_tree_file(&a.out) && crate::distributed::ranks().size == 1 {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
         let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
+        let counts = if crate::memory::out_of_core() {
+            let budget = a.build.budget.budget();
+            with_threads(a.threads, || {
+                crate::memory::build_to_file(&source, &a.out, &a.build, budget)
+            })??
+            .counts_per_level
+        } else {
+            let depth = default_split_depth(K, a.level);
+            let tree = with_threads(a.threads, || stack_source(&source, depth))?
+                .map_err(|e| e.to_string())?;
+            crate::tree_file::write(&a.out, &tree)
+                .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+            tree.counts_per_level()
+        };
+        println!("{}", tree_summary::<K>(&a.out, a.level, &counts));
+        return Ok(());
+    }
+    if crate::distributed::ranks().size == 1 {
+        // A ray file, written slab by slab: one slab's runs held at a time, no cap on their number.
+        let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
+        let bar = crate::render::progress_bar(a.build.progress, "writing slabs");
+        let progress = |done: u64, total: u64| {
+            if let Some(bar) = &bar {
+                bar.set_length(total);
+                bar.set_position(done);
+            }
+        };
+        let mut written = (0, 0);
         let depth = default_split_depth(K, a.level);
-        let tree =
-            with_threads(a.threads, || stack_source(&source, depth))?.map_err(|e| e.to_string())?;
-        crate::tree_file::write(&a.out, &tree)
-            .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
-        println!("{}", tree_summary(&a.out, &tree));
+        write_atomic_with(&a.out, |w| {
+            written = write_rays_source(w, &source, depth, &progress)?;
+            Ok(())
+        })
+        .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+        if let Some(bar) = bar {
+            bar.finish_and_clear();
+        }
+        println!(
+            "{}: K = {K}, L = {}, {} rays, {} voxels",
+            a.out.display(),
+            a.level,
+            written.0,
+            written.1
+        );
         return Ok(());
     }
     let rays = s
         .to_rays(a.level, sample, false)
         .map_err(|e| e.to_string())?;
-    print_summary(&write_output(&rays, &a.out, a.threads)?);
+    print_summary(&write_output(&rays, &a.out, a.threads, &a.build)?);
     Ok(())
 }
 

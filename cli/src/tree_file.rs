@@ -22,12 +22,17 @@ pub fn set(args: &FormatArgs) {
     let _ = VERSION.set(args.format_version);
 }
 
+/// The format version chosen (2 unless set).
+pub fn version() -> u16 {
+    VERSION.get().copied().unwrap_or(2)
+}
+
 /// Writes a tree file atomically in the chosen format version.
 ///
 /// # Errors
 /// Any I/O error, naming the path.
 pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
-    match VERSION.get().copied().unwrap_or(2) {
+    match version() {
         1 => write_ktree_file(path, tree),
         _ => write_ktree_v2_file(path, tree),
     }

@@ -38,6 +38,8 @@ pub struct Args {
     /// Worker threads for stacking a tree (default: all cores). The output is the same for any number.
     #[arg(long)]
     threads: Option<usize>,
+    #[command(flatten)]
+    build: crate::memory::BuildArgs,
 }
 
 /// Voxelizes the input and writes it.
@@ -91,6 +93,6 @@ pub fn run(a: Args) -> Result<(), String> {
             v.open_edges
         );
     }
-    crate::rays::print_summary(&write_output(&v.rays, &a.out, a.threads)?);
+    crate::rays::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?);
     Ok(())
 }

@@ -49,6 +49,7 @@ pub use ktree_v2::{
 };
 pub use octomap_bt::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
 pub use rays_text::{
-    read_rays, read_rays_file, write_rays, write_rays_file, RaysTextError, RaysTextErrorKind,
+    read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source, RaysTextError,
+    RaysTextErrorKind,
 };
 pub use vdb::{read_vdb, write_vdb};

@@ -19,6 +19,7 @@ use thiserror::Error;
 use super::any::AnyRaySet;
 use crate::rays::{Normal, Ray, RayError, RaySet};
 use crate::space::{max_level, MAX_K};
+use crate::stacking::RaySource;
 
 /// What was wrong with a ray file.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -176,6 +177,69 @@ pub fn write_rays<const K: usize>(mut w: impl Write, rays: &RaySet<K>) -> std::i
         )?;
     }
     writeln!(w, "{K} {}", rays.level())?;
+    write_ray_lines(w, rays)
+}
+
+/// Writes the rays of `source` in the text format slab by slab (slabs one cell of depth `depth` wide,
+/// as the out-of-core build uses), holding one slab's runs at a time and calling `progress(done, total)`
+/// after each slab; returns the number of runs and of voxels written. The file is the one [`write_rays`]
+/// writes for the whole set, without the whole set's cap on the number of runs.
+///
+/// ```
+/// use ktree::io::{write_rays, write_rays_source};
+/// use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
+/// let ball = Solid::Quadric(Quadric::<3>::ball([Rational::int(16); 3], Rational::int(11), Frame::Voxel).unwrap());
+/// let (mut whole, mut streamed) = (Vec::new(), Vec::new());
+/// write_rays(&mut whole, &ball.to_rays(5, Sample::Centre, false).unwrap()).unwrap();
+/// let source = SolidSource::new(&ball, 5, Sample::Centre).unwrap();
+/// write_rays_source(&mut streamed, &source, 3, &|_, _| {}).unwrap();
+/// assert_eq!(streamed, whole);
+/// ```
+///
+/// # Errors
+/// Any I/O error; an error of the source, as [`std::io::ErrorKind::Other`] carrying it.
+pub fn write_rays_source<const K: usize, S>(
+    mut w: impl Write,
+    source: &S,
+    depth: u32,
+    progress: &dyn Fn(u64, u64),
+) -> std::io::Result<(u64, u128)>
+where
+    S: RaySource<K>,
+    S::Error: std::error::Error + Send + Sync + 'static,
+{
+    let universe = source.universe();
+    let level = universe.level();
+    let m = depth.min(level);
+    let side = 1u32 << (level - m);
+    let slabs = if K == 1 {
+        vec![0]
+    } else {
+        source.occupied_slabs(m)
+    };
+    writeln!(w, "# ktree rays v1")?;
+    writeln!(w, "{K} {level}")?;
+    let (mut runs, mut voxels) = (0u64, 0u128);
+    for (i, &b0) in slabs.iter().enumerate() {
+        let slab = source
+            .slab(b0 * side..(b0 + 1) * side)
+            .map_err(std::io::Error::other)?;
+        let rays = RaySet::from_sorted_parts(
+            universe,
+            slab.keys.into_owned(),
+            slab.runs.into_owned(),
+            None,
+        );
+        runs += rays.len() as u64;
+        voxels += rays.voxel_count();
+        write_ray_lines(&mut w, &rays)?;
+        progress(i as u64 + 1, slabs.len() as u64);
+    }
+    Ok((runs, voxels))
+}
+
+/// The lines of the runs of a ray set (after the header).
+fn write_ray_lines<const K: usize>(mut w: impl Write, rays: &RaySet<K>) -> std::io::Result<()> {
     let mut line = String::new();
     for (i, ray) in rays.iter().enumerate() {
         use fmt::Write as _;

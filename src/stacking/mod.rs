@@ -4,7 +4,8 @@
 //! ([`stack_pipelined`]); all three build the same tree from the same combine and split steps. The same
 //! tree is also built cell by cell ([`stack_partitioned`], [`stack_source`]): cache-sized subtrees on all
 //! threads, joined level by level; and in parts that run apart, as the ranks of a distributed run do
-//! ([`balanced_slabs`], [`slab_rays`], [`join_parts`]).
+//! ([`balanced_slabs`], [`slab_rays`], [`join_parts`]); or out of core, straight to a `.ktree` file in
+//! bounded memory with the subtrees spilled to temporary files ([`stack_to_file`]).
 //!
 //! ```
 //! use ktree::{rays::ball_rays, reference::DensePyramid, stacking::stack_with_stats};
@@ -17,6 +18,7 @@
 
 mod bitmap;
 mod distribute;
+mod out_of_core;
 mod partition;
 mod pipeline;
 mod radix;
@@ -25,6 +27,10 @@ mod stack;
 
 pub use bitmap::{stack_bitmap, MAX_BITMAP_VOXELS};
 pub use distribute::{balanced_slabs, join_parts, slab_rays};
+pub use out_of_core::{
+    stack_to_file, OutOfCore, OutOfCoreError, OutOfCoreReport, Progress, Stage, BUFFER_BYTES,
+    CELL_BYTES, RUN_BYTES, SUBTREE_BYTES,
+};
 pub use partition::{
     default_split_depth, join_subtrees, stack_partitioned, stack_source, RaySource, SlabRuns,
 };

@@ -145,11 +145,13 @@ pub fn stack_source<const K: usize, S: RaySource<K>>(
     Ok(join_pieces(universe, m, pieces))
 }
 
-/// A non-empty cell of depth `m`: wholly full, or a stacked subtree.
+/// A non-empty cell of depth `m`: wholly full, a stacked subtree, or (when only counting) a mixed cell
+/// left unstacked.
 #[derive(Debug)]
-enum Piece<const K: usize> {
+pub(super) enum Piece<const K: usize> {
     Full,
     Tree(KTree<K>),
+    Unstacked,
 }
 
 /// Stacks the cells of slab `b0` (all of them for `K = 1`); returns the non-empty ones with their Morton
@@ -163,18 +165,33 @@ fn stack_slab<const K: usize, S: RaySource<K>>(
     let t = level - m;
     let side = 1u32 << t;
     let slab = source.slab(b0 * side..(b0 + 1) * side)?;
+    Ok(slab_pieces(&slab, level, m, b0, true))
+}
+
+/// The non-empty cells of slab `b0` (all cells for `K = 1`) from its runs, with their Morton index among
+/// the cells of depth `m`; the mixed cells are stacked when `stack_mixed`, else left
+/// [`Piece::Unstacked`].
+pub(super) fn slab_pieces<const K: usize>(
+    slab: &SlabRuns<'_>,
+    level: u32,
+    m: u32,
+    b0: u32,
+    stack_mixed: bool,
+) -> Vec<(u64, Piece<K>)> {
+    let t = level - m;
+    let side = 1u32 << t;
     let (keys, runs) = (&slab.keys[..], &slab.runs[..]);
     let mut out = Vec::new();
     if runs.is_empty() {
-        return Ok(out);
+        return out;
     }
     if K == 1 {
         let block = Block {
             keys: vec![0; runs.len()],
             runs: runs.to_vec(),
         };
-        split_block::<K>(&block, m, t, [0; K], &mut out);
-        return Ok(out);
+        split_block::<K>(&block, m, t, [0; K], stack_mixed, &mut out);
+        return out;
     }
     // Bucket the slab's runs by block (the cell coordinates along axes 1 … K−2), keeping their order, with
     // column keys made local to the block.
@@ -182,7 +199,7 @@ fn stack_slab<const K: usize, S: RaySource<K>>(
     let local_mask = u64::from(side) - 1;
     let blocks_per_slab = 1usize << ((K - 2) as u32 * m);
     if blocks_per_slab > runs.len().max(64) {
-        return Ok(stack_sparse_slab(keys, runs, level, m, b0));
+        return stack_sparse_slab(keys, runs, level, m, b0, stack_mixed);
     }
     let mut block_of = Vec::with_capacity(runs.len());
     let mut counts = vec![0usize; blocks_per_slab + 1];
@@ -225,9 +242,9 @@ fn stack_slab<const K: usize, S: RaySource<K>>(
         for a in (1..K - 1).rev() {
             cell[a] = ((b >> ((K - 2 - a) as u32 * m)) & ((1 << m) - 1)) as u32;
         }
-        split_block::<K>(&block, m, t, cell, &mut out);
+        split_block::<K>(&block, m, t, cell, stack_mixed, &mut out);
     }
-    Ok(out)
+    out
 }
 
 /// [`stack_slab`] for a slab with many more blocks than runs: the runs are sorted by block instead of
@@ -238,6 +255,7 @@ fn stack_sparse_slab<const K: usize>(
     level: u32,
     m: u32,
     b0: u32,
+    stack_mixed: bool,
 ) -> Vec<(u64, Piece<K>)> {
     let t = level - m;
     let mask = (1u64 << level) - 1;
@@ -275,7 +293,7 @@ fn stack_sparse_slab<const K: usize>(
         for a in (1..K - 1).rev() {
             cell[a] = ((b >> ((K - 2 - a) as u32 * m)) & ((1 << m) - 1)) as u32;
         }
-        split_block::<K>(&block, m, t, cell, &mut out);
+        split_block::<K>(&block, m, t, cell, stack_mixed, &mut out);
     }
     out
 }
@@ -287,13 +305,14 @@ struct Block {
     runs: Vec<(u32, u32)>,
 }
 
-/// Cuts a block's runs into its `2^m` cells along the last axis and stacks the mixed ones. `cell` holds the
-/// block's cell coordinates on the column axes.
+/// Cuts a block's runs into its `2^m` cells along the last axis and stacks the mixed ones (or, unless
+/// `stack_mixed`, lists them unstacked). `cell` holds the block's cell coordinates on the column axes.
 fn split_block<const K: usize>(
     block: &Block,
     m: u32,
     t: u32,
     mut cell: [u32; K],
+    stack_mixed: bool,
     out: &mut Vec<(u64, Piece<K>)>,
 ) {
     let columns = 1u64 << (t as usize * (K - 1));
@@ -304,6 +323,13 @@ fn split_block<const K: usize>(
     }
     let low = (1u32 << t) - 1;
     if mixed.is_empty() {
+        return;
+    }
+    if !stack_mixed {
+        for j in mixed {
+            cell[K - 1] = j as u32;
+            out.push((morton_encode(cell), Piece::Unstacked));
+        }
         return;
     }
     // Hand each mixed cell its clipped runs, in order.
@@ -459,21 +485,48 @@ fn join_pieces<const K: usize>(
     m: u32,
     pieces: Vec<(u64, Piece<K>)>,
 ) -> KTree<K> {
-    let k = K as u32;
-    // The pyramid of the non-empty nodes of depths m, m − 1, …, 0, as sorted (Morton index, state): a node
-    // whose 2^K children are all full is full, any other node with a non-empty child is partial.
-    let base: Vec<(u64, NodeState)> = pieces
+    let base = pieces
         .iter()
-        .map(|(i, p)| match p {
-            Piece::Full => (*i, NodeState::Full),
-            Piece::Tree(t) => (*i, t.root_state()),
+        .filter_map(|(i, p)| match p {
+            Piece::Full => Some((*i, NodeState::Full)),
+            Piece::Tree(t) if t.root_state() != NodeState::Empty => Some((*i, t.root_state())),
+            _ => None,
         })
-        .filter(|p| p.1 != NodeState::Empty)
         .collect();
+    let mut levels = top_levels(K as u32, m, base);
+    // Levels m + 1 …: the concatenation of the subtrees' levels 1 …, in Morton order.
+    let trees: Vec<&KTree<K>> = pieces
+        .iter()
+        .filter_map(|(_, p)| match p {
+            Piece::Tree(t) if t.root_state() == NodeState::Partial => Some(t),
+            _ => None,
+        })
+        .collect();
+    let deepest = trees.iter().map(|t| t.depth_count()).max().unwrap_or(0);
+    let deeper: Vec<PackedStates> = (1..deepest)
+        .into_par_iter()
+        .map(|j| {
+            let mut out = LevelWords::default();
+            for t in trees.iter().filter(|t| t.depth_count() > j) {
+                let s = t.level_states(j);
+                out.append(s.words(), s.len());
+            }
+            out.into_states()
+        })
+        .collect();
+    levels.extend(deeper);
+    KTree::from_levels(universe, levels)
+}
+
+/// The levels `0 … m` of a tree (fewer where the top collapses), finished, from its non-empty cells of
+/// depth `m` in `k` dimensions, as (Morton index, state) sorted by index: a node whose `2^k` children are
+/// all full is full, any other node with a non-empty child is partial, absent children are empty.
+pub(super) fn top_levels(k: u32, m: u32, base: Vec<(u64, NodeState)>) -> Vec<PackedStates> {
+    // The pyramid of the non-empty nodes of depths m, m − 1, …, 0.
     let mut pyramid = vec![base];
     for _ in 0..m {
         let below = pyramid.last().expect("the pyramid has its base");
-        let mut above: Vec<(u64, NodeState)> = Vec::new();
+        let mut above: Vec<(u64, NodeState)> = Vec::with_capacity(below.len() >> k);
         let mut at = 0;
         while at < below.len() {
             let parent = below[at].0 >> k;
@@ -481,7 +534,7 @@ fn join_pieces<const K: usize>(
             while end < below.len() && below[end].0 >> k == parent {
                 end += 1;
             }
-            let full = end - at == 1 << K && below[at..end].iter().all(|c| c.1 == NodeState::Full);
+            let full = end - at == 1 << k && below[at..end].iter().all(|c| c.1 == NodeState::Full);
             above.push((
                 parent,
                 if full {
@@ -526,28 +579,60 @@ fn join_pieces<const K: usize>(
     for l in &mut levels {
         l.finish();
     }
-    // Levels m + 1 …: the concatenation of the subtrees' levels 1 …, in Morton order.
-    let trees: Vec<&KTree<K>> = pieces
-        .iter()
-        .filter_map(|(_, p)| match p {
-            Piece::Tree(t) if t.root_state() == NodeState::Partial => Some(t),
-            _ => None,
-        })
-        .collect();
-    let deepest = trees.iter().map(|t| t.depth_count()).max().unwrap_or(0);
-    let deeper: Vec<PackedStates> = (1..deepest)
-        .into_par_iter()
-        .map(|j| {
-            let mut out = LevelWords::default();
-            for t in trees.iter().filter(|t| t.depth_count() > j) {
-                let s = t.level_states(j);
-                out.append(s.words(), s.len());
+    levels
+}
+
+/// [`top_levels`] from the states of all `2^(k·m)` cells of depth `m`, in Morton order (absent cells
+/// empty): the same levels.
+pub(super) fn top_levels_dense(k: u32, m: u32, base: PackedStates) -> Vec<PackedStates> {
+    // The pyramid of all nodes of depths m, m − 1, …, 0.
+    let mut pyramid = vec![base];
+    for _ in 0..m {
+        let below = pyramid.last().expect("the pyramid has its base");
+        let mut above = PackedStates::with_capacity(below.len() >> k);
+        for p in 0..below.len() >> k {
+            let (mut full, mut empty) = (true, true);
+            for c in p << k..(p + 1) << k {
+                match below.get(c) {
+                    NodeState::Full => empty = false,
+                    NodeState::Partial => (full, empty) = (false, false),
+                    NodeState::Empty => full = false,
+                }
             }
-            out.into_states()
-        })
-        .collect();
-    levels.extend(deeper);
-    KTree::from_levels(universe, levels)
+            above.push(if full {
+                NodeState::Full
+            } else if empty {
+                NodeState::Empty
+            } else {
+                NodeState::Partial
+            });
+        }
+        pyramid.push(above);
+    }
+    pyramid.reverse();
+    // Levels 0 … m: the root, then the children of each partial node, in order.
+    let mut levels = Vec::new();
+    let mut root = PackedStates::with_capacity(1);
+    root.push(pyramid[0].get(0));
+    levels.push(root);
+    for d in 0..m as usize {
+        let mut next = PackedStates::new();
+        for p in 0..pyramid[d].len() {
+            if pyramid[d].get(p) == NodeState::Partial {
+                for c in p << k..(p + 1) << k {
+                    next.push(pyramid[d + 1].get(c));
+                }
+            }
+        }
+        if next.is_empty() {
+            break;
+        }
+        levels.push(next);
+    }
+    for l in &mut levels {
+        l.finish();
+    }
+    levels
 }
 
 /// A level being concatenated: 2-bit codes in words, node `i` at bits `2(i mod 32)` of word `i / 32`.

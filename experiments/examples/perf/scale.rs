@@ -1,17 +1,29 @@
 //! Scale: the voxel-centre sphere (centre U/2, radius (U−1)/2) built from its quadric, end to end, by the
 //! partitioned build (cells of depth `L − 6` stacked apart, rays made slab by slab) on one and two threads,
-//! L = 10 … 13; the whole-set build (all rays, then one stacking) beside it up to L = 12.
+//! L = 10 … 13; the whole-set build (all rays, then one stacking) beside it up to L = 12; and the
+//! out-of-core build (subtrees spilled to temporary files, the `.ktree` written level by level in a memory
+//! budget) at L = 13 and 14.
 
 use std::fmt::Write as _;
 
+use ktree::io::KtreeView;
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{default_split_depth, stack, stack_source, RaySource};
+use ktree::stacking::{
+    default_split_depth, stack, stack_source, stack_to_file, OutOfCore, RaySource,
+};
+use ktree::LevelCounts;
 
 use crate::measure::{best_of, machine_line, results_path, run_child, Measured};
 
 const LEVELS: [u32; 4] = [10, 11, 12, 13];
 /// The whole-set build is run up to this level (it holds every ray and every full cell at once).
 const WHOLE_MAX: u32 = 12;
+/// Levels built out of core, straight to a `.ktree` file.
+const OUT_OF_CORE_LEVELS: [u32; 2] = [13, 14];
+/// The memory budget of the out-of-core builds.
+const OUT_OF_CORE_BUDGET: u64 = 1536 << 20;
+/// Threads of the out-of-core builds.
+const OUT_OF_CORE_THREADS: usize = 2;
 
 fn sphere(level: u32) -> Solid<3> {
     let u = 1i64 << level;
@@ -97,9 +109,74 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             facts.push(("nodes".into(), nodes.to_string()));
             s
         }
+        "ooc" => out_of_core_case(&solid, level, &mut facts)?,
         _ => return Err(format!("unknown case {case}")),
     };
     Ok((seconds, facts))
+}
+
+/// The out-of-core build of the sphere to a `.ktree` in a temporary folder, timed; then (not timed, after
+/// the peak memory of the build is recorded) the file is opened and checked section by section, its counts
+/// compared with the build's, and its voxels with the sum of the runs' lengths made slab by slab again.
+fn out_of_core_case(
+    solid: &Solid<3>,
+    level: u32,
+    facts: &mut Vec<(String, String)>,
+) -> Result<f64, String> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(OUT_OF_CORE_THREADS)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let out = dir.path().join("sphere.ktree");
+    let source = SolidSource::new(solid, level, Sample::Centre).map_err(|e| e.to_string())?;
+    let options = OutOfCore::new(default_split_depth(3, level), OUT_OF_CORE_BUDGET);
+    let start = std::time::Instant::now();
+    let report = pool
+        .install(|| stack_to_file(&source, &out, &options, &|_| {}))
+        .map_err(|e| e.to_string())?;
+    let seconds = start.elapsed().as_secs_f64();
+    let build_peak = ktree_repro::peak_rss_bytes().unwrap_or(0);
+    let view = KtreeView::open(&out).map_err(|e| e.to_string())?;
+    if view.counts_per_level() != report.counts_per_level {
+        return Err(format!(
+            "L = {level}: the file's counts differ from the build's"
+        ));
+    }
+    let voxels: u128 = report
+        .counts_per_level
+        .iter()
+        .map(|c| u128::from(c.full) << (3 * (level - c.level)))
+        .sum();
+    let side = 1u32 << level;
+    let step = 1u32 << level.saturating_sub(6);
+    let (mut rays, mut run_voxels) = (0u64, 0u128);
+    for x in (0..side).step_by(step as usize) {
+        let slab = source.slab(x..x + step).map_err(|e| e.to_string())?;
+        rays += slab.runs.len() as u64;
+        run_voxels += slab
+            .runs
+            .iter()
+            .map(|&(z1, z2)| u128::from(z2 - z1))
+            .sum::<u128>();
+    }
+    if voxels != run_voxels {
+        return Err(format!(
+            "L = {level}: the file holds {voxels} voxels, the runs {run_voxels}"
+        ));
+    }
+    let total = LevelCounts::total(level, &report.counts_per_level);
+    facts.push(("rays".into(), rays.to_string()));
+    facts.push(("voxels".into(), voxels.to_string()));
+    facts.push(("nodes".into(), total.nodes().to_string()));
+    facts.push(("file_bytes".into(), report.file_bytes.to_string()));
+    facts.push(("spilled_bytes".into(), report.spilled_bytes.to_string()));
+    facts.push(("build_peak_bytes".into(), build_peak.to_string()));
+    facts.push((
+        "accounted_peak_bytes".into(),
+        report.peak_accounted_bytes.to_string(),
+    ));
+    Ok(seconds)
 }
 
 fn mib(bytes: u64) -> String {
@@ -109,7 +186,10 @@ fn mib(bytes: u64) -> String {
 /// Measures every case in a child process and writes `results/performance/scale.md`.
 pub fn report() -> Result<String, String> {
     let mut md = String::new();
-    let _ = writeln!(md, "# Scale: the partitioned build, L = 10 … 13\n");
+    let _ = writeln!(
+        md,
+        "# Scale: the partitioned build, L = 10 … 13; out of core, L = 13 and 14\n"
+    );
     let _ = writeln!(
         md,
         "Regenerate with `cargo run --release --example perf -- scale`. Object: the voxels whose centres lie \
@@ -163,6 +243,40 @@ pub fn report() -> Result<String, String> {
                 .map_or("—".into(), |w| format!("{:.3}", w.seconds)),
             whole.as_ref().map_or("—".into(), |w| mib(w.peak_bytes)),
             mib(file),
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\n## Out of core\n\nThe same sphere built by `ktree::stacking::stack_to_file` (what `ktree rays|build|voxelize \
+         … --out FILE.ktree` run): the subtrees of the cells of depth L − 6 spilled to per-level temporary \
+         files as slabs finish, then the `.ktree` version 2 written level by level into a temporary folder, \
+         on {OUT_OF_CORE_THREADS} threads in a budget of {} MiB. One run per level. Peak: the process's \
+         high-water resident set when the file is written (before the checks); accounted: the most the \
+         build's own accounting held. Checks, not timed: the file opens (every section's checksum, shape and \
+         reduction checked), its counts equal the build's, and its voxels equal the sum of the runs' \
+         lengths.\n",
+        OUT_OF_CORE_BUDGET >> 20
+    );
+    let _ = writeln!(
+        md,
+        "| L | rays | voxels | nodes | seconds | ns/node | peak MiB | accounted MiB | spilled MiB | file MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for level in OUT_OF_CORE_LEVELS {
+        let m: Measured = run_child("scale", &format!("ooc-{level}"))?;
+        let nodes: f64 = m.fact("nodes").parse().unwrap_or(f64::NAN);
+        let bytes = |key: &str| mib(m.fact(key).parse().unwrap_or(0));
+        let _ = writeln!(
+            md,
+            "| {level} | {} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {} |",
+            m.fact("rays"),
+            m.fact("voxels"),
+            m.fact("nodes"),
+            m.seconds,
+            m.seconds * 1e9 / nodes,
+            bytes("build_peak_bytes"),
+            bytes("accounted_peak_bytes"),
+            bytes("spilled_bytes"),
+            bytes("file_bytes"),
         );
     }
     let path = results_path("scale");

@@ -1,0 +1,370 @@
+//! `--max-memory`, `--temp-dir` and `--progress` on `ktree build`, `rays`, `voxelize` (trees written out of
+//! core) and `--max-memory` on `ktree op`: the files are byte for byte the in-memory build's; a budget too
+//! small names one that works; an unusable temporary folder or a full disk is a clear error that leaves
+//! the target untouched and no temporary file.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::ktree;
+use ktree::io::{read_rays_file, write_ktree_v2, AnyRaySet};
+use ktree::stacking::stack;
+
+/// The bytes of the tree of a ray file built in memory, as `.ktree` version 2.
+fn in_memory_bytes(rays: &Path) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    match read_rays_file(rays).unwrap() {
+        AnyRaySet::K3(r) => write_ktree_v2(&mut bytes, &stack(&r)).unwrap(),
+        other => panic!("expected K = 3 rays, got K = {}", other.k()),
+    }
+    bytes
+}
+
+/// Everything in a folder, hidden entries included.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+fn ball_rays(dir: &Path, level: u32) -> PathBuf {
+    let rays = dir.join(format!("ball{level}.rays"));
+    let radius = ((1u32 << level) * 7 / 16).to_string();
+    let (ok, _, err) = ktree(&[
+        "rays",
+        "--level",
+        &level.to_string(),
+        "--radius",
+        &radius,
+        "--out",
+        rays.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    rays
+}
+
+#[test]
+fn build_writes_the_in_memory_bytes_for_any_budget_spelling() {
+    let dir = tempfile::tempdir().unwrap();
+    let rays = ball_rays(dir.path(), 7);
+    let expected = in_memory_bytes(&rays);
+    let out = dir.path().join("ball.ktree");
+    for budget in [
+        None,
+        Some("512M"),
+        Some("2G"),
+        Some("100000000"),
+        Some("1.5g"),
+    ] {
+        let mut args = vec![
+            "build",
+            "--rays",
+            rays.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--progress",
+        ];
+        if let Some(b) = budget {
+            args.extend(["--max-memory", b]);
+        }
+        let (ok, stdout, err) = ktree(&args);
+        assert!(ok, "{budget:?}: {err}");
+        assert!(stdout.contains("nodes"), "{stdout}");
+        assert_eq!(std::fs::read(&out).unwrap(), expected, "{budget:?}");
+    }
+    let (ok, _, err) = ktree(&[
+        "build",
+        "--rays",
+        rays.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--max-memory",
+        "lots",
+    ]);
+    assert!(!ok && err.contains("'lots' is not a size"), "{err}");
+}
+
+#[test]
+fn a_budget_too_small_names_one_that_works() {
+    let dir = tempfile::tempdir().unwrap();
+    let rays = ball_rays(dir.path(), 7);
+    let expected = in_memory_bytes(&rays);
+    let out = dir.path().join("ball.ktree");
+    std::fs::write(&out, b"old").unwrap();
+    let rays_bytes = {
+        let AnyRaySet::K3(r) = read_rays_file(&rays).unwrap() else {
+            panic!("K = 3 rays")
+        };
+        16 * r.len() as u64
+    };
+    // The rays alone do not fit.
+    let (ok, _, err) = ktree(&[
+        "build",
+        "--rays",
+        rays.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--max-memory",
+        "1K",
+    ]);
+    assert!(
+        !ok && err.contains("ball7.rays") && err.contains("--max-memory"),
+        "{err}"
+    );
+    // The rays fit, a slab does not.
+    let budget = (rays_bytes + 1000).to_string();
+    let (ok, _, err) = ktree(&[
+        "build",
+        "--rays",
+        rays.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--max-memory",
+        &budget,
+    ]);
+    assert!(!ok && err.contains("too small"), "{err}");
+    let needed: u64 = err
+        .split("at least ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no budget named: {err}"));
+    assert_eq!(std::fs::read(&out).unwrap(), b"old");
+    assert_eq!(entries(dir.path()), vec!["ball.ktree", "ball7.rays"]);
+    let budget = (needed + rays_bytes).to_string();
+    let (ok, _, err) = ktree(&[
+        "build",
+        "--rays",
+        rays.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--max-memory",
+        &budget,
+    ]);
+    assert!(ok, "with the budget named ({budget}): {err}");
+    assert_eq!(std::fs::read(&out).unwrap(), expected);
+}
+
+#[test]
+fn an_unusable_temporary_folder_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let rays = ball_rays(dir.path(), 6);
+    let out = dir.path().join("ball.ktree");
+    std::fs::write(&out, b"old").unwrap();
+    // A plain file where the folder should be: nobody, not even root, can create files in it.
+    let not_a_folder = dir.path().join("not-a-folder");
+    std::fs::write(&not_a_folder, b"").unwrap();
+    for args in [
+        vec!["build", "--rays", rays.to_str().unwrap()],
+        vec!["rays", "--level", "6", "--radius", "20"],
+    ] {
+        let mut args = args.clone();
+        args.extend([
+            "--out",
+            out.to_str().unwrap(),
+            "--temp-dir",
+            not_a_folder.to_str().unwrap(),
+        ]);
+        let (ok, _, err) = ktree(&args);
+        assert!(
+            !ok && err.contains("not-a-folder") && err.contains("temporary folder"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(std::fs::read(&out).unwrap(), b"old");
+        assert_eq!(
+            entries(dir.path()),
+            vec!["ball.ktree", "ball6.rays", "not-a-folder"]
+        );
+    }
+}
+
+#[test]
+fn rays_and_voxelize_build_out_of_core_with_progress() {
+    let dir = tempfile::tempdir().unwrap();
+    let rays = ball_rays(dir.path(), 6);
+    let expected = in_memory_bytes(&rays);
+    let out = dir.path().join("direct.ktree");
+    let (ok, stdout, err) = ktree(&[
+        "rays",
+        "--level",
+        "6",
+        "--radius",
+        "28",
+        "--out",
+        out.to_str().unwrap(),
+        "--max-memory",
+        "64M",
+        "--progress",
+        "--threads",
+        "2",
+    ]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("voxels -> "), "{stdout}");
+    assert_eq!(std::fs::read(&out).unwrap(), expected);
+    // A mesh: the same tree as the in-memory build of its rays.
+    let mesh = common::data_dir().join("meshes/fandisk.obj");
+    let mesh_rays = dir.path().join("bunny.rays");
+    let mesh_tree = dir.path().join("bunny.ktree");
+    for out in [&mesh_rays, &mesh_tree] {
+        let (ok, _, err) = ktree(&[
+            "voxelize",
+            mesh.to_str().unwrap(),
+            "--level",
+            "6",
+            "--fit",
+            "--out",
+            out.to_str().unwrap(),
+            "--max-memory",
+            "256M",
+            "--progress",
+        ]);
+        assert!(ok, "{err}");
+    }
+    assert_eq!(
+        std::fs::read(&mesh_tree).unwrap(),
+        in_memory_bytes(&mesh_rays)
+    );
+}
+
+/// `ktree rays` writes a ray file slab by slab: the file is the whole set's, so building it gives the tree
+/// `ktree rays` writes directly; at L = 12 a quadric's ray count passes no cap.
+#[test]
+fn ray_files_are_written_slab_by_slab() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    let solid = [
+        "--solid",
+        "ellipsoid",
+        "--radii",
+        "30,21.5,17",
+        "--level",
+        "6",
+    ];
+    for out in [p("e.rays"), p("e.ktree")] {
+        let mut args = vec!["rays"];
+        args.extend(solid);
+        args.extend(["--out", &out, "--progress"]);
+        let (ok, _, err) = ktree(&args);
+        assert!(ok, "{err}");
+    }
+    let whole = {
+        use ktree::solid::{Frame, Quadric, Rational, Sample, Solid};
+        let r = |n, d| Rational::new(n, d).unwrap();
+        let q =
+            Quadric::<3>::ellipsoid([r(32, 1); 3], [r(30, 1), r(43, 2), r(17, 1)], Frame::Voxel)
+                .unwrap();
+        let mut text = Vec::new();
+        ktree::io::write_rays(
+            &mut text,
+            &Solid::Quadric(q).to_rays(6, Sample::Centre, false).unwrap(),
+        )
+        .unwrap();
+        text
+    };
+    assert_eq!(std::fs::read(p("e.rays")).unwrap(), whole);
+    let (ok, _, err) = ktree(&["build", "--rays", &p("e.rays"), "--out", &p("f.ktree")]);
+    assert!(ok, "{err}");
+    assert_eq!(
+        std::fs::read(p("f.ktree")).unwrap(),
+        std::fs::read(p("e.ktree")).unwrap()
+    );
+}
+
+#[test]
+fn op_checks_its_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let rays = ball_rays(dir.path(), 6);
+    let a = dir.path().join("a.ktree");
+    let (ok, _, err) = ktree(&[
+        "build",
+        "--rays",
+        rays.to_str().unwrap(),
+        "--out",
+        a.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let c = dir.path().join("c.ktree");
+    let (ok, _, err) = ktree(&[
+        "op",
+        "not",
+        a.to_str().unwrap(),
+        "--out",
+        c.to_str().unwrap(),
+        "--max-memory",
+        "100",
+    ]);
+    assert!(
+        !ok && err.contains("a.ktree") && err.contains("--max-memory"),
+        "{err}"
+    );
+    assert!(!c.exists());
+    let (ok, _, err) = ktree(&[
+        "op",
+        "union",
+        a.to_str().unwrap(),
+        a.to_str().unwrap(),
+        "--out",
+        c.to_str().unwrap(),
+        "--max-memory",
+        "1G",
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!(std::fs::read(&c).unwrap(), std::fs::read(&a).unwrap());
+}
+
+/// A small tmpfs mounted for the test (needs root and `mount`), in a temporary folder kept while it is
+/// mounted; `None` where that is not allowed.
+struct SmallDisk(PathBuf, #[allow(dead_code)] tempfile::TempDir);
+
+impl SmallDisk {
+    fn mount(size: &str) -> Option<Self> {
+        let dir = tempfile::tempdir().ok()?;
+        let mnt = dir.path().join("disk");
+        std::fs::create_dir(&mnt).ok()?;
+        let ok = Command::new("mount")
+            .args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"])
+            .arg(&mnt)
+            .output()
+            .is_ok_and(|o| o.status.success());
+        ok.then_some(Self(mnt, dir))
+    }
+}
+
+impl Drop for SmallDisk {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.0).status();
+    }
+}
+
+#[test]
+fn a_full_temporary_disk_is_a_clear_error() {
+    let Some(disk) = SmallDisk::mount("64k") else {
+        eprintln!("SKIPPED a_full_temporary_disk_is_a_clear_error: cannot mount a tmpfs here (needs root)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let rays = ball_rays(dir.path(), 9);
+    let out = dir.path().join("ball.ktree");
+    std::fs::write(&out, b"old").unwrap();
+    let (ok, _, err) = ktree(&[
+        "build",
+        "--rays",
+        rays.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--temp-dir",
+        disk.0.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("spill file") && err.contains("No space left"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&out).unwrap(), b"old");
+    assert!(entries(&disk.0).is_empty(), "{:?}", entries(&disk.0));
+    assert_eq!(entries(dir.path()), vec!["ball.ktree", "ball9.rays"]);
+}

@@ -1,0 +1,238 @@
+//! Out-of-core stacking writes, for K = 1 … 4 and every split depth, exactly the bytes of the tree built in
+//! memory (and equal to naive insertion) written as a `.ktree` version 2 file; with a budget too small it
+//! names a budget that works, and the build then keeps to it; it leaves no
+//! temporary file behind and the target untouched on failure; and the file does not depend on the number
+//! of threads.
+
+use std::path::Path;
+
+use ktree::io::write_ktree_v2;
+use ktree::reference::{Dim, Fanout, NaiveTree};
+use ktree::stacking::{stack, stack_to_file, OutOfCore, OutOfCoreError, RaySource};
+use ktree::RaySet;
+use ktree_verify::cases::{ray_sets, Case};
+use proptest::prelude::*;
+
+/// The bytes the in-memory build writes.
+fn in_memory_bytes<const K: usize>(rays: &RaySet<K>) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    write_ktree_v2(&mut bytes, &stack(rays)).unwrap();
+    bytes
+}
+
+/// The names in a folder (temporary files and folders included).
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+fn needed_of<E: std::fmt::Debug>(e: OutOfCoreError<E>) -> Result<u64, TestCaseError> {
+    match e {
+        OutOfCoreError::BudgetTooSmall { needed, .. } => Ok(needed),
+        other => Err(TestCaseError::fail(format!(
+            "expected a budget error, got {other:?}"
+        ))),
+    }
+}
+
+fn out_of_core_agrees<const K: usize, S>(source: &S, expected: &[u8]) -> Result<(), TestCaseError>
+where
+    S: RaySource<K>,
+    S::Error: std::fmt::Display + std::fmt::Debug,
+{
+    let level = source.universe().level();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tree.ktree");
+    for depth in 0..=level {
+        let report = stack_to_file(source, &out, &OutOfCore::new(depth, u64::MAX), &|_| {})
+            .map_err(|e| TestCaseError::fail(format!("depth {depth}: {e}")))?;
+        let written = std::fs::read(&out).unwrap();
+        prop_assert!(
+            written == expected,
+            "split depth {}: the out-of-core file differs from the in-memory one",
+            depth
+        );
+        prop_assert_eq!(report.file_bytes, written.len() as u64);
+        // A budget of nothing: refused, naming the smallest budget that works.
+        std::fs::write(&out, b"old").unwrap();
+        let needed = needed_of(
+            stack_to_file(source, &out, &OutOfCore::new(depth, 0), &|_| {}).unwrap_err(),
+        )?;
+        prop_assert_eq!(std::fs::read(&out).unwrap(), b"old".to_vec());
+        let report = stack_to_file(source, &out, &OutOfCore::new(depth, needed), &|_| {})
+            .map_err(|e| TestCaseError::fail(format!("depth {depth}, budget {needed}: {e}")))?;
+        prop_assert!(report.peak_accounted_bytes <= needed);
+        prop_assert!(
+            std::fs::read(&out).unwrap() == expected,
+            "split depth {}: the file written at the smallest budget differs",
+            depth
+        );
+        prop_assert_eq!(entries(dir.path()), vec!["tree.ktree".to_string()]);
+    }
+    Ok(())
+}
+
+fn rays_agree<const K: usize>(case: &Case<K>) -> Result<(), TestCaseError>
+where
+    Dim<K>: Fanout,
+{
+    let rays = &case.rays;
+    prop_assert!(
+        stack(rays) == NaiveTree::from_rays(rays).unwrap().to_tree(),
+        "stacking and naive insertion differ"
+    );
+    out_of_core_agrees::<K, _>(rays, &in_memory_bytes(rays))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn out_of_core_equals_in_memory_k1(case in ray_sets::<1>()) { rays_agree(&case)?; }
+    #[test]
+    fn out_of_core_equals_in_memory_k2(case in ray_sets::<2>()) { rays_agree(&case)?; }
+    #[test]
+    fn out_of_core_equals_in_memory_k3(case in ray_sets::<3>()) { rays_agree(&case)?; }
+    #[test]
+    fn out_of_core_equals_in_memory_k4(case in ray_sets::<4>()) { rays_agree(&case)?; }
+
+    #[test]
+    fn solids_out_of_core(c in prop::array::uniform3(-8i64..72), r in 1i64..60) {
+        use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
+        let ball = Solid::Quadric(Quadric::<3>::ball(
+            c.map(|v| Rational::new(v, 2).unwrap()),
+            Rational::new(r, 2).unwrap(),
+            Frame::Voxel,
+        ).unwrap());
+        let source = SolidSource::new(&ball, 5, Sample::Centre).unwrap();
+        let expected = in_memory_bytes(&ball.to_rays(5, Sample::Centre, false).unwrap());
+        out_of_core_agrees::<3, _>(&source, &expected)?;
+    }
+}
+
+/// The file is the same for any number of threads and any budget that lets several slabs run at once.
+#[test]
+fn any_thread_count_and_budget_give_the_same_file() {
+    let level = 7;
+    let u = 1i64 << level;
+    let rays = ktree::rays::ball_rays::<3>(level, [u, u, u], u - 3).unwrap();
+    let expected = in_memory_bytes(&rays);
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ball.ktree");
+    for threads in [1, 2, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        for depth in [1, 3, 5] {
+            for budget in [u64::MAX, 4 << 20] {
+                let report = pool
+                    .install(|| stack_to_file(&rays, &out, &OutOfCore::new(depth, budget), &|_| {}))
+                    .unwrap();
+                assert_eq!(
+                    std::fs::read(&out).unwrap(),
+                    expected,
+                    "{threads} threads, depth {depth}"
+                );
+                assert!(report.peak_accounted_bytes <= budget);
+            }
+        }
+    }
+}
+
+/// Progress reaches every slab and every level, in order.
+#[test]
+fn progress_counts_slabs_then_levels() {
+    let rays = ktree::rays::ball_rays::<3>(6, [64, 64, 64], 50).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let seen = std::sync::Mutex::new(Vec::new());
+    let report = stack_to_file(
+        &rays,
+        &dir.path().join("b.ktree"),
+        &OutOfCore::new(3, u64::MAX),
+        &|p| seen.lock().unwrap().push(p),
+    )
+    .unwrap();
+    let seen = seen.into_inner().unwrap();
+    use ktree::stacking::Stage;
+    let stacking: Vec<_> = seen.iter().filter(|p| p.stage == Stage::Stacking).collect();
+    let writing: Vec<_> = seen.iter().filter(|p| p.stage == Stage::Writing).collect();
+    assert_eq!(stacking.first().unwrap().done, 0);
+    assert_eq!(stacking.last().unwrap().done, stacking[0].total);
+    assert!(stacking.windows(2).all(|w| w[0].done < w[1].done));
+    assert_eq!(
+        writing.last().unwrap().done,
+        report.counts_per_level.len() as u64
+    );
+    assert_eq!(writing.last().unwrap().total, writing.last().unwrap().done);
+}
+
+/// A temporary folder that cannot hold files is a clear error naming it; the target is untouched and
+/// nothing is left behind.
+#[test]
+fn an_unusable_temporary_folder_is_a_clear_error() {
+    let rays = ktree::rays::ball_rays::<2>(6, [64, 64], 50).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b.ktree");
+    std::fs::write(&out, b"old").unwrap();
+    // A plain file where the folder should be: no one, not even root, can create files in it.
+    let not_a_folder = dir.path().join("not-a-folder");
+    std::fs::write(&not_a_folder, b"").unwrap();
+    let options = OutOfCore {
+        temp_dir: Some(not_a_folder.clone()),
+        ..OutOfCore::new(3, u64::MAX)
+    };
+    let e = stack_to_file(&rays, &out, &options, &|_| {}).unwrap_err();
+    assert!(
+        matches!(e, OutOfCoreError::TempDir { .. }),
+        "unexpected error {e:?}"
+    );
+    let message = e.to_string();
+    assert!(message.contains("not-a-folder"), "{message}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"old");
+    assert_eq!(entries(dir.path()), vec!["b.ktree", "not-a-folder"]);
+}
+
+/// Small objects in universes of the largest level for each K, split anywhere: the file is the in-memory
+/// one.
+#[test]
+fn extreme_levels_split_anywhere() {
+    fn check<const K: usize>() {
+        let level = ktree::max_level(K);
+        let side = 1u64 << level;
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let rays: Vec<ktree::Ray<K>> = (0..6)
+            .map(|_| {
+                let start: [u32; K] = std::array::from_fn(|_| (next() % side) as u32);
+                let z2 = (u64::from(start[K - 1]) + 1 + next() % 40).min(side);
+                ktree::Ray::new(start, z2 as u32)
+            })
+            .collect();
+        let set = RaySet::from_rays(level, rays).unwrap();
+        let expected = in_memory_bytes(&set);
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("t.ktree");
+        for depth in [0, 1, level / 2, level - 1, level] {
+            stack_to_file(&set, &out, &OutOfCore::new(depth, u64::MAX), &|_| {}).unwrap();
+            assert_eq!(
+                std::fs::read(&out).unwrap(),
+                expected,
+                "K={K} depth {depth}"
+            );
+        }
+    }
+    check::<1>();
+    check::<2>();
+    check::<3>();
+    check::<4>();
+}
