@@ -90,6 +90,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             let _ = std::fs::remove_file(&path);
             facts.push(("rays".into(), rays.to_string()));
             facts.push(("nodes".into(), tree.node_count().to_string()));
+            facts.push(("voxels".into(), tree.voxel_count().to_string()));
             facts.push(("file_bytes".into(), bytes.to_string()));
             s
         }
