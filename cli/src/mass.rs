@@ -1,8 +1,11 @@
 //! `ktree mass A [--tolerance t] [--json]`: volume, centroid and second moments of a `.ktree` file; with
-//! `--tolerance`, Meagher's progressive bounds level by level, stopping when the tolerance is met.
+//! `--tolerance`, Meagher's progressive bounds level by level, stopping when the tolerance is met. The
+//! exact properties of a version 2 file are summed from its memory map, leaf by leaf, so a tree larger
+//! than memory is measured without being loaded.
 
 use std::path::PathBuf;
 
+use ktree::io::{ktree_file_version, KtreeView, VERSION_2};
 use ktree::ops;
 use ktree::KTree;
 use serde::Serialize;
@@ -43,6 +46,22 @@ struct Report {
     estimate: Option<f64>,
 }
 
+/// The exact properties of a memory-mapped version 2 file, from its leaves.
+fn view_report<const K: usize>(view: &KtreeView) -> Result<Report, String> {
+    let m = ops::mass_of_leaves(view.level(), |visit| view.for_each_leaf::<K>(visit))
+        .map_err(|e| e.to_string())?;
+    Ok(Report {
+        k: K,
+        volume: m.volume,
+        centroid: m.centroid.to_vec(),
+        central_moments: m.central_moments.iter().map(|r| r.to_vec()).collect(),
+        inertia_tensor: m.inertia_tensor().iter().map(|r| r.to_vec()).collect(),
+        nodes: view.node_count(),
+        progressive: None,
+        estimate: None,
+    })
+}
+
 fn report<const K: usize>(t: &KTree<K>, tolerance: Option<f64>) -> Report {
     let m = ops::mass_properties(t);
     let progressive = tolerance.map(|tol| ops::mass_progressive(t, tol));
@@ -75,8 +94,20 @@ pub fn run(args: Args) -> Result<(), String> {
             return Err(format!("--tolerance must be a number ≥ 0, got {t}"));
         }
     }
-    let tree = read(&args.tree)?;
-    let r = ktree::with_dim!(&tree, AnyTree, t => report(t, args.tolerance));
+    let mapped = args.tolerance.is_none()
+        && ktree_file_version(&args.tree).map_err(|e| e.to_string())? == VERSION_2;
+    let r = if mapped {
+        let view = KtreeView::open(&args.tree).map_err(|e| e.to_string())?;
+        match view.k() {
+            1 => view_report::<1>(&view)?,
+            2 => view_report::<2>(&view)?,
+            3 => view_report::<3>(&view)?,
+            _ => view_report::<4>(&view)?,
+        }
+    } else {
+        let tree = read(&args.tree)?;
+        ktree::with_dim!(&tree, AnyTree, t => report(t, args.tolerance))
+    };
     if args.json {
         println!(
             "{}",

@@ -1,6 +1,7 @@
 //! `--format-version`: the commands that write trees write `.ktree` version 2 by default and version 1 on
 //! request; `stats` reads both (version 2 through a memory map) and prints the same counts; a damaged
-//! version 2 file is an error naming the level's section and its byte offset.
+//! version 2 file is an error naming the level's section and its byte offset; `mass` of a version 2 file,
+//! summed from its memory map, equals `mass` of the same tree loaded from version 1, in K = 2, 3 and 4.
 
 mod common;
 
@@ -56,4 +57,33 @@ fn both_versions_are_written_and_read_alike() {
     assert!(!ok);
     assert!(err.contains(&format!("byte {offset}")), "{err}");
     assert!(err.contains(&format!("level {}", depth - 1)), "{err}");
+}
+
+#[test]
+fn mass_of_a_mapped_file_equals_mass_of_the_loaded_tree() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in ["2", "3", "4"] {
+        let v2 = dir.path().join(format!("v2-{k}.ktree"));
+        let v1 = dir.path().join(format!("v1-{k}.ktree"));
+        let args = [
+            "rays", "-k", k, "--solid", "ball", "--radius", "9", "--level", "5", "--out",
+        ];
+        for (version, path) in [("2", &v2), ("1", &v1)] {
+            let (ok, _, err) = ktree(
+                &[
+                    &["--format-version", version],
+                    &args[..],
+                    &[path.to_str().unwrap()],
+                ]
+                .concat(),
+            );
+            assert!(ok, "{err}");
+        }
+        let (ok2, mapped, err) = ktree(&["mass", v2.to_str().unwrap(), "--json"]);
+        assert!(ok2, "{err}");
+        let (ok1, loaded, err) = ktree(&["mass", v1.to_str().unwrap(), "--json"]);
+        assert!(ok1, "{err}");
+        assert_eq!(mapped, loaded, "K = {k}");
+        assert!(mapped.contains("\"volume\""), "{mapped}");
+    }
 }

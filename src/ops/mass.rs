@@ -11,6 +11,9 @@
 //! that a small object far from the origin keeps its central moments exact to `f64` precision (summed
 //! about the origin, they would cancel).
 
+use std::convert::Infallible;
+
+use crate::space::Cell;
 use crate::tree::{KTree, NodeState};
 
 /// Exact volume, centroid and second moments of an object.
@@ -159,13 +162,42 @@ impl<const K: usize> Sums<K> {
 /// assert_eq!(m.centroid, [1.0, 0.5]);
 /// ```
 pub fn mass_properties<const K: usize>(tree: &KTree<K>) -> MassProperties<K> {
-    let mut per_depth = vec![SizeSums::<K>::new(); tree.depth_count()];
-    tree.for_each_leaf(|cell, state| {
+    let walk = |visit: &mut dyn FnMut(Cell<K>, NodeState)| {
+        tree.for_each_leaf(visit);
+        Ok::<(), Infallible>(())
+    };
+    match mass_of_leaves(tree.level(), walk) {
+        Ok(m) => m,
+        Err(never) => match never {},
+    }
+}
+
+/// [`mass_properties`] of the leaves that `walk` reports (each leaf once, in any order) for a universe of
+/// level `level`: for trees that are not held in memory, such as a memory-mapped `.ktree`
+/// ([`KtreeView::for_each_leaf`](crate::io::KtreeView::for_each_leaf)).
+///
+/// ```
+/// use ktree::{KTree, ops::{mass_of_leaves, mass_properties}};
+/// let a = KTree::<2>::from_dense(2, &[true; 16]).unwrap();
+/// let walk = |visit: &mut dyn FnMut(_, _)| {
+///     a.for_each_leaf(visit);
+///     Ok::<(), ()>(())
+/// };
+/// assert_eq!(mass_of_leaves(a.level(), walk), Ok(mass_properties(&a)));
+/// ```
+///
+/// # Errors
+/// The walk's.
+pub fn mass_of_leaves<const K: usize, E>(
+    level: u32,
+    walk: impl FnOnce(&mut dyn FnMut(Cell<K>, NodeState)) -> Result<(), E>,
+) -> Result<MassProperties<K>, E> {
+    let mut per_depth = vec![SizeSums::<K>::new(); level as usize + 1];
+    walk(&mut |cell, state| {
         if state == NodeState::Full {
             per_depth[cell.level as usize].add(cell.origin);
         }
-    });
-    let level = tree.level();
+    })?;
     let sum_about = |reference: [i128; K]| {
         let mut sums = Sums::<K>::about(reference);
         for (depth, cells) in per_depth.iter().enumerate() {
@@ -197,11 +229,11 @@ pub fn mass_properties<const K: usize>(tree: &KTree<K>) -> MassProperties<K> {
             raw - v * relative[a] * relative[b]
         })
     });
-    MassProperties {
+    Ok(MassProperties {
         volume: sums.volume,
         centroid,
         central_moments,
-    }
+    })
 }
 
 /// Bounds after one level of the progressive computation.

@@ -17,7 +17,7 @@
 //! | the same with integer additions and shifts only (M5, M8) | [`transform_fixed`] | overlay engine, fixed-point cell images updated incrementally | output-sensitive |
 //! | perspective deformation (M6) | [`transform_projective`] with a [`Projective`] map, e.g. [`Projective::perspective`] | overlay engine, voxel-exact | output-sensitive |
 //! | interference (M14) | [`interferes`], [`overlap_cells`], [`first_contact`], [`min_separation`] | simultaneous traversal, early exit; branch and bound | at most linear |
-//! | mass (M10) | [`mass_properties`], [`mass_progressive`] | exact integer moment sums; level-by-level bounds | linear; stops early |
+//! | mass (M10) | [`mass_properties`], [`mass_of_leaves`], [`mass_progressive`] | exact integer moment sums; level-by-level bounds | linear; stops early |
 //! | complexity (M9) | [`complexity`], [`over_translations`], [`over_placements`], [`over_maps`], [`bounding_box`], [`normalise_to_origin`] | node counts | one operation per placement |
 //!
 //! ```
@@ -56,7 +56,9 @@ pub use complexity::{
 pub use error::OpsError;
 pub use fixed::{transform_fixed, FixedAffine};
 pub use interference::{first_contact, interferes, overlap_cells};
-pub use mass::{mass_progressive, mass_properties, LevelBounds, MassProperties, ProgressiveMass};
+pub use mass::{
+    mass_of_leaves, mass_progressive, mass_properties, LevelBounds, MassProperties, ProgressiveMass,
+};
 pub use perspective::{transform_projective, Projective};
 pub use rotate::{rotate_axes, AxisMap};
 pub use scale::{grow, scale, zoom};
