@@ -4,6 +4,9 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(placed) = ktree::io::read_bt(data, "fuzz", None, None, false) {
-        placed.tree.check().expect("a tree from a reader is well formed");
+        placed
+            .tree
+            .check()
+            .expect("a tree from a reader is well formed");
     }
 });

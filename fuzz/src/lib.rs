@@ -2,9 +2,14 @@
 
 use std::path::Path;
 
-use ktree::io::{read_ktree_any, read_rays, write_ktree, write_rays, AnyRaySet, AnyTree};
+use arbitrary::Arbitrary;
+use ktree::io::{
+    read_ktree_any, read_rays, write_ktree, write_ktree_v2, write_rays, AnyRaySet, AnyTree,
+    KtreeFileError, KtreeView,
+};
 use ktree::solid::mesh::{Placement, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
+use ktree::{max_level, KTree, Universe};
 
 /// The largest level at which accepted inputs are voxelized or stacked (keeps one execution fast).
 pub const CHECK_LEVEL: u32 = 5;
@@ -13,6 +18,13 @@ pub const CHECK_LEVEL: u32 = 5;
 pub fn ktree_bytes(tree: &AnyTree) -> Vec<u8> {
     let mut bytes = Vec::new();
     ktree::with_dim!(tree, AnyTree, t => write_ktree(&mut bytes, t)).expect("writing to memory");
+    bytes
+}
+
+/// The `.ktree` version 2 bytes of a tree.
+pub fn ktree_v2_bytes(tree: &AnyTree) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    ktree::with_dim!(tree, AnyTree, t => write_ktree_v2(&mut bytes, t)).expect("writing to memory");
     bytes
 }
 
@@ -43,6 +55,76 @@ pub fn check_accepted_ktree(bytes: &[u8], tree: &AnyTree) {
     );
     let reread = read_ktree_any(&again, "rewritten").expect("a written tree reads back");
     assert_eq!(&reread, tree);
+}
+
+/// A `.ktree` version 2 file that was accepted: it is a checked tree, it is the one file that tree writes
+/// (version 2 is canonical too: padding, rank samples, counts and checksums are all checked), and the
+/// memory-mapped view of the same bytes gives the same tree.
+pub fn check_accepted_ktree_v2(bytes: &[u8], tree: &AnyTree) {
+    crate::check_tree(tree);
+    let again = ktree_v2_bytes(tree);
+    assert_eq!(
+        again, bytes,
+        "an accepted .ktree v2 file is not what its tree writes"
+    );
+    let reread = read_ktree_any(&again, "rewritten").expect("a written tree reads back");
+    assert_eq!(&reread, tree);
+    let view = KtreeView::from_bytes(again, "rewritten").expect("a written tree opens as a view");
+    assert_eq!(view.counts_per_level(), tree.counts_per_level());
+    let from_view = ktree::with_dim!(tree, AnyTree, t => view_tree(&view).is_ok_and(|v| &v == t));
+    assert!(from_view, "the view of an accepted file gives another tree");
+}
+
+/// The tree of a view, of the view's dimension `K`.
+pub fn view_tree<const K: usize>(view: &KtreeView) -> Result<KTree<K>, KtreeFileError> {
+    view.to_tree::<K>()
+}
+
+/// Opens `bytes` as a memory-mapped `.ktree` view: written to a file of this process in the temporary
+/// folder, mapped, and the file removed again (the map stays valid).
+pub fn open_mapped(bytes: &[u8]) -> Result<KtreeView, KtreeFileError> {
+    let path = std::env::temp_dir().join(format!("ktree-fuzz-{}.ktree", std::process::id()));
+    std::fs::write(&path, bytes).expect("writing a temporary file");
+    let view = KtreeView::open(&path);
+    std::fs::remove_file(&path).expect("removing a temporary file");
+    view
+}
+
+/// The largest number of nodes [`arbitrary_tree`] decides (keeps one execution fast).
+pub const MAX_SHAPE_NODES: usize = 4096;
+
+/// A tree of a level-`level` universe (`level ≤ max_level(K)`) described by `shape`: a depth-first walk
+/// from the root in which each byte decides a node — 0 mod 3 empty, 1 full, 2 divided into its `2^K`
+/// children (a divided voxel is full) — and nodes beyond the bytes, or beyond [`MAX_SHAPE_NODES`], are
+/// empty. Siblings all alike are merged, so every reduced tree of the universe has a description.
+pub fn arbitrary_tree<const K: usize>(level: u32, shape: &[u8]) -> KTree<K> {
+    let universe = Universe::<K>::new(level).expect("a level of the universe");
+    let mut cells = Vec::new();
+    let mut bytes = shape.iter().take(MAX_SHAPE_NODES);
+    let mut stack = vec![universe.root()];
+    while let Some(cell) = stack.pop() {
+        match bytes.next().map(|b| b % 3) {
+            Some(1) => cells.push(cell),
+            Some(2) if cell.log_side() > 0 => {
+                stack.extend((0..1 << K).rev().map(|code| cell.child(code)))
+            }
+            Some(2) => cells.push(cell),
+            _ => {}
+        }
+    }
+    KTree::from_cells(universe, &cells).expect("disjoint cells of the universe")
+}
+
+/// [`arbitrary_tree`] of dimension `K = 1 + k mod 4`, at `level` reduced modulo `max_level(K) + 1`.
+pub fn arbitrary_any_tree(k: u8, level: u8, shape: &[u8]) -> AnyTree {
+    let k = 1 + usize::from(k % 4);
+    let level = u32::from(level) % (max_level(k) + 1);
+    match k {
+        1 => AnyTree::from(arbitrary_tree::<1>(level, shape)),
+        2 => AnyTree::from(arbitrary_tree::<2>(level, shape)),
+        3 => AnyTree::from(arbitrary_tree::<3>(level, shape)),
+        _ => AnyTree::from(arbitrary_tree::<4>(level, shape)),
+    }
 }
 
 /// The invariants of a tree that a reader returned.
@@ -98,5 +180,213 @@ pub fn split_at_nul(data: &[u8]) -> (&[u8], &[u8]) {
     match data.iter().position(|&b| b == 0) {
         Some(i) => (&data[..i], &data[i + 1..]),
         None => (data, &[]),
+    }
+}
+
+/// A number written into a text header: integers and floats of any size, or any text in its place.
+#[derive(Debug, Arbitrary)]
+pub enum Number {
+    /// A signed integer.
+    Int(i64),
+    /// An unsigned integer.
+    Big(u64),
+    /// A float (`NaN`, `inf` and subnormals included).
+    Float(f64),
+    /// Any text.
+    Text(String),
+}
+
+impl std::fmt::Display for Number {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Number::Int(v) => write!(f, "{v}"),
+            Number::Big(v) => write!(f, "{v}"),
+            Number::Float(v) => write!(f, "{v}"),
+            Number::Text(v) => write!(f, "{v}"),
+        }
+    }
+}
+
+/// An edit of the lines of a text header (`keyword` picks one of the format's keywords).
+#[derive(Debug, Arbitrary)]
+pub enum HeaderEdit {
+    /// Line `at` becomes a keyword followed by numbers.
+    Replace {
+        /// The line.
+        at: u8,
+        /// The keyword's index.
+        keyword: u8,
+        /// What follows it.
+        numbers: Vec<Number>,
+    },
+    /// A keyword line inserted before line `at`.
+    Insert {
+        /// The line.
+        at: u8,
+        /// The keyword's index.
+        keyword: u8,
+        /// What follows it.
+        numbers: Vec<Number>,
+    },
+    /// Line `at` becomes any text.
+    Text {
+        /// The line.
+        at: u8,
+        /// Its new text.
+        text: String,
+    },
+    /// A line removed.
+    Drop(u8),
+    /// A line repeated.
+    Duplicate(u8),
+    /// Two lines exchanged.
+    Swap(u8, u8),
+}
+
+/// An edit of binary data counted in units of `unit` bytes (a run-length pair, a node, a word).
+#[derive(Debug, Arbitrary)]
+pub enum BodyEdit {
+    /// Bits of a byte flipped.
+    Xor {
+        /// The byte.
+        at: u16,
+        /// The bits.
+        mask: u8,
+    },
+    /// A byte set.
+    Set {
+        /// The byte.
+        at: u16,
+        /// Its value.
+        value: u8,
+    },
+    /// Units removed.
+    Drop {
+        /// The first unit.
+        at: u16,
+        /// How many.
+        len: u8,
+    },
+    /// Units repeated right after themselves.
+    Duplicate {
+        /// The first unit.
+        at: u16,
+        /// How many.
+        len: u8,
+    },
+    /// Bytes cut from the end.
+    Truncate(u16),
+    /// Bytes appended.
+    Append(Vec<u8>),
+}
+
+/// A file made of text header lines (the last one `data`) and a binary body: binvox and OctoMap `.bt`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextHeaderFile {
+    /// The header lines, without their newlines.
+    pub lines: Vec<String>,
+    /// Everything after the header.
+    pub body: Vec<u8>,
+}
+
+impl TextHeaderFile {
+    /// Splits a written file after its first line that is exactly `data`.
+    pub fn split(bytes: &[u8]) -> Self {
+        let mut lines = Vec::new();
+        let mut at = 0;
+        while let Some(len) = bytes[at..].iter().position(|&b| b == b'\n') {
+            let line = String::from_utf8(bytes[at..at + len].to_vec()).expect("a text header");
+            at += len + 1;
+            let last = line == "data";
+            lines.push(line);
+            if last {
+                break;
+            }
+        }
+        Self {
+            lines,
+            body: bytes[at..].to_vec(),
+        }
+    }
+
+    /// The file's bytes.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        for line in &self.lines {
+            bytes.extend_from_slice(line.as_bytes());
+            bytes.push(b'\n');
+        }
+        bytes.extend_from_slice(&self.body);
+        bytes
+    }
+
+    /// Applies a header edit; `keywords` are the format's line keywords.
+    pub fn edit_header(&mut self, edit: &HeaderEdit, keywords: &[&str]) {
+        let n = self.lines.len();
+        let line = |keyword: u8, numbers: &[Number]| {
+            let mut line = keywords[usize::from(keyword) % keywords.len()].to_string();
+            for number in numbers {
+                line.push(' ');
+                line.push_str(&number.to_string());
+            }
+            line
+        };
+        match edit {
+            HeaderEdit::Replace {
+                at,
+                keyword,
+                numbers,
+            } if n > 0 => self.lines[usize::from(*at) % n] = line(*keyword, numbers),
+            HeaderEdit::Insert {
+                at,
+                keyword,
+                numbers,
+            } => self
+                .lines
+                .insert(usize::from(*at) % (n + 1), line(*keyword, numbers)),
+            HeaderEdit::Text { at, text } if n > 0 => {
+                self.lines[usize::from(*at) % n] = text.clone()
+            }
+            HeaderEdit::Drop(at) if n > 0 => {
+                self.lines.remove(usize::from(*at) % n);
+            }
+            HeaderEdit::Duplicate(at) if n > 0 => {
+                let at = usize::from(*at) % n;
+                self.lines.insert(at, self.lines[at].clone());
+            }
+            HeaderEdit::Swap(a, b) if n > 0 => {
+                self.lines.swap(usize::from(*a) % n, usize::from(*b) % n)
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Applies an edit to binary data made of `unit`-byte units.
+pub fn edit_body(body: &mut Vec<u8>, edit: &BodyEdit, unit: usize) {
+    let units = body.len() / unit;
+    match edit {
+        BodyEdit::Xor { at, mask } if !body.is_empty() => {
+            let at = usize::from(*at) % body.len();
+            body[at] ^= mask;
+        }
+        BodyEdit::Set { at, value } if !body.is_empty() => {
+            let at = usize::from(*at) % body.len();
+            body[at] = *value;
+        }
+        BodyEdit::Drop { at, len } if units > 0 => {
+            let first = usize::from(*at) % units;
+            let end = (first + usize::from(*len)).min(units);
+            body.drain(first * unit..end * unit);
+        }
+        BodyEdit::Duplicate { at, len } if units > 0 => {
+            let first = usize::from(*at) % units;
+            let end = (first + usize::from(*len)).min(units);
+            let copy = body[first * unit..end * unit].to_vec();
+            body.splice(end * unit..end * unit, copy);
+        }
+        BodyEdit::Truncate(n) => body.truncate(body.len().saturating_sub(usize::from(*n))),
+        BodyEdit::Append(tail) => body.extend_from_slice(tail),
+        _ => {}
     }
 }

@@ -18,8 +18,8 @@
 use std::io::Write;
 
 use super::grid::{
-    place_boxes, GridBoxes, GridFileError, GridFileErrorKind, GridMeta, GridPlacement, IndexBox,
-    PlacedTree, MAX_GRID_RUNS,
+    max_grid_nodes, place_boxes, GridBoxes, GridFileError, GridFileErrorKind, GridMeta,
+    GridPlacement, IndexBox, PlacedTree, MAX_GRID_RUNS,
 };
 use crate::tree::KTree;
 
@@ -164,7 +164,7 @@ pub fn read_binvox(
     }
     let placement = GridPlacement::choose(boxes.known, offset, level)
         .map_err(|m| fail(0, GridFileErrorKind::GridPlacement(m)))?;
-    let tree = place_boxes(&boxes, &placement)
+    let tree = place_boxes(&boxes, &placement, max_grid_nodes(bytes.len()))
         .map_err(|m| fail(0, GridFileErrorKind::GridPlacement(m)))?;
     Ok(PlacedTree {
         tree,
@@ -277,11 +277,11 @@ pub fn write_binvox(mut w: impl Write, tree: &KTree<3>, meta: &GridMeta) -> std:
             ),
         ));
     }
-    let [tx, ty, tz] = meta.origin;
+    let [tx, ty, tz] = meta.origin.map(header_number);
+    let scale = header_number(meta.voxel_size * d as f64);
     write!(
         w,
-        "#binvox 1\ndim {d} {d} {d}\ntranslate {tx} {ty} {tz}\nscale {}\ndata\n",
-        meta.voxel_size * d as f64
+        "#binvox 1\ndim {d} {d} {d}\ntranslate {tx} {ty} {tz}\nscale {scale}\ndata\n"
     )?;
     let rays = super::tree_rays(tree);
     let side = d as usize;
@@ -309,6 +309,17 @@ pub fn write_binvox(mut w: impl Write, tree: &KTree<3>, meta: &GridMeta) -> std:
         }
     }
     enc.finish()
+}
+
+/// A number of the header in a form that reads back exactly and keeps the line short (header lines are
+/// at most 256 bytes): its plain digits, or with an exponent where those would be long (`1e300`).
+fn header_number(x: f64) -> String {
+    let plain = x.to_string();
+    if plain.len() <= 24 {
+        plain
+    } else {
+        format!("{x:e}")
+    }
 }
 
 struct RunEncoder<W: Write> {

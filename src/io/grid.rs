@@ -29,7 +29,8 @@ pub enum GridFileErrorKind {
     /// A valid file of a kind this reader does not support.
     #[error("unsupported: {0}")]
     Unsupported(String),
-    /// The grid does not fit the universe asked for (or any universe).
+    /// The grid does not fit the universe asked for (or any universe), or its octree there would have more
+    /// nodes than a file of its size may ask for.
     #[error("placement: {0}")]
     GridPlacement(String),
     /// The file could not be read.
@@ -192,12 +193,21 @@ impl GridPlacement {
     }
 }
 
-/// The octree of a grid's boxes placed in a universe. The boxes are disjoint (every grid format here
-/// describes each voxel once), so a cell is full exactly when the volumes of its overlaps with the boxes add
-/// up to its own: the tree is built top-down, reduced as it is made.
+/// The most nodes the octree of a grid file of `file_len` bytes may have: 2^20, plus 2^10 a byte. A box
+/// that the placement leaves unaligned (a large cell at an offset that is not a multiple of its side)
+/// costs nodes in proportion to its surface, so a file of a few bytes could otherwise ask for billions.
+pub(crate) fn max_grid_nodes(file_len: usize) -> u64 {
+    (1 << 20) + ((file_len as u64) << 10)
+}
+
+/// The octree of a grid's boxes placed in a universe, of at most `max_nodes` nodes (else an error). The
+/// boxes are disjoint (every grid format here describes each voxel once), so a cell is full exactly when
+/// the volumes of its overlaps with the boxes add up to its own: the tree is built top-down, reduced as it
+/// is made.
 pub(crate) fn place_boxes(
     boxes: &GridBoxes,
     placement: &GridPlacement,
+    max_nodes: u64,
 ) -> Result<KTree<3>, String> {
     let mut voxel_boxes = Vec::new();
     for (list, clip) in [(&boxes.inside, false), (&boxes.fill, true)] {
@@ -209,7 +219,22 @@ pub(crate) fn place_boxes(
     }
     let mut out = TreeAssembler::<3>::new(placement.level).map_err(|e| e.to_string())?;
     let all: Vec<u32> = (0..voxel_boxes.len() as u32).collect();
-    build(&mut out, [0; 3], placement.level, 0, &voxel_boxes, &all);
+    let mut budget = max_nodes;
+    if !build(
+        &mut out,
+        [0; 3],
+        placement.level,
+        0,
+        &voxel_boxes,
+        &all,
+        &mut budget,
+    ) {
+        return Err(format!(
+            "at offset {:?} in a level-{} universe the grid's octree has more than {max_nodes} nodes \
+             (2^20 + 2^10 a byte of the file): choose an offset that is a multiple of the grid's cell sides",
+            placement.offset, placement.level
+        ));
+    }
     Ok(out.finish())
 }
 
@@ -222,7 +247,12 @@ fn build(
     depth: usize,
     boxes: &[VoxelBox],
     candidates: &[u32],
-) {
+    budget: &mut u64,
+) -> bool {
+    if *budget == 0 {
+        return false;
+    }
+    *budget -= 1;
     let side = 1u64 << log_side;
     let mut covered = 0u128;
     let mut touching = Vec::new();
@@ -249,9 +279,20 @@ fn build(
         let half = 1u32 << (log_side - 1);
         for code in 0..8 {
             let child = std::array::from_fn(|a| lo[a] + if code >> a & 1 == 1 { half } else { 0 });
-            build(out, child, log_side - 1, depth + 1, boxes, &touching);
+            if !build(
+                out,
+                child,
+                log_side - 1,
+                depth + 1,
+                boxes,
+                &touching,
+                budget,
+            ) {
+                return false;
+            }
         }
     }
+    true
 }
 
 /// The runs along the last axis of a tree's full voxels: the ray set that stacks back to the tree.

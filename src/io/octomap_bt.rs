@@ -24,8 +24,8 @@
 use std::io::Write;
 
 use super::grid::{
-    place_boxes, GridBoxes, GridFileError, GridFileErrorKind, GridMeta, GridPlacement, IndexBox,
-    PlacedTree,
+    max_grid_nodes, place_boxes, GridBoxes, GridFileError, GridFileErrorKind, GridMeta,
+    GridPlacement, IndexBox, PlacedTree,
 };
 use crate::tree::{KTree, NodeRef, NodeState};
 
@@ -135,7 +135,7 @@ pub fn read_bt(
     }
     let placement = GridPlacement::choose(boxes.known, offset, level)
         .map_err(|m| fail(0, GridFileErrorKind::GridPlacement(m)))?;
-    let tree = place_boxes(&boxes, &placement)
+    let tree = place_boxes(&boxes, &placement, max_grid_nodes(bytes.len()))
         .map_err(|m| fail(0, GridFileErrorKind::GridPlacement(m)))?;
     Ok(PlacedTree {
         tree,

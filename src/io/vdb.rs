@@ -18,8 +18,8 @@ use std::collections::BTreeMap;
 use std::io::Write;
 
 use super::grid::{
-    place_boxes, GridBoxes, GridFileError, GridFileErrorKind, GridMeta, GridPlacement, IndexBox,
-    PlacedTree, MAX_GRID_RUNS,
+    max_grid_nodes, place_boxes, GridBoxes, GridFileError, GridFileErrorKind, GridMeta,
+    GridPlacement, IndexBox, PlacedTree, MAX_GRID_RUNS,
 };
 use crate::tree::{KTree, NodeState};
 
@@ -645,7 +645,7 @@ pub fn read_vdb(
     }
     let placement = GridPlacement::choose(boxes.known, offset, level)
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;
-    let tree = place_boxes(&boxes, &placement)
+    let tree = place_boxes(&boxes, &placement, max_grid_nodes(bytes.len()))
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;
     Ok(PlacedTree {
         tree,

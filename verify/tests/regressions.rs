@@ -92,3 +92,57 @@ fn central_moments_of_a_small_far_box_are_exact() {
     }
     assert!(m.central_moments[0][1].abs() <= 1e-6 * v);
 }
+
+/// `binvox_structured`: `write_binvox` wrote `translate` and `scale` in plain digits, 301 of them for
+/// `1e300`, and its own reader rejects header lines longer than 256 bytes; the numbers now take an exponent
+/// where the digits would be long, and read back exactly.
+#[test]
+fn binvox_with_huge_or_tiny_metadata_reads_back() {
+    use ktree::io::{read_binvox, write_binvox, GridMeta};
+    let tree =
+        ktree::KTree::<3>::from_dense(1, &[true, false, false, true, false, true, true, false])
+            .unwrap();
+    for meta in [
+        GridMeta {
+            voxel_size: 1e-300,
+            origin: [1e300, -1.5e-300, f64::MAX],
+        },
+        GridMeta {
+            voxel_size: 1e300,
+            origin: [-f64::MAX, 5e-324, 0.1],
+        },
+    ] {
+        let mut bytes = Vec::new();
+        write_binvox(&mut bytes, &tree, &meta).unwrap();
+        let back = read_binvox(&bytes, "meta.binvox", None, None).unwrap();
+        assert_eq!(back.tree, tree);
+        assert_eq!(back.meta.origin, meta.origin);
+        assert_eq!(back.meta.voxel_size, meta.voxel_size * 2.0 / 2.0);
+    }
+}
+
+/// `octomap_bt_structured`: a `.bt` file of 90 bytes — a free voxel at key x = 1 and an occupied cube of
+/// side 2^14 — read at the default placement (offset 32767 on x) puts the cube off its alignment, and its
+/// octree would have billions of nodes (the reader ran out of memory). Grid readers now stop at 2^20 +
+/// 2^10 nodes a byte of the file with a placement error; at an aligned offset the file reads.
+#[test]
+fn bt_cube_off_its_alignment_is_a_placement_error_not_unbounded_memory() {
+    use ktree::io::{read_bt, GridFileErrorKind, BT_HEADER};
+    let mut file = format!("{BT_HEADER}\nid OcTree\nsize 18\nres 1\ndata\n").into_bytes();
+    file.extend_from_slice(&[0b11, 0]); // root: child 0 has children
+    file.extend_from_slice(&[0b10_11, 0]); // depth 1: child 0 has children, child 1 (x + 2^14) occupied
+    for _ in 2..15 {
+        file.extend_from_slice(&[0b11, 0]); // depths 2…14: child 0 has children
+    }
+    file.extend_from_slice(&[0b01_00, 0]); // depth 15: voxel child 1 (key x = 1) free
+    for (level, unknown_full) in [(None, false), (Some(21), true)] {
+        let e = read_bt(&file, "cut.bt", None, level, unknown_full).unwrap_err();
+        assert!(
+            matches!(&e.kind, GridFileErrorKind::GridPlacement(m) if m.contains("nodes")),
+            "{e}"
+        );
+    }
+    let aligned = read_bt(&file, "cut.bt", Some([32768; 3]), Some(16), false).unwrap();
+    assert_eq!(aligned.tree.voxel_count(), 1 << 42);
+    assert!(aligned.tree.node_count() < 1000);
+}
