@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Runs every fuzz target for SECONDS each (default 60), one after the other, and writes
-# results/reliability.md: executions, time, crashes, coverage and peak memory per target.
+# Runs every fuzz target (or the TARGETs given) for SECONDS each (default 60) or FUZZ_RUNS executions
+# (default 10^7), whichever comes first, one after the other, and writes results/reliability.md:
+# executions, time, crashes, coverage and peak memory per target. Each target's latest run is kept in
+# fuzz/target/rows/, so a run of some targets updates their rows and keeps the others'.
 #
 #   fuzz/run.sh [SECONDS] [TARGET...]
 #
@@ -14,6 +16,7 @@ set -uo pipefail
 cd "$(dirname "$0")"
 seconds=${1:-60}
 shift || true
+runs=${FUZZ_RUNS:-10000000}
 export RUSTC_BOOTSTRAP=1
 sanitizer=${SANITIZER:-none}
 targets=("$@")
@@ -23,8 +26,8 @@ fi
 cargo fuzz build -O -s "$sanitizer" || exit 1
 host=$(rustc -vV | sed -n "s/^host: //p")
 logs=target/logs
-mkdir -p "$logs"
-rows=()
+rows_dir=target/rows
+mkdir -p "$logs" "$rows_dir"
 failed=0
 for t in "${targets[@]}"; do
   mkdir -p "target/corpus/$t" "corpus/$t"
@@ -32,7 +35,7 @@ for t in "${targets[@]}"; do
   mkdir -p "artifacts/$t"
   # The binary cargo-fuzz built above, run directly (as `cargo fuzz run` would, without rebuilding).
   "target/$host/release/$t" -artifact_prefix="artifacts/$t/" \
-    -max_total_time="$seconds" -rss_limit_mb=2048 -malloc_limit_mb=2048 -timeout=10 \
+    -max_total_time="$seconds" -runs="$runs" -rss_limit_mb=2048 -malloc_limit_mb=2048 -timeout=10 \
     -print_final_stats=1 "target/corpus/$t" "corpus/$t" >"$logs/$t.log" 2>&1
   status=$?
   took=$(( $(date +%s) - start ))
@@ -49,7 +52,7 @@ for t in "${targets[@]}"; do
     outcome="**${kind:-exit $status}** (see fuzz/artifacts/$t/)"
   fi
   echo "$t: ${execs:-?} executions in ${took} s, crashes: $outcome"
-  rows+=("| \`$t\` | ${execs:-?} | ${took} | $outcome | ${cov:-?} | ${rss:-?} |")
+  echo "| \`$t\` | ${execs:-?} | ${took} | $seconds s or $runs | $outcome | ${cov:-?} | ${rss:-?} |" >"$rows_dir/$t.md"
 done
 if [ "${FUZZ_NO_REPORT:-0}" = 1 ]; then
   exit $failed
@@ -58,14 +61,21 @@ out=../results/reliability.md
 {
   echo "# Reliability: fuzzing"
   echo
-  echo "Written by \`fuzz/run.sh $seconds\` (libFuzzer through cargo-fuzz, sanitizer: $sanitizer, \`-rss_limit_mb=2048\`,"
-  echo "\`-malloc_limit_mb=2048\`, \`-timeout=10\`), one target after the other, each starting from the committed seeds"
-  echo "in \`fuzz/corpus/\` plus what earlier runs on this machine kept in \`fuzz/target/corpus/\`. Coverage is libFuzzer's"
+  echo "Written by \`fuzz/run.sh SECONDS\` (libFuzzer through cargo-fuzz, sanitizer: $sanitizer, \`-rss_limit_mb=2048\`,"
+  echo "\`-malloc_limit_mb=2048\`, \`-timeout=10\`): each target runs until SECONDS pass or \`FUZZ_RUNS\` executions"
+  echo "are done (the budget column), starting from the committed seeds in \`fuzz/corpus/\` plus what earlier runs on"
+  echo "this machine kept in \`fuzz/target/corpus/\`. Each row is its target's latest run. Coverage is libFuzzer's"
   echo "count of covered edges (\`cov\`) and features (\`ft\`) at the end of the run."
   echo
-  echo "| target | executions | seconds | crashes in this run | coverage | peak RSS (MB) |"
-  echo "|---|---:|---:|---|---|---:|"
-  printf '%s\n' "${rows[@]}"
+  echo "| target | executions | seconds | budget | crashes in this run | coverage | peak RSS (MB) |"
+  echo "|---|---:|---:|---|---|---|---:|"
+  for t in $(cargo fuzz list); do
+    if [ -f "$rows_dir/$t.md" ]; then
+      cat "$rows_dir/$t.md"
+    else
+      echo "| \`$t\` | not run | | | | | |"
+    fi
+  done
   echo
   cat FINDINGS.md
 } >"$out"
