@@ -12,6 +12,7 @@
 # Each run starts from the committed seeds in fuzz/corpus/TARGET and keeps what it finds in
 # fuzz/target/corpus/TARGET (not committed). A crash leaves its input in fuzz/artifacts/TARGET/.
 # FUZZ_NO_REPORT=1 skips writing results/reliability.md (the CI smoke run); the exit status is 1 on any crash.
+# FUZZ_REPORT_ONLY=1 runs nothing and writes results/reliability.md from the rows kept so far.
 set -uo pipefail
 cd "$(dirname "$0")"
 seconds=${1:-60}
@@ -23,7 +24,11 @@ targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   mapfile -t targets < <(cargo fuzz list)
 fi
-cargo fuzz build -O -s "$sanitizer" || exit 1
+if [ "${FUZZ_REPORT_ONLY:-0}" = 1 ]; then
+  targets=()
+else
+  cargo fuzz build -O -s "$sanitizer" || exit 1
+fi
 host=$(rustc -vV | sed -n "s/^host: //p")
 logs=target/logs
 rows_dir=target/rows
