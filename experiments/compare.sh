@@ -5,13 +5,14 @@
 #   experiments/compare.sh [COMMIT] [ROUNDS]     (defaults: eda9474, the last commit before the workspace
 #                                                  split; 5 rounds)
 #
-# The earlier commit is checked out in a git worktree under target/ and its perf example built there (a
-# release build of that commit: minutes on a cold cache).
+# The earlier commit is checked out in a git worktree beside the project (../ktree-before-COMMIT: outside
+# this workspace, so that cargo builds it as its own) and its perf example built there (a release build of
+# that commit: minutes on a cold cache).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 commit=${1:-eda9474}
 rounds=${2:-5}
-before=target/before-$commit
+before=../ktree-before-$commit
 if [ ! -d "$before" ]; then
   git worktree add --detach "$before" "$commit"
 fi
