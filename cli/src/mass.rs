@@ -50,28 +50,28 @@ struct Report {
 fn view_report<const K: usize>(view: &KtreeView) -> Result<Report, String> {
     let m = ops::mass_of_leaves(view.level(), |visit| view.for_each_leaf::<K>(visit))
         .map_err(|e| e.to_string())?;
-    Ok(Report {
-        k: K,
-        volume: m.volume,
-        centroid: m.centroid.to_vec(),
-        central_moments: m.central_moments.iter().map(|r| r.to_vec()).collect(),
-        inertia_tensor: m.inertia_tensor().iter().map(|r| r.to_vec()).collect(),
-        nodes: view.node_count(),
-        progressive: None,
-        estimate: None,
-    })
+    Ok(Report::exact(&m, view.node_count()))
+}
+
+impl Report {
+    /// The exact properties of a tree of `nodes` nodes, without progressive bounds.
+    fn exact<const K: usize>(m: &ops::MassProperties<K>, nodes: u64) -> Self {
+        Self {
+            k: K,
+            volume: m.volume,
+            centroid: m.centroid.to_vec(),
+            central_moments: m.central_moments.iter().map(|r| r.to_vec()).collect(),
+            inertia_tensor: m.inertia_tensor().iter().map(|r| r.to_vec()).collect(),
+            nodes,
+            progressive: None,
+            estimate: None,
+        }
+    }
 }
 
 fn report<const K: usize>(t: &KTree<K>, tolerance: Option<f64>) -> Report {
-    let m = ops::mass_properties(t);
     let progressive = tolerance.map(|tol| ops::mass_progressive(t, tol));
     Report {
-        k: K,
-        volume: m.volume,
-        centroid: m.centroid.to_vec(),
-        central_moments: m.central_moments.iter().map(|r| r.to_vec()).collect(),
-        inertia_tensor: m.inertia_tensor().iter().map(|r| r.to_vec()).collect(),
-        nodes: t.node_count(),
         estimate: progressive.as_ref().map(|p| p.estimate),
         progressive: progressive.map(|p| {
             p.levels
@@ -84,6 +84,7 @@ fn report<const K: usize>(t: &KTree<K>, tolerance: Option<f64>) -> Report {
                 })
                 .collect()
         }),
+        ..Report::exact(&ops::mass_properties(t), t.node_count())
     }
 }
 

@@ -104,7 +104,7 @@ pub fn default_split_depth(k: usize, level: u32) -> u32 {
 }
 
 /// Builds the tree of a ray set from the subtrees of its cells of depth `depth` (clamped to `L`), each
-/// stacked apart, on the threads of the current rayon pool. Equal, node for node, to [`stack`].
+/// stacked apart, on the threads of the current rayon pool. Equal, node for node, to [`stack`](super::stack).
 ///
 /// ```
 /// use ktree::{stacking::{stack, stack_partitioned}, Ray, RaySet};
