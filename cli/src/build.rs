@@ -1,6 +1,8 @@
 //! `ktree build --rays FILE --out FILE.ktree [--threads N] [--max-memory SIZE] [--temp-dir DIR]
 //! [--progress]`: stack a ray file into a tree file (out of core: see [`crate::memory`]).
 
+use crate::outln;
+
 use std::path::PathBuf;
 
 use ktree::io::{read_rays_file, AnyRaySet, AnyTree};
@@ -48,7 +50,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
     if crate::memory::out_of_core() {
         let summary = ktree::with_dim!(&rays, AnyRaySet, r => build_out_of_core(r, &args))?;
-        println!("{summary}");
+        outln!("{summary}");
         return Ok(());
     }
     let threads = args.threads;
@@ -65,7 +67,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let write = ktree::with_dim!(&tree, AnyTree, t => crate::tree_file::write(&args.out, t));
     write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
     let c = tree.counts();
-    println!(
+    outln!(
         "{}",
         summary(
             &args.out,

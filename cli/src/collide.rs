@@ -1,6 +1,8 @@
 //! `ktree collide A B [--time-axis N] [--json]`: interference detection between two `.ktree` files, with
 //! the minimum separation when they do not overlap.
 
+use crate::outln;
+
 use std::path::PathBuf;
 
 use ktree::io::AnyTree;
@@ -67,23 +69,23 @@ pub fn run(args: Args) -> Result<(), String> {
     let (ta, tb) = (read(&args.a)?, read(&args.b)?);
     let r = with_pair!(&ta, &tb, (&args.a, &args.b), (x, y) => report(x, y, args.time_axis))?;
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
         );
         return Ok(());
     }
-    println!("collide        {}", if r.collide { "yes" } else { "no" });
-    println!("overlap cells  {}", r.overlap_cells);
-    println!("overlap voxels {}", r.overlap_voxels);
+    outln!("collide        {}", if r.collide { "yes" } else { "no" });
+    outln!("overlap cells  {}", r.overlap_cells);
+    outln!("overlap voxels {}", r.overlap_voxels);
     match r.min_separation {
-        Some(d) => println!("separation     {d} (between voxel centres)"),
-        None => println!("separation     - (an object is empty)"),
+        Some(d) => outln!("separation     {d} (between voxel centres)"),
+        None => outln!("separation     - (an object is empty)"),
     }
     if let Some(axis) = args.time_axis {
         match r.first_contact {
-            Some(t) => println!("first contact  {t} (axis {axis})"),
-            None => println!("first contact  never (axis {axis})"),
+            Some(t) => outln!("first contact  {t} (axis {axis})"),
+            None => outln!("first contact  never (axis {axis})"),
         }
     }
     Ok(())

@@ -1,6 +1,8 @@
 //! `ktree convert IN OUT`: any format to any format, chosen by extension (`.ktree`, `.rays`, `.binvox`, `.bt`,
 //! `.vdb`; meshes and volumes as inputs).
 
+use crate::outln;
+
 use std::path::PathBuf;
 
 use ktree::io::{read_tree_placed, write_tree, Format, ReadOptions, WriteOptions};
@@ -97,7 +99,7 @@ pub fn run(a: Args) -> Result<(), String> {
     let placed = read.placement.map_or(String::new(), |p| {
         format!(" (grid index + {:?} = ktree voxel)", p.offset)
     });
-    println!(
+    outln!(
         "{}: K = {}, L = {}, {} nodes, {} voxels{placed}",
         a.output.display(),
         read.tree.k(),

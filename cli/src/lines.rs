@@ -1,6 +1,8 @@
 //! `ktree lines FILE.ktree [--view VIEW] [--out drawing.svg]`: a line drawing of an octree with hidden
 //! lines removed (Veenstra & Ahuja), as SVG (vector) or PNG (by the output's extension).
 
+use crate::outln;
+
 use std::path::PathBuf;
 
 use ktree::display::{line_drawing_with_progress, png, svg, HiddenLineMethod};
@@ -85,7 +87,7 @@ pub fn run(args: Args) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
     }
     let s = drawing.stats;
-    println!(
+    outln!(
         "wrote {} ({} lines; {} full leaves, {} surrounded skipped, {} graphics nodes, {} segments tested)",
         out.display(),
         s.lines,

@@ -59,6 +59,28 @@ enum Command {
     Convert(convert::Args),
 }
 
+/// Writes a line to standard output, returning from the enclosing function with [`output_error`]'s message
+/// if that fails (`ktree stats A | head` closes the pipe early: that ends the command quietly, not in a panic).
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout(), $($arg)*).map_err(crate::output_error)?;
+    }};
+}
+pub(crate) use outln;
+
+/// What a failed write to standard output is reported as: a closed pipe ends the command quietly.
+pub(crate) fn output_error(e: std::io::Error) -> String {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        BROKEN_PIPE.to_string()
+    } else {
+        format!("cannot write to standard output: {e}")
+    }
+}
+
+/// The error of a write to a closed pipe (the reader has all it wanted).
+const BROKEN_PIPE: &str = "standard output closed";
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let _mpi = distributed::init();
@@ -79,6 +101,7 @@ fn main() -> ExitCode {
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e == BROKEN_PIPE => ExitCode::SUCCESS,
         Err(e) => {
             distributed::report_failure(&e);
             ExitCode::FAILURE

@@ -3,6 +3,8 @@
 //! exact properties of a version 2 file are summed from its memory map, leaf by leaf, so a tree larger
 //! than memory is measured without being loaded.
 
+use crate::outln;
+
 use std::path::PathBuf;
 
 use ktree::io::{ktree_file_version, KtreeView, VERSION_2};
@@ -110,21 +112,24 @@ pub fn run(args: Args) -> Result<(), String> {
         ktree::with_dim!(&tree, AnyTree, t => report(t, args.tolerance))
     };
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
         );
         return Ok(());
     }
     if let Some(levels) = &r.progressive {
-        println!("level        lower        upper  nodes touched");
+        outln!("level        lower        upper  nodes touched");
         for l in levels {
-            println!(
+            outln!(
                 "{:>5} {:>12} {:>12} {:>14}",
-                l.level, l.lower, l.upper, l.nodes_touched
+                l.level,
+                l.lower,
+                l.upper,
+                l.nodes_touched
             );
         }
-        println!(
+        outln!(
             "estimate {:.1} (exact {}), {} of {} nodes touched",
             r.estimate.unwrap_or(f64::NAN),
             r.volume,
@@ -133,9 +138,9 @@ pub fn run(args: Args) -> Result<(), String> {
         );
         return Ok(());
     }
-    println!("K         {}", r.k);
-    println!("volume    {} voxels", r.volume);
-    println!("centroid  {:?}", r.centroid);
+    outln!("K         {}", r.k);
+    outln!("volume    {} voxels", r.volume);
+    outln!("centroid  {:?}", r.centroid);
     let name = if r.k == 3 { "inertia   " } else { "moments   " };
     let rows = if r.k == 3 {
         &r.inertia_tensor
@@ -144,7 +149,7 @@ pub fn run(args: Args) -> Result<(), String> {
     };
     for (i, row) in rows.iter().enumerate() {
         let cells: Vec<String> = row.iter().map(|v| format!("{v:.6e}")).collect();
-        println!(
+        outln!(
             "{}{}",
             if i == 0 { name } else { "          " },
             cells.join("  ")

@@ -1,6 +1,8 @@
 //! `ktree op union|intersect|diff|xor A B --out C` and `ktree op not A --out B`: Boolean operations on
 //! `.ktree` files.
 
+use crate::outln;
+
 use std::path::{Path, PathBuf};
 
 use ktree::io::{read_ktree_file, AnyTree};
@@ -36,7 +38,7 @@ pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> Result<(), String>
     crate::tree_file::write(path, tree)
         .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     let c = tree.counts();
-    println!(
+    outln!(
         "{}: K = {K}, L = {}, {} nodes ({} full, {} empty, {} partial), {} voxels",
         path.display(),
         tree.level(),

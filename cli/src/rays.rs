@@ -1,5 +1,7 @@
 //! `ktree rays --solid NAME ... --level L --out FILE`: an analytic solid (quadric or box) to rays.
 
+use crate::outln;
+
 use std::path::{Path, PathBuf};
 
 use ktree::io::{write_atomic_with, write_rays_file, write_rays_source};
@@ -240,7 +242,7 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
                 .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
             tree.counts_per_level()
         };
-        println!("{}", tree_summary::<K>(&a.out, a.level, &counts));
+        outln!("{}", tree_summary::<K>(&a.out, a.level, &counts));
         return Ok(());
     }
     if crate::distributed::ranks().size == 1 {
@@ -263,7 +265,7 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
         if let Some(bar) = bar {
             bar.finish_and_clear();
         }
-        println!(
+        outln!(
             "{}: K = {K}, L = {}, {} rays, {} voxels",
             a.out.display(),
             a.level,
@@ -275,15 +277,16 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
     let rays = s
         .to_rays(a.level, sample, false)
         .map_err(|e| e.to_string())?;
-    print_summary(&write_output(&rays, &a.out, a.threads, &a.build)?);
+    print_summary(&write_output(&rays, &a.out, a.threads, &a.build)?)?;
     Ok(())
 }
 
 /// Prints a command's summary line, if it has one (ranks other than 0 of an MPI run have none).
-pub fn print_summary(summary: &str) {
+pub fn print_summary(summary: &str) -> Result<(), String> {
     if !summary.is_empty() {
-        println!("{summary}");
+        outln!("{summary}");
     }
+    Ok(())
 }
 
 /// Builds the solid's rays and writes them.

@@ -2,6 +2,8 @@
 //! hidden-surface image of an octree; a quadtree is drawn as a picture of its cells, a 4-D tree as a strip
 //! of time slices.
 
+use crate::outln;
+
 use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -221,7 +223,7 @@ pub fn run(args: Args) -> Result<(), String> {
             if let Some(b) = &bar {
                 b.finish_and_clear();
             }
-            println!(
+            outln!(
                 "wrote {} ({w}x{h}, {} pixels of the object, {} nodes visited, {} culled)",
                 out.display(),
                 image.stats.painted,
@@ -232,7 +234,7 @@ pub fn run(args: Args) -> Result<(), String> {
         AnyTree::K2(tree) => {
             let canvas = plane::quadtree_canvas(&tree, w.min(h)).map_err(|e| e.to_string())?;
             canvas.write_png(&out).map_err(|e| e.to_string())?;
-            println!(
+            outln!(
                 "wrote {} (quadtree, {} leaves)",
                 out.display(),
                 tree.leaves().count()
@@ -250,7 +252,7 @@ pub fn run(args: Args) -> Result<(), String> {
                 }
             }
             let positions: Vec<String> = frames.iter().map(|(p, _)| p.to_string()).collect();
-            println!(
+            outln!(
                 "wrote {} ({} frames of the slices at {} on axis {})",
                 out.display(),
                 frames.len(),

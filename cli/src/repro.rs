@@ -1,5 +1,7 @@
 //! `ktree repro [NAME]`: regenerate reproductions into results/.
 
+use crate::outln;
+
 use std::path::PathBuf;
 
 /// Arguments of `ktree repro`.
@@ -28,7 +30,7 @@ pub fn run(args: Args) -> Result<(), String> {
     };
     for name in names {
         let report = ktree_repro::run(name, &args.out).map_err(|e| format!("{name}: {e}"))?;
-        println!("{report}");
+        outln!("{report}");
     }
     Ok(())
 }

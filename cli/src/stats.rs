@@ -1,6 +1,8 @@
 //! `ktree stats FILE.ktree | --rays FILE [--json]`: node counts of a tree or of the tree a ray file stacks to.
 //! A version 2 tree file is checked and counted through a memory map, in memory independent of its size.
 
+use crate::outln;
+
 use std::path::PathBuf;
 
 use ktree::io::{
@@ -58,33 +60,36 @@ pub fn run(args: Args) -> Result<(), String> {
         _ => return Err("give either a .ktree file or --rays FILE".into()),
     };
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?
         );
         return Ok(());
     }
-    println!("K        {}", stats.k);
-    println!("L        {}", stats.level);
-    println!(
+    outln!("K        {}", stats.k);
+    outln!("L        {}", stats.level);
+    outln!(
         "rays     {}",
         stats.rays.map_or("-".to_string(), |r| r.to_string())
     );
-    println!("full     {}", stats.full);
-    println!("empty    {}", stats.empty);
-    println!("partial  {}", stats.partial);
-    println!("nodes    {}", stats.nodes);
-    println!("bytes    {} (at 2 bits/node)", stats.bytes_at_2_bits);
-    println!(
+    outln!("full     {}", stats.full);
+    outln!("empty    {}", stats.empty);
+    outln!("partial  {}", stats.partial);
+    outln!("nodes    {}", stats.nodes);
+    outln!("bytes    {} (at 2 bits/node)", stats.bytes_at_2_bits);
+    outln!(
         "memory   {} bytes navigable in memory ({:.3} bits/node)",
         stats.memory_bytes,
         stats.memory_bytes as f64 * 8.0 / stats.nodes as f64
     );
-    println!("level        full       empty     partial");
+    outln!("level        full       empty     partial");
     for l in &stats.per_level {
-        println!(
+        outln!(
             "{:>5} {:>11} {:>11} {:>11}",
-            l.level, l.full, l.empty, l.partial
+            l.level,
+            l.full,
+            l.empty,
+            l.partial
         );
     }
     Ok(())

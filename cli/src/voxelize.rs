@@ -1,6 +1,8 @@
 //! `ktree voxelize MESH|VOLUME --level L (--fit | --transform s,tx,ty,tz) --out FILE`: a triangle mesh (OBJ,
 //! STL, PLY) or a volume (raw + JSON sidecar, NIfTI) to rays or a tree.
 
+use crate::outln;
+
 use std::path::PathBuf;
 
 use ktree::io::{voxelize, Format, ReadOptions};
@@ -83,7 +85,7 @@ pub fn run(a: Args) -> Result<(), String> {
     // In a run over several MPI ranks, rank 0 alone reports.
     let root = crate::distributed::ranks().is_root();
     if let (Some(t), true) = (&v.fitted, root) {
-        println!("--fit chose --transform {t}");
+        outln!("--fit chose --transform {t}");
     }
     if v.open_edges > 0 && root {
         eprintln!(
@@ -93,6 +95,6 @@ pub fn run(a: Args) -> Result<(), String> {
             v.open_edges
         );
     }
-    crate::rays::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?);
+    crate::rays::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?)?;
     Ok(())
 }

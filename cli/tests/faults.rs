@@ -1,6 +1,7 @@
 //! Fault injection: a write killed part-way, a full disk, an unreadable or vanished input. The previous
 //! output survives every failed write, no temporary file is left once the next write has run, and every
-//! failure is a clear error naming the file.
+//! failure is a clear error naming the file. A reader that closes the output early (`ktree stats A | head`)
+//! ends the command quietly, not in a panic.
 
 mod common;
 
@@ -228,4 +229,38 @@ fn unreadable_and_vanished_inputs_are_clear_errors() {
         !ok && err.contains("v.raw") && err.contains("No such file"),
         "{err}"
     );
+}
+
+#[test]
+fn a_closed_output_pipe_ends_the_command_quietly() {
+    let dir = tempfile::tempdir().unwrap();
+    let tree = dir.path().join("ball.ktree");
+    let (ok, _, err) = ktree(&[
+        "rays",
+        "--level",
+        "5",
+        "--radius",
+        "11",
+        "--out",
+        tree.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    for args in [
+        vec!["stats", tree.to_str().unwrap()],
+        vec!["stats", tree.to_str().unwrap(), "--json"],
+        vec!["mass", tree.to_str().unwrap()],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_ktree"))
+            .args(&args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Close the reading end before the command has read its file and printed anything.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(out.status.success(), "{args:?}: {stderr}");
+    }
 }
