@@ -106,7 +106,7 @@ class Tree:
     def save(self, path: _Path) -> None:
         """Writes the tree atomically, the format chosen by the extension."""
     def to_bytes(self) -> bytes:
-        """The tree in the .ktree format (2 bits a node, with a checksum)."""
+        """The tree in the .ktree format (version 2: 2 bits a node, checksums per level)."""
     @staticmethod
     def from_bytes(data: bytes) -> Tree:
         """The tree of .ktree bytes."""

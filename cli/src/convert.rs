@@ -94,7 +94,13 @@ pub fn run(a: Args) -> Result<(), String> {
         offset: out_offset,
         meta: Some(meta),
     };
-    write_tree(&a.output, &read.tree, &write_options).map_err(|e| e.to_string())?;
+    if Format::of(&a.output) == Some(Format::Ktree) {
+        // The version --format-version asks for, as every command that writes trees.
+        ktree::with_dim!(&read.tree, AnyTree, t => crate::tree_file::write(&a.output, t))
+            .map_err(|e| format!("cannot write {}: {e}", a.output.display()))?;
+    } else {
+        write_tree(&a.output, &read.tree, &write_options).map_err(|e| e.to_string())?;
+    }
     let c = read.tree.counts();
     let placed = read.placement.map_or(String::new(), |p| {
         format!(" (grid index + {:?} = ktree voxel)", p.offset)

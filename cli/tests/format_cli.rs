@@ -87,3 +87,34 @@ fn mass_of_a_mapped_file_equals_mass_of_the_loaded_tree() {
         assert!(mapped.contains("\"volume\""), "{mapped}");
     }
 }
+
+#[test]
+fn convert_writes_the_version_the_other_commands_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let rays = dir.path().join("ball.rays");
+    let (ok, _, err) = ktree(&[
+        "rays",
+        "--level",
+        "4",
+        "--radius",
+        "6",
+        "--out",
+        rays.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let v2 = dir.path().join("v2.ktree");
+    let v1 = dir.path().join("v1.ktree");
+    let (ok, _, err) = ktree(&["convert", rays.to_str().unwrap(), v2.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = ktree(&[
+        "--format-version",
+        "1",
+        "convert",
+        rays.to_str().unwrap(),
+        v1.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!(ktree_file_version(&v2).unwrap(), 2);
+    assert_eq!(ktree_file_version(&v1).unwrap(), 1);
+    assert_eq!(read_ktree_file(&v2).unwrap(), read_ktree_file(&v1).unwrap());
+}

@@ -410,11 +410,12 @@ impl Tree {
         Ok(py.detach(|| files::write_tree(&path, &self.inner))?)
     }
 
-    /// The tree in the `.ktree` format (2 bits a node, with a checksum), as bytes.
+    /// The tree in the `.ktree` format (version 2: 2 bits a node, checksums per level), as bytes.
     fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
         let bytes = py.detach(|| {
             let mut out = Vec::new();
-            with_dim!(&self.inner, AnyTree, t => ktree::io::write_ktree(&mut out, t)).map(|()| out)
+            with_dim!(&self.inner, AnyTree, t => ktree::io::write_ktree_v2(&mut out, t))
+                .map(|()| out)
         });
         let bytes = bytes.map_err(Failure::value)?;
         Ok(PyBytes::new(py, &bytes))

@@ -18,7 +18,7 @@ use crate::solid::SolidError;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Format {
-    /// `.ktree`: ktree's own tree file.
+    /// `.ktree`: ktree's own tree file (read in either version, written as version 2).
     Ktree,
     /// `.rays`: the ray text format.
     Rays,
@@ -357,7 +357,7 @@ pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result
         super::write_atomic_with(path, |w| fill(w)).map_err(IoError::Write)
     };
     match format {
-        Format::Ktree => crate::with_dim!(tree, AnyTree, t => super::write_ktree_file(path, t))
+        Format::Ktree => crate::with_dim!(tree, AnyTree, t => super::write_ktree_v2_file(path, t))
             .map_err(IoError::Write),
         Format::Rays => {
             crate::with_dim!(tree, AnyTree, t => super::write_rays_file(path, &super::tree_rays(t)))
