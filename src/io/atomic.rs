@@ -46,7 +46,7 @@ pub fn write_atomic_with(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    remove_stale_temporaries(dir, &name);
+    remove_stale(dir, &name, TEMP_SUFFIX);
     let mut tmp = tempfile::Builder::new()
         .prefix(&format!(".{name}."))
         .suffix(&format!(".{}{TEMP_SUFFIX}", std::process::id()))
@@ -62,9 +62,11 @@ pub fn write_atomic_with(
     Ok(())
 }
 
-/// Removes `dir/.NAME.*.PID.ktree-tmp` files left by writers that were killed (their `PID` no longer runs).
-/// Best effort: errors are ignored, and nothing is removed where `/proc` does not list processes.
-fn remove_stale_temporaries(dir: &Path, name: &str) {
+/// Removes `dir/.NAME.*.PID{suffix}` files and folders left by processes that were killed (their `PID` no
+/// longer runs): the temporary files of atomic writes (`.ktree-tmp`) and the spill folders of out-of-core
+/// builds (`.ktree-spill`). Best effort: errors are ignored, and nothing is removed where `/proc` does not
+/// list processes.
+pub(crate) fn remove_stale(dir: &Path, name: &str, suffix: &str) {
     let proc = Path::new("/proc");
     if !proc.join("self").exists() {
         return;
@@ -78,7 +80,7 @@ fn remove_stale_temporaries(dir: &Path, name: &str) {
         let file = file.to_string_lossy();
         let Some(rest) = file
             .strip_prefix(&prefix)
-            .and_then(|r| r.strip_suffix(TEMP_SUFFIX))
+            .and_then(|r| r.strip_suffix(suffix))
         else {
             continue;
         };
@@ -86,7 +88,12 @@ fn remove_stale_temporaries(dir: &Path, name: &str) {
             continue;
         };
         if !proc.join(pid.to_string()).exists() {
-            let _ = std::fs::remove_file(entry.path());
+            let path = entry.path();
+            let _ = if path.is_dir() {
+                std::fs::remove_dir_all(path)
+            } else {
+                std::fs::remove_file(path)
+            };
         }
     }
 }

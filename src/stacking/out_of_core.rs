@@ -28,9 +28,10 @@
 //! its largest slab (with it, every slab fits whatever the order slabs finish in).
 //!
 //! # Temporary files
-//! The spill files live in a hidden folder `.NAME.XXXXXX.ktree-spill` in [`OutOfCore::temp_dir`] (by
+//! The spill files live in a hidden folder `.NAME.XXXXXX.PID.ktree-spill` in [`OutOfCore::temp_dir`] (by
 //! default the output's folder), removed when the build ends, whether it succeeds or fails; a process
-//! killed mid-build leaves it behind.
+//! killed mid-build leaves it behind, and the next build of the same output removes the folders of
+//! processes that no longer run.
 //!
 //! ```
 //! use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
@@ -55,6 +56,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use rayon::prelude::*;
 
 use super::partition::{slab_pieces, top_levels, top_levels_dense, Piece, RaySource};
+
+/// The suffix of spill folders: `.NAME.XXXXXX.PID.ktree-spill`.
+const SPILL_SUFFIX: &str = ".ktree-spill";
 use crate::io::{write_atomic_with, KtreeWriter};
 use crate::tree::{LevelCounts, NodeState, PackedStates};
 
@@ -465,9 +469,10 @@ fn open_spill<E>(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
+    crate::io::remove_stale(&dir, &name, SPILL_SUFFIX);
     let folder = tempfile::Builder::new()
         .prefix(&format!(".{name}."))
-        .suffix(".ktree-spill")
+        .suffix(&format!(".{}{SPILL_SUFFIX}", std::process::id()))
         .tempdir_in(&dir)
         .map_err(temp_err)?;
     let mut spill = Spill {

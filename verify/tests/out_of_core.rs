@@ -1,8 +1,8 @@
 //! Out-of-core stacking writes, for K = 1 … 4 and every split depth, exactly the bytes of the tree built in
 //! memory (and equal to naive insertion) written as a `.ktree` version 2 file; with a budget too small it
 //! names a budget that works, and the build then keeps to it; it leaves no
-//! temporary file behind and the target untouched on failure; and the file does not depend on the number
-//! of threads.
+//! temporary file behind and the target untouched on failure, and removes the spill folders of killed
+//! builds; and the file does not depend on the number of threads.
 
 use std::path::Path;
 
@@ -235,4 +235,39 @@ fn extreme_levels_split_anywhere() {
     check::<2>();
     check::<3>();
     check::<4>();
+}
+
+/// The spill folder of a build that was killed (its process no longer runs) is removed by the next build
+/// of the same output; a live process's folder and other outputs' folders are kept.
+#[test]
+fn the_next_build_removes_the_spill_folders_of_killed_builds() {
+    let rays = ktree::rays::ball_rays::<3>(6, [64, 64, 64], 50).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let dead = dir.path().join(".b.ktree.abc123.4294967295.ktree-spill");
+    let live = dir.path().join(format!(
+        ".b.ktree.abc123.{}.ktree-spill",
+        std::process::id()
+    ));
+    let other = dir.path().join(".c.ktree.abc123.4294967295.ktree-spill");
+    for folder in [&dead, &live, &other] {
+        std::fs::create_dir(folder).unwrap();
+        std::fs::write(folder.join("level-1"), b"spilled").unwrap();
+    }
+    stack_to_file(
+        &rays,
+        &dir.path().join("b.ktree"),
+        &OutOfCore::new(3, u64::MAX),
+        &|_| {},
+    )
+    .unwrap();
+    assert!(!dead.exists(), "a killed build's spill folder stays");
+    assert!(live.exists() && other.exists());
+    assert_eq!(
+        entries(dir.path()),
+        [
+            ".b.ktree.abc123.".to_string() + &std::process::id().to_string() + ".ktree-spill",
+            ".c.ktree.abc123.4294967295.ktree-spill".to_string(),
+            "b.ktree".to_string(),
+        ]
+    );
 }
