@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use common::ktree;
+use common::{ktree, SmallDisk};
 
 /// The temporary files of atomic writes in `dir` (`.NAME.XXXXXX.PID.ktree-tmp`).
 fn temporaries(dir: &Path) -> Vec<PathBuf> {
@@ -87,29 +87,6 @@ fn a_write_killed_part_way_keeps_the_old_file_and_the_next_write_removes_its_tem
         temporaries(dir.path())
     );
     assert_ne!(std::fs::read(&out).unwrap(), old);
-}
-
-/// A small tmpfs mounted for the test (needs root and `mount`); `None` where that is not allowed.
-struct SmallDisk(PathBuf, tempfile::TempDir);
-
-impl SmallDisk {
-    fn mount(size: &str) -> Option<Self> {
-        let dir = tempfile::tempdir().ok()?;
-        let mnt = dir.path().join("disk");
-        std::fs::create_dir(&mnt).ok()?;
-        let ok = Command::new("mount")
-            .args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"])
-            .arg(&mnt)
-            .output()
-            .is_ok_and(|o| o.status.success());
-        ok.then_some(Self(mnt, dir))
-    }
-}
-
-impl Drop for SmallDisk {
-    fn drop(&mut self) {
-        let _ = Command::new("umount").arg(&self.0).status();
-    }
 }
 
 #[test]

@@ -6,9 +6,8 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-use common::ktree;
+use common::{ktree, SmallDisk};
 use ktree::io::{read_rays_file, write_ktree_v2, AnyRaySet};
 use ktree::stacking::stack;
 
@@ -315,30 +314,6 @@ fn op_checks_its_budget() {
     ]);
     assert!(ok, "{err}");
     assert_eq!(std::fs::read(&c).unwrap(), std::fs::read(&a).unwrap());
-}
-
-/// A small tmpfs mounted for the test (needs root and `mount`), in a temporary folder kept while it is
-/// mounted; `None` where that is not allowed.
-struct SmallDisk(PathBuf, #[allow(dead_code)] tempfile::TempDir);
-
-impl SmallDisk {
-    fn mount(size: &str) -> Option<Self> {
-        let dir = tempfile::tempdir().ok()?;
-        let mnt = dir.path().join("disk");
-        std::fs::create_dir(&mnt).ok()?;
-        let ok = Command::new("mount")
-            .args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"])
-            .arg(&mnt)
-            .output()
-            .is_ok_and(|o| o.status.success());
-        ok.then_some(Self(mnt, dir))
-    }
-}
-
-impl Drop for SmallDisk {
-    fn drop(&mut self) {
-        let _ = Command::new("umount").arg(&self.0).status();
-    }
 }
 
 #[test]

@@ -21,3 +21,29 @@ pub fn ktree(args: &[&str]) -> (bool, String, String) {
 pub fn data_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../data")
 }
+
+/// A small tmpfs mounted for a test (needs root and `mount`), in a temporary folder kept while it is
+/// mounted; `None` where that is not allowed. `.0` is the mount point, `.1` the folder holding it (room for
+/// files off the small disk); unmounted when dropped.
+pub struct SmallDisk(pub PathBuf, pub tempfile::TempDir);
+
+impl SmallDisk {
+    /// Mounts a tmpfs of `size` (as `mount -o size=` takes it, e.g. `256k`).
+    pub fn mount(size: &str) -> Option<Self> {
+        let dir = tempfile::tempdir().ok()?;
+        let mnt = dir.path().join("disk");
+        std::fs::create_dir(&mnt).ok()?;
+        let ok = Command::new("mount")
+            .args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"])
+            .arg(&mnt)
+            .output()
+            .is_ok_and(|o| o.status.success());
+        ok.then_some(Self(mnt, dir))
+    }
+}
+
+impl Drop for SmallDisk {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.0).status();
+    }
+}
