@@ -1,13 +1,18 @@
 //! `ktree op union|intersect|diff|xor A B --out C` and `ktree op not A --out B`: Boolean operations on
 //! `.ktree` files.
+//!
+//! When the inputs are `.ktree` version 2 files and the output is one too, the operation streams from the
+//! inputs' memory maps to the output in bounded memory ([`ktree::ops::boolean_files`]), with its spill
+//! files in `--temp-dir`; it is also faster than loading the trees. Otherwise (a version 1 file) the trees
+//! are read into memory, if they and the result fit in the budget (`--max-memory`).
 
 use crate::outln;
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::{read_ktree_file, AnyTree};
-use ktree::ops::{self, BoolOp};
-use ktree::KTree;
+use ktree::io::{ktree_file_version, read_ktree_file, AnyTree};
+use ktree::ops::{self, BoolOp, BooleanFileReport};
+use ktree::{KTree, LevelCounts};
 
 /// Arguments of `ktree op`.
 #[derive(Debug, clap::Args)]
@@ -26,6 +31,10 @@ pub struct Args {
     threads: Option<usize>,
     #[command(flatten)]
     budget: crate::memory::BudgetArgs,
+    /// Folder for the temporary spill files of an operation streamed out of core (default: the output's
+    /// folder).
+    #[arg(long, value_name = "DIR")]
+    temp_dir: Option<PathBuf>,
 }
 
 /// Reads a tree file, with the path in any error.
@@ -37,16 +46,23 @@ pub fn read(path: &Path) -> Result<AnyTree, String> {
 pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> Result<(), String> {
     crate::tree_file::write(path, tree)
         .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    let c = tree.counts();
+    print_summary(path, K, tree.level(), &tree.counts_per_level())
+}
+
+/// Prints the one-line summary of a tree written to `path`, from its counts per level.
+fn print_summary(path: &Path, k: usize, level: u32, counts: &[LevelCounts]) -> Result<(), String> {
+    let c = LevelCounts::total(level, counts);
+    let voxels: u128 = counts
+        .iter()
+        .map(|c| u128::from(c.full) << (k as u32 * (level - c.level)))
+        .sum();
     outln!(
-        "{}: K = {K}, L = {}, {} nodes ({} full, {} empty, {} partial), {} voxels",
+        "{}: K = {k}, L = {level}, {} nodes ({} full, {} empty, {} partial), {voxels} voxels",
         path.display(),
-        tree.level(),
         c.nodes(),
         c.full,
         c.empty,
         c.partial,
-        tree.voxel_count()
     );
     Ok(())
 }
@@ -96,6 +112,35 @@ fn check_budget(args: &Args) -> Result<(), String> {
         .map(drop)
 }
 
+/// The operation streamed from the inputs' memory maps to the output, if the inputs and the output are
+/// `.ktree` version 2 files (`None` otherwise).
+fn stream_op(args: &Args) -> Option<Result<(), String>> {
+    let all_v2 = crate::tree_file::version() == 2
+        && args
+            .inputs
+            .iter()
+            .all(|p| ktree_file_version(p).is_ok_and(|v| v == 2));
+    if !all_v2 {
+        return None;
+    }
+    let temp = args.temp_dir.as_deref();
+    let report: Result<BooleanFileReport, _> = match args.inputs.as_slice() {
+        [a] if args.operation == "not" => ops::complement_file(a, &args.out, temp),
+        [a, b] => {
+            let op = BoolOp::ALL
+                .into_iter()
+                .find(|o| o.name() == args.operation)?;
+            ops::boolean_files(a, b, op, &args.out, temp)
+        }
+        _ => return None,
+    };
+    Some(
+        report
+            .map_err(|e| e.to_string())
+            .and_then(|r| print_summary(&args.out, r.k, r.level, &r.counts_per_level)),
+    )
+}
+
 /// Runs the operation and writes the result, on a pool of `--threads` worker threads.
 pub fn run(args: Args) -> Result<(), String> {
     let threads = args.threads;
@@ -103,6 +148,9 @@ pub fn run(args: Args) -> Result<(), String> {
 }
 
 fn run_op(args: Args) -> Result<(), String> {
+    if let Some(streamed) = stream_op(&args) {
+        return streamed;
+    }
     check_budget(&args)?;
     if args.operation == "not" {
         let [a] = args.inputs.as_slice() else {

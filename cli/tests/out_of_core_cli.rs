@@ -1,5 +1,5 @@
 //! `--max-memory`, `--temp-dir` and `--progress` on `ktree build`, `rays`, `voxelize` (trees written out of
-//! core) and `--max-memory` on `ktree op`: the files are byte for byte the in-memory build's; a budget too
+//! core) and `--max-memory` on `ktree op` (streamed from version 2 files beyond it): the files are byte for byte the in-memory build's; a budget too
 //! small names one that works; an unusable temporary folder or a full disk is a clear error that leaves
 //! the target untouched and no temporary file.
 
@@ -275,45 +275,80 @@ fn ray_files_are_written_slab_by_slab() {
 }
 
 #[test]
-fn op_checks_its_budget() {
+fn op_streams_version_2_files_beyond_its_budget() {
     let dir = tempfile::tempdir().unwrap();
-    let rays = ball_rays(dir.path(), 6);
+    let spill = tempfile::tempdir().unwrap();
     let a = dir.path().join("a.ktree");
-    let (ok, _, err) = ktree(&[
-        "build",
-        "--rays",
-        rays.to_str().unwrap(),
-        "--out",
-        a.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let b = dir.path().join("b.ktree");
+    for (out, centre) in [(&a, "30,32,32"), (&b, "40,28,36")] {
+        let (ok, _, err) = ktree(&[
+            "rays",
+            "--level",
+            "6",
+            "--center",
+            centre,
+            "--radius",
+            "20",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+    }
+    // The same trees as version 1 files, which are read into memory.
+    let (a1, b1) = (dir.path().join("a1.ktree"), dir.path().join("b1.ktree"));
+    for (v2, v1) in [(&a, &a1), (&b, &b1)] {
+        let (ok, _, err) = ktree(&[
+            "--format-version",
+            "1",
+            "convert",
+            v2.to_str().unwrap(),
+            v1.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+    }
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let (a1, b1) = (a1.to_str().unwrap(), b1.to_str().unwrap());
+    for (op, streamed, in_memory) in [
+        ("union", vec![a, b], vec![a1, b1]),
+        ("intersect", vec![a, b], vec![a1, b1]),
+        ("diff", vec![a, b], vec![a1, b1]),
+        ("xor", vec![b, a], vec![b1, a1]),
+        ("not", vec![a], vec![a1]),
+    ] {
+        let run = |inputs: &[&str], budget: &str, name: &str| {
+            let out = dir.path().join(name);
+            let mut args = vec!["op", op];
+            args.extend(inputs);
+            args.extend(["--out", out.to_str().unwrap(), "--max-memory", budget]);
+            args.extend(["--temp-dir", spill.path().to_str().unwrap()]);
+            let (ok, stdout, err) = ktree(&args);
+            assert!(ok, "{op} with {budget}: {err}");
+            (std::fs::read(&out).unwrap(), stdout.replace(name, "OUT"))
+        };
+        // 100 bytes hold no tree: the version 2 files are streamed.
+        assert_eq!(
+            run(&in_memory, "1G", "memory.ktree"),
+            run(&streamed, "100", "streamed.ktree"),
+            "{op}"
+        );
+        assert!(entries(spill.path()).is_empty(), "{op}: spill files left");
+    }
+    // A version 1 input cannot be streamed: the budget is an error naming the input.
     let c = dir.path().join("c.ktree");
     let (ok, _, err) = ktree(&[
         "op",
         "not",
-        a.to_str().unwrap(),
+        a1,
         "--out",
         c.to_str().unwrap(),
         "--max-memory",
         "100",
     ]);
     assert!(
-        !ok && err.contains("a.ktree") && err.contains("--max-memory"),
+        !ok && err.contains("a1.ktree") && err.contains("--max-memory"),
         "{err}"
     );
     assert!(!c.exists());
-    let (ok, _, err) = ktree(&[
-        "op",
-        "union",
-        a.to_str().unwrap(),
-        a.to_str().unwrap(),
-        "--out",
-        c.to_str().unwrap(),
-        "--max-memory",
-        "1G",
-    ]);
-    assert!(ok, "{err}");
-    assert_eq!(std::fs::read(&c).unwrap(), std::fs::read(&a).unwrap());
 }
 
 #[test]

@@ -7,7 +7,7 @@
 //! longer runs (where `/proc` tells; elsewhere they stay, recognisable by the suffix).
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The suffix of temporary files.
 const TEMP_SUFFIX: &str = ".ktree-tmp";
@@ -60,6 +60,41 @@ pub fn write_atomic_with(
     tmp.as_file().sync_all().map_err(with_path)?;
     tmp.persist(path).map_err(|e| with_path(e.error))?;
     Ok(())
+}
+
+/// The suffix of spill folders: `.NAME.XXXXXX.PID.ktree-spill`.
+pub(crate) const SPILL_SUFFIX: &str = ".ktree-spill";
+
+/// Creates the hidden spill folder `.NAME.XXXXXX.PID.ktree-spill` of a build or operation writing `out`, in
+/// `temp_dir` (default: the output's folder, created if needed), after removing the folders of killed
+/// processes ([`remove_stale`]). The folder is removed when the returned guard is dropped.
+///
+/// # Errors
+/// The folder that cannot be used, and why.
+pub(crate) fn spill_folder(
+    out: &Path,
+    temp_dir: Option<&Path>,
+) -> Result<tempfile::TempDir, (PathBuf, std::io::Error)> {
+    let dir = match temp_dir {
+        Some(d) => d.to_path_buf(),
+        None => match out.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        },
+    };
+    if temp_dir.is_none() {
+        std::fs::create_dir_all(&dir).map_err(|e| (dir.clone(), e))?;
+    }
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    remove_stale(&dir, &name, SPILL_SUFFIX);
+    tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(&format!(".{}{SPILL_SUFFIX}", std::process::id()))
+        .tempdir_in(&dir)
+        .map_err(|e| (dir, e))
 }
 
 /// Removes `dir/.NAME.*.PID{suffix}` files and folders left by processes that were killed (their `PID` no

@@ -968,8 +968,23 @@ impl KtreeView {
         NodeState::from_code(code as u8)
     }
 
+    /// Word `j` of the node states of level `depth` (`j` below the level's word count).
+    pub(crate) fn level_word(&self, depth: usize, j: u64) -> u64 {
+        self.word(&self.layout.sections[depth], j)
+    }
+
+    /// The number of nodes of level `depth` (0 below the last level).
+    pub(crate) fn level_nodes(&self, depth: usize) -> u64 {
+        self.layout.sections.get(depth).map_or(0, |s| s.nodes)
+    }
+
+    /// The name given when the view was opened (the file's path).
+    pub(crate) fn name(&self) -> &str {
+        &self.name
+    }
+
     /// The error for a node that is not what the checks at opening found: the file was changed since.
-    fn changed(&self, depth: usize, index: u64) -> KtreeFileError {
+    pub(crate) fn changed(&self, depth: usize, index: u64) -> KtreeFileError {
         let section = &self.layout.sections[depth.min(self.layout.sections.len() - 1)];
         KtreeFileError {
             file: self.name.clone(),
@@ -981,13 +996,17 @@ impl KtreeView {
     }
 
     /// The state of a node the tree's shape says exists, or the error of a file changed since opening.
-    fn checked_state(&self, depth: usize, index: u64) -> Result<NodeState, KtreeFileError> {
+    pub(crate) fn checked_state(
+        &self,
+        depth: usize,
+        index: u64,
+    ) -> Result<NodeState, KtreeFileError> {
         self.state(depth, index)
             .ok_or_else(|| self.changed(depth, index))
     }
 
     /// The number of partial nodes before node `index` of level `depth` (`index` < the level's size).
-    fn partial_rank(&self, depth: usize, index: u64) -> u64 {
+    pub(crate) fn partial_rank(&self, depth: usize, index: u64) -> u64 {
         let s = &self.layout.sections[depth];
         let word = index / NODES_PER_WORD;
         let block = word / WORDS_PER_SAMPLE;

@@ -10,6 +10,7 @@
 //! | operation | functions | method | cost |
 //! |---|---|---|---|
 //! | Booleans (M2) | [`boolean`], [`union`], [`intersection`], [`difference`], [`symmetric_difference`], [`complement`] | simultaneous depth-first traversal; complement on packed words | linear in the nodes reached |
+//! | Booleans of files larger than memory | [`boolean_files`], [`complement_file`] | the same traversal over memory maps, levels spilled and streamed to a `.ktree` | linear; memory bounded by the depth |
 //! | translation (M3) | [`translate`], [`translate_fine`] | fixed overlay of `2^K` obels per target node | linear in the output nodes |
 //! | scaling (M4) | [`grow`], [`zoom`] (by `2^n` through the root), [`scale`] (rational, overlays) | root levels; overlay engine | `O(n·2^K)` + copy; output-sensitive |
 //! | rotations, reflections (M5) | [`rotate_axes`] with any [`AxisMap`] (`K!·2^K` of them) | child reordering | linear |
@@ -32,6 +33,7 @@
 
 pub mod affine;
 mod boolean;
+mod boolean_files;
 mod complexity;
 mod emit;
 mod error;
@@ -48,6 +50,9 @@ mod translate;
 pub use affine::{transform, Affine};
 pub use boolean::{
     boolean, complement, difference, intersection, symmetric_difference, union, BoolOp,
+};
+pub use boolean_files::{
+    boolean_files, boolean_views, complement_file, BooleanFileError, BooleanFileReport,
 };
 pub use complexity::{
     bounding_box, complexity, normalise_to_origin, over_maps, over_placements, over_translations,

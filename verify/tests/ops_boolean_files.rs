@@ -1,0 +1,104 @@
+//! Booleans streamed from `.ktree` files to a `.ktree` file in bounded memory: byte for byte the file of
+//! the in-memory Boolean, in K = 1 … 4, for random objects and for trees large enough to cross many words
+//! and rank samples per level.
+
+use std::path::Path;
+
+use ktree::io::{write_ktree_v2, write_ktree_v2_file};
+use ktree::ops::{self, BoolOp, BooleanFileError};
+use ktree::rays::ball_rays;
+use ktree::stacking::stack;
+use ktree::KTree;
+use ktree_verify::objects::pair;
+use proptest::prelude::*;
+
+fn v2_bytes<const K: usize>(tree: &KTree<K>) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    write_ktree_v2(&mut bytes, tree).unwrap();
+    bytes
+}
+
+/// Every streamed operation on files of `a` and `b` writes the bytes of the in-memory result.
+fn check_streamed<const K: usize>(a: &KTree<K>, b: &KTree<K>, dir: &Path) {
+    let (pa, pb, out) = (
+        dir.join("a.ktree"),
+        dir.join("b.ktree"),
+        dir.join("c.ktree"),
+    );
+    write_ktree_v2_file(&pa, a).unwrap();
+    write_ktree_v2_file(&pb, b).unwrap();
+    for op in BoolOp::ALL {
+        let report = ops::boolean_files(&pa, &pb, op, &out, None).unwrap();
+        let expect = ops::boolean(a, b, op).unwrap();
+        assert!(
+            std::fs::read(&out).unwrap() == v2_bytes(&expect),
+            "{op:?}: streamed file differs from the in-memory result"
+        );
+        assert_eq!(report.counts_per_level, expect.counts_per_level(), "{op:?}");
+    }
+    ops::complement_file(&pa, &out, None).unwrap();
+    assert!(std::fs::read(&out).unwrap() == v2_bytes(&ops::complement(a)));
+    // Nothing is left beside the inputs and the output.
+    assert_eq!(std::fs::read_dir(dir).unwrap().count(), 3);
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(64))]
+    #[test]
+    fn streamed_booleans_k1((a, b) in pair::<1>()) {
+        check_streamed(&a.tree(), &b.tree(), tempfile::tempdir().unwrap().path());
+    }
+    #[test]
+    fn streamed_booleans_k2((a, b) in pair::<2>()) {
+        check_streamed(&a.tree(), &b.tree(), tempfile::tempdir().unwrap().path());
+    }
+    #[test]
+    fn streamed_booleans_k3((a, b) in pair::<3>()) {
+        check_streamed(&a.tree(), &b.tree(), tempfile::tempdir().unwrap().path());
+    }
+    #[test]
+    fn streamed_booleans_k4((a, b) in pair::<4>()) {
+        check_streamed(&a.tree(), &b.tree(), tempfile::tempdir().unwrap().path());
+    }
+}
+
+/// Overlapping balls whose levels hold many words and rank samples: copies, complements and skips of
+/// large subtrees, with positions found again from the samples.
+#[test]
+fn streamed_booleans_of_large_balls() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = stack(&ball_rays::<3>(7, [50, 64, 64], 40).unwrap());
+    let b = stack(&ball_rays::<3>(7, [80, 60, 70], 35).unwrap());
+    assert!(a.level_states(6).len() > 64 * 32);
+    check_streamed(&a, &b, dir.path());
+    let a = stack(&ball_rays::<2>(11, [900, 1024], 700).unwrap());
+    let b = stack(&ball_rays::<2>(11, [1300, 1000], 650).unwrap());
+    check_streamed(&a, &b, dir.path());
+    // One side empty or full at the root.
+    check_streamed(&a, &KTree::<2>::full(11).unwrap(), dir.path());
+    check_streamed(&KTree::<2>::empty(11).unwrap(), &b, dir.path());
+}
+
+#[test]
+fn mismatched_inputs_are_an_error_and_leave_the_target() {
+    let dir = tempfile::tempdir().unwrap();
+    let (pa, pb, out) = (
+        dir.path().join("a.ktree"),
+        dir.path().join("b.ktree"),
+        dir.path().join("c.ktree"),
+    );
+    write_ktree_v2_file(&pa, &KTree::<3>::full(3).unwrap()).unwrap();
+    write_ktree_v2_file(&pb, &KTree::<3>::full(4).unwrap()).unwrap();
+    std::fs::write(&out, b"keep").unwrap();
+    let e = ops::boolean_files(&pa, &pb, BoolOp::Union, &out, None).unwrap_err();
+    assert!(matches!(e, BooleanFileError::Mismatch { .. }), "{e}");
+    assert!(e.to_string().contains("L = 4"), "{e}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"keep");
+    // A damaged input names its file.
+    let mut bytes = std::fs::read(&pa).unwrap();
+    bytes[20] ^= 1;
+    std::fs::write(&pa, &bytes).unwrap();
+    let e = ops::boolean_files(&pa, &pb, BoolOp::Union, &out, None).unwrap_err();
+    assert!(e.to_string().contains("a.ktree"), "{e}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"keep");
+}
