@@ -11,7 +11,10 @@ use ktree::display::{
     default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
     RenderOptions, ISO_TOWARD_EYE,
 };
-use ktree::io::{read_ktree_file, read_rays_file, AnyRaySet, AnyTree};
+use ktree::io::{
+    ktree_file_version, read_ktree_file, read_rays_file, AnyRaySet, AnyTree, KtreeView, MappedTree,
+};
+use ktree::tree::cursor::LevelOrder;
 
 /// Arguments of `ktree render`.
 #[derive(Debug, clap::Args)]
@@ -137,7 +140,6 @@ fn default_out(file: &Path) -> PathBuf {
 /// Renders the file.
 pub fn run(args: Args) -> Result<(), String> {
     let (w, h) = parse_size(&args.size)?;
-    let tree = read_ktree_file(&args.file).map_err(|e| e.to_string())?;
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.file));
     let bar = progress_bar(args.progress, "render");
     let mut tick = |done: u64, total: u64| {
@@ -146,91 +148,17 @@ pub fn run(args: Args) -> Result<(), String> {
             b.set_position(done);
         }
     };
-    match tree {
-        AnyTree::K3(tree) => {
-            let toward = parse_view(&args.camera)?;
-            let mut camera =
-                default_camera(&tree, toward, args.perspective, w, h).map_err(|e| e.to_string())?;
-            if let Some(eye) = &args.eye {
-                camera.eye = parse_vec3(eye, "eye")?;
-                let side = tree.universe().side() as f64;
-                let (lo, hi) = object_bounds(&tree).unwrap_or(([0.0; 3], [side; 3]));
-                camera.target = match &args.target {
-                    Some(t) => parse_vec3(t, "target")?,
-                    None => [0, 1, 2].map(|i| (lo[i] + hi[i]) / 2.0),
-                };
-                if let Projection::Orthographic { .. } = camera.projection {
-                    let diag = ((hi[0] - lo[0]).powi(2)
-                        + (hi[1] - lo[1]).powi(2)
-                        + (hi[2] - lo[2]).powi(2))
-                    .sqrt();
-                    camera.projection = Projection::Orthographic {
-                        height: diag.max(1.0) * 1.05,
-                    };
-                }
-            }
-            if let Some(up) = &args.up {
-                camera.up = parse_vec3(up, "up")?;
-            }
-            let camera: Camera = camera;
-            camera.check().map_err(|e| e.to_string())?;
-            let options = RenderOptions {
-                width: w,
-                height: h,
-                depth: args.depth.is_some(),
-                ..Default::default()
-            };
-            let rays = match &args.rays {
-                None => None,
-                Some(path) => match read_rays_file(path).map_err(|e| e.to_string())? {
-                    AnyRaySet::K3(r) if r.level() != tree.level() => {
-                        return Err(format!(
-                            "{}: level {} does not match the tree's level {}",
-                            path.display(),
-                            r.level(),
-                            tree.level()
-                        ))
-                    }
-                    AnyRaySet::K3(r) if r.has_normals() => Some(r),
-                    AnyRaySet::K3(_) => {
-                        return Err(format!(
-                            "{}: the rays carry no normals to shade with",
-                            path.display()
-                        ))
-                    }
-                    _ => {
-                        return Err(format!(
-                            "{}: normals for an octree need a K = 3 ray file",
-                            path.display()
-                        ))
-                    }
-                },
-            };
-            let image = render_with_progress(
-                &tree,
-                &camera,
-                &RenderOptions {
-                    normals: rays.as_ref(),
-                    ..options
-                },
-                &mut tick,
-            )
-            .map_err(|e| e.to_string())?;
-            png::write_rgb_png(&out, w, h, &image.rgb).map_err(|e| e.to_string())?;
-            if let (Some(path), Some(grey)) = (&args.depth, image.depth_grey()) {
-                png::write_grey_png(path, w, h, &grey).map_err(|e| e.to_string())?;
-            }
-            if let Some(b) = &bar {
-                b.finish_and_clear();
-            }
-            outln!(
-                "wrote {} ({w}x{h}, {} pixels of the object, {} nodes visited, {} culled)",
-                out.display(),
-                image.stats.painted,
-                image.stats.nodes_visited,
-                image.stats.culled
-            );
+    // An octree in a version 2 file is rendered from its memory map, whatever its size.
+    if ktree_file_version(&args.file).is_ok_and(|v| v == 2) {
+        let view = KtreeView::open(&args.file).map_err(|e| e.to_string())?;
+        if view.k() == 3 {
+            let tree = MappedTree::<3>::new(&view).map_err(|e| e.to_string())?;
+            return render_octree(&tree, &args, &out, w, h, bar.as_ref(), &mut tick);
         }
+    }
+    let tree = read_ktree_file(&args.file).map_err(|e| e.to_string())?;
+    match tree {
+        AnyTree::K3(tree) => render_octree(&tree, &args, &out, w, h, bar.as_ref(), &mut tick)?,
         AnyTree::K2(tree) => {
             let canvas = plane::quadtree_canvas(&tree, w.min(h)).map_err(|e| e.to_string())?;
             canvas.write_png(&out).map_err(|e| e.to_string())?;
@@ -264,5 +192,99 @@ pub fn run(args: Args) -> Result<(), String> {
             return Err("a bintree (K = 1) has no picture; render needs K = 2, 3 or 4".into())
         }
     }
+    Ok(())
+}
+
+/// Renders an octree, in memory or memory-mapped, to the PNG `out` (and the depth image if asked).
+fn render_octree<T: LevelOrder<3>>(
+    tree: &T,
+    args: &Args,
+    out: &Path,
+    w: u32,
+    h: u32,
+    bar: Option<&ProgressBar>,
+    tick: &mut dyn FnMut(u64, u64),
+) -> Result<(), String> {
+    let toward = parse_view(&args.camera)?;
+    let mut camera =
+        default_camera(tree, toward, args.perspective, w, h).map_err(|e| e.to_string())?;
+    if let Some(eye) = &args.eye {
+        camera.eye = parse_vec3(eye, "eye")?;
+        let side = tree.universe().side() as f64;
+        let (lo, hi) = object_bounds(tree).unwrap_or(([0.0; 3], [side; 3]));
+        camera.target = match &args.target {
+            Some(t) => parse_vec3(t, "target")?,
+            None => [0, 1, 2].map(|i| (lo[i] + hi[i]) / 2.0),
+        };
+        if let Projection::Orthographic { .. } = camera.projection {
+            let diag =
+                ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
+                    .sqrt();
+            camera.projection = Projection::Orthographic {
+                height: diag.max(1.0) * 1.05,
+            };
+        }
+    }
+    if let Some(up) = &args.up {
+        camera.up = parse_vec3(up, "up")?;
+    }
+    let camera: Camera = camera;
+    camera.check().map_err(|e| e.to_string())?;
+    let options = RenderOptions {
+        width: w,
+        height: h,
+        depth: args.depth.is_some(),
+        ..Default::default()
+    };
+    let rays = match &args.rays {
+        None => None,
+        Some(path) => match read_rays_file(path).map_err(|e| e.to_string())? {
+            AnyRaySet::K3(r) if r.level() != tree.level() => {
+                return Err(format!(
+                    "{}: level {} does not match the tree's level {}",
+                    path.display(),
+                    r.level(),
+                    tree.level()
+                ))
+            }
+            AnyRaySet::K3(r) if r.has_normals() => Some(r),
+            AnyRaySet::K3(_) => {
+                return Err(format!(
+                    "{}: the rays carry no normals to shade with",
+                    path.display()
+                ))
+            }
+            _ => {
+                return Err(format!(
+                    "{}: normals for an octree need a K = 3 ray file",
+                    path.display()
+                ))
+            }
+        },
+    };
+    let image = render_with_progress(
+        tree,
+        &camera,
+        &RenderOptions {
+            normals: rays.as_ref(),
+            ..options
+        },
+        tick,
+    )
+    .map_err(|e| e.to_string())?;
+    png::write_rgb_png(out, w, h, &image.rgb).map_err(|e| e.to_string())?;
+    if let (Some(path), Some(grey)) = (&args.depth, image.depth_grey()) {
+        png::write_grey_png(path, w, h, &grey).map_err(|e| e.to_string())?;
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    outln!(
+        "wrote {} ({w}x{h}, {} pixels of the object, {} nodes visited, {} culled)",
+        out.display(),
+        image.stats.painted,
+        image.stats.nodes_visited,
+        image.stats.culled
+    );
     Ok(())
 }

@@ -172,3 +172,40 @@ fn bad_input_is_a_one_line_error() {
         assert!(err.starts_with("ktree: "), "{err}");
     }
 }
+
+/// A version 2 file is rendered from its memory map: the same pictures and summary as the tree read into
+/// memory from a version 1 file.
+#[test]
+fn version_2_files_render_from_their_map_as_in_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    let tree = stack(&ball_rays::<3>(7, [60, 64, 70], 50).unwrap());
+    write_ktree_file(&p("v1.ktree"), &tree).unwrap();
+    ktree::io::write_ktree_v2_file(&p("v2.ktree"), &tree).unwrap();
+    let render = |file: &str, camera: &str| {
+        let (ok, out, err) = ktree(&[
+            "render",
+            p(file).to_str().unwrap(),
+            "--camera",
+            camera,
+            "--size",
+            "96x64",
+            "--out",
+            p("out.png").to_str().unwrap(),
+            "--depth",
+            p("depth.png").to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        (
+            out,
+            std::fs::read(p("out.png")).unwrap(),
+            std::fs::read(p("depth.png")).unwrap(),
+        )
+    };
+    for camera in ["iso", "top", "1,-2,0.5"] {
+        assert!(
+            render("v1.ktree", camera) == render("v2.ktree", camera),
+            "camera {camera}"
+        );
+    }
+}

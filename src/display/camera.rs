@@ -18,7 +18,8 @@
 
 use super::error::{CameraProblem, DisplayError};
 use crate::space::Cell;
-use crate::tree::{KTree, NodeState};
+use crate::tree::cursor::LevelOrder;
+use crate::tree::NodeState;
 
 /// 3-D vector helpers (private to the display module).
 pub(crate) mod v3 {
@@ -328,7 +329,7 @@ impl Camera {
 
 /// The bounding box `[lo, hi]` (in voxel coordinates) of the full cells of a tree, `None` for an empty
 /// object.
-pub fn object_bounds<const K: usize>(tree: &KTree<K>) -> Option<([f64; K], [f64; K])> {
+pub fn object_bounds<const K: usize, T: LevelOrder<K>>(tree: &T) -> Option<([f64; K], [f64; K])> {
     let mut lo = [f64::INFINITY; K];
     let mut hi = [f64::NEG_INFINITY; K];
     let mut any = false;
@@ -351,8 +352,8 @@ pub fn object_bounds<const K: usize>(tree: &KTree<K>) -> Option<([f64; K], [f64;
 ///
 /// # Errors
 /// As [`Camera::framing`].
-pub fn default_camera(
-    tree: &KTree<3>,
+pub fn default_camera<T: LevelOrder<3>>(
+    tree: &T,
     toward_eye: [f64; 3],
     fov_y_degrees: Option<f64>,
     width: u32,

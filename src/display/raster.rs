@@ -32,7 +32,7 @@ use super::error::{check_size, DisplayError};
 use super::order::{walk_ordered, Order, ViewOrder, Viewer, Walk};
 use crate::rays::RaySet;
 use crate::space::Cell;
-use crate::tree::cursor;
+use crate::tree::cursor::{self, LevelOrder};
 use crate::tree::{NodeRef, NodeState, Octree};
 
 /// Everything a rendering can be asked for besides the tree and the camera, with defaults: a 512×512
@@ -412,8 +412,8 @@ fn ray_normal(rays: &RaySet<3>, v: [u32; 3], axis: usize, dir: [f64; 3]) -> Opti
 ///
 /// # Errors
 /// [`DisplayError::BadSize`] or [`DisplayError::BadCamera`].
-pub fn render(
-    tree: &Octree,
+pub fn render<T: LevelOrder<3>>(
+    tree: &T,
     camera: &Camera,
     options: &RenderOptions,
 ) -> Result<Rendered, DisplayError> {
@@ -424,8 +424,8 @@ pub fn render(
 ///
 /// # Errors
 /// As [`render`].
-pub fn render_with_progress(
-    tree: &Octree,
+pub fn render_with_progress<T: LevelOrder<3>>(
+    tree: &T,
     camera: &Camera,
     options: &RenderOptions,
     progress: &mut dyn FnMut(u64, u64),
@@ -433,8 +433,8 @@ pub fn render_with_progress(
     front_to_back(tree, camera, options, Some(progress))
 }
 
-fn front_to_back(
-    tree: &Octree,
+fn front_to_back<T: LevelOrder<3>>(
+    tree: &T,
     camera: &Camera,
     options: &RenderOptions,
     mut progress: Option<&mut dyn FnMut(u64, u64)>,

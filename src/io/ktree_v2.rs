@@ -1020,6 +1020,11 @@ impl KtreeView {
         ))
     }
 
+    /// The universe, if the file's `K` is `K`.
+    pub(crate) fn universe<const K: usize>(&self) -> Result<Universe<K>, KtreeFileError> {
+        self.dimension::<K>()
+    }
+
     fn dimension<const K: usize>(&self) -> Result<Universe<K>, KtreeFileError> {
         if K != self.k() {
             return Err(KtreeFileError {

@@ -24,6 +24,7 @@ mod formats;
 mod grid;
 mod ktree_file;
 mod ktree_v2;
+mod mapped_tree;
 #[allow(unsafe_code)]
 mod mmap;
 mod octomap_bt;
@@ -48,6 +49,7 @@ pub use ktree_v2::{
     ktree_file_version, write_ktree_v2, write_ktree_v2_file, KtreeView, KtreeWriter,
     VERSION as VERSION_2,
 };
+pub use mapped_tree::MappedTree;
 pub use octomap_bt::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
 pub use rays_text::{
     read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source, RaysTextError,

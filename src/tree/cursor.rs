@@ -31,7 +31,91 @@
 
 use super::ktree::{KTree, NodeRef};
 use super::states::NodeState;
-use crate::space::Cell;
+use crate::space::{Cell, Universe};
+
+/// A tree stored in level order, read as the one-tree walks read it: in memory ([`KTree`]), or through the
+/// memory map of a `.ktree` version 2 file ([`MappedTree`](crate::io::MappedTree)), so that walks such as
+/// rendering run on trees larger than memory.
+pub trait LevelOrder<const K: usize> {
+    /// The universe.
+    fn universe(&self) -> Universe<K>;
+
+    /// The number of stored levels.
+    fn depth_count(&self) -> usize;
+
+    /// The root's state.
+    fn root_state(&self) -> NodeState;
+
+    /// The index (in level `depth + 1`) of the first child of the partial node `index` of level `depth`.
+    fn first_child(&self, depth: usize, index: usize) -> usize;
+
+    /// The states of the `2^K` siblings of level `depth` from `first` (a multiple of `2^K`), two bits each,
+    /// the first in the low bits.
+    fn block_codes(&self, depth: usize, first: usize) -> u32;
+
+    /// The universe level `L`.
+    fn level(&self) -> u32 {
+        self.universe().level()
+    }
+
+    /// The root node.
+    fn root(&self) -> NodeRef<K> {
+        NodeRef {
+            index: 0,
+            cell: self.universe().root(),
+            state: self.root_state(),
+        }
+    }
+
+    /// Visits every leaf (empty and full) in Morton order.
+    fn for_each_leaf(&self, mut visit: impl FnMut(Cell<K>, NodeState))
+    where
+        Self: Sized,
+    {
+        struct Leaves<F>(F);
+        impl<const K: usize, F: FnMut(Cell<K>, NodeState)> Visitor<K> for Leaves<F> {
+            const LEAVES: bool = false;
+            fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+                if node.state != NodeState::Partial {
+                    (self.0)(node.cell, node.state);
+                }
+                Walk::Descend
+            }
+        }
+        walk(self, &mut Leaves(&mut visit));
+    }
+}
+
+impl<const K: usize> LevelOrder<K> for KTree<K> {
+    #[inline]
+    fn universe(&self) -> Universe<K> {
+        KTree::universe(self)
+    }
+
+    #[inline]
+    fn depth_count(&self) -> usize {
+        KTree::depth_count(self)
+    }
+
+    #[inline]
+    fn root_state(&self) -> NodeState {
+        KTree::root_state(self)
+    }
+
+    #[inline(always)]
+    fn first_child(&self, depth: usize, index: usize) -> usize {
+        KTree::first_child(self, depth, index)
+    }
+
+    #[inline(always)]
+    fn block_codes(&self, depth: usize, first: usize) -> u32 {
+        self.level_states(depth).block_codes(first, K)
+    }
+
+    fn for_each_leaf(&self, visit: impl FnMut(Cell<K>, NodeState)) {
+        KTree::for_each_leaf(self, visit)
+    }
+}
 
 /// What a visitor wants after seeing a node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -195,14 +279,14 @@ fn child_ref<const K: usize>(
 }
 
 /// Walks `tree` depth first from the root with `visitor`. Returns `true` if the visitor stopped the walk.
-pub fn walk<const K: usize, V: Visitor<K>>(tree: &KTree<K>, visitor: &mut V) -> bool {
+pub fn walk<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(tree: &T, visitor: &mut V) -> bool {
     walk_from(tree, tree.root(), visitor)
 }
 
 /// Walks the subtree of `node` (a node of `tree`) depth first with `visitor`. Returns `true` if the
 /// visitor stopped the walk.
-pub fn walk_from<const K: usize, V: Visitor<K>>(
-    tree: &KTree<K>,
+pub fn walk_from<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(
+    tree: &T,
     node: NodeRef<K>,
     v: &mut V,
 ) -> bool {
@@ -223,7 +307,7 @@ pub fn walk_from<const K: usize, V: Visitor<K>>(
         }
         let depth = node.cell.level as usize;
         let first = tree.first_child(depth, node.index);
-        let codes = tree.level_states(depth + 1).block_codes(first, K);
+        let codes = tree.block_codes(depth + 1, first);
         let order = v.child_order(&node);
         if V::LEAVES {
             stack.push((node, true));
