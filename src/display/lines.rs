@@ -34,7 +34,7 @@
 use super::camera::v3;
 use super::error::DisplayError;
 use super::hidden::{remove_hidden, Hexagon, HiddenLineMethod};
-use super::neighbours::{edge_occupancy, is_surrounded, shifted};
+use super::neighbours::{shifted, Neighbours};
 use super::order::{ordered_full_cells, Order, Viewer};
 use crate::space::Cell;
 use crate::tree::Octree;
@@ -204,9 +204,10 @@ pub(crate) fn extract(
     let side_u = tree.universe().side();
     let mut cubes = Vec::new();
     let mut pieces = Vec::new();
+    let mut near = Neighbours::new(tree);
     for cell in ordered_full_cells(tree, Viewer::Direction(d), Order::FrontToBack) {
         stats.full_leaves += 1;
-        if is_surrounded(tree, &cell) {
+        if near.is_surrounded(&cell) {
             stats.surrounded += 1;
             continue;
         }
@@ -226,8 +227,8 @@ pub(crate) fn extract(
                     let n1 = shifted(&cell, &[(b, sb)], side_u);
                     let n2 = shifted(&cell, &[(c, sc)], side_u);
                     let dg = shifted(&cell, &[(b, sb), (c, sc)], side_u);
-                    let occ = |r: &Option<Cell<3>>, b_side: bool, c_side: bool| {
-                        edge_occupancy(tree, r.as_ref(), s, axis, (b, b_side), (c, c_side))
+                    let mut occ = |r: &Option<Cell<3>>, b_side: bool, c_side: bool| {
+                        near.edge_occupancy(r.as_ref(), s, axis, (b, b_side), (c, c_side))
                     };
                     // Query the viewer's quadrant first: if it is all full, nothing here shows.
                     let (viewer_q, which) = match (vb, vc) {

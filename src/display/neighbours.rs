@@ -2,7 +2,9 @@
 //! six neighbours with spare child pointers (V3); the level-order tree has no pointers, so a neighbour is
 //! found by descending from the root to the equal-sized cell across a face — `O(L)` rank lookups — and the
 //! part of it that touches the face (or an edge) is read by descending only into the children that touch
-//! it. Both are [`cursor`] walks that choose which children to visit.
+//! it. Both are [`cursor`] walks that choose which children to visit. A [`Neighbours`] asks many such
+//! questions about nearby cells, each descent starting from the deepest ancestor it shares with the last
+//! one ([`cursor::Locator`]).
 //!
 //! ```
 //! use ktree::display::neighbours::is_surrounded;
@@ -15,7 +17,7 @@
 //! ```
 
 use crate::space::Cell;
-use crate::tree::cursor::{self, ChildOrder, Visitor, Walk};
+use crate::tree::cursor::{self, ChildOrder, Locator, Visitor, Walk};
 use crate::tree::{KTree, NodeRef, NodeState};
 
 /// The node whose cell contains the aligned cell `region` and is either a leaf or `region` itself.
@@ -69,40 +71,85 @@ pub fn face_all_full<const K: usize>(
     axis: usize,
     upper: bool,
 ) -> bool {
-    struct AllFull {
-        face: ChildOrder,
-        all_full: bool,
-    }
-    impl<const K: usize> Visitor<K> for AllFull {
-        fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-            if node.state == NodeState::Empty {
-                self.all_full = false;
-                return Walk::Stop;
-            }
-            Walk::Descend
-        }
-        fn child_order(&self, _node: &NodeRef<K>) -> ChildOrder {
-            self.face
-        }
-    }
-    let mut query = AllFull {
-        face: ChildOrder::half::<K>(axis, upper),
-        all_full: true,
-    };
-    cursor::walk_from(tree, locate(tree, region), &mut query);
-    query.all_full
+    Neighbours::new(tree).face_all_full(region, axis, upper)
 }
 
 /// Whether a full leaf is surrounded: each of its `2K` faces touches only full voxels across it (V5).
 /// Faces on the universe's boundary are open.
 pub fn is_surrounded<const K: usize>(tree: &KTree<K>, cell: &Cell<K>) -> bool {
-    let side = tree.universe().side();
-    (0..K).all(|axis| {
-        [false, true].iter().all(|&upper| {
-            face_neighbour_cell(cell, axis, upper, side)
-                .is_some_and(|n| face_all_full(tree, &n, axis, !upper))
+    Neighbours::new(tree).is_surrounded(cell)
+}
+
+/// Questions about the cells near one another in a tree, each descent starting from the deepest ancestor
+/// shared with the previous question's cell.
+///
+/// ```
+/// use ktree::display::neighbours::Neighbours;
+/// use ktree::KTree;
+/// let full = KTree::<3>::full(2).unwrap();
+/// let u = full.universe();
+/// let mut n = Neighbours::new(&full);
+/// assert!(n.is_surrounded(&u.cell([1, 1, 1], 2).unwrap()));
+/// assert!(!n.is_surrounded(&u.cell([0, 0, 0], 2).unwrap()));
+/// ```
+#[derive(Debug, Clone)]
+pub struct Neighbours<'t, const K: usize> {
+    tree: &'t KTree<K>,
+    locator: Locator<K>,
+}
+
+impl<'t, const K: usize> Neighbours<'t, K> {
+    /// Questions about `tree`.
+    pub fn new(tree: &'t KTree<K>) -> Self {
+        Self {
+            tree,
+            locator: Locator::new(tree),
+        }
+    }
+
+    /// As [`locate`].
+    pub fn locate(&mut self, region: &Cell<K>) -> NodeRef<K> {
+        self.locator.locate(self.tree, region)
+    }
+
+    /// As [`face_all_full`].
+    pub fn face_all_full(&mut self, region: &Cell<K>, axis: usize, upper: bool) -> bool {
+        struct AllFull {
+            face: ChildOrder,
+            all_full: bool,
+        }
+        impl<const K: usize> Visitor<K> for AllFull {
+            const LEAVES: bool = false;
+            fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+                if node.state == NodeState::Empty {
+                    self.all_full = false;
+                    return Walk::Stop;
+                }
+                Walk::Descend
+            }
+            fn child_order(&self, _node: &NodeRef<K>) -> ChildOrder {
+                self.face
+            }
+        }
+        let mut query = AllFull {
+            face: ChildOrder::half::<K>(axis, upper),
+            all_full: true,
+        };
+        let node = self.locate(region);
+        cursor::walk_from(self.tree, node, &mut query);
+        query.all_full
+    }
+
+    /// As [`is_surrounded`].
+    pub fn is_surrounded(&mut self, cell: &Cell<K>) -> bool {
+        let side = self.tree.universe().side();
+        (0..K).all(|axis| {
+            [false, true].iter().all(|&upper| {
+                face_neighbour_cell(cell, axis, upper, side)
+                    .is_some_and(|n| self.face_all_full(&n, axis, !upper))
+            })
         })
-    })
+    }
 }
 
 /// The occupancy of a 3-D region's edge line: the region is an aligned cube; the edge runs along `axis`
@@ -114,53 +161,69 @@ pub fn edge_occupancy(
     region: Option<&Cell<3>>,
     side: u32,
     axis: usize,
-    (b, side_b): (usize, bool),
-    (c, side_c): (usize, bool),
+    b: (usize, bool),
+    c: (usize, bool),
 ) -> Vec<(u32, u32, bool)> {
-    let mut out: Vec<(u32, u32, bool)> = Vec::new();
-    let Some(region) = region else {
-        return vec![(0, side, false)];
-    };
-    let node = locate(tree, region);
-    let base = region.origin[axis];
-    let mut push = |start: u32, end: u32, full: bool| match out.last_mut() {
-        Some(last) if last.2 == full && last.1 == start => last.1 = end,
-        _ => out.push((start, end, full)),
-    };
-    if node.state != NodeState::Partial {
-        push(0, side, node.state == NodeState::Full);
-        return out;
-    }
-    // Depth-first along the edge, lower half first.
-    struct Edge<F> {
-        along: ChildOrder,
+    Neighbours::new(tree).edge_occupancy(region, side, axis, b, c)
+}
+
+impl Neighbours<'_, 3> {
+    /// As [`edge_occupancy`].
+    pub fn edge_occupancy(
+        &mut self,
+        region: Option<&Cell<3>>,
+        side: u32,
         axis: usize,
-        base: u32,
-        push: F,
-    }
-    impl<F: FnMut(u32, u32, bool)> Visitor<3> for Edge<F> {
-        fn visit(&mut self, n: &NodeRef<3>) -> Walk {
-            if n.state != NodeState::Partial {
-                let start = n.cell.origin[self.axis] - self.base;
-                (self.push)(
-                    start,
-                    start + n.cell.side() as u32,
-                    n.state == NodeState::Full,
-                );
+        (b, side_b): (usize, bool),
+        (c, side_c): (usize, bool),
+    ) -> Vec<(u32, u32, bool)> {
+        let mut out: Vec<(u32, u32, bool)> = Vec::new();
+        let Some(region) = region else {
+            return vec![(0, side, false)];
+        };
+        let tree = self.tree;
+        let node = self.locate(region);
+        let base = region.origin[axis];
+        let mut push = |start: u32, end: u32, full: bool| match out.last_mut() {
+            Some(last) if last.2 == full && last.1 == start => last.1 = end,
+            _ => out.push((start, end, full)),
+        };
+        if node.state != NodeState::Partial {
+            push(0, side, node.state == NodeState::Full);
+            return out;
+        }
+        // Depth-first along the edge, lower half first.
+        struct Edge<F> {
+            along: ChildOrder,
+            axis: usize,
+            base: u32,
+            push: F,
+        }
+        impl<F: FnMut(u32, u32, bool)> Visitor<3> for Edge<F> {
+            const LEAVES: bool = false;
+            fn visit(&mut self, n: &NodeRef<3>) -> Walk {
+                if n.state != NodeState::Partial {
+                    let start = n.cell.origin[self.axis] - self.base;
+                    (self.push)(
+                        start,
+                        start + n.cell.side() as u32,
+                        n.state == NodeState::Full,
+                    );
+                }
+                Walk::Descend
             }
-            Walk::Descend
+            fn child_order(&self, _n: &NodeRef<3>) -> ChildOrder {
+                self.along
+            }
         }
-        fn child_order(&self, _n: &NodeRef<3>) -> ChildOrder {
-            self.along
-        }
+        let corner = (usize::from(side_b) << b) | (usize::from(side_c) << c);
+        let mut query = Edge {
+            along: ChildOrder::from_codes([corner, corner | 1 << axis]),
+            axis,
+            base,
+            push,
+        };
+        cursor::walk_from(tree, node, &mut query);
+        out
     }
-    let corner = (usize::from(side_b) << b) | (usize::from(side_c) << c);
-    let mut query = Edge {
-        along: ChildOrder::from_codes([corner, corner | 1 << axis]),
-        axis,
-        base,
-        push,
-    };
-    cursor::walk_from(tree, node, &mut query);
-    out
 }

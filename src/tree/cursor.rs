@@ -29,6 +29,8 @@
 //! assert_eq!(v.0, Some(4));
 //! ```
 
+use smallvec::SmallVec;
+
 use super::ktree::{KTree, NodeRef};
 use super::states::NodeState;
 use crate::space::{Cell, Universe};
@@ -292,7 +294,8 @@ pub fn walk_from<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(
 ) -> bool {
     // Depth first with an explicit stack: a node to visit, or a partial node to leave once the entries
     // above it (its children's) are done.
-    let mut stack: Vec<(NodeRef<K>, bool)> = Vec::with_capacity(16 * (tree.depth_count() + 1));
+    // Inline up to 64 entries: the narrow walks (a face, an edge, a point) run without allocating.
+    let mut stack: SmallVec<[(NodeRef<K>, bool); 64]> = SmallVec::new();
     stack.push((node, false));
     while let Some((node, leaving)) = stack.pop() {
         if leaving {
@@ -517,6 +520,17 @@ pub fn child<const K: usize>(tree: &KTree<K>, node: &NodeRef<K>, code: usize) ->
 /// ```
 #[inline]
 pub fn locate<const K: usize>(tree: &KTree<K>, start: NodeRef<K>, target: &Cell<K>) -> NodeRef<K> {
+    descend(tree, start, target, |_| {})
+}
+
+/// [`locate`], calling `on_step` with each node stepped to.
+#[inline(always)]
+fn descend<const K: usize>(
+    tree: &KTree<K>,
+    start: NodeRef<K>,
+    target: &Cell<K>,
+    mut on_step: impl FnMut(&NodeRef<K>),
+) -> NodeRef<K> {
     debug_assert!(start.cell.level <= target.level);
     let bit_top = tree.level().saturating_sub(1);
     let mut node = start;
@@ -528,11 +542,78 @@ pub fn locate<const K: usize>(tree: &KTree<K>, start: NodeRef<K>, target: &Cell<
         }
         let first = tree.first_child(node.cell.level as usize, node.index);
         node = child_ref(tree, &node, first, code, false);
+        on_step(&node);
     }
     // The steps did not track origins: the node's cell is the target's ancestor at its level.
     let low = ((1u64 << node.cell.log_side) - 1) as u32;
     node.cell.origin = target.origin.map(|o| o & !low);
     node
+}
+
+/// Point location that remembers its last path from the root: a target near the previous one (a
+/// neighbour of the same leaf, the next leaf in Morton order) is found from their deepest common ancestor
+/// instead of from the root. Gives what [`locate`] from the root gives.
+///
+/// ```
+/// use ktree::tree::cursor::{locate, Locator};
+/// use ktree::KTree;
+/// let tree = KTree::<2>::from_dense(3, &(0..64).map(|i| i % 5 == 0).collect::<Vec<_>>()).unwrap();
+/// let mut locator = Locator::new(&tree);
+/// for (x, y) in [(3, 4), (3, 5), (7, 0), (0, 0)] {
+///     let voxel = tree.universe().cell([x, y], 3).unwrap();
+///     assert_eq!(locator.locate(&tree, &voxel), locate(&tree, tree.root(), &voxel));
+/// }
+/// ```
+#[derive(Debug, Clone)]
+pub struct Locator<const K: usize> {
+    /// `(index, state)` of the node at each depth of the last path.
+    path: [(usize, NodeState); 33],
+    /// Nodes on the last path.
+    len: usize,
+    /// The origin of the last target.
+    last: [u32; K],
+}
+
+impl<const K: usize> Locator<K> {
+    /// A locator for `tree`, its path at the root.
+    pub fn new(tree: &KTree<K>) -> Self {
+        let mut path = [(0, NodeState::Empty); 33];
+        path[0] = (0, tree.root_state());
+        Self {
+            path,
+            len: 1,
+            last: [0; K],
+        }
+    }
+
+    /// As [`locate`] from the root of `tree` (the tree the locator was made for).
+    pub fn locate(&mut self, tree: &KTree<K>, target: &Cell<K>) -> NodeRef<K> {
+        let top = tree.level();
+        // The depth down to which the last target's ancestors are the target's.
+        let differ = (0..K)
+            .map(|a| 32 - (self.last[a] ^ target.origin[a]).leading_zeros())
+            .max()
+            .unwrap_or(0);
+        let common = top.saturating_sub(differ) as usize;
+        let depth = common.min(self.len - 1).min(target.level as usize);
+        let (index, state) = self.path[depth];
+        let start = NodeRef {
+            index,
+            cell: Cell {
+                origin: target.origin,
+                level: depth as u32,
+                log_side: top - depth as u32,
+            },
+            state,
+        };
+        let path = &mut self.path;
+        let node = descend(tree, start, target, |n| {
+            path[n.cell.level as usize] = (n.index, n.state)
+        });
+        self.len = node.cell.level as usize + 1;
+        self.last = target.origin;
+        node
+    }
 }
 
 /// The state of the voxel `point` (inside `start`'s cell): [`locate`] for one voxel when only its state is

@@ -1,9 +1,11 @@
 //! The cursor against brute force on the dense array, K = 1 … 4: one-tree and two-tree walks visit exactly
 //! the nodes (cells and states) a recursive enumeration of the dense array finds, in the same order, with
-//! skipping and early exit; point location and subtree ranges agree with the dense array.
+//! skipping and early exit; point location (from the root, or from a [`Locator`]'s last path) and subtree
+//! ranges agree with the dense array.
 
 use ktree::tree::cursor::{
-    locate, subtree_ranges, walk, walk_pair, ChildOrder, PairNode, PairVisitor, Visitor, Walk,
+    locate, subtree_ranges, walk, walk_pair, ChildOrder, Locator, PairNode, PairVisitor, Visitor,
+    Walk,
 };
 use ktree::tree::NodeRef;
 use ktree::{Cell, KTree, NodeState, Universe};
@@ -272,4 +274,37 @@ fn a_single_leaf_tree_is_one_visit() {
     };
     assert!(!walk(&tree, &mut v));
     assert_eq!(v.seen, [(tree.universe().root(), NodeState::Full)]);
+}
+
+/// A locator that keeps its path finds, for any sequence of cells, what a descent from the root finds.
+fn check_locator<const K: usize>(o: &Obj<K>, picks: &[(u64, u32)]) -> Result<(), TestCaseError> {
+    let tree = o.tree();
+    let u = tree.universe();
+    let mut locator = Locator::new(&tree);
+    for &(seed, level) in picks {
+        let level = level % (u.level() + 1);
+        let side = 1u64 << level;
+        let origin = std::array::from_fn(|a| {
+            let x = (seed >> (16 * a)) % side;
+            (x << (u.level() - level)) as u32
+        });
+        let target = u.cell(origin, level).unwrap();
+        prop_assert_eq!(
+            locator.locate(&tree, &target),
+            locate(&tree, tree.root(), &target)
+        );
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(64))]
+    #[test]
+    fn locator_matches_locate_k1(o in object::<1>(), p in prop::collection::vec((any::<u64>(), 0..32u32), 1..40)) { check_locator(&o, &p)?; }
+    #[test]
+    fn locator_matches_locate_k2(o in object::<2>(), p in prop::collection::vec((any::<u64>(), 0..32u32), 1..40)) { check_locator(&o, &p)?; }
+    #[test]
+    fn locator_matches_locate_k3(o in object::<3>(), p in prop::collection::vec((any::<u64>(), 0..32u32), 1..40)) { check_locator(&o, &p)?; }
+    #[test]
+    fn locator_matches_locate_k4(o in object::<4>(), p in prop::collection::vec((any::<u64>(), 0..32u32), 1..40)) { check_locator(&o, &p)?; }
 }
