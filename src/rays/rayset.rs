@@ -318,8 +318,12 @@ impl<const K: usize> RaySet<K> {
     }
 
     /// The column of a key (last coordinate 0): the inverse of [`RaySet::column_key`].
-    pub fn column_of_key(&self, mut key: u64) -> [u32; K] {
-        let level = self.level();
+    pub fn column_of_key(&self, key: u64) -> [u32; K] {
+        Self::column_of_key_at(self.level(), key)
+    }
+
+    /// [`RaySet::column_of_key`] in a universe of level `level`.
+    pub fn column_of_key_at(level: u32, mut key: u64) -> [u32; K] {
         let mask = (1u64 << level) - 1;
         let mut point = [0u32; K];
         for c in point[..K - 1].iter_mut().rev() {

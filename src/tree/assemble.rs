@@ -297,13 +297,21 @@ impl<const K: usize> KTree<K> {
             universe,
             levels: LevelWriter::new(),
         };
-        emit_leaves::<K, _>(&mut out, universe.level(), cells);
+        emit_leaves::<K, _>(&mut out, universe.level(), cells.iter().copied());
         out.finish()
     }
 
     /// Like [`KTree::from_sorted_morton`], with each cell packed as `Morton key << 5 | level` (needs
     /// `K·L + 5 ≤ 64`); sorting such packed values sorts the cells.
     pub(crate) fn from_sorted_packed(universe: Universe<K>, cells: &[u64]) -> KTree<K> {
+        Self::from_sorted_packed_keys(universe, cells.iter().copied())
+    }
+
+    /// [`KTree::from_sorted_packed`] from the keys as they come (read from a sorted file, say).
+    pub(crate) fn from_sorted_packed_keys(
+        universe: Universe<K>,
+        cells: impl IntoIterator<Item = u64>,
+    ) -> KTree<K> {
         debug_assert!(K as u32 * universe.level() + 5 <= 64);
         let mut out = TreeAssembler::<K> {
             universe,
@@ -349,7 +357,11 @@ impl CellKey for u64 {
 /// the maximal rows of a run, in Morton space), and before each leaf the partial nodes it is the first
 /// descendant of are opened: those at the depths where the leaf's position is aligned to the node's size.
 /// Cost: `O(nodes)`.
-fn emit_leaves<const K: usize, C: CellKey>(out: &mut TreeAssembler<K>, level: u32, cells: &[C]) {
+fn emit_leaves<const K: usize, C: CellKey>(
+    out: &mut TreeAssembler<K>,
+    level: u32,
+    cells: impl IntoIterator<Item = C>,
+) {
     let k = K as u32;
     let end = 1u128 << (k * level);
     let mut pos = 0u128;

@@ -1,7 +1,7 @@
 //! The other ways of running stacking build the tree of the in-memory stacker, K = 1 … 4: with the
 //! dimension-level lists as sequential disk files (same tree, same traffic through every list, never more
-//! than three files open), as a pipeline of one thread per stage, and through a bitmap pyramid (the way
-//! the cells of a partitioned build are stacked).
+//! than three files open, lists sorted in memory or on disk in bounded runs), as a pipeline of one thread
+//! per stage, and through a bitmap pyramid (the way the cells of a partitioned build are stacked).
 
 use ktree_verify::cases;
 
@@ -15,34 +15,43 @@ fn modes_agree<const K: usize>(case: &Case<K>) -> Result<(), TestCaseError> {
     let rays = &case.rays;
     let (tree, stats) = stack_with_stats(rays);
     let dir = tempfile::tempdir().unwrap();
-    let (on_disk, disk_stats, files) =
-        stack_with_file_lists(rays, dir.path()).map_err(|e| TestCaseError::fail(e.to_string()))?;
-    prop_assert!(
-        on_disk == tree,
-        "file lists and memory differ node for node"
-    );
-    prop_assert_eq!(
-        &disk_stats.entered,
-        &stats.entered,
-        "items entering each list"
-    );
-    prop_assert_eq!(
-        &disk_stats.combined,
-        &stats.combined,
-        "groups combined in each list"
-    );
-    prop_assert_eq!(&disk_stats.split, &stats.split, "items split in each list");
-    prop_assert_eq!(disk_stats.cells, stats.cells);
-    prop_assert_eq!(disk_stats.maximal_rows, stats.maximal_rows);
-    prop_assert!(
-        files.max_open_files <= 3,
-        "{} files open at once",
-        files.max_open_files
-    );
-    prop_assert!(
-        std::fs::read_dir(dir.path()).unwrap().next().is_none(),
-        "list files left behind"
-    );
+    // Lists sorted in memory, then on disk in runs of 8 keys (merged two at a time).
+    for max_items in [usize::MAX, 8] {
+        let (on_disk, disk_stats, files) = stack_with_file_lists(rays, dir.path(), max_items)
+            .map_err(|e| TestCaseError::fail(e.to_string()))?;
+        prop_assert!(
+            files.largest_list <= (max_items as u64).saturating_add(1 << rays.level()),
+            "{} keys held with runs of {max_items}",
+            files.largest_list
+        );
+        prop_assert_eq!(disk_stats.rays, stats.rays);
+        prop_assert!(
+            on_disk == tree,
+            "file lists and memory differ node for node"
+        );
+        prop_assert_eq!(
+            &disk_stats.entered,
+            &stats.entered,
+            "items entering each list"
+        );
+        prop_assert_eq!(
+            &disk_stats.combined,
+            &stats.combined,
+            "groups combined in each list"
+        );
+        prop_assert_eq!(&disk_stats.split, &stats.split, "items split in each list");
+        prop_assert_eq!(disk_stats.cells, stats.cells);
+        prop_assert_eq!(disk_stats.maximal_rows, stats.maximal_rows);
+        prop_assert!(
+            files.max_open_files <= 3,
+            "{} files open at once",
+            files.max_open_files
+        );
+        prop_assert!(
+            std::fs::read_dir(dir.path()).unwrap().next().is_none(),
+            "list files left behind"
+        );
+    }
     let pipelined = stack_pipelined(rays);
     prop_assert!(
         pipelined == tree,
