@@ -27,6 +27,7 @@ mod ktree_v2;
 #[allow(unsafe_code)]
 mod mmap;
 mod octomap_bt;
+mod rays_source;
 mod rays_text;
 mod vdb;
 
@@ -49,6 +50,7 @@ pub use ktree_v2::{
     VERSION as VERSION_2,
 };
 pub use octomap_bt::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
+pub use rays_source::{open_rays_file, AnyRaysFileSource, RaysFile, RaysFileSource};
 pub use rays_text::{
     read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source, RaysTextError,
     RaysTextErrorKind,

@@ -3,12 +3,15 @@
 //! and the out-of-core build from the source writes, byte for byte, the file of the tree stacked in memory
 //! from the whole set (random small meshes, volumes and ray files, and the meshes and volumes of data/).
 
-use ktree::io::write_ktree_v2;
+use ktree::io::{
+    open_rays_file, read_rays_file, write_ktree_v2, write_rays, write_rays_file, AnyRaySet,
+    AnyRaysFileSource, RaysFile, RaysFileSource,
+};
 use ktree::solid::mesh::{MeshSource, Placement, TriangleMesh};
 use ktree::solid::volume::{Select, Volume, VolumeSource};
 use ktree::stacking::{stack, stack_to_file, OutOfCore, RaySource};
-use ktree::RaySet;
-use ktree_verify::cases;
+use ktree::{Ray, RaySet};
+use ktree_verify::cases::{self, ray_sets, Case};
 use proptest::prelude::*;
 
 /// Every slab of every width has the runs of the whole set, and the occupied slabs hold them all.
@@ -35,7 +38,7 @@ where
                 b
             );
             prop_assert!(
-                r.is_empty() || occupied.contains(&b),
+                r.is_empty() || K == 1 || occupied.contains(&b),
                 "depth {}, slab {} not listed",
                 m,
                 b
@@ -189,4 +192,149 @@ fn bundled_volumes_equal_their_whole_rays() {
         slabs_agree(&source, &whole).unwrap();
         file_agrees(&source, &whole, [0, 3, 5, level]).unwrap();
     }
+}
+
+/// A source of a ray file and the file read whole give the same runs slab by slab, the same counts and
+/// the same tree file.
+fn ray_source_agrees<const K: usize>(
+    source: &RaysFileSource<K>,
+    whole: &RaySet<K>,
+) -> Result<(), TestCaseError> {
+    prop_assert_eq!(source.runs(), whole.len() as u64);
+    prop_assert_eq!(source.voxel_count(), whole.voxel_count());
+    slabs_agree(source, whole)?;
+    file_agrees(source, whole, 0..=whole.level())
+}
+
+/// The ray file of `case` as `write_rays` writes it is opened slab by slab (not read whole) and agrees
+/// with the set.
+fn ray_file_agrees<const K: usize>(case: &Case<K>) -> Result<(), TestCaseError> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.rays");
+    write_rays_file(&path, &case.rays).unwrap();
+    let whole = read_rays_file(&path).unwrap();
+    prop_assert!(whole == AnyRaySet::from(case.rays.clone()));
+    let RaysFile::Sorted(source) = open_rays_file(&path).unwrap() else {
+        return Err(TestCaseError::fail("a sorted file was read whole"));
+    };
+    match (&source, &whole) {
+        (AnyRaysFileSource::K1(s), AnyRaySet::K1(r)) => ray_source_agrees(s, r),
+        (AnyRaysFileSource::K2(s), AnyRaySet::K2(r)) => ray_source_agrees(s, r),
+        (AnyRaysFileSource::K3(s), AnyRaySet::K3(r)) => ray_source_agrees(s, r),
+        (AnyRaysFileSource::K4(s), AnyRaySet::K4(r)) => ray_source_agrees(s, r),
+        _ => Err(TestCaseError::fail("the source has another dimension")),
+    }
+}
+
+/// The lines of a ray file (header included) as `write_rays` writes them.
+fn ray_lines<const K: usize>(rays: &RaySet<K>) -> Vec<String> {
+    let mut text = Vec::new();
+    write_rays(&mut text, rays).unwrap();
+    String::from_utf8(text)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+/// Opening a file gives what reading it whole gives: the same set (read whole, or indexed with the same
+/// runs), or the same error.
+fn opens_as_read(text: &str) -> Result<(), TestCaseError> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("edited.rays");
+    std::fs::write(&path, text).unwrap();
+    match (open_rays_file(&path), read_rays_file(&path)) {
+        (Err(a), Err(b)) => prop_assert_eq!(a, b),
+        (Ok(RaysFile::Whole(a)), Ok(b)) => prop_assert!(a == b, "read whole, a different set"),
+        (Ok(RaysFile::Sorted(s)), Ok(b)) => match (&s, &b) {
+            (AnyRaysFileSource::K1(s), AnyRaySet::K1(r)) => ray_source_agrees(s, r)?,
+            (AnyRaysFileSource::K2(s), AnyRaySet::K2(r)) => ray_source_agrees(s, r)?,
+            (AnyRaysFileSource::K3(s), AnyRaySet::K3(r)) => ray_source_agrees(s, r)?,
+            (AnyRaysFileSource::K4(s), AnyRaySet::K4(r)) => ray_source_agrees(s, r)?,
+            _ => return Err(TestCaseError::fail("the source has another dimension")),
+        },
+        (a, b) => {
+            return Err(TestCaseError::fail(format!(
+                "opened {:?}, read {:?}",
+                a.map(|_| ()),
+                b.map(|_| ())
+            )))
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(32))]
+
+    #[test]
+    fn ray_file_slabs_k1(case in ray_sets::<1>()) { ray_file_agrees(&case)?; }
+    #[test]
+    fn ray_file_slabs_k2(case in ray_sets::<2>()) { ray_file_agrees(&case)?; }
+    #[test]
+    fn ray_file_slabs_k3(case in ray_sets::<3>()) { ray_file_agrees(&case)?; }
+    #[test]
+    fn ray_file_slabs_k4(case in ray_sets::<4>()) { ray_file_agrees(&case)?; }
+
+    /// Lines moved, repeated, or replaced by bad text (a field, a number out of range, a comment): the
+    /// file opens as it reads whole — the same rays or the same error naming the file and line.
+    #[test]
+    fn edited_ray_files_open_as_they_read(
+        case in ray_sets::<3>(),
+        edits in prop::collection::vec((0usize..64, 0usize..64, 0u8..6), 1..4),
+    ) {
+        let mut lines = ray_lines(&case.rays);
+        for (i, j, what) in edits {
+            let n = lines.len();
+            let (i, j) = (i % n, j % n);
+            match what {
+                0 => lines.swap(i, j),
+                1 => { let l = lines[i].clone(); lines.insert(j, l); }
+                2 => lines[i] = "1 2 x 4".into(),
+                3 => lines[i] = format!("{} 99999", lines[i]),
+                4 => lines[i] = "0 0 7 3".into(),
+                _ => lines.insert(i, "# a comment".into()),
+            }
+        }
+        opens_as_read(&(lines.join("\n") + "\n"))?;
+    }
+}
+
+#[test]
+fn unsorted_overlapping_and_bad_files_open_as_they_read() {
+    for text in [
+        "",
+        "# only a comment\n",
+        "3 4\n1 2 3 4\n",
+        "3 4\n1 2 3 4\n0 0 0 1\n",
+        "3 4\n1 2 3 8\n1 2 5 9\n",
+        "3 4\n1 2 3 8\n1 2 8 9\n",
+        "3 4\n1 2 3 8\n1 2 x 9\n",
+        "3 4\n1 2 3 8\n1 16 3 4\n",
+        "3 4\n1 2 3 8 0 0 1 0 0 -1\n",
+        "3 4\n1 2 3 8 0 0 1 0 0 -1\n2 0 0 1\n",
+        "2 3\n1 5 4\n",
+        "1 4\n5 5\n",
+        "1 4\n0 3\n5 7\n",
+        "5 3\n",
+    ] {
+        opens_as_read(text).unwrap_or_else(|e| panic!("{text:?}: {e}"));
+    }
+    // A file changed after it was opened: the slab read names the file and line.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("changing.rays");
+    let rays = RaySet::<3>::from_rays(4, [Ray::new([1, 2, 3], 8), Ray::new([9, 0, 0], 3)]).unwrap();
+    write_rays_file(&path, &rays).unwrap();
+    let Ok(RaysFile::Sorted(AnyRaysFileSource::K3(source))) = open_rays_file(&path) else {
+        panic!("a sorted file")
+    };
+    std::fs::write(&path, "# ktree rays v1\n3 4\n1 2 3 8\n9 0 x 3\n").unwrap();
+    let e = source.slab(8..16).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}:4: field 3 (\"x\") is not a whole number",
+            path.display()
+        )
+    );
 }
