@@ -40,6 +40,8 @@ pub use formats::{
     read_tree, read_tree_placed, voxelize, write_tree, Format, IoError, ReadOptions, ReadTree,
     Voxelized, WriteOptions,
 };
+#[cfg(any(feature = "mesh", feature = "volume"))]
+pub use formats::{voxel_source, VoxelSource, VoxelizedSource};
 pub use grid::{tree_rays, GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree};
 pub use ktree_file::{
     read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file, KtreeFileError,

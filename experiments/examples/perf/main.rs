@@ -15,6 +15,7 @@ mod measure;
 mod ops;
 mod scale;
 mod solids;
+mod sources;
 
 use std::process::ExitCode;
 
@@ -29,6 +30,7 @@ fn main() -> ExitCode {
             "ops" => measure::child(|| ops::run_case(case)),
             "display" => measure::child(|| display::run_case(case)),
             "scale" => measure::child(|| scale::run_case(case)),
+            "sources" => measure::child(|| sources::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -60,8 +62,9 @@ fn main() -> ExitCode {
             "display" => display::report(),
             "scale" => scale::report(),
             "interop" => interop::report(),
+            "sources" => sources::report(),
             other => Err(format!(
-                "unknown area '{other}' (known: build, solids, ops, display, scale, interop)"
+                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, sources)"
             )),
         };
         match result {
