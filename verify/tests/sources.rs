@@ -135,6 +135,22 @@ proptest! {
         mesh_agrees(&mesh, level, &placement)?;
     }
 
+    /// Large triangles in universes of several buckets of columns (one per cell of the default depth):
+    /// triangles crossing buckets and slabs.
+    #[test]
+    fn mesh_slabs_across_buckets(
+        mesh in soups(),
+        level in 7u32..=8,
+        shift in prop::array::uniform3(-40i32..40),
+    ) {
+        let scale = f64::from(1u32 << (level - 4)) / 1.5;
+        let placement = Placement { scale, translate: shift.map(f64::from) };
+        let whole = mesh.to_rays(level, &placement).unwrap();
+        let source = MeshSource::new(&mesh, level, &placement).unwrap();
+        slabs_agree(&source, &whole.rays)?;
+        file_agrees(&source, &whole.rays, [0, 1, 3, level])?;
+    }
+
     #[test]
     fn closed_boxes_equal_the_whole_mesh(
         lo in prop::array::uniform3(-2i32..30),
