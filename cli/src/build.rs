@@ -5,8 +5,8 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::{read_rays_file, AnyRaySet, AnyTree};
-use ktree::stacking::{default_split_depth, stack_partitioned};
+use ktree::io::{open_rays_file, read_rays_file, AnyRaySet, AnyTree, RaysFile, RaysFileSource};
+use ktree::stacking::{default_split_depth, stack_partitioned, RaySource};
 use ktree::{KTree, LevelCounts, RaySet};
 
 /// Arguments of `ktree build`.
@@ -47,12 +47,20 @@ pub fn stack_cells<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
 
 /// Reads the rays, stacks them, writes the tree, and prints a one-line summary.
 pub fn run(args: Args) -> Result<(), String> {
-    let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
     if crate::memory::out_of_core() {
-        let summary = ktree::with_dim!(&rays, AnyRaySet, r => build_out_of_core(r, &args))?;
+        // A sorted file is read slab by slab as the cells are stacked; another is read whole.
+        let summary = match open_rays_file(&args.rays).map_err(|e| e.to_string())? {
+            RaysFile::Sorted(source) => {
+                ktree::with_dim!(&source, AnyRaysFileSource, s => build_source(s, &args))?
+            }
+            RaysFile::Whole(rays) => {
+                ktree::with_dim!(&rays, AnyRaySet, r => build_out_of_core(r, &args))?
+            }
+        };
         outln!("{summary}");
         return Ok(());
     }
+    let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
     let threads = args.threads;
     let tree = match &rays {
         AnyRaySet::K1(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K1),
@@ -97,6 +105,25 @@ fn build_out_of_core<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<St
         K,
         rays.level(),
         rays.len(),
+        c,
+        c.nodes().div_ceil(4),
+    ))
+}
+
+/// Stacks a ray file read slab by slab straight into the output, out of core; returns the summary.
+fn build_source<const K: usize>(source: &RaysFileSource<K>, args: &Args) -> Result<String, String> {
+    let what = format!("the index of {}", args.rays.display());
+    let budget = args.build.budget.left_after(&what, source.heap_bytes())?;
+    let report = with_threads(args.threads, || {
+        crate::memory::build_to_file(source, &args.out, &args.build, budget)
+    })??;
+    let level = source.universe().level();
+    let c = LevelCounts::total(level, &report.counts_per_level);
+    Ok(summary(
+        &args.out,
+        K,
+        level,
+        source.runs() as usize,
         c,
         c.nodes().div_ceil(4),
     ))

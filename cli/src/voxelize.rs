@@ -3,12 +3,18 @@
 
 use crate::outln;
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
 
-use ktree::io::{voxelize, Format, ReadOptions};
+use ktree::io::{voxel_source, voxelize, Format, ReadOptions, VoxelSource};
 use ktree::solid::mesh::Placement;
 use ktree::solid::volume::Select;
+use ktree::stacking::{RaySource, SlabRuns};
+use ktree::{LevelCounts, Universe};
 
+use crate::build::with_threads;
 use crate::rays::write_output;
 
 /// Arguments of `ktree voxelize`.
@@ -81,20 +87,110 @@ pub fn run(a: Args) -> Result<(), String> {
             .map_err(|_| format!("--offset '{}': expected three numbers", a.offset))?;
         options.offset = Some(off.map(i64::from));
     }
-    let v = voxelize(&a.input, &options).map_err(|e| e.to_string())?;
     // In a run over several MPI ranks, rank 0 alone reports.
     let root = crate::distributed::ranks().is_root();
-    if let (Some(t), true) = (&v.fitted, root) {
-        outln!("--fit chose --transform {t}");
+    if is_tree_file(&a.out) && crate::memory::out_of_core() {
+        // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
+        let v = voxel_source(&a.input, &options).map_err(|e| e.to_string())?;
+        remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
+        outln!("{}", build_out_of_core(&v.source, &a)?);
+        return Ok(());
     }
-    if v.open_edges > 0 && root {
-        eprintln!(
-            "warning: {}: the mesh is not closed ({} edges not shared by exactly two triangles); inside is \
-             decided by the winding along each column, so some columns may leak or lose runs",
-            a.input.display(),
-            v.open_edges
-        );
-    }
+    let v = voxelize(&a.input, &options).map_err(|e| e.to_string())?;
+    remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
     crate::rays::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?)?;
     Ok(())
+}
+
+/// Prints the transform `--fit` chose and warns about a mesh that is not closed (`root`: this process
+/// reports).
+fn remarks(
+    input: &Path,
+    fitted: Option<&str>,
+    open_edges: usize,
+    root: bool,
+) -> Result<(), String> {
+    if let (Some(t), true) = (fitted, root) {
+        outln!("--fit chose --transform {t}");
+    }
+    if open_edges > 0 && root {
+        eprintln!(
+            "warning: {}: the mesh is not closed ({open_edges} edges not shared by exactly two triangles); \
+             inside is decided by the winding along each column, so some columns may leak or lose runs",
+            input.display(),
+        );
+    }
+    Ok(())
+}
+
+/// Whether an output path names a tree file (`.ktree`) rather than a ray file.
+fn is_tree_file(out: &Path) -> bool {
+    out.extension().is_some_and(|e| e == "ktree")
+}
+
+/// Stacks the source straight into the output, out of core, in the budget less what the source holds;
+/// returns the summary (the one [`write_output`] prints for a tree).
+fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
+    let what = match source {
+        VoxelSource::Mesh(_) => format!("the placed triangles of {}", a.input.display()),
+        VoxelSource::Volume(_) => format!("the samples of {}", a.input.display()),
+    };
+    let budget = a.build.budget.left_after(&what, source.heap_bytes())?;
+    let counted = CountedRuns::new(source);
+    let report = with_threads(a.threads, || {
+        crate::memory::build_to_file(&counted, &a.out, &a.build, budget)
+    })??;
+    let level = source.universe().level();
+    let c = LevelCounts::total(level, &report.counts_per_level);
+    Ok(format!(
+        "{}: K = 3, L = {level}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
+        a.out.display(),
+        counted.runs(),
+        crate::memory::voxels::<3>(level, &report.counts_per_level),
+        c.nodes(),
+        c.full,
+        c.empty,
+        c.partial
+    ))
+}
+
+/// A source that counts the runs of its slabs as they are made (a slab made twice is counted once).
+struct CountedRuns<'a, S> {
+    source: &'a S,
+    /// The runs of each slab made, by its first column along axis 0.
+    runs: Mutex<BTreeMap<u32, u64>>,
+}
+
+impl<'a, S> CountedRuns<'a, S> {
+    fn new(source: &'a S) -> Self {
+        Self {
+            source,
+            runs: Mutex::new(BTreeMap::new()),
+        }
+    }
+
+    /// The runs of the slabs made.
+    fn runs(&self) -> u64 {
+        let runs = self.runs.lock().unwrap_or_else(PoisonError::into_inner);
+        runs.values().sum()
+    }
+}
+
+impl<S: RaySource<3>> RaySource<3> for CountedRuns<'_, S> {
+    type Error = S::Error;
+
+    fn universe(&self) -> Universe<3> {
+        self.source.universe()
+    }
+
+    fn slab(&self, x: Range<u32>) -> Result<SlabRuns<'_>, S::Error> {
+        let slab = self.source.slab(x.clone())?;
+        let mut runs = self.runs.lock().unwrap_or_else(PoisonError::into_inner);
+        runs.insert(x.start, slab.runs.len() as u64);
+        Ok(slab)
+    }
+
+    fn occupied_slabs(&self, m: u32) -> Vec<u32> {
+        self.source.occupied_slabs(m)
+    }
 }

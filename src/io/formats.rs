@@ -275,8 +275,145 @@ fn solid_error(path: &Path) -> impl Fn(SolidError) -> IoError + '_ {
     }
 }
 
+/// A mesh or a volume producing its rays slab by slab ([`MeshSource`](crate::solid::mesh::MeshSource),
+/// [`VolumeSource`](crate::solid::volume::VolumeSource)), for building its tree out of core without
+/// holding the whole ray set; the runs are those of [`voxelize`] with the same options.
+#[cfg(any(feature = "mesh", feature = "volume"))]
+#[derive(Debug, Clone)]
+pub enum VoxelSource {
+    /// A placed mesh.
+    #[cfg(feature = "mesh")]
+    Mesh(crate::solid::mesh::MeshSource),
+    /// A volume with its selection and offset.
+    #[cfg(feature = "volume")]
+    Volume(crate::solid::volume::VolumeSource),
+}
+
+#[cfg(any(feature = "mesh", feature = "volume"))]
+impl VoxelSource {
+    /// The bytes the source holds (see `heap_bytes` of each source).
+    pub fn heap_bytes(&self) -> u64 {
+        match self {
+            #[cfg(feature = "mesh")]
+            Self::Mesh(m) => m.heap_bytes(),
+            #[cfg(feature = "volume")]
+            Self::Volume(v) => v.heap_bytes(),
+        }
+    }
+}
+
+#[cfg(any(feature = "mesh", feature = "volume"))]
+impl crate::stacking::RaySource<3> for VoxelSource {
+    type Error = std::convert::Infallible;
+
+    fn universe(&self) -> crate::Universe<3> {
+        match self {
+            #[cfg(feature = "mesh")]
+            Self::Mesh(m) => m.universe(),
+            #[cfg(feature = "volume")]
+            Self::Volume(v) => v.universe(),
+        }
+    }
+
+    fn slab(
+        &self,
+        x: std::ops::Range<u32>,
+    ) -> Result<crate::stacking::SlabRuns<'_>, std::convert::Infallible> {
+        match self {
+            #[cfg(feature = "mesh")]
+            Self::Mesh(m) => m.slab(x),
+            #[cfg(feature = "volume")]
+            Self::Volume(v) => v.slab(x),
+        }
+    }
+
+    fn occupied_slabs(&self, m: u32) -> Vec<u32> {
+        match self {
+            #[cfg(feature = "mesh")]
+            Self::Mesh(s) => s.occupied_slabs(m),
+            #[cfg(feature = "volume")]
+            Self::Volume(v) => v.occupied_slabs(m),
+        }
+    }
+}
+
+/// A mesh or a volume as a [`VoxelSource`], with what was chosen or noticed on the way.
+#[cfg(any(feature = "mesh", feature = "volume"))]
+#[derive(Debug, Clone)]
+pub struct VoxelizedSource {
+    /// The source of the voxels inside.
+    pub source: VoxelSource,
+    /// Meshes placed by fitting: the transform chosen, as `s,tx,ty,tz`.
+    pub fitted: Option<String>,
+    /// Meshes: edges not shared by exactly two triangles (0 for a closed mesh).
+    pub open_edges: usize,
+}
+
+/// Like [`voxelize`], producing the rays slab by slab: reads the mesh or volume, checks the options and
+/// the placement, and returns a source whose slabs hold the runs [`voxelize`] returns.
+///
+/// ```
+/// use ktree::io::{voxel_source, voxelize, ReadOptions};
+/// use ktree::stacking::{stack, stack_source};
+/// use std::path::Path;
+/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/meshes/fandisk.obj");
+/// let options = ReadOptions { level: Some(5), ..ReadOptions::default() };
+/// let slabs = voxel_source(&path, &options).unwrap();
+/// let whole = voxelize(&path, &options).unwrap();
+/// assert_eq!((&slabs.fitted, slabs.open_edges), (&whole.fitted, whole.open_edges));
+/// assert_eq!(stack_source(&slabs.source, 2).unwrap(), stack(&whole.rays));
+/// ```
+///
+/// # Errors
+/// As [`voxelize`].
+#[cfg(any(feature = "mesh", feature = "volume"))]
+pub fn voxel_source(path: &Path, options: &ReadOptions) -> Result<VoxelizedSource, IoError> {
+    let solid = solid_error(path);
+    match format_of(path)? {
+        #[cfg(feature = "mesh")]
+        Format::Mesh => {
+            let (mesh, level, placement, fitted) = mesh_input(path, options)?;
+            let source =
+                crate::solid::mesh::MeshSource::new(&mesh, level, &placement).map_err(&solid)?;
+            Ok(VoxelizedSource {
+                source: VoxelSource::Mesh(source),
+                fitted,
+                open_edges: mesh.open_edges(),
+            })
+        }
+        #[cfg(feature = "volume")]
+        Format::Volume => {
+            let (volume, level, offset, select) = volume_input(path, options)?;
+            let source = crate::solid::volume::VolumeSource::new(volume, level, offset, select)
+                .map_err(&solid)?;
+            Ok(VoxelizedSource {
+                source: VoxelSource::Volume(source),
+                fitted: None,
+                open_edges: 0,
+            })
+        }
+        #[cfg(not(feature = "mesh"))]
+        Format::Mesh => Err(usage(path, "meshes are read with the `mesh` feature")),
+        #[cfg(not(feature = "volume"))]
+        Format::Volume => Err(usage(path, "volumes are read with the `volume` feature")),
+        _ => Err(usage(path, "not a mesh or a volume")),
+    }
+}
+
+/// The mesh of a file with its level and placement (and the placement as text when it was fitted).
 #[cfg(feature = "mesh")]
-fn voxelize_mesh(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
+fn mesh_input(
+    path: &Path,
+    options: &ReadOptions,
+) -> Result<
+    (
+        crate::solid::mesh::TriangleMesh,
+        u32,
+        crate::solid::mesh::Placement,
+        Option<String>,
+    ),
+    IoError,
+> {
     use crate::solid::mesh::{Placement, TriangleMesh};
     let solid = solid_error(path);
     let level = options
@@ -290,7 +427,13 @@ fn voxelize_mesh(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoErro
             (p, Some(p.to_arg()))
         }
     };
-    let r = mesh.to_rays(level, &placement).map_err(&solid)?;
+    Ok((mesh, level, placement, fitted))
+}
+
+#[cfg(feature = "mesh")]
+fn voxelize_mesh(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
+    let (mesh, level, placement, fitted) = mesh_input(path, options)?;
+    let r = mesh.to_rays(level, &placement).map_err(solid_error(path))?;
     Ok(Voxelized {
         rays: r.rays,
         fitted,
@@ -303,8 +446,20 @@ fn voxelize_mesh(path: &Path, _: &ReadOptions) -> Result<Voxelized, IoError> {
     Err(usage(path, "meshes are read with the `mesh` feature"))
 }
 
+/// The volume of a file with its level, offset and selection.
 #[cfg(feature = "volume")]
-fn voxelize_volume(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
+fn volume_input(
+    path: &Path,
+    options: &ReadOptions,
+) -> Result<
+    (
+        crate::solid::volume::Volume,
+        u32,
+        [u32; 3],
+        crate::solid::volume::Select,
+    ),
+    IoError,
+> {
     use crate::solid::volume::Volume;
     let solid = solid_error(path);
     let select = options
@@ -320,9 +475,15 @@ fn voxelize_volume(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoEr
     };
     let v = Volume::read(path).map_err(&solid)?;
     let level = options.level.unwrap_or_else(|| v.fitting_level());
+    Ok((v, level, [offset[0], offset[1], offset[2]], select))
+}
+
+#[cfg(feature = "volume")]
+fn voxelize_volume(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
+    let (v, level, offset, select) = volume_input(path, options)?;
     let rays = v
-        .to_rays(level, [offset[0], offset[1], offset[2]], select)
-        .map_err(&solid)?;
+        .to_rays(level, offset, select)
+        .map_err(solid_error(path))?;
     Ok(Voxelized {
         rays,
         fitted: None,

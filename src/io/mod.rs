@@ -28,6 +28,7 @@ mod mapped_tree;
 #[allow(unsafe_code)]
 mod mmap;
 mod octomap_bt;
+mod rays_source;
 mod rays_text;
 mod vdb;
 
@@ -40,6 +41,8 @@ pub use formats::{
     read_tree, read_tree_placed, voxelize, write_tree, Format, IoError, ReadOptions, ReadTree,
     Voxelized, WriteOptions,
 };
+#[cfg(any(feature = "mesh", feature = "volume"))]
+pub use formats::{voxel_source, VoxelSource, VoxelizedSource};
 pub use grid::{tree_rays, GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree};
 pub use ktree_file::{
     read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file, KtreeFileError,
@@ -51,6 +54,7 @@ pub use ktree_v2::{
 };
 pub use mapped_tree::MappedTree;
 pub use octomap_bt::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
+pub use rays_source::{open_rays_file, AnyRaysFileSource, RaysFile, RaysFileSource};
 pub use rays_text::{
     read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source, RaysTextError,
     RaysTextErrorKind,

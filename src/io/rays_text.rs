@@ -111,12 +111,20 @@ impl std::error::Error for RaysTextError {}
 /// # Errors
 /// [`RaysTextError`] naming the file and line of the first problem.
 pub fn read_rays(reader: impl BufRead, file: &str) -> Result<AnyRaySet, RaysTextError> {
-    let mut lines = NumberedLines {
-        reader,
-        line: 0,
-        buf: String::new(),
-        file,
-    };
+    let mut lines = NumberedLines::new(reader, file, 0);
+    let (k, level) = read_header(&mut lines)?;
+    match k {
+        1 => read_body::<1, _>(lines, level).map(AnyRaySet::K1),
+        2 => read_body::<2, _>(lines, level).map(AnyRaySet::K2),
+        3 => read_body::<3, _>(lines, level).map(AnyRaySet::K3),
+        _ => read_body::<4, _>(lines, level).map(AnyRaySet::K4),
+    }
+}
+
+/// Reads the header line `K L` and checks it.
+pub(super) fn read_header<R: BufRead>(
+    lines: &mut NumberedLines<'_, R>,
+) -> Result<(usize, u32), RaysTextError> {
     let Some(header) = lines.next_content()? else {
         return Err(lines.error(0, RaysTextErrorKind::Empty));
     };
@@ -141,13 +149,7 @@ pub fn read_rays(reader: impl BufRead, file: &str) -> Result<AnyRaySet, RaysText
             },
         ));
     }
-    let level = level as u32;
-    match k {
-        1 => read_body::<1, _>(lines, level).map(AnyRaySet::K1),
-        2 => read_body::<2, _>(lines, level).map(AnyRaySet::K2),
-        3 => read_body::<3, _>(lines, level).map(AnyRaySet::K3),
-        _ => read_body::<4, _>(lines, level).map(AnyRaySet::K4),
-    }
+    Ok((k, level as u32))
 }
 
 /// Reads a ray file from disk.
@@ -266,15 +268,31 @@ pub fn write_rays_file<const K: usize>(path: &Path, rays: &RaySet<K>) -> std::io
     super::write_atomic_with(path, |w| write_rays(w, rays))
 }
 
-struct NumberedLines<'a, R> {
+pub(super) struct NumberedLines<'a, R> {
     reader: R,
-    line: usize,
+    pub(super) line: usize,
     buf: String,
     file: &'a str,
+    /// The byte offset of the next line.
+    offset: u64,
+    /// The byte offset of the last line read.
+    pub(super) line_offset: u64,
 }
 
-impl<R: BufRead> NumberedLines<'_, R> {
-    fn error(&self, line: usize, kind: RaysTextErrorKind) -> RaysTextError {
+impl<'a, R: BufRead> NumberedLines<'a, R> {
+    /// Lines of `reader` (named `file` in errors), the first of them line `line + 1`.
+    pub(super) fn new(reader: R, file: &'a str, line: usize) -> Self {
+        Self {
+            reader,
+            line,
+            buf: String::new(),
+            file,
+            offset: 0,
+            line_offset: 0,
+        }
+    }
+
+    pub(super) fn error(&self, line: usize, kind: RaysTextErrorKind) -> RaysTextError {
         RaysTextError {
             file: self.file.to_string(),
             line,
@@ -283,7 +301,7 @@ impl<R: BufRead> NumberedLines<'_, R> {
     }
 
     /// The next line that is not blank or a comment, trimmed.
-    fn next_content(&mut self) -> Result<Option<String>, RaysTextError> {
+    pub(super) fn next_content(&mut self) -> Result<Option<String>, RaysTextError> {
         loop {
             self.buf.clear();
             let n = self
@@ -294,36 +312,33 @@ impl<R: BufRead> NumberedLines<'_, R> {
                 return Ok(None);
             }
             self.line += 1;
+            self.line_offset = self.offset;
+            self.offset += n as u64;
             let t = self.buf.trim();
             if !t.is_empty() && !t.starts_with('#') {
                 return Ok(Some(t.to_string()));
             }
         }
     }
-}
 
-fn read_body<const K: usize, R: BufRead>(
-    mut lines: NumberedLines<'_, R>,
-    level: u32,
-) -> Result<RaySet<K>, RaysTextError> {
-    let plain = K + 1;
-    let with_normals = plain + 2 * K;
-    let mut rays: Vec<Ray<K>> = Vec::new();
-    let mut normals: Vec<[Normal<K>; 2]> = Vec::new();
-    let mut line_of: Vec<usize> = Vec::new();
-    let mut has_normals: Option<bool> = None;
-    while let Some(text) = lines.next_content()? {
-        let line = lines.line;
+    /// Parses the run line `text` (the last line read): `K + 1` whole numbers, then `2·K` normal
+    /// components when `normals`.
+    pub(super) fn parse_run<const K: usize>(
+        &self,
+        text: &str,
+        normals: bool,
+    ) -> Result<(Ray<K>, Option<[Normal<K>; 2]>), RaysTextError> {
+        let line = self.line;
+        let plain = K + 1;
         let fields: Vec<&str> = text.split_ascii_whitespace().collect();
-        let expect_normals = *has_normals.get_or_insert(fields.len() == with_normals);
-        let expected = if expect_normals { with_normals } else { plain };
+        let expected = if normals { plain + 2 * K } else { plain };
         if fields.len() != expected {
-            let normals = if expect_normals {
+            let normals = if normals {
                 ", then 2·K normal components"
             } else {
                 ""
             };
-            return Err(lines.error(
+            return Err(self.error(
                 line,
                 RaysTextErrorKind::FieldCount {
                     expected,
@@ -336,7 +351,7 @@ fn read_body<const K: usize, R: BufRead>(
         let mut z2 = 0u32;
         for (i, f) in fields[..plain].iter().enumerate() {
             let v: u32 = f.parse().map_err(|_| {
-                lines.error(
+                self.error(
                     line,
                     RaysTextErrorKind::NotANumber {
                         field: i + 1,
@@ -351,24 +366,41 @@ fn read_body<const K: usize, R: BufRead>(
                 z2 = v;
             }
         }
-        rays.push(Ray::new(start, z2));
-        line_of.push(line);
-        if expect_normals {
-            let mut n = [[0f32; K]; 2];
-            for (i, f) in fields[plain..].iter().enumerate() {
-                n[i / K][i % K] = f.parse().map_err(|_| {
-                    lines.error(
-                        line,
-                        RaysTextErrorKind::NotANumber {
-                            field: plain + i + 1,
-                            text: f.to_string(),
-                            what: "number",
-                        },
-                    )
-                })?;
-            }
-            normals.push(n);
+        if !normals {
+            return Ok((Ray::new(start, z2), None));
         }
+        let mut n = [[0f32; K]; 2];
+        for (i, f) in fields[plain..].iter().enumerate() {
+            n[i / K][i % K] = f.parse().map_err(|_| {
+                self.error(
+                    line,
+                    RaysTextErrorKind::NotANumber {
+                        field: plain + i + 1,
+                        text: f.to_string(),
+                        what: "number",
+                    },
+                )
+            })?;
+        }
+        Ok((Ray::new(start, z2), Some(n)))
+    }
+}
+
+fn read_body<const K: usize, R: BufRead>(
+    mut lines: NumberedLines<'_, R>,
+    level: u32,
+) -> Result<RaySet<K>, RaysTextError> {
+    let mut rays: Vec<Ray<K>> = Vec::new();
+    let mut normals: Vec<[Normal<K>; 2]> = Vec::new();
+    let mut line_of: Vec<usize> = Vec::new();
+    let mut has_normals: Option<bool> = None;
+    while let Some(text) = lines.next_content()? {
+        let expect_normals =
+            *has_normals.get_or_insert(text.split_ascii_whitespace().count() == K + 1 + 2 * K);
+        let (ray, n) = lines.parse_run::<K>(&text, expect_normals)?;
+        rays.push(ray);
+        line_of.push(lines.line);
+        normals.extend(n);
     }
     let result = if has_normals == Some(true) {
         RaySet::from_rays_with_normals(level, rays.into_iter().zip(normals))

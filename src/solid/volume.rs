@@ -6,6 +6,8 @@
 //! as NIfTI prescribes). Volume voxel `(i, j, k)` becomes universe voxel `offset + (i, j, k)`, unscaled.
 //!
 //! The cost is one pass over the samples (a dense input has to be read anyway) plus the rays.
+//! [`VolumeSource`] gives the same runs one slab of columns at a time, so that a tree can be built out of
+//! core without holding the whole ray set.
 //!
 //! ```
 //! use ktree::solid::volume::{Select, Volume};
@@ -17,6 +19,9 @@
 //! assert_eq!(rays.voxel_count(), brain.count(Select::AtLeast(1.0)) as u128);
 //! ```
 
+use std::borrow::Cow;
+use std::convert::Infallible;
+use std::ops::Range;
 use std::path::Path;
 
 use serde::Deserialize;
@@ -24,6 +29,7 @@ use serde::Deserialize;
 use super::SolidError;
 use crate::rays::RaySet;
 use crate::space::Universe;
+use crate::stacking::{RaySource, SlabRuns};
 
 /// Which samples are inside.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -375,6 +381,13 @@ impl Volume {
         offset: [u32; 3],
         select: Select,
     ) -> Result<RaySet<3>, SolidError> {
+        let universe = self.placed(level, offset)?;
+        let (columns, runs) = self.slab_runs(level, offset, select, 0..universe.side());
+        Ok(RaySet::from_sorted_parts(universe, columns, runs, None))
+    }
+
+    /// The universe of level `level`, checked to hold the volume at `offset`.
+    fn placed(&self, level: u32, offset: [u32; 3]) -> Result<Universe<3>, SolidError> {
         let universe = Universe::<3>::new(level)?;
         let side = universe.side();
         for a in 0..3 {
@@ -385,10 +398,24 @@ impl Volume {
                 )));
             }
         }
+        Ok(universe)
+    }
+
+    /// The column keys and runs of the universe columns whose axis-0 coordinate lies in `x`, in
+    /// [`RaySet`] order (the volume placed at `offset`, checked to fit).
+    fn slab_runs(
+        &self,
+        level: u32,
+        offset: [u32; 3],
+        select: Select,
+        x: Range<u64>,
+    ) -> (Vec<u64>, Vec<(u32, u32)>) {
         let [nx, ny, nz] = self.shape;
+        let first = x.start.saturating_sub(u64::from(offset[0])).min(nx as u64) as usize;
+        let last = x.end.saturating_sub(u64::from(offset[0])).min(nx as u64) as usize;
         let mut columns = Vec::new();
         let mut runs = Vec::new();
-        for x in 0..nx {
+        for x in first..last {
             for y in 0..ny {
                 let key =
                     (u64::from(offset[0]) + x as u64) << level | (u64::from(offset[1]) + y as u64);
@@ -407,7 +434,89 @@ impl Volume {
                 }
             }
         }
-        Ok(RaySet::from_sorted_parts(universe, columns, runs, None))
+        (columns, runs)
+    }
+}
+
+/// A volume placed in a universe with a selection, producing its rays slab by slab for
+/// [`stack_to_file`](crate::stacking::stack_to_file) and [`stack_source`](crate::stacking::stack_source):
+/// each slab's runs come from the volume's samples in that slab alone, and equal the runs of that slab in
+/// [`Volume::to_rays`]. No whole ray set is held.
+///
+/// ```
+/// use ktree::solid::volume::{Select, Volume, VolumeSource};
+/// use ktree::stacking::{stack, stack_source};
+/// let v = Volume::new([3, 2, 2], vec![0.0, 9.0, 9.0, 9.0, 0.0, 9.0, 9.0, 9.0, 9.0, 0.0, 0.0, 9.0], [1.0; 3]).unwrap();
+/// let whole = v.to_rays(3, [1, 2, 3], Select::AtLeast(5.0)).unwrap();
+/// let source = VolumeSource::new(v, 3, [1, 2, 3], Select::AtLeast(5.0)).unwrap();
+/// assert_eq!(stack_source(&source, 1).unwrap(), stack(&whole));
+/// ```
+#[derive(Debug, Clone)]
+pub struct VolumeSource {
+    volume: Volume,
+    universe: Universe<3>,
+    offset: [u32; 3],
+    select: Select,
+}
+
+impl VolumeSource {
+    /// The samples of `volume` chosen by `select`, its sample `(i, j, k)` at voxel `offset + (i, j, k)` of a
+    /// universe of level `level` (as [`Volume::to_rays`]).
+    ///
+    /// # Errors
+    /// As [`Volume::to_rays`].
+    pub fn new(
+        volume: Volume,
+        level: u32,
+        offset: [u32; 3],
+        select: Select,
+    ) -> Result<Self, SolidError> {
+        let universe = volume.placed(level, offset)?;
+        Ok(Self {
+            volume,
+            universe,
+            offset,
+            select,
+        })
+    }
+
+    /// The volume.
+    pub fn volume(&self) -> &Volume {
+        &self.volume
+    }
+
+    /// The bytes the source holds: the volume's samples.
+    pub fn heap_bytes(&self) -> u64 {
+        std::mem::size_of_val(self.volume.values()) as u64
+    }
+}
+
+impl RaySource<3> for VolumeSource {
+    type Error = Infallible;
+
+    fn universe(&self) -> Universe<3> {
+        self.universe
+    }
+
+    fn slab(&self, x: Range<u32>) -> Result<SlabRuns<'_>, Infallible> {
+        let (keys, runs) = self.volume.slab_runs(
+            self.universe.level(),
+            self.offset,
+            self.select,
+            u64::from(x.start)..u64::from(x.end),
+        );
+        Ok(SlabRuns {
+            keys: Cow::Owned(keys),
+            runs: Cow::Owned(runs),
+        })
+    }
+
+    /// The slabs that meet the volume's extent along axis 0.
+    fn occupied_slabs(&self, m: u32) -> Vec<u32> {
+        let t = self.universe.level() - m.min(self.universe.level());
+        let lo = self.offset[0] >> t;
+        let hi = (u64::from(self.offset[0]) + self.volume.shape[0] as u64 - 1) >> t;
+        (lo..=hi as u32).collect()
     }
 }
 

@@ -15,6 +15,7 @@ mod measure;
 mod ops;
 mod scale;
 mod solids;
+mod sources;
 mod streaming;
 
 use std::process::ExitCode;
@@ -31,6 +32,7 @@ fn main() -> ExitCode {
             "display" => measure::child(|| display::run_case(case)),
             "scale" => measure::child(|| scale::run_case(case)),
             "streaming" => measure::child(|| streaming::run_case(case)),
+            "sources" => measure::child(|| sources::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -63,8 +65,9 @@ fn main() -> ExitCode {
             "scale" => scale::report(),
             "interop" => interop::report(),
             "streaming" => streaming::report(),
+            "sources" => sources::report(),
             other => Err(format!(
-                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming)"
+                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming, sources)"
             )),
         };
         match result {
