@@ -13,6 +13,16 @@
 //! ([`write_atomic_with`]), so the bytes are exactly those of the tree built in memory and written by
 //! [`write_ktree_v2`](crate::io::write_ktree_v2), for any number of threads.
 //!
+//! # In parts
+//! The two phases also run apart, as the ranks of a distributed run do: [`stack_part`] stacks some of the
+//! slabs (a share cut by [`balanced_parts`] from the costs [`slab_cost`] estimates) into spill files of its
+//! own; one part takes the others' indexes ([`SpilledPart::index_words`], [`SpilledPart::add_part`]: the
+//! cells' states and the stacked cells' Morton indexes and node counts) and writes the file
+//! ([`SpilledPart::write`]), walking the stacked cells of all parts in Morton order and taking each
+//! piece from its own spill files or from the stream of words the owning part sends in its own Morton
+//! order ([`SpilledPart::stream_levels`]). The bytes are those of [`stack_to_file`], which is one part
+//! of every slab.
+//!
 //! # Memory
 //! The budget ([`OutOfCore::max_memory`]) is kept by accounting, not by measuring the process:
 //! [`RUN_BYTES`] bytes per run of each slab being stacked (its copies and the subtrees made from it, until

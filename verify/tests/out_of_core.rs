@@ -381,3 +381,37 @@ fn the_next_build_removes_the_spill_folders_of_killed_builds() {
         ]
     );
 }
+
+/// The writing part refuses an index that is not that of a part of its build, without panicking.
+#[test]
+fn a_foreign_or_damaged_part_index_is_refused() {
+    let ball = ktree::rays::ball_rays::<3>(5, [16, 16, 16], 20).unwrap();
+    let other = ktree::rays::ball_rays::<3>(6, [16, 16, 16], 20).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tree.ktree");
+    let options = OutOfCore::new(2, u64::MAX);
+    let slabs = build_slabs(&ball, 2);
+    let (first, second) = slabs.split_at(slabs.len() / 2);
+    let mut writer = stack_part(&ball, first, &out, &options, &|_| {}).unwrap();
+    let part = stack_part(&ball, second, &out, &options, &|_| {}).unwrap();
+    let foreign = stack_part(&other, &build_slabs(&other, 2), &out, &options, &|_| {}).unwrap();
+    let words = part.index_words();
+    let mut damaged = vec![
+        foreign.index_words(),
+        words[..words.len() - 1].to_vec(),
+        Vec::new(),
+        vec![0; 20],
+    ];
+    let mut bad_count = words.clone();
+    let last = bad_count.len() - 1;
+    bad_count[last] = u64::MAX;
+    damaged.push(bad_count);
+    for index in damaged {
+        let e = writer.add_part(&index).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::InvalidData, "{e}");
+    }
+    assert_eq!(writer.add_part(&words).unwrap(), {
+        let mut part = part;
+        part.stream_levels(64, &mut |_| Ok(())).unwrap()
+    });
+}
