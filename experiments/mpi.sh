@@ -2,7 +2,8 @@
 # Builds of the voxel-centre sphere (centre U/2, radius (U-1)/2) over 1, 2 and 4 MPI ranks on this machine,
 # writing results/performance/mpi.md: wall time, bytes sent to rank 0, peak memory (resident set) per rank,
 # and whether the file is byte-identical to the single-process one; at every level with the default budget,
-# and at the last level also with a small budget per rank (BUDGET, default 96M).
+# and at the last level also with a small budget per rank (BUDGET, default 96M) and with 2 ranks of one
+# thread each.
 # Usage: experiments/mpi.sh [LEVELS...] (default 11 12 13).
 # Needs OpenMPI (openmpi-bin, libopenmpi-dev), libclang-dev and GNU time (/usr/bin/time, for one process);
 # builds `ktree` with the cargo feature `mpi`.
@@ -30,16 +31,18 @@ out=results/performance/mpi.md
   echo "own share included; one process is measured by GNU time. The budget is \`--max-memory\` per rank"
   echo "(default: half the machine's memory). This machine has $(nproc) cores: 2 ranks use one core each, but"
   echo "each rank also runs \`--threads\` = all cores for its slabs, so even 2 ranks oversubscribe the cores"
-  echo "twice; 4 ranks share the cores four times over. The times show what partition, streaming and the"
-  echo "oversubscribed cores cost here, not the speed-up of ranks with cores of their own."
+  echo "twice (the last row gives each of 2 ranks one thread); 4 ranks share the cores four times over. The"
+  echo "times show what partition, streaming and the oversubscribed cores cost here, not the speed-up of ranks"
+  echo "with cores of their own. Other work on the machine shows in the load average."
   echo
-  echo "| L | ranks | budget per rank | seconds | bytes sent to rank 0 | peak MiB per rank (rank 0 first) | same bytes as 1 process |"
-  echo "|---|---:|---|---:|---:|---|---|"
+  echo "| L | ranks | threads per rank | budget per rank | seconds | bytes sent to rank 0 | peak MiB per rank (rank 0 first) | same bytes as 1 process |"
+  echo "|---|---:|---|---|---:|---:|---|---|"
 } > "$work/report.md"
-run() { # L P BUDGET|default
-  local L=$1 P=$2 B=$3 U=$((1 << $1))
+run() { # L P BUDGET|default [THREADS]
+  local L=$1 P=$2 B=$3 T=${4:-all} U=$((1 << $1))
   local args=(rays --solid ball --level "$L" --center "$((U / 2)),$((U / 2)),$((U / 2))" --radius "$(((U - 1) / 2)).5")
   [ "$B" = default ] || args+=(--max-memory "$B")
+  [ "$T" = all ] || args+=(--threads "$T")
   local file="$work/ball-$P-$B.ktree" start end secs moved peaks same
   start=$(date +%s.%N)
   if [ "$P" = 1 ]; then
@@ -60,7 +63,7 @@ run() { # L P BUDGET|default
   fi
   same=yes
   cmp -s "$work/ball1.ktree" "$file" || same=NO
-  printf '| %s | %s | %s | %.2f | %s | %s | %s |\n' "$L" "$P" "$B" "$secs" "${moved:-0}" "${peaks:-—}" "$same" >> "$work/report.md"
+  printf '| %s | %s | %s | %s | %.2f | %s | %s | %s |\n' "$L" "$P" "$T" "$B" "$secs" "${moved:-0}" "${peaks:-—}" "$same" >> "$work/report.md"
   rm -f "$file"
 }
 for L in "${levels[@]}"; do
@@ -68,6 +71,7 @@ for L in "${levels[@]}"; do
 done
 last=${levels[${#levels[@]}-1]}
 for P in 1 2 4; do run "$last" "$P" "$budget"; done
+run "$last" 2 default 1
 { cat "$work/report.md"; echo; cat docs/mpi.md; } > "$out.tmp"
 mv "$out.tmp" "$out"
 echo "wrote $out"
