@@ -4,7 +4,8 @@
 //! temporary file behind and the target untouched on failure, and removes the spill folders of killed
 //! builds; and the file does not depend on the number of threads. Built in parts (as the ranks of a
 //! distributed run build it: balanced shares of the slabs stacked apart, their indexes added to one part
-//! and their levels streamed to it in chunks), the file is the same, for 1 … 5 parts and any chunk size.
+//! and their levels streamed to it in chunks), the file is the same, for 1 … 5 parts and any chunk size;
+//! a damaged index or a stream that breaks off is an error that leaves the target and no temporary file.
 
 use std::path::Path;
 
@@ -414,4 +415,50 @@ fn a_foreign_or_damaged_part_index_is_refused() {
         let mut part = part;
         part.stream_levels(64, &mut |_| Ok(())).unwrap()
     });
+}
+
+/// A part whose stream breaks off while the file is written: the write fails naming the cause, the
+/// target keeps its old bytes, and no temporary file or spill folder remains.
+#[test]
+fn a_stream_that_breaks_off_fails_the_write_and_keeps_the_target() {
+    let ball = ktree::rays::ball_rays::<3>(6, [32, 32, 32], 40).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tree.ktree");
+    std::fs::write(&out, b"old").unwrap();
+    let options = OutOfCore::new(3, u64::MAX);
+    let slabs = build_slabs(&ball, 3);
+    let (first, second) = slabs.split_at(slabs.len() / 2);
+    let mut writer = stack_part(&ball, first, &out, &options, &|_| {}).unwrap();
+    let mut part = stack_part(&ball, second, &out, &options, &|_| {}).unwrap();
+    let words = writer.add_part(&part.index_words()).unwrap();
+    let mut stream = Vec::new();
+    part.stream_levels(16, &mut |c| {
+        stream.extend_from_slice(c);
+        Ok(())
+    })
+    .unwrap();
+    drop(part);
+    assert_eq!(stream.len() as u64, words);
+    assert!(words > 2);
+    // The stream breaks off half-way.
+    stream.truncate(stream.len() / 2);
+    let mut stream = stream.into_iter();
+    let e = writer
+        .write::<String>(
+            &out,
+            &mut |_, piece| {
+                for w in piece.iter_mut() {
+                    *w = stream
+                        .next()
+                        .ok_or_else(|| std::io::Error::other("the sender stopped"))?;
+                }
+                Ok(())
+            },
+            &|_| {},
+        )
+        .unwrap_err();
+    assert!(matches!(e, OutOfCoreError::Output { .. }), "{e:?}");
+    assert!(e.to_string().contains("the sender stopped"), "{e}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"old".to_vec());
+    assert_eq!(entries(dir.path()), vec!["tree.ktree".to_string()]);
 }
