@@ -30,14 +30,18 @@ pub fn with_threads<T: Send>(
     threads: Option<usize>,
     work: impl FnOnce() -> T + Send,
 ) -> Result<T, String> {
+    Ok(thread_pool(threads)?.install(work))
+}
+
+/// A pool of `threads` worker threads (all cores when `None`).
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
     if threads == Some(0) {
         return Err("--threads 0: at least one thread is needed".into());
     }
-    let pool = rayon::ThreadPoolBuilder::new()
+    rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
-    Ok(pool.install(work))
+        .map_err(|e| format!("cannot start worker threads: {e}"))
 }
 
 /// Stacks rays cell by cell on the current thread pool (see [`ktree::stacking::stack_partitioned`]).
@@ -45,7 +49,8 @@ pub fn stack_cells<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
     stack_partitioned(rays, default_split_depth(K, rays.level()))
 }
 
-/// Reads the rays, stacks them, writes the tree, and prints a one-line summary.
+/// Reads the rays, stacks them, writes the tree, and prints a one-line summary (in a run over several
+/// MPI ranks, every rank reads the whole ray file; rank 0 alone writes and prints).
 pub fn run(args: Args) -> Result<(), String> {
     if crate::memory::out_of_core() {
         // A sorted file is read slab by slab as the cells are stacked; another is read whole.
@@ -57,20 +62,16 @@ pub fn run(args: Args) -> Result<(), String> {
                 ktree::with_dim!(&rays, AnyRaySet, r => build_out_of_core(r, &args))?
             }
         };
-        outln!("{summary}");
-        return Ok(());
+        return crate::rays::print_summary(&summary);
     }
+    crate::rays::one_process_for_version_1()?;
     let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
     let threads = args.threads;
     let tree = match &rays {
-        AnyRaySet::K1(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K1),
-        AnyRaySet::K2(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K2),
-        AnyRaySet::K3(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K3),
-        AnyRaySet::K4(r) => crate::distributed::stack(r, threads)?.map(AnyTree::K4),
-    };
-    // In a run over several MPI ranks, rank 0 alone writes.
-    let Some(tree) = tree else {
-        return Ok(());
+        AnyRaySet::K1(r) => AnyTree::K1(with_threads(threads, || stack_cells(r))?),
+        AnyRaySet::K2(r) => AnyTree::K2(with_threads(threads, || stack_cells(r))?),
+        AnyRaySet::K3(r) => AnyTree::K3(with_threads(threads, || stack_cells(r))?),
+        AnyRaySet::K4(r) => AnyTree::K4(with_threads(threads, || stack_cells(r))?),
     };
     let write = ktree::with_dim!(&tree, AnyTree, t => crate::tree_file::write(&args.out, t));
     write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
@@ -89,16 +90,19 @@ pub fn run(args: Args) -> Result<(), String> {
     Ok(())
 }
 
-/// Stacks the rays straight into the output, out of core; returns the summary.
+/// Stacks the rays straight into the output, out of core (across the MPI ranks of the run, if several);
+/// returns the summary (empty on ranks other than 0).
 fn build_out_of_core<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<String, String> {
     let what = format!("the rays of {}", args.rays.display());
     let budget = args
         .build
         .budget
         .left_after(&what, crate::memory::ray_bytes(rays))?;
-    let report = with_threads(args.threads, || {
-        crate::memory::build_to_file(rays, &args.out, &args.build, budget)
-    })??;
+    let Some(report) =
+        crate::distributed::build_to_file(rays, &args.out, args.threads, &args.build, budget)?
+    else {
+        return Ok(String::new());
+    };
     let c = LevelCounts::total(rays.level(), &report.counts_per_level);
     Ok(summary(
         &args.out,
@@ -110,13 +114,16 @@ fn build_out_of_core<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<St
     ))
 }
 
-/// Stacks a ray file read slab by slab straight into the output, out of core; returns the summary.
+/// Stacks a ray file read slab by slab straight into the output, out of core (across the MPI ranks of
+/// the run, if several, each reading its slabs' lines); returns the summary (empty on ranks other than 0).
 fn build_source<const K: usize>(source: &RaysFileSource<K>, args: &Args) -> Result<String, String> {
     let what = format!("the index of {}", args.rays.display());
     let budget = args.build.budget.left_after(&what, source.heap_bytes())?;
-    let report = with_threads(args.threads, || {
-        crate::memory::build_to_file(source, &args.out, &args.build, budget)
-    })??;
+    let Some(report) =
+        crate::distributed::build_to_file(source, &args.out, args.threads, &args.build, budget)?
+    else {
+        return Ok(String::new());
+    };
     let level = source.universe().level();
     let c = LevelCounts::total(level, &report.counts_per_level);
     Ok(summary(

@@ -1,15 +1,37 @@
 //! Building across MPI ranks (cargo feature `mpi`; without it, one process does everything).
 //!
-//! Started as `mpirun -n P ktree rays|build|voxelize …`, every rank reads the same input (a ray file, a
-//! mesh, a volume or a solid's description) and keeps only the columns of its slab: contiguous along axis 0
-//! and balanced by their number of runs ([`ktree::stacking::balanced_slabs`]). Each rank stacks its slab
-//! (on all its threads) and sends its tree, in the `.ktree` encoding, to rank 0, which joins the parts by
-//! union ([`ktree::stacking::join_parts`]) as they arrive — in rank order, so rank 0 holds its own tree,
-//! the tree joined so far and one received part — and writes the one output file, atomically. The result
-//! is byte for byte the single-process file. A rank that fails stops the whole run (`MPI_Abort`) before
-//! anything is written.
+//! Started as `mpirun -n P ktree rays|build|voxelize … --out F.ktree`, every rank runs the out-of-core
+//! build of [`ktree::stacking`] on its share of the slabs of cells, in `--max-memory` bytes of its own:
+//!
+//! 1. **Partition.** The slabs of cells (one cell wide along axis 0, [`ktree::stacking::build_slabs`]) are
+//!    measured by their runs ([`ktree::stacking::slab_cost`]: rank `r` measures the slabs `r, r + P, …`, an
+//!    all-reduce shares the costs) and cut into `P` contiguous ranges of about equal cost
+//!    ([`ktree::stacking::balanced_parts`]).
+//! 2. **Stacking.** Each rank stacks the cells of its slabs and spills their subtrees to files of its own
+//!    ([`ktree::stacking::stack_part`]). A solid makes only the rays of the rank's slabs; a ray file, mesh
+//!    or volume is read whole by every rank.
+//! 3. **Index.** Every other rank sends rank 0 the index of its part (the states of its cells of depth `m`,
+//!    and the Morton index and node counts per level of each cell it stacked — as much as the
+//!    single-process build holds for those cells).
+//! 4. **Writing.** Rank 0 writes the one file ([`ktree::stacking::SpilledPart::write`], atomically): the
+//!    top levels from all the cells' states, then each level in global Morton order of the cells, taking
+//!    each cell's piece from its owner — its own spill files, or the stream of chunks (at most 4 MiB) that
+//!    every other rank sends in its own Morton order. Rank 0 takes from each stream in the order it was
+//!    sent, so the blocking sends cannot deadlock; it holds at most one chunk per other rank, each other
+//!    rank one chunk, and these buffers come out of the budget. The file is byte for byte the
+//!    single-process file.
+//!
+//! **Failure.** The ranks agree after each phase whether one failed (an all-reduce); then every rank drops
+//! its spill folder, waits for the others to have dropped theirs, and fails: the failed rank prints its
+//! error with its rank, nothing is written. A rank that fails while sending its levels ends its stream with
+//! a failure mark, and rank 0, whose write then fails, takes the rest of the other streams before agreeing.
+//! A failure outside the build (an input a rank cannot read) stops every rank with `MPI_Abort`.
 
-use ktree::{KTree, RaySet};
+use std::path::Path;
+
+use ktree::stacking::{OutOfCoreReport, RaySource};
+
+use crate::memory::BuildArgs;
 
 /// The partition of the run: this process's rank and the number of ranks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -27,24 +49,35 @@ impl Ranks {
     }
 }
 
-/// Builds the tree of `rays` across the ranks of the run: `Some(tree)` on rank 0 (and in a run of one
-/// process), `None` on the other ranks, whose part has been sent to rank 0.
+/// The error of the ranks that did not fail when another did (they print nothing: the failed rank does).
+const STOPPED: &str = "stopped: another rank failed";
+
+/// Builds the tree of `source` into the `.ktree` (version 2) file `out` across the ranks of the run, out
+/// of core in `budget` bytes per rank, on `threads` worker threads per rank (all cores when `None`):
+/// `Some(report)` on rank 0 (and in a run of one process), `None` on the other ranks.
 ///
 /// # Errors
-/// A message if a part cannot be exchanged or joined.
-pub fn stack<const K: usize>(
-    rays: &RaySet<K>,
+/// A message naming the output if the build fails on this rank; [`STOPPED`] if it failed on another.
+pub fn build_to_file<const K: usize, S>(
+    source: &S,
+    out: &Path,
     threads: Option<usize>,
-) -> Result<Option<KTree<K>>, String> {
-    imp::stack(rays, threads)
-}
-
-/// Stacks rays in this process, cell by cell on `threads` worker threads (all cores when `None`).
-fn stack_here<const K: usize>(
-    rays: &RaySet<K>,
-    threads: Option<usize>,
-) -> Result<KTree<K>, String> {
-    crate::build::with_threads(threads, || crate::build::stack_cells(rays))
+    args: &BuildArgs,
+    budget: u64,
+) -> Result<Option<OutOfCoreReport>, String>
+where
+    S: RaySource<K>,
+    S::Error: std::fmt::Display,
+{
+    if ranks().size == 1 {
+        return crate::build::with_threads(threads, || {
+            crate::memory::build_to_file(source, out, args, budget)
+        })?
+        .map(Some);
+    }
+    // MPI is called from this thread only; the pool stacks.
+    let pool = crate::build::thread_pool(threads)?;
+    imp::build_to_file(source, out, &pool, args, budget)
 }
 
 /// This process's rank and the number of ranks (`0` of `1` without MPI).
@@ -52,13 +85,19 @@ pub fn ranks() -> Ranks {
     imp::ranks()
 }
 
-/// Reports a failed command: with several ranks, stops every rank of the run (nothing is written, as the
-/// output is written by rank 0 only after every part arrived); otherwise prints the error.
+/// Reports a failed command. With several ranks: a failure the ranks agreed on is printed by the rank
+/// that failed (with its rank) and every rank ends on its own; any other failure is printed with the
+/// rank and stops every rank of the run (`MPI_Abort`; nothing is written). In one process: prints it.
 pub fn report_failure(message: &str) {
     let r = ranks();
     if r.size > 1 {
-        eprintln!("ktree: rank {} of {}: {message}", r.rank, r.size);
-        imp::abort();
+        if message != STOPPED {
+            eprintln!("ktree: rank {} of {}: {message}", r.rank, r.size);
+        }
+        if !imp::settled() {
+            imp::abort();
+        }
+        return;
     }
     eprintln!("ktree: {message}");
 }
@@ -71,7 +110,9 @@ pub fn init() -> imp::Guard {
 #[cfg(not(feature = "mpi"))]
 mod imp {
     use super::Ranks;
-    use ktree::{KTree, RaySet};
+    use crate::memory::BuildArgs;
+    use ktree::stacking::{OutOfCoreReport, RaySource};
+    use std::path::Path;
 
     /// Nothing to hold without MPI.
     pub struct Guard;
@@ -86,23 +127,42 @@ mod imp {
 
     pub fn abort() {}
 
-    pub fn stack<const K: usize>(
-        rays: &RaySet<K>,
-        threads: Option<usize>,
-    ) -> Result<Option<KTree<K>>, String> {
-        super::stack_here(rays, threads).map(Some)
+    pub fn settled() -> bool {
+        true
+    }
+
+    /// One process builds everything.
+    pub fn build_to_file<const K: usize, S>(
+        source: &S,
+        out: &Path,
+        pool: &rayon::ThreadPool,
+        args: &BuildArgs,
+        budget: u64,
+    ) -> Result<Option<OutOfCoreReport>, String>
+    where
+        S: RaySource<K>,
+        S::Error: std::fmt::Display,
+    {
+        pool.install(|| crate::memory::build_to_file(source, out, args, budget))
+            .map(Some)
     }
 }
 
 #[cfg(feature = "mpi")]
 mod imp {
-    use mpi::topology::SimpleCommunicator;
-    use mpi::traits::*;
+    use std::path::Path;
+    use std::sync::atomic::{AtomicBool, Ordering};
 
-    use super::Ranks;
-    use ktree::io::{read_ktree, write_ktree};
-    use ktree::stacking::{balanced_slabs, join_parts, slab_rays};
-    use ktree::{KTree, RaySet};
+    use mpi::collective::SystemOperation;
+    use mpi::topology::{Process, SimpleCommunicator};
+    use mpi::traits::*;
+    use rayon::prelude::*;
+
+    use super::{Ranks, STOPPED};
+    use crate::memory::BuildArgs;
+    use ktree::stacking::{
+        balanced_parts, build_slabs, slab_cost, stack_part, OutOfCoreReport, RaySource,
+    };
 
     /// Keeps MPI initialised; finalises it when dropped.
     pub struct Guard {
@@ -131,56 +191,170 @@ mod imp {
         world().abort(1);
     }
 
-    /// Largest message sent at once (MPI counts are 32-bit).
-    const CHUNK: usize = 1 << 30;
+    /// Set when the ranks agreed that the build failed and every rank cleaned up.
+    static SETTLED: AtomicBool = AtomicBool::new(false);
 
-    pub fn stack<const K: usize>(
-        rays: &RaySet<K>,
-        threads: Option<usize>,
-    ) -> Result<Option<KTree<K>>, String> {
-        let Ranks { rank, size } = ranks();
-        if size == 1 {
-            return super::stack_here(rays, threads).map(Some);
+    pub fn settled() -> bool {
+        SETTLED.load(Ordering::SeqCst)
+    }
+
+    /// The largest message of the index and the level streams, in bytes.
+    const CHUNK_BYTES: u64 = 4 << 20;
+    /// The smallest, in bytes (when the budget is small).
+    const MIN_CHUNK_BYTES: u64 = 64 << 10;
+    /// The first word of a stream message: the chunk follows.
+    const CHUNK: u64 = 0;
+    /// The first word of a stream message: the sender failed, its stream ends.
+    const FAILED: u64 = 1;
+
+    /// Words per message: at most [`CHUNK_BYTES`], and a sixteenth of the budget shared by the buffers
+    /// rank 0 holds (one per other rank).
+    fn chunk_words(budget: u64, size: usize) -> usize {
+        let bytes = (budget / 16 / size as u64).clamp(MIN_CHUNK_BYTES, CHUNK_BYTES);
+        (bytes / 8) as usize
+    }
+
+    /// The ranks agree whether one failed: `Ok` if none did; else this rank's error, or [`STOPPED`].
+    fn agree<T>(w: &SimpleCommunicator, outcome: Result<T, String>) -> Result<T, String> {
+        let failed = u64::from(outcome.is_err());
+        let mut any = 0u64;
+        w.all_reduce_into(&failed, &mut any, SystemOperation::sum());
+        match outcome {
+            Err(e) => Err(e),
+            Ok(_) if any > 0 => Err(STOPPED.to_string()),
+            ok => ok,
         }
-        let slabs = balanced_slabs(rays, size);
-        let mine = super::stack_here(&slab_rays(rays, slabs[rank].clone()), threads)?;
+    }
+
+    pub fn build_to_file<const K: usize, S>(
+        source: &S,
+        out: &Path,
+        pool: &rayon::ThreadPool,
+        args: &BuildArgs,
+        budget: u64,
+    ) -> Result<Option<OutOfCoreReport>, String>
+    where
+        S: RaySource<K>,
+        S::Error: std::fmt::Display,
+    {
         let w = world();
+        let outcome = run(&w, source, out, pool, args, budget);
+        if outcome.is_err() {
+            // Every rank has dropped its spill folder: none is stopped before it could.
+            w.barrier();
+            SETTLED.store(true, Ordering::SeqCst);
+        }
+        outcome
+    }
+
+    /// The phases of the build, each ending with an agreement (the spill folder is dropped on return).
+    fn run<const K: usize, S>(
+        w: &SimpleCommunicator,
+        source: &S,
+        out: &Path,
+        pool: &rayon::ThreadPool,
+        args: &BuildArgs,
+        budget: u64,
+    ) -> Result<Option<OutOfCoreReport>, String>
+    where
+        S: RaySource<K>,
+        S::Error: std::fmt::Display,
+    {
+        let Ranks { rank, size } = ranks();
+        let level = source.universe().level();
+        let chunk = chunk_words(budget, size);
+        // The message buffers come out of the budget: rank 0 holds one per other rank.
+        let held = 8 * chunk as u64 * if rank == 0 { size as u64 - 1 } else { 1 };
+        let options = crate::memory::options::<K>(level, args, budget.saturating_sub(held));
+        let depth = options.depth;
+
+        // 1. Partition: the slabs' costs, each rank measuring every P-th slab.
+        let slabs = build_slabs(source, depth);
+        let mut costs = vec![0u64; slabs.len()];
+        let measured = pool
+            .install(|| {
+                slabs
+                    .par_iter()
+                    .enumerate()
+                    .filter(|(i, _)| i % size == rank)
+                    .map(|(i, &b0)| slab_cost(source, depth, b0).map(|c| (i, c)))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(|e| format!("{}: {e}", out.display()));
+        let measured = agree(w, measured)?;
+        for (i, c) in measured {
+            costs[i] = c;
+        }
+        let mut all = vec![0u64; costs.len()];
+        w.all_reduce_into(&costs[..], &mut all[..], SystemOperation::sum());
+        let mine = balanced_parts(&all, size)[rank].clone();
+
+        // 2. Stacking: this rank's slabs, spilled.
+        let bar = crate::render::progress_bar(args.progress && rank == 0, "stacking");
+        let progress = |p| crate::memory::report_progress(bar.as_ref(), p);
+        let part = pool
+            .install(|| stack_part(source, &slabs[mine], out, &options, &progress))
+            .map_err(|e| crate::memory::describe(out, e, held));
+        let mut part = agree(w, part)?;
+
+        // 3. Index, and 4. levels: the other ranks send, rank 0 writes.
         let root = w.process_at_rank(0);
         if rank != 0 {
-            let mut bytes = Vec::new();
-            write_ktree(&mut bytes, &mine).map_err(|e| e.to_string())?;
-            root.send(&(bytes.len() as u64));
-            for chunk in bytes.chunks(CHUNK) {
-                root.send(chunk);
+            send_words(&root, &part.index_words(), chunk);
+            agree(w, Ok(()))?;
+            let mut message = Vec::with_capacity(chunk + 1);
+            let streamed = part.stream_levels(chunk, &mut |words| {
+                message.clear();
+                message.push(CHUNK);
+                message.extend_from_slice(words);
+                root.send(&message[..]);
+                Ok(())
+            });
+            if streamed.is_err() {
+                root.send(&[FAILED][..]);
             }
-            root.send(&ktree_repro::peak_rss_bytes().unwrap_or(0));
+            drop(part);
+            agree(
+                w,
+                streamed.map_err(|e| format!("{}: sending the levels: {e}", out.display())),
+            )?;
+            root.gather_into(&ktree_repro::peak_rss_bytes().unwrap_or(0));
             return Ok(None);
         }
         let mut moved = 0u64;
-        let mut peaks = vec![0];
-        let parts = (1..size).map(|r| {
+        let mut streams = Vec::with_capacity(size - 1);
+        let mut added = Ok(());
+        for r in 1..size {
             let from = w.process_at_rank(r as i32);
-            let (len, _) = from.receive::<u64>();
-            let mut bytes = Vec::with_capacity(len as usize);
-            while (bytes.len() as u64) < len {
-                let (chunk, _) = from.receive_vec::<u8>();
-                bytes.extend_from_slice(&chunk);
+            let words = receive_words(&from);
+            moved += 8 * words.len() as u64;
+            match part.add_part(&words) {
+                Ok(total) => streams.push(Stream::new(from, total)),
+                Err(e) if added.is_ok() => added = Err(format!("rank {r}: {e}")),
+                Err(_) => {}
             }
-            moved += len;
-            let (p, _) = from.receive::<u64>();
-            peaks.push(p);
-            read_ktree::<K>(&bytes, &format!("<part of rank {r}>")).map_err(|e| e.to_string())
-        });
-        let mut error = None;
-        let joined = join_parts(
-            mine,
-            parts.map_while(|p| p.map_err(|e| error = Some(e)).ok()),
-        );
-        if let Some(e) = error {
-            return Err(e);
         }
-        let tree = joined.map_err(|e| e.to_string())?;
-        peaks[0] = ktree_repro::peak_rss_bytes().unwrap_or(0);
+        agree(w, added)?;
+        let written = part.write::<String>(
+            out,
+            &mut |owner, words| streams[owner - 1].fill(owner, words),
+            &progress,
+        );
+        if let Some(bar) = bar {
+            bar.finish_and_clear();
+        }
+        // Take what is left of the streams, so that no rank waits on a send.
+        for stream in &mut streams {
+            stream.drain();
+            moved += stream.received;
+        }
+        let report = agree(
+            w,
+            written.map_err(|e| crate::memory::describe(out, e, held)),
+        )?;
+        let mut peaks = vec![0u64; size];
+        let own = ktree_repro::peak_rss_bytes().unwrap_or(0);
+        root.gather_into_root(&own, &mut peaks[..]);
         eprintln!(
             "ktree: {size} ranks; {moved} bytes sent to rank 0; peak memory per rank (MiB): {}",
             peaks
@@ -189,6 +363,95 @@ mod imp {
                 .collect::<Vec<_>>()
                 .join(" ")
         );
-        Ok(Some(tree))
+        Ok(Some(report))
+    }
+
+    /// Sends `words` to `to`: their number, then chunks of at most `chunk` words.
+    fn send_words(to: &Process<'_>, words: &[u64], chunk: usize) {
+        to.send(&(words.len() as u64));
+        for piece in words.chunks(chunk) {
+            to.send(piece);
+        }
+    }
+
+    /// Receives what [`send_words`] sends.
+    fn receive_words(from: &Process<'_>) -> Vec<u64> {
+        let (len, _) = from.receive::<u64>();
+        let mut words = Vec::new();
+        while (words.len() as u64) < len {
+            let (piece, _) = from.receive_vec::<u64>();
+            if words.is_empty() {
+                words = piece;
+            } else {
+                words.extend_from_slice(&piece);
+            }
+        }
+        words
+    }
+
+    /// The level stream of one other rank, as rank 0 takes it: the chunk being read.
+    struct Stream<'a> {
+        from: Process<'a>,
+        chunk: Vec<u64>,
+        /// The next word of `chunk` to take.
+        at: usize,
+        /// Words the stream still brings.
+        left: u64,
+        /// The sender failed: its stream has ended.
+        failed: bool,
+        /// Bytes received.
+        received: u64,
+    }
+
+    impl<'a> Stream<'a> {
+        fn new(from: Process<'a>, words: u64) -> Self {
+            Self {
+                from,
+                chunk: Vec::new(),
+                at: 0,
+                left: words,
+                failed: false,
+                received: 0,
+            }
+        }
+
+        /// Receives the next message; `false` if the sender failed.
+        fn next(&mut self) -> bool {
+            let (message, _) = self.from.receive_vec::<u64>();
+            self.received += 8 * message.len() as u64;
+            if message.first() != Some(&CHUNK) {
+                self.failed = true;
+                return false;
+            }
+            self.left = self.left.saturating_sub(message.len() as u64 - 1);
+            self.chunk = message;
+            self.at = 1;
+            true
+        }
+
+        /// Fills `words` with the next words of the stream of rank `owner`.
+        fn fill(&mut self, owner: usize, mut words: &mut [u64]) -> std::io::Result<()> {
+            while !words.is_empty() {
+                if self.at == self.chunk.len() && (self.failed || self.left == 0 || !self.next()) {
+                    return Err(std::io::Error::other(format!(
+                        "rank {owner} failed while sending its levels"
+                    )));
+                }
+                let take = words.len().min(self.chunk.len() - self.at);
+                words[..take].copy_from_slice(&self.chunk[self.at..self.at + take]);
+                self.at += take;
+                words = &mut words[take..];
+            }
+            Ok(())
+        }
+
+        /// Receives (and drops) what is left of the stream.
+        fn drain(&mut self) {
+            self.chunk = Vec::new();
+            self.at = 0;
+            while self.left > 0 && !self.failed {
+                self.next();
+            }
+        }
     }
 }

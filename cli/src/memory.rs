@@ -6,6 +6,7 @@
 //! are stacked and streamed into the output, so only the top of the tree and the slabs being stacked are
 //! held. The file is byte for byte the one the in-memory build writes. The budget covers what the command
 //! holds besides: the rays it was given whole (a ray file, a mesh's or a volume's rays) count against it.
+//! Across MPI ranks the budget applies to each rank (see [`crate::distributed`]).
 
 use std::path::{Path, PathBuf};
 
@@ -128,24 +129,43 @@ where
     S: RaySource<K>,
     S::Error: std::fmt::Display,
 {
-    let level = source.universe().level();
-    let options = OutOfCore {
-        temp_dir: args.temp_dir.clone(),
-        ..OutOfCore::new(default_split_depth(K, level), budget)
-    };
+    let options = options::<K>(source.universe().level(), args, budget);
     let bar = crate::render::progress_bar(args.progress, "stacking");
     let report = stack_to_file(source, out, &options, &|p| report_progress(bar.as_ref(), p));
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    report.map_err(|e| match e {
-        OutOfCoreError::BudgetTooSmall { .. } => format!("{}: {e} (--max-memory)", out.display()),
-        OutOfCoreError::Output { .. } => format!("cannot write {}: {e}", out.display()),
-        other => format!("{}: {other}", out.display()),
-    })
+    report.map_err(|e| describe(out, e, 0))
 }
 
-fn report_progress(bar: Option<&ProgressBar>, p: Progress) {
+/// How a tree of level `level` is built out of core: cells of the default split depth, `budget` bytes,
+/// the spill folder of `args`.
+pub fn options<const K: usize>(level: u32, args: &BuildArgs, budget: u64) -> OutOfCore {
+    OutOfCore {
+        temp_dir: args.temp_dir.clone(),
+        ..OutOfCore::new(default_split_depth(K, level), budget)
+    }
+}
+
+/// The message of a failed out-of-core build of `out`; `held` bytes were set apart from the budget before
+/// the build (message buffers) and are added back to the budgets it names.
+pub fn describe<E: std::fmt::Display>(out: &Path, e: OutOfCoreError<E>, held: u64) -> String {
+    match e {
+        OutOfCoreError::BudgetTooSmall { budget, needed } => format!(
+            "{}: {} (--max-memory)",
+            out.display(),
+            OutOfCoreError::<E>::BudgetTooSmall {
+                budget: budget.saturating_add(held),
+                needed: needed.saturating_add(held),
+            }
+        ),
+        OutOfCoreError::Output { .. } => format!("cannot write {}: {e}", out.display()),
+        other => format!("{}: {other}", out.display()),
+    }
+}
+
+/// Shows the progress of an out-of-core build on `bar`, if any.
+pub fn report_progress(bar: Option<&ProgressBar>, p: Progress) {
     let Some(bar) = bar else {
         return;
     };
@@ -175,10 +195,10 @@ pub fn ray_bytes<const K: usize>(rays: &RaySet<K>) -> u64 {
     rays.len() as u64 * per_run
 }
 
-/// Whether the trees written in this run are built out of core: a `.ktree` of format version 2 written by
-/// one process.
+/// Whether the trees written in this run are built out of core: a `.ktree` of format version 2 (by one
+/// process or across MPI ranks; version 1 is built in memory, by one process only).
 pub fn out_of_core() -> bool {
-    crate::tree_file::version() == 2 && crate::distributed::ranks().size == 1
+    crate::tree_file::version() == 2
 }
 
 #[cfg(test)]

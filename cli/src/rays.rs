@@ -147,9 +147,10 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
 }
 
 /// Writes rays as text, or stacks them into a `.ktree` file, by the output's extension; returns a summary.
-/// A tree is built out of core in the budget of `build` less what the rays hold (see [`crate::memory`]),
-/// except in a run over several MPI ranks or for format version 1: there every rank takes part in the
-/// build in memory and rank 0 alone writes and returns the summary (the others return an empty one).
+/// A tree of format version 2 is built out of core in the budget of `build` less what the rays hold (see
+/// [`crate::memory`]), across the MPI ranks of the run if several: every rank holds the rays whole, rank 0
+/// alone writes and returns the summary (the others return an empty one). Version 1 is built in memory by
+/// one process.
 pub fn write_output<const K: usize>(
     rays: &RaySet<K>,
     out: &Path,
@@ -161,14 +162,13 @@ pub fn write_output<const K: usize>(
             let budget = build
                 .budget
                 .left_after("the rays", crate::memory::ray_bytes(rays))?;
-            with_threads(threads, || {
-                crate::memory::build_to_file(rays, out, build, budget)
-            })??
-            .counts_per_level
+            match crate::distributed::build_to_file(rays, out, threads, build, budget)? {
+                Some(report) => report.counts_per_level,
+                None => return Ok(String::new()),
+            }
         } else {
-            let Some(tree) = crate::distributed::stack(rays, threads)? else {
-                return Ok(String::new());
-            };
+            one_process_for_version_1()?;
+            let tree = with_threads(threads, || crate::build::stack_cells(rays))?;
             crate::tree_file::write(out, &tree)
                 .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
             tree.counts_per_level()
@@ -199,8 +199,21 @@ pub fn write_output<const K: usize>(
     }
 }
 
+/// Trees of format version 1 are built in memory by one process: an error in a run over several MPI
+/// ranks.
+pub fn one_process_for_version_1() -> Result<(), String> {
+    if crate::distributed::ranks().size > 1 {
+        return Err(
+            "--format-version 1: trees of version 1 are written by one process; across MPI ranks, \
+             write version 2 (and convert it with `ktree convert` if needed)"
+                .into(),
+        );
+    }
+    Ok(())
+}
+
 /// Whether an output path names a tree file (`.ktree`) rather than a ray file.
-fn is_tree_file(out: &Path) -> bool {
+pub fn is_tree_file(out: &Path) -> bool {
     out.extension().is_some_and(|e| e == "ktree")
 }
 
@@ -225,16 +238,18 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
     } else {
         Sample::Centre
     };
-    if is_tree_file(&a.out) && crate::distributed::ranks().size == 1 {
-        // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
+    if is_tree_file(&a.out) {
+        // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole
+        // (across MPI ranks, each rank makes the rays of its own slabs only).
         let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
         let counts = if crate::memory::out_of_core() {
             let budget = a.build.budget.budget();
-            with_threads(a.threads, || {
-                crate::memory::build_to_file(&source, &a.out, &a.build, budget)
-            })??
-            .counts_per_level
+            match crate::distributed::build_to_file(&source, &a.out, a.threads, &a.build, budget)? {
+                Some(report) => report.counts_per_level,
+                None => return Ok(()),
+            }
         } else {
+            one_process_for_version_1()?;
             let depth = default_split_depth(K, a.level);
             let tree = with_threads(a.threads, || stack_source(&source, depth))?
                 .map_err(|e| e.to_string())?;
@@ -245,39 +260,36 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
         outln!("{}", tree_summary::<K>(&a.out, a.level, &counts));
         return Ok(());
     }
-    if crate::distributed::ranks().size == 1 {
-        // A ray file, written slab by slab: one slab's runs held at a time, no cap on their number.
-        let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
-        let bar = crate::render::progress_bar(a.build.progress, "writing slabs");
-        let progress = |done: u64, total: u64| {
-            if let Some(bar) = &bar {
-                bar.set_length(total);
-                bar.set_position(done);
-            }
-        };
-        let mut written = (0, 0);
-        let depth = default_split_depth(K, a.level);
-        write_atomic_with(&a.out, |w| {
-            written = write_rays_source(w, &source, depth, &progress)?;
-            Ok(())
-        })
-        .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
-        if let Some(bar) = bar {
-            bar.finish_and_clear();
-        }
-        outln!(
-            "{}: K = {K}, L = {}, {} rays, {} voxels",
-            a.out.display(),
-            a.level,
-            written.0,
-            written.1
-        );
+    if !crate::distributed::ranks().is_root() {
+        // A ray file is written by rank 0 alone.
         return Ok(());
     }
-    let rays = s
-        .to_rays(a.level, sample, false)
-        .map_err(|e| e.to_string())?;
-    print_summary(&write_output(&rays, &a.out, a.threads, &a.build)?)?;
+    // A ray file, written slab by slab: one slab's runs held at a time, no cap on their number.
+    let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
+    let bar = crate::render::progress_bar(a.build.progress, "writing slabs");
+    let progress = |done: u64, total: u64| {
+        if let Some(bar) = &bar {
+            bar.set_length(total);
+            bar.set_position(done);
+        }
+    };
+    let mut written = (0, 0);
+    let depth = default_split_depth(K, a.level);
+    write_atomic_with(&a.out, |w| {
+        written = write_rays_source(w, &source, depth, &progress)?;
+        Ok(())
+    })
+    .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    outln!(
+        "{}: K = {K}, L = {}, {} rays, {} voxels",
+        a.out.display(),
+        a.level,
+        written.0,
+        written.1
+    );
     Ok(())
 }
 

@@ -15,7 +15,7 @@ use ktree::stacking::{RaySource, SlabRuns};
 use ktree::{LevelCounts, Universe};
 
 use crate::build::with_threads;
-use crate::rays::write_output;
+use crate::rays::{is_tree_file, write_output};
 
 /// Arguments of `ktree voxelize`.
 #[derive(Debug, clap::Args)]
@@ -89,8 +89,10 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     // In a run over several MPI ranks, rank 0 alone reports.
     let root = crate::distributed::ranks().is_root();
-    if is_tree_file(&a.out) && crate::memory::out_of_core() {
+    if is_tree_file(&a.out) && crate::memory::out_of_core() && crate::distributed::ranks().size == 1
+    {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
+        // (Across MPI ranks, every rank makes the rays whole and keeps its slabs: `write_output`.)
         let v = voxel_source(&a.input, &options).map_err(|e| e.to_string())?;
         remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
         outln!("{}", build_out_of_core(&v.source, &a)?);
@@ -121,11 +123,6 @@ fn remarks(
         );
     }
     Ok(())
-}
-
-/// Whether an output path names a tree file (`.ktree`) rather than a ray file.
-fn is_tree_file(out: &Path) -> bool {
-    out.extension().is_some_and(|e| e == "ktree")
 }
 
 /// Stacks the source straight into the output, out of core, in the budget less what the source holds;

@@ -1,6 +1,8 @@
 //! Builds over MPI ranks write the very file a single process writes (`mpirun -n 2`, and 3 ranks
-//! oversubscribed on this machine), in K = 2, 3 and 4, for `rays`, `build` and `voxelize`; a failed run
-//! leaves no output. Compiled with the cargo feature `mpi` only; needs `mpirun` (OpenMPI) on the PATH.
+//! oversubscribed on this machine), in K = 2, 3 and 4, for `rays`, `build` and `voxelize`, also in the
+//! smallest `--max-memory` per rank the build names; a failed run (before the build, or while rank 0
+//! writes) leaves no output and no spill folder. Compiled with the cargo feature `mpi` only; needs
+//! `mpirun` (OpenMPI) on the PATH.
 #![cfg(feature = "mpi")]
 
 mod common;
@@ -8,7 +10,7 @@ mod common;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use common::{data_dir, ktree};
+use common::{data_dir, ktree, SmallDisk};
 
 /// Runs `mpirun -n ranks ktree args…` (allowed as root, oversubscribed, traffic on this machine only).
 fn mpirun(ranks: usize, args: &[&str]) -> Output {
@@ -30,7 +32,27 @@ fn mpirun(ranks: usize, args: &[&str]) -> Output {
         .expect("run mpirun (install openmpi-bin)")
 }
 
-/// Runs one command alone and over 2 and 3 ranks, writing `out` each time; the files must be identical.
+/// The names in a folder (hidden spill folders included).
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// The largest budget named by "needs a budget of at least N bytes" in the ranks' messages.
+fn needed_budget(stderr: &str) -> Option<u64> {
+    stderr
+        .split("needs a budget of at least ")
+        .skip(1)
+        .filter_map(|rest| rest.split(' ').next()?.parse().ok())
+        .max()
+}
+
+/// Runs one command alone and over 2 and 3 ranks, writing `out` each time; the files must be identical,
+/// and the output's folder must hold nothing else (no spill folder left).
 fn same_bytes(dir: &Path, name: &str, command: &[&str]) {
     let single = dir.join(format!("{name}-1.ktree"));
     let mut args: Vec<&str> = command.to_vec();
@@ -58,7 +80,54 @@ fn same_bytes(dir: &Path, name: &str, command: &[&str]) {
             single_stdout.lines().count(),
             "rank 0 alone prints: {summary}"
         );
+        std::fs::remove_file(&path).unwrap();
     }
+    assert_eq!(entries(dir), vec![format!("{name}-1.ktree")], "{name}");
+    std::fs::remove_file(&single).unwrap();
+}
+
+/// Runs one command over `ranks` ranks with a budget per rank too small, then with the budget the
+/// ranks name, until it runs (the budget of rank 0 also covers the index of every part, which it learns
+/// only once the others have stacked); the file must be the single-process one.
+fn same_bytes_in_the_budget_named(dir: &Path, name: &str, command: &[&str], ranks: usize) {
+    let single = dir.join(format!("{name}-1.ktree"));
+    let mut args: Vec<&str> = command.to_vec();
+    let single_s = single.to_str().unwrap().to_string();
+    args.extend(["--out", &single_s]);
+    let (ok, _, err) = ktree(&args);
+    assert!(ok, "{name}: single process failed: {err}");
+    let path = dir.join(format!("{name}-{ranks}.ktree"));
+    let path_s = path.to_str().unwrap().to_string();
+    let mut budget = 1u64 << 10;
+    let mut tries = 0;
+    loop {
+        let budget_s = budget.to_string();
+        let mut args: Vec<&str> = command.to_vec();
+        args.extend(["--out", &path_s, "--max-memory", &budget_s]);
+        let out = mpirun(ranks, &args);
+        if out.status.success() {
+            break;
+        }
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!path.exists(), "{name}: a failed run left its output");
+        let needed = needed_budget(&err)
+            .unwrap_or_else(|| panic!("{name}: no budget named in the failure: {err}"));
+        assert!(
+            needed > budget,
+            "{name}: {needed} named after {budget}: {err}"
+        );
+        budget = needed;
+        tries += 1;
+        assert!(tries < 4, "{name}: still too small at {budget}: {err}");
+    }
+    assert!(tries > 0, "{name}: the first budget was not too small");
+    assert!(
+        std::fs::read(&path).unwrap() == std::fs::read(&single).unwrap(),
+        "{name}: {ranks} ranks in {budget} bytes each wrote other bytes"
+    );
+    std::fs::remove_file(&path).unwrap();
+    std::fs::remove_file(&single).unwrap();
+    assert!(entries(dir).is_empty(), "{name}: left {:?}", entries(dir));
 }
 
 #[test]
@@ -92,13 +161,49 @@ fn solids_over_ranks_write_the_single_process_file() {
             "rays", "-k", "4", "--solid", "ball", "--level", "4", "--radius", "6",
         ],
     );
+    same_bytes(
+        d,
+        "segment",
+        &[
+            "rays", "-k", "1", "--solid", "ball", "--level", "9", "--radius", "100",
+        ],
+    );
+}
+
+#[test]
+fn a_small_budget_per_rank_names_one_that_works_and_writes_the_same_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    same_bytes_in_the_budget_named(
+        d,
+        "disk",
+        &[
+            "rays", "-k", "2", "--solid", "ball", "--level", "9", "--radius", "200",
+        ],
+        2,
+    );
+    same_bytes_in_the_budget_named(
+        d,
+        "ball",
+        &["rays", "--solid", "ball", "--level", "8", "--radius", "100"],
+        3,
+    );
+    same_bytes_in_the_budget_named(
+        d,
+        "ball4",
+        &[
+            "rays", "-k", "4", "--solid", "ball", "--level", "5", "--radius", "12",
+        ],
+        3,
+    );
 }
 
 #[test]
 fn ray_files_and_meshes_over_ranks_write_the_single_process_file() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let rays = d.join("box.rays");
+    let inputs = tempfile::tempdir().unwrap();
+    let rays = inputs.path().join("box.rays");
     let (ok, _, err) = ktree(&[
         "rays",
         "-k",
@@ -141,8 +246,74 @@ fn a_failed_run_stops_every_rank_and_writes_nothing() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("in.rays"), "the error names the input: {err}");
-    assert!(
-        std::fs::read_dir(dir.path()).unwrap().next().is_none(),
-        "no file left behind"
+    assert!(entries(dir.path()).is_empty(), "no file left behind");
+}
+
+#[test]
+fn a_failure_while_rank_0_writes_leaves_no_output_and_no_spill_folder() {
+    let Some(disk) = SmallDisk::mount("64k") else {
+        eprintln!("SKIPPED a_failure_while_rank_0_writes_leaves_no_output_and_no_spill_folder: cannot mount a tmpfs here (needs root)");
+        return;
+    };
+    let spill = tempfile::tempdir().unwrap();
+    let out = disk.0.join("ball.ktree");
+    // The file (about 300 KB) does not fit on the disk; the spill files go elsewhere.
+    let run = mpirun(
+        3,
+        &[
+            "rays",
+            "--solid",
+            "ball",
+            "--level",
+            "9",
+            "--radius",
+            "200",
+            "--temp-dir",
+            spill.path().to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
     );
+    assert!(!run.status.success());
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        err.contains("rank 0 of 3") && err.contains("ball.ktree"),
+        "rank 0 names the output: {err}"
+    );
+    assert!(
+        !err.contains("rank 1 of 3") && !err.contains("rank 2 of 3"),
+        "the ranks that did not fail say nothing: {err}"
+    );
+    assert!(entries(&disk.0).is_empty(), "left {:?}", entries(&disk.0));
+    assert!(
+        entries(spill.path()).is_empty(),
+        "left {:?}",
+        entries(spill.path())
+    );
+}
+
+#[test]
+fn format_version_1_over_ranks_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("v1.ktree");
+    let run = mpirun(
+        2,
+        &[
+            "rays",
+            "--solid",
+            "ball",
+            "--level",
+            "5",
+            "--radius",
+            "10",
+            "--format-version",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(!run.status.success());
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(err.contains("--format-version 1"), "{err}");
+    assert!(entries(dir.path()).is_empty());
 }

@@ -3,9 +3,10 @@
 //! the lists as sequential disk files ([`stack_with_file_lists`]), or as a pipeline of one thread per stage
 //! ([`stack_pipelined`]); all three build the same tree from the same combine and split steps. The same
 //! tree is also built cell by cell ([`stack_partitioned`], [`stack_source`]): cache-sized subtrees on all
-//! threads, joined level by level; and in parts that run apart, as the ranks of a distributed run do
-//! ([`balanced_slabs`], [`slab_rays`], [`join_parts`]); or out of core, straight to a `.ktree` file in
-//! bounded memory with the subtrees spilled to temporary files ([`stack_to_file`]).
+//! threads, joined level by level; or out of core, straight to a `.ktree` file in bounded memory with the
+//! subtrees spilled to temporary files ([`stack_to_file`]) — also in parts that run apart, as the ranks of
+//! a distributed run do, each stacking its share of the slabs ([`balanced_parts`], [`stack_part`]) and one
+//! writing the file from all of them ([`SpilledPart`]).
 //!
 //! ```
 //! use ktree::{rays::ball_rays, reference::DensePyramid, stacking::stack_with_stats};
@@ -17,7 +18,6 @@
 //! ```
 
 mod bitmap;
-mod distribute;
 mod out_of_core;
 mod partition;
 mod pipeline;
@@ -26,10 +26,10 @@ mod sequential;
 mod stack;
 
 pub use bitmap::{stack_bitmap, MAX_BITMAP_VOXELS};
-pub use distribute::{balanced_slabs, join_parts, slab_rays};
 pub use out_of_core::{
-    stack_to_file, OutOfCore, OutOfCoreError, OutOfCoreReport, Progress, Stage, BUFFER_BYTES,
-    CELL_BYTES, RUN_BYTES, SUBTREE_BYTES,
+    balanced_parts, build_slabs, slab_cost, stack_part, stack_to_file, OutOfCore, OutOfCoreError,
+    OutOfCoreReport, Progress, SpilledPart, Stage, BUFFER_BYTES, CELL_BYTES, MAX_PARTS, RUN_BYTES,
+    SUBTREE_BYTES,
 };
 pub use partition::{
     default_split_depth, join_subtrees, stack_partitioned, stack_source, RaySource, SlabRuns,

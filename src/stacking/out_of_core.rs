@@ -13,6 +13,16 @@
 //! ([`write_atomic_with`]), so the bytes are exactly those of the tree built in memory and written by
 //! [`write_ktree_v2`](crate::io::write_ktree_v2), for any number of threads.
 //!
+//! # In parts
+//! The two phases also run apart, as the ranks of a distributed run do: [`stack_part`] stacks some of the
+//! slabs (a share cut by [`balanced_parts`] from the costs [`slab_cost`] estimates) into spill files of its
+//! own; one part takes the others' indexes ([`SpilledPart::index_words`], [`SpilledPart::add_part`]: the
+//! cells' states and the stacked cells' Morton indexes and node counts) and writes the file
+//! ([`SpilledPart::write`]), walking the stacked cells of all parts in Morton order and taking each
+//! piece from its own spill files or from the stream of words the owning part sends in its own Morton
+//! order ([`SpilledPart::stream_levels`]). The bytes are those of [`stack_to_file`], which is one part
+//! of every slab.
+//!
 //! # Memory
 //! The budget ([`OutOfCore::max_memory`]) is kept by accounting, not by measuring the process:
 //! [`RUN_BYTES`] bytes per run of each slab being stacked (its copies and the subtrees made from it, until
@@ -300,7 +310,8 @@ enum SlabOutcome<const K: usize> {
 /// `.ktree` version 2 file, in the memory budget `options.max_memory`, on the threads of the current rayon
 /// pool; `progress` is called (on the calling thread) as slabs are stacked and levels written. The file
 /// is byte for byte the one [`write_ktree_v2_file`](crate::io::write_ktree_v2_file) writes for the tree
-/// [`stack_source`](super::stack_source) builds.
+/// [`stack_source`](super::stack_source) builds. It is [`stack_part`] of every slab of
+/// [`build_slabs`] followed by [`SpilledPart::write`].
 ///
 /// # Errors
 /// [`OutOfCoreError`]: the source's first error (in slab order), a budget too small, a temporary folder
@@ -316,15 +327,94 @@ where
     S: RaySource<K>,
     S::Error: Display,
 {
+    let slabs = build_slabs(source, options.depth);
+    let part = stack_part(source, &slabs, out, options, progress)?;
+    part.write(
+        out,
+        &mut |_, _| Err(std::io::Error::other("no other part")),
+        progress,
+    )
+}
+
+/// The slabs of cells of depth `depth` (clamped to `L`) an out-of-core build stacks, numbered along axis 0
+/// in increasing order: those of [`RaySource::occupied_slabs`] (the one slab `0` for `K = 1`).
+pub fn build_slabs<const K: usize, S: RaySource<K>>(source: &S, depth: u32) -> Vec<u32> {
+    if K == 1 {
+        vec![0]
+    } else {
+        source.occupied_slabs(depth.min(source.universe().level()))
+    }
+}
+
+/// The estimated cost of stacking slab `b0` of the cells of depth `depth`: the bytes accounted for its runs
+/// ([`RUN_BYTES`] each), which the size of the subtrees it makes follows. The runs are made and dropped.
+///
+/// # Errors
+/// The source's error.
+pub fn slab_cost<const K: usize, S: RaySource<K>>(
+    source: &S,
+    depth: u32,
+    b0: u32,
+) -> Result<u64, S::Error> {
+    let level = source.universe().level();
+    let side = 1u32 << (level - depth.min(level));
+    let slab = source.slab(b0 * side..(b0 + 1) * side)?;
+    Ok(slab.runs.len() as u64 * RUN_BYTES)
+}
+
+/// Cuts a sequence of slabs with their costs into `parts` contiguous ranges (of positions in `costs`, in
+/// order, covering it) of about equal total cost; some ranges are empty when there are fewer slabs than
+/// parts.
+///
+/// ```
+/// use ktree::stacking::balanced_parts;
+/// assert_eq!(balanced_parts(&[5, 1, 1, 1, 1, 1], 2), vec![0..1, 1..6]);
+/// assert_eq!(balanced_parts(&[1], 3), vec![0..1, 1..1, 1..1]);
+/// ```
+pub fn balanced_parts(costs: &[u64], parts: usize) -> Vec<std::ops::Range<usize>> {
+    let parts = parts.max(1);
+    let total: u128 = costs.iter().map(|&c| u128::from(c.max(1))).sum();
+    let mut bounds = vec![0usize];
+    let mut at = 0usize;
+    let mut sum = 0u128;
+    for p in 1..parts {
+        // The part ends after the last slab whose middle lies within its share of the total (rounded up:
+        // ties go to the earlier part).
+        let share = (total * p as u128).div_ceil(parts as u128);
+        while at < costs.len() && 2 * sum + u128::from(costs[at].max(1)) <= 2 * share {
+            sum += u128::from(costs[at].max(1));
+            at += 1;
+        }
+        bounds.push(at);
+    }
+    bounds.push(costs.len());
+    bounds.windows(2).map(|w| w[0]..w[1]).collect()
+}
+
+/// The stacking phase of an out-of-core build run on some of its slabs (for a process that builds a
+/// share of the tree): the cells of `slabs` (numbers from [`build_slabs`], increasing) are stacked as
+/// [`stack_to_file`] does and their subtrees spilled next to `out` (or in [`OutOfCore::temp_dir`]);
+/// nothing is written to `out`. The part's index travels to the process that writes
+/// ([`SpilledPart::index_words`], [`SpilledPart::add_part`]) and its levels follow
+/// ([`SpilledPart::stream_levels`]).
+///
+/// # Errors
+/// As [`stack_to_file`] (the budget covers this part alone).
+pub fn stack_part<const K: usize, S>(
+    source: &S,
+    slabs: &[u32],
+    out: &Path,
+    options: &OutOfCore,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<SpilledPart, OutOfCoreError<S::Error>>
+where
+    S: RaySource<K>,
+    S::Error: Display,
+{
     let universe = source.universe();
     let level = universe.level();
     let m = options.depth.min(level);
     let t = level - m;
-    let slabs = if K == 1 {
-        vec![0]
-    } else {
-        source.occupied_slabs(m)
-    };
     let mut spill = open_spill(out, options.temp_dir.as_deref(), t as usize)?;
     let mut budget = Budget {
         max: options.max_memory,
@@ -341,7 +431,7 @@ where
         done,
         total,
     });
-    let mut queue: VecDeque<u32> = slabs.into();
+    let mut queue: VecDeque<u32> = slabs.iter().copied().collect();
     // The largest slab cost seen; the first slab runs alone to learn it.
     let mut largest = 0u64;
     let mut window = 1;
@@ -426,23 +516,437 @@ where
         });
     }
     budget.peak = budget.peak.max(end);
-    let spilled_bytes = 8 * spill.words.iter().sum::<u64>();
-    let subtrees = index.mortons.len() as u64;
-    let counts_per_level =
-        write_levels::<K, S::Error>(out, level, m, cells, &index, spill, progress)?;
-    let file_bytes = std::fs::metadata(out)
+    let spilled_words = spill.words.iter().sum::<u64>();
+    let Spill { dir, files, .. } = spill;
+    let mut readers = Vec::with_capacity(files.len());
+    for (j, file) in files.into_iter().enumerate() {
+        let path = dir.path().join(format!("level-{}", j + 1));
+        let file = file.into_inner().map_err(|e| OutOfCoreError::Spill {
+            path: path.clone(),
+            source: e.into_error(),
+        })?;
+        readers.push((path, file));
+    }
+    Ok(SpilledPart {
+        k: K as u32,
+        level,
+        m,
+        cells,
+        own: index,
+        others: Vec::new(),
+        dir,
+        readers,
+        budget,
+        largest,
+        spilled_bytes: 8 * spilled_words,
+    })
+}
+
+/// The cells of some slabs stacked and their subtrees spilled ([`stack_part`]), and the index of the
+/// parts other processes stacked ([`add_part`](Self::add_part)): all that is needed to write the tree
+/// ([`write`](Self::write)), with the levels of the other parts received as streams. The spill folder is
+/// removed when the part is dropped.
+pub struct SpilledPart {
+    k: u32,
+    level: u32,
+    m: u32,
+    /// The states of the non-empty cells of depth `m`, of this part and the parts added.
+    cells: CellStates,
+    /// The cells stacked here.
+    own: SubtreeIndex,
+    /// The cells stacked by the parts added, owner `1, 2, …` in the order added.
+    others: Vec<SubtreeIndex>,
+    dir: tempfile::TempDir,
+    /// The spill files of levels `1 … t`, for reading back.
+    readers: Vec<(PathBuf, File)>,
+    budget: Budget,
+    largest: u64,
+    /// Bytes written to spill files by this part and the parts added.
+    spilled_bytes: u64,
+}
+
+/// The words of an index header: magic, K, L, m, dense, cell words, subtrees, spilled bytes.
+const INDEX_HEADER: usize = 8;
+/// The most parts a tree is written from.
+pub const MAX_PARTS: usize = 1 << 16;
+/// The first word of a part's index.
+const INDEX_MAGIC: u64 = u64::from_le_bytes(*b"ktpart01");
+
+impl SpilledPart {
+    /// Levels of a subtree below its root.
+    fn t(&self) -> usize {
+        (self.level - self.m) as usize
+    }
+
+    /// The cells of depth `m` stacked by this part.
+    pub fn subtrees(&self) -> u64 {
+        self.own.mortons.len() as u64
+    }
+
+    /// The index of this part for the process that writes the tree ([`add_part`](Self::add_part)): the
+    /// states of its non-empty cells of depth `m`, and for each cell it stacked its Morton index and node
+    /// count per subtree level — a few words per stacked cell, nothing of the subtrees themselves.
+    pub fn index_words(&self) -> Vec<u64> {
+        let (dense, cell_words): (u64, Vec<u64>) = match &self.cells {
+            CellStates::Dense(words) => (1, words.clone()),
+            CellStates::Sparse(cells) => (
+                0,
+                cells
+                    .iter()
+                    .flat_map(|&(morton, state)| [morton, state as u64])
+                    .collect(),
+            ),
+        };
+        let mut words = vec![
+            INDEX_MAGIC,
+            u64::from(self.k),
+            u64::from(self.level),
+            u64::from(self.m),
+            dense,
+            cell_words.len() as u64,
+            self.own.mortons.len() as u64,
+            self.spilled_bytes,
+        ];
+        words.extend(cell_words);
+        words.extend(&self.own.mortons);
+        words.extend(&self.own.counts);
+        words
+    }
+
+    /// Adds the index of a part stacked elsewhere ([`index_words`](Self::index_words) of a part of the
+    /// same build, over other slabs), as owner `1, 2, …` in the order added; returns the number of words
+    /// its [`stream_levels`](Self::stream_levels) sends.
+    ///
+    /// # Errors
+    /// [`std::io::ErrorKind::InvalidData`] if `words` is not the index of a part of this build.
+    pub fn add_part(&mut self, words: &[u64]) -> std::io::Result<u64> {
+        let bad = |what: &str| {
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("the index of part {}: {what}", self.others.len() + 1),
+            )
+        };
+        if self.others.len() + 1 >= MAX_PARTS {
+            return Err(bad("too many parts"));
+        }
+        if words.len() < INDEX_HEADER || words[0] != INDEX_MAGIC {
+            return Err(bad("not a part index"));
+        }
+        let dense = matches!(self.cells, CellStates::Dense(_));
+        if words[1..5]
+            != [
+                u64::from(self.k),
+                u64::from(self.level),
+                u64::from(self.m),
+                u64::from(dense),
+            ]
+        {
+            return Err(bad("another K, level, split depth or cell layout"));
+        }
+        let t = self.t();
+        let (cell_words, n) = (words[5], words[6]);
+        let expected =
+            (n as u128) * (t as u128 + 1) + u128::from(cell_words) + INDEX_HEADER as u128;
+        if expected != words.len() as u128 {
+            return Err(bad("its length does not match its header"));
+        }
+        let cell_words = cell_words as usize;
+        let n = n as usize;
+        let body = &words[INDEX_HEADER..];
+        let (cell_part, rest) = body.split_at(cell_words);
+        let (mortons, counts) = rest.split_at(n);
+        let k = u64::from(self.k);
+        let mut stream = 0u64;
+        for (s, &morton) in mortons.iter().enumerate() {
+            if u128::from(morton) >> (k * u64::from(self.m)) != 0 {
+                return Err(bad("a cell outside the universe"));
+            }
+            for (j, &nodes) in counts[s * t..(s + 1) * t].iter().enumerate() {
+                if u128::from(nodes) > 1u128 << (k * (j as u64 + 1)).min(127) {
+                    return Err(bad("more nodes than a subtree level holds"));
+                }
+                stream += nodes.div_ceil(32);
+            }
+        }
+        match &mut self.cells {
+            CellStates::Dense(own) => {
+                if own.len() != cell_words {
+                    return Err(bad("another number of cells"));
+                }
+                for (a, b) in own.iter_mut().zip(cell_part) {
+                    let both = *a | b;
+                    if both & (both >> 1) & 0x5555_5555_5555_5555 != 0 {
+                        return Err(bad("a cell state code 11, or a cell of two parts"));
+                    }
+                    *a = both;
+                }
+            }
+            CellStates::Sparse(own) => {
+                for pair in cell_part.chunks_exact(2) {
+                    let state = u8::try_from(pair[1])
+                        .ok()
+                        .and_then(NodeState::from_code)
+                        .ok_or_else(|| bad("a cell state code above 2"))?;
+                    own.push((pair[0], state));
+                }
+            }
+        }
+        self.spilled_bytes += words[7];
+        self.others.push(SubtreeIndex {
+            mortons: mortons.to_vec(),
+            counts: counts.to_vec(),
+        });
+        Ok(stream)
+    }
+
+    /// Sends this part's subtree levels to the process that writes the tree: for each level `1 … t`, the
+    /// pieces of the cells it stacked in Morton order (each piece `⌈nodes / 32⌉` words), concatenated and
+    /// cut into chunks of at most `chunk_words` words handed to `send` in order; returns the words sent.
+    /// The writer takes them in the same order ([`write`](Self::write)).
+    ///
+    /// # Errors
+    /// A spill file that cannot be read back (naming it), or the error of `send`.
+    pub fn stream_levels(
+        &mut self,
+        chunk_words: usize,
+        send: &mut dyn FnMut(&[u64]) -> std::io::Result<()>,
+    ) -> std::io::Result<u64> {
+        let chunk_words = chunk_words.max(1);
+        let t = self.t();
+        let n = self.own.mortons.len();
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_unstable_by_key(|&s| self.own.mortons[s]);
+        let mut chunk: Vec<u64> = Vec::with_capacity(chunk_words);
+        let mut sent = 0u64;
+        let mut offsets = vec![0u64; n];
+        for j in 0..t {
+            let at = level_offsets(&self.own, t, j, &mut offsets);
+            let (path, file) = &mut self.readers[j];
+            let mut reader = SpillReader::new(path, file, at);
+            for &s in &order {
+                let count = self.own.counts[s * t + j].div_ceil(32);
+                let mut left = count;
+                reader.seek(offsets[s])?;
+                while left > 0 {
+                    let take = left.min((chunk_words - chunk.len()) as u64);
+                    reader.read_into(take as usize, &mut chunk)?;
+                    left -= take;
+                    if chunk.len() == chunk_words {
+                        send(&chunk)?;
+                        sent += chunk.len() as u64;
+                        chunk.clear();
+                    }
+                }
+            }
+        }
+        if !chunk.is_empty() {
+            send(&chunk)?;
+            sent += chunk.len() as u64;
+        }
+        Ok(sent)
+    }
+
+    /// The writing phase: writes the tree to `out` as a `.ktree` version 2 file, atomically — the top levels
+    /// from the cells' states, then each level below as the pieces of the stacked cells in Morton order,
+    /// each from its owner: this part's spill files, or `receive(owner, words)`, which fills `words` with
+    /// the next words of that owner's [`stream_levels`](Self::stream_levels).
+    ///
+    /// # Errors
+    /// [`OutOfCoreError::BudgetTooSmall`] if the index of all parts does not fit in the budget; the output
+    /// or a spill file that cannot be written or read (an error of `receive` included). The target is then
+    /// untouched; the spill folder is removed in any case.
+    pub fn write<E>(
+        self,
+        out: &Path,
+        receive: &mut dyn FnMut(usize, &mut [u64]) -> std::io::Result<()>,
+        progress: &(dyn Fn(Progress) + Sync),
+    ) -> Result<OutOfCoreReport, OutOfCoreError<E>> {
+        let SpilledPart {
+            k,
+            level,
+            m,
+            cells,
+            own,
+            others,
+            dir,
+            mut readers,
+            mut budget,
+            largest,
+            spilled_bytes,
+        } = self;
+        let t = (level - m) as usize;
+        let parts: Vec<&SubtreeIndex> = std::iter::once(&own).chain(&others).collect();
+        let subtrees: usize = parts.iter().map(|p| p.mortons.len()).sum();
+        let end = budget.fixed(cells.bytes(), subtrees);
+        if end > budget.max {
+            return Err(OutOfCoreError::BudgetTooSmall {
+                budget: budget.max,
+                needed: end + largest,
+            });
+        }
+        budget.peak = budget.peak.max(end);
+        let top = cells.into_top_levels(k, m);
+        // The stacked cells of every part in Morton order, as (owner, position in its index).
+        // (Packed in one word: the owner in the top 16 bits, at most `MAX_PARTS`.)
+        let mut order: Vec<u64> = Vec::with_capacity(subtrees);
+        for (owner, part) in parts.iter().enumerate() {
+            order.extend((0..part.mortons.len() as u64).map(|s| (owner as u64) << 48 | s));
+        }
+        let unpack = |o: u64| ((o >> 48) as usize, (o & ((1 << 48) - 1)) as usize);
+        order.sort_unstable_by_key(|&o| {
+            let (owner, s) = unpack(o);
+            parts[owner].mortons[s]
+        });
+        let deepest = (1..=t)
+            .rev()
+            .find(|&j| {
+                parts
+                    .iter()
+                    .any(|p| (0..p.mortons.len()).any(|s| p.counts[s * t + j - 1] > 0))
+            })
+            .unwrap_or(0);
+        let total = (top.len() + deepest) as u64;
+        let mut counts = Vec::new();
+        write_atomic_with(out, |w| {
+            let mut writer = KtreeWriter::new(w, k as usize, level)?;
+            let mut done = 0;
+            for states in &top {
+                writer.append_states(states)?;
+                writer.end_level()?;
+                done += 1;
+                progress(Progress {
+                    stage: Stage::Writing,
+                    done,
+                    total,
+                });
+            }
+            drop(top);
+            let mut offsets = vec![0u64; own.mortons.len()];
+            let mut words: Vec<u64> = Vec::new();
+            for (j, (path, file)) in readers.iter_mut().enumerate().take(deepest) {
+                let at = level_offsets(&own, t, j, &mut offsets);
+                let mut reader = SpillReader::new(path, file, at);
+                for &o in &order {
+                    let (owner, s) = unpack(o);
+                    let nodes = parts[owner].counts[s * t + j];
+                    if nodes == 0 {
+                        continue;
+                    }
+                    let count = nodes.div_ceil(32) as usize;
+                    words.clear();
+                    if owner == 0 {
+                        reader.seek(offsets[s])?;
+                        reader.read_into(count, &mut words)?;
+                    } else {
+                        words.resize(count, 0);
+                        receive(owner, &mut words)?;
+                    }
+                    writer.append_words(&words, nodes)?;
+                }
+                writer.end_level()?;
+                done += 1;
+                progress(Progress {
+                    stage: Stage::Writing,
+                    done,
+                    total,
+                });
+            }
+            counts = writer.counts_per_level();
+            writer.finish().map(drop)
+        })
         .map_err(|source| OutOfCoreError::Output {
             path: out.to_path_buf(),
             source,
-        })?
-        .len();
-    Ok(OutOfCoreReport {
-        counts_per_level,
-        file_bytes,
-        subtrees,
-        spilled_bytes,
-        peak_accounted_bytes: budget.peak,
-    })
+        })?;
+        drop(readers);
+        drop(dir);
+        let file_bytes = std::fs::metadata(out)
+            .map_err(|source| OutOfCoreError::Output {
+                path: out.to_path_buf(),
+                source,
+            })?
+            .len();
+        Ok(OutOfCoreReport {
+            counts_per_level: counts,
+            file_bytes,
+            subtrees: subtrees as u64,
+            spilled_bytes,
+            peak_accounted_bytes: budget.peak,
+        })
+    }
+}
+
+/// Sets `offsets[s]` to the word offset of cell `s`'s piece in spill file `j + 1` (pieces are in the order
+/// the cells were spilled); returns the file's length in words.
+fn level_offsets(index: &SubtreeIndex, t: usize, j: usize, offsets: &mut [u64]) -> u64 {
+    let mut at = 0u64;
+    for (s, offset) in offsets.iter_mut().enumerate() {
+        *offset = at;
+        at += index.counts[s * t + j].div_ceil(32);
+    }
+    at
+}
+
+/// Reads pieces of one spill file back, one read per piece (pieces are taken out of the order they were
+/// spilled in, so a buffer ahead would mostly be wasted); errors name the file.
+struct SpillReader<'a> {
+    path: &'a Path,
+    file: &'a mut File,
+    /// The word the file is at (`u64::MAX`: unknown).
+    at: u64,
+    /// The file's length in words.
+    len: u64,
+    bytes: Vec<u8>,
+}
+
+impl<'a> SpillReader<'a> {
+    fn new(path: &'a Path, file: &'a mut File, len: u64) -> Self {
+        Self {
+            path,
+            file,
+            at: u64::MAX,
+            len,
+            bytes: Vec::new(),
+        }
+    }
+
+    fn error(&self, e: std::io::Error) -> std::io::Error {
+        std::io::Error::new(e.kind(), format!("spill file {}: {e}", self.path.display()))
+    }
+
+    /// Moves to word `word` (no system call when the file is already there).
+    fn seek(&mut self, word: u64) -> std::io::Result<()> {
+        if word != self.at {
+            self.at = u64::MAX;
+            self.file
+                .seek(SeekFrom::Start(8 * word))
+                .map_err(|e| self.error(e))?;
+            self.at = word;
+        }
+        Ok(())
+    }
+
+    /// Appends the next `count` words to `words`.
+    fn read_into(&mut self, count: usize, words: &mut Vec<u64>) -> std::io::Result<()> {
+        if self.at.saturating_add(count as u64) > self.len {
+            return Err(self.error(std::io::Error::new(
+                std::io::ErrorKind::UnexpectedEof,
+                "shorter than its index",
+            )));
+        }
+        self.bytes.resize(8 * count, 0);
+        if let Err(e) = self.file.read_exact(&mut self.bytes) {
+            self.at = u64::MAX;
+            return Err(self.error(e));
+        }
+        words.extend(
+            self.bytes
+                .chunks_exact(8)
+                .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))),
+        );
+        self.at += count as u64;
+        Ok(())
+    }
 }
 
 /// Creates the spill folder and its `t` files.
@@ -573,105 +1077,4 @@ where
         }
     }
     Ok(budget.fixed(cells.bytes_with(more), subtrees) + largest)
-}
-
-/// Writes the output: the top levels from the cells' states, then each level below as the subtrees'
-/// levels read back from the spill files in Morton order.
-fn write_levels<const K: usize, E>(
-    out: &Path,
-    level: u32,
-    m: u32,
-    cells: CellStates,
-    index: &SubtreeIndex,
-    spill: Spill,
-    progress: &(dyn Fn(Progress) + Sync),
-) -> Result<Vec<LevelCounts>, OutOfCoreError<E>> {
-    let Spill {
-        dir,
-        files,
-        words: _,
-    } = spill;
-    let t = files.len();
-    let mut readers = Vec::with_capacity(t);
-    for (j, file) in files.into_iter().enumerate() {
-        let path = dir.path().join(format!("level-{}", j + 1));
-        let file = file.into_inner().map_err(|e| OutOfCoreError::Spill {
-            path: path.clone(),
-            source: e.into_error(),
-        })?;
-        readers.push((path, file));
-    }
-    let top = cells.into_top_levels(K as u32, m);
-    let n = index.mortons.len();
-    // The stacked cells in Morton order, and the deepest subtree level.
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_unstable_by_key(|&s| index.mortons[s]);
-    let deepest = (1..=t)
-        .rev()
-        .find(|&j| (0..n).any(|s| index.counts[s * t + j - 1] > 0))
-        .unwrap_or(0);
-    let total = (top.len() + deepest) as u64;
-    let mut counts = Vec::new();
-    write_atomic_with(out, |w| {
-        let mut writer = KtreeWriter::new(w, K, level)?;
-        let mut done = 0;
-        for states in &top {
-            writer.append_states(states)?;
-            writer.end_level()?;
-            done += 1;
-            progress(Progress {
-                stage: Stage::Writing,
-                done,
-                total,
-            });
-        }
-        drop(top);
-        let mut offsets = vec![0u64; n];
-        let mut buffer: Vec<u8> = Vec::new();
-        let mut words: Vec<u64> = Vec::new();
-        for (j, (path, file)) in readers.iter_mut().enumerate().take(deepest) {
-            let with_path = |e: std::io::Error| {
-                std::io::Error::new(e.kind(), format!("spill file {}: {e}", path.display()))
-            };
-            let mut at = 0u64;
-            for (s, offset) in offsets.iter_mut().enumerate() {
-                *offset = at;
-                at += index.counts[s * t + j].div_ceil(32);
-            }
-            for &s in &order {
-                let nodes = index.counts[s * t + j];
-                if nodes == 0 {
-                    continue;
-                }
-                let count = nodes.div_ceil(32) as usize;
-                buffer.resize(8 * count, 0);
-                file.seek(SeekFrom::Start(8 * offsets[s]))
-                    .map_err(with_path)?;
-                file.read_exact(&mut buffer).map_err(with_path)?;
-                words.clear();
-                words.extend(
-                    buffer
-                        .chunks_exact(8)
-                        .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))),
-                );
-                writer.append_words(&words, nodes)?;
-            }
-            writer.end_level()?;
-            done += 1;
-            progress(Progress {
-                stage: Stage::Writing,
-                done,
-                total,
-            });
-        }
-        counts = writer.counts_per_level();
-        writer.finish().map(drop)
-    })
-    .map_err(|source| OutOfCoreError::Output {
-        path: out.to_path_buf(),
-        source,
-    })?;
-    drop(readers);
-    drop(dir);
-    Ok(counts)
 }

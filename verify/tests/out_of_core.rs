@@ -2,13 +2,19 @@
 //! memory (and equal to naive insertion) written as a `.ktree` version 2 file; with a budget too small it
 //! names a budget that works, and the build then keeps to it; it leaves no
 //! temporary file behind and the target untouched on failure, and removes the spill folders of killed
-//! builds; and the file does not depend on the number of threads.
+//! builds; and the file does not depend on the number of threads. Built in parts (as the ranks of a
+//! distributed run build it: balanced shares of the slabs stacked apart, their indexes added to one part
+//! and their levels streamed to it in chunks), the file is the same, for 1 … 5 parts and any chunk size;
+//! a damaged index or a stream that breaks off is an error that leaves the target and no temporary file.
 
 use std::path::Path;
 
 use ktree::io::write_ktree_v2;
 use ktree::reference::{Dim, Fanout, NaiveTree};
-use ktree::stacking::{stack, stack_to_file, OutOfCore, OutOfCoreError, RaySource};
+use ktree::stacking::{
+    balanced_parts, build_slabs, slab_cost, stack, stack_part, stack_to_file, OutOfCore,
+    OutOfCoreError, RaySource,
+};
 use ktree::RaySet;
 use ktree_verify::cases::{ray_sets, Case};
 use proptest::prelude::*;
@@ -76,6 +82,94 @@ where
     Ok(())
 }
 
+/// Builds the file in `parts` parts: part 0 writes, the others' levels reach it as chunks of
+/// `chunk` words; checks the bytes, the balance of the parts and that no spill folder remains.
+fn parts_agree<const K: usize, S>(
+    source: &S,
+    expected: &[u8],
+    parts: usize,
+    chunk: usize,
+) -> Result<(), TestCaseError>
+where
+    S: RaySource<K>,
+    S::Error: std::fmt::Display + std::fmt::Debug,
+{
+    let level = source.universe().level();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tree.ktree");
+    for depth in 0..=level {
+        let options = OutOfCore::new(depth, u64::MAX);
+        let slabs = build_slabs(source, depth);
+        let costs: Vec<u64> = slabs
+            .iter()
+            .map(|&b0| slab_cost(source, depth, b0).unwrap())
+            .collect();
+        let ranges = balanced_parts(&costs, parts);
+        prop_assert_eq!(ranges.len(), parts);
+        prop_assert_eq!(ranges[0].start, 0);
+        prop_assert_eq!(ranges[parts - 1].end, slabs.len());
+        for w in ranges.windows(2) {
+            prop_assert_eq!(w[0].end, w[1].start, "the parts follow one another");
+        }
+        // No part is more than one slab away from an equal share.
+        let total: u64 = costs.iter().map(|&c| c.max(1)).sum();
+        let largest = costs.iter().map(|&c| c.max(1)).max().unwrap_or(0);
+        for r in &ranges {
+            let cost: u64 = costs[r.clone()].iter().map(|&c| c.max(1)).sum();
+            prop_assert!(
+                cost <= total / parts as u64 + largest + 1,
+                "unbalanced: {:?}",
+                ranges
+            );
+        }
+        let mut stacked: Vec<_> = ranges
+            .iter()
+            .map(|r| stack_part(source, &slabs[r.clone()], &out, &options, &|_| {}).unwrap())
+            .collect();
+        let mut writer = stacked.remove(0);
+        let mut streams = Vec::new();
+        for mut other in stacked {
+            let words = writer.add_part(&other.index_words()).unwrap();
+            let mut stream = Vec::new();
+            let sent = other
+                .stream_levels(chunk, &mut |c| {
+                    assert!(!c.is_empty() && c.len() <= chunk);
+                    stream.extend_from_slice(c);
+                    Ok(())
+                })
+                .unwrap();
+            prop_assert_eq!(sent, words);
+            prop_assert_eq!(stream.len() as u64, words);
+            streams.push(stream.into_iter());
+        }
+        writer
+            .write::<String>(
+                &out,
+                &mut |owner, words| {
+                    for w in words.iter_mut() {
+                        *w = streams[owner - 1]
+                            .next()
+                            .expect("the stream holds the piece");
+                    }
+                    Ok(())
+                },
+                &|_| {},
+            )
+            .unwrap();
+        prop_assert!(
+            std::fs::read(&out).unwrap() == expected,
+            "split depth {}, {} parts: the file differs from the in-memory one",
+            depth,
+            parts
+        );
+        for (i, s) in streams.iter_mut().enumerate() {
+            prop_assert!(s.next().is_none(), "part {} sent words not written", i + 1);
+        }
+        prop_assert_eq!(entries(dir.path()), vec!["tree.ktree".to_string()]);
+    }
+    Ok(())
+}
+
 fn rays_agree<const K: usize>(case: &Case<K>) -> Result<(), TestCaseError>
 where
     Dim<K>: Fanout,
@@ -99,6 +193,23 @@ proptest! {
     fn out_of_core_equals_in_memory_k3(case in ray_sets::<3>()) { rays_agree(&case)?; }
     #[test]
     fn out_of_core_equals_in_memory_k4(case in ray_sets::<4>()) { rays_agree(&case)?; }
+
+    #[test]
+    fn parts_k1(case in ray_sets::<1>(), parts in 1usize..=5, chunk in 1usize..40) {
+        parts_agree::<1, _>(&case.rays, &in_memory_bytes(&case.rays), parts, chunk)?;
+    }
+    #[test]
+    fn parts_k2(case in ray_sets::<2>(), parts in 1usize..=5, chunk in 1usize..40) {
+        parts_agree::<2, _>(&case.rays, &in_memory_bytes(&case.rays), parts, chunk)?;
+    }
+    #[test]
+    fn parts_k3(case in ray_sets::<3>(), parts in 1usize..=5, chunk in 1usize..40) {
+        parts_agree::<3, _>(&case.rays, &in_memory_bytes(&case.rays), parts, chunk)?;
+    }
+    #[test]
+    fn parts_k4(case in ray_sets::<4>(), parts in 1usize..=5, chunk in 1usize..40) {
+        parts_agree::<4, _>(&case.rays, &in_memory_bytes(&case.rays), parts, chunk)?;
+    }
 
     #[test]
     fn solids_out_of_core(c in prop::array::uniform3(-8i64..72), r in 1i64..60) {
@@ -270,4 +381,84 @@ fn the_next_build_removes_the_spill_folders_of_killed_builds() {
             "b.ktree".to_string(),
         ]
     );
+}
+
+/// The writing part refuses an index that is not that of a part of its build, without panicking.
+#[test]
+fn a_foreign_or_damaged_part_index_is_refused() {
+    let ball = ktree::rays::ball_rays::<3>(5, [16, 16, 16], 20).unwrap();
+    let other = ktree::rays::ball_rays::<3>(6, [16, 16, 16], 20).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tree.ktree");
+    let options = OutOfCore::new(2, u64::MAX);
+    let slabs = build_slabs(&ball, 2);
+    let (first, second) = slabs.split_at(slabs.len() / 2);
+    let mut writer = stack_part(&ball, first, &out, &options, &|_| {}).unwrap();
+    let part = stack_part(&ball, second, &out, &options, &|_| {}).unwrap();
+    let foreign = stack_part(&other, &build_slabs(&other, 2), &out, &options, &|_| {}).unwrap();
+    let words = part.index_words();
+    let mut damaged = vec![
+        foreign.index_words(),
+        words[..words.len() - 1].to_vec(),
+        Vec::new(),
+        vec![0; 20],
+    ];
+    let mut bad_count = words.clone();
+    let last = bad_count.len() - 1;
+    bad_count[last] = u64::MAX;
+    damaged.push(bad_count);
+    for index in damaged {
+        let e = writer.add_part(&index).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::InvalidData, "{e}");
+    }
+    assert_eq!(writer.add_part(&words).unwrap(), {
+        let mut part = part;
+        part.stream_levels(64, &mut |_| Ok(())).unwrap()
+    });
+}
+
+/// A part whose stream breaks off while the file is written: the write fails naming the cause, the
+/// target keeps its old bytes, and no temporary file or spill folder remains.
+#[test]
+fn a_stream_that_breaks_off_fails_the_write_and_keeps_the_target() {
+    let ball = ktree::rays::ball_rays::<3>(6, [32, 32, 32], 40).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tree.ktree");
+    std::fs::write(&out, b"old").unwrap();
+    let options = OutOfCore::new(3, u64::MAX);
+    let slabs = build_slabs(&ball, 3);
+    let (first, second) = slabs.split_at(slabs.len() / 2);
+    let mut writer = stack_part(&ball, first, &out, &options, &|_| {}).unwrap();
+    let mut part = stack_part(&ball, second, &out, &options, &|_| {}).unwrap();
+    let words = writer.add_part(&part.index_words()).unwrap();
+    let mut stream = Vec::new();
+    part.stream_levels(16, &mut |c| {
+        stream.extend_from_slice(c);
+        Ok(())
+    })
+    .unwrap();
+    drop(part);
+    assert_eq!(stream.len() as u64, words);
+    assert!(words > 2);
+    // The stream breaks off half-way.
+    stream.truncate(stream.len() / 2);
+    let mut stream = stream.into_iter();
+    let e = writer
+        .write::<String>(
+            &out,
+            &mut |_, piece| {
+                for w in piece.iter_mut() {
+                    *w = stream
+                        .next()
+                        .ok_or_else(|| std::io::Error::other("the sender stopped"))?;
+                }
+                Ok(())
+            },
+            &|_| {},
+        )
+        .unwrap_err();
+    assert!(matches!(e, OutOfCoreError::Output { .. }), "{e:?}");
+    assert!(e.to_string().contains("the sender stopped"), "{e}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"old".to_vec());
+    assert_eq!(entries(dir.path()), vec!["tree.ktree".to_string()]);
 }
