@@ -1,11 +1,13 @@
 //! `--max-memory SIZE`, `--temp-dir DIR` and `--progress`: trees written out of core, in a memory budget.
-//! (`ktree op` takes `--max-memory` alone: it holds its trees in memory and checks that they fit.)
+//! (`ktree op` streams version 2 files in bounded memory, and checks that trees it must load fit.)
 //!
-//! A command that writes a `.ktree` (version 2) from rays in one process builds it with
+//! A command that writes a `.ktree` (version 2) from rays builds it with
 //! [`ktree::stacking::stack_to_file`]: the subtrees of the cells are spilled to temporary files as they
 //! are stacked and streamed into the output, so only the top of the tree and the slabs being stacked are
 //! held. The file is byte for byte the one the in-memory build writes. The budget covers what the command
-//! holds besides: the rays it was given whole (a ray file, a mesh's or a volume's rays) count against it.
+//! holds besides: a solid, a sorted ray file, a mesh or a volume makes its rays slab by slab, and only its
+//! own data (the ray file's index, the placed triangles, the samples) counts against it; rays read whole (an
+//! unsorted ray file) count whole.
 //! Across MPI ranks the budget applies to each rank (see [`crate::distributed`]).
 
 use std::path::{Path, PathBuf};

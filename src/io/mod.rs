@@ -34,7 +34,7 @@ mod vdb;
 
 pub use any::TreeStats;
 pub use any::{AnyRaySet, AnyTree};
-pub(crate) use atomic::{remove_stale, spill_folder};
+pub(crate) use atomic::spill_folder;
 pub use atomic::{write_atomic, write_atomic_with};
 pub use binvox::{read_binvox, write_binvox, BINVOX_MAX_DIM};
 pub use formats::{

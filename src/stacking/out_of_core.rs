@@ -67,8 +67,6 @@ use rayon::prelude::*;
 
 use super::partition::{slab_pieces, top_levels, top_levels_dense, Piece, RaySource};
 
-/// The suffix of spill folders: `.NAME.XXXXXX.PID.ktree-spill`.
-const SPILL_SUFFIX: &str = ".ktree-spill";
 use crate::io::{write_atomic_with, KtreeWriter};
 use crate::tree::{LevelCounts, NodeState, PackedStates};
 
@@ -955,30 +953,8 @@ fn open_spill<E>(
     temp_dir: Option<&Path>,
     t: usize,
 ) -> Result<Spill, OutOfCoreError<E>> {
-    let dir = match temp_dir {
-        Some(d) => d.to_path_buf(),
-        None => match out.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-            _ => PathBuf::from("."),
-        },
-    };
-    let temp_err = |source| OutOfCoreError::TempDir {
-        path: dir.clone(),
-        source,
-    };
-    if temp_dir.is_none() {
-        std::fs::create_dir_all(&dir).map_err(temp_err)?;
-    }
-    let name = out
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    crate::io::remove_stale(&dir, &name, SPILL_SUFFIX);
-    let folder = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(&format!(".{}{SPILL_SUFFIX}", std::process::id()))
-        .tempdir_in(&dir)
-        .map_err(temp_err)?;
+    let folder = crate::io::spill_folder(out, temp_dir)
+        .map_err(|(path, source)| OutOfCoreError::TempDir { path, source })?;
     let mut spill = Spill {
         dir: folder,
         files: Vec::with_capacity(t),
