@@ -46,7 +46,7 @@ fn gap2<const K: usize>(a: &Cell<K>, b: &Cell<K>) -> u128 {
 /// [`OpsError::LevelMismatch`] when the levels differ.
 pub fn min_separation<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Option<f64>, OpsError> {
     same_level(a, b)?;
-    // Heap entries: (bound, (depth, index, cell) of a, of b), smallest bound first.
+    // A pair: (depth, index, cell) of a node of a, of b; the heap pops the smallest bound first.
     type Side<const K: usize> = (usize, usize, Cell<K>);
     let node = |tree: &KTree<K>, s: Side<K>| NodeRef {
         index: s.1,
@@ -54,9 +54,13 @@ pub fn min_separation<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Opti
         state: tree.state(s.0, s.1),
     };
     let root = a.universe().root();
-    let mut heap: BinaryHeap<Reverse<(u128, Side<K>, Side<K>)>> = BinaryHeap::new();
-    heap.push(Reverse((0, (0, 0, root), (0, 0, root))));
-    while let Some(Reverse((bound, sa, sb))) = heap.pop() {
+    // The heap orders small entries (bound, shallowness, place in `pairs`); the pairs stay put. Among
+    // equal bounds the deepest pair comes first: it is the nearest to a pair of full leaves.
+    let mut pairs: Vec<(Side<K>, Side<K>)> = vec![((0, 0, root), (0, 0, root))];
+    let mut heap: BinaryHeap<Reverse<(u128, usize, usize)>> = BinaryHeap::new();
+    heap.push(Reverse((0, usize::MAX, 0)));
+    while let Some(Reverse((bound, _, at))) = heap.pop() {
+        let (sa, sb) = pairs[at];
         let (na, nb) = (node(a, sa), node(b, sb));
         if na.state == NodeState::Empty || nb.state == NodeState::Empty {
             continue;
@@ -74,7 +78,9 @@ pub fn min_separation<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Opti
             }
             let side = (child.cell.level as usize, child.index, child.cell);
             let (ca, cb) = if split_a { (side, sb) } else { (sa, side) };
-            heap.push(Reverse((gap2(&ca.2, &cb.2), ca, cb)));
+            let shallowness = usize::MAX - (ca.0 + cb.0);
+            heap.push(Reverse((gap2(&ca.2, &cb.2), shallowness, pairs.len())));
+            pairs.push((ca, cb));
         }
     }
     Ok(None)
