@@ -159,7 +159,8 @@ where
             let mut chunk = Vec::new();
             loop {
                 let more = list.fill(&mut chunk, lists)?;
-                let cut = if more {
+                // (At the voxel level every item is a group of its own, in any order.)
+                let cut = if more && sh > 0 {
                     let last = chunk.last().map_or(0, |&k| k >> sh);
                     chunk.partition_point(|&k| k >> sh < last)
                 } else {
@@ -555,6 +556,14 @@ impl ListFiles {
             self.open -= 1;
             self.delete(&path)?;
             return Ok(None);
+        }
+        if bits == 0 && len > self.max_items as u64 {
+            // Unsorted: the file is read as it is, in chunks, and deleted after.
+            return Ok(Some(SortedList {
+                len,
+                memory: None,
+                file: Some(input),
+            }));
         }
         let mut runs = VecDeque::new();
         loop {
