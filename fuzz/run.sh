@@ -45,15 +45,16 @@ for t in "${targets[@]}"; do
     -print_final_stats=1 "target/corpus/$t" "corpus/$t" >"$logs/$t.log" 2>&1
   status=$?
   took=$(( $(date +%s) - start ))
-  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$logs/$t.log" | grep -o '[0-9]*$' | tail -1)
-  rss=$(grep -o 'stat::peak_rss_mb: *[0-9]*' "$logs/$t.log" | grep -o '[0-9]*$' | tail -1)
-  cov=$(grep -o 'cov: [0-9]* ft: [0-9]*' "$logs/$t.log" | tail -1)
+  # -a: a log may hold raw bytes of inputs (dictionary entries), which would make grep call it binary.
+  execs=$(grep -ao 'stat::number_of_executed_units: *[0-9]*' "$logs/$t.log" | grep -o '[0-9]*$' | tail -1)
+  rss=$(grep -ao 'stat::peak_rss_mb: *[0-9]*' "$logs/$t.log" | grep -o '[0-9]*$' | tail -1)
+  cov=$(grep -ao 'cov: [0-9]* ft: [0-9]*' "$logs/$t.log" | tail -1)
   if [ $status -eq 0 ]; then
     outcome="none"
   else
     failed=1
     # The kind of failure, and for a panic the source file's name (never a path of this machine).
-    kind=$(grep -o -m1 -E 'panicked at [^:]*|ERROR: libFuzzer: [a-z -]*|ERROR: AddressSanitizer: [a-z-]*' "$logs/$t.log" \
+    kind=$(grep -ao -m1 -E 'panicked at [^:]*|ERROR: libFuzzer: [a-z -]*|ERROR: AddressSanitizer: [a-z-]*' "$logs/$t.log" \
       | head -1 | sed -E 's#(panicked at ).*/#\1#')
     outcome="**${kind:-exit $status}** (see fuzz/artifacts/$t/)"
   fi
