@@ -183,11 +183,11 @@ pub fn report_progress(bar: Option<&ProgressBar>, p: Progress) {
     bar.set_position(p.done);
 }
 
-/// The voxels of a tree from its counts per level in a level-`level` universe of `K` dimensions.
-pub fn voxels<const K: usize>(level: u32, counts: &[LevelCounts]) -> u128 {
+/// The voxels of a tree from its counts per level in a level-`level` universe of `k` dimensions.
+pub fn voxels(k: usize, level: u32, counts: &[LevelCounts]) -> u128 {
     counts
         .iter()
-        .map(|c| u128::from(c.full) << (K as u32 * (level - c.level)))
+        .map(|c| u128::from(c.full) << (k as u32 * (level - c.level)))
         .sum()
 }
 

@@ -52,10 +52,7 @@ pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> Result<(), String>
 /// Prints the one-line summary of a tree written to `path`, from its counts per level.
 fn print_summary(path: &Path, k: usize, level: u32, counts: &[LevelCounts]) -> Result<(), String> {
     let c = LevelCounts::total(level, counts);
-    let voxels: u128 = counts
-        .iter()
-        .map(|c| u128::from(c.full) << (k as u32 * (level - c.level)))
-        .sum();
+    let voxels = crate::memory::voxels(k, level, counts);
     outln!(
         "{}: K = {k}, L = {level}, {} nodes ({} full, {} empty, {} partial), {voxels} voxels",
         path.display(),

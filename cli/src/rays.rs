@@ -223,7 +223,7 @@ fn tree_summary<const K: usize>(out: &Path, level: u32, counts: &[LevelCounts]) 
     format!(
         "{}: K = {K}, L = {level}, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
         out.display(),
-        crate::memory::voxels::<K>(level, counts),
+        crate::memory::voxels(K, level, counts),
         c.nodes(),
         c.full,
         c.empty,

@@ -143,7 +143,7 @@ fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
         "{}: K = 3, L = {level}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
         a.out.display(),
         counted.runs(),
-        crate::memory::voxels::<3>(level, &report.counts_per_level),
+        crate::memory::voxels(3, level, &report.counts_per_level),
         c.nodes(),
         c.full,
         c.empty,

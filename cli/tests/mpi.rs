@@ -10,7 +10,7 @@ mod common;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use common::{data_dir, ktree, SmallDisk};
+use common::{data_dir, entries, ktree, SmallDisk};
 
 /// Runs `mpirun -n ranks ktree args…` (allowed as root, oversubscribed, traffic on this machine only).
 fn mpirun(ranks: usize, args: &[&str]) -> Output {
@@ -30,16 +30,6 @@ fn mpirun(ranks: usize, args: &[&str]) -> Output {
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .output()
         .expect("run mpirun (install openmpi-bin)")
-}
-
-/// The names in a folder (hidden spill folders included).
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 /// The largest budget named by "needs a budget of at least N bytes" in the ranks' messages.

@@ -7,7 +7,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{ktree, SmallDisk};
+use common::{entries, ktree, SmallDisk};
 use ktree::io::{read_rays_file, write_ktree_v2, AnyRaySet};
 use ktree::stacking::stack;
 
@@ -19,16 +19,6 @@ fn in_memory_bytes(rays: &Path) -> Vec<u8> {
         other => panic!("expected K = 3 rays, got K = {}", other.k()),
     }
     bytes
-}
-
-/// Everything in a folder, hidden entries included.
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 fn ball_rays(dir: &Path, level: u32) -> PathBuf {

@@ -54,12 +54,12 @@ const HEADER_BYTES: usize = 16;
 const ENTRY_BYTES: usize = 32;
 const TAIL_BYTES: usize = 16;
 /// Nodes in a word.
-const NODES_PER_WORD: u64 = 32;
+pub(crate) const NODES_PER_WORD: u64 = 32;
 /// Words between two rank samples.
 const WORDS_PER_SAMPLE: u64 = 64;
 /// Bytes scanned at a time when a file's sections are checked through the map.
 const WINDOW_BYTES: usize = 1 << 20;
-const LOW_BITS: u64 = 0x5555_5555_5555_5555;
+pub(crate) const LOW_BITS: u64 = 0x5555_5555_5555_5555;
 
 #[inline]
 fn partial_mask(word: u64) -> u64 {
@@ -73,7 +73,7 @@ fn full_mask(word: u64) -> u64 {
 
 /// The mask of the low `nodes` 2-bit slots of a word (`nodes ≤ 32`).
 #[inline]
-fn slots_mask(nodes: u64) -> u64 {
+pub(crate) fn slots_mask(nodes: u64) -> u64 {
     if nodes >= NODES_PER_WORD {
         u64::MAX
     } else {
@@ -167,15 +167,53 @@ pub struct KtreeWriter<W: Write> {
     buffer: Vec<u8>,
 }
 
+/// Nodes appended two bits each at any position, handed out as whole words: the shifted append of
+/// [`KtreeWriter`] and of the streamed Booleans' output levels.
+#[derive(Debug, Default, Clone, Copy)]
+pub(crate) struct WordPacker {
+    /// Nodes not yet forming a whole word, in the low bits.
+    pending: u64,
+    pending_nodes: u64,
+}
+
+impl WordPacker {
+    /// Appends the `take ≤ 32` nodes of `word` (low bits first); returns the word they complete, if any.
+    #[inline]
+    pub(crate) fn push(&mut self, word: u64, take: u64) -> Option<u64> {
+        let word = word & slots_mask(take);
+        let p = self.pending_nodes;
+        let joined = self.pending | word.checked_shl(2 * p as u32).unwrap_or(0);
+        if p + take >= NODES_PER_WORD {
+            // `p > 0` here unless the word is whole, so the shift below is less than 64.
+            self.pending = if p == 0 {
+                0
+            } else {
+                word >> (2 * (NODES_PER_WORD - p))
+            };
+            self.pending_nodes = p + take - NODES_PER_WORD;
+            Some(joined)
+        } else {
+            self.pending = joined;
+            self.pending_nodes = p + take;
+            None
+        }
+    }
+
+    /// The last, partly filled word (`None` if the nodes so far fill whole words), leaving the packer empty.
+    pub(crate) fn flush(&mut self) -> Option<u64> {
+        let last = (self.pending_nodes > 0).then_some(self.pending);
+        *self = Self::default();
+        last
+    }
+}
+
 /// The level being written.
 #[derive(Debug, Default)]
 struct LevelWriter {
     nodes: u64,
     full: u64,
     partial: u64,
-    /// Nodes not yet forming a whole word, in the low bits.
-    pending: u64,
-    pending_nodes: u64,
+    packer: WordPacker,
     words: u64,
     samples: Vec<u64>,
     hasher: crc32fast::Hasher,
@@ -245,21 +283,8 @@ impl<W: Write> KtreeWriter<W> {
                     self.finished.len()
                 )));
             }
-            let level = &mut self.current;
-            let p = level.pending_nodes;
-            let joined = level.pending | word.checked_shl(2 * p as u32).unwrap_or(0);
-            if p + take >= NODES_PER_WORD {
-                // `p > 0` here unless the word is whole, so the shift below is less than 64.
-                level.pending = if p == 0 {
-                    0
-                } else {
-                    word >> (2 * (NODES_PER_WORD - p))
-                };
-                level.pending_nodes = p + take - NODES_PER_WORD;
-                self.emit(joined)?;
-            } else {
-                level.pending = joined;
-                level.pending_nodes = p + take;
+            if let Some(whole) = self.current.packer.push(word, take) {
+                self.emit(whole)?;
             }
             remaining -= take;
         }
@@ -310,10 +335,7 @@ impl<W: Write> KtreeWriter<W> {
                 self.level
             )));
         }
-        if self.current.pending_nodes > 0 {
-            let word = self.current.pending;
-            self.current.pending = 0;
-            self.current.pending_nodes = 0;
+        if let Some(word) = self.current.packer.flush() {
             self.emit(word)?;
         }
         let samples = std::mem::take(&mut self.current.samples);

@@ -52,6 +52,7 @@ pub use ktree_v2::{
     ktree_file_version, write_ktree_v2, write_ktree_v2_file, KtreeView, KtreeWriter,
     VERSION as VERSION_2,
 };
+pub(crate) use ktree_v2::{slots_mask, WordPacker, LOW_BITS, NODES_PER_WORD};
 pub use mapped_tree::MappedTree;
 pub use octomap_bt::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
 pub use rays_source::{open_rays_file, AnyRaysFileSource, RaysFile, RaysFileSource};

@@ -39,14 +39,13 @@ use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
 use super::BoolOp;
-use crate::io::{KtreeFileError, KtreeView, KtreeWriter};
+use crate::io::{
+    slots_mask, KtreeFileError, KtreeView, KtreeWriter, WordPacker, LOW_BITS, NODES_PER_WORD,
+};
 use crate::tree::{LevelCounts, NodeState};
 
 /// Bytes of each I/O buffer (one per output level, one for the output).
 pub const BUFFER_BYTES: usize = 1 << 16;
-
-const LOW_BITS: u64 = 0x5555_5555_5555_5555;
-const NODES_PER_WORD: u64 = 32;
 
 /// Why a streamed Boolean failed. The target file is untouched and the spill files are removed.
 #[derive(Debug, thiserror::Error)]
@@ -402,9 +401,7 @@ struct OutputLevel {
     path: PathBuf,
     file: BufWriter<File>,
     nodes: u64,
-    /// Nodes not yet forming a whole word, in the low bits.
-    pending: u64,
-    pending_nodes: u64,
+    packer: WordPacker,
 }
 
 impl OutputLevels {
@@ -420,8 +417,7 @@ impl OutputLevels {
                     path,
                     file: BufWriter::with_capacity(BUFFER_BYTES, file),
                     nodes: 0,
-                    pending: 0,
-                    pending_nodes: 0,
+                    packer: WordPacker::default(),
                 })
             })
             .collect::<Result<_, BooleanFileError>>()?;
@@ -431,18 +427,8 @@ impl OutputLevels {
     /// Appends `nodes` (≤ 32) nodes packed in `word` to level `depth`.
     fn append(&mut self, depth: usize, word: u64, nodes: u64) -> Result<(), BooleanFileError> {
         let level = &mut self.levels[depth - 1];
-        let word = word & slots_mask(nodes);
-        let p = level.pending_nodes;
-        level.pending |= word.checked_shl(2 * p as u32).unwrap_or(0);
         level.nodes += nodes;
-        if p + nodes >= NODES_PER_WORD {
-            let whole = level.pending;
-            level.pending = if p == 0 {
-                0
-            } else {
-                word >> (2 * (NODES_PER_WORD - p))
-            };
-            level.pending_nodes = p + nodes - NODES_PER_WORD;
+        if let Some(whole) = level.packer.push(word, nodes) {
             level
                 .file
                 .write_all(&whole.to_le_bytes())
@@ -450,8 +436,6 @@ impl OutputLevels {
                     path: level.path.clone(),
                     source,
                 })?;
-        } else {
-            level.pending_nodes = p + nodes;
         }
         Ok(())
     }
@@ -504,8 +488,7 @@ impl OutputLevels {
         let mut spilled_bytes = 0;
         let mut readers = Vec::new();
         for mut l in self.levels {
-            if l.pending_nodes > 0 {
-                let word = l.pending;
+            if let Some(word) = l.packer.flush() {
                 l.file.write_all(&word.to_le_bytes()).map_err(|source| {
                     BooleanFileError::Spill {
                         path: l.path.clone(),
@@ -562,14 +545,5 @@ impl OutputLevels {
             counts_per_level: counts,
             spilled_bytes,
         })
-    }
-}
-
-/// The mask of the low `nodes` 2-bit slots of a word (`nodes ≤ 32`).
-fn slots_mask(nodes: u64) -> u64 {
-    if nodes >= NODES_PER_WORD {
-        u64::MAX
-    } else {
-        (1u64 << (2 * nodes)) - 1
     }
 }
