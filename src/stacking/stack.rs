@@ -138,12 +138,16 @@ fn stack_impl<const K: usize>(rays: &RaySet<K>, path: RowPath) -> (KTree<K>, Sta
     for d in 1..K {
         stacker.flush(d);
     }
+    // Destructured in full, so that the stages' lists are freed before the tree is assembled.
     let Stacker {
         cells,
         mut stats,
         scratch,
+        stages,
+        combined_buf,
         ..
     } = stacker;
+    drop((stages, combined_buf));
     stats.cells = cells.len();
     (cells.into_tree(universe, scratch), stats)
 }
