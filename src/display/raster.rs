@@ -362,6 +362,26 @@ fn shade(normal: [f64; 3], light: [f64; 3], base: [u8; 3]) -> [u8; 3] {
     base.map(|c| (f64::from(c) * k).round().clamp(0.0, 255.0) as u8)
 }
 
+/// The shaded colour of each of the six axis-aligned faces, computed once an image: a face is lit the same
+/// wherever it is seen, and a pixel's colour is then a lookup.
+struct FaceColours([[u8; 3]; 6]);
+
+impl FaceColours {
+    fn new(light: [f64; 3], base: [u8; 3]) -> Self {
+        Self(std::array::from_fn(|i| {
+            let mut normal = [0.0; 3];
+            normal[i / 2] = if i % 2 == 1 { -1.0 } else { 1.0 };
+            shade(normal, light, base)
+        }))
+    }
+
+    /// The colour of the face on `axis` that a ray along `dir` enters (the face looks against the ray).
+    #[inline]
+    fn entered(&self, axis: usize, dir: [f64; 3]) -> [u8; 3] {
+        self.0[2 * axis + usize::from(dir[axis] > 0.0)]
+    }
+}
+
 /// Looks up the surface normal of the voxel `v` seen through a face on `axis` from the rays' normals:
 /// the run's end normal for a face across the run, else the end normals interpolated along the run.
 fn ray_normal(rays: &RaySet<3>, v: [u32; 3], axis: usize, dir: [f64; 3]) -> Option<[f64; 3]> {
@@ -452,6 +472,7 @@ fn front_to_back<T: LevelOrder<3>>(
         .normals
         .filter(|r| r.has_normals() && r.level() == tree.level());
     let light = light_for(camera);
+    let faces = FaceColours::new(light, options.colour);
     let mut cov = Coverage::new(w, h);
     let mut stats = RenderStats::default();
     let total = cov.uncovered();
@@ -487,12 +508,7 @@ fn front_to_back<T: LevelOrder<3>>(
                 let Some((t, axis, o, d)) = screen.hit(x, y, lo, hi) else {
                     return false;
                 };
-                let face = {
-                    let mut n = [0.0; 3];
-                    n[axis] = if d[axis] > 0.0 { -1.0 } else { 1.0 };
-                    n
-                };
-                let normal = normals
+                let c = normals
                     .and_then(|rays| {
                         // The voxel of the cell just behind the hit point.
                         let p = v3::add_scaled(o, t, d);
@@ -511,8 +527,10 @@ fn front_to_back<T: LevelOrder<3>>(
                         }
                         ray_normal(rays, v, axis, d)
                     })
-                    .unwrap_or(face);
-                let c = shade(normal, light, options.colour);
+                    .map_or_else(
+                        || faces.entered(axis, d),
+                        |normal| shade(normal, light, options.colour),
+                    );
                 rgb[3 * (row + x as usize)..3 * (row + x as usize) + 3].copy_from_slice(&c);
                 if let Some(dep) = depth.as_mut() {
                     dep[row + x as usize] = t as f32;
@@ -570,7 +588,7 @@ pub fn render_back_to_front(
     let mut depth = options.depth.then(|| vec![f32::INFINITY; pixels]);
     let mut cells = options.cells.then(|| vec![None; pixels]);
     let mut hit_any = vec![false; pixels];
-    let light = light_for(camera);
+    let faces = FaceColours::new(light_for(camera), options.colour);
     let mut stats = RenderStats::default();
     walk_ordered(tree, viewer(camera), Order::BackToFront, |node| {
         stats.nodes_visited += 1;
@@ -587,9 +605,7 @@ pub fn render_back_to_front(
                 stats.pixel_tests += 1;
                 if let Some((t, axis, _, d)) = screen.hit(x, y, lo, hi) {
                     let i = y as usize * w as usize + x as usize;
-                    let mut n = [0.0; 3];
-                    n[axis] = if d[axis] > 0.0 { -1.0 } else { 1.0 };
-                    rgb[3 * i..3 * i + 3].copy_from_slice(&shade(n, light, options.colour));
+                    rgb[3 * i..3 * i + 3].copy_from_slice(&faces.entered(axis, d));
                     hit_any[i] = true;
                     if let Some(dep) = depth.as_mut() {
                         dep[i] = t as f32;

@@ -63,10 +63,16 @@ proptest! {
         for p in 0..(w * h) as usize {
             match (pc[p], rc[p]) {
                 (None, None) => {}
-                (Some(a), Some(b)) => prop_assert!(
-                    a == b || (pd[p] - rd[p]).abs() <= 1e-5 * rd[p].abs().max(1.0),
-                    "pixel {}: painter sees {:?} at {}, z-buffer {:?} at {}", p, a, pd[p], b, rd[p]
-                ),
+                (Some(a), Some(b)) => {
+                    prop_assert!(
+                        a == b || (pd[p] - rd[p]).abs() <= 1e-5 * rd[p].abs().max(1.0),
+                        "pixel {}: painter sees {:?} at {}, z-buffer {:?} at {}", p, a, pd[p], b, rd[p]
+                    );
+                    if a == b {
+                        // The same leaf through the same pixel: the same face, shaded alike.
+                        prop_assert_eq!(&painter.rgb[3 * p..3 * p + 3], &reference.rgb[3 * p..3 * p + 3]);
+                    }
+                }
                 (a, b) => prop_assert!(false, "pixel {}: painter {:?}, z-buffer {:?}", p, a, b),
             }
         }
