@@ -65,6 +65,17 @@ impl<const K: usize> Out<K> {
         }
     }
 
+    /// Appends the runs `range` of `set` as they are (with their normals, or zero normals if `set` has
+    /// none).
+    fn copy(&mut self, set: &RaySet<K>, range: std::ops::Range<usize>) {
+        self.columns
+            .extend_from_slice(&set.column_keys()[range.clone()]);
+        self.runs.extend_from_slice(&set.runs()[range.clone()]);
+        if let Some(ns) = self.normals.as_mut() {
+            ns.extend(range.map(|i| set.normals(i).unwrap_or([[0.0; K]; 2])));
+        }
+    }
+
     fn push(&mut self, key: u64, z1: u32, z2: u32, n: [Normal<K>; 2]) {
         self.columns.push(key);
         self.runs.push((z1, z2));
@@ -212,7 +223,18 @@ impl<const K: usize> RaySet<K> {
             };
             let i_end = i + ka[i..].iter().take_while(|&&k| k == key).count();
             let j_end = j + kb[j..].iter().take_while(|&&k| k == key).count();
-            merge_column(self, i..i_end, other, j..j_end, key, op, &mut out);
+            if j == j_end {
+                // A column of `self` only: its runs are kept whole or dropped whole.
+                if op.apply(true, false) {
+                    out.copy(self, i..i_end);
+                }
+            } else if i == i_end {
+                if op.apply(false, true) {
+                    out.copy(other, j..j_end);
+                }
+            } else {
+                merge_column(self, i..i_end, other, j..j_end, key, op, &mut out);
+            }
             i = i_end;
             j = j_end;
         }
@@ -286,6 +308,57 @@ fn merge_column<const K: usize>(
                 open = None;
             }
             _ => {}
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Ray;
+
+    /// Columns held by one operand only are copied whole; the copy equals what the run-end sweep gives,
+    /// normals included.
+    #[test]
+    fn one_sided_columns_copy_what_the_sweep_gives() {
+        let n = |x: f32| [x, 1.0 - x];
+        let a = RaySet::<2>::from_rays_with_normals(
+            4,
+            [
+                (Ray::new([1, 0], 3), [n(0.1), n(0.2)]),
+                (Ray::new([1, 5], 7), [n(0.3), n(0.4)]),
+                (Ray::new([2, 4], 5), [n(0.5), n(0.6)]),
+            ],
+        )
+        .unwrap();
+        let b = RaySet::<2>::from_rays_with_normals(
+            4,
+            [
+                (Ray::new([1, 2], 6), [n(0.7), n(0.8)]),
+                (Ray::new([3, 2], 6), [n(0.9), n(1.0)]),
+            ],
+        )
+        .unwrap();
+        for op in [Op::Union, Op::Intersection, Op::Difference] {
+            for (x, y) in [(&a, &b), (&b, &a)] {
+                let merged = x.merge(y, op).unwrap();
+                let mut swept = Out::<2>::new(true);
+                let (kx, ky) = (x.column_keys(), y.column_keys());
+                let mut keys: Vec<u64> = kx.iter().chain(ky).copied().collect();
+                keys.sort_unstable();
+                keys.dedup();
+                for key in keys {
+                    let rx = kx.partition_point(|&k| k < key)..kx.partition_point(|&k| k <= key);
+                    let ry = ky.partition_point(|&k| k < key)..ky.partition_point(|&k| k <= key);
+                    merge_column(x, rx, y, ry, key, op, &mut swept);
+                }
+                assert_eq!(merged.column_keys(), swept.columns, "{op:?}");
+                assert_eq!(merged.runs(), swept.runs, "{op:?}");
+                let normals: Vec<_> = (0..merged.len())
+                    .map(|i| merged.normals(i).unwrap())
+                    .collect();
+                assert_eq!(Some(normals), swept.normals, "{op:?}");
+            }
         }
     }
 }
