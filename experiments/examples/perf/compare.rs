@@ -1,8 +1,9 @@
 //! `perf compare BEFORE LABEL [ROUNDS]` (run by `experiments/compare.sh`): every case of the ops, display, build and solids reports, timed by
 //! this program and by `BEFORE` (the perf example built from an earlier commit, named `LABEL` in the
 //! report), alternating one run of each, `ROUNDS` times (default 5); the best of each side is kept. Both sides
-//! see the same machine at the same moments, so the ratio holds even where the load moves the times.
-//! Writes `results/performance/compare.md`.
+//! see the same machine at the same moments, so the ratio holds even where the load moves the times. How far
+//! each side's median lies above its best is the case's spread: a ratio above 1 by less than that is told
+//! apart from a real slowdown. Writes `results/performance/compare.md`.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -44,7 +45,11 @@ pub fn report(args: &[String]) -> Result<String, String> {
         return Err("usage: perf compare BEFORE_PERF_BINARY LABEL [ROUNDS]".into());
     };
     let rounds: usize = match rest.first() {
-        Some(r) => r.parse().map_err(|_| format!("bad ROUNDS '{r}'"))?,
+        Some(r) => r
+            .parse()
+            .ok()
+            .filter(|&n| n > 0)
+            .ok_or(format!("bad ROUNDS '{r}': a count of at least 1"))?,
         None => 5,
     };
     let before = Path::new(before);
@@ -60,42 +65,64 @@ pub fn report(args: &[String]) -> Result<String, String> {
         "Regenerate with `experiments/compare.sh {label} {rounds}`: it builds the perf example of commit \
          `{label}` and runs `perf compare` with it. Each case runs in a fresh process, \
          alternately from the earlier build and from this one, {rounds} times each; the table keeps the best \
-         time of each side. A ratio below 1 means this build is faster.\n\nMachine: {}. Load average (1, 5, \
-         15 min) when the comparison started: {}.\n",
+         time of each side. A ratio below 1 means this build is faster. The spread is how far the median of \
+         a side's {rounds} times lies above its best (the larger of the two sides): the run-to-run noise of \
+         the case on this machine.\n\nMachine: {}. Load average (1, 5, 15 min) when the comparison started: \
+         {}.\n",
         machine_line(),
         load.split_whitespace().take(3).collect::<Vec<_>>().join(", ")
     );
     let _ = writeln!(
         md,
-        "| area | case | {label} s | now s | now / {label} |\n|---|---|---:|---:|---:|"
+        "| area | case | {label} s | now s | now / {label} | spread |\n|---|---|---:|---:|---:|---:|"
     );
-    let mut slower = Vec::new();
+    let (mut slower, mut within_spread) = (Vec::new(), Vec::new());
     for (area, case) in cases() {
-        let (mut best_before, mut best_after) = (f64::INFINITY, f64::INFINITY);
+        let (mut times_before, mut times_after) = (Vec::new(), Vec::new());
         for _ in 0..rounds {
-            best_before = best_before.min(run_child_of(before, area, &case)?.seconds);
-            best_after = best_after.min(run_child_of(&after, area, &case)?.seconds);
+            times_before.push(run_child_of(before, area, &case)?.seconds);
+            times_after.push(run_child_of(&after, area, &case)?.seconds);
         }
+        let (best_before, spread_before) = best_and_spread(&mut times_before);
+        let (best_after, spread_after) = best_and_spread(&mut times_after);
+        let spread = spread_before.max(spread_after);
         let ratio = best_after / best_before;
-        if ratio > 1.0 {
-            slower.push(format!("{area} {case} ({ratio:.3})"));
+        if ratio > 1.0 + spread {
+            slower.push(format!("{area} {case} ({ratio:.3}, spread {spread:.3})"));
+        } else if ratio > 1.0 {
+            within_spread.push(format!("{area} {case} ({ratio:.3}, spread {spread:.3})"));
         }
         let _ = writeln!(
             md,
-            "| {area} | {case} | {best_before:.4} | {best_after:.4} | {ratio:.3} |"
+            "| {area} | {case} | {best_before:.4} | {best_after:.4} | {ratio:.3} | {spread:.3} |"
         );
-        eprintln!("{area} {case}: {best_before:.4} s -> {best_after:.4} s ({ratio:.3})");
+        eprintln!(
+            "{area} {case}: {best_before:.4} s -> {best_after:.4} s ({ratio:.3}, spread {spread:.3})"
+        );
     }
-    let _ = writeln!(
-        md,
-        "\nCases slower now than at `{label}`: {}.",
-        if slower.is_empty() {
+    let list = |cases: &[String]| {
+        if cases.is_empty() {
             "none".to_string()
         } else {
-            slower.join(", ")
+            cases.join(", ")
         }
+    };
+    let _ = writeln!(
+        md,
+        "\nCases slower now than at `{label}` by more than their spread: {}.\n\nCases slower by less than \
+         their spread (within this machine's noise): {}.",
+        list(&slower),
+        list(&within_spread)
     );
     let path = results_path("compare");
     ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
+}
+
+/// The best of `times` and how far their median lies above it, as a fraction of the best.
+fn best_and_spread(times: &mut [f64]) -> (f64, f64) {
+    times.sort_by(f64::total_cmp);
+    let best = times[0];
+    let median = times[times.len() / 2];
+    (best, median / best - 1.0)
 }
