@@ -247,6 +247,26 @@ fn a_box_of_many_leaves_is_nine_lines() {
 }
 
 #[test]
+fn a_diagonal_view_keeps_edges_behind_a_wall_hidden() {
+    // Seen along (1, −1, 0), the column's corner edge lines up with the outline shared by the wall's
+    // voxels around a surrounded one (the wall meets the crossing column there): nothing may show
+    // through that seam.
+    let dense = dense_of(
+        3,
+        &[
+            ([0, 2, 0], [6, 3, 7]),
+            ([4, 0, 0], [5, 4, 3]),
+            ([2, 3, 3], [3, 4, 7]),
+        ],
+    );
+    let tree = KTree::<3>::from_dense(3, &dense).unwrap();
+    for method in [HiddenLineMethod::Pairwise, HiddenLineMethod::Bucketed] {
+        let d = line_drawing(&tree, [1.0, -1.0, 0.0], method).unwrap();
+        check_drawing(&dense, &d).unwrap();
+    }
+}
+
+#[test]
 fn an_l_shape_shows_its_concave_edge() {
     // Two boxes forming an L: the concave crease between the lower slab's top and the tower's front.
     let dense = dense_of(3, &[([0, 0, 0], [4, 4, 2]), ([0, 2, 2], [4, 4, 4])]);
