@@ -502,8 +502,7 @@ impl Placed {
         for x in x0..=x1 {
             let (mut e, mut height) = (e_row, row);
             for y in tri.y.0..=tri.y.1 {
-                if covers(e[0], p[0], p[1]) && covers(e[1], p[1], p[2]) && covers(e[2], p[2], p[0])
-                {
+                if (0..3).all(|k| covers(e[k], edges[k].0, edges[k].1)) {
                     // Leaving: the first voxel whose centre is above the height; entering: the first
                     // voxel whose centre is at or above it.
                     let pos = if exit {
@@ -718,7 +717,6 @@ impl RaySource<3> for MeshSource {
     }
 }
 
-/// Twice the signed area of `(a, b, c)` projected on the xy-plane, exactly.
 /// `n = q·d + r` with `0 ≤ r < d` (`d > 0`), kept exact while `n` moves by steps: one division a
 /// triangle instead of one a crossing.
 #[derive(Debug, Clone, Copy)]
@@ -745,6 +743,7 @@ impl Quotient {
     }
 }
 
+/// Twice the signed area of `(a, b, c)` projected on the xy-plane, exactly.
 fn orient(a: [i64; 3], b: [i64; 3], c: [i64; 3]) -> i128 {
     i128::from(b[0] - a[0]) * i128::from(c[1] - a[1])
         - i128::from(b[1] - a[1]) * i128::from(c[0] - a[0])
