@@ -38,6 +38,7 @@
 #![deny(unsafe_code)]
 
 pub mod display;
+pub mod fs;
 pub mod io;
 pub mod ops;
 pub mod rays;
@@ -47,6 +48,6 @@ pub mod space;
 pub mod stacking;
 pub mod tree;
 
-pub use rays::{Ray, RaySet};
+pub use rays::{AnyRaySet, Ray, RaySet};
 pub use space::{max_level, Cell, Universe, MAX_K};
-pub use tree::{KTree, LevelCounts, NodeState, Octree, Quadtree};
+pub use tree::{AnyTree, KTree, LevelCounts, NodeState, Octree, Quadtree};

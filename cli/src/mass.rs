@@ -7,7 +7,7 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::{ktree_file_version, KtreeView, VERSION_2};
+use ktree::io::{ktree_file_version, KtreeView, VERSION};
 use ktree::ops;
 use ktree::KTree;
 use serde::Serialize;
@@ -98,7 +98,7 @@ pub fn run(args: Args) -> Result<(), String> {
         }
     }
     let mapped = args.tolerance.is_none()
-        && ktree_file_version(&args.tree).map_err(|e| e.to_string())? == VERSION_2;
+        && ktree_file_version(&args.tree).map_err(|e| e.to_string())? == VERSION;
     let r = if mapped {
         let view = KtreeView::open(&args.tree).map_err(|e| e.to_string())?;
         match view.k() {

@@ -6,7 +6,7 @@ use crate::outln;
 use std::path::PathBuf;
 
 use ktree::io::{
-    ktree_file_version, read_ktree_file, read_rays_file, KtreeView, TreeStats, VERSION_2,
+    ktree_file_version, read_ktree_file, read_rays_file, KtreeView, TreeStats, VERSION,
 };
 use ktree::tree::heap_bytes_for_levels;
 
@@ -47,7 +47,7 @@ fn view_stats(view: &KtreeView) -> TreeStats {
 pub fn run(args: Args) -> Result<(), String> {
     // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
     let stats = match (&args.tree, &args.rays) {
-        (Some(path), None) if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION_2 => {
+        (Some(path), None) if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION => {
             view_stats(&KtreeView::open(path).map_err(|e| e.to_string())?)
         }
         (Some(path), None) => read_ktree_file(path)

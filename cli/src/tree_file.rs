@@ -3,7 +3,8 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use ktree::io::{write_ktree_file, write_ktree_v2_file};
+use ktree::fs::write_atomic_with;
+use ktree::io::{write_ktree_file, write_ktree_v1};
 use ktree::KTree;
 
 static VERSION: OnceLock<u16> = OnceLock::new();
@@ -33,7 +34,7 @@ pub fn version() -> u16 {
 /// Any I/O error, naming the path.
 pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
     match version() {
-        1 => write_ktree_file(path, tree),
-        _ => write_ktree_v2_file(path, tree),
+        1 => write_atomic_with(path, |w| write_ktree_v1(w, tree)),
+        _ => write_ktree_file(path, tree),
     }
 }

@@ -50,7 +50,7 @@ fuzz_target!(|input: Input| {
         assert_eq!(read_ktree_any(&again, "rewritten").as_ref(), Ok(&read));
         check_views(&again, &read);
         let version = u16::from_le_bytes([input.file[6], input.file[7]]);
-        if version == ktree::io::VERSION_2 {
+        if version == ktree::io::VERSION {
             assert_eq!(
                 again, input.file,
                 "an accepted version 2 file is not what its tree writes"

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use arbitrary::Arbitrary;
 use ktree::io::{
-    read_ktree_any, read_rays, write_ktree, write_ktree_v2, write_rays, AnyRaySet, AnyTree,
+    read_ktree_any, read_rays, write_ktree_v1, write_ktree_v2, write_rays, AnyRaySet, AnyTree,
     KtreeFileError, KtreeView,
 };
 use ktree::solid::mesh::{Placement, TriangleMesh};
@@ -14,10 +14,10 @@ use ktree::{max_level, KTree, Universe};
 /// The largest level at which accepted inputs are voxelized or stacked (keeps one execution fast).
 pub const CHECK_LEVEL: u32 = 5;
 
-/// The `.ktree` bytes of a tree.
+/// The `.ktree` version 1 bytes of a tree.
 pub fn ktree_bytes(tree: &AnyTree) -> Vec<u8> {
     let mut bytes = Vec::new();
-    ktree::with_dim!(tree, AnyTree, t => write_ktree(&mut bytes, t)).expect("writing to memory");
+    ktree::with_dim!(tree, AnyTree, t => write_ktree_v1(&mut bytes, t)).expect("writing to memory");
     bytes
 }
 

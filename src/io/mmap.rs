@@ -32,7 +32,7 @@ impl FileMap {
         // * a file truncated underneath makes the kernel raise `SIGBUS` on the first access to a page past
         //   the new end, which terminates the process (it does not corrupt memory).
         // `.ktree` files are written to a temporary file and renamed over the target
-        // (`crate::io::write_atomic_with`), so ktree itself never changes a file that a reader has mapped: a
+        // (`crate::fs::write_atomic_with`), so ktree itself never changes a file that a reader has mapped: a
         // rename leaves the old inode, and the old bytes, in place for existing maps.
         let map = unsafe { options.map(file)? };
         Ok(Self { map })

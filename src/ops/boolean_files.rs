@@ -165,7 +165,7 @@ pub fn boolean_views(
         }
     }
     let depths = a.depth_count().max(b.map_or(0, KtreeView::depth_count));
-    let folder = crate::io::spill_folder(out, temp_dir)
+    let folder = crate::fs::spill_folder(out, temp_dir)
         .map_err(|(path, source)| BooleanFileError::TempDir { path, source })?;
     let mut levels = OutputLevels::create(folder.path(), depths)?;
     let mut inputs = [Input::new(a, depths), Input::new(b.unwrap_or(a), depths)];

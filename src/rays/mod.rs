@@ -12,12 +12,14 @@
 //! assert_eq!(rows, [(1, 1), (2, 2), (4, 2), (6, 1)]);
 //! ```
 
+mod any;
 mod ball;
 mod csg;
 mod rayset;
 mod rows;
 mod split;
 
+pub use any::AnyRaySet;
 pub use ball::ball_rays;
 pub use csg::CsgError;
 pub use rayset::{ColumnGroups, Normal, Ray, RayError, RaySet};

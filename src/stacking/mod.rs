@@ -17,6 +17,7 @@
 //! assert_eq!(tree.voxel_count(), ball.voxel_count());
 //! ```
 
+mod any;
 mod bitmap;
 mod out_of_core;
 mod partition;

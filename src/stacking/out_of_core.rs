@@ -953,7 +953,7 @@ fn open_spill<E>(
     temp_dir: Option<&Path>,
     t: usize,
 ) -> Result<Spill, OutOfCoreError<E>> {
-    let folder = crate::io::spill_folder(out, temp_dir)
+    let folder = crate::fs::spill_folder(out, temp_dir)
         .map_err(|(path, source)| OutOfCoreError::TempDir { path, source })?;
     let mut spill = Spill {
         dir: folder,

@@ -13,13 +13,17 @@
 //! assert_eq!(children.len(), 4);
 //! ```
 
+mod any;
 mod assemble;
 pub mod cursor;
 mod error;
 mod ktree;
 mod operators;
 mod states;
+mod to_rays;
 
+pub(crate) use any::from_typed;
+pub use any::{AnyTree, TreeStats};
 pub(crate) use assemble::{LevelWriter, TreeAssembler};
 pub use error::TreeError;
 pub use ktree::{

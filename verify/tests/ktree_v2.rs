@@ -7,8 +7,8 @@ use ktree_verify::cases;
 
 use cases::{ray_sets, Case};
 use ktree::io::{
-    read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_v2, write_ktree_v2_file,
-    KtreeFileErrorKind, KtreeView, KtreeWriter,
+    read_ktree, read_ktree_any, read_ktree_file, write_ktree_v1, write_ktree_v2,
+    write_ktree_v2_file, KtreeFileErrorKind, KtreeView, KtreeWriter,
 };
 use ktree::stacking::stack;
 use ktree::tree::PackedStates;
@@ -75,7 +75,7 @@ fn round_trips<const K: usize>(case: &Case<K>, cuts: &[usize]) -> Result<(), Tes
     prop_assert_eq!(pieces, bytes.clone(), "pieces joined differently");
     // Version 1 of the same tree still reads back.
     let mut v1 = Vec::new();
-    write_ktree(&mut v1, &tree).unwrap();
+    write_ktree_v1(&mut v1, &tree).unwrap();
     prop_assert!(read_ktree::<K>(&v1, "v1").unwrap() == tree);
     // A few truncations and a padding: errors naming an offset inside or at the end of the file.
     for &cut in cuts {

@@ -16,7 +16,7 @@ use std::path::Path;
 
 use thiserror::Error;
 
-use super::any::AnyRaySet;
+use crate::rays::AnyRaySet;
 use crate::rays::{Normal, Ray, RayError, RaySet};
 use crate::space::{max_level, MAX_K};
 use crate::stacking::RaySource;
@@ -265,7 +265,7 @@ fn write_ray_lines<const K: usize>(mut w: impl Write, rays: &RaySet<K>) -> std::
 /// # Errors
 /// Any I/O error, naming the path.
 pub fn write_rays_file<const K: usize>(path: &Path, rays: &RaySet<K>) -> std::io::Result<()> {
-    super::write_atomic_with(path, |w| write_rays(w, rays))
+    crate::fs::write_atomic_with(path, |w| write_rays(w, rays))
 }
 
 pub(super) struct NumberedLines<'a, R> {

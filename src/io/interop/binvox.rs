@@ -283,7 +283,7 @@ pub fn write_binvox(mut w: impl Write, tree: &KTree<3>, meta: &GridMeta) -> std:
         w,
         "#binvox 1\ndim {d} {d} {d}\ntranslate {tx} {ty} {tz}\nscale {scale}\ndata\n"
     )?;
-    let rays = super::tree_rays(tree);
+    let rays = tree.to_rays();
     let side = d as usize;
     let mut slab = vec![false; side * side]; // indexed z·D + y: the stream's order within a slab
     let mut enc = RunEncoder {

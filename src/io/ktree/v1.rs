@@ -1,5 +1,6 @@
 //! The `.ktree` file, version 1: a tree in level order at Meagher's 2 bits a node, in one checksummed body
-//! (version 2, with a section per level, is in `ktree_v2`; the readers here read both).
+//! (version 2, with a section per level, is in [`v2`](super::v2)). It is read everywhere and written only by
+//! [`write_ktree_v1`], for tests and tools that need old files.
 //!
 //! | offset | size | content |
 //! |---|---|---|
@@ -18,104 +19,23 @@
 //! them and with the file's length *before* allocating, the checksum, the totals, and the tree's invariants
 //! (reduced, no partial voxels). Any mismatch is an error naming the file and the byte offset.
 
-use std::fmt;
 use std::io::Write;
-use std::path::Path;
 
-use thiserror::Error;
-
-use super::any::AnyTree;
+use super::{KtreeFileError, KtreeFileErrorKind, MAGIC};
 use crate::space::{max_level, Universe, MAX_K};
-use crate::tree::{KTree, NodeState, PackedStates};
+use crate::tree::{AnyTree, KTree, NodeState, PackedStates};
 
-/// The magic bytes at the start of a `.ktree` file.
-pub const MAGIC: &[u8; 6] = b"KTREE\0";
-/// The format version of this layout (version 2 is [`crate::io::KtreeWriter`]'s).
-pub const VERSION: u16 = 1;
+/// The format version of this layout.
+pub(super) const VERSION: u16 = 1;
 
-/// What was wrong with a `.ktree` file.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
-#[non_exhaustive]
-pub enum KtreeFileErrorKind {
-    /// Not a `.ktree` file.
-    #[error("not a .ktree file (bad magic)")]
-    BadMagic,
-    /// Written by a newer version of ktree.
-    #[error("format version {0} is not supported (this ktree reads versions 1 and 2)")]
-    Version(u16),
-    /// `K` or `L` out of range.
-    #[error("bad header: {0}")]
-    Header(String),
-    /// The file ends early or has extra bytes.
-    #[error("file is {found} bytes but the header describes {expected}: truncated or padded")]
-    Length {
-        /// Bytes the header implies.
-        expected: u64,
-        /// Bytes present.
-        found: u64,
-    },
-    /// The checksum does not match: the file is corrupted.
-    #[error(
-        "checksum mismatch (stored {stored:08x}, computed {computed:08x}): the file is corrupted"
-    )]
-    Checksum {
-        /// Stored CRC.
-        stored: u32,
-        /// Computed CRC.
-        computed: u32,
-    },
-    /// The checksum of one level's section (version 2) does not match: the file is corrupted.
-    #[error("checksum mismatch in the section of level {level} (stored {stored:08x}, computed {computed:08x}): the file is corrupted")]
-    SectionChecksum {
-        /// The tree level whose section is corrupted.
-        level: usize,
-        /// Stored CRC.
-        stored: u32,
-        /// Computed CRC.
-        computed: u32,
-    },
-    /// The node states are inconsistent.
-    #[error("bad tree: {0}")]
-    Tree(String),
-    /// The tree has another dimension than the caller asked for.
-    #[error("the file holds a K = {found} tree, K = {expected} was expected")]
-    Dimension {
-        /// K asked for.
-        expected: usize,
-        /// K in the file.
-        found: usize,
-    },
-    /// The file could not be read.
-    #[error("cannot read: {0}")]
-    Io(String),
-}
-
-/// An error reading a `.ktree` file, with the file and the byte offset.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct KtreeFileError {
-    /// The file (or a name for the input).
-    pub file: String,
-    /// Byte offset where the problem was found.
-    pub offset: u64,
-    /// What was wrong.
-    pub kind: KtreeFileErrorKind,
-}
-
-impl fmt::Display for KtreeFileError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: byte {}: {}", self.file, self.offset, self.kind)
-    }
-}
-
-impl std::error::Error for KtreeFileError {}
-
-/// Writes a tree in the `.ktree` format.
+/// Writes a tree as a `.ktree` version 1 file: for tests and tools that need files in the old layout.
+/// [`write_ktree`](crate::io::write_ktree) writes the current version.
 ///
 /// ```
 /// use ktree::{io, KTree};
 /// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
 /// let mut bytes = Vec::new();
-/// io::write_ktree(&mut bytes, &tree).unwrap();
+/// io::write_ktree_v1(&mut bytes, &tree).unwrap();
 /// assert_eq!(io::read_ktree::<2>(&bytes, "mem").unwrap(), tree);
 /// bytes[20] ^= 1; // corrupt a byte
 /// assert!(io::read_ktree::<2>(&bytes, "mem").is_err());
@@ -123,7 +43,7 @@ impl std::error::Error for KtreeFileError {}
 ///
 /// # Errors
 /// Any I/O error.
-pub fn write_ktree<const K: usize>(mut w: impl Write, tree: &KTree<K>) -> std::io::Result<()> {
+pub fn write_ktree_v1<const K: usize>(mut w: impl Write, tree: &KTree<K>) -> std::io::Result<()> {
     let mut bytes = Vec::with_capacity(64 + tree.bytes_at_two_bits() as usize);
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&VERSION.to_le_bytes());
@@ -160,47 +80,9 @@ pub fn write_ktree<const K: usize>(mut w: impl Write, tree: &KTree<K>) -> std::i
     w.write_all(&bytes)
 }
 
-/// Writes a `.ktree` file atomically (temporary file, then rename).
-///
-/// # Errors
-/// Any I/O error, naming the path.
-pub fn write_ktree_file<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
-    super::write_atomic_with(path, |w| write_ktree(w, tree))
-}
-
-/// Reads a `.ktree` file's bytes, expecting dimension `K`.
-///
-/// # Errors
-/// [`KtreeFileError`] for any inconsistency, or [`KtreeFileErrorKind::Dimension`] if the file's `K` differs.
-pub fn read_ktree<const K: usize>(bytes: &[u8], file: &str) -> Result<KTree<K>, KtreeFileError> {
-    let any = read_ktree_any(bytes, file)?;
-    let found = any.k();
-    any.into_dim::<K>().map_err(|_| KtreeFileError {
-        file: file.to_string(),
-        offset: 8,
-        kind: KtreeFileErrorKind::Dimension { expected: K, found },
-    })
-}
-
-/// Reads a `.ktree` file from disk, of whatever dimension it holds.
-///
-/// # Errors
-/// As [`read_ktree_any`]; an unreadable file is [`KtreeFileErrorKind::Io`].
-pub fn read_ktree_file(path: &Path) -> Result<AnyTree, KtreeFileError> {
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| KtreeFileError {
-        file: name.clone(),
-        offset: 0,
-        kind: KtreeFileErrorKind::Io(e.to_string()),
-    })?;
-    read_ktree_any(&bytes, &name)
-}
-
-/// Reads a `.ktree` file's bytes (version 1 or 2), of whatever dimension they hold.
-///
-/// # Errors
-/// [`KtreeFileError`] naming the byte offset of the first inconsistency.
-pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileError> {
+/// Reads a version 1 file's bytes (called by [`read_ktree_any`](crate::io::read_ktree_any) once the magic
+/// and version are read).
+pub(super) fn read_v1_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileError> {
     let fail = |offset: usize, kind| KtreeFileError {
         file: file.to_string(),
         offset: offset as u64,
@@ -221,18 +103,8 @@ pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileErro
             .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")))
             .ok_or_else(|| truncated(at))
     };
-    if bytes.len() < 6 || &bytes[..6] != MAGIC {
-        return Err(fail(0, KtreeFileErrorKind::BadMagic));
-    }
     if bytes.len() < 16 {
         return Err(truncated(bytes.len()));
-    }
-    let version = u16::from_le_bytes([bytes[6], bytes[7]]);
-    if version == super::ktree_v2::VERSION {
-        return super::ktree_v2::read_v2_any(bytes, file);
-    }
-    if version != VERSION {
-        return Err(fail(6, KtreeFileErrorKind::Version(version)));
     }
     let k = bytes[8] as usize;
     if !(1..=MAX_K).contains(&k) {
@@ -360,33 +232,17 @@ fn assemble<const K: usize>(level: u32, levels: Vec<PackedStates>) -> KTree<K> {
     KTree::from_levels(Universe::new(level).expect("level checked"), levels)
 }
 
-impl AnyTree {
-    /// The tree as `KTree<K>`, or `self` back if it has another dimension.
-    ///
-    /// # Errors
-    /// `Err(self)` when the dimension differs.
-    pub fn into_dim<const K: usize>(self) -> Result<KTree<K>, Self> {
-        let boxed: Box<dyn std::any::Any> = match self {
-            AnyTree::K1(t) if K == 1 => Box::new(t),
-            AnyTree::K2(t) if K == 2 => Box::new(t),
-            AnyTree::K3(t) if K == 3 => Box::new(t),
-            AnyTree::K4(t) if K == 4 => Box::new(t),
-            other => return Err(other),
-        };
-        Ok(*boxed.downcast::<KTree<K>>().expect("K matched above"))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::read_ktree;
     use crate::rays::ball_rays;
     use crate::stacking::stack;
 
     fn sample() -> Vec<u8> {
         let tree = stack(&ball_rays::<3>(4, [10, 12, 14], 9).unwrap());
         let mut bytes = Vec::new();
-        write_ktree(&mut bytes, &tree).unwrap();
+        write_ktree_v1(&mut bytes, &tree).unwrap();
         bytes
     }
 

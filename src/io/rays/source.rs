@@ -28,9 +28,8 @@ use std::io::{BufReader, Seek, SeekFrom};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use super::any::AnyRaySet;
-use super::rays_text::{read_header, NumberedLines};
-use super::{read_rays_file, RaysTextError, RaysTextErrorKind};
+use super::text::{read_header, read_rays_file, NumberedLines, RaysTextError, RaysTextErrorKind};
+use crate::rays::AnyRaySet;
 use crate::rays::Ray;
 use crate::space::Universe;
 use crate::stacking::{RaySource, SlabRuns};

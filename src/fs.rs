@@ -1,3 +1,5 @@
+//! The file-system layer below everything that writes: atomic writes and spill folders.
+//!
 //! Writing output files atomically: into a temporary file in the same directory, then renamed over the
 //! target, so a crash or a full disk never leaves a half-written file where a good one was.
 //!
@@ -17,7 +19,7 @@ const TEMP_SUFFIX: &str = ".ktree-tmp";
 /// ```
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("sub/out.txt");
-/// ktree::io::write_atomic(&path, b"hello").unwrap();
+/// ktree::fs::write_atomic(&path, b"hello").unwrap();
 /// assert_eq!(std::fs::read(&path).unwrap(), b"hello");
 /// ```
 ///

@@ -1,13 +1,12 @@
-//! Trees and ray sets whose dimension is known only at run time (read from a file).
+//! Trees whose dimension is known only at run time (read from a file): [`AnyTree`].
 
-use crate::rays::RaySet;
 use crate::tree::{KTree, LevelCounts};
 
 /// The statistics of a tree: its dimension, level, node counts and size. With the `serde` feature these
 /// are the keys of `ktree stats --json`.
 ///
 /// ```
-/// use ktree::{io::AnyTree, KTree};
+/// use ktree::{AnyTree, KTree};
 /// let tree = AnyTree::from(KTree::<2>::from_dense(1, &[true, false, false, false]).unwrap());
 /// let s = tree.stats(None);
 /// assert_eq!((s.k, s.level, s.nodes, s.full, s.partial), (2, 1, 5, 1, 1));
@@ -51,34 +50,45 @@ pub enum AnyTree {
     K4(KTree<4>),
 }
 
-/// A [`RaySet`] of any supported dimension, as read from a ray file whose header names `K`.
-#[derive(Debug, Clone, PartialEq)]
-pub enum AnyRaySet {
-    /// Rays of a bintree universe.
-    K1(RaySet<1>),
-    /// Rays of a quadtree universe.
-    K2(RaySet<2>),
-    /// Rays of an octree universe.
-    K3(RaySet<3>),
-    /// Rays of a 4-D universe.
-    K4(RaySet<4>),
-}
-
-/// Runs an expression on the typed value inside an [`AnyTree`] or [`AnyRaySet`]:
+/// Runs an expression on the typed value inside an [`AnyTree`] or a [`RaySet`](crate::AnyRaySet):
 /// `with_dim!(any, AnyTree, t => t.node_count())`. The expression is compiled once per `K`.
 #[macro_export]
 macro_rules! with_dim {
-    ($value:expr, $kind:ident, $name:ident => $body:expr) => {
+    ($value:expr, AnyTree, $name:ident => $body:expr) => {
+        $crate::with_dim!(@match $value, $crate::tree::AnyTree, $name => $body)
+    };
+    ($value:expr, AnyRaySet, $name:ident => $body:expr) => {
+        $crate::with_dim!(@match $value, $crate::rays::AnyRaySet, $name => $body)
+    };
+    ($value:expr, AnyRaysFileSource, $name:ident => $body:expr) => {
+        $crate::with_dim!(@match $value, $crate::io::AnyRaysFileSource, $name => $body)
+    };
+    (@match $value:expr, $($kind:ident)::+, $name:ident => $body:expr) => {
         match $value {
-            $crate::io::$kind::K1($name) => $body,
-            $crate::io::$kind::K2($name) => $body,
-            $crate::io::$kind::K3($name) => $body,
-            $crate::io::$kind::K4($name) => $body,
+            $($kind)::+::K1($name) => $body,
+            $($kind)::+::K2($name) => $body,
+            $($kind)::+::K3($name) => $body,
+            $($kind)::+::K4($name) => $body,
         }
     };
 }
 
 impl AnyTree {
+    /// The tree as `KTree<K>`, or `self` back if it has another dimension.
+    ///
+    /// # Errors
+    /// `Err(self)` when the dimension differs.
+    pub fn into_dim<const K: usize>(self) -> Result<KTree<K>, Self> {
+        let boxed: Box<dyn std::any::Any> = match self {
+            AnyTree::K1(t) if K == 1 => Box::new(t),
+            AnyTree::K2(t) if K == 2 => Box::new(t),
+            AnyTree::K3(t) if K == 3 => Box::new(t),
+            AnyTree::K4(t) if K == 4 => Box::new(t),
+            other => return Err(other),
+        };
+        Ok(*boxed.downcast::<KTree<K>>().expect("K matched above"))
+    }
+
     /// The dimension `K`.
     pub fn k(&self) -> usize {
         match self {
@@ -132,43 +142,6 @@ impl AnyTree {
     }
 }
 
-impl AnyRaySet {
-    /// The dimension `K`.
-    pub fn k(&self) -> usize {
-        match self {
-            Self::K1(_) => 1,
-            Self::K2(_) => 2,
-            Self::K3(_) => 3,
-            Self::K4(_) => 4,
-        }
-    }
-
-    /// The universe level `L`.
-    pub fn level(&self) -> u32 {
-        with_dim!(self, AnyRaySet, r => r.level())
-    }
-
-    /// The number of runs.
-    pub fn len(&self) -> usize {
-        with_dim!(self, AnyRaySet, r => r.len())
-    }
-
-    /// Whether there is no run.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Builds the tree by stacking.
-    pub fn stack(&self) -> AnyTree {
-        match self {
-            Self::K1(r) => AnyTree::K1(crate::stacking::stack(r)),
-            Self::K2(r) => AnyTree::K2(crate::stacking::stack(r)),
-            Self::K3(r) => AnyTree::K3(crate::stacking::stack(r)),
-            Self::K4(r) => AnyTree::K4(crate::stacking::stack(r)),
-        }
-    }
-}
-
 /// `From<$typed<K>>` for an enum of the four dimensions, by downcasting to the one `K` that matches.
 macro_rules! from_typed {
     ($typed:ident, $any:ident) => {
@@ -196,5 +169,6 @@ macro_rules! from_typed {
     };
 }
 
+pub(crate) use from_typed;
+
 from_typed!(KTree, AnyTree);
-from_typed!(RaySet, AnyRaySet);

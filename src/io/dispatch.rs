@@ -9,10 +9,16 @@ use std::path::Path;
 
 use thiserror::Error;
 
-use super::grid::{GridFileError, GridMeta, GridPlacement, PlacedTree};
-use super::{AnyTree, KtreeFileError, RaysTextError};
+use super::interop::{
+    read_binvox, read_bt, read_vdb, write_binvox, write_bt, write_vdb, GridFileError,
+    GridFileErrorKind, GridMeta, GridPlacement, PlacedTree,
+};
+use super::ktree::{read_ktree_file, write_ktree_file, KtreeFileError};
+use super::rays::{read_rays_file, write_rays_file, RaysTextError};
+use crate::fs::write_atomic_with;
 use crate::rays::RaySet;
 use crate::solid::SolidError;
+use crate::tree::AnyTree;
 
 /// A file format known to [`read_tree`] and [`write_tree`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -195,27 +201,26 @@ pub fn read_tree_placed(path: &Path, options: &ReadOptions) -> Result<ReadTree, 
         remarks: Vec::new(),
     };
     let bytes = || {
-        std::fs::read(path).map_err(|e| {
-            GridFileError::new(&name, 0, super::grid::GridFileErrorKind::Io(e.to_string()))
-        })
+        std::fs::read(path)
+            .map_err(|e| GridFileError::new(&name, 0, GridFileErrorKind::Io(e.to_string())))
     };
     match format_of(path)? {
-        Format::Ktree => Ok(plain(super::read_ktree_file(path)?)),
-        Format::Rays => Ok(plain(super::read_rays_file(path)?.stack())),
-        Format::Binvox => Ok(grid(super::read_binvox(
+        Format::Ktree => Ok(plain(read_ktree_file(path)?)),
+        Format::Rays => Ok(plain(read_rays_file(path)?.stack())),
+        Format::Binvox => Ok(grid(read_binvox(
             &bytes()?,
             &name,
             options.offset,
             options.level,
         )?)),
-        Format::OctomapBt => Ok(grid(super::read_bt(
+        Format::OctomapBt => Ok(grid(read_bt(
             &bytes()?,
             &name,
             options.offset,
             options.level,
             options.unknown_full,
         )?)),
-        Format::Vdb => Ok(grid(super::read_vdb(
+        Format::Vdb => Ok(grid(read_vdb(
             &bytes()?,
             &name,
             options.offset,
@@ -496,7 +501,7 @@ fn voxelize_volume(path: &Path, _: &ReadOptions) -> Result<Voxelized, IoError> {
     Err(usage(path, "volumes are read with the `volume` feature"))
 }
 
-/// Writes a tree to a file of the format its extension names, atomically ([`super::write_atomic`]).
+/// Writes a tree to a file of the format its extension names, atomically ([`crate::fs::write_atomic`]).
 ///
 /// # Errors
 /// [`IoError::Usage`] for an input-only format or a tree the format cannot hold (binvox, `.bt` and `.vdb`
@@ -515,15 +520,14 @@ pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result
         )),
     };
     let write = |fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
-        super::write_atomic_with(path, |w| fill(w)).map_err(IoError::Write)
+        write_atomic_with(path, |w| fill(w)).map_err(IoError::Write)
     };
     match format {
-        Format::Ktree => crate::with_dim!(tree, AnyTree, t => super::write_ktree_v2_file(path, t))
-            .map_err(IoError::Write),
-        Format::Rays => {
-            crate::with_dim!(tree, AnyTree, t => super::write_rays_file(path, &super::tree_rays(t)))
-                .map_err(IoError::Write)
+        Format::Ktree => {
+            crate::with_dim!(tree, AnyTree, t => write_ktree_file(path, t)).map_err(IoError::Write)
         }
+        Format::Rays => crate::with_dim!(tree, AnyTree, t => write_rays_file(path, &t.to_rays()))
+            .map_err(IoError::Write),
         Format::Binvox => {
             let t = octree()?;
             if options.offset != [0; 3] {
@@ -532,15 +536,15 @@ pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result
                     "binvox grids start at index 0: write with offset 0",
                 ));
             }
-            write(&|w| super::write_binvox(w, t, &meta))
+            write(&|w| write_binvox(w, t, &meta))
         }
         Format::OctomapBt => {
             let t = octree()?;
-            write(&|w| super::write_bt(w, t, options.offset, meta.voxel_size))
+            write(&|w| write_bt(w, t, options.offset, meta.voxel_size))
         }
         Format::Vdb => {
             let t = octree()?;
-            write(&|w| super::write_vdb(w, t, options.offset, &meta))
+            write(&|w| write_vdb(w, t, options.offset, &meta))
         }
         Format::Mesh | Format::Volume => Err(usage(
             path,

@@ -1,8 +1,8 @@
 //! A `.ktree` version 2 file read as a tree in place: the walks of [`cursor`](crate::tree::cursor) (and so
 //! rendering) run on its memory map, for trees larger than memory.
 
-use super::ktree_v2::KtreeView;
-use super::KtreeFileError;
+use super::KtreeView;
+use crate::io::KtreeFileError;
 use crate::space::Universe;
 use crate::tree::cursor::LevelOrder;
 use crate::tree::NodeState;
@@ -33,7 +33,7 @@ impl<'a, const K: usize> MappedTree<'a, K> {
     /// The tree of `view`.
     ///
     /// # Errors
-    /// [`KtreeFileErrorKind::Dimension`](super::KtreeFileErrorKind::Dimension) if the file's `K` is not `K`.
+    /// [`KtreeFileErrorKind::Dimension`](crate::io::KtreeFileErrorKind::Dimension) if the file's `K` is not `K`.
     pub fn new(view: &'a KtreeView) -> Result<Self, KtreeFileError> {
         Ok(Self {
             view,

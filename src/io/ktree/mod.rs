@@ -1,0 +1,213 @@
+//! The `.ktree` file: a tree in level order at Meagher's 2 bits a node (`00` empty, `01` full, `10` partial),
+//! checksummed. Two versions exist and both are read everywhere ([`read_ktree`], [`read_ktree_any`],
+//! [`read_ktree_file`]); only the current one, [`VERSION`] = 2, is written ([`write_ktree`]):
+//!
+//! * [`v2`]: one word-aligned section per level with rank samples, written as a stream ([`KtreeWriter`]) and
+//!   read in place through a memory map ([`KtreeView`], [`MappedTree`]), for trees larger than memory;
+//! * [`v1`]: one body for the whole tree, read into memory; written only by [`v1::write_ktree_v1`].
+//!
+//! ```
+//! use ktree::{io, KTree};
+//! let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
+//! let mut bytes = Vec::new();
+//! io::write_ktree(&mut bytes, &tree).unwrap();
+//! assert_eq!(u16::from_le_bytes([bytes[6], bytes[7]]), io::VERSION);
+//! assert_eq!(io::read_ktree::<2>(&bytes, "mem").unwrap(), tree);
+//! bytes[20] ^= 1; // corrupt a byte
+//! assert!(io::read_ktree::<2>(&bytes, "mem").is_err());
+//! ```
+
+use std::fmt;
+use std::fs::File;
+use std::io::Write;
+use std::path::Path;
+
+use thiserror::Error;
+
+use crate::tree::{AnyTree, KTree};
+
+pub mod v1;
+pub mod v2;
+
+pub use v2::{KtreeView, KtreeWriter, MappedTree};
+
+/// The format version [`write_ktree`] writes.
+pub const VERSION: u16 = v2::VERSION;
+
+/// The magic bytes at the start of a `.ktree` file.
+pub const MAGIC: &[u8; 6] = b"KTREE\0";
+
+/// What was wrong with a `.ktree` file.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum KtreeFileErrorKind {
+    /// Not a `.ktree` file.
+    #[error("not a .ktree file (bad magic)")]
+    BadMagic,
+    /// Written by a newer version of ktree.
+    #[error("format version {0} is not supported (this ktree reads versions 1 and 2)")]
+    Version(u16),
+    /// `K` or `L` out of range.
+    #[error("bad header: {0}")]
+    Header(String),
+    /// The file ends early or has extra bytes.
+    #[error("file is {found} bytes but the header describes {expected}: truncated or padded")]
+    Length {
+        /// Bytes the header implies.
+        expected: u64,
+        /// Bytes present.
+        found: u64,
+    },
+    /// The checksum does not match: the file is corrupted.
+    #[error(
+        "checksum mismatch (stored {stored:08x}, computed {computed:08x}): the file is corrupted"
+    )]
+    Checksum {
+        /// Stored CRC.
+        stored: u32,
+        /// Computed CRC.
+        computed: u32,
+    },
+    /// The checksum of one level's section (version 2) does not match: the file is corrupted.
+    #[error("checksum mismatch in the section of level {level} (stored {stored:08x}, computed {computed:08x}): the file is corrupted")]
+    SectionChecksum {
+        /// The tree level whose section is corrupted.
+        level: usize,
+        /// Stored CRC.
+        stored: u32,
+        /// Computed CRC.
+        computed: u32,
+    },
+    /// The node states are inconsistent.
+    #[error("bad tree: {0}")]
+    Tree(String),
+    /// The tree has another dimension than the caller asked for.
+    #[error("the file holds a K = {found} tree, K = {expected} was expected")]
+    Dimension {
+        /// K asked for.
+        expected: usize,
+        /// K in the file.
+        found: usize,
+    },
+    /// The file could not be read.
+    #[error("cannot read: {0}")]
+    Io(String),
+}
+
+/// An error reading a `.ktree` file, with the file and the byte offset.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct KtreeFileError {
+    /// The file (or a name for the input).
+    pub file: String,
+    /// Byte offset where the problem was found.
+    pub offset: u64,
+    /// What was wrong.
+    pub kind: KtreeFileErrorKind,
+}
+
+impl fmt::Display for KtreeFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: byte {}: {}", self.file, self.offset, self.kind)
+    }
+}
+
+impl std::error::Error for KtreeFileError {}
+
+/// Writes a tree as a `.ktree` file of the current version ([`VERSION`]).
+///
+/// # Errors
+/// Any I/O error.
+pub fn write_ktree<const K: usize>(out: impl Write, tree: &KTree<K>) -> std::io::Result<()> {
+    v2::write_ktree_v2(out, tree)
+}
+
+/// Writes a `.ktree` file of the current version atomically (temporary file, then rename).
+///
+/// # Errors
+/// Any I/O error, naming the path.
+pub fn write_ktree_file<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
+    crate::fs::write_atomic_with(path, |w| write_ktree(w, tree))
+}
+
+/// Reads a `.ktree` file's bytes (either version), expecting dimension `K`.
+///
+/// # Errors
+/// [`KtreeFileError`] for any inconsistency, or [`KtreeFileErrorKind::Dimension`] if the file's `K` differs.
+pub fn read_ktree<const K: usize>(bytes: &[u8], file: &str) -> Result<KTree<K>, KtreeFileError> {
+    let any = read_ktree_any(bytes, file)?;
+    let found = any.k();
+    any.into_dim::<K>().map_err(|_| KtreeFileError {
+        file: file.to_string(),
+        offset: 8,
+        kind: KtreeFileErrorKind::Dimension { expected: K, found },
+    })
+}
+
+/// Reads a `.ktree` file from disk (either version), of whatever dimension it holds.
+///
+/// # Errors
+/// As [`read_ktree_any`]; an unreadable file is [`KtreeFileErrorKind::Io`].
+pub fn read_ktree_file(path: &Path) -> Result<AnyTree, KtreeFileError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| KtreeFileError {
+        file: name.clone(),
+        offset: 0,
+        kind: KtreeFileErrorKind::Io(e.to_string()),
+    })?;
+    read_ktree_any(&bytes, &name)
+}
+
+/// Reads a `.ktree` file's bytes (version 1 or 2), of whatever dimension they hold.
+///
+/// # Errors
+/// [`KtreeFileError`] naming the byte offset of the first inconsistency.
+pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileError> {
+    let fail = |offset: u64, kind| KtreeFileError {
+        file: file.to_string(),
+        offset,
+        kind,
+    };
+    if bytes.len() < 6 || &bytes[..6] != MAGIC {
+        return Err(fail(0, KtreeFileErrorKind::BadMagic));
+    }
+    if bytes.len() < 8 {
+        return Err(fail(
+            bytes.len() as u64,
+            KtreeFileErrorKind::Length {
+                expected: 16,
+                found: bytes.len() as u64,
+            },
+        ));
+    }
+    match u16::from_le_bytes([bytes[6], bytes[7]]) {
+        v1::VERSION => v1::read_v1_any(bytes, file),
+        v2::VERSION => v2::read_v2_any(bytes, file),
+        other => Err(fail(6, KtreeFileErrorKind::Version(other))),
+    }
+}
+
+/// The format version of a `.ktree` file (1 or 2), from its first 8 bytes.
+///
+/// # Errors
+/// [`KtreeFileErrorKind::BadMagic`] for another file; [`KtreeFileErrorKind::Io`] if it cannot be read.
+pub fn ktree_file_version(path: &Path) -> Result<u16, KtreeFileError> {
+    let name = path.display().to_string();
+    let head = File::open(path)
+        .and_then(|f| {
+            let len = f.metadata()?.len().min(8) as usize;
+            v2::read_at(&f, 0, len)
+        })
+        .map_err(|e| KtreeFileError {
+            file: name.clone(),
+            offset: 0,
+            kind: KtreeFileErrorKind::Io(e.to_string()),
+        })?;
+    if head.len() < 8 || &head[..6] != MAGIC {
+        return Err(KtreeFileError {
+            file: name,
+            offset: 0,
+            kind: KtreeFileErrorKind::BadMagic,
+        });
+    }
+    Ok(u16::from_le_bytes([head[6], head[7]]))
+}

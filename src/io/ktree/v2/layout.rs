@@ -1,0 +1,311 @@
+//! The `.ktree` file, version 2: one word-aligned, checksummed section per tree level, written as a stream
+//! and read by memory-mapping.
+//!
+//! All integers are little-endian; every section starts at a multiple of 8 bytes.
+//!
+//! | offset | size | content |
+//! |---|---|---|
+//! | 0 | 6 | magic `KTREE\0` |
+//! | 6 | 2 | format version, `u16` (= 2) |
+//! | 8 | 1 | `K` (1…4) |
+//! | 9 | 1 | `L` (0…[`crate::max_level`]`(K)`) |
+//! | 10 | 6 | reserved, 0 |
+//! | 16 | 8·(W₀ + R₀) | section 0 (the root level) |
+//! | … | 8·(W_d + R_d) | section `d`, right after section `d − 1` |
+//! | S | 32·D | directory: per level `d`, nodes `n_d`, full nodes, partial nodes (`u64` each), CRC-32 of section `d` (`u32`), reserved `u32` = 0 |
+//! | S + 32·D | 8 | the file's length in bytes (`u64`) |
+//! | S + 32·D + 8 | 4 | `D`, the number of levels (`u32`) |
+//! | S + 32·D + 12 | 4 | CRC-32 of the header (bytes 0…15) and of everything from S up to here |
+//!
+//! Section `d` holds `W_d = ⌈n_d / 32⌉` words of node states — node `i` of the level in bits `2·(i mod 32)`
+//! of word `i / 32`, `00` empty, `01` full, `10` partial, unused bits 0 (the in-memory layout of
+//! [`PackedStates`]) — followed by `R_d = ⌈W_d / 64⌉` rank samples: sample `b` is the number of partial
+//! nodes in words `0 … 64·b − 1`. With them the first child of a node (`2^K` × the partial nodes before
+//! it) is found from the map by at most 64 word pop-counts, without an index in memory. The section's CRC
+//! covers its words and samples.
+//!
+//! The directory is at the end so that the file can be written in one pass, level after level, by a
+//! builder that never holds the whole tree ([`KtreeWriter`]). A reader finds it from the last 16 bytes.
+//!
+//! # Checks
+//! Opening a file ([`KtreeView::open`], [`read_ktree_any`](crate::io::read_ktree_any)) checks, before
+//! allocating or mapping anything proportional to the sizes it reads: the magic, version, K, L and reserved
+//! bytes; that the length recorded at the end is the file's length (a truncated or padded file fails here,
+//! with the offset); the directory's checksum; that the sections exactly fill the space between header and
+//! directory; and the tree's shape (one root, `n_{d+1} = 2^K · partial_d`, no partial node at the last
+//! level). Then every section is scanned in bounded windows: its checksum (a mismatch names the level and
+//! the section's byte offset), the unused code `11`, zero padding, the rank samples, the full and partial
+//! counts of the directory, and that the tree is reduced (no `2^K` siblings all full or all empty).
+
+use super::super::{KtreeFileError, KtreeFileErrorKind, MAGIC};
+use crate::space::{max_level, MAX_K};
+use crate::tree::LevelCounts;
+
+/// The format version of this layout.
+pub const VERSION: u16 = 2;
+
+pub(crate) const HEADER_BYTES: usize = 16;
+pub(crate) const ENTRY_BYTES: usize = 32;
+pub(crate) const TAIL_BYTES: usize = 16;
+/// Nodes in a word.
+pub(crate) const NODES_PER_WORD: u64 = 32;
+/// Words between two rank samples.
+pub(crate) const WORDS_PER_SAMPLE: u64 = 64;
+/// Bytes scanned at a time when a file's sections are checked through the map.
+pub(crate) const WINDOW_BYTES: usize = 1 << 20;
+pub(crate) const LOW_BITS: u64 = 0x5555_5555_5555_5555;
+
+#[inline]
+pub(crate) fn partial_mask(word: u64) -> u64 {
+    (word >> 1) & !word & LOW_BITS
+}
+
+#[inline]
+pub(crate) fn full_mask(word: u64) -> u64 {
+    word & !(word >> 1) & LOW_BITS
+}
+
+/// The mask of the low `nodes` 2-bit slots of a word (`nodes ≤ 32`).
+#[inline]
+pub(crate) fn slots_mask(nodes: u64) -> u64 {
+    if nodes >= NODES_PER_WORD {
+        u64::MAX
+    } else {
+        (1u64 << (2 * nodes)) - 1
+    }
+}
+
+pub(crate) fn words_of(nodes: u64) -> u64 {
+    nodes.div_ceil(NODES_PER_WORD)
+}
+
+pub(crate) fn samples_of(words: u64) -> u64 {
+    words.div_ceil(WORDS_PER_SAMPLE)
+}
+
+pub(crate) fn invalid(message: String) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidInput, message)
+}
+
+pub(crate) fn header_bytes(k: usize, level: u32) -> [u8; HEADER_BYTES] {
+    let mut h = [0u8; HEADER_BYTES];
+    h[..6].copy_from_slice(MAGIC);
+    h[6..8].copy_from_slice(&VERSION.to_le_bytes());
+    h[8] = k as u8;
+    h[9] = level as u8;
+    h
+}
+
+/// One level's directory entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Section {
+    /// Byte offset of the section's first word.
+    pub(crate) offset: u64,
+    pub(crate) nodes: u64,
+    pub(crate) full: u64,
+    pub(crate) partial: u64,
+    pub(crate) crc: u32,
+}
+
+impl Section {
+    pub(crate) fn words(&self) -> u64 {
+        words_of(self.nodes)
+    }
+
+    pub(crate) fn samples_offset(&self) -> u64 {
+        self.offset + 8 * self.words()
+    }
+
+    pub(crate) fn bytes(&self) -> u64 {
+        8 * (self.words() + samples_of(self.words()))
+    }
+}
+
+/// The shape of a version 2 file: its header and directory, checked.
+#[derive(Debug, Clone)]
+pub(crate) struct Layout {
+    pub(crate) k: usize,
+    pub(crate) level: u32,
+    pub(crate) sections: Vec<Section>,
+}
+
+pub(crate) fn u64_at(bytes: &[u8], at: usize) -> u64 {
+    u64::from_le_bytes(bytes[at..at + 8].try_into().expect("8 bytes"))
+}
+
+pub(crate) fn u32_at(bytes: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"))
+}
+
+impl Layout {
+    /// Reads and checks the header and directory. `head` is the file's first 16 bytes, `len` its length,
+    /// and `tail(n)` returns its last `n` bytes (`n ≤ len`).
+    pub(crate) fn parse(
+        file: &str,
+        head: &[u8],
+        len: u64,
+        mut tail: impl FnMut(usize) -> Result<Vec<u8>, KtreeFileError>,
+    ) -> Result<Self, KtreeFileError> {
+        let fail = |offset: u64, kind| KtreeFileError {
+            file: file.to_string(),
+            offset,
+            kind,
+        };
+        let header_error =
+            |offset: u64, message: String| fail(offset, KtreeFileErrorKind::Header(message));
+        if head.len() < 6 || &head[..6] != MAGIC {
+            return Err(fail(0, KtreeFileErrorKind::BadMagic));
+        }
+        let minimum = (HEADER_BYTES + ENTRY_BYTES + TAIL_BYTES) as u64;
+        if len < minimum || head.len() < HEADER_BYTES {
+            return Err(fail(
+                len,
+                KtreeFileErrorKind::Length {
+                    expected: minimum,
+                    found: len,
+                },
+            ));
+        }
+        let version = u16::from_le_bytes([head[6], head[7]]);
+        if version != VERSION {
+            return Err(fail(6, KtreeFileErrorKind::Version(version)));
+        }
+        let k = head[8] as usize;
+        if !(1..=MAX_K).contains(&k) {
+            return Err(header_error(8, format!("K = {k} is not 1 to {MAX_K}")));
+        }
+        let level = u32::from(head[9]);
+        if level > max_level(k) {
+            return Err(header_error(
+                9,
+                format!("L = {level} exceeds {} for K = {k}", max_level(k)),
+            ));
+        }
+        if head[10..16].iter().any(|&b| b != 0) {
+            return Err(header_error(10, "reserved bytes are not 0".into()));
+        }
+        let end = tail(TAIL_BYTES)?;
+        let tail_at = len - TAIL_BYTES as u64;
+        let recorded = u64_at(&end, 0);
+        if recorded != len {
+            return Err(fail(
+                len.min(recorded),
+                KtreeFileErrorKind::Length {
+                    expected: recorded,
+                    found: len,
+                },
+            ));
+        }
+        let depth = u32_at(&end, 8) as u64;
+        let directory_bytes = depth * ENTRY_BYTES as u64;
+        if depth == 0
+            || depth > u64::from(level) + 1
+            || directory_bytes + minimum - ENTRY_BYTES as u64 > len
+        {
+            return Err(header_error(
+                tail_at + 8,
+                format!(
+                    "{depth} levels recorded for a level-{level} universe in a {len}-byte file"
+                ),
+            ));
+        }
+        let directory_at = tail_at - directory_bytes;
+        let directory = tail(directory_bytes as usize + TAIL_BYTES)?;
+        let stored = u32_at(&directory, directory.len() - 4);
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(&head[..HEADER_BYTES]);
+        hasher.update(&directory[..directory.len() - 4]);
+        let computed = hasher.finalize();
+        if stored != computed {
+            return Err(fail(
+                len - 4,
+                KtreeFileErrorKind::Checksum { stored, computed },
+            ));
+        }
+        let mut sections = Vec::with_capacity(depth as usize);
+        let mut offset = HEADER_BYTES as u64;
+        for d in 0..depth as usize {
+            let e = &directory[d * ENTRY_BYTES..(d + 1) * ENTRY_BYTES];
+            let entry_at = directory_at + (d * ENTRY_BYTES) as u64;
+            let section = Section {
+                offset,
+                nodes: u64_at(e, 0),
+                full: u64_at(e, 8),
+                partial: u64_at(e, 16),
+                crc: u32_at(e, 24),
+            };
+            let shape_error = |message: String| fail(entry_at, KtreeFileErrorKind::Tree(message));
+            if u32_at(e, 28) != 0 {
+                return Err(shape_error(format!("reserved field of level {d} is not 0")));
+            }
+            let expected = match sections.last() {
+                None => Some(1),
+                Some(above) => {
+                    let above: &Section = above;
+                    above.partial.checked_mul(1 << k)
+                }
+            };
+            if Some(section.nodes) != expected {
+                return Err(shape_error(format!(
+                    "level {d} has {} nodes, the level above calls for {expected:?}",
+                    section.nodes
+                )));
+            }
+            if !matches!(section.full.checked_add(section.partial), Some(n) if n <= section.nodes) {
+                return Err(shape_error(format!(
+                    "level {d}: more full and partial nodes than nodes"
+                )));
+            }
+            if d + 1 == depth as usize && section.partial > 0 {
+                return Err(shape_error(format!(
+                    "the last level ({d}) has {} partial nodes without children",
+                    section.partial
+                )));
+            }
+            // Nodes are below 2^64 / 2^K·…: the section's byte size cannot overflow past the file's length
+            // check below because every level is at most 2^K times the one above and the file is finite.
+            offset = match offset.checked_add(section.bytes()) {
+                Some(o) if o <= directory_at => o,
+                _ => {
+                    return Err(fail(
+                        directory_at,
+                        KtreeFileErrorKind::Length {
+                            expected: directory_at,
+                            found: len,
+                        },
+                    ))
+                }
+            };
+            sections.push(section);
+        }
+        if offset != directory_at {
+            return Err(fail(
+                offset,
+                KtreeFileErrorKind::Tree(format!(
+                    "the sections end at byte {offset} but the directory starts at {directory_at}"
+                )),
+            ));
+        }
+        Ok(Self { k, level, sections })
+    }
+
+    pub(crate) fn counts_per_level(&self) -> Vec<LevelCounts> {
+        self.sections
+            .iter()
+            .enumerate()
+            .map(|(d, s)| LevelCounts {
+                level: d as u32,
+                full: s.full,
+                empty: s.nodes - s.full - s.partial,
+                partial: s.partial,
+            })
+            .collect()
+    }
+}
+
+pub(crate) fn layout_of_bytes(bytes: &[u8], file: &str) -> Result<Layout, KtreeFileError> {
+    let len = bytes.len() as u64;
+    Layout::parse(file, &bytes[..bytes.len().min(HEADER_BYTES)], len, |n| {
+        Ok(bytes[bytes.len() - n..].to_vec())
+    })
+}

@@ -1,0 +1,147 @@
+//! The `.ktree` file, version 2: one word-aligned, checksummed section per tree level, written as a stream
+//! ([`KtreeWriter`]) and read by memory-mapping ([`KtreeView`], [`MappedTree`]). The byte layout and the checks
+//! are described in [`layout`].
+
+mod check;
+pub(crate) mod layout;
+mod mapped;
+mod view;
+mod writer;
+
+pub(crate) use check::read_v2_any;
+pub use layout::VERSION;
+pub(crate) use layout::{slots_mask, LOW_BITS, NODES_PER_WORD};
+pub use mapped::MappedTree;
+pub(crate) use view::read_at;
+pub use view::KtreeView;
+pub(crate) use writer::WordPacker;
+pub use writer::{write_ktree_v2, write_ktree_v2_file, KtreeWriter};
+
+#[cfg(test)]
+mod tests {
+    use super::layout::*;
+    use super::*;
+    use crate::io::KtreeFileErrorKind;
+    use crate::rays::ball_rays;
+    use crate::stacking::stack;
+    use crate::tree::{KTree, NodeState, PackedStates};
+
+    fn sample() -> (KTree<3>, Vec<u8>) {
+        let tree = stack(&ball_rays::<3>(4, [10, 12, 14], 9).unwrap());
+        let mut bytes = Vec::new();
+        write_ktree_v2(&mut bytes, &tree).unwrap();
+        (tree, bytes)
+    }
+
+    #[test]
+    fn round_trip_view_and_pieces_agree() {
+        let (tree, bytes) = sample();
+        assert_eq!(bytes.len() % 8, 0);
+        let back = read_v2_any(&bytes, "s").unwrap().into_dim::<3>().unwrap();
+        assert_eq!(back, tree);
+        let view = KtreeView::from_bytes(bytes.clone(), "s").unwrap();
+        assert_eq!(view.counts_per_level(), tree.counts_per_level());
+        assert_eq!(view.to_tree::<3>().unwrap(), tree);
+        for x in (0..16).step_by(3) {
+            for y in 0..16 {
+                for z in (0..16).step_by(2) {
+                    assert_eq!(view.contains([x, y, z]).unwrap(), tree.contains([x, y, z]));
+                }
+            }
+        }
+        let mut leaves = Vec::new();
+        view.for_each_leaf::<3>(|c, s| leaves.push((c, s))).unwrap();
+        assert_eq!(leaves, tree.leaves().collect::<Vec<_>>());
+        // Each level in odd-sized pieces: the shifted appends give the same bytes.
+        let mut pieces = Vec::new();
+        let mut w = KtreeWriter::new(&mut pieces, 3, tree.level()).unwrap();
+        for d in 0..tree.depth_count() {
+            let level = tree.level_states(d);
+            let mut i = 0;
+            let mut size = 1;
+            while i < level.len() {
+                let n = size.min(level.len() - i);
+                let mut piece = PackedStates::new();
+                (i..i + n).for_each(|j| piece.push(level.get(j)));
+                piece.finish();
+                w.append_states(&piece).unwrap();
+                i += n;
+                size = size % 45 + 7;
+            }
+            w.end_level().unwrap();
+        }
+        w.finish().unwrap();
+        assert_eq!(pieces, bytes);
+    }
+
+    #[test]
+    fn bad_section_checksum_names_level_and_offset() {
+        let (tree, mut bytes) = sample();
+        let view = KtreeView::from_bytes(bytes.clone(), "s").unwrap();
+        let last = view.depth_count() - 1;
+        let offset = view.layout.sections[last].offset;
+        // Swap two different 2-bit codes inside the last section: counts stay equal, the CRC does not.
+        let at = offset as usize;
+        let word = u64_at(&bytes, at);
+        let swapped = (0..32)
+            .flat_map(|i| (0..32).map(move |j| (i, j)))
+            .find_map(|(i, j)| {
+                let (a, b) = (word >> (2 * i) & 3, word >> (2 * j) & 3);
+                (a != b).then(|| word ^ (a ^ b) << (2 * i) ^ (a ^ b) << (2 * j))
+            })
+            .unwrap();
+        bytes[at..at + 8].copy_from_slice(&swapped.to_le_bytes());
+        let e = read_v2_any(&bytes, "s").unwrap_err();
+        assert_eq!(e.offset, offset);
+        assert!(
+            matches!(e.kind, KtreeFileErrorKind::SectionChecksum { level, .. } if level == last),
+            "{e}"
+        );
+        assert!(e.to_string().contains(&format!("level {last}")), "{e}");
+        let _ = tree;
+    }
+
+    #[test]
+    fn a_file_changed_underneath_a_view_gives_errors_not_panics() {
+        use std::io::{Seek, SeekFrom, Write as _};
+        let (tree, bytes) = sample();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.ktree");
+        std::fs::write(&path, &bytes).unwrap();
+        let view = KtreeView::open(&path).unwrap();
+        assert!(view.is_mapped());
+        assert_eq!(view.to_tree::<3>().unwrap(), tree);
+        // Overwrite every section in place with code 11: the map shows the new bytes.
+        let directory_at = view
+            .layout
+            .sections
+            .last()
+            .map(|s| s.offset + s.bytes())
+            .unwrap();
+        let mut f = std::fs::OpenOptions::new().write(true).open(&path).unwrap();
+        f.seek(SeekFrom::Start(HEADER_BYTES as u64)).unwrap();
+        f.write_all(&vec![0xFF; directory_at as usize - HEADER_BYTES])
+            .unwrap();
+        f.sync_all().unwrap();
+        assert!(view.contains([10u32, 12, 14]).is_err());
+        assert!(view.for_each_leaf::<3>(|_, _| {}).is_err());
+        assert!(view.to_tree::<3>().is_err());
+        assert!(KtreeView::open(&path).is_err(), "reopening checks again");
+    }
+
+    #[test]
+    fn writer_rejects_a_broken_shape() {
+        let mut w = KtreeWriter::new(Vec::new(), 2, 2).unwrap();
+        w.push(NodeState::Partial).unwrap();
+        w.end_level().unwrap();
+        w.append_words(&[0b10], 3).unwrap();
+        assert!(w.end_level().is_err(), "3 children of one partial node");
+        let mut w = KtreeWriter::new(Vec::new(), 2, 2).unwrap();
+        w.push(NodeState::Partial).unwrap();
+        assert!(w.finish().is_err(), "a partial leaf");
+        assert!(KtreeWriter::new(Vec::new(), 2, 2)
+            .unwrap()
+            .append_words(&[0b11], 1)
+            .is_err());
+    }
+}

@@ -1,0 +1,349 @@
+//! [`KtreeView`]: a checked version 2 file read in place through a memory map.
+
+use std::fs::File;
+use std::path::Path;
+
+use super::super::{KtreeFileError, KtreeFileErrorKind};
+use super::check::check_bytes;
+use super::layout::*;
+use crate::io::mmap::FileMap;
+use crate::space::{Cell, Universe};
+use crate::tree::{KTree, LevelCounts, NodeState, PackedStates};
+
+/// Where a view's bytes are.
+#[derive(Debug)]
+enum Backing {
+    /// A file, mapped whole.
+    Map(FileMap),
+    /// Bytes in memory.
+    Bytes(Vec<u8>),
+}
+
+/// A read-only view of a `.ktree` version 2 file through a memory map: statistics, point queries and leaf
+/// iteration without loading the levels into memory.
+///
+/// Opening checks the whole file (the checks listed with the layout in the README) by scanning it through
+/// windows of 1 MiB that are unmapped after use, holding besides only one level's rank samples (1/256 of
+/// the level); queries then read only the pages they touch.
+///
+/// ```
+/// use ktree::{io, KTree};
+/// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("t.ktree");
+/// io::write_ktree_v2_file(&path, &tree).unwrap();
+/// let view = io::KtreeView::open(&path).unwrap();
+/// assert_eq!(view.counts(), tree.counts());
+/// assert!(view.contains([0u32, 0]).unwrap() && !view.contains([1u32, 0]).unwrap());
+/// ```
+#[derive(Debug)]
+pub struct KtreeView {
+    name: String,
+    backing: Backing,
+    pub(super) layout: Layout,
+}
+
+impl KtreeView {
+    /// Opens and checks a version 2 file.
+    ///
+    /// # Errors
+    /// [`KtreeFileError`] naming the file and byte offset of the first problem
+    /// ([`KtreeFileErrorKind::Version`] for a version 1 file: read those with
+    /// [`read_ktree_file`](crate::io::read_ktree_file)).
+    pub fn open(path: &Path) -> Result<Self, KtreeFileError> {
+        let name = path.display().to_string();
+        let io_error = |offset: u64, e: std::io::Error| KtreeFileError {
+            file: name.clone(),
+            offset,
+            kind: KtreeFileErrorKind::Io(e.to_string()),
+        };
+        let file = File::open(path).map_err(|e| io_error(0, e))?;
+        let len = file.metadata().map_err(|e| io_error(0, e))?.len();
+        let len_usize = usize::try_from(len).map_err(|_| {
+            io_error(
+                0,
+                std::io::Error::other("the file is larger than the address space"),
+            )
+        })?;
+        let head =
+            read_at(&file, 0, (len as usize).min(HEADER_BYTES)).map_err(|e| io_error(0, e))?;
+        let layout = Layout::parse(&name, &head, len, |n| {
+            read_at(&file, len - n as u64, n).map_err(|e| io_error(len - n as u64, e))
+        })?;
+        layout.check_sections(&name, |offset, n, f| {
+            let window = FileMap::map(&file, offset, n).map_err(|e| io_error(offset, e))?;
+            f(window.bytes())
+        })?;
+        let map = FileMap::map(&file, 0, len_usize).map_err(|e| io_error(0, e))?;
+        Ok(Self {
+            name,
+            backing: Backing::Map(map),
+            layout,
+        })
+    }
+
+    /// A view of a version 2 file's bytes held in memory (`name` is used in errors).
+    ///
+    /// # Errors
+    /// As [`KtreeView::open`].
+    pub fn from_bytes(bytes: Vec<u8>, name: &str) -> Result<Self, KtreeFileError> {
+        let layout = layout_of_bytes(&bytes, name)?;
+        check_bytes(&layout, &bytes, name)?;
+        Ok(Self {
+            name: name.to_string(),
+            backing: Backing::Bytes(bytes),
+            layout,
+        })
+    }
+
+    fn bytes(&self) -> &[u8] {
+        match &self.backing {
+            Backing::Map(map) => map.bytes(),
+            Backing::Bytes(b) => b,
+        }
+    }
+
+    /// Whether the view reads through a memory map (rather than bytes in memory).
+    pub fn is_mapped(&self) -> bool {
+        matches!(self.backing, Backing::Map(_))
+    }
+
+    /// The dimension `K`.
+    pub fn k(&self) -> usize {
+        self.layout.k
+    }
+
+    /// The universe level `L`.
+    pub fn level(&self) -> u32 {
+        self.layout.level
+    }
+
+    /// The number of stored levels.
+    pub fn depth_count(&self) -> usize {
+        self.layout.sections.len()
+    }
+
+    /// Node counts per level, from the root down (read from the checked directory).
+    pub fn counts_per_level(&self) -> Vec<LevelCounts> {
+        self.layout.counts_per_level()
+    }
+
+    /// Total node counts (`level` holds the universe level), as [`KTree::counts`].
+    pub fn counts(&self) -> LevelCounts {
+        LevelCounts::total(self.level(), &self.counts_per_level())
+    }
+
+    /// The total number of nodes.
+    pub fn node_count(&self) -> u64 {
+        self.layout.sections.iter().map(|s| s.nodes).sum()
+    }
+
+    /// Bytes needed at Meagher's 2 bits a node.
+    pub fn bytes_at_two_bits(&self) -> u64 {
+        self.node_count().div_ceil(4)
+    }
+
+    fn word(&self, section: &Section, j: u64) -> u64 {
+        u64_at(self.bytes(), (section.offset + 8 * j) as usize)
+    }
+
+    /// The state of node `index` at `depth`, or `None` if there is no such node.
+    pub fn state(&self, depth: usize, index: u64) -> Option<NodeState> {
+        let s = self.layout.sections.get(depth)?;
+        if index >= s.nodes {
+            return None;
+        }
+        let code = self.word(s, index / NODES_PER_WORD) >> (2 * (index % NODES_PER_WORD)) & 3;
+        NodeState::from_code(code as u8)
+    }
+
+    /// Word `j` of the node states of level `depth` (`j` below the level's word count).
+    pub(crate) fn level_word(&self, depth: usize, j: u64) -> u64 {
+        self.word(&self.layout.sections[depth], j)
+    }
+
+    /// The number of nodes of level `depth` (0 below the last level).
+    pub(crate) fn level_nodes(&self, depth: usize) -> u64 {
+        self.layout.sections.get(depth).map_or(0, |s| s.nodes)
+    }
+
+    /// The name given when the view was opened (the file's path).
+    pub(crate) fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The error for a node that is not what the checks at opening found: the file was changed since.
+    pub(crate) fn changed(&self, depth: usize, index: u64) -> KtreeFileError {
+        let section = &self.layout.sections[depth.min(self.layout.sections.len() - 1)];
+        KtreeFileError {
+            file: self.name.clone(),
+            offset: section.offset + 8 * (index / NODES_PER_WORD),
+            kind: KtreeFileErrorKind::Tree(format!(
+                "node {index} of level {depth} is missing or has the code 11: the file was changed after it was opened"
+            )),
+        }
+    }
+
+    /// The state of a node the tree's shape says exists, or the error of a file changed since opening.
+    pub(crate) fn checked_state(
+        &self,
+        depth: usize,
+        index: u64,
+    ) -> Result<NodeState, KtreeFileError> {
+        self.state(depth, index)
+            .ok_or_else(|| self.changed(depth, index))
+    }
+
+    /// The number of partial nodes before node `index` of level `depth` (`index` < the level's size).
+    pub(crate) fn partial_rank(&self, depth: usize, index: u64) -> u64 {
+        let s = &self.layout.sections[depth];
+        let word = index / NODES_PER_WORD;
+        let block = word / WORDS_PER_SAMPLE;
+        let mut rank = u64_at(self.bytes(), (s.samples_offset() + 8 * block) as usize);
+        for j in block * WORDS_PER_SAMPLE..word {
+            rank = rank.saturating_add(u64::from(partial_mask(self.word(s, j)).count_ones()));
+        }
+        let slot = index % NODES_PER_WORD;
+        rank.saturating_add(u64::from(
+            (partial_mask(self.word(s, word)) & slots_mask(slot)).count_ones(),
+        ))
+    }
+
+    /// The universe, if the file's `K` is `K`.
+    pub(crate) fn universe<const K: usize>(&self) -> Result<Universe<K>, KtreeFileError> {
+        self.dimension::<K>()
+    }
+
+    fn dimension<const K: usize>(&self) -> Result<Universe<K>, KtreeFileError> {
+        if K != self.k() {
+            return Err(KtreeFileError {
+                file: self.name.clone(),
+                offset: 8,
+                kind: KtreeFileErrorKind::Dimension {
+                    expected: K,
+                    found: self.k(),
+                },
+            });
+        }
+        Ok(Universe::new(self.level()).expect("level checked when opened"))
+    }
+
+    /// Whether the voxel `point` is inside the object (`O(L)` node reads, each rank at most 64 word
+    /// pop-counts). Points outside the universe are outside the object.
+    ///
+    /// # Errors
+    /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`.
+    pub fn contains<const K: usize>(&self, point: [u32; K]) -> Result<bool, KtreeFileError> {
+        let universe = self.dimension::<K>()?;
+        if universe.check_point(point).is_err() {
+            return Ok(false);
+        }
+        let mut index = 0u64;
+        for depth in 0..self.depth_count() {
+            match self.checked_state(depth, index)? {
+                NodeState::Empty => return Ok(false),
+                NodeState::Full => return Ok(true),
+                NodeState::Partial if depth + 1 >= self.depth_count() => {
+                    return Err(self.changed(depth, index))
+                }
+                NodeState::Partial => {
+                    let bit = self.level() - 1 - depth as u32;
+                    let code = point
+                        .iter()
+                        .enumerate()
+                        .fold(0u64, |c, (axis, &x)| c | u64::from(x >> bit & 1) << axis);
+                    // Saturating: a rank sample changed underneath must not overflow (the node is then
+                    // missing, an error).
+                    index = self
+                        .partial_rank(depth, index)
+                        .saturating_mul(1 << K)
+                        .saturating_add(code);
+                }
+            }
+        }
+        Ok(false)
+    }
+
+    /// Visits every leaf (empty and full) in Morton (depth-first) order, as [`KTree::for_each_leaf`].
+    /// Needs no rank: in depth-first order the partial nodes of each level are met in level order, so the
+    /// children of the next one are the next `2^K` nodes of the level below.
+    ///
+    /// # Errors
+    /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`.
+    pub fn for_each_leaf<const K: usize>(
+        &self,
+        mut visit: impl FnMut(Cell<K>, NodeState),
+    ) -> Result<(), KtreeFileError> {
+        let universe = self.dimension::<K>()?;
+        let mut next_child = vec![0u64; self.depth_count() + 1];
+        let mut stack = vec![(universe.root(), 0u64)];
+        while let Some((cell, index)) = stack.pop() {
+            let depth = cell.level as usize;
+            match self.checked_state(depth, index)? {
+                NodeState::Partial if depth + 1 >= self.depth_count() => {
+                    return Err(self.changed(depth, index))
+                }
+                NodeState::Partial => {
+                    let first = next_child[depth + 1];
+                    next_child[depth + 1] += 1 << K;
+                    for code in (0..1usize << K).rev() {
+                        stack.push((cell.child(code), first + code as u64));
+                    }
+                }
+                state => visit(cell, state),
+            }
+        }
+        Ok(())
+    }
+
+    /// Visits the full leaves in Morton order: the object's linear tree.
+    ///
+    /// # Errors
+    /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`.
+    pub fn for_each_full_cell<const K: usize>(
+        &self,
+        mut visit: impl FnMut(Cell<K>),
+    ) -> Result<(), KtreeFileError> {
+        self.for_each_leaf::<K>(|cell, state| {
+            if state == NodeState::Full {
+                visit(cell)
+            }
+        })
+    }
+
+    /// Loads the tree into memory.
+    ///
+    /// # Errors
+    /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`.
+    pub fn to_tree<const K: usize>(&self) -> Result<KTree<K>, KtreeFileError> {
+        let universe = self.dimension::<K>()?;
+        let levels = self
+            .layout
+            .sections
+            .iter()
+            .enumerate()
+            .map(|(depth, s)| {
+                let words = (0..s.words()).map(|j| self.word(s, j)).collect();
+                PackedStates::from_words(words, s.nodes as usize)
+                    .map_err(|_| self.changed(depth, 0))
+            })
+            .collect::<Result<_, _>>()?;
+        let tree = KTree::from_levels(universe, levels);
+        tree.check().map_err(|e| KtreeFileError {
+            file: self.name.clone(),
+            offset: HEADER_BYTES as u64,
+            kind: KtreeFileErrorKind::Tree(e.to_string()),
+        })?;
+        Ok(tree)
+    }
+}
+
+/// Reads `n` bytes of `file` at `offset`.
+pub(crate) fn read_at(file: &File, offset: u64, n: usize) -> std::io::Result<Vec<u8>> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut f = file;
+    f.seek(SeekFrom::Start(offset))?;
+    let mut buf = vec![0u8; n];
+    f.read_exact(&mut buf)?;
+    Ok(buf)
+}

@@ -1,0 +1,320 @@
+//! [`KtreeWriter`]: a version 2 file written level by level, in one pass, without holding the tree.
+
+use std::io::Write;
+use std::path::Path;
+
+use super::layout::*;
+use crate::space::{max_level, MAX_K};
+use crate::tree::{KTree, LevelCounts, NodeState, PackedStates};
+
+/// Writes a `.ktree` version 2 file level by level, from the root down, without holding the tree.
+///
+/// A level is given as one or more *pieces*, each a run of consecutive nodes packed two bits a node in
+/// `u64` words exactly as in [`PackedStates::words`] (node `j` of the piece in bits `2·(j mod 32)` of word
+/// `j / 32`; bits beyond the piece's node count are ignored). A piece may end in the middle of a word: the
+/// next piece is shifted to continue right after it, so the subtrees of consecutive cells, built apart, can
+/// be appended one after the other at every level. [`KtreeWriter::end_level`] closes a level (the next
+/// append starts the next one); [`KtreeWriter::finish`] writes the directory. Memory held: one partial word
+/// and one rank sample per 2048 nodes of the current level.
+///
+/// The writer checks the tree's shape as it goes (a root level of one node, each level `2^K` times the
+/// partial nodes of the level above, no code `11`, no partial node at the last level) and returns
+/// [`std::io::ErrorKind::InvalidInput`] when it is broken; whether the tree is reduced is checked when the
+/// file is read.
+///
+/// ```
+/// use ktree::{io, KTree, NodeState};
+/// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
+/// let mut bytes = Vec::new();
+/// let mut w = io::KtreeWriter::new(&mut bytes, 2, 1).unwrap();
+/// w.push(NodeState::Partial).unwrap();
+/// w.end_level().unwrap();
+/// // The four children in two pieces: [full, empty] then [empty, full] (one word each).
+/// w.append_words(&[0b0001], 2).unwrap();
+/// w.append_words(&[0b0100], 2).unwrap();
+/// w.finish().unwrap();
+/// assert_eq!(io::read_ktree::<2>(&bytes, "mem").unwrap(), tree);
+/// ```
+#[derive(Debug)]
+pub struct KtreeWriter<W: Write> {
+    out: W,
+    k: usize,
+    level: u32,
+    /// Bytes written so far.
+    written: u64,
+    finished: Vec<Section>,
+    current: LevelWriter,
+    buffer: Vec<u8>,
+}
+
+/// Nodes appended two bits each at any position, handed out as whole words: the shifted append of
+/// [`KtreeWriter`] and of the streamed Booleans' output levels.
+#[derive(Debug, Default, Clone, Copy)]
+pub(crate) struct WordPacker {
+    /// Nodes not yet forming a whole word, in the low bits.
+    pending: u64,
+    pending_nodes: u64,
+}
+
+impl WordPacker {
+    /// Appends the `take ≤ 32` nodes of `word` (low bits first); returns the word they complete, if any.
+    #[inline]
+    pub(crate) fn push(&mut self, word: u64, take: u64) -> Option<u64> {
+        let word = word & slots_mask(take);
+        let p = self.pending_nodes;
+        let joined = self.pending | word.checked_shl(2 * p as u32).unwrap_or(0);
+        if p + take >= NODES_PER_WORD {
+            // `p > 0` here unless the word is whole, so the shift below is less than 64.
+            self.pending = if p == 0 {
+                0
+            } else {
+                word >> (2 * (NODES_PER_WORD - p))
+            };
+            self.pending_nodes = p + take - NODES_PER_WORD;
+            Some(joined)
+        } else {
+            self.pending = joined;
+            self.pending_nodes = p + take;
+            None
+        }
+    }
+
+    /// The last, partly filled word (`None` if the nodes so far fill whole words), leaving the packer empty.
+    pub(crate) fn flush(&mut self) -> Option<u64> {
+        let last = (self.pending_nodes > 0).then_some(self.pending);
+        *self = Self::default();
+        last
+    }
+}
+
+/// The level being written.
+#[derive(Debug, Default)]
+struct LevelWriter {
+    nodes: u64,
+    full: u64,
+    partial: u64,
+    packer: WordPacker,
+    words: u64,
+    samples: Vec<u64>,
+    hasher: crc32fast::Hasher,
+}
+
+impl<W: Write> KtreeWriter<W> {
+    /// Starts a file for a `K = k` tree in a level-`level` universe, writing the header.
+    ///
+    /// # Errors
+    /// `InvalidInput` for `k` or `level` out of range; any I/O error.
+    pub fn new(mut out: W, k: usize, level: u32) -> std::io::Result<Self> {
+        if !(1..=MAX_K).contains(&k) || level > max_level(k) {
+            return Err(invalid(format!(
+                "K = {k}, L = {level} is not a valid universe"
+            )));
+        }
+        out.write_all(&header_bytes(k, level))?;
+        Ok(Self {
+            out,
+            k,
+            level,
+            written: HEADER_BYTES as u64,
+            finished: Vec::new(),
+            current: LevelWriter::default(),
+            buffer: Vec::with_capacity(1 << 16),
+        })
+    }
+
+    /// Appends one node to the current level.
+    ///
+    /// # Errors
+    /// Any I/O error.
+    pub fn push(&mut self, state: NodeState) -> std::io::Result<()> {
+        self.append_words(&[state as u64], 1)
+    }
+
+    /// Appends a whole [`PackedStates`] (for instance a level of a tree, or of a subtree) to the current
+    /// level.
+    ///
+    /// # Errors
+    /// Any I/O error.
+    pub fn append_states(&mut self, states: &PackedStates) -> std::io::Result<()> {
+        self.append_words(states.words(), states.len() as u64)
+    }
+
+    /// Appends `nodes` nodes packed in `words` (the first node in the low bits of `words[0]`) to the current
+    /// level, shifted to follow the nodes already appended.
+    ///
+    /// # Errors
+    /// `InvalidInput` if `words` holds fewer than `nodes` nodes or a node has the unused code `11`; any I/O
+    /// error.
+    pub fn append_words(&mut self, words: &[u64], nodes: u64) -> std::io::Result<()> {
+        let needed = words_of(nodes);
+        if (words.len() as u64) < needed {
+            return Err(invalid(format!(
+                "{} words cannot hold {nodes} nodes",
+                words.len()
+            )));
+        }
+        let mut remaining = nodes;
+        for &word in &words[..needed as usize] {
+            let take = remaining.min(NODES_PER_WORD);
+            let word = word & slots_mask(take);
+            if (word >> 1) & word & LOW_BITS != 0 {
+                return Err(invalid(format!(
+                    "a node of level {} has the unused code 11",
+                    self.finished.len()
+                )));
+            }
+            if let Some(whole) = self.current.packer.push(word, take) {
+                self.emit(whole)?;
+            }
+            remaining -= take;
+        }
+        self.current.nodes += nodes;
+        Ok(())
+    }
+
+    /// Writes one complete word of the current level.
+    fn emit(&mut self, word: u64) -> std::io::Result<()> {
+        let level = &mut self.current;
+        if level.words % WORDS_PER_SAMPLE == 0 {
+            level.samples.push(level.partial);
+        }
+        level.words += 1;
+        level.full += u64::from(full_mask(word).count_ones());
+        level.partial += u64::from(partial_mask(word).count_ones());
+        self.buffer.extend_from_slice(&word.to_le_bytes());
+        if self.buffer.len() >= 1 << 16 {
+            self.flush_buffer()?;
+        }
+        Ok(())
+    }
+
+    fn flush_buffer(&mut self) -> std::io::Result<()> {
+        self.current.hasher.update(&self.buffer);
+        self.out.write_all(&self.buffer)?;
+        self.written += self.buffer.len() as u64;
+        self.buffer.clear();
+        Ok(())
+    }
+
+    /// Closes the current level: the next append starts the level below.
+    ///
+    /// # Errors
+    /// `InvalidInput` if the level is empty, the root level is not one node, the level's size is not `2^K`
+    /// times the partial nodes of the level above, or the tree would be deeper than the universe; any I/O
+    /// error.
+    pub fn end_level(&mut self) -> std::io::Result<()> {
+        let depth = self.finished.len();
+        let nodes = self.current.nodes;
+        let expected = match self.finished.last() {
+            None => 1,
+            Some(above) => above.partial << self.k,
+        };
+        if nodes != expected || depth > self.level as usize {
+            return Err(invalid(format!(
+                "level {depth} has {nodes} nodes, but the levels above call for {expected} (universe level {})",
+                self.level
+            )));
+        }
+        if let Some(word) = self.current.packer.flush() {
+            self.emit(word)?;
+        }
+        let samples = std::mem::take(&mut self.current.samples);
+        for s in samples {
+            self.buffer.extend_from_slice(&s.to_le_bytes());
+        }
+        self.flush_buffer()?;
+        let level = std::mem::take(&mut self.current);
+        let section_bytes = 8 * (level.words + samples_of(level.words));
+        self.finished.push(Section {
+            offset: self.written - section_bytes,
+            nodes,
+            full: level.full,
+            partial: level.partial,
+            crc: level.hasher.finalize(),
+        });
+        Ok(())
+    }
+
+    /// The node counts of the levels closed so far (`level` = depth), as the file's directory will hold them.
+    pub fn counts_per_level(&self) -> Vec<LevelCounts> {
+        self.finished
+            .iter()
+            .enumerate()
+            .map(|(d, s)| LevelCounts {
+                level: d as u32,
+                full: s.full,
+                empty: s.nodes - s.full - s.partial,
+                partial: s.partial,
+            })
+            .collect()
+    }
+
+    /// Closes the last level if nodes were appended to it, writes the directory, and returns the output.
+    ///
+    /// # Errors
+    /// `InvalidInput` if no level was written or the last level has partial nodes; any I/O error.
+    pub fn finish(mut self) -> std::io::Result<W> {
+        if self.current.nodes > 0 {
+            self.end_level()?;
+        }
+        match self.finished.last() {
+            None => return Err(invalid("no level was written".into())),
+            Some(last) if last.partial > 0 => {
+                return Err(invalid(format!(
+                    "the last level ({}) has {} partial nodes without children",
+                    self.finished.len() - 1,
+                    last.partial
+                )))
+            }
+            Some(_) => {}
+        }
+        let depth = self.finished.len();
+        let mut tail = Vec::with_capacity(depth * ENTRY_BYTES + TAIL_BYTES);
+        for s in &self.finished {
+            for v in [s.nodes, s.full, s.partial] {
+                tail.extend_from_slice(&v.to_le_bytes());
+            }
+            tail.extend_from_slice(&s.crc.to_le_bytes());
+            tail.extend_from_slice(&0u32.to_le_bytes());
+        }
+        let len = self.written + tail.len() as u64 + TAIL_BYTES as u64;
+        tail.extend_from_slice(&len.to_le_bytes());
+        tail.extend_from_slice(&(depth as u32).to_le_bytes());
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(&header_bytes(self.k, self.level));
+        hasher.update(&tail);
+        tail.extend_from_slice(&hasher.finalize().to_le_bytes());
+        self.out.write_all(&tail)?;
+        self.out.flush()?;
+        Ok(self.out)
+    }
+}
+
+/// Writes a tree as a `.ktree` version 2 file.
+///
+/// ```
+/// use ktree::{io, KTree};
+/// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
+/// let mut bytes = Vec::new();
+/// io::write_ktree_v2(&mut bytes, &tree).unwrap();
+/// assert_eq!(io::read_ktree::<2>(&bytes, "mem").unwrap(), tree);
+/// ```
+///
+/// # Errors
+/// Any I/O error.
+pub fn write_ktree_v2<const K: usize>(out: impl Write, tree: &KTree<K>) -> std::io::Result<()> {
+    let mut w = KtreeWriter::new(out, K, tree.level())?;
+    for d in 0..tree.depth_count() {
+        w.append_states(tree.level_states(d))?;
+        w.end_level()?;
+    }
+    w.finish().map(drop)
+}
+
+/// Writes a `.ktree` version 2 file atomically (temporary file, then rename).
+///
+/// # Errors
+/// Any I/O error, naming the path.
+pub fn write_ktree_v2_file<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
+    crate::fs::write_atomic_with(path, |w| write_ktree_v2(w, tree))
+}
