@@ -2,7 +2,8 @@
 
 Coordinates are ``[x, y, z, ...]`` as in the ``ktree`` command-line tool: a dense array ``a`` has
 ``a[x, y, z]`` for voxel (x, y, z), and rays run along the last axis. Long calls release the GIL; errors
-are ``ValueError`` (bad input) or ``OSError`` (files) with the library's message.
+are ``ValueError`` (bad input) or ``OSError`` (files: ``FileNotFoundError``, ``PermissionError``, … as the
+system says, with ``filename`` set) with the library's message.
 """
 
 from fractions import Fraction

@@ -135,6 +135,51 @@ pub(crate) fn remove_stale(dir: &Path, name: &str, suffix: &str) {
     }
 }
 
+/// An I/O failure kept whole inside a file error, so that its [`source`](std::error::Error::source) is the
+/// [`std::io::Error`] and a caller can act on its [`kind`](IoCause::kind) (Python raises `FileNotFoundError`,
+/// `PermissionError`, …). Cloneable, and equal when kind and message are.
+///
+/// ```
+/// use std::error::Error;
+/// let e = ktree::io::read_ktree_file(std::path::Path::new("no/such.ktree")).unwrap_err();
+/// let io = e.source().and_then(|s| s.downcast_ref::<std::io::Error>()).unwrap();
+/// assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
+/// ```
+#[derive(Debug, Clone)]
+pub struct IoCause(std::sync::Arc<std::io::Error>);
+
+impl IoCause {
+    /// What kind of failure it was.
+    pub fn kind(&self) -> std::io::ErrorKind {
+        self.0.kind()
+    }
+
+    /// The error itself.
+    pub fn error(&self) -> &std::io::Error {
+        &self.0
+    }
+}
+
+impl From<std::io::Error> for IoCause {
+    fn from(e: std::io::Error) -> Self {
+        Self(std::sync::Arc::new(e))
+    }
+}
+
+impl std::fmt::Display for IoCause {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl PartialEq for IoCause {
+    fn eq(&self, other: &Self) -> bool {
+        self.kind() == other.kind() && self.0.to_string() == other.0.to_string()
+    }
+}
+
+impl Eq for IoCause {}
+
 #[cfg(test)]
 mod tests {
     use super::*;

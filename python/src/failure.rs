@@ -1,16 +1,31 @@
 //! Errors of the bindings, made without the interpreter lock and turned into Python exceptions after.
 
-use pyo3::exceptions::{PyOSError, PyValueError};
+use std::io::ErrorKind;
+use std::path::Path;
+
+use pyo3::exceptions::{
+    PyFileExistsError, PyFileNotFoundError, PyIsADirectoryError, PyNotADirectoryError, PyOSError,
+    PyPermissionError, PyValueError,
+};
 use pyo3::PyErr;
 
 /// What went wrong, as the library says it: bad input or parameters (`ValueError`) or a file that cannot be
-/// read or written (`OSError`).
+/// read or written (`OSError`, or the subclass its kind names, with `filename` set).
 #[derive(Debug)]
 pub(crate) enum Failure {
     /// Bad input: `ValueError`.
     Value(String),
-    /// A file system failure: `OSError`.
-    Os(String),
+    /// A file system failure: `OSError` or a subclass.
+    Os {
+        /// What failed, as `std::io` says it.
+        kind: ErrorKind,
+        /// The system's error number, where there is one (`errno`).
+        errno: i32,
+        /// The message (`strerror`): the library's whole message, naming the file.
+        message: String,
+        /// The file (`filename`).
+        filename: String,
+    },
 }
 
 impl Failure {
@@ -18,13 +33,45 @@ impl Failure {
     pub(crate) fn value(e: impl std::fmt::Display) -> Self {
         Self::Value(e.to_string())
     }
+
+    /// An `OSError` (or subclass) if an `std::io::Error` is `e` or among its sources, else a `ValueError`.
+    pub(crate) fn of_error(e: &(dyn std::error::Error + 'static), path: &Path) -> Self {
+        let mut cause = Some(e);
+        while let Some(c) = cause {
+            if let Some(io) = c.downcast_ref::<std::io::Error>() {
+                return Self::Os {
+                    kind: io.kind(),
+                    errno: io.raw_os_error().unwrap_or(0),
+                    message: e.to_string(),
+                    filename: path.display().to_string(),
+                };
+            }
+            cause = c.source();
+        }
+        Self::value(e)
+    }
 }
 
 impl From<Failure> for PyErr {
     fn from(f: Failure) -> Self {
         match f {
             Failure::Value(m) => PyValueError::new_err(m),
-            Failure::Os(m) => PyOSError::new_err(m),
+            Failure::Os {
+                kind,
+                errno,
+                message,
+                filename,
+            } => {
+                let args = (errno, message, filename);
+                match kind {
+                    ErrorKind::NotFound => PyFileNotFoundError::new_err(args),
+                    ErrorKind::PermissionDenied => PyPermissionError::new_err(args),
+                    ErrorKind::AlreadyExists => PyFileExistsError::new_err(args),
+                    ErrorKind::IsADirectory => PyIsADirectoryError::new_err(args),
+                    ErrorKind::NotADirectory => PyNotADirectoryError::new_err(args),
+                    _ => PyOSError::new_err(args),
+                }
+            }
         }
     }
 }
@@ -49,9 +96,9 @@ value_errors!(
 
 impl From<ktree::solid::SolidError> for Failure {
     fn from(e: ktree::solid::SolidError) -> Self {
-        match e {
-            ktree::solid::SolidError::Io { .. } => Self::Os(e.to_string()),
-            other => Self::value(other),
+        match &e {
+            ktree::solid::SolidError::Io { path, .. } => Self::of_error(&e, &path.clone()),
+            _ => Self::value(e),
         }
     }
 }

@@ -653,3 +653,34 @@ def test_calls_from_threads_agree_with_serial_calls(rng):
     for (d1, i1), (d2, i2) in zip(serial, parallel):
         np.testing.assert_array_equal(d1, d2)
         np.testing.assert_array_equal(i1, i2)
+
+
+@pytest.mark.parametrize(
+    "name", ["missing.ktree", "missing.rays", "missing.vdb", "missing.bt", "missing.binvox", "missing.obj"]
+)
+def test_a_missing_file_raises_file_not_found_with_its_name(tmp_path, name):
+    path = tmp_path / name
+    with pytest.raises(FileNotFoundError) as caught:
+        ktree.Tree.load(str(path))
+    assert caught.value.filename == str(path)
+    assert name in str(caught.value)
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root reads files whatever their mode")
+@pytest.mark.parametrize("name", ["locked.ktree", "locked.vdb", "locked.bt"])
+def test_an_unreadable_file_raises_permission_error(tmp_path, name):
+    path = tmp_path / name
+    ktree.Tree.from_dense(np.ones((2, 2, 2), dtype=bool)).save(str(path))
+    path.chmod(0)
+    with pytest.raises(PermissionError) as caught:
+        ktree.Tree.load(str(path))
+    assert caught.value.filename == str(path)
+
+
+def test_saving_into_a_file_in_place_of_a_folder_raises_an_os_error(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    with pytest.raises(OSError) as caught:
+        ktree.Tree.from_dense(np.ones((2, 2), dtype=bool)).save(str(blocker / "out.ktree"))
+    assert caught.value.filename == str(blocker / "out.ktree")
+    assert not isinstance(caught.value, ValueError)

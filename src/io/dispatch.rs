@@ -143,7 +143,7 @@ pub enum IoError {
     },
     /// Writing failed (the message names the file).
     #[error("{0}")]
-    Write(std::io::Error),
+    Write(#[source] std::io::Error),
 }
 
 fn usage(path: &Path, message: impl Into<String>) -> IoError {
@@ -202,7 +202,7 @@ pub fn read_tree_placed(path: &Path, options: &ReadOptions) -> Result<ReadTree, 
     };
     let bytes = || {
         std::fs::read(path)
-            .map_err(|e| GridFileError::new(&name, 0, GridFileErrorKind::Io(e.to_string())))
+            .map_err(|e| GridFileError::new(&name, 0, GridFileErrorKind::Io(e.into())))
     };
     match format_of(path)? {
         Format::Ktree => Ok(plain(read_ktree_file(path)?)),

@@ -34,7 +34,7 @@ pub enum GridFileErrorKind {
     GridPlacement(String),
     /// The file could not be read.
     #[error("cannot read: {0}")]
-    Io(String),
+    Io(crate::fs::IoCause),
 }
 
 /// An error reading or writing a grid file, with the file and the byte offset where it was found.
@@ -54,7 +54,14 @@ impl fmt::Display for GridFileError {
     }
 }
 
-impl std::error::Error for GridFileError {}
+impl std::error::Error for GridFileError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &self.kind {
+            GridFileErrorKind::Io(cause) => Some(cause.error()),
+            _ => None,
+        }
+    }
+}
 
 impl GridFileError {
     pub(crate) fn new(file: &str, offset: usize, kind: GridFileErrorKind) -> Self {

@@ -91,7 +91,7 @@ pub enum KtreeFileErrorKind {
     },
     /// The file could not be read.
     #[error("cannot read: {0}")]
-    Io(String),
+    Io(crate::fs::IoCause),
 }
 
 /// An error reading a `.ktree` file, with the file and the byte offset.
@@ -111,7 +111,14 @@ impl fmt::Display for KtreeFileError {
     }
 }
 
-impl std::error::Error for KtreeFileError {}
+impl std::error::Error for KtreeFileError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &self.kind {
+            KtreeFileErrorKind::Io(cause) => Some(cause.error()),
+            _ => None,
+        }
+    }
+}
 
 /// Writes a tree as a `.ktree` file of the current version ([`VERSION`]).
 ///
@@ -152,7 +159,7 @@ pub fn read_ktree_file(path: &Path) -> Result<AnyTree, KtreeFileError> {
     let bytes = std::fs::read(path).map_err(|e| KtreeFileError {
         file: name.clone(),
         offset: 0,
-        kind: KtreeFileErrorKind::Io(e.to_string()),
+        kind: KtreeFileErrorKind::Io(e.into()),
     })?;
     read_ktree_any(&bytes, &name)
 }
@@ -200,7 +207,7 @@ pub fn ktree_file_version(path: &Path) -> Result<u16, KtreeFileError> {
         .map_err(|e| KtreeFileError {
             file: name.clone(),
             offset: 0,
-            kind: KtreeFileErrorKind::Io(e.to_string()),
+            kind: KtreeFileErrorKind::Io(e.into()),
         })?;
     if head.len() < 8 || &head[..6] != MAGIC {
         return Err(KtreeFileError {

@@ -216,7 +216,7 @@ impl<const K: usize> RaySource<K> for RaysFileSource<K> {
                 runs: Cow::Owned(runs),
             });
         }
-        let io = |e: std::io::Error| self.error(line, RaysTextErrorKind::Io(e.to_string()));
+        let io = |e: std::io::Error| self.error(line, RaysTextErrorKind::Io(e.into()));
         let mut file = File::open(&self.path).map_err(io)?;
         file.seek(SeekFrom::Start(offset)).map_err(io)?;
         let mut lines = NumberedLines::new(BufReader::new(file), &self.name, line - 1);

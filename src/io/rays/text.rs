@@ -71,7 +71,7 @@ pub enum RaysTextErrorKind {
     BadRun(String),
     /// The file could not be read.
     #[error("cannot read: {0}")]
-    Io(String),
+    Io(crate::fs::IoCause),
 }
 
 /// An error in a ray file, with where it happened.
@@ -95,7 +95,14 @@ impl fmt::Display for RaysTextError {
     }
 }
 
-impl std::error::Error for RaysTextError {}
+impl std::error::Error for RaysTextError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &self.kind {
+            RaysTextErrorKind::Io(cause) => Some(cause.error()),
+            _ => None,
+        }
+    }
+}
 
 /// Reads a ray file into a ray set of the dimension its header names.
 ///
@@ -161,7 +168,7 @@ pub fn read_rays_file(path: &Path) -> Result<AnyRaySet, RaysTextError> {
     let file = std::fs::File::open(path).map_err(|e| RaysTextError {
         file: name.clone(),
         line: 0,
-        kind: RaysTextErrorKind::Io(e.to_string()),
+        kind: RaysTextErrorKind::Io(e.into()),
     })?;
     read_rays(std::io::BufReader::new(file), &name)
 }
@@ -307,7 +314,7 @@ impl<'a, R: BufRead> NumberedLines<'a, R> {
             let n = self
                 .reader
                 .read_line(&mut self.buf)
-                .map_err(|e| self.error(self.line + 1, RaysTextErrorKind::Io(e.to_string())))?;
+                .map_err(|e| self.error(self.line + 1, RaysTextErrorKind::Io(e.into())))?;
             if n == 0 {
                 return Ok(None);
             }

@@ -1,6 +1,6 @@
 //! The `.ktree` file, version 2: one word-aligned, checksummed section per tree level, written as a stream
 //! ([`KtreeWriter`]) and read by memory-mapping ([`KtreeView`], [`MappedTree`]). The byte layout and the checks
-//! are described in [`layout`].
+//! are described in the `layout` module's docs (and the README).
 
 mod check;
 pub(crate) mod layout;

@@ -55,7 +55,7 @@ impl KtreeView {
         let io_error = |offset: u64, e: std::io::Error| KtreeFileError {
             file: name.clone(),
             offset,
-            kind: KtreeFileErrorKind::Io(e.to_string()),
+            kind: KtreeFileErrorKind::Io(e.into()),
         };
         let file = File::open(path).map_err(|e| io_error(0, e))?;
         let len = file.metadata().map_err(|e| io_error(0, e))?.len();
