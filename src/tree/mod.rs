@@ -21,6 +21,7 @@ mod ktree;
 mod operators;
 mod states;
 mod to_rays;
+pub(crate) mod words;
 
 pub(crate) use any::from_typed;
 pub use any::{AnyTree, TreeStats};
