@@ -106,6 +106,13 @@ fn partials_in(words: &[u64]) -> u64 {
     n
 }
 
+#[cold]
+#[inline(never)]
+#[track_caller]
+pub(crate) fn node_out_of_range(i: usize, len: usize) -> ! {
+    panic!("node {i} of a level of {len} nodes")
+}
+
 impl PackedStates {
     /// An empty level.
     pub(crate) fn new() -> Self {
@@ -227,10 +234,24 @@ impl PackedStates {
         self.len == 0
     }
 
-    /// The state of node `i` (`i < len`).
+    /// The state of node `i`.
+    ///
+    /// ```
+    /// use ktree::{tree::PackedStates, NodeState};
+    /// let level = PackedStates::from_words(vec![0b10_01_00], 3).unwrap();
+    /// assert_eq!(level.get(2), NodeState::Partial);
+    /// ```
+    ///
+    /// # Panics
+    /// If `i ≥ len`, in release builds as in debug ones (the slots past the end of the last word are
+    /// padding, not nodes). Indexing, as of a slice: the trees' invariants keep the indices their navigation
+    /// computes in range, so an index out of range is a caller's bug, not a state.
     #[inline]
+    #[track_caller]
     pub fn get(&self, i: usize) -> NodeState {
-        debug_assert!(i < self.len);
+        if i >= self.len {
+            node_out_of_range(i, self.len);
+        }
         NodeState::from_bits((self.words[i / NODES_PER_WORD] >> (2 * (i % NODES_PER_WORD))) as u32)
     }
 
@@ -366,6 +387,13 @@ mod tests {
             assert_eq!(packed.partial_rank(i), i);
         }
         assert_eq!(packed.partial_count(), n);
+    }
+
+    #[test]
+    #[should_panic(expected = "node 5 of a level of 3 nodes")]
+    fn get_past_the_end_panics_rather_than_reading_padding() {
+        let level = PackedStates::from_words(vec![0b10_01_00], 3).unwrap();
+        let _ = level.get(5);
     }
 
     #[test]
