@@ -42,7 +42,7 @@ impl NodeState {
     }
 }
 
-use super::words::{full_count, partial_mask, unused_mask, NODES_PER_WORD};
+use super::words::{full_count, partial_count, partial_mask, unused_mask, NODES_PER_WORD};
 use super::TreeError;
 
 /// Words per rank block: 256 nodes share one 16-bit block rank.
@@ -101,7 +101,7 @@ fn partials_in(words: &[u64]) -> u64 {
         n += u64::from((partial_mask(p[0]) | partial_mask(p[1]) << 1).count_ones());
     }
     if let [w] = pairs.remainder() {
-        n += u64::from(partial_mask(*w).count_ones());
+        n += u64::from(partial_count(*w));
     }
     n
 }
