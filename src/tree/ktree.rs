@@ -143,7 +143,7 @@ pub type Tree4 = KTree<4>;
 /// let tree = KTree::<1>::from_dense(1, &[true, false]).unwrap();
 /// let root = tree.root();
 /// assert_eq!((root.index(), root.depth(), root.state()), (0, 0, NodeState::Partial));
-/// let kids: Vec<_> = tree.children(&root).map(|c| (c.cell().origin, c.state())).collect();
+/// let kids: Vec<_> = tree.children(&root).map(|c| (c.cell().origin(), c.state())).collect();
 /// assert_eq!(kids, [([0], NodeState::Full), ([1], NodeState::Empty)]);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
