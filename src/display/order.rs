@@ -19,8 +19,8 @@
 //! let tree = KTree::<3>::from_dense(1, &dense).unwrap();
 //! let mut seen = Vec::new();
 //! walk_ordered(&tree, Viewer::Direction([-1.0, 0.0, 0.0]), Order::FrontToBack, |n| {
-//!     if n.state == ktree::NodeState::Full {
-//!         seen.push(n.cell.origin()[0]);
+//!     if n.state() == ktree::NodeState::Full {
+//!         seen.push(n.cell().origin()[0]);
 //!     }
 //!     Walk::Descend
 //! });
@@ -96,7 +96,7 @@ pub fn child_at<const K: usize>(near: usize, j: usize, order: Order) -> usize {
 /// let tree = stack(&ball_rays::<3>(4, [16, 16, 16], 14).unwrap());
 /// let mut full = 0;
 /// walk_ordered(&tree, Viewer::Direction([1.0, 0.5, -0.2]), Order::FrontToBack, |n| {
-///     full += usize::from(n.state == ktree::NodeState::Full);
+///     full += usize::from(n.state() == ktree::NodeState::Full);
 ///     Walk::Descend
 /// });
 /// assert_eq!(full, tree.full_cells().count());

@@ -41,7 +41,6 @@ pub use interop::{
     GridFileErrorKind, GridMeta, GridPlacement, PlacedTree, BINVOX_MAX_DIM, BT_DEPTH, BT_HEADER,
 };
 pub use ktree::v1::write_ktree_v1;
-pub(crate) use ktree::v2::{slots_mask, WordPacker, LOW_BITS, NODES_PER_WORD};
 pub use ktree::v2::{write_ktree_v2, write_ktree_v2_file};
 pub use ktree::{
     ktree_file_version, read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file,

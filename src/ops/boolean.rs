@@ -15,6 +15,7 @@
 use super::emit::{collapse, leaf, LevelWriter};
 use super::OpsError;
 use crate::tree::cursor::{walk_pair, PairNode, PairVisitor, Walk};
+use crate::tree::words::{self, NODES_PER_WORD};
 use crate::tree::{KTree, NodeState};
 
 /// A binary Boolean operation.
@@ -248,25 +249,16 @@ pub fn symmetric_difference<const K: usize>(
 /// assert_eq!(complement(&a).to_dense().unwrap(), [false, true, true, true]);
 /// ```
 pub fn complement<const K: usize>(a: &KTree<K>) -> KTree<K> {
-    const LOW: u64 = 0x5555_5555_5555_5555;
     let levels = (0..a.depth_count())
         .map(|d| {
             let l = a.level_states(d);
             let n = l.len();
+            // Whole words complemented; the last word only in its used slots.
             let words: Vec<u64> = l
                 .words()
                 .iter()
                 .enumerate()
-                .map(|(w, &word)| {
-                    let used = (n - 32 * w).min(32);
-                    let valid = if used == 32 {
-                        u64::MAX
-                    } else {
-                        (1u64 << (2 * used)) - 1
-                    };
-                    // A slot that is not partial (high bit clear) gets its low bit flipped.
-                    word ^ (!(word >> 1) & LOW & valid)
-                })
+                .map(|(w, &word)| words::complement(word, n - NODES_PER_WORD * w))
                 .collect();
             l.with_same_partials(words)
         })

@@ -39,10 +39,12 @@ use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
 use super::BoolOp;
-use crate::io::{
-    slots_mask, KtreeFileError, KtreeView, KtreeWriter, WordPacker, LOW_BITS, NODES_PER_WORD,
-};
+use crate::io::{KtreeFileError, KtreeView, KtreeWriter};
+use crate::tree::words::{self, WordPacker};
 use crate::tree::{LevelCounts, NodeState};
+
+/// Nodes in a word, counted as the file's node counts are.
+const NODES_PER_WORD: u64 = words::NODES_PER_WORD as u64;
 
 /// Bytes of each I/O buffer (one per output level, one for the output).
 pub const BUFFER_BYTES: usize = 1 << 16;
@@ -383,10 +385,7 @@ impl Walk<'_, '_> {
         if children.iter().all(|&c| c == NodeState::Empty) {
             return Ok(NodeState::Empty);
         }
-        let word = children
-            .iter()
-            .enumerate()
-            .fold(0u64, |w, (j, &c)| w | (c as u64) << (2 * j));
+        let word = words::pack(children);
         self.levels.append(depth + 1, word, children.len() as u64)?;
         Ok(NodeState::Partial)
     }
@@ -428,7 +427,7 @@ impl OutputLevels {
     fn append(&mut self, depth: usize, word: u64, nodes: u64) -> Result<(), BooleanFileError> {
         let level = &mut self.levels[depth - 1];
         level.nodes += nodes;
-        if let Some(whole) = level.packer.push(word, nodes) {
+        if let Some(whole) = level.packer.push(word, nodes as usize) {
             level
                 .file
                 .write_all(&whole.to_le_bytes())
@@ -458,18 +457,17 @@ impl OutputLevels {
         let mut partial = 0;
         while at < start + nodes {
             let take = (start + nodes - at).min(NODES_PER_WORD);
-            let (j, off) = (at / NODES_PER_WORD, at % NODES_PER_WORD);
-            let mut word = view.level_word(depth, j) >> (2 * off);
-            if off > 0 && j + 1 < words {
-                word |= view.level_word(depth, j + 1) << (2 * (NODES_PER_WORD - off));
-            }
-            let word = word & slots_mask(take);
-            let partials = (word >> 1) & !word & LOW_BITS;
-            partial += u64::from(partials.count_ones());
+            let word = words::read_codes(
+                |j| view.level_word(depth, j as u64),
+                words as usize,
+                at as usize,
+                take as usize,
+            );
+            partial += u64::from(words::partial_count(word));
             let word = match copy {
                 Polarity::Same => word,
-                // Full and empty swap (flip the low bit of every non-partial slot); partial stays.
-                Polarity::Complement => word ^ (!(word >> 1) & LOW_BITS & slots_mask(take)),
+                // Full and empty swap; partial stays.
+                Polarity::Complement => words::complement(word, take as usize),
             };
             self.append(depth, word, take)?;
             at += take;

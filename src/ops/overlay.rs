@@ -34,7 +34,7 @@
 use super::emit::{collapse, leaf, LevelWriter};
 use crate::space::Cell;
 use crate::tree::cursor::voxel_state;
-use crate::tree::{KTree, NodeRef, NodeState};
+use crate::tree::{KTree, NodeState};
 
 /// How target voxels map back into the source universe.
 pub trait Preimage<const K: usize> {
@@ -154,11 +154,7 @@ impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
         let Some(e) = near.map(|k| self.overlay[k]).find(|e| e.cell.contains(p)) else {
             return self.src.contains(p);
         };
-        let start = NodeRef {
-            index: e.index,
-            cell: e.cell,
-            state: self.src.state(e.depth, e.index),
-        };
+        let start = self.src.node_at(e.index, e.cell);
         voxel_state(self.src, &start, p) == NodeState::Full
     }
 

@@ -195,7 +195,6 @@ fn permutations<const K: usize>(
 pub fn rotate_axes<const K: usize>(tree: &KTree<K>, map: &AxisMap<K>) -> KTree<K> {
     let table = map.child_table();
     let fanout = 1usize << K;
-    let block_mask = (1u64 << (2 * fanout)) - 1;
     let mut out = LevelWriter::new();
     out.push(0, tree.root_state());
     // Level by level: the source indices of the output's partial nodes at `depth`, in output order. Each
@@ -206,11 +205,11 @@ pub fn rotate_axes<const K: usize>(tree: &KTree<K>, map: &AxisMap<K>) -> KTree<K
     }
     let mut depth = 0;
     while !partials.is_empty() {
-        let words = tree.level_states(depth + 1).words();
+        let below = tree.level_states(depth + 1);
         let mut next = Vec::with_capacity(partials.len() * 2);
         for &index in &partials {
             let first = tree.first_child(depth, index);
-            let block = (words[first / 32] >> (2 * (first % 32))) & block_mask;
+            let block = below.block_codes(first, K);
             let mut kids = [NodeState::Empty; 16];
             for (kid, &src) in kids.iter_mut().zip(&table[..fanout]) {
                 *kid = match block >> (2 * src) & 3 {

@@ -12,7 +12,7 @@ use std::collections::BinaryHeap;
 use super::boolean::same_level;
 use super::OpsError;
 use crate::space::Cell;
-use crate::tree::{KTree, NodeRef, NodeState};
+use crate::tree::{KTree, NodeState};
 
 /// Squared distance between the nearest voxel centres of two cells.
 fn gap2<const K: usize>(a: &Cell<K>, b: &Cell<K>) -> u128 {
@@ -48,11 +48,7 @@ pub fn min_separation<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Opti
     same_level(a, b)?;
     // A pair: (depth, index, cell) of a node of a, of b; the heap pops the smallest bound first.
     type Side<const K: usize> = (usize, usize, Cell<K>);
-    let node = |tree: &KTree<K>, s: Side<K>| NodeRef {
-        index: s.1,
-        cell: s.2,
-        state: tree.state(s.0, s.1),
-    };
+    let node = |tree: &KTree<K>, s: Side<K>| tree.node_at(s.1, s.2);
     let root = a.universe().root();
     // The heap orders small entries (bound, shallowness, place in `pairs`); the pairs stay put. Among
     // equal bounds the deepest pair comes first: it is the nearest to a pair of full leaves.

@@ -68,6 +68,7 @@ use rayon::prelude::*;
 use super::partition::{slab_pieces, top_levels, top_levels_dense, Piece, RaySource};
 
 use crate::io::{write_atomic_with, KtreeWriter};
+use crate::tree::words::unused_mask;
 use crate::tree::{LevelCounts, NodeState, PackedStates};
 
 /// Bytes accounted for each run of a slab being stacked: the runs and their copies while they are cut
@@ -673,7 +674,7 @@ impl SpilledPart {
                 }
                 for (a, b) in own.iter_mut().zip(cell_part) {
                     let both = *a | b;
-                    if both & (both >> 1) & 0x5555_5555_5555_5555 != 0 {
+                    if unused_mask(both) != 0 {
                         return Err(bad("a cell state code 11, or a cell of two parts"));
                     }
                     *a = both;

@@ -30,6 +30,7 @@ use rayon::prelude::*;
 use super::stack_bitmap;
 use crate::rays::RaySet;
 use crate::space::{morton_encode, Universe};
+use crate::tree::words::LevelWords;
 use crate::tree::{KTree, NodeState, PackedStates};
 
 /// The runs of one slab of columns: the column keys (as [`RaySet::column_key`], non-decreasing) and the
@@ -509,9 +510,9 @@ fn join_pieces<const K: usize>(
             let mut out = LevelWords::default();
             for t in trees.iter().filter(|t| t.depth_count() > j) {
                 let s = t.level_states(j);
-                out.append(s.words(), s.len());
+                out.append_words(s.words(), s.len());
             }
-            out.into_states()
+            into_states(out)
         })
         .collect();
     levels.extend(deeper);
@@ -635,35 +636,10 @@ pub(super) fn top_levels_dense(k: u32, m: u32, base: PackedStates) -> Vec<Packed
     levels
 }
 
-/// A level being concatenated: 2-bit codes in words, node `i` at bits `2(i mod 32)` of word `i / 32`.
-#[derive(Debug, Default)]
-struct LevelWords {
-    words: Vec<u64>,
-    len: usize,
-}
-
-impl LevelWords {
-    /// Appends `len` nodes given as packed words (bits beyond `len` zero), shifting them into place.
-    fn append(&mut self, words: &[u64], len: usize) {
-        let offset = 2 * (self.len % 32) as u32;
-        if offset == 0 {
-            self.words.extend_from_slice(&words[..len.div_ceil(32)]);
-        } else {
-            self.words.reserve(words.len());
-            for &w in &words[..len.div_ceil(32)] {
-                let last = self.words.len() - 1;
-                self.words[last] |= w << offset;
-                self.words.push(w >> (64 - offset));
-            }
-        }
-        self.len += len;
-        self.words.truncate(self.len.div_ceil(32));
-    }
-
-    fn into_states(self) -> PackedStates {
-        PackedStates::from_words(self.words, self.len)
-            .expect("concatenated levels hold valid 2-bit codes")
-    }
+/// The level of concatenated subtree levels.
+fn into_states(level: LevelWords) -> PackedStates {
+    let (words, len) = level.into_words();
+    PackedStates::from_words(words, len).expect("concatenated levels hold valid 2-bit codes")
 }
 
 #[cfg(test)]
@@ -686,9 +662,9 @@ mod tests {
                 expected.push(s);
             }
             part.finish();
-            joined.append(part.words(), part.len());
+            joined.append_words(part.words(), part.len());
         }
         expected.finish();
-        assert_eq!(joined.into_states(), expected);
+        assert_eq!(into_states(joined), expected);
     }
 }

@@ -7,6 +7,7 @@
 use super::cursor::subtree_ranges;
 use super::ktree::KTree;
 use super::states::{NodeState, PackedStates};
+use super::words::{pack, LevelWords};
 use super::TreeError;
 use crate::space::{Cell, DimCheck, SpaceError, Universe};
 
@@ -55,65 +56,6 @@ pub(crate) struct LevelWriter {
     levels: Vec<LevelWords>,
 }
 
-/// One level being written: node `i` at bits `2(i mod 32)` of word `i / 32`.
-#[derive(Debug, Clone, Default)]
-struct LevelWords {
-    words: Vec<u64>,
-    len: usize,
-}
-
-const LOW_BITS: u64 = 0x5555_5555_5555_5555;
-
-/// The low `2·slots` bits set (`slots ≤ 32`).
-#[inline]
-fn slot_mask(slots: usize) -> u64 {
-    if slots >= 32 {
-        u64::MAX
-    } else {
-        (1u64 << (2 * slots)) - 1
-    }
-}
-
-impl LevelWords {
-    /// Appends `slots ≤ 32` states packed in the low bits of `chunk` (higher bits clear).
-    #[inline]
-    fn append(&mut self, chunk: u64, slots: usize) {
-        let offset = self.len % 32;
-        if offset == 0 {
-            self.words.push(chunk);
-        } else {
-            let last = self.words.len() - 1;
-            self.words[last] |= chunk << (2 * offset);
-            if offset + slots > 32 {
-                self.words.push(chunk >> (64 - 2 * offset));
-            }
-        }
-        self.len += slots;
-    }
-
-    /// Appends the states `start .. start + n` of the packed `src`, leaves complemented if `invert`.
-    fn append_range(&mut self, src: &[u64], start: usize, n: usize, invert: bool) {
-        self.words.reserve(n.div_ceil(32) + 1);
-        let mut at = start;
-        let end = start + n;
-        while at < end {
-            let slots = (end - at).min(32);
-            let (w, s) = (at / 32, 2 * (at % 32));
-            let mut chunk = src[w] >> s;
-            if s > 0 && w + 1 < src.len() {
-                chunk |= src[w + 1] << (64 - s);
-            }
-            let valid = slot_mask(slots);
-            chunk &= valid;
-            if invert {
-                chunk ^= !(chunk >> 1) & LOW_BITS & valid;
-            }
-            self.append(chunk, slots);
-            at += slots;
-        }
-    }
-}
-
 impl LevelWriter {
     /// An empty writer.
     pub(crate) fn new() -> Self {
@@ -122,7 +64,7 @@ impl LevelWriter {
 
     /// Whether nothing was written.
     pub(crate) fn is_empty(&self) -> bool {
-        self.levels.iter().all(|l| l.len == 0)
+        self.levels.iter().all(|l| l.len() == 0)
     }
 
     #[inline]
@@ -136,17 +78,13 @@ impl LevelWriter {
     /// Appends a node at `depth`.
     #[inline]
     pub(crate) fn push(&mut self, depth: usize, state: NodeState) {
-        self.level(depth).append(state as u64, 1);
+        self.level(depth).push(state as u64, 1);
     }
 
     /// Appends a block of sibling states (at most 32) at `depth`.
     #[inline]
     pub(crate) fn push_block(&mut self, depth: usize, kids: &[NodeState]) {
-        let chunk = kids
-            .iter()
-            .enumerate()
-            .fold(0u64, |w, (i, &s)| w | (s as u64) << (2 * i));
-        self.level(depth).append(chunk, kids.len());
+        self.level(depth).push(pack(kids), kids.len());
     }
 
     /// Appends the descendants of node `index` at `depth` of `tree` (not the node itself), the node's
@@ -178,7 +116,7 @@ impl LevelWriter {
 
     /// The levels written, without trailing empty levels (at least one level).
     pub(crate) fn finish(mut self) -> Vec<PackedStates> {
-        while self.levels.len() > 1 && self.levels.last().is_some_and(|l| l.len == 0) {
+        while self.levels.len() > 1 && self.levels.last().is_some_and(|l| l.len() == 0) {
             self.levels.pop();
         }
         if self.levels.is_empty() {
@@ -187,7 +125,8 @@ impl LevelWriter {
         self.levels
             .into_iter()
             .map(|l| {
-                PackedStates::from_words(l.words, l.len)
+                let (words, len) = l.into_words();
+                PackedStates::from_words(words, len)
                     .expect("the writer only stores valid 2-bit codes")
             })
             .collect()
@@ -205,7 +144,7 @@ impl LevelWriter {
         }
         let root_level = self.level(0);
         *root_level = LevelWords::default();
-        root_level.append(root as u64, 1);
+        root_level.push(root as u64, 1);
         KTree::from_levels(universe, self.finish())
     }
 }

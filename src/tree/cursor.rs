@@ -16,8 +16,8 @@
 //! struct FirstBig(Option<u64>);
 //! impl Visitor<1> for FirstBig {
 //!     fn visit(&mut self, node: &NodeRef<1>) -> Walk {
-//!         if node.state == NodeState::Full && node.cell.side() >= 2 {
-//!             self.0 = Some(node.cell.side());
+//!         if node.state() == NodeState::Full && node.cell().side() >= 2 {
+//!             self.0 = Some(node.cell().side());
 //!             return Walk::Stop;
 //!         }
 //!         Walk::Descend
@@ -31,7 +31,7 @@
 
 use smallvec::SmallVec;
 
-use super::ktree::{KTree, NodeRef};
+use super::ktree::{KTree, NodeRef, TreeId};
 use super::states::NodeState;
 use crate::space::{Cell, Universe};
 
@@ -66,6 +66,7 @@ pub trait LevelOrder<const K: usize> {
             index: 0,
             cell: self.universe().root(),
             state: self.root_state(),
+            tree: TreeId::NONE,
         }
     }
 
@@ -102,6 +103,11 @@ impl<const K: usize> LevelOrder<K> for KTree<K> {
     #[inline]
     fn root_state(&self) -> NodeState {
         KTree::root_state(self)
+    }
+
+    #[inline]
+    fn root(&self) -> NodeRef<K> {
+        KTree::root(self)
     }
 
     #[inline(always)]
@@ -277,6 +283,7 @@ fn child_ref<const K: usize>(
         index: first + code,
         cell: step(&node.cell, code, origins),
         state: tree.state(node.cell.level as usize + 1, first + code),
+        tree: node.tree,
     }
 }
 
@@ -287,11 +294,16 @@ pub fn walk<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(tree: &T, visitor: 
 
 /// Walks the subtree of `node` (a node of `tree`) depth first with `visitor`. Returns `true` if the
 /// visitor stopped the walk.
+///
+/// # Panics
+/// If `node` is a node of another tree (see [`NodeRef`]).
+#[track_caller]
 pub fn walk_from<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(
     tree: &T,
     node: NodeRef<K>,
     v: &mut V,
 ) -> bool {
+    node.assert_of(tree.root().tree);
     // Depth first with an explicit stack: a node to visit, or a partial node to leave once the entries
     // above it (its children's) are done.
     // Inline up to 64 entries: the narrow walks (a face, an edge, a point) run without allocating.
@@ -323,6 +335,7 @@ pub fn walk_from<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(
                     index: first + code,
                     cell: step(&node.cell, code, V::ORIGINS),
                     state: NodeState::from_bits(codes >> (2 * code)),
+                    tree: node.tree,
                 },
                 false,
             ));
@@ -498,10 +511,20 @@ fn descend_pair<const K: usize, V: PairVisitor<K>>(
 /// use ktree::tree::cursor::child;
 /// use ktree::{KTree, NodeState};
 /// let tree = KTree::<1>::from_dense(1, &[false, true]).unwrap();
-/// assert_eq!(child(&tree, &tree.root(), 1).state, NodeState::Full);
+/// assert_eq!(child(&tree, &tree.root(), 1).state(), NodeState::Full);
 /// ```
+///
+/// # Panics
+/// If `node` is a node of another tree (see [`NodeRef`]), is not partial, or `code ≥ 2^K`.
 #[inline]
+#[track_caller]
 pub fn child<const K: usize>(tree: &KTree<K>, node: &NodeRef<K>, code: usize) -> NodeRef<K> {
+    node.assert_of(tree.id());
+    assert!(
+        node.state == NodeState::Partial && code < KTree::<K>::FANOUT,
+        "child {code} of a {:?} node of a K = {K} tree",
+        node.state
+    );
     let first = tree.first_child(node.cell.level as usize, node.index);
     child_ref(tree, node, first, code, true)
 }
@@ -516,10 +539,15 @@ pub fn child<const K: usize>(tree: &KTree<K>, node: &NodeRef<K>, code: usize) ->
 /// let tree = KTree::<1>::from_dense(2, &[false, true, true, true]).unwrap();
 /// let voxel = tree.universe().cell([3], 2).unwrap();
 /// let node = locate(&tree, tree.root(), &voxel);
-/// assert_eq!((node.state, node.cell.side()), (NodeState::Full, 2));
+/// assert_eq!((node.state(), node.cell().side()), (NodeState::Full, 2));
 /// ```
+///
+/// # Panics
+/// If `start` is a node of another tree (see [`NodeRef`]).
 #[inline]
+#[track_caller]
 pub fn locate<const K: usize>(tree: &KTree<K>, start: NodeRef<K>, target: &Cell<K>) -> NodeRef<K> {
+    start.assert_of(tree.id());
     descend(tree, start, target, |_| {})
 }
 
@@ -572,6 +600,8 @@ pub struct Locator<const K: usize> {
     len: usize,
     /// The origin of the last target.
     last: [u32; K],
+    /// The tree the path is in.
+    tree: TreeId,
 }
 
 impl<const K: usize> Locator<K> {
@@ -583,11 +613,20 @@ impl<const K: usize> Locator<K> {
             path,
             len: 1,
             last: [0; K],
+            tree: tree.id(),
         }
     }
 
     /// As [`locate`] from the root of `tree` (the tree the locator was made for).
+    ///
+    /// # Panics
+    /// If `tree` is not the tree (or a clone of the tree) the locator was made for.
+    #[track_caller]
     pub fn locate(&mut self, tree: &KTree<K>, target: &Cell<K>) -> NodeRef<K> {
+        assert!(
+            self.tree == tree.id(),
+            "a Locator is used only with the tree (or a clone of the tree) it was made for"
+        );
         let top = tree.level();
         // The depth down to which the last target's ancestors are the target's.
         let differ = (0..K)
@@ -605,6 +644,7 @@ impl<const K: usize> Locator<K> {
                 log_side: top - depth as u32,
             },
             state,
+            tree: self.tree,
         };
         let path = &mut self.path;
         let node = descend(tree, start, target, |n| {
@@ -626,12 +666,17 @@ impl<const K: usize> Locator<K> {
 /// assert_eq!(voxel_state(&tree, &tree.root(), [0]), NodeState::Empty);
 /// assert_eq!(voxel_state(&tree, &tree.root(), [3]), NodeState::Full);
 /// ```
+///
+/// # Panics
+/// If `start` is a node of another tree (see [`NodeRef`]).
 #[inline(always)]
+#[track_caller]
 pub fn voxel_state<const K: usize>(
     tree: &KTree<K>,
     start: &NodeRef<K>,
     point: [u32; K],
 ) -> NodeState {
+    start.assert_of(tree.id());
     let (mut depth, mut index) = (start.cell.level as usize, start.index);
     let (mut state, mut log_side) = (start.state, start.cell.log_side);
     while state == NodeState::Partial {

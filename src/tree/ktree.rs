@@ -1,6 +1,8 @@
 //! `KTree<K>`: a compact, pointer-free, navigable k-tree in level order.
 
-use super::states::{NodeState, PackedStates};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use super::states::{node_out_of_range, NodeState, PackedStates};
 use super::TreeError;
 use crate::rays::RaySet;
 use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
@@ -80,10 +82,43 @@ impl LevelCounts {
 /// assert!((&a | &KTree::<1>::full(3)?).is_err()); // another universe
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone)]
 pub struct KTree<const K: usize> {
     universe: Universe<K>,
     levels: Vec<PackedStates>,
+    /// Which tree this is, for its [`NodeRef`]s: not part of the object (`==` ignores it); a clone keeps it.
+    id: TreeId,
+}
+
+impl<const K: usize> PartialEq for KTree<K> {
+    fn eq(&self, other: &Self) -> bool {
+        self.universe == other.universe && self.levels == other.levels
+    }
+}
+
+impl<const K: usize> Eq for KTree<K> {}
+
+impl<const K: usize> std::hash::Hash for KTree<K> {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.universe.hash(state);
+        self.levels.hash(state);
+    }
+}
+
+/// The identity of a built tree: the trees of one process get distinct ones, so that a [`NodeRef`] knows
+/// the tree it belongs to. `TreeId::NONE` marks nodes of a tree without one (a memory-mapped tree).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(crate) struct TreeId(u64);
+
+impl TreeId {
+    /// No identity.
+    pub(crate) const NONE: TreeId = TreeId(0);
+
+    /// A new identity, distinct from every other one handed out in this process.
+    fn fresh() -> Self {
+        static NEXT: AtomicU64 = AtomicU64::new(1);
+        TreeId(NEXT.fetch_add(1, Ordering::Relaxed))
+    }
 }
 
 /// A bintree (K = 1).
@@ -95,15 +130,78 @@ pub type Octree = KTree<3>;
 /// A 4-D (e.g. time-space) tree (K = 4).
 pub type Tree4 = KTree<4>;
 
-/// A node of a tree, as seen while navigating: its position in level order and its cell.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A node of a tree, as seen while navigating: its position in level order, its cell and its state.
+///
+/// A `NodeRef` comes from the tree it belongs to ([`KTree::root`], [`KTree::children`], the walks of
+/// [`crate::tree::cursor`]) and is navigated in that tree (or a clone of it) only: given to another tree's
+/// [`KTree::children`], [`cursor::child`](crate::tree::cursor::child),
+/// [`cursor::walk_from`](crate::tree::cursor::walk_from) or the other functions of the cursor that take a
+/// node, it makes them panic with a message saying so, rather than read another tree's nodes.
+///
+/// ```
+/// use ktree::{KTree, NodeState};
+/// let tree = KTree::<1>::from_dense(1, &[true, false]).unwrap();
+/// let root = tree.root();
+/// assert_eq!((root.index(), root.depth(), root.state()), (0, 0, NodeState::Partial));
+/// let kids: Vec<_> = tree.children(&root).map(|c| (c.cell().origin(), c.state())).collect();
+/// assert_eq!(kids, [([0], NodeState::Full), ([1], NodeState::Empty)]);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct NodeRef<const K: usize> {
     /// Index of the node within its level.
-    pub index: usize,
+    pub(crate) index: usize,
     /// The node's cell (its level is the node's depth).
-    pub cell: Cell<K>,
+    pub(crate) cell: Cell<K>,
     /// The node's state.
-    pub state: NodeState,
+    pub(crate) state: NodeState,
+    /// The tree the node belongs to.
+    pub(crate) tree: TreeId,
+}
+
+impl<const K: usize> NodeRef<K> {
+    /// The node's index within its level (level order).
+    #[inline]
+    pub fn index(&self) -> usize {
+        self.index
+    }
+
+    /// The node's cell; its level is the node's depth.
+    #[inline]
+    pub fn cell(&self) -> Cell<K> {
+        self.cell
+    }
+
+    /// The node's depth (0 for the root), the level of its cell.
+    #[inline]
+    pub fn depth(&self) -> usize {
+        self.cell.level as usize
+    }
+
+    /// The node's state.
+    #[inline]
+    pub fn state(&self) -> NodeState {
+        self.state
+    }
+
+    /// Panics unless the node belongs to the tree of identity `tree`: the one check behind every function
+    /// that navigates from a given node.
+    #[inline]
+    #[track_caller]
+    pub(crate) fn assert_of(&self, tree: TreeId) {
+        if self.tree != tree {
+            node_of_another_tree(self.cell.level, self.index);
+        }
+    }
+}
+
+#[cold]
+#[inline(never)]
+#[track_caller]
+fn node_of_another_tree(depth: u32, index: usize) -> ! {
+    panic!(
+        "the node at depth {depth}, index {index} belongs to another tree: a NodeRef is navigated only in \
+         the tree (or a clone of the tree) it came from"
+    )
 }
 
 impl<const K: usize> KTree<K> {
@@ -132,10 +230,7 @@ impl<const K: usize> KTree<K> {
         let mut root = PackedStates::with_capacity(1);
         root.push(state);
         root.finish();
-        Ok(Self {
-            universe,
-            levels: vec![root],
-        })
+        Ok(Self::from_levels(universe, vec![root]))
     }
 
     /// The tree of the given levels (level 0 holds the root; see [`KTree`] for the layout), checked by
@@ -157,12 +252,33 @@ impl<const K: usize> KTree<K> {
         let () = DimCheck::<K>::OK;
         let universe = Universe::new(level)?;
         check_levels::<K>(level, &levels)?;
-        Ok(Self { universe, levels })
+        Ok(Self::from_levels(universe, levels))
     }
 
     /// Assembles a tree from its levels. The caller guarantees the structure (see [`KTree::check`]).
     pub(crate) fn from_levels(universe: Universe<K>, levels: Vec<PackedStates>) -> Self {
-        Self { universe, levels }
+        Self {
+            universe,
+            levels,
+            id: TreeId::fresh(),
+        }
+    }
+
+    /// The node `index` of the level of `cell` (the caller vouches that the node's cell is `cell`).
+    #[inline]
+    pub(crate) fn node_at(&self, index: usize, cell: Cell<K>) -> NodeRef<K> {
+        NodeRef {
+            index,
+            cell,
+            state: self.state(cell.level as usize, index),
+            tree: self.id,
+        }
+    }
+
+    /// The tree's identity, carried by its [`NodeRef`]s.
+    #[inline]
+    pub(crate) fn id(&self) -> TreeId {
+        self.id
     }
 
     /// The tree of a ray set, by stacking ([`crate::stacking::stack`]); also `KTree::from(&rays)`.
@@ -204,16 +320,30 @@ impl<const K: usize> KTree<K> {
     }
 
     /// The state of node `index` at `depth`.
+    ///
+    /// # Panics
+    /// If the tree has no level `depth` or the level no node `index` ([`KTree::depth_count`],
+    /// [`PackedStates::len`]).
+    #[track_caller]
     pub fn state(&self, depth: usize, index: usize) -> NodeState {
         self.levels[depth].get(index)
     }
 
     /// The level-order index of the first child of the partial node `index` at `depth`
     /// (its children are this index and the next `2^K − 1`, at `depth + 1`).
+    ///
+    /// # Panics
+    /// If the node does not exist, as [`KTree::state`]; in debug builds also if it is not partial (a leaf
+    /// has no children: the index returned is then that of the next partial node's first child).
     #[inline]
+    #[track_caller]
     pub fn first_child(&self, depth: usize, index: usize) -> usize {
-        debug_assert_eq!(self.levels[depth].get(index), NodeState::Partial);
-        self.levels[depth].partial_rank(index) << K
+        let level = &self.levels[depth];
+        debug_assert_eq!(level.get(index), NodeState::Partial);
+        if index >= level.len() {
+            node_out_of_range(index, level.len());
+        }
+        level.partial_rank(index) << K
     }
 
     /// The total number of nodes.
@@ -265,11 +395,17 @@ impl<const K: usize> KTree<K> {
             index: 0,
             cell: self.universe.root(),
             state: self.root_state(),
+            tree: self.id,
         }
     }
 
-    /// The children of a partial node, in child-code order (empty for a leaf).
+    /// The children of a partial node of this tree, in child-code order (empty for a leaf).
+    ///
+    /// # Panics
+    /// If `node` is a node of another tree (see [`NodeRef`]).
+    #[track_caller]
     pub fn children(&self, node: &NodeRef<K>) -> impl Iterator<Item = NodeRef<K>> + '_ {
+        node.assert_of(self.id);
         let (first, count) = if node.state == NodeState::Partial {
             (
                 self.first_child(node.cell.level as usize, node.index),
@@ -280,10 +416,12 @@ impl<const K: usize> KTree<K> {
         };
         let depth = node.cell.level as usize + 1;
         let cell = node.cell;
+        let tree = self.id;
         (0..count).map(move |code| NodeRef {
             index: first + code,
             cell: cell.child(code),
             state: self.levels[depth].get(first + code),
+            tree,
         })
     }
 
@@ -503,4 +641,108 @@ pub fn heap_bytes_for_levels(per_level: &[LevelCounts]) -> usize {
         .map(|l| PackedStates::heap_bytes_for(l.nodes() as usize))
         .sum::<usize>()
         + per_level.len() * std::mem::size_of::<PackedStates>()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tree::cursor::{child, locate, walk_from, Locator, Visitor, Walk};
+
+    /// Two bintrees of level 2 with the same shape at the top (a partial root whose first child is
+    /// partial) and other voxels: a node of one is a valid position in the other.
+    fn two_trees() -> (KTree<1>, KTree<1>) {
+        let a = KTree::<1>::from_dense(2, &[true, false, true, true]).unwrap();
+        let b = KTree::<1>::from_dense(2, &[false, true, false, false]).unwrap();
+        (a, b)
+    }
+
+    fn first_child_of(tree: &KTree<1>) -> NodeRef<1> {
+        let node = tree.children(&tree.root()).next().unwrap();
+        assert_eq!(node.state(), NodeState::Partial);
+        node
+    }
+
+    #[test]
+    fn nodes_navigate_in_their_tree_and_its_clones() {
+        let (a, _) = two_trees();
+        let node = first_child_of(&a);
+        let kids: Vec<_> = a.children(&node).map(|c| c.state()).collect();
+        assert_eq!(kids, [NodeState::Full, NodeState::Empty]);
+        let clone = a.clone();
+        assert_eq!(clone.children(&node).count(), 2);
+        assert_eq!(child(&clone, &node, 0).cell().origin, [0]);
+    }
+
+    #[test]
+    #[should_panic(expected = "belongs to another tree")]
+    fn children_refuse_a_node_of_another_tree() {
+        let (a, b) = two_trees();
+        let _ = b.children(&first_child_of(&a)).count();
+    }
+
+    #[test]
+    #[should_panic(expected = "belongs to another tree")]
+    fn children_refuse_a_node_past_the_end_of_another_tree() {
+        let (a, _) = two_trees();
+        let small = KTree::<1>::from_dense(2, &[true, true, false, true]).unwrap();
+        let _ = small.children(&first_child_of(&a)).count();
+    }
+
+    #[test]
+    #[should_panic(expected = "belongs to another tree")]
+    fn child_refuses_a_node_of_another_tree() {
+        let (a, b) = two_trees();
+        let _ = child(&b, &first_child_of(&a), 1);
+    }
+
+    #[test]
+    #[should_panic(expected = "belongs to another tree")]
+    fn walk_from_refuses_a_node_of_another_tree() {
+        struct All;
+        impl Visitor<1> for All {
+            fn visit(&mut self, _: &NodeRef<1>) -> Walk {
+                Walk::Descend
+            }
+        }
+        let (a, b) = two_trees();
+        walk_from(&b, first_child_of(&a), &mut All);
+    }
+
+    #[test]
+    #[should_panic(expected = "belongs to another tree")]
+    fn locate_refuses_a_start_of_another_tree() {
+        let (a, b) = two_trees();
+        let voxel = b.universe().cell([1], 2).unwrap();
+        let _ = locate(&b, first_child_of(&a), &voxel);
+    }
+
+    #[test]
+    #[should_panic(expected = "made for")]
+    fn a_locator_refuses_another_tree() {
+        let (a, b) = two_trees();
+        let mut locator = Locator::new(&a);
+        let _ = locator.locate(&b, &b.universe().cell([1], 2).unwrap());
+    }
+
+    #[test]
+    #[should_panic(expected = "node 1 of a level of 1 nodes")]
+    fn state_past_the_end_of_a_level_panics_rather_than_reading_padding() {
+        let (a, _) = two_trees();
+        let _ = a.state(0, 1);
+    }
+
+    #[test]
+    #[should_panic(expected = "node 3 of a level of 2 nodes")]
+    fn first_child_past_the_end_of_a_level_panics() {
+        let (a, _) = two_trees();
+        let _ = a.first_child(1, 3);
+    }
+
+    #[test]
+    fn equal_objects_are_equal_trees_whatever_their_identity() {
+        let (a, _) = two_trees();
+        let again = KTree::<1>::from_dense(2, &[true, false, true, true]).unwrap();
+        assert_ne!(a.id(), again.id());
+        assert_eq!(a, again);
+    }
 }

@@ -9,7 +9,7 @@
 //! assert_eq!(tree.voxel_count(), 4);
 //! assert!(tree.contains([0, 3]) && !tree.contains([1, 3]));
 //! assert_eq!(tree.bytes_at_two_bits(), tree.node_count().div_ceil(4));
-//! let children: Vec<_> = tree.children(&tree.root()).map(|c| c.state).collect();
+//! let children: Vec<_> = tree.children(&tree.root()).map(|c| c.state()).collect();
 //! assert_eq!(children.len(), 4);
 //! ```
 
@@ -21,6 +21,7 @@ mod ktree;
 mod operators;
 mod states;
 mod to_rays;
+pub(crate) mod words;
 
 pub(crate) use any::from_typed;
 pub use any::{AnyTree, TreeStats};

@@ -42,15 +42,14 @@ impl NodeState {
     }
 }
 
+use super::words::{full_count, partial_count, partial_mask, unused_mask, NODES_PER_WORD};
 use super::TreeError;
 
-const NODES_PER_WORD: usize = 32;
 /// Words per rank block: 256 nodes share one 16-bit block rank.
 const WORDS_PER_BLOCK: usize = 8;
 /// Blocks per superblock: 65 536 nodes share one 64-bit superblock rank, so that a block rank (partial
 /// nodes from the superblock's start to the block's) is below 2^16.
 const BLOCKS_PER_SUPER: usize = 256;
-const LOW_BITS: u64 = 0x5555_5555_5555_5555;
 
 /// One tree level: node states at 2 bits each in `u64` words, and a two-tier rank index over the partial
 /// nodes so that the rank of a node (the partial nodes before it) is found in constant time.
@@ -73,18 +72,6 @@ pub struct PackedStates {
     block_rank: Vec<u16>,
     /// The number of partial nodes.
     partial: usize,
-}
-
-/// Mask with the low bit of each 2-bit slot set where the slot holds `Partial` (`10`).
-#[inline(always)]
-fn partial_mask(word: u64) -> u64 {
-    (word >> 1) & !word & LOW_BITS
-}
-
-/// Mask with the low bit of each 2-bit slot set where the slot holds `Full` (`01`).
-#[inline]
-fn full_mask(word: u64) -> u64 {
-    word & !(word >> 1) & LOW_BITS
 }
 
 /// Adds the partial slots of `word` into 4-bit fields of `acc` (at most 2 a word per field): up to seven
@@ -114,9 +101,16 @@ fn partials_in(words: &[u64]) -> u64 {
         n += u64::from((partial_mask(p[0]) | partial_mask(p[1]) << 1).count_ones());
     }
     if let [w] = pairs.remainder() {
-        n += u64::from(partial_mask(*w).count_ones());
+        n += u64::from(partial_count(*w));
     }
     n
+}
+
+#[cold]
+#[inline(never)]
+#[track_caller]
+pub(crate) fn node_out_of_range(i: usize, len: usize) -> ! {
+    panic!("node {i} of a level of {len} nodes")
 }
 
 impl PackedStates {
@@ -188,8 +182,8 @@ impl PackedStates {
                 len,
             });
         }
-        if let Some(w) = words.iter().position(|&w| (w >> 1) & w & LOW_BITS != 0) {
-            let slot = ((words[w] >> 1) & words[w] & LOW_BITS).trailing_zeros() as usize / 2;
+        if let Some(w) = words.iter().position(|&w| unused_mask(w) != 0) {
+            let slot = unused_mask(words[w]).trailing_zeros() as usize / 2;
             return Err(TreeError::UnusedCode {
                 node: w * NODES_PER_WORD + slot,
             });
@@ -213,7 +207,7 @@ impl PackedStates {
         debug_assert!(
             words.len() == self.words.len()
                 && words.iter().zip(&self.words).all(|(&new, &old)| {
-                    partial_mask(new) == partial_mask(old) && (new >> 1) & new & LOW_BITS == 0
+                    partial_mask(new) == partial_mask(old) && unused_mask(new) == 0
                 })
         );
         Self {
@@ -240,10 +234,24 @@ impl PackedStates {
         self.len == 0
     }
 
-    /// The state of node `i` (`i < len`).
+    /// The state of node `i`.
+    ///
+    /// ```
+    /// use ktree::{tree::PackedStates, NodeState};
+    /// let level = PackedStates::from_words(vec![0b10_01_00], 3).unwrap();
+    /// assert_eq!(level.get(2), NodeState::Partial);
+    /// ```
+    ///
+    /// # Panics
+    /// If `i ≥ len`, in release builds as in debug ones (the slots past the end of the last word are
+    /// padding, not nodes). Indexing, as of a slice: the trees' invariants keep the indices their navigation
+    /// computes in range, so an index out of range is a caller's bug, not a state.
     #[inline]
+    #[track_caller]
     pub fn get(&self, i: usize) -> NodeState {
-        debug_assert!(i < self.len);
+        if i >= self.len {
+            node_out_of_range(i, self.len);
+        }
         NodeState::from_bits((self.words[i / NODES_PER_WORD] >> (2 * (i % NODES_PER_WORD))) as u32)
     }
 
@@ -322,10 +330,7 @@ impl PackedStates {
 
     /// The number of full nodes in the level.
     pub fn full_count(&self) -> usize {
-        self.words
-            .iter()
-            .map(|&w| full_mask(w).count_ones() as usize)
-            .sum()
+        self.words.iter().map(|&w| full_count(w) as usize).sum()
     }
 
     /// The bytes a level of `len` nodes holds once built ([`PackedStates::heap_bytes`]), without building it.
@@ -382,6 +387,13 @@ mod tests {
             assert_eq!(packed.partial_rank(i), i);
         }
         assert_eq!(packed.partial_count(), n);
+    }
+
+    #[test]
+    #[should_panic(expected = "node 5 of a level of 3 nodes")]
+    fn get_past_the_end_panics_rather_than_reading_padding() {
+        let level = PackedStates::from_words(vec![0b10_01_00], 3).unwrap();
+        let _ = level.get(5);
     }
 
     #[test]

@@ -80,10 +80,10 @@ struct Record<const K: usize> {
 
 impl<const K: usize> Visitor<K> for Record<K> {
     fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-        self.seen.push((node.cell, node.state));
+        self.seen.push((node.cell(), node.state()));
         if self.seen.len() >= self.limit {
             Walk::Stop
-        } else if skips(&node.cell, self.rule) {
+        } else if skips(&node.cell(), self.rule) {
             Walk::Skip
         } else {
             Walk::Descend
@@ -130,9 +130,9 @@ fn check_one<const K: usize>(
     for (i, &full) in dense.iter().enumerate().step_by(7) {
         let voxel = u.cell(u.dense_point(i), u.level()).unwrap();
         let node = locate(&tree, tree.root(), &voxel);
-        prop_assert!(node.cell.contains(voxel.origin()));
+        prop_assert!(node.cell().contains(voxel.origin()));
         prop_assert_eq!(
-            node.state,
+            node.state(),
             if full {
                 NodeState::Full
             } else {

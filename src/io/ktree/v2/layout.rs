@@ -53,26 +53,12 @@ pub(crate) const NODES_PER_WORD: u64 = 32;
 pub(crate) const WORDS_PER_SAMPLE: u64 = 64;
 /// Bytes scanned at a time when a file's sections are checked through the map.
 pub(crate) const WINDOW_BYTES: usize = 1 << 20;
-pub(crate) const LOW_BITS: u64 = 0x5555_5555_5555_5555;
+pub(crate) use crate::tree::words::{full_mask, partial_mask, LOW_BITS};
 
-#[inline]
-pub(crate) fn partial_mask(word: u64) -> u64 {
-    (word >> 1) & !word & LOW_BITS
-}
-
-#[inline]
-pub(crate) fn full_mask(word: u64) -> u64 {
-    word & !(word >> 1) & LOW_BITS
-}
-
-/// The mask of the low `nodes` 2-bit slots of a word (`nodes ≤ 32`).
+/// The mask of the low `nodes` 2-bit slots of a word, for node counts of a file.
 #[inline]
 pub(crate) fn slots_mask(nodes: u64) -> u64 {
-    if nodes >= NODES_PER_WORD {
-        u64::MAX
-    } else {
-        (1u64 << (2 * nodes)) - 1
-    }
+    crate::tree::words::slots_mask(nodes.min(NODES_PER_WORD) as usize)
 }
 
 pub(crate) fn words_of(nodes: u64) -> u64 {

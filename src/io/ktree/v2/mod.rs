@@ -10,11 +10,9 @@ mod writer;
 
 pub(crate) use check::read_v2_any;
 pub use layout::VERSION;
-pub(crate) use layout::{slots_mask, LOW_BITS, NODES_PER_WORD};
 pub use mapped::MappedTree;
 pub(crate) use view::read_at;
 pub use view::KtreeView;
-pub(crate) use writer::WordPacker;
 pub use writer::{write_ktree_v2, write_ktree_v2_file, KtreeWriter};
 
 #[cfg(test)]

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use super::layout::*;
 use crate::space::{max_level, MAX_K};
+use crate::tree::words::WordPacker;
 use crate::tree::{KTree, LevelCounts, NodeState, PackedStates};
 
 /// Writes a `.ktree` version 2 file level by level, from the root down, without holding the tree.
@@ -45,46 +46,6 @@ pub struct KtreeWriter<W: Write> {
     finished: Vec<Section>,
     current: LevelWriter,
     buffer: Vec<u8>,
-}
-
-/// Nodes appended two bits each at any position, handed out as whole words: the shifted append of
-/// [`KtreeWriter`] and of the streamed Booleans' output levels.
-#[derive(Debug, Default, Clone, Copy)]
-pub(crate) struct WordPacker {
-    /// Nodes not yet forming a whole word, in the low bits.
-    pending: u64,
-    pending_nodes: u64,
-}
-
-impl WordPacker {
-    /// Appends the `take ≤ 32` nodes of `word` (low bits first); returns the word they complete, if any.
-    #[inline]
-    pub(crate) fn push(&mut self, word: u64, take: u64) -> Option<u64> {
-        let word = word & slots_mask(take);
-        let p = self.pending_nodes;
-        let joined = self.pending | word.checked_shl(2 * p as u32).unwrap_or(0);
-        if p + take >= NODES_PER_WORD {
-            // `p > 0` here unless the word is whole, so the shift below is less than 64.
-            self.pending = if p == 0 {
-                0
-            } else {
-                word >> (2 * (NODES_PER_WORD - p))
-            };
-            self.pending_nodes = p + take - NODES_PER_WORD;
-            Some(joined)
-        } else {
-            self.pending = joined;
-            self.pending_nodes = p + take;
-            None
-        }
-    }
-
-    /// The last, partly filled word (`None` if the nodes so far fill whole words), leaving the packer empty.
-    pub(crate) fn flush(&mut self) -> Option<u64> {
-        let last = (self.pending_nodes > 0).then_some(self.pending);
-        *self = Self::default();
-        last
-    }
 }
 
 /// The level being written.
@@ -163,7 +124,7 @@ impl<W: Write> KtreeWriter<W> {
                     self.finished.len()
                 )));
             }
-            if let Some(whole) = self.current.packer.push(word, take) {
+            if let Some(whole) = self.current.packer.push(word, take as usize) {
                 self.emit(whole)?;
             }
             remaining -= take;
