@@ -3,8 +3,10 @@
 //! they accept is well formed, and the library's operations run on it without panicking.
 
 use ktree::io::{read_ktree_any, write_ktree, write_ktree_v1};
+use ktree::rays::RayError;
 use ktree::solid::mesh::{Placement, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
+use ktree::space::SpaceError;
 use ktree::tree::PackedStates;
 use ktree::{KTree, Ray, RaySet, Universe};
 use ktree_verify::objects::object;
@@ -45,30 +47,211 @@ fn exercise<const K: usize>(tree: &KTree<K>) {
     assert_eq!(back.ok().as_ref(), Some(tree));
 }
 
+/// The largest universe level for K = 3.
+const MAX_LEVEL: u32 = ktree::max_level(3);
+
+/// A valid cell: a universe level, a cell level no deeper than it, and an origin on the cell grid inside it.
+fn valid_cell() -> impl Strategy<Value = (u32, u32, [u32; 3])> {
+    (0..=MAX_LEVEL)
+        .prop_flat_map(|universe| (Just(universe), 0..=universe))
+        .prop_flat_map(|(universe, at)| {
+            let cells_per_axis = 1u32 << at;
+            let side = 1u32 << (universe - at);
+            (
+                Just(universe),
+                Just(at),
+                prop::array::uniform3(0..cells_per_axis),
+            )
+                .prop_map(move |(u, a, index)| (u, a, index.map(|i| i * side)))
+        })
+}
+
+/// A cell with one thing wrong, and the error it must get.
+#[derive(Debug, Clone, Copy)]
+enum BadCell {
+    /// The universe level is beyond `max_level(3)`.
+    UniverseTooLarge,
+    /// The cell level is deeper than the universe's.
+    TooDeep,
+    /// One origin coordinate is not a multiple of the cell's side.
+    Misaligned,
+    /// One origin coordinate is outside the universe.
+    Outside,
+}
+
+/// A cell of the given kind of wrong: `(kind, universe level, cell level, origin)`.
+fn bad_cell() -> impl Strategy<Value = (BadCell, u32, u32, [u32; 3])> {
+    let valid = valid_cell();
+    prop_oneof![
+        (
+            MAX_LEVEL + 1..=u32::MAX,
+            any::<u32>(),
+            prop::array::uniform3(coordinate())
+        )
+            .prop_map(|(u, a, o)| (BadCell::UniverseTooLarge, u, a, o)),
+        (valid_cell(), 1..=u32::MAX - MAX_LEVEL).prop_map(|((u, _, o), deeper)| (
+            BadCell::TooDeep,
+            u,
+            u + deeper,
+            o
+        )),
+        // A cell of side 2 or more, with one coordinate moved off its grid (but inside the universe).
+        (
+            valid.prop_filter("side > 1", |&(u, a, _)| a < u),
+            0usize..3,
+            any::<u32>()
+        )
+            .prop_map(|((u, a, mut o), axis, shift)| {
+                let side = 1u32 << (u - a);
+                o[axis] += 1 + shift % (side - 1);
+                (BadCell::Misaligned, u, a, o)
+            }),
+        (valid_cell(), 0usize..3, any::<u32>()).prop_map(|((u, a, mut o), axis, value)| {
+            let side = 1u64 << u;
+            o[axis] = (side + u64::from(value) % ((1u64 << 32) - side)) as u32;
+            (BadCell::Outside, u, a, o)
+        }),
+    ]
+}
+
+/// A valid run in a level-`level` universe of K = 3.
+fn valid_ray(level: u32) -> impl Strategy<Value = Ray<3>> {
+    let side = 1u32 << level;
+    (0..side, 0..side, 0..side)
+        .prop_flat_map(move |(x, y, z1)| (Just([x, y, z1]), z1 + 1..=side))
+        .prop_map(|(start, z2)| Ray::new(start, z2))
+}
+
+/// A level and up to 12 valid runs in it.
+fn valid_rays() -> impl Strategy<Value = (u32, Vec<Ray<3>>)> {
+    (0u32..6).prop_flat_map(|level| (Just(level), prop::collection::vec(valid_ray(level), 0..12)))
+}
+
+/// A run with one thing wrong.
+#[derive(Debug, Clone, Copy)]
+enum BadRay {
+    /// A column coordinate outside the universe.
+    ColumnOutside,
+    /// `z1` or `z2` beyond the universe's side.
+    RunOutside,
+    /// `z2 ≤ z1`.
+    EmptyRun,
+}
+
+/// A bad run of the given kind in a level-`level` universe.
+fn bad_ray(level: u32) -> impl Strategy<Value = (BadRay, Ray<3>)> {
+    let side = 1u32 << level;
+    prop_oneof![
+        (valid_ray(level), 0usize..2, side..=u32::MAX).prop_map(|(mut r, axis, value)| {
+            r.start[axis] = value;
+            (BadRay::ColumnOutside, r)
+        }),
+        (valid_ray(level), any::<bool>(), side + 1..=u32::MAX).prop_map(
+            move |(mut r, at_start, value)| {
+                if at_start {
+                    r.start[2] = value;
+                } else {
+                    r.z2 = value;
+                }
+                (BadRay::RunOutside, r)
+            }
+        ),
+        (0..=side)
+            .prop_flat_map(move |z1| (valid_ray(level), Just(z1), 0..=z1))
+            .prop_map(|(mut r, z1, z2)| {
+                r.start[2] = z1;
+                r.z2 = z2;
+                (BadRay::EmptyRun, r)
+            }),
+    ]
+}
+
+/// Valid runs with one bad run inserted among them: `(level, runs, where the bad one is, its kind)`.
+fn rays_with_one_bad() -> impl Strategy<Value = (u32, Vec<Ray<3>>, usize, BadRay)> {
+    valid_rays()
+        .prop_flat_map(|(level, rays)| {
+            let n = rays.len();
+            (Just(level), Just(rays), 0..=n, bad_ray(level))
+        })
+        .prop_map(|(level, mut rays, at, (kind, bad))| {
+            rays.insert(at, bad);
+            (level, rays, at, kind)
+        })
+}
+
 proptest! {
     #[test]
-    fn cells_are_checked(origin in prop::array::uniform3(coordinate()), universe in level(), at in level()) {
-        if let Ok(u) = Universe::<3>::new(universe) {
-            if let Ok(c) = u.cell(origin, at) {
-                prop_assert_eq!(c.universe_level(), universe);
-                prop_assert_eq!(c.level(), at);
-                prop_assert!(c.origin().iter().all(|&o| u64::from(o) % c.side() == 0));
-                prop_assert!(c.origin().iter().all(|&o| u64::from(o) < u.side()));
+    fn valid_cells_are_accepted((universe, at, origin) in valid_cell()) {
+        let u = Universe::<3>::new(universe).unwrap();
+        let c = u.cell(origin, at).unwrap();
+        prop_assert_eq!(c.universe_level(), universe);
+        prop_assert_eq!(c.level(), at);
+        prop_assert_eq!(c.origin(), origin);
+        prop_assert_eq!(c.side(), 1u64 << (universe - at));
+        prop_assert!(c.origin().iter().all(|&o| u64::from(o) % c.side() == 0));
+        prop_assert!(c.origin().iter().all(|&o| u64::from(o) < u.side()));
+        prop_assert!(c.contains(origin));
+    }
+
+    #[test]
+    fn bad_cells_are_rejected_with_their_error((kind, universe, at, origin) in bad_cell()) {
+        match kind {
+            BadCell::UniverseTooLarge => {
+                let e = Universe::<3>::new(universe).unwrap_err();
+                prop_assert!(matches!(e, SpaceError::LevelTooLarge { k: 3, level, max: MAX_LEVEL } if level == universe), "{e:?}");
+            }
+            BadCell::TooDeep | BadCell::Misaligned => {
+                let e = Universe::<3>::new(universe).unwrap().cell(origin, at).unwrap_err();
+                prop_assert!(matches!(&e, SpaceError::Misaligned { origin: o, level, universe_level } if o[..] == origin[..] && *level == at && *universe_level == universe), "{e:?}");
+            }
+            BadCell::Outside => {
+                let e = Universe::<3>::new(universe).unwrap().cell(origin, at).unwrap_err();
+                let axis = origin.iter().position(|&o| u64::from(o) >= 1u64 << universe).unwrap();
+                prop_assert_eq!(e, SpaceError::OutOfUniverse { axis, value: origin[axis].into(), side: 1u64 << universe });
             }
         }
     }
 
     #[test]
-    fn ray_sets_are_checked(
-        level in level(),
-        rays in prop::collection::vec((prop::array::uniform3(coordinate()), coordinate()), 0..12),
-    ) {
-        let rays = rays.into_iter().map(|(start, z2)| Ray::new(start, z2));
-        if let Ok(set) = RaySet::<3>::from_rays(level, rays) {
-            let tree = KTree::from_rays(&set);
-            prop_assert_eq!(tree.voxel_count(), set.voxel_count());
-            exercise(&tree);
+    fn valid_ray_sets_are_accepted((level, rays) in valid_rays()) {
+        let set = RaySet::<3>::from_rays(level, rays.iter().copied()).unwrap();
+        // The dumbest reference: the set of voxels the runs cover.
+        let voxels: std::collections::BTreeSet<[u32; 3]> = rays
+            .iter()
+            .flat_map(|r| (r.z1()..r.z2).map(move |z| [r.start[0], r.start[1], z]))
+            .collect();
+        prop_assert_eq!(set.voxel_count(), voxels.len() as u128);
+        let tree = KTree::from_rays(&set);
+        prop_assert_eq!(tree.voxel_count(), voxels.len() as u128);
+        for &v in &voxels {
+            prop_assert!(tree.contains(v));
         }
+        exercise(&tree);
+    }
+
+    #[test]
+    fn bad_ray_sets_are_rejected_with_their_error((level, rays, at, kind) in rays_with_one_bad()) {
+        let e = RaySet::<3>::from_rays(level, rays.iter().copied()).unwrap_err();
+        let bad = rays[at];
+        let side = 1u64 << level;
+        match kind {
+            BadRay::ColumnOutside => {
+                let axis = bad.start[..2].iter().position(|&c| u64::from(c) >= side).unwrap();
+                prop_assert_eq!(e, RayError::ColumnOutside { index: at, axis, value: bad.start[axis], side });
+            }
+            BadRay::RunOutside => {
+                prop_assert_eq!(e, RayError::RunOutside { index: at, z1: bad.z1(), z2: bad.z2, side });
+            }
+            BadRay::EmptyRun => {
+                prop_assert_eq!(e, RayError::EmptyRun { index: at, z1: bad.z1(), z2: bad.z2 });
+            }
+        }
+    }
+
+    #[test]
+    fn ray_sets_beyond_the_largest_level_are_rejected(level in MAX_LEVEL + 1..=u32::MAX, (_, rays) in valid_rays()) {
+        let e = RaySet::<3>::from_rays(level, rays).unwrap_err();
+        prop_assert!(matches!(e, RayError::Space(SpaceError::LevelTooLarge { level: l, .. }) if l == level), "{e:?}");
     }
 
     #[test]
