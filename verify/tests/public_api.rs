@@ -11,6 +11,8 @@ use ktree::tree::PackedStates;
 use ktree::{KTree, Ray, RaySet, Universe};
 use ktree_verify::objects::object;
 use proptest::prelude::*;
+use proptest::test_runner::{TestCaseError, TestRunner};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Small numbers most of the time, any `u32` sometimes.
 fn coordinate() -> impl Strategy<Value = u32> {
@@ -253,124 +255,314 @@ proptest! {
         let e = RaySet::<3>::from_rays(level, rays).unwrap_err();
         prop_assert!(matches!(e, RayError::Space(SpaceError::LevelTooLarge { level: l, .. }) if l == level), "{e:?}");
     }
+}
 
-    #[test]
-    fn meshes_are_checked(
-        vertices in prop::collection::vec(prop::array::uniform3(real()), 0..8),
-        triangles in prop::collection::vec(prop::array::uniform3(prop_oneof![0u32..8, any::<u32>()]), 0..8),
-        level in level(),
-        scale in real(),
-        translate in prop::array::uniform3(real()),
-    ) {
-        if let Ok(mesh) = TriangleMesh::new(vertices, triangles) {
-            let _ = (mesh.bounds(), mesh.signed_volume(), mesh.surface_area(), mesh.open_edges());
-            let placements = [Placement::fit(&mesh, level).ok(), Some(Placement { scale, translate })];
+/// Runs `check` on the cases of `strategy` (256, or `PROPTEST_CASES`); `check` answers whether the case was
+/// accepted and so reached the checks. Panics with proptest's report if a check fails; returns how many
+/// cases were accepted, and of how many.
+fn accepted_of<S: Strategy>(
+    strategy: S,
+    check: impl Fn(S::Value) -> Result<bool, TestCaseError>,
+) -> (u32, u32) {
+    let config = ktree_verify::config(256);
+    let cases = config.cases;
+    let accepted = AtomicU32::new(0);
+    let mut runner = TestRunner::new(config);
+    if let Err(e) = runner.run(&strategy, |value| {
+        if check(value)? {
+            accepted.fetch_add(1, Ordering::Relaxed);
+        }
+        Ok(())
+    }) {
+        panic!("{e}");
+    }
+    (accepted.into_inner(), cases)
+}
+
+/// Asserts that at least `1 / one_in` of the cases of a property were accepted, so that the checks behind
+/// the acceptance ran (the strategies are built so that many more are).
+fn assert_accepted((accepted, cases): (u32, u32), one_in: u32) {
+    assert!(
+        accepted >= cases / one_in,
+        "only {accepted} of {cases} cases reached the checks (at least 1 in {one_in} expected)"
+    );
+}
+
+#[test]
+fn meshes_are_checked() {
+    // Arbitrary vertices and indices, or a well-formed mesh: finite vertices, indices among them.
+    let well_formed = (3usize..8)
+        .prop_flat_map(|n| {
+            (
+                prop::collection::vec(prop::array::uniform3(-10.0..10.0f64), n),
+                prop::collection::vec(prop::array::uniform3(0..n as u32), 1..8),
+            )
+        })
+        .boxed();
+    let arbitrary = (
+        prop::collection::vec(prop::array::uniform3(real()), 0..8),
+        prop::collection::vec(
+            prop::array::uniform3(prop_oneof![0u32..8, any::<u32>()]),
+            0..8,
+        ),
+    )
+        .boxed();
+    let strategy = (
+        prop_oneof![arbitrary, well_formed],
+        2u32..6,
+        real(),
+        prop::array::uniform3(real()),
+    )
+        .prop_map(|((v, t), level, scale, translate)| (v, t, level, scale, translate));
+    let counts = accepted_of(
+        strategy,
+        |(vertices, triangles, level, scale, translate)| {
+            let Ok(mesh) = TriangleMesh::new(vertices, triangles) else {
+                return Ok(false);
+            };
+            let _ = (
+                mesh.bounds(),
+                mesh.signed_volume(),
+                mesh.surface_area(),
+                mesh.open_edges(),
+            );
+            let placements = [
+                Placement::fit(&mesh, level).ok(),
+                Some(Placement { scale, translate }),
+            ];
+            let mut voxelized = false;
             for p in placements.iter().flatten() {
                 if let Ok(r) = mesh.to_rays(level, p) {
                     exercise(&KTree::from_rays(&r.rays));
+                    voxelized = true;
                 }
             }
-        }
-    }
+            Ok(voxelized)
+        },
+    );
+    println!("meshes voxelized: {counts:?}");
+    assert_accepted(counts, 8);
+}
 
-    #[test]
-    fn volumes_are_checked(
-        shape in prop::array::uniform3(prop_oneof![8 => 0usize..5, 1 => any::<usize>()]),
-        samples in prop::collection::vec(real(), 130),
-        short in prop_oneof![3 => Just(0usize), 1 => 0usize..3],
-        level in level(),
-        offset in prop::array::uniform3(coordinate()),
-        label in any::<bool>(),
-    ) {
+#[test]
+fn volumes_are_checked() {
+    // Arbitrary shapes, levels and offsets, or a volume that fits its universe: sides 1 to 4, a level of
+    // at least 3 and an offset that keeps it inside.
+    let arbitrary = (
+        prop::array::uniform3(prop_oneof![8 => 0usize..5, 1 => any::<usize>()]),
+        prop_oneof![3 => Just(0usize), 1 => 0usize..3],
+        level(),
+        prop::array::uniform3(coordinate()),
+    )
+        .boxed();
+    let fitting = (
+        prop::array::uniform3(1usize..5),
+        3u32..6,
+        prop::array::uniform3(0u32..5),
+    )
+        .prop_map(|(shape, level, offset)| (shape, 0, level, offset))
+        .boxed();
+    let strategy = (
+        prop_oneof![arbitrary, fitting],
+        prop::collection::vec(real(), 130),
+        any::<bool>(),
+    )
+        .prop_map(|((shape, short, level, offset), samples, label)| {
+            (shape, samples, short, level, offset, label)
+        });
+    let counts = accepted_of(strategy, |(shape, samples, short, level, offset, label)| {
         // Mostly as many samples as the shape has voxels, sometimes fewer.
-        let n = shape.iter().try_fold(1usize, |p, &s| p.checked_mul(s)).unwrap_or(usize::MAX);
+        let n = shape
+            .iter()
+            .try_fold(1usize, |p, &s| p.checked_mul(s))
+            .unwrap_or(usize::MAX);
         let values = samples[..n.min(samples.len()).saturating_sub(short)].to_vec();
-        if let Ok(volume) = Volume::new(shape, values, [1.0; 3]) {
-            let select = if label { Select::Label(1.0) } else { Select::AtLeast(0.0) };
-            let _ = volume.fitting_level();
-            if let Ok(rays) = volume.to_rays(level, offset, select) {
-                prop_assert_eq!(rays.voxel_count(), volume.count(select) as u128);
-                exercise(&KTree::from_rays(&rays));
-            }
-        }
-    }
+        let Ok(volume) = Volume::new(shape, values, [1.0; 3]) else {
+            return Ok(false);
+        };
+        let select = if label {
+            Select::Label(1.0)
+        } else {
+            Select::AtLeast(0.0)
+        };
+        let _ = volume.fitting_level();
+        let Ok(rays) = volume.to_rays(level, offset, select) else {
+            return Ok(false);
+        };
+        prop_assert_eq!(rays.voxel_count(), volume.count(select) as u128);
+        exercise(&KTree::from_rays(&rays));
+        Ok(true)
+    });
+    println!("volumes voxelized: {counts:?}");
+    assert_accepted(counts, 8);
+}
 
-    #[test]
-    fn trees_from_raw_words_are_checked(
-        level in level(),
-        raw in prop::collection::vec((prop::collection::vec(any::<u64>(), 0..3), 0usize..70), 0..4),
-    ) {
-        let levels: Result<Vec<PackedStates>, _> =
-            raw.into_iter().map(|(words, len)| PackedStates::from_words(words, len)).collect();
-        if let Ok(levels) = levels {
-            if let Ok(tree) = KTree::<2>::from_level_states(level, levels) {
-                exercise(&tree);
-            }
-        }
-    }
+#[test]
+fn trees_from_raw_words_are_checked() {
+    // Arbitrary words, or the words of a real tree (which must be accepted).
+    let arbitrary = (
+        level(),
+        prop::collection::vec(
+            (prop::collection::vec(any::<u64>(), 0..3), 0usize..70),
+            0..4,
+        ),
+    )
+        .boxed();
+    let real_tree = object::<2>()
+        .prop_map(|obj| {
+            let tree = obj.tree();
+            let levels = (0..tree.depth_count())
+                .map(|d| {
+                    (
+                        tree.level_states(d).words().to_vec(),
+                        tree.level_states(d).len(),
+                    )
+                })
+                .collect::<Vec<_>>();
+            (obj.level, levels)
+        })
+        .boxed();
+    let strategy = prop_oneof![arbitrary, real_tree];
+    let counts = accepted_of(strategy, |(level, raw)| {
+        let levels: Result<Vec<PackedStates>, _> = raw
+            .into_iter()
+            .map(|(words, len)| PackedStates::from_words(words, len))
+            .collect();
+        let Ok(Ok(tree)) = levels.map(|levels| KTree::<2>::from_level_states(level, levels)) else {
+            return Ok(false);
+        };
+        exercise(&tree);
+        Ok(true)
+    });
+    println!("trees from raw words: {counts:?}");
+    assert_accepted(counts, 4);
+}
 
-    #[test]
-    fn trees_from_changed_levels_are_checked(obj in object::<2>(), depth in any::<prop::sample::Index>(), bit in any::<prop::sample::Index>()) {
+#[test]
+fn trees_from_changed_levels_are_checked() {
+    let strategy = (
+        object::<2>(),
+        any::<prop::sample::Index>(),
+        any::<prop::sample::Index>(),
+    );
+    let counts = accepted_of(strategy, |(obj, depth, bit)| {
         // A real tree with one bit of one level flipped: sometimes still a tree, mostly not.
         let tree = obj.tree();
         let mut levels: Vec<(Vec<u64>, usize)> = (0..tree.depth_count())
-            .map(|d| (tree.level_states(d).words().to_vec(), tree.level_states(d).len()))
+            .map(|d| {
+                (
+                    tree.level_states(d).words().to_vec(),
+                    tree.level_states(d).len(),
+                )
+            })
             .collect();
         let d = depth.index(levels.len());
         let bits = levels[d].0.len() * 64;
-        prop_assume!(bits > 0);
+        if bits == 0 {
+            return Ok(false);
+        }
         let b = bit.index(bits);
         levels[d].0[b / 64] ^= 1 << (b % 64);
-        let levels: Result<Vec<PackedStates>, _> =
-            levels.into_iter().map(|(words, len)| PackedStates::from_words(words, len)).collect();
-        if let Ok(levels) = levels {
-            if let Ok(changed) = KTree::<2>::from_level_states(obj.level, levels) {
-                exercise(&changed);
-            }
-        }
-    }
+        let levels: Result<Vec<PackedStates>, _> = levels
+            .into_iter()
+            .map(|(words, len)| PackedStates::from_words(words, len))
+            .collect();
+        let Ok(Ok(changed)) = levels.map(|levels| KTree::<2>::from_level_states(obj.level, levels))
+        else {
+            return Ok(false);
+        };
+        exercise(&changed);
+        Ok(true)
+    });
+    println!("trees from changed levels: {counts:?}");
+    assert_accepted(counts, 128);
+}
 
-    #[test]
-    fn trees_from_cells_are_checked(
-        level in 0u32..5,
-        cells in prop::collection::vec((prop::array::uniform2(0u32..16), 0u32..5), 0..12),
-    ) {
+#[test]
+fn trees_from_cells_are_checked() {
+    let strategy = (
+        0u32..5,
+        prop::collection::vec((prop::array::uniform2(0u32..16), 0u32..5), 0..12),
+    );
+    let counts = accepted_of(strategy, |(level, cells)| {
         let u = Universe::<2>::new(level).unwrap();
-        let cells: Vec<_> = cells.into_iter().filter_map(|(o, l)| u.cell(o, l).ok()).collect();
-        if let Ok(tree) = KTree::from_cells(u, &cells) {
-            let given: u128 = cells.iter().map(|c| c.volume()).sum();
-            prop_assert_eq!(tree.voxel_count(), given);
-            for c in &cells {
-                prop_assert!(tree.contains(c.origin()));
+        let cells: Vec<_> = cells
+            .into_iter()
+            .filter_map(|(o, l)| u.cell(o, l).ok())
+            .collect();
+        let Ok(tree) = KTree::from_cells(u, &cells) else {
+            return Ok(false);
+        };
+        let given: u128 = cells.iter().map(|c| c.volume()).sum();
+        prop_assert_eq!(tree.voxel_count(), given);
+        for c in &cells {
+            prop_assert!(tree.contains(c.origin()));
+        }
+        exercise(&tree);
+        Ok(true)
+    });
+    println!("trees from cells: {counts:?}");
+    assert_accepted(counts, 8);
+}
+
+/// Arbitrary bytes, or a real `.ktree` file whole or cut.
+fn ktree_bytes() -> impl Strategy<Value = Vec<u8>> {
+    prop_oneof![
+        prop::collection::vec(any::<u8>(), 0..120),
+        (object::<3>(), any::<prop::sample::Index>(), any::<bool>()).prop_map(
+            |(obj, cut, whole)| {
+                let mut bytes = Vec::new();
+                write_ktree(&mut bytes, &obj.tree()).unwrap();
+                if !whole {
+                    bytes.truncate(cut.index(bytes.len()));
+                }
+                bytes
             }
-            exercise(&tree);
-        }
-    }
+        ),
+    ]
+}
 
-    #[test]
-    fn ktree_bytes_are_checked(bytes in prop::collection::vec(any::<u8>(), 0..120)) {
-        if let Ok(tree) = read_ktree_any(&bytes, "any.ktree") {
-            ktree::with_dim!(&tree, AnyTree, t => exercise(t));
-        }
-    }
+#[test]
+fn ktree_bytes_are_checked() {
+    let counts = accepted_of(ktree_bytes(), |bytes| {
+        let Ok(tree) = read_ktree_any(&bytes, "any.ktree") else {
+            return Ok(false);
+        };
+        ktree::with_dim!(&tree, AnyTree, t => exercise(t));
+        Ok(true)
+    });
+    println!("ktree bytes read: {counts:?}");
+    assert_accepted(counts, 16);
+}
 
-    #[test]
-    fn changed_ktree_files_with_a_fixed_checksum_are_checked(
-        obj in object::<3>(),
-        at in any::<prop::sample::Index>(),
-        value in any::<u8>(),
-    ) {
+#[test]
+fn changed_ktree_files_with_a_fixed_checksum_are_checked() {
+    // A byte changed, or (one case in four) none: the file as written, which must be read.
+    let change = prop_oneof![1 => Just(None), 3 => any::<u8>().prop_map(Some)];
+    let strategy = (object::<3>(), any::<prop::sample::Index>(), change);
+    let counts = accepted_of(strategy, |(obj, at, value)| {
         // Change one byte, then make the checksum agree, so that the structural checks must catch it.
         let mut bytes = Vec::new();
         write_ktree_v1(&mut bytes, &obj.tree()).unwrap();
         let crc_at = bytes.len() - 4;
-        bytes[at.index(crc_at)] = value;
+        if let Some(value) = value {
+            bytes[at.index(crc_at)] = value;
+        }
         let crc = crc_of(&bytes[..crc_at]);
         bytes[crc_at..].copy_from_slice(&crc.to_le_bytes());
-        if let Ok(tree) = read_ktree_any(&bytes, "changed.ktree") {
-            ktree::with_dim!(&tree, AnyTree, t => exercise(t));
-        }
-    }
+        let read = read_ktree_any(&bytes, "changed.ktree");
+        prop_assert!(
+            value.is_some() || read.is_ok(),
+            "an unchanged file is refused: {read:?}"
+        );
+        let Ok(tree) = read else {
+            return Ok(false);
+        };
+        ktree::with_dim!(&tree, AnyTree, t => exercise(t));
+        Ok(true)
+    });
+    println!("changed ktree files read: {counts:?}");
+    assert_accepted(counts, 8);
 }
 
 /// CRC-32 (IEEE), bit by bit: the checksum of `.ktree` files.
