@@ -7,7 +7,6 @@ mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::{Duration, Instant};
 
 use common::{ktree, SmallDisk};
 
@@ -37,31 +36,45 @@ fn rays_to(level: u32, out: &Path) -> Command {
     c
 }
 
+/// Runs `command` with a file-size limit of `blocks` blocks (of 512 or 1024 bytes, as the shell counts them):
+/// the kernel kills the process with `SIGXFSZ` at its first write past the limit, in the middle of its
+/// output, and no clean-up runs — a kill at a known point, whatever the machine's speed.
+#[cfg(unix)]
+fn killed_at_size(command: &Command, blocks: u32) -> std::process::ExitStatus {
+    let mut shell = Command::new("sh");
+    shell
+        .arg("-c")
+        .arg(format!(
+            "ulimit -c 0; ulimit -f {blocks}; exec \"$0\" \"$@\""
+        ))
+        .arg(command.get_program())
+        .args(command.get_args());
+    if let Some(dir) = command.get_current_dir() {
+        shell.current_dir(dir);
+    }
+    shell.status().unwrap()
+}
+
+#[cfg(unix)]
 #[test]
 fn a_write_killed_part_way_keeps_the_old_file_and_the_next_write_removes_its_temporary() {
+    use std::os::unix::process::ExitStatusExt;
+
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ball.rays");
     assert!(rays_to(3, &out).status().unwrap().success());
     let old = std::fs::read(&out).unwrap();
-    // A level-11 ball is about 3 million runs (tens of MB of text): kill the writer as soon as its
-    // temporary file appears, while it is being filled.
-    let mut child = rays_to(11, &out).spawn().unwrap();
-    let start = Instant::now();
-    let killed_mid_write = loop {
-        if !temporaries(dir.path()).is_empty() {
-            child.kill().unwrap(); // SIGKILL on Unix: no clean-up runs
-            break true;
-        }
-        if child.try_wait().unwrap().is_some() || start.elapsed() > Duration::from_secs(120) {
-            let _ = child.kill();
-            break false;
-        }
-        std::thread::sleep(Duration::from_micros(200));
-    };
-    child.wait().unwrap();
-    assert!(
-        killed_mid_write,
-        "the writer finished before its temporary file was seen"
+    // The complete level-7 file (about 10 000 runs, over 100 kB), written elsewhere, for comparison.
+    let whole_path = dir.path().join("whole").join("ball.rays");
+    assert!(rays_to(7, &whole_path).status().unwrap().success());
+    let whole = std::fs::read(&whole_path).unwrap();
+    // The same write over the old file, killed once 16 blocks (at most 16 kB) are written.
+    let status = killed_at_size(&rays_to(7, &out), 16);
+    const SIGXFSZ: i32 = 25;
+    assert_eq!(
+        status.signal(),
+        Some(SIGXFSZ),
+        "the writer was not killed by the size limit: {status}"
     );
     assert_eq!(
         std::fs::read(&out).unwrap(),
@@ -78,6 +91,14 @@ fn a_write_killed_part_way_keeps_the_old_file_and_the_next_write_removes_its_tem
     assert!(
         name.starts_with(".ball.rays."),
         "unrecognisable temporary {name}"
+    );
+    // The temporary holds the start of the output, and not all of it: the kill came part-way.
+    let partial = std::fs::read(&left[0]).unwrap();
+    assert!(
+        !partial.is_empty() && partial.len() < whole.len() && whole.starts_with(&partial),
+        "the temporary is not a strict beginning of the output: {} of {} bytes",
+        partial.len(),
+        whole.len()
     );
     // The next write to the same target removes it.
     assert!(rays_to(2, &out).status().unwrap().success());

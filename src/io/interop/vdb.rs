@@ -482,6 +482,14 @@ pub fn read_vdb(
         if !has_offsets {
             break;
         }
+        // The next descriptor starts where this grid ends, which must lie past this descriptor: otherwise
+        // a small file with a large grid count would read the same bytes again and again.
+        if usize::try_from(end_at).map_or(true, |e| e <= r.at) {
+            r.at -= 8;
+            return Err(r.fail(GridFileErrorKind::Data(format!(
+                "the grid ends at byte {end_at}, not past its descriptor"
+            ))));
+        }
         r.at = usize::try_from(end_at)
             .unwrap_or(usize::MAX)
             .min(bytes.len());
@@ -689,6 +697,30 @@ mod tests {
         )
         .unwrap();
         assert!(bytes.len() < 8 * 50_000, "{} bytes", bytes.len());
+    }
+
+    #[test]
+    fn a_grid_end_before_its_descriptor_is_refused_at_the_first_descriptor() {
+        // A header, a grid count of 100 000, and one descriptor of another grid type whose end position
+        // points back at the descriptor itself: the scan must stop there, not read it 100 000 times.
+        let mut b = MAGIC.to_le_bytes().to_vec();
+        b.extend_from_slice(&FILE_VERSION.to_le_bytes());
+        b.extend_from_slice(&[0; 8]);
+        b.push(1);
+        b.extend_from_slice(&[b'0'; 36]);
+        b.extend_from_slice(&0u32.to_le_bytes());
+        b.extend_from_slice(&100_000i32.to_le_bytes());
+        let descriptor_at = b.len() as i64;
+        for s in ["g", "Tree_float_5_4_3", ""] {
+            put_str(&mut b, s);
+        }
+        let end_field_at = b.len() + 16;
+        for p in [0, 0, descriptor_at] {
+            b.extend_from_slice(&p.to_le_bytes());
+        }
+        let e = read_vdb(&b, "loop", None, None).unwrap_err();
+        assert!(matches!(e.kind, GridFileErrorKind::Data(_)), "{e}");
+        assert_eq!(e.offset, end_field_at as u64, "{e}");
     }
 
     #[test]
