@@ -19,10 +19,13 @@ mod error;
 mod ktree;
 mod operators;
 mod states;
+pub mod storage;
 
 pub(crate) use assemble::{LevelWriter, TreeAssembler};
+pub use cursor::Leaves;
 pub use error::TreeError;
 pub use ktree::{
-    heap_bytes_for_levels, Bintree, KTree, Leaves, LevelCounts, NodeRef, Octree, Quadtree, Tree4,
+    heap_bytes_for_levels, Bintree, KTree, LevelCounts, NodeRef, Octree, Quadtree, Tree4,
 };
 pub use states::{NodeState, PackedStates};
+pub use storage::TreeStorage;
