@@ -18,6 +18,7 @@ pub mod cursor;
 mod error;
 mod ktree;
 mod operators;
+pub mod sink;
 mod states;
 pub mod storage;
 
