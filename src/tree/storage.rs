@@ -69,8 +69,8 @@ pub trait TreeStorage<const K: usize> {
     /// The storage's read error, for instance when the block is not in the level.
     fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Self::Error>;
 
-    /// The states of the `n ≤ 32` nodes of level `depth` from `first`, two bits each, the first in the low
-    /// bits (higher bits clear): what bulk copies of a subtree read. The default reads the blocks of
+    /// The states of the `n ≤ 32` nodes of level `depth ≥ 1` from `first`, two bits each, the first in the
+    /// low bits (higher bits clear): what bulk copies of a subtree read. The default reads the blocks of
     /// siblings the range covers.
     ///
     /// # Errors
@@ -141,7 +141,7 @@ pub trait LevelOrder<const K: usize> {
     /// the first in the low bits.
     fn block_codes(&self, depth: usize, first: usize) -> u32;
 
-    /// As [`TreeStorage::slots`]; the default reads the blocks of siblings the range covers.
+    /// As [`TreeStorage::slots`] (`depth ≥ 1`); the default reads the blocks of siblings the range covers.
     fn slots(&self, depth: usize, first: usize, n: usize) -> u64 {
         let fanout = 1usize << K;
         let mut word = 0u64;
@@ -266,5 +266,83 @@ pub(crate) fn infallible<T>(result: Result<T, Infallible>) -> T {
     match result {
         Ok(value) => value,
         Err(never) => match never {},
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tree::sink::{copy_subtree, LevelSink, MemorySink};
+
+    /// A tree in memory read only through the required reads: the provided `slots` is under test.
+    struct BlocksOnly<'a, const K: usize>(&'a KTree<K>);
+
+    impl<const K: usize> LevelOrder<K> for BlocksOnly<'_, K> {
+        fn universe(&self) -> Universe<K> {
+            self.0.universe()
+        }
+        fn depth_count(&self) -> usize {
+            self.0.depth_count()
+        }
+        fn root_state(&self) -> NodeState {
+            self.0.root_state()
+        }
+        fn first_child(&self, depth: usize, index: usize) -> usize {
+            self.0.first_child(depth, index)
+        }
+        fn block_codes(&self, depth: usize, first: usize) -> u32 {
+            LevelOrder::block_codes(self.0, depth, first)
+        }
+    }
+
+    fn tree<const K: usize>(level: u32, seed: u64) -> KTree<K> {
+        let n = 1usize << (K as u32 * level);
+        let dense: Vec<bool> = (0..n as u64)
+            .map(|i| (i.wrapping_mul(seed) ^ (i >> 3)) % 7 < 3)
+            .collect();
+        KTree::from_dense(level, &dense).unwrap()
+    }
+
+    fn slots_and_copies_agree<const K: usize>(level: u32) {
+        for seed in [3, 11, 12345] {
+            let t = tree::<K>(level, seed);
+            let b = BlocksOnly(&t);
+            // Below the root every level is whole blocks of siblings.
+            for depth in 1..t.depth_count() {
+                let len = t.level_states(depth).len();
+                for first in 0..len {
+                    for n in 1..=32.min(len - first) {
+                        assert_eq!(
+                            LevelOrder::slots(&b, depth, first, n),
+                            LevelOrder::slots(&t, depth, first, n),
+                            "K = {K}, depth {depth}, {first} + {n}"
+                        );
+                    }
+                }
+            }
+            if t.root_state() == NodeState::Partial {
+                for invert in [false, true] {
+                    let mut sink = MemorySink::new(t.universe());
+                    infallible(copy_subtree::<K, _, _, Infallible>(
+                        &mut sink, &b, 0, 0, invert,
+                    ));
+                    let copy = infallible(sink.finish(NodeState::Partial));
+                    let expect = if invert {
+                        crate::ops::complement(&t)
+                    } else {
+                        t.clone()
+                    };
+                    assert_eq!(copy, expect, "K = {K}, invert {invert}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn provided_slots_and_subtree_copies_read_what_the_words_hold() {
+        slots_and_copies_agree::<1>(7);
+        slots_and_copies_agree::<2>(4);
+        slots_and_copies_agree::<3>(3);
+        slots_and_copies_agree::<4>(2);
     }
 }
