@@ -16,7 +16,8 @@ use super::error::DisplayError;
 use super::png::Canvas;
 use super::raster::{render, RenderOptions, Rendered};
 use crate::space::{Cell, Universe};
-use crate::tree::{KTree, NodeState, Octree, Tree4};
+use crate::tree::cursor::{walk, Visitor, Walk};
+use crate::tree::{KTree, NodeRef, NodeState, Octree, Tree4};
 
 /// The octree of the 4-D tree's slice at `position` along `axis` (the remaining axes keep their order).
 ///
@@ -51,23 +52,41 @@ pub fn slice_4d(tree: &Tree4, axis: usize, position: u32) -> Result<Octree, Disp
         }
         out
     };
-    let mut cells: Vec<Cell<3>> = Vec::new();
-    let mut stack = vec![tree.root()];
-    while let Some(node) = stack.pop() {
-        let o = node.cell.origin[axis];
-        if position < o || u64::from(position - o) >= node.cell.side() {
-            continue;
-        }
-        match node.state {
-            NodeState::Empty => {}
-            NodeState::Full => cells.push(Cell {
-                origin: drop_axis(node.cell.origin),
-                level: node.cell.level,
-                log_side: node.cell.log_side,
-            }),
-            NodeState::Partial => stack.extend(tree.children(&node)),
+    // The full leaves whose cells meet the slab `position` on `axis`, found by one walk that skips every
+    // subtree outside the slab.
+    struct Slab<F> {
+        axis: usize,
+        position: u32,
+        full: F,
+    }
+    impl<F: FnMut(&Cell<4>)> Visitor<4> for Slab<F> {
+        const LEAVES: bool = false;
+        fn visit(&mut self, node: &NodeRef<4>) -> Walk {
+            let o = node.cell.origin[self.axis];
+            if self.position < o || u64::from(self.position - o) >= node.cell.side() {
+                return Walk::Skip;
+            }
+            if node.state == NodeState::Full {
+                (self.full)(&node.cell);
+            }
+            Walk::Descend
         }
     }
+    let mut cells: Vec<Cell<3>> = Vec::new();
+    walk(
+        tree,
+        &mut Slab {
+            axis,
+            position,
+            full: |cell: &Cell<4>| {
+                cells.push(Cell {
+                    origin: drop_axis(cell.origin),
+                    level: cell.level,
+                    log_side: cell.log_side,
+                })
+            },
+        },
+    );
     cells.sort_unstable_by_key(|c| c.morton());
     Ok(KTree::from_sorted_cells(universe, &merge_siblings(cells)))
 }

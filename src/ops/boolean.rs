@@ -12,9 +12,13 @@
 //! Two trees of different universe levels are an error ([`OpsError::LevelMismatch`]); trees of different
 //! dimension `K` cannot be combined at all — `KTree<2>` and `KTree<3>` are different types.
 
-use super::emit::{collapse, leaf, LevelWriter};
+use std::convert::Infallible;
+
+use super::emit::{collapse, leaf};
 use super::OpsError;
-use crate::tree::cursor::{walk_pair, PairNode, PairVisitor, Walk};
+use crate::tree::cursor::{try_walk_pair, PairNode, PairVisitor, Walk};
+use crate::tree::sink::{copy_subtree, LevelSink, MemorySink};
+use crate::tree::storage::{infallible, TreeStorage};
 use crate::tree::words::{self, NODES_PER_WORD};
 use crate::tree::{KTree, NodeState};
 
@@ -61,88 +65,116 @@ impl BoolOp {
     }
 }
 
-/// What the result is over a region where one input is the leaf `fixed` and the other is `x`.
-#[derive(Clone, Copy)]
-enum Outcome {
+/// What the result is over a region where one input is a leaf and the other is not: the operation's truth
+/// table with one side fixed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Outcome {
+    /// The result is this leaf, whatever the other side holds.
     Leaf(NodeState),
+    /// The result is the other side's subtree.
     Copy,
+    /// The result is the complement of the other side's subtree.
     Invert,
 }
 
-/// The Boolean as a two-tree walk: a pair is decided on the spot where a leaf decides it (a leaf, a copy
-/// of the other subtree or its complement), else its children are visited and the pair is decided when
-/// it is left, from its children's states.
-struct Merge<'a, const K: usize> {
-    a: &'a KTree<K>,
-    b: &'a KTree<K>,
-    op: BoolOp,
-    out: LevelWriter,
-    /// `kids[d]`: the states decided so far for the children (at depth `d`) of the open pair above.
-    kids: Vec<[NodeState; 16]>,
-}
-
-impl<const K: usize> Merge<'_, K> {
-    /// Result over a region where input `a` is the leaf `la` (`a_fixed`) or `b` is (`!a_fixed`).
-    fn outcome(&self, fixed_full: bool, a_fixed: bool) -> Outcome {
-        let (r0, r1) = if a_fixed {
-            (
-                self.op.apply(fixed_full, false),
-                self.op.apply(fixed_full, true),
-            )
-        } else {
-            (
-                self.op.apply(false, fixed_full),
-                self.op.apply(true, fixed_full),
-            )
+impl Outcome {
+    /// The result of `op` where one side is the leaf `fixed_full` (full or empty): `a`'s if `a_fixed`,
+    /// else `b`'s.
+    pub(crate) fn of(op: BoolOp, fixed_full: bool, a_fixed: bool) -> Self {
+        let apply = |x: bool| {
+            if a_fixed {
+                op.apply(fixed_full, x)
+            } else {
+                op.apply(x, fixed_full)
+            }
         };
-        match (r0, r1) {
+        match (apply(false), apply(true)) {
             (r, s) if r == s => Outcome::Leaf(leaf(r)),
             (false, true) => Outcome::Copy,
             _ => Outcome::Invert,
         }
     }
+}
 
+/// The Boolean as a two-tree walk over any two storages, writing to any level sink: a pair is decided on
+/// the spot where a leaf decides it (a leaf, a copy of the other subtree or its complement), else its
+/// children are visited and the pair is decided when it is left, from its children's states. The first
+/// error (a read of a subtree being copied, or a write) stops the walk and is kept.
+struct Merge<'a, const K: usize, A, B, S, E> {
+    a: &'a A,
+    b: &'a B,
+    op: BoolOp,
+    out: S,
+    /// `kids[d]`: the states decided so far for the children (at depth `d`) of the open pair above.
+    kids: Vec<[NodeState; 16]>,
+    error: Option<E>,
+}
+
+impl<const K: usize, A, B, S, E> Merge<'_, K, A, B, S, E>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+    S: LevelSink,
+    E: From<A::Error> + From<S::Error>,
+{
     /// Records the result `state` of the pair at `depth` with child code `code`.
     #[inline]
     fn decide(&mut self, depth: usize, code: usize, state: NodeState) {
         self.kids[depth][code] = state;
     }
+
+    /// The result over a partial node of one side (`a`'s if `of_a`) where the other is the leaf
+    /// `other_full`: a leaf, or the node's subtree copied (complemented if the table says so).
+    #[inline]
+    fn one_side(&mut self, of_a: bool, depth: usize, index: usize, other_full: bool) -> NodeState {
+        let invert = match Outcome::of(self.op, other_full, !of_a) {
+            Outcome::Leaf(s) => return s,
+            Outcome::Copy => false,
+            Outcome::Invert => true,
+        };
+        let copied = if of_a {
+            copy_subtree::<K, _, _, E>(&mut self.out, self.a, depth, index, invert)
+        } else {
+            copy_subtree::<K, _, _, E>(&mut self.out, self.b, depth, index, invert)
+        };
+        if let Err(e) = copied {
+            self.error.get_or_insert(e);
+        }
+        NodeState::Partial
+    }
 }
 
-impl<const K: usize> PairVisitor<K> for Merge<'_, K> {
+impl<const K: usize, A, B, S, E> PairVisitor<K> for Merge<'_, K, A, B, S, E>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+    S: LevelSink,
+    E: From<A::Error> + From<S::Error>,
+{
     const ORIGINS: bool = false;
 
     #[inline]
     fn visit(&mut self, pair: &PairNode<K>) -> Walk {
+        if self.error.is_some() {
+            return Walk::Stop;
+        }
         let (depth, code) = (pair.cell.level as usize, pair.code);
         let state = match (pair.a.state, pair.b.state) {
             (NodeState::Partial, NodeState::Partial) => return Walk::Descend,
             (NodeState::Partial, lb) => {
-                let invert = match self.outcome(lb == NodeState::Full, false) {
-                    Outcome::Leaf(s) => {
-                        self.decide(depth, code, s);
-                        return Walk::Skip;
-                    }
-                    outcome => matches!(outcome, Outcome::Invert),
-                };
-                self.out
-                    .copy_subtree(self.a, depth, pair.a.index, depth, invert)
+                self.one_side(true, depth, pair.a.index, lb == NodeState::Full)
             }
             (la, NodeState::Partial) => {
-                let invert = match self.outcome(la == NodeState::Full, true) {
-                    Outcome::Leaf(s) => {
-                        self.decide(depth, code, s);
-                        return Walk::Skip;
-                    }
-                    outcome => matches!(outcome, Outcome::Invert),
-                };
-                self.out
-                    .copy_subtree(self.b, depth, pair.b.index, depth, invert)
+                self.one_side(false, depth, pair.b.index, la == NodeState::Full)
             }
             (la, lb) => leaf(self.op.apply(la == NodeState::Full, lb == NodeState::Full)),
         };
         self.decide(depth, code, state);
-        Walk::Skip
+        if self.error.is_some() {
+            Walk::Stop
+        } else {
+            Walk::Skip
+        }
     }
 
     #[inline]
@@ -153,12 +185,71 @@ impl<const K: usize> PairVisitor<K> for Merge<'_, K> {
         let state = match collapse(kids) {
             Some(s) => s,
             None => {
-                self.out.push_block(depth + 1, kids);
+                if let Err(e) = self.out.push_block(depth + 1, kids) {
+                    self.error.get_or_insert(e.into());
+                }
                 NodeState::Partial
             }
         };
         self.decide(depth, pair.code, state);
     }
+}
+
+/// `a op b` written to `sink`, for trees of the same universe in any storages: the one Boolean behind
+/// [`boolean`] (in memory) and [`boolean_files`](super::boolean_files) (mapped files, spilled levels).
+/// The output is reduced.
+///
+/// # Errors
+/// The first read error of `a` or `b`, or write error of `sink`.
+pub(crate) fn boolean_into<const K: usize, A, B, S, E>(
+    a: &A,
+    b: &B,
+    op: BoolOp,
+    sink: S,
+) -> Result<S::Output, E>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+    S: LevelSink,
+    E: From<A::Error> + From<S::Error>,
+{
+    let depths = a.depth_count().max(b.depth_count());
+    let mut m = Merge {
+        a,
+        b,
+        op,
+        out: sink,
+        kids: vec![[NodeState::Empty; 16]; depths + 1],
+        error: None,
+    };
+    let walked = try_walk_pair(a, b, &mut m);
+    if let Some(e) = m.error {
+        return Err(e);
+    }
+    walked?;
+    let root = m.kids[0][0];
+    Ok(m.out.finish(root)?)
+}
+
+/// The complement of `a` written to `sink`: the root's subtree copied with full and empty swapped.
+///
+/// # Errors
+/// The first read error of `a` or write error of `sink`.
+pub(crate) fn complement_into<const K: usize, A, S, E>(a: &A, mut sink: S) -> Result<S::Output, E>
+where
+    A: TreeStorage<K>,
+    S: LevelSink,
+    E: From<A::Error> + From<S::Error>,
+{
+    let root = match a.root_state()? {
+        NodeState::Partial => {
+            copy_subtree::<K, _, _, E>(&mut sink, a, 0, 0, true)?;
+            NodeState::Partial
+        }
+        NodeState::Full => NodeState::Empty,
+        NodeState::Empty => NodeState::Full,
+    };
+    Ok(sink.finish(root)?)
 }
 
 /// Checks that two trees share a universe level.
@@ -192,17 +283,8 @@ pub fn boolean<const K: usize>(
     op: BoolOp,
 ) -> Result<KTree<K>, OpsError> {
     same_level(a, b)?;
-    let depths = a.depth_count().max(b.depth_count());
-    let mut m = Merge {
-        a,
-        b,
-        op,
-        out: LevelWriter::new(),
-        kids: vec![[NodeState::Empty; 16]; depths + 1],
-    };
-    walk_pair(a, b, &mut m);
-    let root = m.kids[0][0];
-    Ok(m.out.finish_with_root(a.universe(), root))
+    let merged: Result<_, Infallible> = boolean_into(a, b, op, MemorySink::new(a.universe()));
+    Ok(infallible(merged))
 }
 
 /// `A ∪ B`. See [`boolean`].

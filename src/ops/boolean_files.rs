@@ -2,19 +2,18 @@
 //! memory.
 //!
 //! # How it runs
-//! The inputs are read through their memory maps ([`KtreeView`]) by one simultaneous depth-first walk, as
-//! [`boolean`](super::boolean) walks two trees in memory: where one side is a leaf, the result under it is a
-//! leaf, a copy of the other side's subtree or its complement (level ranges copied word by word), and two
-//! partial nodes are walked child by child. The result is produced in *post-order*: a node's `2^K` child
-//! states are appended to the output level below once all of them are known, so a node whose children all
-//! turn out full (or empty) collapses before anything of it is written, and the blocks of every level come
-//! out in level order (a node finishes after every node before it at its depth). Each output level is
-//! appended to its own temporary *spill file*; at the end they are streamed, level by level, into the
-//! `.ktree` through a [`KtreeWriter`], written to a temporary file and renamed over the target.
+//! The inputs are read through their memory maps ([`KtreeView`]) as a [`TreeStorage`] whose every read is
+//! checked, by the Boolean that [`boolean`](super::boolean) runs on trees in memory — the same pair walk,
+//! merge and truth table: where one side is a leaf, the result under it is a leaf, a copy of the other
+//! side's subtree or its complement (level ranges copied word by word), and two partial nodes are walked
+//! child by child. The result is produced in *post-order*: a node's `2^K` child states are appended to the
+//! output level below once all of them are known, so a node whose children all turn out full (or empty)
+//! collapses before anything of it is written, and the blocks of every level come out in level order (a
+//! node finishes after every node before it at its depth). The output is a [`LevelSink`] that appends each
+//! level to its own temporary *spill file* ([`SpillLevels`]); at the end they are streamed, level by level,
+//! into the `.ktree` through a [`KtreeWriter`], written to a temporary file and renamed over the target.
 //!
-//! Child positions in the inputs come from running counts of the children blocks met at each depth (the
-//! depth-first walk meets the partial nodes of every level in level order), re-synchronised from the file's
-//! rank samples after a skipped subtree.
+//! Child positions in the inputs come from the file's rank samples (at most 64 word pop-counts each).
 //!
 //! # Memory
 //! What the process allocates is bounded by the depth of the trees, not their size: the walk's stack, one
@@ -38,8 +37,12 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
+use super::boolean::{boolean_into, complement_into};
 use super::BoolOp;
-use crate::io::{KtreeFileError, KtreeView, KtreeWriter};
+use crate::io::{KtreeFileError, KtreeFileErrorKind, KtreeView, KtreeWriter};
+use crate::space::Universe;
+use crate::tree::sink::LevelSink;
+use crate::tree::storage::TreeStorage;
 use crate::tree::words::{self, WordPacker};
 use crate::tree::{LevelCounts, NodeState};
 
@@ -110,6 +113,16 @@ pub struct BooleanFileReport {
     pub spilled_bytes: u64,
 }
 
+/// The operation of a streamed Boolean: a binary operation with its second operand, or the complement of
+/// the first.
+#[derive(Debug, Clone, Copy)]
+pub enum ViewOperation<'a> {
+    /// `a op b`.
+    Binary(BoolOp, &'a KtreeView),
+    /// `¬a`.
+    Complement,
+}
+
 /// Writes `a op b` to the `.ktree` version 2 file `out`, reading the version 2 files `a` and `b` through
 /// their memory maps, in bounded memory (see the module's notes). Spill files go to a hidden folder in
 /// `temp_dir` (default: the output's folder), removed at the end. The bytes are those of
@@ -126,7 +139,7 @@ pub fn boolean_files(
 ) -> Result<BooleanFileReport, BooleanFileError> {
     let va = KtreeView::open(a)?;
     let vb = KtreeView::open(b)?;
-    boolean_views(&va, Some(&vb), Some(op), out, temp_dir)
+    boolean_views(&va, ViewOperation::Binary(op, &vb), out, temp_dir)
 }
 
 /// Writes the complement of the version 2 file `a` to `out`, level by level, in bounded memory (see
@@ -140,21 +153,31 @@ pub fn complement_file(
     temp_dir: Option<&Path>,
 ) -> Result<BooleanFileReport, BooleanFileError> {
     let va = KtreeView::open(a)?;
-    boolean_views(&va, None, None, out, temp_dir)
+    boolean_views(&va, ViewOperation::Complement, out, temp_dir)
 }
 
-/// `a op b` of two views (or the complement of `a` when `b` and `op` are `None`) to `out`.
+/// `operation` applied to the view `a` (and the second operand it names), written to `out`.
+///
+/// ```
+/// use ktree::{io, ops, KTree};
+/// let dir = tempfile::tempdir().unwrap();
+/// let (pa, pc) = (dir.path().join("a.ktree"), dir.path().join("c.ktree"));
+/// let a = KTree::<1>::from_dense(2, &[true, false, false, true]).unwrap();
+/// io::write_ktree_v2_file(&pa, &a).unwrap();
+/// let view = io::KtreeView::open(&pa).unwrap();
+/// ops::boolean_views(&view, ops::ViewOperation::Complement, &pc, None).unwrap();
+/// assert_eq!(io::read_ktree_file(&pc).unwrap(), io::AnyTree::K1(ops::complement(&a)));
+/// ```
 ///
 /// # Errors
 /// As [`boolean_files`].
 pub fn boolean_views(
     a: &KtreeView,
-    b: Option<&KtreeView>,
-    op: Option<BoolOp>,
+    operation: ViewOperation<'_>,
     out: &Path,
     temp_dir: Option<&Path>,
 ) -> Result<BooleanFileReport, BooleanFileError> {
-    if let Some(b) = b {
+    if let ViewOperation::Binary(_, b) = operation {
         if (a.k(), a.level()) != (b.k(), b.level()) {
             return Err(BooleanFileError::Mismatch {
                 a: a.name().to_string(),
@@ -166,234 +189,136 @@ pub fn boolean_views(
             });
         }
     }
-    let depths = a.depth_count().max(b.map_or(0, KtreeView::depth_count));
+    match a.k() {
+        1 => boolean_views_k::<1>(a, operation, out, temp_dir),
+        2 => boolean_views_k::<2>(a, operation, out, temp_dir),
+        3 => boolean_views_k::<3>(a, operation, out, temp_dir),
+        // Any other `K` is refused by `ViewStorage::new`.
+        _ => boolean_views_k::<4>(a, operation, out, temp_dir),
+    }
+}
+
+/// [`boolean_views`] for files of dimension `K`.
+fn boolean_views_k<const K: usize>(
+    a: &KtreeView,
+    operation: ViewOperation<'_>,
+    out: &Path,
+    temp_dir: Option<&Path>,
+) -> Result<BooleanFileReport, BooleanFileError> {
+    let sa = ViewStorage::<K>::new(a)?;
+    let sb = match operation {
+        ViewOperation::Binary(_, b) => Some(ViewStorage::<K>::new(b)?),
+        ViewOperation::Complement => None,
+    };
+    let depths = a.depth_count().max(sb.map_or(0, |b| b.view.depth_count()));
     let folder = crate::fs::spill_folder(out, temp_dir)
         .map_err(|(path, source)| BooleanFileError::TempDir { path, source })?;
-    let mut levels = OutputLevels::create(folder.path(), depths)?;
-    let mut inputs = [Input::new(a, depths), Input::new(b.unwrap_or(a), depths)];
-    let root = match (b, op) {
-        (Some(_), Some(op)) => {
-            let mut walk = Walk {
-                inputs: &mut inputs,
-                levels: &mut levels,
-                op,
-                k: a.k(),
-            };
-            walk.pair(0, 0, 0)?
-        }
-        _ => {
-            let mut walk = Walk {
-                inputs: &mut inputs,
-                levels: &mut levels,
-                op: BoolOp::Difference,
-                k: a.k(),
-            };
-            walk.side(0, 0, 0, Polarity::Complement)?
-        }
+    let sink = SpillLevels::create(folder.path(), depths, K, a.level(), out)?;
+    let report = match (operation, sb) {
+        (ViewOperation::Binary(op, _), Some(sb)) => boolean_into(&sa, &sb, op, sink),
+        _ => complement_into(&sa, sink),
     };
-    let report = levels.finish(root, a.k(), a.level(), out);
     drop(folder);
     report
 }
 
-/// One input and where the walk is in it.
-struct Input<'a> {
+/// A version 2 file read through its view as a [`TreeStorage`], every read checked against the shape
+/// found when the file was opened: a file changed since gives an error naming the file and a byte offset
+/// within the level read, never a read past the map.
+#[derive(Debug, Clone, Copy)]
+struct ViewStorage<'a, const K: usize> {
     view: &'a KtreeView,
-    /// Per depth `d`: the index of the next children block to meet at depth `d`.
-    next: Vec<u64>,
-    /// Bit `d` set: `next[d]` is out of date (a subtree above was skipped).
-    stale: u64,
+    universe: Universe<K>,
 }
 
-impl<'a> Input<'a> {
-    fn new(view: &'a KtreeView, depths: usize) -> Self {
-        Self {
+impl<'a, const K: usize> ViewStorage<'a, K> {
+    fn new(view: &'a KtreeView) -> Result<Self, KtreeFileError> {
+        Ok(Self {
             view,
-            next: vec![0; depths + 1],
-            stale: 0,
+            universe: view.universe::<K>()?,
+        })
+    }
+
+    /// The error for nodes `index …` of level `depth` that the shape says exist but the file does not
+    /// hold as it did: the offset is that of the level's last word read, within the file.
+    fn changed(&self, depth: usize, index: u64) -> KtreeFileError {
+        let depth = depth.min(self.view.depth_count().saturating_sub(1));
+        let last = index.min(self.view.level_nodes(depth).saturating_sub(1));
+        let mut error = self.view.changed(depth, last);
+        error.kind = KtreeFileErrorKind::Tree(format!(
+            "node {index} of level {depth} is missing or has the code 11: the file was changed after it was opened"
+        ));
+        error
+    }
+
+    /// The `n ≤ 32` states of level `depth` from `first`, checked to be in the level.
+    fn read(&self, depth: usize, first: u64, n: u64) -> Result<u64, KtreeFileError> {
+        if depth >= self.view.depth_count()
+            || first.saturating_add(n) > self.view.level_nodes(depth)
+        {
+            return Err(self.changed(depth, first));
         }
-    }
-
-    fn state(&self, depth: usize, index: u64) -> Result<NodeState, KtreeFileError> {
-        self.view.checked_state(depth, index)
-    }
-
-    /// The first child of the partial node `index` of level `depth`, met in depth-first order.
-    fn first_child(&mut self, depth: usize, index: u64, k: usize) -> u64 {
-        let below = depth + 1;
-        if self.stale >> below & 1 == 1 {
-            self.next[below] = self.view.partial_rank(depth, index) << k;
-            self.stale &= !(1 << below);
+        let words = self.view.level_nodes(depth).div_ceil(NODES_PER_WORD);
+        let (j, off) = (first / NODES_PER_WORD, first % NODES_PER_WORD);
+        let mut word = self.view.level_word(depth, j) >> (2 * off);
+        if off > 0 && j + 1 < words {
+            word |= self.view.level_word(depth, j + 1) << (2 * (NODES_PER_WORD - off));
         }
-        let first = self.next[below];
-        self.next[below] += 1 << k;
-        first
-    }
-
-    /// The walk does not enter the subtree of a partial node of level `depth`.
-    fn skip(&mut self, depth: usize) {
-        self.stale |= u64::MAX << (depth + 1);
-    }
-}
-
-/// How a subtree goes into the result.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Polarity {
-    Same,
-    Complement,
-}
-
-/// The result as a function of one side, the other side being a leaf.
-enum Under {
-    Leaf(NodeState),
-    Subtree(Polarity),
-}
-
-impl Under {
-    /// What `op` makes of `other` when this side is the leaf `full` (`leaf_is_a`: the leaf is `a`'s).
-    fn of(op: BoolOp, full: bool, leaf_is_a: bool) -> Self {
-        let f = |x: bool| {
-            if leaf_is_a {
-                op.apply(full, x)
-            } else {
-                op.apply(x, full)
-            }
-        };
-        match (f(false), f(true)) {
-            (false, false) => Under::Leaf(NodeState::Empty),
-            (true, true) => Under::Leaf(NodeState::Full),
-            (false, true) => Under::Subtree(Polarity::Same),
-            (true, false) => Under::Subtree(Polarity::Complement),
+        let word = word & words::slots_mask(n as usize);
+        // A code 11 is not a state: the bytes are not the file's any more.
+        if words::unused_mask(word) != 0 {
+            return Err(self.changed(depth, first));
         }
+        Ok(word)
     }
 }
 
-/// The simultaneous walk.
-struct Walk<'w, 'a> {
-    inputs: &'w mut [Input<'a>; 2],
-    levels: &'w mut OutputLevels,
-    op: BoolOp,
-    k: usize,
-}
+impl<const K: usize> TreeStorage<K> for ViewStorage<'_, K> {
+    type Error = KtreeFileError;
 
-impl Walk<'_, '_> {
-    /// The result at node `ia` of `a` and `ib` of `b`, both at `depth`; the levels below are appended.
-    fn pair(&mut self, depth: usize, ia: u64, ib: u64) -> Result<NodeState, BooleanFileError> {
-        let sa = self.inputs[0].state(depth, ia)?;
-        let sb = self.inputs[1].state(depth, ib)?;
-        match (sa, sb) {
-            (NodeState::Partial, NodeState::Partial) => {}
-            (NodeState::Partial, leaf) => {
-                return self.one_side(
-                    0,
-                    depth,
-                    ia,
-                    Under::of(self.op, leaf == NodeState::Full, false),
-                )
-            }
-            (leaf, NodeState::Partial) => {
-                return self.one_side(
-                    1,
-                    depth,
-                    ib,
-                    Under::of(self.op, leaf == NodeState::Full, true),
-                )
-            }
-            (x, y) => {
-                let full = self.op.apply(x == NodeState::Full, y == NodeState::Full);
-                return Ok(if full {
-                    NodeState::Full
-                } else {
-                    NodeState::Empty
-                });
-            }
-        }
-        let ca = self.inputs[0].first_child(depth, ia, self.k);
-        let cb = self.inputs[1].first_child(depth, ib, self.k);
-        let mut children = [NodeState::Empty; 16];
-        for (code, child) in children.iter_mut().enumerate().take(1 << self.k) {
-            *child = self.pair(depth + 1, ca + code as u64, cb + code as u64)?;
-        }
-        self.close(depth, &children[..1 << self.k])
+    fn universe(&self) -> Universe<K> {
+        self.universe
     }
 
-    fn one_side(
-        &mut self,
-        side: usize,
-        depth: usize,
-        index: u64,
-        under: Under,
-    ) -> Result<NodeState, BooleanFileError> {
-        match under {
-            Under::Leaf(state) => {
-                self.inputs[side].skip(depth);
-                Ok(state)
-            }
-            Under::Subtree(copy) => self.side(side, depth, index, copy),
-        }
+    fn depth_count(&self) -> usize {
+        self.view.depth_count()
     }
 
-    /// The partial node `index` of side `side` at `depth`, copied (or complemented) into the result.
-    fn side(
-        &mut self,
-        side: usize,
-        depth: usize,
-        index: u64,
-        copy: Polarity,
-    ) -> Result<NodeState, BooleanFileError> {
-        let state = self.inputs[side].state(depth, index)?;
-        if state != NodeState::Partial {
-            return Ok(match (state, copy) {
-                (s, Polarity::Same) => s,
-                (NodeState::Full, Polarity::Complement) => NodeState::Empty,
-                _ => NodeState::Full,
-            });
-        }
-        let input = &mut self.inputs[side];
-        let mut start = input.first_child(depth, index, self.k);
-        let mut nodes = 1u64 << self.k;
-        let mut d = depth + 1;
-        while nodes > 0 {
-            let partial = self
-                .levels
-                .append_range(input.view, d, start, nodes, copy)?;
-            let end = start + nodes;
-            input.next[d] = end;
-            input.stale &= !(1 << d);
-            if partial == 0 {
-                break;
-            }
-            start = input.view.partial_rank(d, start) << self.k;
-            nodes = partial << self.k;
-            d += 1;
-        }
-        // The depths down to the subtree's last level are in step (the blocks after the subtree come
-        // next); below it, positions are found again from the rank samples.
-        input.stale |= u64::MAX << (d + 1);
-        Ok(NodeState::Partial)
+    fn root_state(&self) -> Result<NodeState, KtreeFileError> {
+        self.view.checked_state(0, 0)
     }
 
-    /// A partial-partial node whose children are known: collapses it, or appends the children below it.
-    fn close(
-        &mut self,
-        depth: usize,
-        children: &[NodeState],
-    ) -> Result<NodeState, BooleanFileError> {
-        if children.iter().all(|&c| c == NodeState::Full) {
-            return Ok(NodeState::Full);
+    fn first_child(&self, depth: usize, index: usize) -> Result<usize, KtreeFileError> {
+        let index = index as u64;
+        if depth + 1 >= self.view.depth_count()
+            || self.view.checked_state(depth, index)? != NodeState::Partial
+        {
+            return Err(self.changed(depth, index));
         }
-        if children.iter().all(|&c| c == NodeState::Empty) {
-            return Ok(NodeState::Empty);
+        let first = self.view.partial_rank(depth, index).saturating_mul(1 << K);
+        if first.saturating_add(1 << K) > self.view.level_nodes(depth + 1) {
+            return Err(self.changed(depth + 1, first));
         }
-        let word = words::pack(children);
-        self.levels.append(depth + 1, word, children.len() as u64)?;
-        Ok(NodeState::Partial)
+        Ok(first as usize)
+    }
+
+    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, KtreeFileError> {
+        Ok(self.read(depth, first as u64, 1 << K)? as u32)
+    }
+
+    fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, KtreeFileError> {
+        self.read(depth, first as u64, n as u64)
     }
 }
 
-/// The result's levels `1 …`, each appended to its spill file.
-struct OutputLevels {
+/// A [`LevelSink`] that appends each level `1 …` of a tree to its own spill file and, when finished,
+/// streams them into a `.ktree` version 2 file (written to a temporary file and renamed over the target):
+/// trees larger than memory, written in bounded memory.
+pub(crate) struct SpillLevels {
     levels: Vec<OutputLevel>,
+    k: usize,
+    level: u32,
+    out: PathBuf,
 }
 
 struct OutputLevel {
@@ -403,8 +328,16 @@ struct OutputLevel {
     packer: WordPacker,
 }
 
-impl OutputLevels {
-    fn create(folder: &Path, depths: usize) -> Result<Self, BooleanFileError> {
+impl SpillLevels {
+    /// Spill files for the levels `1 … depths − 1` of a `K = k`, `L = level` tree in `folder`, to be
+    /// written to `out`.
+    pub(crate) fn create(
+        folder: &Path,
+        depths: usize,
+        k: usize,
+        level: u32,
+        out: &Path,
+    ) -> Result<Self, BooleanFileError> {
         let levels = (1..depths)
             .map(|d| {
                 let path = folder.join(format!("level-{d}"));
@@ -420,11 +353,16 @@ impl OutputLevels {
                 })
             })
             .collect::<Result<_, BooleanFileError>>()?;
-        Ok(Self { levels })
+        Ok(Self {
+            levels,
+            k,
+            level,
+            out: out.to_path_buf(),
+        })
     }
 
     /// Appends `nodes` (≤ 32) nodes packed in `word` to level `depth`.
-    fn append(&mut self, depth: usize, word: u64, nodes: u64) -> Result<(), BooleanFileError> {
+    fn append_word(&mut self, depth: usize, word: u64, nodes: u64) -> Result<(), BooleanFileError> {
         let level = &mut self.levels[depth - 1];
         level.nodes += nodes;
         if let Some(whole) = level.packer.push(word, nodes as usize) {
@@ -439,50 +377,9 @@ impl OutputLevels {
         Ok(())
     }
 
-    /// Appends nodes `start … start + nodes` of `view`'s level `depth` (complemented if asked) to the same
-    /// level of the result; returns how many of them are partial.
-    fn append_range(
-        &mut self,
-        view: &KtreeView,
-        depth: usize,
-        start: u64,
-        nodes: u64,
-        copy: Polarity,
-    ) -> Result<u64, BooleanFileError> {
-        if start + nodes > view.level_nodes(depth) {
-            return Err(view.changed(depth, start + nodes - 1).into());
-        }
-        let words = view.level_nodes(depth).div_ceil(NODES_PER_WORD);
-        let mut at = start;
-        let mut partial = 0;
-        while at < start + nodes {
-            let take = (start + nodes - at).min(NODES_PER_WORD);
-            let word = words::read_codes(
-                |j| view.level_word(depth, j as u64),
-                words as usize,
-                at as usize,
-                take as usize,
-            );
-            partial += u64::from(words::partial_count(word));
-            let word = match copy {
-                Polarity::Same => word,
-                // Full and empty swap; partial stays.
-                Polarity::Complement => words::complement(word, take as usize),
-            };
-            self.append(depth, word, take)?;
-            at += take;
-        }
-        Ok(partial)
-    }
-
     /// Writes the result (root `root`) to `out`: the root level, then each spilled level.
-    fn finish(
-        self,
-        root: NodeState,
-        k: usize,
-        level: u32,
-        out: &Path,
-    ) -> Result<BooleanFileReport, BooleanFileError> {
+    fn write(self, root: NodeState) -> Result<BooleanFileReport, BooleanFileError> {
+        let (k, level, out) = (self.k, self.level, self.out.as_path());
         let mut spilled_bytes = 0;
         let mut readers = Vec::new();
         for mut l in self.levels {
@@ -543,5 +440,19 @@ impl OutputLevels {
             counts_per_level: counts,
             spilled_bytes,
         })
+    }
+}
+
+impl LevelSink for SpillLevels {
+    type Error = BooleanFileError;
+    type Output = BooleanFileReport;
+
+    #[inline]
+    fn append(&mut self, depth: usize, word: u64, n: usize) -> Result<(), BooleanFileError> {
+        self.append_word(depth, word, n as u64)
+    }
+
+    fn finish(self, root: NodeState) -> Result<BooleanFileReport, BooleanFileError> {
+        self.write(root)
     }
 }

@@ -53,6 +53,7 @@ pub use boolean::{
 };
 pub use boolean_files::{
     boolean_files, boolean_views, complement_file, BooleanFileError, BooleanFileReport,
+    ViewOperation,
 };
 pub use complexity::{
     bounding_box, complexity, normalise_to_origin, over_maps, over_placements, over_translations,

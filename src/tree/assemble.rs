@@ -81,6 +81,12 @@ impl LevelWriter {
         self.level(depth).push(state as u64, 1);
     }
 
+    /// Appends `slots ≤ 32` states packed in the low bits of `chunk` (higher bits clear) at `depth`.
+    #[inline]
+    pub(crate) fn append_word(&mut self, depth: usize, chunk: u64, slots: usize) {
+        self.level(depth).push(chunk, slots);
+    }
+
     /// Appends a block of sibling states (at most 32) at `depth`.
     #[inline]
     pub(crate) fn push_block(&mut self, depth: usize, kids: &[NodeState]) {

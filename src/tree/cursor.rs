@@ -33,97 +33,9 @@ use smallvec::SmallVec;
 
 use super::ktree::{KTree, NodeRef, TreeId};
 use super::states::NodeState;
-use crate::space::{Cell, Universe};
-
-/// A tree stored in level order, read as the one-tree walks read it: in memory ([`KTree`]), or through the
-/// memory map of a `.ktree` version 2 file ([`MappedTree`](crate::io::MappedTree)), so that walks such as
-/// rendering run on trees larger than memory.
-pub trait LevelOrder<const K: usize> {
-    /// The universe.
-    fn universe(&self) -> Universe<K>;
-
-    /// The number of stored levels.
-    fn depth_count(&self) -> usize;
-
-    /// The root's state.
-    fn root_state(&self) -> NodeState;
-
-    /// The index (in level `depth + 1`) of the first child of the partial node `index` of level `depth`.
-    fn first_child(&self, depth: usize, index: usize) -> usize;
-
-    /// The states of the `2^K` siblings of level `depth` from `first` (a multiple of `2^K`), two bits each,
-    /// the first in the low bits.
-    fn block_codes(&self, depth: usize, first: usize) -> u32;
-
-    /// The universe level `L`.
-    fn level(&self) -> u32 {
-        self.universe().level()
-    }
-
-    /// The root node.
-    fn root(&self) -> NodeRef<K> {
-        NodeRef {
-            index: 0,
-            cell: self.universe().root(),
-            state: self.root_state(),
-            tree: TreeId::NONE,
-        }
-    }
-
-    /// Visits every leaf (empty and full) in Morton order.
-    fn for_each_leaf(&self, mut visit: impl FnMut(Cell<K>, NodeState))
-    where
-        Self: Sized,
-    {
-        struct Leaves<F>(F);
-        impl<const K: usize, F: FnMut(Cell<K>, NodeState)> Visitor<K> for Leaves<F> {
-            const LEAVES: bool = false;
-            fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-                if node.state != NodeState::Partial {
-                    (self.0)(node.cell, node.state);
-                }
-                Walk::Descend
-            }
-        }
-        walk(self, &mut Leaves(&mut visit));
-    }
-}
-
-impl<const K: usize> LevelOrder<K> for KTree<K> {
-    #[inline]
-    fn universe(&self) -> Universe<K> {
-        KTree::universe(self)
-    }
-
-    #[inline]
-    fn depth_count(&self) -> usize {
-        KTree::depth_count(self)
-    }
-
-    #[inline]
-    fn root_state(&self) -> NodeState {
-        KTree::root_state(self)
-    }
-
-    #[inline]
-    fn root(&self) -> NodeRef<K> {
-        KTree::root(self)
-    }
-
-    #[inline(always)]
-    fn first_child(&self, depth: usize, index: usize) -> usize {
-        KTree::first_child(self, depth, index)
-    }
-
-    #[inline(always)]
-    fn block_codes(&self, depth: usize, first: usize) -> u32 {
-        self.level_states(depth).block_codes(first, K)
-    }
-
-    fn for_each_leaf(&self, visit: impl FnMut(Cell<K>, NodeState)) {
-        KTree::for_each_leaf(self, visit)
-    }
-}
+use super::storage::infallible;
+pub use super::storage::{LevelOrder, TreeStorage};
+use crate::space::Cell;
 
 /// What a visitor wants after seeing a node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -288,12 +200,13 @@ fn child_ref<const K: usize>(
 }
 
 /// Walks `tree` depth first from the root with `visitor`. Returns `true` if the visitor stopped the walk.
+/// For a storage whose reads can fail, [`try_walk`].
 pub fn walk<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(tree: &T, visitor: &mut V) -> bool {
-    walk_from(tree, tree.root(), visitor)
+    infallible(try_walk(tree, visitor))
 }
 
 /// Walks the subtree of `node` (a node of `tree`) depth first with `visitor`. Returns `true` if the
-/// visitor stopped the walk.
+/// visitor stopped the walk. For a storage whose reads can fail, [`try_walk_from`].
 ///
 /// # Panics
 /// If `node` is a node of another tree (see [`NodeRef`]).
@@ -303,7 +216,31 @@ pub fn walk_from<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(
     node: NodeRef<K>,
     v: &mut V,
 ) -> bool {
-    node.assert_of(tree.root().tree);
+    infallible(try_walk_from(tree, node, v))
+}
+
+/// [`walk`] over any storage: `Ok(true)` if the visitor stopped the walk, the storage's error if a read
+/// failed (the walk then ends).
+///
+/// # Errors
+/// The storage's read error.
+pub fn try_walk<const K: usize, T: TreeStorage<K>, V: Visitor<K>>(
+    tree: &T,
+    visitor: &mut V,
+) -> Result<bool, T::Error> {
+    try_walk_from(tree, tree.root()?, visitor)
+}
+
+/// [`walk_from`] over any storage.
+///
+/// # Errors
+/// The storage's read error.
+pub fn try_walk_from<const K: usize, T: TreeStorage<K>, V: Visitor<K>>(
+    tree: &T,
+    node: NodeRef<K>,
+    v: &mut V,
+) -> Result<bool, T::Error> {
+    node.assert_of(tree.root()?.tree);
     // Depth first with an explicit stack: a node to visit, or a partial node to leave once the entries
     // above it (its children's) are done.
     // Inline up to 64 entries: the narrow walks (a face, an edge, a point) run without allocating.
@@ -315,14 +252,14 @@ pub fn walk_from<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(
             continue;
         }
         match v.visit(&node) {
-            Walk::Stop => return true,
+            Walk::Stop => return Ok(true),
             Walk::Skip => continue,
             Walk::Descend if node.state != NodeState::Partial => continue,
             Walk::Descend => {}
         }
         let depth = node.cell.level as usize;
-        let first = tree.first_child(depth, node.index);
-        let codes = tree.block_codes(depth + 1, first);
+        let first = tree.first_child(depth, node.index)?;
+        let codes = tree.block_codes(depth + 1, first)?;
         let order = v.child_order(&node);
         if V::LEAVES {
             stack.push((node, true));
@@ -341,7 +278,97 @@ pub fn walk_from<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(
             ));
         }
     }
-    false
+    Ok(false)
+}
+
+/// The leaves of a tree (empty and full) with their cells, in Morton (depth-first) order, read from any
+/// storage: each item is a leaf or the storage's read error (after which the iterator ends). For a tree
+/// in memory, [`Leaves`] gives the leaves themselves.
+///
+/// Needs no rank lookup: a depth-first walk meets the partial nodes of each depth in index order, so
+/// their children blocks follow one another.
+#[derive(Debug, Clone)]
+pub struct TryLeaves<'a, const K: usize, T> {
+    tree: &'a T,
+    /// Nodes still to visit (cell, index in its level, state), the next on top.
+    stack: Vec<(Cell<K>, usize, NodeState)>,
+    /// Per depth, the first child of the next partial node met at the depth above.
+    next_first: Vec<usize>,
+    /// The root still to read (nothing is read before the first `next`).
+    fresh: bool,
+}
+
+impl<'a, const K: usize, T: TreeStorage<K>> TryLeaves<'a, K, T> {
+    /// The leaves of `tree`.
+    pub fn new(tree: &'a T) -> Self {
+        Self {
+            tree,
+            stack: Vec::new(),
+            next_first: vec![0; tree.depth_count() + 1],
+            fresh: true,
+        }
+    }
+}
+
+impl<const K: usize, T: TreeStorage<K>> Iterator for TryLeaves<'_, K, T> {
+    type Item = Result<(Cell<K>, NodeState), T::Error>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if std::mem::take(&mut self.fresh) {
+            match self.tree.root_state() {
+                Ok(state) => self.stack.push((self.tree.universe().root(), 0, state)),
+                Err(e) => return Some(Err(e)),
+            }
+        }
+        while let Some((cell, _, state)) = self.stack.pop() {
+            if state != NodeState::Partial {
+                return Some(Ok((cell, state)));
+            }
+            let below = cell.level as usize + 1;
+            let first = self.next_first[below];
+            self.next_first[below] += 1 << K;
+            let codes = match self.tree.block_codes(below, first) {
+                Ok(codes) => codes,
+                Err(e) => {
+                    self.stack.clear();
+                    return Some(Err(e));
+                }
+            };
+            for code in (0..1usize << K).rev() {
+                let child = NodeState::from_bits(codes >> (2 * code));
+                self.stack.push((cell.child(code), first + code, child));
+            }
+        }
+        None
+    }
+}
+
+/// The leaves of a tree whose reads cannot fail, in Morton order: [`TryLeaves`] without the `Result`.
+///
+/// ```
+/// use ktree::tree::cursor::Leaves;
+/// use ktree::{KTree, NodeState};
+/// let tree = KTree::<1>::from_dense(2, &[true, true, false, true]).unwrap();
+/// let states: Vec<NodeState> = Leaves::new(&tree).map(|(_, s)| s).collect();
+/// assert_eq!(states, [NodeState::Full, NodeState::Empty, NodeState::Full]);
+/// ```
+#[derive(Debug, Clone)]
+pub struct Leaves<'a, const K: usize, T = KTree<K>>(TryLeaves<'a, K, T>);
+
+impl<'a, const K: usize, T: LevelOrder<K>> Leaves<'a, K, T> {
+    /// The leaves of `tree`.
+    pub fn new(tree: &'a T) -> Self {
+        Self(TryLeaves::new(tree))
+    }
+}
+
+impl<const K: usize, T: LevelOrder<K>> Iterator for Leaves<'_, K, T> {
+    type Item = (Cell<K>, NodeState);
+
+    #[inline]
+    fn next(&mut self) -> Option<Self::Item> {
+        self.0.next().map(infallible)
+    }
 }
 
 /// Where one tree stands in a two-tree walk: its node at the walk's cell, or the leaf above the cell that
@@ -412,22 +439,40 @@ pub trait PairVisitor<const K: usize> {
 /// walk_pair(&a, &b, &mut m);
 /// assert!(m.0);
 /// ```
-pub fn walk_pair<const K: usize, V: PairVisitor<K>>(
-    a: &KTree<K>,
-    b: &KTree<K>,
+pub fn walk_pair<const K: usize, A: LevelOrder<K>, B: LevelOrder<K>, V: PairVisitor<K>>(
+    a: &A,
+    b: &B,
     visitor: &mut V,
 ) -> bool {
+    infallible(try_walk_pair(a, b, visitor))
+}
+
+/// [`walk_pair`] over any two storages with the same read error: `Ok(true)` if the visitor stopped the
+/// walk.
+///
+/// # Errors
+/// The first read error of either storage (the walk then ends).
+pub fn try_walk_pair<const K: usize, A, B, V>(
+    a: &A,
+    b: &B,
+    visitor: &mut V,
+) -> Result<bool, A::Error>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+    V: PairVisitor<K>,
+{
     debug_assert_eq!(a.level(), b.level());
     let root = PairNode {
         cell: a.universe().root(),
         code: 0,
         a: Side {
             index: 0,
-            state: a.root_state(),
+            state: a.root_state()?,
         },
         b: Side {
             index: 0,
-            state: b.root_state(),
+            state: b.root_state()?,
         },
     };
     visit_pair(a, b, &root, visitor)
@@ -449,44 +494,60 @@ fn child_side(side: &Side, first: usize, codes: u32, code: usize) -> Side {
 
 /// The first child of `side` and its children's codes (zeros for a leaf).
 #[inline(always)]
-fn children_of<const K: usize>(tree: &KTree<K>, side: &Side, depth: usize) -> (usize, u32) {
+fn children_of<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    side: &Side,
+    depth: usize,
+) -> Result<(usize, u32), T::Error> {
     if side.state == NodeState::Partial {
-        let first = tree.first_child(depth, side.index);
-        (first, tree.level_states(depth + 1).block_codes(first, K))
+        let first = tree.first_child(depth, side.index)?;
+        Ok((first, tree.block_codes(depth + 1, first)?))
     } else {
-        (0, 0)
+        Ok((0, 0))
     }
 }
 
 /// Visits `pair`; descends into its children if asked to and either side is partial. `true` when stopped.
 #[inline(always)]
-fn visit_pair<const K: usize, V: PairVisitor<K>>(
-    a: &KTree<K>,
-    b: &KTree<K>,
+fn visit_pair<const K: usize, A, B, V>(
+    a: &A,
+    b: &B,
     pair: &PairNode<K>,
     v: &mut V,
-) -> bool {
+) -> Result<bool, A::Error>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+    V: PairVisitor<K>,
+{
     match v.visit(pair) {
-        Walk::Stop => true,
-        Walk::Skip => false,
-        Walk::Descend => {
-            (pair.a.state == NodeState::Partial || pair.b.state == NodeState::Partial)
-                && descend_pair(a, b, pair, v)
+        Walk::Stop => Ok(true),
+        Walk::Skip => Ok(false),
+        Walk::Descend
+            if pair.a.state == NodeState::Partial || pair.b.state == NodeState::Partial =>
+        {
+            descend_pair(a, b, pair, v)
         }
+        Walk::Descend => Ok(false),
     }
 }
 
 /// Visits the children of `pair` (already visited; at least one side partial), then leaves it. `true`
 /// when stopped.
-fn descend_pair<const K: usize, V: PairVisitor<K>>(
-    a: &KTree<K>,
-    b: &KTree<K>,
+fn descend_pair<const K: usize, A, B, V>(
+    a: &A,
+    b: &B,
     pair: &PairNode<K>,
     v: &mut V,
-) -> bool {
+) -> Result<bool, A::Error>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+    V: PairVisitor<K>,
+{
     let depth = pair.cell.level as usize;
-    let (fa, codes_a) = children_of(a, &pair.a, depth);
-    let (fb, codes_b) = children_of(b, &pair.b, depth);
+    let (fa, codes_a) = children_of(a, &pair.a, depth)?;
+    let (fb, codes_b) = children_of(b, &pair.b, depth)?;
     let order = v.child_order(pair);
     for j in 0..order.len() {
         let code = order.code(j);
@@ -496,12 +557,12 @@ fn descend_pair<const K: usize, V: PairVisitor<K>>(
             a: child_side(&pair.a, fa, codes_a, code),
             b: child_side(&pair.b, fb, codes_b, code),
         };
-        if visit_pair(a, b, &child, v) {
-            return true;
+        if visit_pair(a, b, &child, v)? {
+            return Ok(true);
         }
     }
     v.leave(pair);
-    false
+    Ok(false)
 }
 
 /// The child `code` of the partial node `node` of `tree`: one step of navigation, the one every walk

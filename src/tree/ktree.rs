@@ -2,6 +2,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use super::cursor::Leaves;
 use super::states::{node_out_of_range, NodeState, PackedStates};
 use super::TreeError;
 use crate::rays::RaySet;
@@ -450,11 +451,7 @@ impl<const K: usize> KTree<K> {
     /// assert_eq!(states, [NodeState::Full, NodeState::Empty, NodeState::Full]);
     /// ```
     pub fn leaves(&self) -> Leaves<'_, K> {
-        Leaves {
-            tree: self,
-            stack: vec![(self.universe.root(), 0)],
-            next_first: vec![0; self.depth_count()],
-        }
+        Leaves::new(self)
     }
 
     /// The full leaves in Morton order: the linear tree (Gargantini) of the object.
@@ -521,39 +518,6 @@ impl<const K: usize> From<&RaySet<K>> for KTree<K> {
     /// [`KTree::from_rays`].
     fn from(rays: &RaySet<K>) -> Self {
         Self::from_rays(rays)
-    }
-}
-
-/// The leaves of a tree in Morton order, with their cells: see [`KTree::leaves`].
-#[derive(Debug, Clone)]
-pub struct Leaves<'a, const K: usize> {
-    tree: &'a KTree<K>,
-    /// Nodes still to visit (cell and index in its level), the next on top.
-    stack: Vec<(Cell<K>, usize)>,
-    /// Per depth, the first child of the next partial node met there. A depth-first walk meets the partial
-    /// nodes of each depth in index order, so their children blocks follow one another: no rank lookup.
-    next_first: Vec<usize>,
-}
-
-impl<const K: usize> Iterator for Leaves<'_, K> {
-    type Item = (Cell<K>, NodeState);
-
-    fn next(&mut self) -> Option<Self::Item> {
-        while let Some((cell, index)) = self.stack.pop() {
-            let depth = cell.level as usize;
-            match self.tree.levels[depth].get(index) {
-                NodeState::Partial => {
-                    let first = self.next_first[depth];
-                    debug_assert_eq!(first, self.tree.first_child(depth, index));
-                    self.next_first[depth] += KTree::<K>::FANOUT;
-                    for code in (0..KTree::<K>::FANOUT).rev() {
-                        self.stack.push((cell.child(code), first + code));
-                    }
-                }
-                state => return Some((cell, state)),
-            }
-        }
-        None
     }
 }
 

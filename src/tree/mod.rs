@@ -19,15 +19,19 @@ pub mod cursor;
 mod error;
 mod ktree;
 mod operators;
+pub mod sink;
 mod states;
+pub mod storage;
 mod to_rays;
 pub(crate) mod words;
 
 pub(crate) use any::from_typed;
 pub use any::{AnyTree, TreeStats};
 pub(crate) use assemble::{LevelWriter, TreeAssembler};
+pub use cursor::Leaves;
 pub use error::TreeError;
 pub use ktree::{
-    heap_bytes_for_levels, Bintree, KTree, Leaves, LevelCounts, NodeRef, Octree, Quadtree, Tree4,
+    heap_bytes_for_levels, Bintree, KTree, LevelCounts, NodeRef, Octree, Quadtree, Tree4,
 };
 pub use states::{NodeState, PackedStates};
+pub use storage::TreeStorage;

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use ktree::io::{write_ktree_v2, write_ktree_v2_file};
-use ktree::ops::{self, BoolOp, BooleanFileError};
+use ktree::io::{read_ktree_file, write_ktree_v2, write_ktree_v2_file, AnyTree, KtreeView};
+use ktree::ops::{self, BoolOp, BooleanFileError, ViewOperation};
 use ktree::rays::ball_rays;
 use ktree::stacking::stack;
 use ktree::KTree;
@@ -42,8 +42,52 @@ fn check_streamed<const K: usize>(a: &KTree<K>, b: &KTree<K>, dir: &Path) {
     assert_eq!(std::fs::read_dir(dir).unwrap().count(), 3);
 }
 
+/// Every operation of [`ViewOperation`] on views of `a` and `b` (the dense arrays `da`, `db`) writes the
+/// in-memory result, which is the dense reference's.
+fn check_views<const K: usize>(a: &KTree<K>, b: &KTree<K>, da: &[bool], db: &[bool], dir: &Path)
+where
+    AnyTree: From<KTree<K>>,
+{
+    let (pa, pb, out) = (
+        dir.join("a.ktree"),
+        dir.join("b.ktree"),
+        dir.join("c.ktree"),
+    );
+    write_ktree_v2_file(&pa, a).unwrap();
+    write_ktree_v2_file(&pb, b).unwrap();
+    let (va, vb) = (KtreeView::open(&pa).unwrap(), KtreeView::open(&pb).unwrap());
+    let read = |path: &Path| read_ktree_file(path).unwrap();
+    for op in BoolOp::ALL {
+        ops::boolean_views(&va, ViewOperation::Binary(op, &vb), &out, None).unwrap();
+        let expect = ops::boolean(a, b, op).unwrap();
+        assert_eq!(read(&out), AnyTree::from(expect.clone()), "{op:?}");
+        let dense: Vec<bool> = da.iter().zip(db).map(|(&x, &y)| op.apply(x, y)).collect();
+        assert_eq!(expect.to_dense().unwrap(), dense, "{op:?}");
+    }
+    ops::boolean_views(&va, ViewOperation::Complement, &out, None).unwrap();
+    assert_eq!(read(&out), AnyTree::from(ops::complement(a)));
+    let dense: Vec<bool> = da.iter().map(|&x| !x).collect();
+    assert_eq!(ops::complement(a).to_dense().unwrap(), dense);
+}
+
 proptest! {
     #![proptest_config(ktree_verify::config(64))]
+    #[test]
+    fn view_operations_k1((a, b) in pair::<1>()) {
+        check_views(&a.tree(), &b.tree(), &a.dense(), &b.dense(), tempfile::tempdir().unwrap().path());
+    }
+    #[test]
+    fn view_operations_k2((a, b) in pair::<2>()) {
+        check_views(&a.tree(), &b.tree(), &a.dense(), &b.dense(), tempfile::tempdir().unwrap().path());
+    }
+    #[test]
+    fn view_operations_k3((a, b) in pair::<3>()) {
+        check_views(&a.tree(), &b.tree(), &a.dense(), &b.dense(), tempfile::tempdir().unwrap().path());
+    }
+    #[test]
+    fn view_operations_k4((a, b) in pair::<4>()) {
+        check_views(&a.tree(), &b.tree(), &a.dense(), &b.dense(), tempfile::tempdir().unwrap().path());
+    }
     #[test]
     fn streamed_booleans_k1((a, b) in pair::<1>()) {
         check_streamed(&a.tree(), &b.tree(), tempfile::tempdir().unwrap().path());

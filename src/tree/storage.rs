@@ -1,0 +1,352 @@
+//! Where a tree's levels are read from: the one storage trait every walk runs over.
+//!
+//! A tree is stored in level order, two bits a node, and the walks of [`cursor`](super::cursor) only ever
+//! ask a storage for the state codes of a block of siblings and for the first child of a partial node.
+//! [`TreeStorage`] is that question with a fallible answer, so that the same walks run on a tree in memory
+//! ([`KTree`], whose reads cannot fail: its error is [`Infallible`]) and on a file read in place, whose
+//! reads fail with an error naming the file and the byte offset when the file no longer is what it was.
+//!
+//! [`LevelOrder`] is the storage whose reads cannot fail; every `LevelOrder` is a `TreeStorage` with the
+//! error [`Infallible`], and the walks over it return their result without a `Result`.
+//!
+//! ```
+//! use ktree::tree::storage::TreeStorage;
+//! use ktree::{KTree, NodeState};
+//! let tree = KTree::<1>::from_dense(2, &[true, true, false, true]).unwrap();
+//! // The root is partial; its children are nodes 0 and 1 of level 1.
+//! assert_eq!(TreeStorage::root_state(&tree), Ok(NodeState::Partial));
+//! assert_eq!(TreeStorage::first_child(&tree, 0, 0), Ok(0));
+//! assert_eq!(tree.block_states(1, 0), Ok([NodeState::Full, NodeState::Partial].to_vec()));
+//! ```
+
+use std::convert::Infallible;
+
+use super::ktree::TreeId;
+use super::ktree::{KTree, NodeRef};
+use super::states::NodeState;
+use super::words::slots_mask;
+use crate::space::Universe;
+
+/// A `K`-dimensional tree stored in level order, read one block of siblings at a time. Reads may fail
+/// (a file changed underneath): every read returns `Result<_, Self::Error>`.
+///
+/// Implementors give the five reads; the rest is provided. Implemented by every [`LevelOrder`] (with
+/// [`Infallible`] errors) and by stored files read in place.
+pub trait TreeStorage<const K: usize> {
+    /// Why a read failed ([`Infallible`] for a tree in memory).
+    type Error;
+
+    /// The universe.
+    fn universe(&self) -> Universe<K>;
+
+    /// The number of stored levels.
+    fn depth_count(&self) -> usize;
+
+    /// The root's state.
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn root_state(&self) -> Result<NodeState, Self::Error>;
+
+    /// The index (in level `depth + 1`) of the first child of the partial node `index` of level `depth`.
+    ///
+    /// # Errors
+    /// The storage's read error, for instance when `index` is not a partial node of the level.
+    fn first_child(&self, depth: usize, index: usize) -> Result<usize, Self::Error>;
+
+    /// The states of the `2^K` siblings of level `depth` from `first` (a multiple of `2^K`), two bits each,
+    /// the first in the low bits.
+    ///
+    /// # Errors
+    /// The storage's read error, for instance when the block is not in the level.
+    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Self::Error>;
+
+    /// The states of the `n ≤ 32` nodes of level `depth ≥ 1` from `first`, two bits each, the first in the
+    /// low bits (higher bits clear): what bulk copies of a subtree read. The default reads the blocks of
+    /// siblings the range covers.
+    ///
+    /// # Errors
+    /// The storage's read error, for instance when the range is not in the level.
+    fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, Self::Error> {
+        let fanout = 1usize << K;
+        let mut word = 0u64;
+        let mut at = first - first % fanout;
+        while at < first + n {
+            let codes = u64::from(self.block_codes(depth, at)?);
+            let shift = 2 * (at as i64 - first as i64);
+            word |= if shift >= 0 {
+                codes << shift
+            } else {
+                codes >> -shift
+            };
+            at += fanout;
+        }
+        Ok(word & slots_mask(n))
+    }
+
+    /// The universe level `L`.
+    fn level(&self) -> u32 {
+        self.universe().level()
+    }
+
+    /// The root node.
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn root(&self) -> Result<NodeRef<K>, Self::Error> {
+        Ok(NodeRef {
+            index: 0,
+            cell: self.universe().root(),
+            state: self.root_state()?,
+            tree: TreeId::NONE,
+        })
+    }
+
+    /// The states of the block of siblings of level `depth` from `first`, in code order.
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn block_states(&self, depth: usize, first: usize) -> Result<Vec<NodeState>, Self::Error> {
+        let codes = self.block_codes(depth, first)?;
+        Ok((0..1usize << K)
+            .map(|c| NodeState::from_bits(codes >> (2 * c)))
+            .collect())
+    }
+}
+
+/// A tree stored in level order whose reads cannot fail: a tree in memory ([`KTree`]). Every
+/// `LevelOrder` is a [`TreeStorage`] with the error [`Infallible`], so the walks over it return plain
+/// results.
+pub trait LevelOrder<const K: usize> {
+    /// The universe.
+    fn universe(&self) -> Universe<K>;
+
+    /// The number of stored levels.
+    fn depth_count(&self) -> usize;
+
+    /// The root's state.
+    fn root_state(&self) -> NodeState;
+
+    /// The index (in level `depth + 1`) of the first child of the partial node `index` of level `depth`.
+    fn first_child(&self, depth: usize, index: usize) -> usize;
+
+    /// The states of the `2^K` siblings of level `depth` from `first` (a multiple of `2^K`), two bits each,
+    /// the first in the low bits.
+    fn block_codes(&self, depth: usize, first: usize) -> u32;
+
+    /// As [`TreeStorage::slots`] (`depth ≥ 1`); the default reads the blocks of siblings the range covers.
+    fn slots(&self, depth: usize, first: usize, n: usize) -> u64 {
+        let fanout = 1usize << K;
+        let mut word = 0u64;
+        let mut at = first - first % fanout;
+        while at < first + n {
+            let codes = u64::from(self.block_codes(depth, at));
+            let shift = 2 * (at as i64 - first as i64);
+            word |= if shift >= 0 {
+                codes << shift
+            } else {
+                codes >> -shift
+            };
+            at += fanout;
+        }
+        word & slots_mask(n)
+    }
+
+    /// The universe level `L`.
+    fn level(&self) -> u32 {
+        self.universe().level()
+    }
+
+    /// The root node.
+    fn root(&self) -> NodeRef<K> {
+        NodeRef {
+            index: 0,
+            cell: self.universe().root(),
+            state: self.root_state(),
+            tree: TreeId::NONE,
+        }
+    }
+
+    /// Visits every leaf (empty and full) in Morton order.
+    fn for_each_leaf(&self, mut visit: impl FnMut(crate::space::Cell<K>, NodeState))
+    where
+        Self: Sized,
+    {
+        for (cell, state) in super::cursor::Leaves::new(self) {
+            visit(cell, state);
+        }
+    }
+}
+
+impl<const K: usize, T: LevelOrder<K>> TreeStorage<K> for T {
+    type Error = Infallible;
+
+    #[inline(always)]
+    fn universe(&self) -> Universe<K> {
+        LevelOrder::universe(self)
+    }
+
+    #[inline(always)]
+    fn depth_count(&self) -> usize {
+        LevelOrder::depth_count(self)
+    }
+
+    #[inline(always)]
+    fn root_state(&self) -> Result<NodeState, Infallible> {
+        Ok(LevelOrder::root_state(self))
+    }
+
+    #[inline(always)]
+    fn first_child(&self, depth: usize, index: usize) -> Result<usize, Infallible> {
+        Ok(LevelOrder::first_child(self, depth, index))
+    }
+
+    #[inline(always)]
+    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Infallible> {
+        Ok(LevelOrder::block_codes(self, depth, first))
+    }
+
+    #[inline(always)]
+    fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, Infallible> {
+        Ok(LevelOrder::slots(self, depth, first, n))
+    }
+
+    #[inline(always)]
+    fn root(&self) -> Result<NodeRef<K>, Infallible> {
+        Ok(LevelOrder::root(self))
+    }
+}
+
+impl<const K: usize> LevelOrder<K> for KTree<K> {
+    #[inline]
+    fn universe(&self) -> Universe<K> {
+        KTree::universe(self)
+    }
+
+    #[inline]
+    fn depth_count(&self) -> usize {
+        KTree::depth_count(self)
+    }
+
+    #[inline]
+    fn root_state(&self) -> NodeState {
+        KTree::root_state(self)
+    }
+
+    #[inline]
+    fn root(&self) -> NodeRef<K> {
+        KTree::root(self)
+    }
+
+    #[inline(always)]
+    fn first_child(&self, depth: usize, index: usize) -> usize {
+        KTree::first_child(self, depth, index)
+    }
+
+    #[inline(always)]
+    fn block_codes(&self, depth: usize, first: usize) -> u32 {
+        self.level_states(depth).block_codes(first, K)
+    }
+
+    #[inline(always)]
+    fn slots(&self, depth: usize, first: usize, n: usize) -> u64 {
+        let words = self.level_states(depth).words();
+        let (w, s) = (first / 32, 2 * (first % 32));
+        let mut chunk = words[w] >> s;
+        if s > 0 && w + 1 < words.len() {
+            chunk |= words[w + 1] << (64 - s);
+        }
+        chunk & slots_mask(n)
+    }
+
+    fn for_each_leaf(&self, visit: impl FnMut(crate::space::Cell<K>, NodeState)) {
+        KTree::for_each_leaf(self, visit)
+    }
+}
+
+/// The value of a read that cannot fail.
+#[inline(always)]
+pub(crate) fn infallible<T>(result: Result<T, Infallible>) -> T {
+    match result {
+        Ok(value) => value,
+        Err(never) => match never {},
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tree::sink::{copy_subtree, LevelSink, MemorySink};
+
+    /// A tree in memory read only through the required reads: the provided `slots` is under test.
+    struct BlocksOnly<'a, const K: usize>(&'a KTree<K>);
+
+    impl<const K: usize> LevelOrder<K> for BlocksOnly<'_, K> {
+        fn universe(&self) -> Universe<K> {
+            self.0.universe()
+        }
+        fn depth_count(&self) -> usize {
+            self.0.depth_count()
+        }
+        fn root_state(&self) -> NodeState {
+            self.0.root_state()
+        }
+        fn first_child(&self, depth: usize, index: usize) -> usize {
+            self.0.first_child(depth, index)
+        }
+        fn block_codes(&self, depth: usize, first: usize) -> u32 {
+            LevelOrder::block_codes(self.0, depth, first)
+        }
+    }
+
+    fn tree<const K: usize>(level: u32, seed: u64) -> KTree<K> {
+        let n = 1usize << (K as u32 * level);
+        let dense: Vec<bool> = (0..n as u64)
+            .map(|i| (i.wrapping_mul(seed) ^ (i >> 3)) % 7 < 3)
+            .collect();
+        KTree::from_dense(level, &dense).unwrap()
+    }
+
+    fn slots_and_copies_agree<const K: usize>(level: u32) {
+        for seed in [3, 11, 12345] {
+            let t = tree::<K>(level, seed);
+            let b = BlocksOnly(&t);
+            // Below the root every level is whole blocks of siblings.
+            for depth in 1..t.depth_count() {
+                let len = t.level_states(depth).len();
+                for first in 0..len {
+                    for n in 1..=32.min(len - first) {
+                        assert_eq!(
+                            LevelOrder::slots(&b, depth, first, n),
+                            LevelOrder::slots(&t, depth, first, n),
+                            "K = {K}, depth {depth}, {first} + {n}"
+                        );
+                    }
+                }
+            }
+            if t.root_state() == NodeState::Partial {
+                for invert in [false, true] {
+                    let mut sink = MemorySink::new(t.universe());
+                    infallible(copy_subtree::<K, _, _, Infallible>(
+                        &mut sink, &b, 0, 0, invert,
+                    ));
+                    let copy = infallible(sink.finish(NodeState::Partial));
+                    let expect = if invert {
+                        crate::ops::complement(&t)
+                    } else {
+                        t.clone()
+                    };
+                    assert_eq!(copy, expect, "K = {K}, invert {invert}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn provided_slots_and_subtree_copies_read_what_the_words_hold() {
+        slots_and_copies_agree::<1>(7);
+        slots_and_copies_agree::<2>(4);
+        slots_and_copies_agree::<3>(3);
+        slots_and_copies_agree::<4>(2);
+    }
+}
