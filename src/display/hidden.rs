@@ -136,7 +136,7 @@ fn visible_parts(seg: &Piece, hidden: &mut [(Exact, Exact)], out: &mut Vec<Edge3
             u1: to.to_f64(),
         });
     };
-    hidden.sort_unstable_by(|a, b| a.0.cmp(&b.0));
+    hidden.sort_unstable_by_key(|a| a.0);
     let mut at = Exact::int(seg.u0);
     for &(h0, h1) in hidden.iter() {
         if h0 > at {

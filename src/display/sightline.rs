@@ -11,8 +11,10 @@
 //! `d_k = 0`). `d_ε` has no zero component and no rational ratio between two components, so no two lattice
 //! lines project onto each other, no sightline runs inside a face plane and a sightline through a lattice
 //! segment meets other lattice edges at isolated points only. A predicate that is a tie for `d` is decided
-//! by the first non-zero coefficient of its polynomial in `ε`; the powers 1, 2, 4 (and their pairwise sums
-//! 3, 5, 6) are all distinct, so every predicate that is not identically zero is decided.
+//! by the first non-zero coefficient of its polynomial in `ε`. The predicates are linear in the direction,
+//! and the powers 1, 2, 4 of the three axes are distinct, so every predicate that is not identically zero
+//! is decided. (Ends of hidden parts are compared at `ε = 0`: ends that tie there only decide whether a
+//! single point is hidden.)
 //!
 //! **The hidden part.** A point `p` is hidden by a cube `C` when the line `p + t·d_ε` meets the open cube:
 //! the open `t`-intervals of the three slabs of `C` intersect, i.e. for every ordered pair of axes `(i, j)`
@@ -29,8 +31,7 @@ use crate::space::Cell;
 /// coordinates below 2²² keep every product of the predicates inside `i128`.
 const DIRECTION_BITS: i32 = 50;
 
-/// The power of `ε` tilting each axis (all sums of two distinct entries differ from each other and from
-/// the entries themselves).
+/// The power of `ε` tilting each axis: distinct and increasing with the axis.
 const TILT_POWER: [u32; 3] = [1, 2, 4];
 
 /// An exact number on a lattice line: a fraction `num / den` (`den > 0`) or an infinite end.
@@ -141,7 +142,7 @@ impl ExactView {
         if at_zero != 0 {
             return at_zero.cmp(&0);
         }
-        // The powers of ε increase with the axis index.
+        // The powers of ε increase with the axis index (TILT_POWER).
         coef.into_iter()
             .find(|&c| c != 0)
             .map_or(Ordering::Equal, |c| c.cmp(&0))
