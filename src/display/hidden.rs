@@ -2,17 +2,17 @@
 //! nodes that come before its owner in the front-to-back list — exactly those that can be in front of it.
 //!
 //! * [`HiddenLineMethod::Pairwise`] is the paper's method (V7): every segment is tested against *every*
-//!   earlier graphics node, first with Cohen–Sutherland-like bit codes (one bit per half-plane of the
-//!   projected hexagon: a segment whose two end codes share a bit is outside), then by clipping. The
-//!   cost is quadratic in the number of graphics nodes.
-//! * [`HiddenLineMethod::Bucketed`] puts the hexagons into a screen grid once, each bucket keeping its
-//!   graphics nodes in front-to-back order; a segment is tested only against the earlier nodes in the
-//!   buckets its bounding box meets, each once. Same tests, same answer, a small fraction of the work.
+//!   earlier graphics node. The cost is quadratic in the number of graphics nodes.
+//! * [`HiddenLineMethod::Bucketed`] puts the screen boxes of the graphics nodes into a screen grid once,
+//!   each bucket keeping its graphics nodes in front-to-back order; a segment is tested only against the
+//!   earlier nodes in the buckets its box meets, each once. Same tests, same answer, a small fraction of
+//!   the work.
 //!
-//! Projections are hexagons given by their half-planes `n_k · q ≤ c_k`; the hexagon of a cube of side `s`
-//! at origin `o` is the unit cube's hexagon scaled by `s` and moved to the projection of `o`. A segment is
-//! hidden where it lies strictly inside (by a tolerance of 10⁻⁹ of the universe's side) — a segment
-//! on the border of a hexagon stays visible.
+//! The test itself is exact: the part of a segment a cube hides is an open interval with rational ends,
+//! computed in integers from the lattice coordinates and the integer view direction, with ties (a
+//! segment along the outline of a cube's projection, a sightline through a seam between two cubes)
+//! decided by the symbolic tilt of the view described in [`super::lines`]. Screen boxes (in `f64`, grown
+//! by 10⁻⁹ of the universe's side) only choose which cubes to test, never the answer.
 //!
 //! ```
 //! use ktree::display::{line_drawing, HiddenLineMethod};
@@ -25,6 +25,7 @@
 //! ```
 
 use super::lines::{Edge3, LineStats, Piece};
+use super::sightline::{Exact, ExactView};
 use crate::space::Cell;
 
 /// Which hidden-line method to use.
@@ -37,70 +38,81 @@ pub enum HiddenLineMethod {
     Bucketed,
 }
 
-/// The projection of the unit cube in a parallel view: its half-planes and bounding box.
+/// The parallel projection onto the screen, used to find the graphics nodes whose projection may meet a
+/// segment (the exact decision is [`ExactView::hidden_part`]'s).
 #[derive(Debug, Clone)]
-pub(crate) struct Hexagon {
+pub(crate) struct ScreenBoxes {
     right: [f64; 3],
     up: [f64; 3],
-    /// Outward normals of the hull's edges.
-    normals: Vec<[f64; 2]>,
-    /// `n_k · q ≤ support[k]` for the unit cube at the origin.
-    support: Vec<f64>,
     /// Bounding box of the unit cube's projection: `[xmin, ymin, xmax, ymax]`.
-    bbox: [f64; 4],
-    eps: f64,
+    unit_box: [f64; 4],
+    /// Every box is grown by this margin (10⁻⁹ of the universe's side), far above the rounding of the
+    /// projection, so that no cube touching a segment is missed.
+    margin: f64,
 }
 
-impl Hexagon {
+impl ScreenBoxes {
     pub(crate) fn new(right: [f64; 3], up: [f64; 3], scale: f64) -> Self {
-        let mut pts: Vec<[f64; 2]> = (0..8)
-            .map(|c| {
-                let p = [
-                    f64::from(c & 1),
-                    f64::from(c >> 1 & 1),
-                    f64::from(c >> 2 & 1),
-                ];
-                [dot3(p, right), dot3(p, up)]
-            })
-            .collect();
-        let hull = convex_hull(&mut pts);
-        let mut normals = Vec::new();
-        let mut support = Vec::new();
-        for i in 0..hull.len() {
-            let (a, b) = (hull[i], hull[(i + 1) % hull.len()]);
-            let e = [b[0] - a[0], b[1] - a[1]];
-            let len = (e[0] * e[0] + e[1] * e[1]).sqrt();
-            if len < 1e-12 {
-                continue;
-            }
-            let n = [e[1] / len, -e[0] / len];
-            normals.push(n);
-            support.push(n[0] * a[0] + n[1] * a[1]);
-        }
-        let mut bbox = [
+        let mut unit_box = [
             f64::INFINITY,
             f64::INFINITY,
             f64::NEG_INFINITY,
             f64::NEG_INFINITY,
         ];
-        for p in &hull {
-            bbox[0] = bbox[0].min(p[0]);
-            bbox[1] = bbox[1].min(p[1]);
-            bbox[2] = bbox[2].max(p[0]);
-            bbox[3] = bbox[3].max(p[1]);
+        for c in 0..8u32 {
+            let p = [
+                f64::from(c & 1),
+                f64::from(c >> 1 & 1),
+                f64::from(c >> 2 & 1),
+            ];
+            let q = [dot3(p, right), dot3(p, up)];
+            unit_box[0] = unit_box[0].min(q[0]);
+            unit_box[1] = unit_box[1].min(q[1]);
+            unit_box[2] = unit_box[2].max(q[0]);
+            unit_box[3] = unit_box[3].max(q[1]);
         }
         Self {
             right,
             up,
-            normals,
-            support,
-            bbox,
-            eps: 1e-9 * scale.max(1.0),
+            unit_box,
+            margin: 1e-9 * scale.max(1.0),
         }
     }
 
     fn project(&self, p: [f64; 3]) -> [f64; 2] {
         [dot3(p, self.right), dot3(p, self.up)]
+    }
+
+    /// The grown screen box of a cube.
+    fn of_cube(&self, cell: &Cell<3>) -> [f64; 4] {
+        let s = cell.side() as f64;
+        let o = self.project(cell.origin.map(f64::from));
+        let m = self.margin;
+        [
+            o[0] + s * self.unit_box[0] - m,
+            o[1] + s * self.unit_box[1] - m,
+            o[0] + s * self.unit_box[2] + m,
+            o[1] + s * self.unit_box[3] + m,
+        ]
+    }
+
+    /// The grown screen box of a segment.
+    fn of_segment(&self, seg: &Piece) -> [f64; 4] {
+        let e = Edge3 {
+            axis: seg.axis,
+            fixed: seg.fixed,
+            u0: f64::from(seg.u0),
+            u1: f64::from(seg.u1),
+        };
+        let a = self.project(e.point(e.u0));
+        let b = self.project(e.point(e.u1));
+        let m = self.margin;
+        [
+            a[0].min(b[0]) - m,
+            a[1].min(b[1]) - m,
+            a[0].max(b[0]) + m,
+            a[1].max(b[1]) + m,
+        ]
     }
 }
 
@@ -108,125 +120,33 @@ fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// Counter-clockwise convex hull (Andrew's monotone chain).
-fn convex_hull(pts: &mut [[f64; 2]]) -> Vec<[f64; 2]> {
-    pts.sort_by(|a, b| a.partial_cmp(b).expect("finite"));
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
-        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    };
-    let mut hull: Vec<[f64; 2]> = Vec::new();
-    for pass in 0..2 {
-        let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &[f64; 2]>> = if pass == 0 {
-            Box::new(pts.iter())
-        } else {
-            Box::new(pts.iter().rev())
-        };
-        for &p in iter {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 1e-15
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
-    hull
-}
-
-/// A graphics node's projection: its half-plane bounds and bounding box.
-struct CubeProj {
-    c: Vec<f64>,
-    bbox: [f64; 4],
-}
-
-fn project_cube(hex: &Hexagon, cell: &Cell<3>) -> CubeProj {
-    let s = cell.side() as f64;
-    let o = hex.project(cell.origin.map(f64::from));
-    CubeProj {
-        c: hex
-            .normals
-            .iter()
-            .zip(&hex.support)
-            .map(|(n, h)| n[0] * o[0] + n[1] * o[1] + s * h)
-            .collect(),
-        bbox: [
-            o[0] + s * hex.bbox[0],
-            o[1] + s * hex.bbox[1],
-            o[0] + s * hex.bbox[2],
-            o[1] + s * hex.bbox[3],
-        ],
-    }
-}
-
-/// The parameter interval `(t0, t1)` of the segment `a → b` strictly inside the cube's hexagon, if any.
-#[inline]
-fn clip(hex: &Hexagon, cube: &CubeProj, a: [f64; 2], b: [f64; 2]) -> Option<(f64, f64)> {
-    let eps = hex.eps;
-    // Bit codes: bit k set when an end point is outside (or on) half-plane k.
-    let mut fa = [0.0f64; 8];
-    let mut fb = [0.0f64; 8];
-    let (mut code_a, mut code_b) = (0u8, 0u8);
-    for (k, n) in hex.normals.iter().enumerate() {
-        fa[k] = n[0] * a[0] + n[1] * a[1] - cube.c[k];
-        fb[k] = n[0] * b[0] + n[1] * b[1] - cube.c[k];
-        code_a |= u8::from(fa[k] >= -eps) << k;
-        code_b |= u8::from(fb[k] >= -eps) << k;
-    }
-    if code_a & code_b != 0 {
-        return None;
-    }
-    if code_a == 0 && code_b == 0 {
-        return Some((0.0, 1.0));
-    }
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    for k in 0..hex.normals.len() {
-        // Inside: fa + t (fb − fa) < −eps.
-        let denom = fb[k] - fa[k];
-        let num = -eps - fa[k];
-        if denom == 0.0 {
-            if num <= 0.0 {
-                return None;
-            }
-        } else if denom > 0.0 {
-            t1 = t1.min(num / denom);
-        } else {
-            t0 = t0.max(num / denom);
-        }
-    }
-    (t1 - t0 > 1e-12).then_some((t0, t1))
-}
-
 #[inline]
 fn boxes_meet(a: &[f64; 4], b: &[f64; 4]) -> bool {
     a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3]
 }
 
-/// The visible parts of one segment given its hidden parameter intervals.
-fn visible_parts(seg: &Piece, hidden: &mut [(f64, f64)], out: &mut Vec<Edge3>) {
-    let (u0, u1) = (f64::from(seg.u0), f64::from(seg.u1));
-    let len = u1 - u0;
-    let mut emit = |t0: f64, t1: f64| {
-        if (t1 - t0) * len > 1e-7 {
-            out.push(Edge3 {
-                axis: seg.axis,
-                fixed: seg.fixed,
-                u0: u0 + t0 * len,
-                u1: if t1 >= 1.0 { u1 } else { u0 + t1 * len },
-            });
-        }
+/// The visible parts of one segment given its hidden parts (exact, within the segment): the gaps of
+/// positive exact length between them.
+fn visible_parts(seg: &Piece, hidden: &mut [(Exact, Exact)], out: &mut Vec<Edge3>) {
+    let mut emit = |from: Exact, to: Exact| {
+        out.push(Edge3 {
+            axis: seg.axis,
+            fixed: seg.fixed,
+            u0: from.to_f64(),
+            u1: to.to_f64(),
+        });
     };
-    hidden.sort_unstable_by(|a, b| a.0.partial_cmp(&b.0).expect("finite"));
-    let mut at = 0.0f64;
+    hidden.sort_unstable_by_key(|a| a.0);
+    let mut at = Exact::int(seg.u0);
     for &(h0, h1) in hidden.iter() {
         if h0 > at {
             emit(at, h0);
         }
         at = at.max(h1);
     }
-    if at < 1.0 {
-        emit(at, 1.0);
+    let end = Exact::int(seg.u1);
+    if at < end {
+        emit(at, end);
     }
 }
 
@@ -234,48 +154,33 @@ fn visible_parts(seg: &Piece, hidden: &mut [(f64, f64)], out: &mut Vec<Edge3>) {
 pub(crate) fn remove_hidden(
     cubes: &[Cell<3>],
     segments: &[Piece],
-    hex: &Hexagon,
+    view: &ExactView,
+    screen: &ScreenBoxes,
     method: HiddenLineMethod,
     stats: &mut LineStats,
     mut progress: Option<&mut dyn FnMut(u64, u64)>,
 ) -> Vec<Edge3> {
-    let projs: Vec<CubeProj> = cubes.iter().map(|c| project_cube(hex, c)).collect();
+    let boxes: Vec<[f64; 4]> = cubes.iter().map(|c| screen.of_cube(c)).collect();
     let total = segments.len() as u64;
     let mut out = Vec::new();
-    let mut hidden: Vec<(f64, f64)> = Vec::new();
+    let mut hidden: Vec<(Exact, Exact)> = Vec::new();
     let mut tests = 0u64;
-    let ends = |seg: &Piece| {
-        let e = Edge3 {
-            axis: seg.axis,
-            fixed: seg.fixed,
-            u0: f64::from(seg.u0),
-            u1: f64::from(seg.u1),
-        };
-        let a = hex.project(e.point(e.u0));
-        let b = hex.project(e.point(e.u1));
-        let bbox = [
-            a[0].min(b[0]),
-            a[1].min(b[1]),
-            a[0].max(b[0]),
-            a[1].max(b[1]),
-        ];
-        (a, b, bbox)
-    };
     // The pairwise method tests every cube in front of a segment; the bucketed one only the cubes in the
     // screen-grid buckets the segment's box touches. Both keep the same occluders in the same order.
-    let grid = (method == HiddenLineMethod::Bucketed).then(|| Grid::new(&projs));
-    let mut seen = vec![u32::MAX; if grid.is_some() { projs.len() } else { 0 }];
+    let grid = (method == HiddenLineMethod::Bucketed).then(|| Grid::new(&boxes));
+    let mut seen = vec![u32::MAX; if grid.is_some() { cubes.len() } else { 0 }];
     for (i, seg) in segments.iter().enumerate() {
-        let (a, b, bbox) = ends(seg);
+        let bbox = screen.of_segment(seg);
         hidden.clear();
-        let mut test = |cube: &CubeProj| {
+        let mut test = |cube: &Cell<3>| {
             tests += 1;
-            if let Some(h) = clip(hex, cube, a, b) {
+            let axis = usize::from(seg.axis);
+            if let Some(h) = view.hidden_part(axis, seg.fixed, (seg.u0, seg.u1), cube) {
                 hidden.push(h);
             }
         };
         match &grid {
-            None => projs[..seg.owner as usize].iter().for_each(&mut test),
+            None => cubes[..seg.owner as usize].iter().for_each(&mut test),
             Some(grid) => {
                 let (gx0, gy0, gx1, gy1) = grid.range(&bbox);
                 for gy in gy0..=gy1 {
@@ -288,9 +193,8 @@ pub(crate) fn remove_hidden(
                                 continue;
                             }
                             seen[j as usize] = i as u32;
-                            let cube = &projs[j as usize];
-                            if boxes_meet(&cube.bbox, &bbox) {
-                                test(cube);
+                            if boxes_meet(&boxes[j as usize], &bbox) {
+                                test(&cubes[j as usize]);
                             }
                         }
                     }
@@ -322,25 +226,25 @@ struct Grid {
 }
 
 impl Grid {
-    fn new(projs: &[CubeProj]) -> Self {
+    fn new(boxes: &[[f64; 4]]) -> Self {
         let mut b = [
             f64::INFINITY,
             f64::INFINITY,
             f64::NEG_INFINITY,
             f64::NEG_INFINITY,
         ];
-        for p in projs {
-            b[0] = b[0].min(p.bbox[0]);
-            b[1] = b[1].min(p.bbox[1]);
-            b[2] = b[2].max(p.bbox[2]);
-            b[3] = b[3].max(p.bbox[3]);
+        for p in boxes {
+            b[0] = b[0].min(p[0]);
+            b[1] = b[1].min(p[1]);
+            b[2] = b[2].max(p[2]);
+            b[3] = b[3].max(p[3]);
         }
-        if projs.is_empty() {
+        if boxes.is_empty() {
             b = [0.0, 0.0, 1.0, 1.0];
         }
         let (w, h) = ((b[2] - b[0]).max(1e-9), (b[3] - b[1]).max(1e-9));
         // About two graphics nodes per bucket, at most 2^20 buckets.
-        let target = (projs.len() as f64 / 2.0).clamp(1.0, (1u64 << 20) as f64);
+        let target = (boxes.len() as f64 / 2.0).clamp(1.0, (1u64 << 20) as f64);
         let cell = (w * h / target).sqrt().max(1e-9);
         let nx = ((w / cell).ceil() as usize).clamp(1, 4096);
         let ny = ((h / cell).ceil() as usize).clamp(1, 4096);
@@ -352,8 +256,8 @@ impl Grid {
             ny,
             buckets: vec![Vec::new(); nx * ny],
         };
-        for (j, p) in projs.iter().enumerate() {
-            let (gx0, gy0, gx1, gy1) = grid.range(&p.bbox);
+        for (j, p) in boxes.iter().enumerate() {
+            let (gx0, gy0, gx1, gy1) = grid.range(p);
             for gy in gy0..=gy1 {
                 for gx in gx0..=gx1 {
                     grid.buckets[gy * nx + gx].push(j as u32);

@@ -16,9 +16,24 @@
 //!    and a faster bucketed one; both give the same result.
 //! 5. Touching collinear visible pieces are joined into long lines ("dots" removed, V4).
 //!
-//! The view direction is nudged by at most 10⁻⁴ on any axis it is parallel to, so that no two parallel
-//! lattice lines project onto the same line: in an exact axis view, hidden edges behind a crack would
-//! project exactly onto it and be judged visible.
+//! **Exact views, ties broken symbolically.** The drawing is of the requested direction exactly: the
+//! projection ([`LineDrawing::right`], [`LineDrawing::up`]) is that of the requested direction, normalised.
+//! Every visibility decision (which leaf's edge faces the viewer, the front-to-back order, which part of a
+//! segment a graphics node hides) is exact integer arithmetic on the lattice coordinates and on the
+//! direction's components as integers in units of 2⁻⁵⁰ of the largest one. Where the direction is
+//! degenerate for the lattice (an axis view, a diagonal such as (1, −1, 0) or (1, 1, 1), where lattice lines
+//! project onto one another and points fall exactly on outlines), the decision is the one for the view
+//! whose direction into the scene has its magnitudes grown by an infinitesimal `(ε, ε², ε⁴)` on the three
+//! axes, a zero component counting as positive (simulation of simplicity: the first non-zero coefficient
+//! of a predicate's polynomial in `ε` decides it, and none is identically zero). So:
+//!
+//! * a sightline that runs along a seam between two full cells is hidden by one of them: no hidden edge
+//!   leaks through the outlines of a wall, whatever the direction;
+//! * a hidden part that shrinks to a point in the tilted view hides nothing, and a visible part is drawn
+//!   only when its exact length is positive;
+//! * the edges of a face seen exactly edge-on are drawn, as they are in every nearby tilted view: seen
+//!   from `+z`, a box shows its top face's four edges, the bottom edges of its `−x` and `−y` faces (drawn on
+//!   top of the top face's) and three vertical edges (drawn as points).
 //!
 //! ```
 //! use ktree::display::{line_drawing, HiddenLineMethod};
@@ -29,13 +44,18 @@
 //! let voxel = KTree::<3>::from_dense(1, &dense).unwrap();
 //! let d = line_drawing(&voxel, [1.0, -0.8, 0.6], HiddenLineMethod::Bucketed).unwrap();
 //! assert_eq!(d.lines.len(), 9);
+//! // Seen along a diagonal: the same nine edges, drawn in the exact diagonal view.
+//! let d = line_drawing(&voxel, [1.0, 1.0, 1.0], HiddenLineMethod::Bucketed).unwrap();
+//! assert_eq!(d.lines.len(), 9);
+//! assert_eq!(d.view_dir[0], d.view_dir[1]);
 //! ```
 
 use super::camera::v3;
 use super::error::DisplayError;
-use super::hidden::{remove_hidden, Hexagon, HiddenLineMethod};
+use super::hidden::{remove_hidden, HiddenLineMethod, ScreenBoxes};
 use super::neighbours::{shifted, Neighbours};
 use super::order::{ordered_full_cells, Order, Viewer};
+use super::sightline::ExactView;
 use crate::space::Cell;
 use crate::tree::Octree;
 
@@ -110,7 +130,7 @@ pub struct LineStats {
 /// A line drawing: the visible edges in 3-D and the parallel projection that draws them.
 #[derive(Debug, Clone)]
 pub struct LineDrawing {
-    /// The view direction used (into the scene; unit; possibly nudged, see the module docs).
+    /// The view direction (into the scene, unit): the requested one, normalised.
     pub view_dir: [f64; 3],
     /// Screen right, in world coordinates.
     pub right: [f64; 3],
@@ -162,43 +182,6 @@ impl LineDrawing {
     }
 }
 
-/// The view direction actually used for `toward_eye` (from the object towards the viewer): the
-/// opposite, with components smaller than 10⁻⁴ nudged to 10⁻⁴, then the y and z components scaled by
-/// 1 + 10⁻⁴·(√5 − 1)/2 and 1 + 10⁻⁴·(√2 − 1), normalised.
-///
-/// The second nudge breaks the lattice alignments of diagonal views: along (1, −1, 0) or (1, 1, 1) whole
-/// lattice lines project onto one another, and an edge that lies on the shared outline of the hexagons
-/// around a hidden voxel slips between them. After it, lines that coincided project apart by about
-/// 10⁻⁴ of the distance between them.
-///
-/// ```
-/// use ktree::display::nudged_view_dir;
-/// let d = nudged_view_dir([1.0, -1.0, 0.0]).unwrap();
-/// assert!(d[2] > 0.0 && d[0] < 0.0 && d[1] > 0.0);
-/// assert!((d[0] + d[1]).abs() > 1e-5); // no longer exactly diagonal
-/// ```
-///
-/// # Errors
-/// [`DisplayError::BadDirection`] for a zero or non-finite vector.
-pub fn nudged_view_dir(toward_eye: [f64; 3]) -> Result<[f64; 3], DisplayError> {
-    let d = v3::normalize([-toward_eye[0], -toward_eye[1], -toward_eye[2]])
-        .ok_or_else(|| DisplayError::BadDirection(toward_eye.to_vec()))?;
-    const NUDGE: f64 = 1e-4;
-    let d = d.map(|x| {
-        if x.abs() < NUDGE {
-            if x < 0.0 {
-                -NUDGE
-            } else {
-                NUDGE
-            }
-        } else {
-            x
-        }
-    });
-    let tilt = [1.0, 1.0 + NUDGE * 0.618_034, 1.0 + NUDGE * 0.414_214];
-    Ok(v3::normalize([d[0] * tilt[0], d[1] * tilt[1], d[2] * tilt[2]]).expect("non-zero"))
-}
-
 /// One edge piece before merging: line key, `[u0, u1)` in voxel units, owner (graphics node index).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Piece {
@@ -212,14 +195,15 @@ pub(crate) struct Piece {
 /// The graphics nodes (non-surrounded full leaves in front-to-back order) and their edge pieces.
 pub(crate) fn extract(
     tree: &Octree,
-    d: [f64; 3],
+    view: &ExactView,
     stats: &mut LineStats,
 ) -> (Vec<Cell<3>>, Vec<Piece>) {
     let side_u = tree.universe().side();
     let mut cubes = Vec::new();
     let mut pieces = Vec::new();
     let mut near = Neighbours::new(tree);
-    for cell in ordered_full_cells(tree, Viewer::Direction(d), Order::FrontToBack) {
+    let order = Viewer::Direction(view.signs());
+    for cell in ordered_full_cells(tree, order, Order::FrontToBack) {
         stats.full_leaves += 1;
         if near.is_surrounded(&cell) {
             stats.surrounded += 1;
@@ -232,9 +216,10 @@ pub(crate) fn extract(
             let [b, c] = other_axes(axis);
             for sb in [false, true] {
                 for sc in [false, true] {
-                    // Towards the viewer across the edge's faces? (β·e_b · (−d) > 0)
-                    let vb = (if sb { -d[b] } else { d[b] }) > 0.0;
-                    let vc = (if sc { -d[c] } else { d[c] }) > 0.0;
+                    // Towards the viewer across the edge's faces? (the viewer is on the upper side of
+                    // axis b when the tilted direction into the scene decreases along it)
+                    let vb = sb != view.increasing(b);
+                    let vc = sc != view.increasing(c);
                     if !vb && !vc {
                         continue; // the viewer's quadrant is this full leaf
                     }
@@ -391,9 +376,7 @@ pub(crate) fn join_lines(mut pieces: Vec<Edge3>) -> Vec<Edge3> {
     let mut out: Vec<Edge3> = Vec::with_capacity(pieces.len());
     for p in pieces {
         match out.last_mut() {
-            Some(last) if last.key() == p.key() && p.u0 <= last.u1 + 1e-9 => {
-                last.u1 = last.u1.max(p.u1)
-            }
+            Some(last) if last.key() == p.key() && p.u0 <= last.u1 => last.u1 = last.u1.max(p.u1),
             _ => out.push(p),
         }
     }
@@ -443,7 +426,10 @@ fn draw(
     method: HiddenLineMethod,
     progress: Option<&mut dyn FnMut(u64, u64)>,
 ) -> Result<LineDrawing, DisplayError> {
-    let d = nudged_view_dir(toward_eye)?;
+    let into_scene = toward_eye.map(|x| -x);
+    let d =
+        v3::normalize(into_scene).ok_or_else(|| DisplayError::BadDirection(toward_eye.to_vec()))?;
+    let view = ExactView::new(into_scene);
     let up0 = if d[0].abs() < 1e-3 && d[1].abs() < 1e-3 {
         [0.0, 1.0, 0.0]
     } else {
@@ -455,11 +441,13 @@ fn draw(
         nodes: tree.node_count(),
         ..Default::default()
     };
-    let (cubes, pieces) = extract(tree, d, &mut stats);
+    let (cubes, pieces) = extract(tree, &view, &mut stats);
     let segments = merge_pieces(pieces);
     stats.segments = segments.len() as u64;
-    let hex = Hexagon::new(right, up, tree.universe().side() as f64);
-    let visible = remove_hidden(&cubes, &segments, &hex, method, &mut stats, progress);
+    let screen = ScreenBoxes::new(right, up, tree.universe().side() as f64);
+    let visible = remove_hidden(
+        &cubes, &segments, &view, &screen, method, &mut stats, progress,
+    );
     stats.visible_pieces = visible.len() as u64;
     let lines = join_lines(visible);
     stats.lines = lines.len() as u64;

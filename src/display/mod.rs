@@ -29,6 +29,7 @@ pub mod order;
 pub mod plane;
 pub mod png;
 pub mod raster;
+mod sightline;
 pub mod slices;
 pub mod svg;
 
@@ -36,9 +37,7 @@ pub use camera::{default_camera, object_bounds, Camera, Projection, ISO_TOWARD_E
 pub use coverage::Coverage;
 pub use error::{check_size, CameraProblem, DisplayError, MAX_IMAGE_SIDE, MAX_PIXELS};
 pub use hidden::HiddenLineMethod;
-pub use lines::{
-    line_drawing, line_drawing_with_progress, nudged_view_dir, Edge3, LineDrawing, LineStats,
-};
+pub use lines::{line_drawing, line_drawing_with_progress, Edge3, LineDrawing, LineStats};
 pub use order::{near_child, ordered_full_cells, walk_ordered, Order, Viewer, Walk};
 pub use raster::{
     render, render_back_to_front, render_with_progress, render_zbuffer, RenderOptions, RenderStats,
