@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 /// The suffix of temporary files.
 const TEMP_SUFFIX: &str = ".ktree-tmp";
 
-/// Writes `bytes` to `path` atomically, creating the parent directory if needed.
+/// Writes `bytes` to `path` atomically, creating the parent directory if needed. A new file gets the mode
+/// `File::create` would give it (0666 less the umask); a file replaced keeps its mode.
 ///
 /// ```
 /// let dir = tempfile::tempdir().unwrap();
@@ -49,11 +50,22 @@ pub fn write_atomic_with(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     remove_stale(dir, &name, TEMP_SUFFIX);
-    let mut tmp = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(&format!(".{}{TEMP_SUFFIX}", std::process::id()))
-        .tempfile_in(dir)
-        .map_err(with_path)?;
+    let (prefix, suffix) = (
+        format!(".{name}."),
+        format!(".{}{TEMP_SUFFIX}", std::process::id()),
+    );
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(&suffix);
+    // The mode a plain `File::create` gives (0666 less the umask), not the temporary file's 0600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder.tempfile_in(dir).map_err(with_path)?;
+    // A file replaced keeps its mode.
+    if let Ok(old) = std::fs::metadata(path) {
+        tmp.as_file()
+            .set_permissions(old.permissions())
+            .map_err(with_path)?;
+    }
     {
         let mut w = std::io::BufWriter::new(tmp.as_file_mut());
         fill(&mut w).map_err(with_path)?;
@@ -209,6 +221,25 @@ mod tests {
             other.exists(),
             "another target's temporary file was removed"
         );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn outputs_get_the_mode_of_a_plain_create_and_a_replaced_file_keeps_its_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("plain");
+        std::fs::File::create(&plain).unwrap();
+        let new = dir.path().join("new.ktree");
+        write_atomic(&new, b"x").unwrap();
+        assert_eq!(mode(&new), mode(&plain), "a new output's mode");
+        let kept = dir.path().join("kept.ktree");
+        std::fs::write(&kept, b"old").unwrap();
+        std::fs::set_permissions(&kept, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_atomic(&kept, b"new").unwrap();
+        assert_eq!(mode(&kept), 0o640, "a replaced file's mode");
+        assert_eq!(std::fs::read(&kept).unwrap(), b"new");
     }
 
     #[test]
