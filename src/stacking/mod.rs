@@ -18,6 +18,7 @@
 //! ```
 
 mod bitmap;
+mod cells;
 mod out_of_core;
 mod partition;
 mod pipeline;
@@ -28,7 +29,7 @@ mod stack;
 pub use bitmap::{stack_bitmap, MAX_BITMAP_VOXELS};
 pub use out_of_core::{
     balanced_parts, build_slabs, slab_cost, stack_part, stack_to_file, OutOfCore, OutOfCoreError,
-    OutOfCoreReport, Progress, SpilledPart, Stage, BUFFER_BYTES, CELL_BYTES, MAX_PARTS, RUN_BYTES,
+    OutOfCoreReport, Progress, SpilledPart, Stage, BUFFER_BYTES, MAX_PARTS, RUN_BYTES,
     SUBTREE_BYTES,
 };
 pub use partition::{
