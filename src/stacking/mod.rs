@@ -19,6 +19,7 @@
 
 mod any;
 mod bitmap;
+mod cells;
 mod out_of_core;
 mod partition;
 mod pipeline;
@@ -29,7 +30,7 @@ mod stack;
 pub use bitmap::{stack_bitmap, MAX_BITMAP_VOXELS};
 pub use out_of_core::{
     balanced_parts, build_slabs, slab_cost, stack_part, stack_to_file, OutOfCore, OutOfCoreError,
-    OutOfCoreReport, Progress, SpilledPart, Stage, BUFFER_BYTES, CELL_BYTES, MAX_PARTS, RUN_BYTES,
+    OutOfCoreReport, Progress, SpilledPart, Stage, BUFFER_BYTES, MAX_PARTS, RUN_BYTES,
     SUBTREE_BYTES,
 };
 pub use partition::{

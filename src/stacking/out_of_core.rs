@@ -26,16 +26,19 @@
 //! # Memory
 //! The budget ([`OutOfCore::max_memory`]) is kept by accounting, not by measuring the process:
 //! [`RUN_BYTES`] bytes per run of each slab being stacked (its copies and the subtrees made from it, until
-//! they are spilled), the states of the cells of depth `m` (2 bits a cell, all of them, up to `2^28` cells;
-//! above, [`CELL_BYTES`] per non-empty cell), [`SUBTREE_BYTES`] plus 8 per level for
-//! each stacked cell, and the I/O buffers ([`BUFFER_BYTES`] per spill file and two more). The first slab
-//! runs alone; then rounds of up to as many slabs as the rayon pool has threads run at once, as many as
-//! the largest slab seen so far allows in what is left of the budget; a slab whose rays turn out not to fit
-//! beside those already admitted is set aside (its rays dropped) for the next round. Only these rays, made
-//! before their size is known, are held beyond the accounted figure. If a slab does not fit even alone, the
-//! slabs not yet stacked are only measured (their rays made and their cells classified, nothing stacked)
-//! and [`OutOfCoreError::BudgetTooSmall`] names the budget the build needs: what it holds at its end plus
-//! its largest slab (with it, every slab fits whatever the order slabs finish in).
+//! they are spilled), 48 bytes per block of the full cells of depth `m` — kept reduced, as the top of the
+//! tree is: `2^K` full siblings are one block of their parent, so a solid's interior costs a few blocks,
+//! not one entry per cell — [`SUBTREE_BYTES`] plus 8 per level for each stacked cell, and the I/O
+//! buffers ([`BUFFER_BYTES`] per spill file and two more). A budget below the buffers fails before any
+//! slab is made. The first slab runs alone; then rounds of up to as many slabs as the rayon pool has
+//! threads run at once, as many as the largest slab seen so far allows in what is left of the budget; a
+//! slab whose rays turn out not to fit beside those already admitted is set aside (its rays dropped) for
+//! the next round. Only these rays, made before their size is known, are held beyond the accounted
+//! figure. A slab that does not fit even alone ends the build at once with
+//! [`OutOfCoreError::BudgetTooSmall`], naming what is known to be needed then (what is held plus the
+//! largest slab seen): a build given it gets at least as far, and a later, larger slab may ask for more.
+//! When the stacking ends, the index of the stacked cells is checked against the budget; the budget it
+//! names then (what the build holds at its end plus its largest slab) is enough for the whole build.
 //!
 //! # Temporary files
 //! The spill files live in a hidden folder `.NAME.XXXXXX.PID.ktree-spill` in [`OutOfCore::temp_dir`] (by
@@ -65,23 +68,15 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use super::partition::{slab_pieces, top_levels, top_levels_dense, Piece, RaySource};
+use super::cells::{CellBlock, CellStates};
+use super::partition::{slab_pieces, Piece, RaySource};
 
 use crate::io::{write_atomic_with, KtreeWriter};
-use crate::tree::words::unused_mask;
-use crate::tree::{LevelCounts, NodeState, PackedStates};
+use crate::tree::{LevelCounts, NodeState};
 
 /// Bytes accounted for each run of a slab being stacked: the runs and their copies while they are cut
 /// into cells, and the subtrees made from them until they are spilled.
 pub const RUN_BYTES: u64 = 64;
-/// Bytes accounted for each non-empty cell of depth `m` when they are listed (more than `2^28` cells): its
-/// Morton index and state, and its share of the top levels made from them at the end. Up to `2^28` cells
-/// are kept densely instead, at 2 bits each, accounted three times over (the pyramid and the top levels).
-pub const CELL_BYTES: u64 = 24;
-/// The cells of depth `m` are kept densely, two bits each, when there are at most `2^DENSE_BITS` of them
-/// (64 MiB); above, as a sorted list of the non-empty ones.
-const DENSE_BITS: u32 = 28;
-
 /// Bytes accounted for each stacked cell, besides 8 per level of its subtree (its place in the index and
 /// in the order the levels are written in).
 pub const SUBTREE_BYTES: u64 = 24;
@@ -151,7 +146,8 @@ pub enum OutOfCoreError<E> {
     /// The source could not produce its rays.
     #[error("{0}")]
     Source(E),
-    /// Not even one slab of cells (or the index of the stacked cells) fits in the budget.
+    /// Not even one slab of cells (or the index of the stacked cells, or the I/O buffers) fits in the
+    /// budget.
     #[error(
         "a memory budget of {} is too small for this build: it needs a budget of at least {}",
         bytes_text(*budget),
@@ -160,7 +156,9 @@ pub enum OutOfCoreError<E> {
     BudgetTooSmall {
         /// The budget given, in bytes.
         budget: u64,
-        /// A budget with which the build runs, in bytes: what it holds at its end plus its largest slab.
+        /// The least budget known to be needed, in bytes: what the build held when it failed plus its
+        /// largest slab so far (a budget with which the whole build runs when the index at the end is
+        /// what did not fit).
         needed: u64,
     },
     /// The folder for the spill files cannot be used.
@@ -220,60 +218,6 @@ impl Spill {
 struct SubtreeIndex {
     mortons: Vec<u64>,
     counts: Vec<u64>,
-}
-
-/// The states of the non-empty cells of depth `m`.
-enum CellStates {
-    /// All `2^(K·m)` cells, two bits each in Morton order (`00` for the empty ones).
-    Dense(Vec<u64>),
-    /// The non-empty cells as (Morton index, state).
-    Sparse(Vec<(u64, NodeState)>),
-}
-
-impl CellStates {
-    fn new(k: u32, m: u32) -> Self {
-        if k * m <= DENSE_BITS {
-            Self::Dense(vec![0; (1usize << (k * m)).div_ceil(32)])
-        } else {
-            Self::Sparse(Vec::new())
-        }
-    }
-
-    fn set(&mut self, index: u64, state: NodeState) {
-        match self {
-            Self::Dense(words) => {
-                words[(index / 32) as usize] |= (state as u64) << (2 * (index % 32))
-            }
-            Self::Sparse(cells) => cells.push((index, state)),
-        }
-    }
-
-    /// The bytes accounted for the cells once `more` further non-empty cells are added.
-    fn bytes_with(&self, more: usize) -> u64 {
-        match self {
-            Self::Dense(words) => 3 * 8 * words.len() as u64,
-            Self::Sparse(cells) => (cells.len() + more) as u64 * CELL_BYTES,
-        }
-    }
-
-    fn bytes(&self) -> u64 {
-        self.bytes_with(0)
-    }
-
-    /// The top levels `0 … m` of the tree.
-    fn into_top_levels(self, k: u32, m: u32) -> Vec<PackedStates> {
-        match self {
-            Self::Dense(words) => {
-                let base = PackedStates::from_words(words, 1usize << (k * m))
-                    .expect("cells hold the codes of node states");
-                top_levels_dense(k, m, base)
-            }
-            Self::Sparse(mut cells) => {
-                cells.sort_unstable();
-                top_levels(k, m, cells)
-            }
-        }
-    }
 }
 
 /// The memory accounting of a build.
@@ -422,6 +366,14 @@ where
     };
     let mut cells = CellStates::new(K as u32, m);
     let mut index = SubtreeIndex::default();
+    // What is held before any slab is stacked (the buffers): a budget below it fails before any work.
+    let before = budget.fixed(cells.bytes(), 0);
+    if before > budget.max {
+        return Err(OutOfCoreError::BudgetTooSmall {
+            budget: budget.max,
+            needed: before,
+        });
+    }
     let threads = rayon::current_num_threads().max(1);
     let total = slabs.len() as u64;
     let mut done = 0u64;
@@ -454,7 +406,7 @@ where
                     in_flight.fetch_sub(cost, Ordering::SeqCst);
                     return Ok(SlabOutcome::SetAside);
                 }
-                let pieces = slab_pieces::<K>(&slab, level, m, b0, true);
+                let pieces = slab_pieces::<K>(&slab, level, m, b0);
                 Ok(SlabOutcome::Stacked { cost, pieces })
             })
             .collect::<Vec<Result<SlabOutcome<K>, OutOfCoreError<S::Error>>>>();
@@ -479,19 +431,10 @@ where
         }
         budget.peak = budget.peak.max(fixed + round_cost);
         if too_big {
-            set_aside.extend(queue);
-            let needed = survey::<K, S>(
-                source,
-                &budget,
-                m,
-                &set_aside,
-                &cells,
-                index.mortons.len(),
-                largest,
-            )?;
+            // Fail at once, naming what is known to be needed: what is held plus the largest slab.
             return Err(OutOfCoreError::BudgetTooSmall {
                 budget: budget.max,
-                needed,
+                needed: fixed + largest,
             });
         }
         for &b0 in set_aside.iter().rev() {
@@ -564,12 +507,12 @@ pub struct SpilledPart {
     spilled_bytes: u64,
 }
 
-/// The words of an index header: magic, K, L, m, dense, cell words, subtrees, spilled bytes.
+/// The words of an index header: magic, K, L, m, 0 (reserved), cell words, subtrees, spilled bytes.
 const INDEX_HEADER: usize = 8;
 /// The most parts a tree is written from.
 pub const MAX_PARTS: usize = 1 << 16;
 /// The first word of a part's index.
-const INDEX_MAGIC: u64 = u64::from_le_bytes(*b"ktpart01");
+const INDEX_MAGIC: u64 = u64::from_le_bytes(*b"ktpart02");
 
 impl SpilledPart {
     /// Levels of a subtree below its root.
@@ -583,25 +526,20 @@ impl SpilledPart {
     }
 
     /// The index of this part for the process that writes the tree ([`add_part`](Self::add_part)): the
-    /// states of its non-empty cells of depth `m`, and for each cell it stacked its Morton index and node
-    /// count per subtree level — a few words per stacked cell, nothing of the subtrees themselves.
+    /// blocks of its full cells of depth `m` (first cell and depth), and for each cell it stacked its
+    /// Morton index and node count per subtree level — a few words per stacked cell, nothing of the subtrees themselves.
     pub fn index_words(&self) -> Vec<u64> {
-        let (dense, cell_words): (u64, Vec<u64>) = match &self.cells {
-            CellStates::Dense(words) => (1, words.clone()),
-            CellStates::Sparse(cells) => (
-                0,
-                cells
-                    .iter()
-                    .flat_map(|&(morton, state)| [morton, state as u64])
-                    .collect(),
-            ),
-        };
+        let cell_words: Vec<u64> = self
+            .cells
+            .held()
+            .flat_map(|b| [b.first, u64::from(b.depth)])
+            .collect();
         let mut words = vec![
             INDEX_MAGIC,
             u64::from(self.k),
             u64::from(self.level),
             u64::from(self.m),
-            dense,
+            0,
             cell_words.len() as u64,
             self.own.mortons.len() as u64,
             self.spilled_bytes,
@@ -631,16 +569,18 @@ impl SpilledPart {
         if words.len() < INDEX_HEADER || words[0] != INDEX_MAGIC {
             return Err(bad("not a part index"));
         }
-        let dense = matches!(self.cells, CellStates::Dense(_));
         if words[1..5]
             != [
                 u64::from(self.k),
                 u64::from(self.level),
                 u64::from(self.m),
-                u64::from(dense),
+                0,
             ]
         {
             return Err(bad("another K, level, split depth or cell layout"));
+        }
+        if words[5] % 2 != 0 {
+            return Err(bad("an odd number of cell words"));
         }
         let t = self.t();
         let (cell_words, n) = (words[5], words[6]);
@@ -667,29 +607,25 @@ impl SpilledPart {
                 stream += nodes.div_ceil(32);
             }
         }
-        match &mut self.cells {
-            CellStates::Dense(own) => {
-                if own.len() != cell_words {
-                    return Err(bad("another number of cells"));
-                }
-                for (a, b) in own.iter_mut().zip(cell_part) {
-                    let both = *a | b;
-                    if unused_mask(both) != 0 {
-                        return Err(bad("a cell state code 11, or a cell of two parts"));
-                    }
-                    *a = both;
-                }
+        let m = self.m;
+        let mut blocks = Vec::with_capacity(cell_words / 2);
+        for pair in cell_part.chunks_exact(2) {
+            let (first, depth) = (pair[0], pair[1]);
+            if depth > u64::from(m)
+                || u128::from(first) >> (k * u64::from(m)) != 0
+                || first % (1u64 << (k * (u64::from(m) - depth))) != 0
+            {
+                return Err(bad("a block of cells out of place"));
             }
-            CellStates::Sparse(own) => {
-                for pair in cell_part.chunks_exact(2) {
-                    let state = u8::try_from(pair[1])
-                        .ok()
-                        .and_then(NodeState::from_code)
-                        .ok_or_else(|| bad("a cell state code above 2"))?;
-                    own.push((pair[0], state));
-                }
-            }
+            blocks.push(CellBlock {
+                first,
+                depth: depth as u32,
+                state: NodeState::Full,
+            });
         }
+        self.cells
+            .add_blocks(blocks)
+            .map_err(|_| bad("a cell of two parts"))?;
         self.spilled_bytes += words[7];
         self.others.push(SubtreeIndex {
             mortons: mortons.to_vec(),
@@ -784,7 +720,6 @@ impl SpilledPart {
             });
         }
         budget.peak = budget.peak.max(end);
-        let top = cells.into_top_levels(k, m);
         // The stacked cells of every part in Morton order, as (owner, position in its index).
         // (Packed in one word: the owner in the top 16 bits, at most `MAX_PARTS`.)
         let mut order: Vec<u64> = Vec::with_capacity(subtrees);
@@ -796,6 +731,23 @@ impl SpilledPart {
             let (owner, s) = unpack(o);
             parts[owner].mortons[s]
         });
+        let partial: Vec<u64> = order
+            .iter()
+            .map(|&o| {
+                let (owner, s) = unpack(o);
+                parts[owner].mortons[s]
+            })
+            .collect();
+        let top = cells
+            .into_top_levels(&partial)
+            .map_err(|_| OutOfCoreError::Output {
+                path: out.to_path_buf(),
+                source: std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    "the indexes of the parts overlap: a cell of depth m was stacked twice or is also full",
+                ),
+            })?;
+        drop(partial);
         let deepest = (1..=t)
             .rev()
             .find(|&j| {
@@ -986,19 +938,18 @@ fn spill_piece<const K: usize, E>(
 ) -> Result<(), OutOfCoreError<E>> {
     let tree = match piece {
         Piece::Full => {
-            cells.set(morton, NodeState::Full);
+            cells.set_full(morton);
             return Ok(());
         }
         Piece::Tree(tree) => tree,
-        Piece::Unstacked => unreachable!("stacked slabs have no unstacked cells"),
     };
     match tree.root_state() {
         NodeState::Empty => return Ok(()),
         NodeState::Full => {
-            cells.set(morton, NodeState::Full);
+            cells.set_full(morton);
             return Ok(());
         }
-        NodeState::Partial => cells.set(morton, NodeState::Partial),
+        NodeState::Partial => {}
     }
     index.mortons.push(morton);
     for j in 1..=spill.files.len() {
@@ -1021,37 +972,4 @@ fn spill_piece<const K: usize, E>(
         index.counts.push(nodes);
     }
     Ok(())
-}
-
-/// Measures the slabs not stacked (their rays made and cells classified, nothing stacked) and returns
-/// the budget with which any slab fits at any point of the build: what the build holds at its end (every
-/// mixed cell counted as stacked) plus the largest slab.
-fn survey<const K: usize, S>(
-    source: &S,
-    budget: &Budget,
-    m: u32,
-    rest: &[u32],
-    cells: &CellStates,
-    mut subtrees: usize,
-    mut largest: u64,
-) -> Result<u64, OutOfCoreError<S::Error>>
-where
-    S: RaySource<K>,
-{
-    let level = source.universe().level();
-    let side = 1u32 << (level - m);
-    let mut more = 0;
-    for &b0 in rest {
-        let slab = source
-            .slab(b0 * side..(b0 + 1) * side)
-            .map_err(OutOfCoreError::Source)?;
-        largest = largest.max(slab.runs.len() as u64 * RUN_BYTES);
-        for (_, piece) in slab_pieces::<K>(&slab, level, m, b0, false) {
-            more += 1;
-            if matches!(piece, Piece::Unstacked) {
-                subtrees += 1;
-            }
-        }
-    }
-    Ok(budget.fixed(cells.bytes_with(more), subtrees) + largest)
 }

@@ -27,6 +27,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
+use super::cells::{top_levels_of_blocks, CellBlock};
 use super::stack_bitmap;
 use crate::rays::RaySet;
 use crate::space::{morton_encode, Universe};
@@ -146,13 +147,11 @@ pub fn stack_source<const K: usize, S: RaySource<K>>(
     Ok(join_pieces(universe, m, pieces))
 }
 
-/// A non-empty cell of depth `m`: wholly full, a stacked subtree, or (when only counting) a mixed cell
-/// left unstacked.
+/// A non-empty cell of depth `m`: wholly full, or a stacked subtree.
 #[derive(Debug)]
 pub(super) enum Piece<const K: usize> {
     Full,
     Tree(KTree<K>),
-    Unstacked,
 }
 
 /// Stacks the cells of slab `b0` (all of them for `K = 1`); returns the non-empty ones with their Morton
@@ -166,18 +165,16 @@ fn stack_slab<const K: usize, S: RaySource<K>>(
     let t = level - m;
     let side = 1u32 << t;
     let slab = source.slab(b0 * side..(b0 + 1) * side)?;
-    Ok(slab_pieces(&slab, level, m, b0, true))
+    Ok(slab_pieces(&slab, level, m, b0))
 }
 
 /// The non-empty cells of slab `b0` (all cells for `K = 1`) from its runs, with their Morton index among
-/// the cells of depth `m`; the mixed cells are stacked when `stack_mixed`, else left
-/// [`Piece::Unstacked`].
+/// the cells of depth `m`, the mixed cells stacked.
 pub(super) fn slab_pieces<const K: usize>(
     slab: &SlabRuns<'_>,
     level: u32,
     m: u32,
     b0: u32,
-    stack_mixed: bool,
 ) -> Vec<(u64, Piece<K>)> {
     let t = level - m;
     let side = 1u32 << t;
@@ -191,7 +188,7 @@ pub(super) fn slab_pieces<const K: usize>(
             keys: vec![0; runs.len()],
             runs: runs.to_vec(),
         };
-        split_block::<K>(&block, m, t, [0; K], stack_mixed, &mut out);
+        split_block::<K>(&block, m, t, [0; K], &mut out);
         return out;
     }
     // Bucket the slab's runs by block (the cell coordinates along axes 1 … K−2), keeping their order, with
@@ -200,7 +197,7 @@ pub(super) fn slab_pieces<const K: usize>(
     let local_mask = u64::from(side) - 1;
     let blocks_per_slab = 1usize << ((K - 2) as u32 * m);
     if blocks_per_slab > runs.len().max(64) {
-        return stack_sparse_slab(keys, runs, level, m, b0, stack_mixed);
+        return stack_sparse_slab(keys, runs, level, m, b0);
     }
     let mut block_of = Vec::with_capacity(runs.len());
     let mut counts = vec![0usize; blocks_per_slab + 1];
@@ -243,7 +240,7 @@ pub(super) fn slab_pieces<const K: usize>(
         for a in (1..K - 1).rev() {
             cell[a] = ((b >> ((K - 2 - a) as u32 * m)) & ((1 << m) - 1)) as u32;
         }
-        split_block::<K>(&block, m, t, cell, stack_mixed, &mut out);
+        split_block::<K>(&block, m, t, cell, &mut out);
     }
     out
 }
@@ -256,7 +253,6 @@ fn stack_sparse_slab<const K: usize>(
     level: u32,
     m: u32,
     b0: u32,
-    stack_mixed: bool,
 ) -> Vec<(u64, Piece<K>)> {
     let t = level - m;
     let mask = (1u64 << level) - 1;
@@ -294,7 +290,7 @@ fn stack_sparse_slab<const K: usize>(
         for a in (1..K - 1).rev() {
             cell[a] = ((b >> ((K - 2 - a) as u32 * m)) & ((1 << m) - 1)) as u32;
         }
-        split_block::<K>(&block, m, t, cell, stack_mixed, &mut out);
+        split_block::<K>(&block, m, t, cell, &mut out);
     }
     out
 }
@@ -306,14 +302,12 @@ struct Block {
     runs: Vec<(u32, u32)>,
 }
 
-/// Cuts a block's runs into its `2^m` cells along the last axis and stacks the mixed ones (or, unless
-/// `stack_mixed`, lists them unstacked). `cell` holds the block's cell coordinates on the column axes.
+/// Cuts a block's runs into its `2^m` cells along the last axis and stacks the mixed ones. `cell` holds the block's cell coordinates on the column axes.
 fn split_block<const K: usize>(
     block: &Block,
     m: u32,
     t: u32,
     mut cell: [u32; K],
-    stack_mixed: bool,
     out: &mut Vec<(u64, Piece<K>)>,
 ) {
     let columns = 1u64 << (t as usize * (K - 1));
@@ -324,13 +318,6 @@ fn split_block<const K: usize>(
     }
     let low = (1u32 << t) - 1;
     if mixed.is_empty() {
-        return;
-    }
-    if !stack_mixed {
-        for j in mixed {
-            cell[K - 1] = j as u32;
-            out.push((morton_encode(cell), Piece::Unstacked));
-        }
         return;
     }
     // Hand each mixed cell its clipped runs, in order.
@@ -486,15 +473,21 @@ fn join_pieces<const K: usize>(
     m: u32,
     pieces: Vec<(u64, Piece<K>)>,
 ) -> KTree<K> {
-    let base = pieces
+    let base: Vec<CellBlock> = pieces
         .iter()
-        .filter_map(|(i, p)| match p {
-            Piece::Full => Some((*i, NodeState::Full)),
-            Piece::Tree(t) if t.root_state() != NodeState::Empty => Some((*i, t.root_state())),
-            _ => None,
+        .filter_map(|(i, p)| {
+            let state = match p {
+                Piece::Full => NodeState::Full,
+                Piece::Tree(t) => t.root_state(),
+            };
+            (state != NodeState::Empty).then_some(CellBlock {
+                first: *i,
+                depth: m,
+                state,
+            })
         })
         .collect();
-    let mut levels = top_levels(K as u32, m, base);
+    let mut levels = top_levels_of_blocks(K as u32, m, &base);
     // Levels m + 1 …: the concatenation of the subtrees' levels 1 …, in Morton order.
     let trees: Vec<&KTree<K>> = pieces
         .iter()
@@ -517,123 +510,6 @@ fn join_pieces<const K: usize>(
         .collect();
     levels.extend(deeper);
     KTree::from_levels(universe, levels)
-}
-
-/// The levels `0 … m` of a tree (fewer where the top collapses), finished, from its non-empty cells of
-/// depth `m` in `k` dimensions, as (Morton index, state) sorted by index: a node whose `2^k` children are
-/// all full is full, any other node with a non-empty child is partial, absent children are empty.
-pub(super) fn top_levels(k: u32, m: u32, base: Vec<(u64, NodeState)>) -> Vec<PackedStates> {
-    // The pyramid of the non-empty nodes of depths m, m − 1, …, 0.
-    let mut pyramid = vec![base];
-    for _ in 0..m {
-        let below = pyramid.last().expect("the pyramid has its base");
-        let mut above: Vec<(u64, NodeState)> = Vec::with_capacity(below.len() >> k);
-        let mut at = 0;
-        while at < below.len() {
-            let parent = below[at].0 >> k;
-            let mut end = at;
-            while end < below.len() && below[end].0 >> k == parent {
-                end += 1;
-            }
-            let full = end - at == 1 << k && below[at..end].iter().all(|c| c.1 == NodeState::Full);
-            above.push((
-                parent,
-                if full {
-                    NodeState::Full
-                } else {
-                    NodeState::Partial
-                },
-            ));
-            at = end;
-        }
-        pyramid.push(above);
-    }
-    pyramid.reverse();
-    // Levels 0 … m: the root, then the children of each partial node, in order (absent ones empty).
-    let mut levels = Vec::new();
-    let mut root = PackedStates::with_capacity(1);
-    root.push(pyramid[0].first().map_or(NodeState::Empty, |r| r.1));
-    levels.push(root);
-    for d in 0..m as usize {
-        let mut next = PackedStates::new();
-        let children = &pyramid[d + 1];
-        let mut at = 0;
-        for &(i, s) in &pyramid[d] {
-            if s != NodeState::Partial {
-                continue;
-            }
-            for c in i << k..(i + 1) << k {
-                while at < children.len() && children[at].0 < c {
-                    at += 1;
-                }
-                match children.get(at) {
-                    Some(&(ci, cs)) if ci == c => next.push(cs),
-                    _ => next.push(NodeState::Empty),
-                }
-            }
-        }
-        if next.is_empty() {
-            break;
-        }
-        levels.push(next);
-    }
-    for l in &mut levels {
-        l.finish();
-    }
-    levels
-}
-
-/// [`top_levels`] from the states of all `2^(k·m)` cells of depth `m`, in Morton order (absent cells
-/// empty): the same levels.
-pub(super) fn top_levels_dense(k: u32, m: u32, base: PackedStates) -> Vec<PackedStates> {
-    // The pyramid of all nodes of depths m, m − 1, …, 0.
-    let mut pyramid = vec![base];
-    for _ in 0..m {
-        let below = pyramid.last().expect("the pyramid has its base");
-        let mut above = PackedStates::with_capacity(below.len() >> k);
-        for p in 0..below.len() >> k {
-            let (mut full, mut empty) = (true, true);
-            for c in p << k..(p + 1) << k {
-                match below.get(c) {
-                    NodeState::Full => empty = false,
-                    NodeState::Partial => (full, empty) = (false, false),
-                    NodeState::Empty => full = false,
-                }
-            }
-            above.push(if full {
-                NodeState::Full
-            } else if empty {
-                NodeState::Empty
-            } else {
-                NodeState::Partial
-            });
-        }
-        pyramid.push(above);
-    }
-    pyramid.reverse();
-    // Levels 0 … m: the root, then the children of each partial node, in order.
-    let mut levels = Vec::new();
-    let mut root = PackedStates::with_capacity(1);
-    root.push(pyramid[0].get(0));
-    levels.push(root);
-    for d in 0..m as usize {
-        let mut next = PackedStates::new();
-        for p in 0..pyramid[d].len() {
-            if pyramid[d].get(p) == NodeState::Partial {
-                for c in p << k..(p + 1) << k {
-                    next.push(pyramid[d + 1].get(c));
-                }
-            }
-        }
-        if next.is_empty() {
-            break;
-        }
-        levels.push(next);
-    }
-    for l in &mut levels {
-        l.finish();
-    }
-    levels
 }
 
 /// The level of concatenated subtree levels.

@@ -1,6 +1,6 @@
 //! Out-of-core stacking writes, for K = 1 … 4 and every split depth, exactly the bytes of the tree built in
 //! memory (and equal to naive insertion) written as a `.ktree` version 2 file; with a budget too small it
-//! names a budget that works, and the build then keeps to it; it leaves no
+//! names a larger budget, and the budgets named lead to one with which the build runs and keeps to it; it leaves no
 //! temporary file behind and the target untouched on failure, and removes the spill folders of killed
 //! builds; and the file does not depend on the number of threads. Built in parts (as the ranks of a
 //! distributed run build it: balanced shares of the slabs stacked apart, their indexes added to one part
@@ -63,14 +63,26 @@ where
             depth
         );
         prop_assert_eq!(report.file_bytes, written.len() as u64);
-        // A budget of nothing: refused, naming the smallest budget that works.
+        // A budget of nothing: refused at once, naming a budget needed; each budget named is larger than
+        // the one refused, and in a few steps the build runs.
         std::fs::write(&out, b"old").unwrap();
-        let needed = needed_of(
-            stack_to_file(source, &out, &OutOfCore::new(depth, 0), &|_| {}).unwrap_err(),
-        )?;
-        prop_assert_eq!(std::fs::read(&out).unwrap(), b"old".to_vec());
-        let report = stack_to_file(source, &out, &OutOfCore::new(depth, needed), &|_| {})
-            .map_err(|e| TestCaseError::fail(format!("depth {depth}, budget {needed}: {e}")))?;
+        let mut budget = 0u64;
+        let (report, needed) = loop {
+            match stack_to_file(source, &out, &OutOfCore::new(depth, budget), &|_| {}) {
+                Ok(report) => break (report, budget),
+                Err(e) => {
+                    let needed = needed_of(e)?;
+                    prop_assert!(needed > budget, "budget {} named after {}", needed, budget);
+                    prop_assert_eq!(std::fs::read(&out).unwrap(), b"old".to_vec());
+                    prop_assert_eq!(
+                        entries(dir.path()),
+                        vec!["tree.ktree".to_string()],
+                        "a failed build leaves no temporary file"
+                    );
+                    budget = needed;
+                }
+            }
+        };
         prop_assert!(report.peak_accounted_bytes <= needed);
         prop_assert!(
             std::fs::read(&out).unwrap() == expected,
@@ -461,4 +473,48 @@ fn a_stream_that_breaks_off_fails_the_write_and_keeps_the_target() {
     assert!(e.to_string().contains("the sender stopped"), "{e}");
     assert_eq!(std::fs::read(&out).unwrap(), b"old".to_vec());
     assert_eq!(entries(dir.path()), vec!["tree.ktree".to_string()]);
+}
+
+/// The non-empty cells of depth `m` of a tree: what a build that lists every such cell holds.
+fn nonempty_cells_of_depth<const K: usize>(tree: &ktree::KTree<K>, m: u32) -> u64 {
+    let counts = tree.counts_per_level();
+    let mut cells = 0u64;
+    for c in counts.iter().filter(|c| c.level <= m) {
+        cells += c.full << (K as u32 * (m - c.level));
+        if c.level == m {
+            cells += c.partial;
+        }
+    }
+    cells
+}
+
+/// The full interior costs the build a few blocks, not an entry per cell: a ball whose cells of depth
+/// `m` are too many to list in the budget (at 24 bytes each, as a list of the non-empty cells would
+/// take) builds in it, the file that of the in-memory build.
+#[test]
+fn a_solid_interior_does_not_fill_the_budget() {
+    fn check<const K: usize>(level: u32, depth: u32, radius: i64, budget: u64) {
+        let u = 1i64 << level;
+        let rays = ktree::rays::ball_rays::<K>(level, [u; K], 2 * radius).unwrap();
+        let tree = stack(&rays);
+        let listed = 24 * nonempty_cells_of_depth(&tree, depth);
+        assert!(
+            listed > 4 * budget,
+            "K = {K}: the cells listed take {listed} bytes, not beyond the budget {budget}"
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("ball.ktree");
+        let report = stack_to_file(&rays, &out, &OutOfCore::new(depth, budget), &|_| {})
+            .unwrap_or_else(|e| panic!("K = {K}, L = {level}: {e}"));
+        assert!(report.peak_accounted_bytes <= budget);
+        let mut expected = Vec::new();
+        write_ktree_v2(&mut expected, &tree).unwrap();
+        assert!(
+            std::fs::read(&out).unwrap() == expected,
+            "K = {K}: the file differs"
+        );
+    }
+    // 1.3·10^7 cells of side 2 in the disk; 1.1·10^6 cells of side 4 in the ball.
+    check::<2>(16, 15, 4096, 4 << 20);
+    check::<3>(12, 10, 256, 6 << 20);
 }
