@@ -153,7 +153,10 @@ pub fn run(args: Args) -> Result<(), String> {
         let view = KtreeView::open(&args.file).map_err(|e| e.to_string())?;
         if view.k() == 3 {
             let tree = MappedTree::<3>::new(&view).map_err(|e| e.to_string())?;
-            return render_octree(&tree, &args, &out, w, h, bar.as_ref(), &mut tick);
+            let rendered = render_octree(&tree, &args, &out, w, h, bar.as_ref(), &mut tick);
+            // A file changed while it was read: its error, not a picture of what was read.
+            tree.failure().map_err(|e| e.to_string())?;
+            return rendered;
         }
     }
     let tree = read_ktree_file(&args.file).map_err(|e| e.to_string())?;

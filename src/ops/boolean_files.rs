@@ -260,9 +260,9 @@ impl<'a, const K: usize> ViewStorage<'a, K> {
         }
         let words = self.view.level_nodes(depth).div_ceil(NODES_PER_WORD);
         let (j, off) = (first / NODES_PER_WORD, first % NODES_PER_WORD);
-        let mut word = self.view.level_word(depth, j) >> (2 * off);
+        let mut word = self.view.level_word(depth, j)? >> (2 * off);
         if off > 0 && j + 1 < words {
-            word |= self.view.level_word(depth, j + 1) << (2 * (NODES_PER_WORD - off));
+            word |= self.view.level_word(depth, j + 1)? << (2 * (NODES_PER_WORD - off));
         }
         let word = word & words::slots_mask(n as usize);
         // A code 11 is not a state: the bytes are not the file's any more.
@@ -295,7 +295,7 @@ impl<const K: usize> TreeStorage<K> for ViewStorage<'_, K> {
         {
             return Err(self.changed(depth, index));
         }
-        let first = self.view.partial_rank(depth, index).saturating_mul(1 << K);
+        let first = self.view.partial_rank(depth, index)?.saturating_mul(1 << K);
         if first.saturating_add(1 << K) > self.view.level_nodes(depth + 1) {
             return Err(self.changed(depth + 1, first));
         }

@@ -6,6 +6,7 @@ use crate::io::KtreeFileError;
 use crate::space::Universe;
 use crate::tree::cursor::LevelOrder;
 use crate::tree::NodeState;
+use std::sync::OnceLock;
 
 /// A `K`-dimensional tree read through a [`KtreeView`]: what the walks need, with each first child found
 /// from the file's rank samples (at most 64 word pop-counts) instead of an index in memory.
@@ -23,10 +24,12 @@ use crate::tree::NodeState;
 /// mapped.for_each_leaf(|cell, state| leaves.push((cell, state)));
 /// assert_eq!(leaves, tree.leaves().collect::<Vec<_>>());
 /// ```
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug)]
 pub struct MappedTree<'a, const K: usize> {
     view: &'a KtreeView,
     universe: Universe<K>,
+    /// The first read that found the file changed since it was opened.
+    failure: OnceLock<KtreeFileError>,
 }
 
 impl<'a, const K: usize> MappedTree<'a, K> {
@@ -38,6 +41,25 @@ impl<'a, const K: usize> MappedTree<'a, K> {
         Ok(Self {
             view,
             universe: view.universe::<K>()?,
+            failure: OnceLock::new(),
+        })
+    }
+
+    /// `Ok` if every read so far found the file as it was checked when opened; otherwise the first
+    /// failed read's error (naming the file and a byte offset inside it). Walks over a file changed
+    /// underneath read the nodes they cannot find as empty and go on: call this after a walk.
+    ///
+    /// # Errors
+    /// The first failed read's error.
+    pub fn failure(&self) -> Result<(), KtreeFileError> {
+        self.failure.get().map_or(Ok(()), |e| Err(e.clone()))
+    }
+
+    /// `value` of a read, or `fallback` after recording its error.
+    fn checked<T>(&self, read: Result<T, KtreeFileError>, fallback: T) -> T {
+        read.unwrap_or_else(|e| {
+            let _ = self.failure.set(e);
+            fallback
         })
     }
 }
@@ -52,17 +74,89 @@ impl<const K: usize> LevelOrder<K> for MappedTree<'_, K> {
     }
 
     fn root_state(&self) -> NodeState {
-        self.view.state(0, 0).unwrap_or(NodeState::Empty)
+        self.checked(self.view.checked_state(0, 0), NodeState::Empty)
     }
 
     fn first_child(&self, depth: usize, index: usize) -> usize {
-        (self.view.partial_rank(depth, index as u64) << K) as usize
+        let first = self
+            .view
+            .partial_rank(depth, index as u64)
+            .map(|rank| rank.saturating_mul(1 << K))
+            .and_then(|first| {
+                // The whole block of children must be in the level below.
+                if first.saturating_add(1 << K) <= self.view.level_nodes(depth + 1) {
+                    Ok(first as usize)
+                } else {
+                    Err(self.view.changed(depth + 1, first))
+                }
+            });
+        self.checked(first, 0)
     }
 
     fn block_codes(&self, depth: usize, first: usize) -> u32 {
         // `2^K` divides 32: the block lies in one word.
         let first = first as u64;
-        let word = self.view.level_word(depth, first / 32) >> (2 * (first % 32));
-        (word & ((1u64 << (2 << K)) - 1)) as u32
+        let block = if first.saturating_add(1 << K) <= self.view.level_nodes(depth) {
+            self.view.level_word(depth, first / 32)
+        } else {
+            Err(self.view.changed(depth, first))
+        };
+        let word = self.checked(block, 0) >> (2 * (first % 32));
+        let codes = (word & ((1u64 << (2 << K)) - 1)) as u32;
+        // A code 11 is no state: the bytes are not the file's any more.
+        if crate::tree::words::unused_mask(u64::from(codes)) != 0 {
+            let _ = self.failure.set(self.view.changed(depth, first));
+            return 0;
+        }
+        codes
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rays::ball_rays;
+    use crate::stacking::stack;
+
+    /// A file rewritten in place (same inode) with a smaller, different tree after it was opened: walks
+    /// and queries give errors naming offsets inside the file, never a panic.
+    #[test]
+    fn a_file_rewritten_in_place_after_opening_gives_errors_not_panics() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.ktree");
+        let big = stack(&ball_rays::<3>(6, [30, 33, 35], 50).unwrap());
+        crate::io::write_ktree_file(&path, &big).unwrap();
+        let len = std::fs::metadata(&path).unwrap().len();
+        let view = KtreeView::open(&path).unwrap();
+        // Rewrite in place (the same inode, so the map shows the new bytes): first another, smaller tree
+        // over the start with the rest all ones, then all ones.
+        let mut small = Vec::new();
+        crate::io::write_ktree(
+            &mut small,
+            &stack(&ball_rays::<3>(6, [10, 12, 14], 9).unwrap()),
+        )
+        .unwrap();
+        small.resize(len as usize, 0xFF);
+        std::fs::write(&path, &small).unwrap();
+        let mapped = MappedTree::<3>::new(&view).unwrap();
+        mapped.for_each_leaf(|_, _| {});
+        if let Err(e) = mapped.failure() {
+            assert!(e.offset < len, "{e}");
+        }
+        std::fs::write(&path, vec![0xFF; len as usize]).unwrap();
+        let mapped = MappedTree::<3>::new(&view).unwrap();
+        mapped.for_each_leaf(|_, _| {});
+        let e = mapped
+            .failure()
+            .expect_err("a changed file read without an error");
+        assert!(e.offset < len, "{e}");
+        assert!(e.to_string().contains("changed after it was opened"), "{e}");
+        for p in [[0u32, 0, 0], [30, 33, 35], [63, 63, 63], [31, 40, 20]] {
+            if let Err(e) = view.contains(p) {
+                assert!(e.offset < len, "{e}");
+            }
+        }
+        let _ = view.for_each_leaf::<3>(|_, _| {});
+        let _ = view.to_tree::<3>();
     }
 }

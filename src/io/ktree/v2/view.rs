@@ -157,9 +157,13 @@ impl KtreeView {
         NodeState::from_code(code as u8)
     }
 
-    /// Word `j` of the node states of level `depth` (`j` below the level's word count).
-    pub(crate) fn level_word(&self, depth: usize, j: u64) -> u64 {
-        self.word(&self.layout.sections[depth], j)
+    /// Word `j` of the node states of level `depth`, or the error of a file changed since opening when
+    /// the level has no such word (every read stays inside the sections checked at opening).
+    pub(crate) fn level_word(&self, depth: usize, j: u64) -> Result<u64, KtreeFileError> {
+        match self.layout.sections.get(depth) {
+            Some(s) if j < s.words() => Ok(self.word(s, j)),
+            _ => Err(self.changed(depth, j.saturating_mul(NODES_PER_WORD))),
+        }
     }
 
     /// The number of nodes of level `depth` (0 below the last level).
@@ -174,10 +178,12 @@ impl KtreeView {
 
     /// The error for a node that is not what the checks at opening found: the file was changed since.
     pub(crate) fn changed(&self, depth: usize, index: u64) -> KtreeFileError {
+        // The offset named is that of the last word read inside the level, so it lies within the file.
         let section = &self.layout.sections[depth.min(self.layout.sections.len() - 1)];
+        let inside = index.min(section.nodes.saturating_sub(1));
         KtreeFileError {
             file: self.name.clone(),
-            offset: section.offset + 8 * (index / NODES_PER_WORD),
+            offset: section.offset + 8 * (inside / NODES_PER_WORD),
             kind: KtreeFileErrorKind::Tree(format!(
                 "node {index} of level {depth} is missing or has the code 11: the file was changed after it was opened"
             )),
@@ -195,8 +201,14 @@ impl KtreeView {
     }
 
     /// The number of partial nodes before node `index` of level `depth` (`index` < the level's size).
-    pub(crate) fn partial_rank(&self, depth: usize, index: u64) -> u64 {
-        let s = &self.layout.sections[depth];
+    ///
+    /// # Errors
+    /// The error of a file changed since opening if the level has no node `index`.
+    pub(crate) fn partial_rank(&self, depth: usize, index: u64) -> Result<u64, KtreeFileError> {
+        let s = match self.layout.sections.get(depth) {
+            Some(s) if index < s.nodes => s,
+            _ => return Err(self.changed(depth, index)),
+        };
         let word = index / NODES_PER_WORD;
         let block = word / WORDS_PER_SAMPLE;
         let mut rank = u64_at(self.bytes(), (s.samples_offset() + 8 * block) as usize);
@@ -204,9 +216,9 @@ impl KtreeView {
             rank = rank.saturating_add(u64::from(partial_mask(self.word(s, j)).count_ones()));
         }
         let slot = index % NODES_PER_WORD;
-        rank.saturating_add(u64::from(
+        Ok(rank.saturating_add(u64::from(
             (partial_mask(self.word(s, word)) & slots_mask(slot)).count_ones(),
-        ))
+        )))
     }
 
     /// The universe, if the file's `K` is `K`.
@@ -255,7 +267,7 @@ impl KtreeView {
                     // Saturating: a rank sample changed underneath must not overflow (the node is then
                     // missing, an error).
                     index = self
-                        .partial_rank(depth, index)
+                        .partial_rank(depth, index)?
                         .saturating_mul(1 << K)
                         .saturating_add(code);
                 }
