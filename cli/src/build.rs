@@ -5,8 +5,9 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::{open_rays_file, read_rays_file, AnyRaySet, AnyTree, RaysFile, RaysFileSource};
+use ktree::io::{open_rays_file, read_rays_file, RaysFile, RaysFileSource};
 use ktree::stacking::{default_split_depth, stack_partitioned, RaySource};
+use ktree::{AnyRaySet, AnyTree};
 use ktree::{KTree, LevelCounts, RaySet};
 
 /// Arguments of `ktree build`.

@@ -5,8 +5,8 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::AnyTree;
 use ktree::ops;
+use ktree::AnyTree;
 use ktree::KTree;
 use serde::Serialize;
 

@@ -6,7 +6,8 @@ use crate::outln;
 use std::path::PathBuf;
 
 use ktree::display::{line_drawing_with_progress, png, svg, HiddenLineMethod};
-use ktree::io::{read_ktree_file, AnyTree};
+use ktree::io::read_ktree_file;
+use ktree::AnyTree;
 
 use crate::render::{parse_size, parse_view, progress_bar};
 

@@ -10,8 +10,9 @@ use crate::outln;
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::{ktree_file_version, read_ktree_file, AnyTree};
+use ktree::io::{ktree_file_version, read_ktree_file};
 use ktree::ops::{self, BoolOp, BooleanFileReport};
+use ktree::AnyTree;
 use ktree::{KTree, LevelCounts};
 
 /// Arguments of `ktree op`.

@@ -4,7 +4,8 @@ use crate::outln;
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::{write_atomic_with, write_rays_file, write_rays_source};
+use ktree::fs::write_atomic_with;
+use ktree::io::{write_rays_file, write_rays_source};
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSource};
 use ktree::stacking::{default_split_depth, stack_source};
 use ktree::{LevelCounts, RaySet};

@@ -11,10 +11,9 @@ use ktree::display::{
     default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
     RenderOptions, ISO_TOWARD_EYE,
 };
-use ktree::io::{
-    ktree_file_version, read_ktree_file, read_rays_file, AnyRaySet, AnyTree, KtreeView, MappedTree,
-};
+use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, MappedTree};
 use ktree::tree::cursor::LevelOrder;
+use ktree::{AnyRaySet, AnyTree};
 
 /// Arguments of `ktree render`.
 #[derive(Debug, clap::Args)]

@@ -5,10 +5,9 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::{
-    ktree_file_version, read_ktree_file, read_rays_file, KtreeView, TreeStats, VERSION,
-};
+use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, VERSION};
 use ktree::tree::heap_bytes_for_levels;
+use ktree::tree::TreeStats;
 
 /// Arguments of `ktree stats`.
 #[derive(Debug, clap::Args)]

@@ -181,7 +181,7 @@ fn version_2_files_render_from_their_map_as_in_memory() {
     let p = |name: &str| dir.path().join(name);
     let tree = stack(&ball_rays::<3>(7, [60, 64, 70], 50).unwrap());
     ktree::fs::write_atomic_with(&p("v1.ktree"), |w| ktree::io::write_ktree_v1(w, &tree)).unwrap();
-    ktree::io::write_ktree_v2_file(&p("v2.ktree"), &tree).unwrap();
+    ktree::io::write_ktree_file(&p("v2.ktree"), &tree).unwrap();
     let render = |file: &str, camera: &str| {
         let (ok, out, err) = ktree(&[
             "render",

@@ -8,9 +8,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use common::{data_dir, ktree};
-use ktree::io::{read_tree, write_tree, AnyTree, ReadOptions, WriteOptions};
+use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
 use ktree::stacking::stack;
+use ktree::AnyTree;
 use ktree::{KTree, NodeState};
 
 /// Builds `octomap_check` against the installed OctoMap into `dir`, or says why it cannot.

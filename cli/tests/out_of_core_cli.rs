@@ -8,14 +8,15 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{entries, ktree, SmallDisk};
-use ktree::io::{read_rays_file, write_ktree_v2, AnyRaySet};
+use ktree::io::{read_rays_file, write_ktree};
 use ktree::stacking::stack;
+use ktree::AnyRaySet;
 
 /// The bytes of the tree of a ray file built in memory, as `.ktree` version 2.
 fn in_memory_bytes(rays: &Path) -> Vec<u8> {
     let mut bytes = Vec::new();
     match read_rays_file(rays).unwrap() {
-        AnyRaySet::K3(r) => write_ktree_v2(&mut bytes, &stack(&r)).unwrap(),
+        AnyRaySet::K3(r) => write_ktree(&mut bytes, &stack(&r)).unwrap(),
         other => panic!("expected K = 3 rays, got K = {}", other.k()),
     }
     bytes

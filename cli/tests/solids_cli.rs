@@ -5,8 +5,9 @@ mod common;
 
 use common::ktree;
 
-use ktree::io::{read_ktree_file, read_rays_file, AnyRaySet};
+use ktree::io::{read_ktree_file, read_rays_file};
 use ktree::solid::{Frame, Quadric, Rational, Sample};
+use ktree::AnyRaySet;
 
 #[test]
 fn rays_writes_the_library_result() {

@@ -7,15 +7,16 @@ mod common;
 use std::path::Path;
 
 use common::ktree;
-use ktree::io::{read_rays_file, voxelize, write_ktree_v2, AnyRaySet, ReadOptions};
+use ktree::io::{read_rays_file, voxelize, write_ktree, ReadOptions};
 use ktree::solid::mesh::{Placement, TriangleMesh};
 use ktree::solid::volume::Select;
 use ktree::stacking::stack;
+use ktree::AnyRaySet;
 
 /// The bytes of the tree of a ray set built in memory, as `.ktree` version 2.
 fn in_memory_bytes(rays: &AnyRaySet) -> Vec<u8> {
     let mut bytes = Vec::new();
-    ktree::with_dim!(rays, AnyRaySet, r => write_ktree_v2(&mut bytes, &stack(r)).unwrap());
+    ktree::with_dim!(rays, AnyRaySet, r => write_ktree(&mut bytes, &stack(r)).unwrap());
     bytes
 }
 

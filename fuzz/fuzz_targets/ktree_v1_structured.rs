@@ -4,7 +4,8 @@
 //! the file of the tree it reads as.
 #![no_main]
 use arbitrary::Arbitrary;
-use ktree::io::{read_ktree_any, AnyTree};
+use ktree::io::{read_ktree_any};
+use ktree::{AnyTree};
 use ktree::KTree;
 use libfuzzer_sys::fuzz_target;
 

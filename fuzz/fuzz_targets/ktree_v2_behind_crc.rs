@@ -7,7 +7,8 @@
 //! both views alike (same offset, same kind), or is exactly the file of the tree it reads as.
 #![no_main]
 use arbitrary::Arbitrary;
-use ktree::io::{read_ktree_any, AnyTree, KtreeView};
+use ktree::io::{read_ktree_any, KtreeView};
+use ktree::{AnyTree};
 use libfuzzer_sys::fuzz_target;
 
 #[derive(Debug, Arbitrary)]

@@ -3,7 +3,8 @@
 //! the same tree; then any file (version 1 or 2) that reads is written in version 2 and read back unchanged.
 #![no_main]
 use arbitrary::Arbitrary;
-use ktree::io::{read_ktree_any, AnyTree, KtreeView};
+use ktree::io::{read_ktree_any, KtreeView};
+use ktree::{AnyTree};
 use libfuzzer_sys::fuzz_target;
 
 #[derive(Debug, Arbitrary)]

@@ -6,7 +6,7 @@
 //! that placement, and read back as the same tree.
 #![no_main]
 use arbitrary::Arbitrary;
-use ktree::io::{read_bt, write_bt, GridPlacement, BT_DEPTH};
+use ktree::io::{read_bt, write_bt, BT_DEPTH, GridPlacement};
 use libfuzzer_sys::fuzz_target;
 
 #[derive(Debug, Arbitrary)]

@@ -3,10 +3,8 @@
 use std::path::Path;
 
 use arbitrary::Arbitrary;
-use ktree::io::{
-    read_ktree_any, read_rays, write_ktree_v1, write_ktree_v2, write_rays, AnyRaySet, AnyTree,
-    KtreeFileError, KtreeView,
-};
+use ktree::io::{read_ktree_any, read_rays, write_ktree, write_ktree_v1, write_rays, KtreeFileError, KtreeView};
+use ktree::{AnyRaySet, AnyTree};
 use ktree::solid::mesh::{Placement, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
 use ktree::{max_level, KTree, Universe};
@@ -24,7 +22,7 @@ pub fn ktree_bytes(tree: &AnyTree) -> Vec<u8> {
 /// The `.ktree` version 2 bytes of a tree.
 pub fn ktree_v2_bytes(tree: &AnyTree) -> Vec<u8> {
     let mut bytes = Vec::new();
-    ktree::with_dim!(tree, AnyTree, t => write_ktree_v2(&mut bytes, t)).expect("writing to memory");
+    ktree::with_dim!(tree, AnyTree, t => write_ktree(&mut bytes, t)).expect("writing to memory");
     bytes
 }
 

@@ -12,7 +12,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::common::{fit_line, font_available, LineFit};
-use ktree::io::write_atomic;
+use ktree::fs::write_atomic;
 use ktree::rays::{maximal_rows, RaySet};
 use ktree::solid::{Frame, Quadric, Rational, Sample};
 use ktree::Ray;

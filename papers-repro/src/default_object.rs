@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use ktree::io::write_atomic;
+use ktree::fs::write_atomic;
 use ktree::rays::ball_rays;
 use ktree::stacking::stack_with_stats;
 

@@ -9,11 +9,11 @@ use std::ffi::CString;
 use std::path::PathBuf;
 
 use ktree::display::{self, HiddenLineMethod, RenderOptions, ISO_TOWARD_EYE};
-use ktree::io::AnyTree;
 use ktree::ops::{self, BoolOp};
 use ktree::solid::mesh::{Placement, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
 use ktree::space::{Universe, DENSE_LIMIT};
+use ktree::AnyTree;
 use ktree::{with_dim, KTree};
 use numpy::ndarray::{Array3, ArrayD, ArrayViewD, IxDyn, ShapeBuilder};
 use numpy::{
@@ -414,8 +414,7 @@ impl Tree {
     fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
         let bytes = py.detach(|| {
             let mut out = Vec::new();
-            with_dim!(&self.inner, AnyTree, t => ktree::io::write_ktree_v2(&mut out, t))
-                .map(|()| out)
+            with_dim!(&self.inner, AnyTree, t => ktree::io::write_ktree(&mut out, t)).map(|()| out)
         });
         let bytes = bytes.map_err(Failure::value)?;
         Ok(PyBytes::new(py, &bytes))

@@ -166,7 +166,8 @@ fn format_of(path: &Path) -> Result<Format, IoError> {
 /// Reads a tree from a file of any format, chosen by extension.
 ///
 /// ```
-/// use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions, AnyTree};
+/// use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions};
+/// use ktree::AnyTree;
 /// let dir = tempfile::tempdir().unwrap();
 /// let tree = AnyTree::K3(ktree::stacking::stack(&ktree::rays::ball_rays::<3>(4, [8, 8, 8], 6).unwrap()));
 /// for name in ["ball.ktree", "ball.rays", "ball.binvox", "ball.bt", "ball.vdb"] {

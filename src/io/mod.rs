@@ -41,7 +41,6 @@ pub use interop::{
     GridFileErrorKind, GridMeta, GridPlacement, PlacedTree, BINVOX_MAX_DIM, BT_DEPTH, BT_HEADER,
 };
 pub use ktree::v1::write_ktree_v1;
-pub use ktree::v2::{write_ktree_v2, write_ktree_v2_file};
 pub use ktree::{
     ktree_file_version, read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file,
     KtreeFileError, KtreeFileErrorKind, KtreeView, KtreeWriter, MappedTree, MAGIC, VERSION,
@@ -50,8 +49,3 @@ pub use rays::{
     open_rays_file, read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source,
     AnyRaysFileSource, RaysFile, RaysFileSource, RaysTextError, RaysTextErrorKind,
 };
-
-// The types that moved out of `io` keep this path while code is migrated to theirs.
-pub use crate::fs::{write_atomic, write_atomic_with};
-pub use crate::rays::AnyRaySet;
-pub use crate::tree::{AnyTree, TreeStats};

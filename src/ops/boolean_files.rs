@@ -27,10 +27,10 @@
 //! let (pa, pb, pc) = (dir.path().join("a.ktree"), dir.path().join("b.ktree"), dir.path().join("c.ktree"));
 //! let a = KTree::<2>::from_dense(2, &[true; 16]).unwrap();
 //! let b = KTree::<2>::from_dense(2, &(0..16).map(|i| i % 3 == 0).collect::<Vec<_>>()).unwrap();
-//! io::write_ktree_v2_file(&pa, &a).unwrap();
-//! io::write_ktree_v2_file(&pb, &b).unwrap();
+//! io::write_ktree_file(&pa, &a).unwrap();
+//! io::write_ktree_file(&pb, &b).unwrap();
 //! ops::boolean_files(&pa, &pb, ops::BoolOp::Difference, &pc, None).unwrap();
-//! assert_eq!(io::read_ktree_file(&pc).unwrap(), io::AnyTree::K2(ops::difference(&a, &b).unwrap()));
+//! assert_eq!(io::read_ktree_file(&pc).unwrap(), ktree::AnyTree::K2(ops::difference(&a, &b).unwrap()));
 //! ```
 
 use std::fs::File;
@@ -126,7 +126,7 @@ pub enum ViewOperation<'a> {
 /// Writes `a op b` to the `.ktree` version 2 file `out`, reading the version 2 files `a` and `b` through
 /// their memory maps, in bounded memory (see the module's notes). Spill files go to a hidden folder in
 /// `temp_dir` (default: the output's folder), removed at the end. The bytes are those of
-/// [`write_ktree_v2`](crate::io::write_ktree_v2) of [`boolean`](super::boolean) of the trees.
+/// [`write_ktree`](crate::io::write_ktree) of [`boolean`](super::boolean) of the trees.
 ///
 /// # Errors
 /// [`BooleanFileError`]; the target is then untouched.
@@ -163,10 +163,10 @@ pub fn complement_file(
 /// let dir = tempfile::tempdir().unwrap();
 /// let (pa, pc) = (dir.path().join("a.ktree"), dir.path().join("c.ktree"));
 /// let a = KTree::<1>::from_dense(2, &[true, false, false, true]).unwrap();
-/// io::write_ktree_v2_file(&pa, &a).unwrap();
+/// io::write_ktree_file(&pa, &a).unwrap();
 /// let view = io::KtreeView::open(&pa).unwrap();
 /// ops::boolean_views(&view, ops::ViewOperation::Complement, &pc, None).unwrap();
-/// assert_eq!(io::read_ktree_file(&pc).unwrap(), io::AnyTree::K1(ops::complement(&a)));
+/// assert_eq!(io::read_ktree_file(&pc).unwrap(), ktree::AnyTree::K1(ops::complement(&a)));
 /// ```
 ///
 /// # Errors
@@ -403,7 +403,7 @@ impl SpillLevels {
             }
         }
         let mut counts = Vec::new();
-        crate::io::write_atomic_with(out, |w| {
+        crate::fs::write_atomic_with(out, |w| {
             let mut writer = KtreeWriter::new(BufWriter::with_capacity(BUFFER_BYTES, w), k, level)?;
             writer.push(root)?;
             writer.end_level()?;

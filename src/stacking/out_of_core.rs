@@ -11,7 +11,7 @@
 //! concatenation, in Morton order of the cells, of the subtrees' levels `j` read back from spill file `j`
 //! (the writer shifts each piece into place). The file goes to a temporary file renamed over the target
 //! ([`write_atomic_with`]), so the bytes are exactly those of the tree built in memory and written by
-//! [`write_ktree_v2`](crate::io::write_ktree_v2), for any number of threads.
+//! [`write_ktree`](crate::io::write_ktree), for any number of threads.
 //!
 //! # In parts
 //! The two phases also run apart, as the ranks of a distributed run do: [`stack_part`] stacks some of the
@@ -55,7 +55,7 @@
 //! let out = dir.path().join("ball.ktree");
 //! let report = stack_to_file(&source, &out, &OutOfCore::new(2, 1 << 30), &|_| {}).unwrap();
 //! let tree = stack_source(&source, 2).unwrap();
-//! assert_eq!(ktree::io::read_ktree_file(&out).unwrap(), ktree::io::AnyTree::K3(tree.clone()));
+//! assert_eq!(ktree::io::read_ktree_file(&out).unwrap(), ktree::AnyTree::K3(tree.clone()));
 //! assert_eq!(report.counts_per_level, tree.counts_per_level());
 //! ```
 
@@ -71,7 +71,8 @@ use rayon::prelude::*;
 use super::cells::{CellBlock, CellStates};
 use super::partition::{slab_pieces, Piece, RaySource};
 
-use crate::io::{write_atomic_with, KtreeWriter};
+use crate::fs::write_atomic_with;
+use crate::io::KtreeWriter;
 use crate::tree::{LevelCounts, NodeState};
 
 /// Bytes accounted for each run of a slab being stacked: the runs and their copies while they are cut
@@ -252,7 +253,7 @@ enum SlabOutcome<const K: usize> {
 /// Builds the tree of `source` from its cells of depth `options.depth` and writes it to `out` as a
 /// `.ktree` version 2 file, in the memory budget `options.max_memory`, on the threads of the current rayon
 /// pool; `progress` is called (on the calling thread) as slabs are stacked and levels written. The file
-/// is byte for byte the one [`write_ktree_v2_file`](crate::io::write_ktree_v2_file) writes for the tree
+/// is byte for byte the one [`write_ktree_file`](crate::io::write_ktree_file) writes for the tree
 /// [`stack_source`](super::stack_source) builds. It is [`stack_part`] of every slab of
 /// [`build_slabs`] followed by [`SpilledPart::write`].
 ///

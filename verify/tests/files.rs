@@ -4,8 +4,9 @@
 use ktree_verify::cases;
 
 use cases::{ray_sets, Case};
-use ktree::io::{read_ktree, read_ktree_any, read_rays, write_ktree_v1, write_rays, AnyRaySet};
+use ktree::io::{read_ktree, read_ktree_any, read_rays, write_ktree_v1, write_rays};
 use ktree::stacking::stack;
+use ktree::AnyRaySet;
 use proptest::prelude::*;
 
 fn round_trips<const K: usize>(

@@ -7,8 +7,8 @@ use ktree_verify::cases;
 
 use cases::{ray_sets, Case};
 use ktree::io::{
-    read_ktree, read_ktree_any, read_ktree_file, write_ktree_v1, write_ktree_v2,
-    write_ktree_v2_file, KtreeFileErrorKind, KtreeView, KtreeWriter,
+    read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file, write_ktree_v1,
+    KtreeFileErrorKind, KtreeView, KtreeWriter,
 };
 use ktree::stacking::stack;
 use ktree::tree::PackedStates;
@@ -17,7 +17,7 @@ use proptest::prelude::*;
 
 fn v2_bytes<const K: usize>(tree: &KTree<K>) -> Vec<u8> {
     let mut bytes = Vec::new();
-    write_ktree_v2(&mut bytes, tree).unwrap();
+    write_ktree(&mut bytes, tree).unwrap();
     bytes
 }
 
@@ -30,7 +30,7 @@ fn round_trips<const K: usize>(case: &Case<K>, cuts: &[usize]) -> Result<(), Tes
     // Through a file and its memory map.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("t.ktree");
-    write_ktree_v2_file(&path, &tree).unwrap();
+    write_ktree_file(&path, &tree).unwrap();
     prop_assert_eq!(std::fs::read(&path).unwrap(), bytes.clone());
     let view = KtreeView::open(&path).map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert!(view.is_mapped());

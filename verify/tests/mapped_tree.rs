@@ -2,7 +2,7 @@
 //! gives: the same leaves in K = 1 … 4, the same view-order walk and the same rendered image.
 
 use ktree::display::{default_camera, render, RenderOptions, ISO_TOWARD_EYE};
-use ktree::io::{write_ktree_v2, KtreeView, MappedTree};
+use ktree::io::{write_ktree, KtreeView, MappedTree};
 use ktree::rays::ball_rays;
 use ktree::stacking::stack;
 use ktree::tree::cursor::LevelOrder;
@@ -12,7 +12,7 @@ use proptest::prelude::*;
 
 fn view_of<const K: usize>(tree: &KTree<K>) -> KtreeView {
     let mut bytes = Vec::new();
-    write_ktree_v2(&mut bytes, tree).unwrap();
+    write_ktree(&mut bytes, tree).unwrap();
     KtreeView::from_bytes(bytes, "mem").unwrap()
 }
 

@@ -6,9 +6,10 @@
 
 use ktree_verify::sparse;
 
-use ktree::io::{read_ktree, read_rays, write_ktree, write_rays, AnyRaySet};
+use ktree::io::{read_ktree, read_rays, write_ktree, write_rays};
 use ktree::ops::{self, AxisMap, BoolOp};
 use ktree::stacking::stack;
+use ktree::AnyRaySet;
 use ktree::{KTree, RaySet};
 use proptest::prelude::*;
 use sparse::{boxes, point, union_volume, Boxes, Cuboid};

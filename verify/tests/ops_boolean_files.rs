@@ -4,17 +4,18 @@
 
 use std::path::Path;
 
-use ktree::io::{read_ktree_file, write_ktree_v2, write_ktree_v2_file, AnyTree, KtreeView};
+use ktree::io::{read_ktree_file, write_ktree, write_ktree_file, KtreeView};
 use ktree::ops::{self, BoolOp, BooleanFileError, ViewOperation};
 use ktree::rays::ball_rays;
 use ktree::stacking::stack;
+use ktree::AnyTree;
 use ktree::KTree;
 use ktree_verify::objects::pair;
 use proptest::prelude::*;
 
 fn v2_bytes<const K: usize>(tree: &KTree<K>) -> Vec<u8> {
     let mut bytes = Vec::new();
-    write_ktree_v2(&mut bytes, tree).unwrap();
+    write_ktree(&mut bytes, tree).unwrap();
     bytes
 }
 
@@ -25,8 +26,8 @@ fn check_streamed<const K: usize>(a: &KTree<K>, b: &KTree<K>, dir: &Path) {
         dir.join("b.ktree"),
         dir.join("c.ktree"),
     );
-    write_ktree_v2_file(&pa, a).unwrap();
-    write_ktree_v2_file(&pb, b).unwrap();
+    write_ktree_file(&pa, a).unwrap();
+    write_ktree_file(&pb, b).unwrap();
     for op in BoolOp::ALL {
         let report = ops::boolean_files(&pa, &pb, op, &out, None).unwrap();
         let expect = ops::boolean(a, b, op).unwrap();
@@ -53,8 +54,8 @@ where
         dir.join("b.ktree"),
         dir.join("c.ktree"),
     );
-    write_ktree_v2_file(&pa, a).unwrap();
-    write_ktree_v2_file(&pb, b).unwrap();
+    write_ktree_file(&pa, a).unwrap();
+    write_ktree_file(&pb, b).unwrap();
     let (va, vb) = (KtreeView::open(&pa).unwrap(), KtreeView::open(&pb).unwrap());
     let read = |path: &Path| read_ktree_file(path).unwrap();
     for op in BoolOp::ALL {
@@ -131,8 +132,8 @@ fn mismatched_inputs_are_an_error_and_leave_the_target() {
         dir.path().join("b.ktree"),
         dir.path().join("c.ktree"),
     );
-    write_ktree_v2_file(&pa, &KTree::<3>::full(3).unwrap()).unwrap();
-    write_ktree_v2_file(&pb, &KTree::<3>::full(4).unwrap()).unwrap();
+    write_ktree_file(&pa, &KTree::<3>::full(3).unwrap()).unwrap();
+    write_ktree_file(&pb, &KTree::<3>::full(4).unwrap()).unwrap();
     std::fs::write(&out, b"keep").unwrap();
     let e = ops::boolean_files(&pa, &pb, BoolOp::Union, &out, None).unwrap_err();
     assert!(matches!(e, BooleanFileError::Mismatch { .. }), "{e}");

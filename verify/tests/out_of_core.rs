@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use ktree::io::write_ktree_v2;
+use ktree::io::write_ktree;
 use ktree::reference::{Dim, Fanout, NaiveTree};
 use ktree::stacking::{
     balanced_parts, build_slabs, slab_cost, stack, stack_part, stack_to_file, OutOfCore,
@@ -22,7 +22,7 @@ use proptest::prelude::*;
 /// The bytes the in-memory build writes.
 fn in_memory_bytes<const K: usize>(rays: &RaySet<K>) -> Vec<u8> {
     let mut bytes = Vec::new();
-    write_ktree_v2(&mut bytes, &stack(rays)).unwrap();
+    write_ktree(&mut bytes, &stack(rays)).unwrap();
     bytes
 }
 
@@ -508,7 +508,7 @@ fn a_solid_interior_does_not_fill_the_budget() {
             .unwrap_or_else(|e| panic!("K = {K}, L = {level}: {e}"));
         assert!(report.peak_accounted_bytes <= budget);
         let mut expected = Vec::new();
-        write_ktree_v2(&mut expected, &tree).unwrap();
+        write_ktree(&mut expected, &tree).unwrap();
         assert!(
             std::fs::read(&out).unwrap() == expected,
             "K = {K}: the file differs"

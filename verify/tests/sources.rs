@@ -4,12 +4,13 @@
 //! from the whole set (random small meshes, volumes and ray files, and the meshes and volumes of data/).
 
 use ktree::io::{
-    open_rays_file, read_rays_file, write_ktree_v2, write_rays, write_rays_file, AnyRaySet,
-    AnyRaysFileSource, RaysFile, RaysFileSource,
+    open_rays_file, read_rays_file, write_ktree, write_rays, write_rays_file, AnyRaysFileSource,
+    RaysFile, RaysFileSource,
 };
 use ktree::solid::mesh::{MeshSource, Placement, TriangleMesh};
 use ktree::solid::volume::{Select, Volume, VolumeSource};
 use ktree::stacking::{stack, stack_to_file, OutOfCore, RaySource};
+use ktree::AnyRaySet;
 use ktree::{Ray, RaySet};
 use ktree_verify::cases::{self, ray_sets, Case};
 use proptest::prelude::*;
@@ -59,7 +60,7 @@ where
     S::Error: std::fmt::Display,
 {
     let mut expected = Vec::new();
-    write_ktree_v2(&mut expected, &stack(whole)).unwrap();
+    write_ktree(&mut expected, &stack(whole)).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tree.ktree");
     for depth in depths {

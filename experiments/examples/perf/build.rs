@@ -134,6 +134,6 @@ pub fn report() -> Result<String, String> {
          (U^3 voxels in memory)."
     );
     let path = results_path("build");
-    ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
+    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
 }

@@ -115,7 +115,7 @@ pub fn report(args: &[String]) -> Result<String, String> {
         list(&within_spread)
     );
     let path = results_path("compare");
-    ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
+    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
 }
 

@@ -188,6 +188,6 @@ pub fn report() -> Result<String, String> {
         last.0 / last.1
     );
     let path = results_path("display");
-    ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
+    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
 }

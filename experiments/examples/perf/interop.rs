@@ -8,12 +8,11 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use ktree::io::{
-    read_tree, voxelize, write_ktree_v2_file, write_tree, AnyTree, ReadOptions, WriteOptions,
-};
+use ktree::io::{read_tree, voxelize, write_ktree_file, write_tree, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
 use ktree::solid::volume::Select;
 use ktree::stacking::stack;
+use ktree::AnyTree;
 
 const LEVEL: u32 = 8;
 
@@ -101,7 +100,7 @@ pub fn report() -> Result<String, String> {
             .iter()
             .map(|f| dir.path().join(f))
             .collect();
-        write_ktree_v2_file(&paths[0], t).map_err(|e| e.to_string())?;
+        write_ktree_file(&paths[0], t).map_err(|e| e.to_string())?;
         for p in &paths[1..] {
             write_tree(p, &tree, &WriteOptions::default()).map_err(|e| e.to_string())?;
         }
@@ -148,7 +147,7 @@ pub fn report() -> Result<String, String> {
         );
     }
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/interop.md");
-    ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
+    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok("results/interop.md".into())
 }
 

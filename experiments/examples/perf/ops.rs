@@ -286,7 +286,7 @@ pub fn report() -> Result<String, String> {
          than the Booleans."
     );
     let path = results_path("ops");
-    ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
+    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
 }
 

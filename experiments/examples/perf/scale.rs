@@ -281,6 +281,6 @@ pub fn report() -> Result<String, String> {
         );
     }
     let path = results_path("scale");
-    ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
+    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
 }

@@ -198,6 +198,6 @@ pub fn report() -> Result<String, String> {
          measured here). `?` marks facts a case does not report."
     );
     let path = results_path("solids");
-    ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
+    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
 }

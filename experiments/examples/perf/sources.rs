@@ -9,13 +9,15 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use ktree::fs::write_atomic_with;
 use ktree::io::{
-    open_rays_file, read_rays_file, voxel_source, voxelize, write_atomic_with, write_rays_source,
-    AnyRaySet, AnyRaysFileSource, RaysFile, ReadOptions,
+    open_rays_file, read_rays_file, voxel_source, voxelize, write_rays_source, AnyRaysFileSource,
+    RaysFile, ReadOptions,
 };
 use ktree::solid::volume::Select;
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
 use ktree::stacking::{default_split_depth, stack_to_file, OutOfCore, RaySource};
+use ktree::AnyRaySet;
 
 use crate::measure::{machine_line, results_path, run_child};
 
@@ -233,6 +235,6 @@ pub fn report() -> Result<String, String> {
         );
     }
     let path = results_path("sources");
-    ktree::io::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
+    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
 }

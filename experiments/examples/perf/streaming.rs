@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 
-use ktree::io::{read_ktree_file, write_ktree_v2_file, AnyTree};
+use ktree::io::{read_ktree_file, write_ktree_file};
 use ktree::ops::{self, BoolOp};
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
 use ktree::stacking::{default_split_depth, stack_to_file, OutOfCore};
+use ktree::AnyTree;
 use ktree::LevelCounts;
 
 use crate::measure::{machine_line, results_path, run_child, Measured};
@@ -113,7 +114,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
                 Some(o) => ops::boolean(&ta, &load(&b)?, o).map_err(|e| e.to_string())?,
                 None => ops::complement(&ta),
             };
-            write_ktree_v2_file(&out, &result).map_err(|e| e.to_string())?;
+            write_ktree_file(&out, &result).map_err(|e| e.to_string())?;
             result.counts_per_level()
         }
         "stream" => {

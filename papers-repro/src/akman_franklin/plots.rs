@@ -148,7 +148,7 @@ impl Plot {
             let root = SVGBackend::with_string(&mut text, (900, 600)).into_drawing_area();
             self.draw(root, crate::common::font_available())?;
         }
-        ktree::io::write_atomic(&svg, text.as_bytes()).map_err(|e| e.to_string())?;
+        ktree::fs::write_atomic(&svg, text.as_bytes()).map_err(|e| e.to_string())?;
         let mut pixels = vec![0u8; 900 * 600 * 3];
         {
             let root = BitMapBackend::with_buffer(&mut pixels, (900, 600)).into_drawing_area();

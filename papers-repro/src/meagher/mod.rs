@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use ktree::io::write_atomic;
+use ktree::fs::write_atomic;
 
 /// Largest sphere level of the timing study.
 pub const TIMING_MAX_LEVEL: u32 = 9;

@@ -14,7 +14,7 @@ use ktree::display::{
     default_camera, line_drawing, png, render, svg, HiddenLineMethod, LineDrawing, RenderOptions,
     ISO_TOWARD_EYE,
 };
-use ktree::io::write_atomic;
+use ktree::fs::write_atomic;
 use ktree::stacking::stack;
 use ktree::tree::Octree;
 

@@ -125,7 +125,7 @@ impl std::error::Error for KtreeFileError {
 /// # Errors
 /// Any I/O error.
 pub fn write_ktree<const K: usize>(out: impl Write, tree: &KTree<K>) -> std::io::Result<()> {
-    v2::write_ktree_v2(out, tree)
+    v2::write_levels(out, tree)
 }
 
 /// Writes a `.ktree` file of the current version atomically (temporary file, then rename).

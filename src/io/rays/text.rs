@@ -107,7 +107,8 @@ impl std::error::Error for RaysTextError {
 /// Reads a ray file into a ray set of the dimension its header names.
 ///
 /// ```
-/// use ktree::io::{read_rays, AnyRaySet};
+/// use ktree::io::read_rays;
+/// use ktree::AnyRaySet;
 /// let text = "# ktree rays v1\n2 3\n1 0 4\n1 3 6\n";
 /// let AnyRaySet::K2(rays) = read_rays(text.as_bytes(), "example").unwrap() else { panic!() };
 /// assert_eq!(rays.len(), 1); // [0,4) and [3,6) merged

@@ -17,7 +17,7 @@ use std::sync::OnceLock;
 /// let tree = KTree::<2>::from_dense(2, &(0..16).map(|i| i % 3 == 0).collect::<Vec<_>>()).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("t.ktree");
-/// io::write_ktree_v2_file(&path, &tree).unwrap();
+/// io::write_ktree_file(&path, &tree).unwrap();
 /// let view = io::KtreeView::open(&path).unwrap();
 /// let mapped = io::MappedTree::<2>::new(&view).unwrap();
 /// let mut leaves = Vec::new();

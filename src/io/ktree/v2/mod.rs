@@ -13,7 +13,8 @@ pub use layout::VERSION;
 pub use mapped::MappedTree;
 pub(crate) use view::read_at;
 pub use view::KtreeView;
-pub use writer::{write_ktree_v2, write_ktree_v2_file, KtreeWriter};
+pub(crate) use writer::write_levels;
+pub use writer::KtreeWriter;
 
 #[cfg(test)]
 mod tests {
@@ -27,7 +28,7 @@ mod tests {
     fn sample() -> (KTree<3>, Vec<u8>) {
         let tree = stack(&ball_rays::<3>(4, [10, 12, 14], 9).unwrap());
         let mut bytes = Vec::new();
-        write_ktree_v2(&mut bytes, &tree).unwrap();
+        write_levels(&mut bytes, &tree).unwrap();
         (tree, bytes)
     }
 

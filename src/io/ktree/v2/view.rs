@@ -31,7 +31,7 @@ enum Backing {
 /// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("t.ktree");
-/// io::write_ktree_v2_file(&path, &tree).unwrap();
+/// io::write_ktree_file(&path, &tree).unwrap();
 /// let view = io::KtreeView::open(&path).unwrap();
 /// assert_eq!(view.counts(), tree.counts());
 /// assert!(view.contains([0u32, 0]).unwrap() && !view.contains([1u32, 0]).unwrap());

@@ -1,7 +1,6 @@
 //! [`KtreeWriter`]: a version 2 file written level by level, in one pass, without holding the tree.
 
 use std::io::Write;
-use std::path::Path;
 
 use super::layout::*;
 use crate::space::{max_level, MAX_K};
@@ -251,31 +250,15 @@ impl<W: Write> KtreeWriter<W> {
     }
 }
 
-/// Writes a tree as a `.ktree` version 2 file.
-///
-/// ```
-/// use ktree::{io, KTree};
-/// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
-/// let mut bytes = Vec::new();
-/// io::write_ktree_v2(&mut bytes, &tree).unwrap();
-/// assert_eq!(io::read_ktree::<2>(&bytes, "mem").unwrap(), tree);
-/// ```
-///
-/// # Errors
-/// Any I/O error.
-pub fn write_ktree_v2<const K: usize>(out: impl Write, tree: &KTree<K>) -> std::io::Result<()> {
+/// Writes a tree as a version 2 file, level by level ([`write_ktree`](crate::io::write_ktree) calls it).
+pub(crate) fn write_levels<const K: usize>(
+    out: impl Write,
+    tree: &KTree<K>,
+) -> std::io::Result<()> {
     let mut w = KtreeWriter::new(out, K, tree.level())?;
     for d in 0..tree.depth_count() {
         w.append_states(tree.level_states(d))?;
         w.end_level()?;
     }
     w.finish().map(drop)
-}
-
-/// Writes a `.ktree` version 2 file atomically (temporary file, then rename).
-///
-/// # Errors
-/// Any I/O error, naming the path.
-pub fn write_ktree_v2_file<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
-    crate::fs::write_atomic_with(path, |w| write_ktree_v2(w, tree))
 }
