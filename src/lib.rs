@@ -18,10 +18,27 @@
 //! * [`reference`](mod@reference): the reference builders the tests compare against (naive insertion, dense pyramid).
 //! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
-//! * [`io`]: the ray text format and the `.ktree` file format.
+//! * [`io`]: files, one module per format — `.ktree` (version 2 written, streamed and memory-mapped; version 1
+//!   read), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb`.
+//! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
 //! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
+//!
+//! # Layers
+//! Each layer imports only those below it, with the exceptions listed after the picture:
+//! ```text
+//!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text;
+//!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in)
+//!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink
+//!  stacking/          the builders (the paper's list stacking; the partition, in memory or out of core)
+//!  solid/             quadrics, meshes, volumes → rays, slab by slab
+//!  tree/              KTree, AnyTree, the storage trait, the walks, the level sink, packed 2-bit words
+//!  rays/   space   fs (atomic writes, spill folders)
+//! ```
+//! Not yet so: `KTree::from_rays` calls the builder (tree → stacking); the ray sources of `solid/` implement
+//! `stacking::RaySource` (solid → stacking); the out-of-core builder and the streamed Booleans write their
+//! output through `io::KtreeWriter` and read their inputs through `io::KtreeView` (stacking, ops → io).
 //!
 //! # Example
 //! ```
