@@ -656,7 +656,7 @@ def test_calls_from_threads_agree_with_serial_calls(rng):
 
 
 @pytest.mark.parametrize(
-    "name", ["missing.ktree", "missing.rays", "missing.vdb", "missing.bt", "missing.binvox", "missing.obj"]
+    "name", ["missing.ktree", "missing.rays", "missing.vdb", "missing.bt", "missing.binvox", "missing.obj", "missing.nii"]
 )
 def test_a_missing_file_raises_file_not_found_with_its_name(tmp_path, name):
     path = tmp_path / name

@@ -273,6 +273,17 @@ pub fn voxelize(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError
     }
 }
 
+/// A missing or unreadable input is said as such (an I/O error) before any option is asked for.
+#[cfg(any(feature = "mesh", feature = "volume"))]
+fn readable(path: &Path) -> Result<(), SolidError> {
+    std::fs::File::open(path)
+        .map(drop)
+        .map_err(|source| SolidError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+}
+
 #[cfg(any(feature = "mesh", feature = "volume"))]
 fn solid_error(path: &Path) -> impl Fn(SolidError) -> IoError + '_ {
     move |source| IoError::Solid {
@@ -422,6 +433,7 @@ fn mesh_input(
 > {
     use crate::solid::mesh::{Placement, TriangleMesh};
     let solid = solid_error(path);
+    readable(path).map_err(&solid)?;
     let level = options
         .level
         .ok_or_else(|| usage(path, "a mesh needs a universe level"))?;
@@ -468,6 +480,7 @@ fn volume_input(
 > {
     use crate::solid::volume::Volume;
     let solid = solid_error(path);
+    readable(path).map_err(&solid)?;
     let select = options
         .select
         .ok_or_else(|| usage(path, "a volume needs a threshold or a label"))?;
