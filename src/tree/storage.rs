@@ -27,6 +27,29 @@ use super::states::NodeState;
 use super::words::slots_mask;
 use crate::space::Universe;
 
+/// The `n ≤ 32` states from node `first`, gathered from the blocks of `2^K` siblings that cover them
+/// (`block(at)` reads the block starting at node `at`): the default of both storages' `slots`.
+fn slots_from_blocks<const K: usize, E>(
+    first: usize,
+    n: usize,
+    mut block: impl FnMut(usize) -> Result<u32, E>,
+) -> Result<u64, E> {
+    let fanout = 1usize << K;
+    let mut word = 0u64;
+    let mut at = first - first % fanout;
+    while at < first + n {
+        let codes = u64::from(block(at)?);
+        let shift = 2 * (at as i64 - first as i64);
+        word |= if shift >= 0 {
+            codes << shift
+        } else {
+            codes >> -shift
+        };
+        at += fanout;
+    }
+    Ok(word & slots_mask(n))
+}
+
 /// A `K`-dimensional tree stored in level order, read one block of siblings at a time. Reads may fail
 /// (a file changed underneath): every read returns `Result<_, Self::Error>`.
 ///
@@ -68,20 +91,7 @@ pub trait TreeStorage<const K: usize> {
     /// # Errors
     /// The storage's read error, for instance when the range is not in the level.
     fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, Self::Error> {
-        let fanout = 1usize << K;
-        let mut word = 0u64;
-        let mut at = first - first % fanout;
-        while at < first + n {
-            let codes = u64::from(self.block_codes(depth, at)?);
-            let shift = 2 * (at as i64 - first as i64);
-            word |= if shift >= 0 {
-                codes << shift
-            } else {
-                codes >> -shift
-            };
-            at += fanout;
-        }
-        Ok(word & slots_mask(n))
+        slots_from_blocks::<K, _>(first, n, |at| self.block_codes(depth, at))
     }
 
     /// The universe level `L`.
@@ -136,20 +146,9 @@ pub trait LevelOrder<const K: usize> {
 
     /// As [`TreeStorage::slots`] (`depth ≥ 1`); the default reads the blocks of siblings the range covers.
     fn slots(&self, depth: usize, first: usize, n: usize) -> u64 {
-        let fanout = 1usize << K;
-        let mut word = 0u64;
-        let mut at = first - first % fanout;
-        while at < first + n {
-            let codes = u64::from(self.block_codes(depth, at));
-            let shift = 2 * (at as i64 - first as i64);
-            word |= if shift >= 0 {
-                codes << shift
-            } else {
-                codes >> -shift
-            };
-            at += fanout;
-        }
-        word & slots_mask(n)
+        infallible(slots_from_blocks::<K, _>(first, n, |at| {
+            Ok(self.block_codes(depth, at))
+        }))
     }
 
     /// The universe level `L`.

@@ -276,16 +276,7 @@ impl Layout {
     }
 
     pub(crate) fn counts_per_level(&self) -> Vec<LevelCounts> {
-        self.sections
-            .iter()
-            .enumerate()
-            .map(|(d, s)| LevelCounts {
-                level: d as u32,
-                full: s.full,
-                empty: s.nodes - s.full - s.partial,
-                partial: s.partial,
-            })
-            .collect()
+        counts_of(&self.sections)
     }
 }
 
@@ -294,4 +285,18 @@ pub(crate) fn layout_of_bytes(bytes: &[u8], file: &str) -> Result<Layout, KtreeF
     Layout::parse(file, &bytes[..bytes.len().min(HEADER_BYTES)], len, |n| {
         Ok(bytes[bytes.len() - n..].to_vec())
     })
+}
+
+/// The node counts of directory entries, one per level from the root (`level` = depth).
+pub(crate) fn counts_of(sections: &[Section]) -> Vec<LevelCounts> {
+    sections
+        .iter()
+        .enumerate()
+        .map(|(d, s)| LevelCounts {
+            level: d as u32,
+            full: s.full,
+            empty: s.nodes - s.full - s.partial,
+            partial: s.partial,
+        })
+        .collect()
 }

@@ -197,16 +197,7 @@ impl<W: Write> KtreeWriter<W> {
 
     /// The node counts of the levels closed so far (`level` = depth), as the file's directory will hold them.
     pub fn counts_per_level(&self) -> Vec<LevelCounts> {
-        self.finished
-            .iter()
-            .enumerate()
-            .map(|(d, s)| LevelCounts {
-                level: d as u32,
-                full: s.full,
-                empty: s.nodes - s.full - s.partial,
-                partial: s.partial,
-            })
-            .collect()
+        counts_of(&self.finished)
     }
 
     /// Closes the last level if nodes were appended to it, writes the directory, and returns the output.
