@@ -6,7 +6,7 @@ use crate::outln;
 use std::path::PathBuf;
 
 use ktree::io::{open_rays_file, read_rays_file, RaysFile, RaysFileSource};
-use ktree::stacking::{default_split_depth, stack_partitioned, RaySource};
+use ktree::stacking::RaySource;
 use ktree::{AnyRaySet, AnyTree};
 use ktree::{KTree, LevelCounts, RaySet};
 
@@ -45,9 +45,9 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> 
         .map_err(|e| format!("cannot start worker threads: {e}"))
 }
 
-/// Stacks rays cell by cell on the current thread pool (see [`ktree::stacking::stack_partitioned`]).
+/// Stacks rays cell by cell on the current thread pool (see [`ktree::stacking::Builder`]).
 pub fn stack_cells<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
-    stack_partitioned(rays, default_split_depth(K, rays.level()))
+    KTree::from_rays(rays)
 }
 
 /// Reads the rays, stacks them, writes the tree, and prints a one-line summary (in a run over several

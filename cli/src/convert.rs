@@ -6,7 +6,7 @@ use crate::outln;
 use std::path::PathBuf;
 
 use ktree::io::{read_tree_placed, write_tree, Format, ReadOptions, WriteOptions};
-use ktree::solid::mesh::Placement;
+use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
 
 /// Arguments of `ktree convert`.
@@ -68,7 +68,7 @@ pub fn run(a: Args) -> Result<(), String> {
         mesh_placement: a
             .transform
             .as_deref()
-            .map(Placement::parse)
+            .map(MeshTransform::parse)
             .transpose()
             .map_err(|e| e.to_string())?,
         select: match (a.threshold, a.label) {

@@ -3,12 +3,12 @@
 //! Started as `mpirun -n P ktree rays|build|voxelize … --out F.ktree`, every rank runs the out-of-core
 //! build of [`ktree::stacking`] on its share of the slabs of cells, in `--max-memory` bytes of its own:
 //!
-//! 1. **Partition.** The slabs of cells (one cell wide along axis 0, [`ktree::stacking::build_slabs`]) are
-//!    measured by their runs ([`ktree::stacking::slab_cost`]: rank `r` measures the slabs `r, r + P, …`, an
+//! 1. **Partition.** The slabs of cells (one cell wide along axis 0, [`ktree::stacking::Builder::slabs`]) are
+//!    measured by their runs ([`ktree::stacking::Builder::slab_cost`]: rank `r` measures the slabs `r, r + P, …`, an
 //!    all-reduce shares the costs) and cut into `P` contiguous ranges of about equal cost
 //!    ([`ktree::stacking::balanced_parts`]).
 //! 2. **Stacking.** Each rank stacks the cells of its slabs and spills their subtrees to files of its own
-//!    ([`ktree::stacking::stack_part`]). A solid makes only the rays of the rank's slabs; a ray file, mesh
+//!    ([`ktree::stacking::Builder::stack_part`]). A solid makes only the rays of the rank's slabs; a ray file, mesh
 //!    or volume is read whole by every rank.
 //! 3. **Index.** Every other rank sends rank 0 the index of its part (the states of its cells of depth `m`,
 //!    and the Morton index and node counts per level of each cell it stacked — as much as the
@@ -160,9 +160,7 @@ mod imp {
 
     use super::{Ranks, STOPPED};
     use crate::memory::BuildArgs;
-    use ktree::stacking::{
-        balanced_parts, build_slabs, slab_cost, stack_part, OutOfCoreReport, RaySource,
-    };
+    use ktree::stacking::{balanced_parts, OutOfCoreReport, RaySource};
 
     /// Keeps MPI initialised; finalises it when dropped.
     pub struct Guard {
@@ -261,15 +259,16 @@ mod imp {
         S::Error: std::fmt::Display,
     {
         let Ranks { rank, size } = ranks();
-        let level = source.universe().level();
         let chunk = chunk_words(budget, size);
         // The message buffers come out of the budget: rank 0 holds one per other rank.
         let held = 8 * chunk as u64 * if rank == 0 { size as u64 - 1 } else { 1 };
-        let options = crate::memory::options::<K>(level, args, budget.saturating_sub(held));
-        let depth = options.depth;
+        let part_budget = budget.saturating_sub(held);
+        let bar = crate::render::progress_bar(args.progress && rank == 0, "stacking");
+        let progress = |p| crate::memory::report_progress(bar.as_ref(), p);
+        let builder = crate::memory::builder(source, args).progress(&progress);
 
         // 1. Partition: the slabs' costs, each rank measuring every P-th slab.
-        let slabs = build_slabs(source, depth);
+        let slabs = builder.slabs();
         let mut costs = vec![0u64; slabs.len()];
         let measured = pool
             .install(|| {
@@ -277,7 +276,7 @@ mod imp {
                     .par_iter()
                     .enumerate()
                     .filter(|(i, _)| i % size == rank)
-                    .map(|(i, &b0)| slab_cost(source, depth, b0).map(|c| (i, c)))
+                    .map(|(i, &b0)| builder.slab_cost(b0).map(|c| (i, c)))
                     .collect::<Result<Vec<_>, _>>()
             })
             .map_err(|e| format!("{}: {e}", out.display()));
@@ -290,10 +289,8 @@ mod imp {
         let mine = balanced_parts(&all, size)[rank].clone();
 
         // 2. Stacking: this rank's slabs, spilled.
-        let bar = crate::render::progress_bar(args.progress && rank == 0, "stacking");
-        let progress = |p| crate::memory::report_progress(bar.as_ref(), p);
         let part = pool
-            .install(|| stack_part(source, &slabs[mine], out, &options, &progress))
+            .install(|| builder.stack_part(&slabs[mine], out, part_budget))
             .map_err(|e| crate::memory::describe(out, e, held));
         let mut part = agree(w, part)?;
 

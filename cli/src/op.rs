@@ -65,25 +65,10 @@ fn print_summary(path: &Path, k: usize, level: u32, counts: &[LevelCounts]) -> R
     Ok(())
 }
 
-/// Pairs two trees of the same dimension, or explains the mismatch.
-macro_rules! with_pair {
-    ($a:expr, $b:expr, $names:expr, ($x:ident, $y:ident) => $body:expr) => {
-        match ($a, $b) {
-            (AnyTree::K1($x), AnyTree::K1($y)) => $body,
-            (AnyTree::K2($x), AnyTree::K2($y)) => $body,
-            (AnyTree::K3($x), AnyTree::K3($y)) => $body,
-            (AnyTree::K4($x), AnyTree::K4($y)) => $body,
-            (x, y) => Err(format!(
-                "{} is a K = {} tree but {} is K = {}: both must have the same dimension",
-                $names.0.display(),
-                x.k(),
-                $names.1.display(),
-                y.k()
-            )),
-        }
-    };
+/// The message for two input trees that cannot be combined.
+pub fn pair_error(a: &Path, b: &Path, e: ops::OpsError) -> String {
+    format!("{} and {}: {e}", a.display(), b.display())
 }
-pub(crate) use with_pair;
 
 /// Checks that the operation fits in the budget: it holds its input trees (about as large in memory as in
 /// their files) and a result at most as large as them together.
@@ -168,8 +153,6 @@ fn run_op(args: Args) -> Result<(), String> {
         .find(|o| o.name() == args.operation)
         .ok_or_else(|| format!("unknown operation {}", args.operation))?;
     let (ta, tb) = (read(a)?, read(b)?);
-    with_pair!(&ta, &tb, (a, b), (x, y) => {
-        let out = ops::boolean(x, y, op).map_err(|e| format!("{} and {}: {e}", a.display(), b.display()))?;
-        write(&args.out, &out)
-    })
+    let out = ta.boolean(&tb, op).map_err(|e| pair_error(a, b, e))?;
+    ktree::with_dim!(&out, AnyTree, t => write(&args.out, t))
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use ktree::fs::write_atomic_with;
 use ktree::io::{write_rays_file, write_rays_source};
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{default_split_depth, stack_source};
+use ktree::stacking::{default_split_depth, Builder};
 use ktree::{LevelCounts, RaySet};
 
 use crate::build::with_threads;
@@ -251,8 +251,7 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
             }
         } else {
             one_process_for_version_1()?;
-            let depth = default_split_depth(K, a.level);
-            let tree = with_threads(a.threads, || stack_source(&source, depth))?
+            let tree = with_threads(a.threads, || Builder::new(&source).build())?
                 .map_err(|e| e.to_string())?;
             crate::tree_file::write(&a.out, &tree)
                 .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 use ktree::display::{
     default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
-    RenderOptions, ISO_TOWARD_EYE,
+    RenderOptions,
 };
 use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, MappedTree};
 use ktree::tree::cursor::LevelOrder;
@@ -94,28 +94,11 @@ pub fn parse_vec3(s: &str, what: &str) -> Result<[f64; 3], String> {
     Ok(v)
 }
 
-/// A named view or a direction `X,Y,Z`, from the object towards the eye.
+/// A named view or a direction `X,Y,Z`, from the object towards the eye ([`ktree::display::View`]).
 pub fn parse_view(s: &str) -> Result<[f64; 3], String> {
-    Ok(match s {
-        "iso" => ISO_TOWARD_EYE,
-        "top" => [0.0, 0.0, 1.0],
-        "bottom" => [0.0, 0.0, -1.0],
-        "front" => [0.0, -1.0, 0.0],
-        "back" => [0.0, 1.0, 0.0],
-        "right" => [1.0, 0.0, 0.0],
-        "left" => [-1.0, 0.0, 0.0],
-        other => {
-            let v = parse_vec3(other, "view").map_err(|_| {
-                format!(
-                    "view '{other}' must be iso, top, bottom, front, back, left, right or X,Y,Z"
-                )
-            })?;
-            if v.iter().all(|&x| x == 0.0) {
-                return Err("the view direction must not be zero".into());
-            }
-            v
-        }
-    })
+    s.parse::<ktree::display::View>()
+        .map(|v| v.toward_eye())
+        .map_err(|e| e.to_string())
 }
 
 /// A progress bar that the library's callbacks can drive, or none.

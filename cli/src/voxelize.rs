@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
 use ktree::io::{voxel_source, voxelize, Format, ReadOptions, VoxelSource};
-use ktree::solid::mesh::Placement;
+use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
 use ktree::stacking::{RaySource, SlabRuns};
 use ktree::{LevelCounts, Universe};
@@ -61,7 +61,7 @@ pub fn run(a: Args) -> Result<(), String> {
             return Err("--level L is required for a mesh".into());
         }
         options.mesh_placement = match (&a.transform, a.fit) {
-            (Some(t), _) => Some(Placement::parse(t).map_err(|e| e.to_string())?),
+            (Some(t), _) => Some(MeshTransform::parse(t).map_err(|e| e.to_string())?),
             (None, true) => None,
             (None, false) => return Err("a mesh needs --fit or --transform s,tx,ty,tz".into()),
         };
