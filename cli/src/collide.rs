@@ -5,7 +5,7 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use crate::op::{pair_error, read};
+use crate::common::tree_file::{pair_error, read};
 
 /// Arguments of `ktree collide`.
 #[derive(Debug, clap::Args)]

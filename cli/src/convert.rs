@@ -96,7 +96,7 @@ pub fn run(a: Args) -> Result<(), String> {
     };
     if Format::of(&a.output) == Some(Format::Ktree) {
         // The version --format-version asks for, as every command that writes trees.
-        ktree::with_dim!(&read.tree, AnyTree, t => crate::tree_file::write(&a.output, t))
+        ktree::with_dim!(&read.tree, AnyTree, t => crate::common::tree_file::write_tree(&a.output, t))
             .map_err(|e| format!("cannot write {}: {e}", a.output.display()))?;
     } else {
         write_tree(&a.output, &read.tree, &write_options).map_err(|e| e.to_string())?;

@@ -6,7 +6,10 @@ use crate::outln;
 
 use std::path::{Path, PathBuf};
 
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
+
+use crate::common::picture::{parse_size, parse_vec3, parse_view};
+use crate::common::progress::progress_bar;
 use ktree::display::{
     default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
     RenderOptions,
@@ -60,59 +63,6 @@ pub struct Args {
     /// Show a progress bar.
     #[arg(long)]
     progress: bool,
-}
-
-/// Parses `WxH`.
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("size '{s}' must be WIDTHxHEIGHT, e.g. 800x600"))?;
-    let p = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("size '{s}' must be WIDTHxHEIGHT with whole numbers"))
-    };
-    let (w, h) = (p(w)?, p(h)?);
-    ktree::display::check_size(w, h).map_err(|e| e.to_string())?;
-    Ok((w, h))
-}
-
-/// Parses `X,Y,Z`.
-pub fn parse_vec3(s: &str, what: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    let bad = || format!("{what} '{s}' must be three numbers X,Y,Z");
-    if parts.len() != 3 {
-        return Err(bad());
-    }
-    let mut v = [0.0f64; 3];
-    for (x, p) in v.iter_mut().zip(parts) {
-        *x = p.trim().parse().map_err(|_| bad())?;
-        if !x.is_finite() {
-            return Err(bad());
-        }
-    }
-    Ok(v)
-}
-
-/// A named view or a direction `X,Y,Z`, from the object towards the eye ([`ktree::display::View`]).
-pub fn parse_view(s: &str) -> Result<[f64; 3], String> {
-    s.parse::<ktree::display::View>()
-        .map(|v| v.toward_eye())
-        .map_err(|e| e.to_string())
-}
-
-/// A progress bar that the library's callbacks can drive, or none.
-pub fn progress_bar(enabled: bool, what: &str) -> Option<ProgressBar> {
-    enabled.then(|| {
-        let bar = ProgressBar::new(1);
-        bar.set_style(
-            ProgressStyle::with_template("{msg} [{bar:40}] {percent}% {elapsed}")
-                .expect("valid template")
-                .progress_chars("=> "),
-        );
-        bar.set_message(what.to_string());
-        bar
-    })
 }
 
 fn default_out(file: &Path) -> PathBuf {

@@ -12,8 +12,8 @@
 
 use std::path::{Path, PathBuf};
 
-use indicatif::ProgressBar;
-use ktree::stacking::{BuildError, Builder, OutOfCoreReport, Progress, RaySource, Stage};
+use crate::common::progress::report_progress;
+use ktree::stacking::{BuildError, Builder, OutOfCoreReport, RaySource};
 use ktree::{LevelCounts, RaySet};
 
 /// The share of the machine's memory used when no `--max-memory` is given: a half.
@@ -128,7 +128,7 @@ where
     S: RaySource<K>,
     S::Error: std::fmt::Display,
 {
-    let bar = crate::render::progress_bar(args.progress, "stacking");
+    let bar = crate::common::progress::progress_bar(args.progress, "stacking");
     let progress = |p| report_progress(bar.as_ref(), p);
     let report = builder(source, args)
         .progress(&progress)
@@ -168,23 +168,6 @@ pub fn describe<E: std::fmt::Display>(out: &Path, e: BuildError<E>, held: u64) -
     }
 }
 
-/// Shows the progress of an out-of-core build on `bar`, if any.
-pub fn report_progress(bar: Option<&ProgressBar>, p: Progress) {
-    let Some(bar) = bar else {
-        return;
-    };
-    let message = match p.stage {
-        Stage::Stacking => "stacking slabs",
-        Stage::Writing => "writing levels",
-    };
-    if bar.length() != Some(p.total) || bar.message() != message {
-        bar.set_message(message);
-        bar.set_length(p.total);
-        bar.reset_elapsed();
-    }
-    bar.set_position(p.done);
-}
-
 /// The voxels of a tree from its counts per level in a level-`level` universe of `k` dimensions.
 pub fn voxels(k: usize, level: u32, counts: &[LevelCounts]) -> u128 {
     counts
@@ -202,7 +185,7 @@ pub fn ray_bytes<const K: usize>(rays: &RaySet<K>) -> u64 {
 /// Whether the trees written in this run are built out of core: a `.ktree` of format version 2 (by one
 /// process or across MPI ranks; version 1 is built in memory, by one process only).
 pub fn out_of_core() -> bool {
-    crate::tree_file::version() == 2
+    crate::common::tree_file::version() == 2
 }
 
 #[cfg(test)]
