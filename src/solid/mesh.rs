@@ -595,8 +595,8 @@ impl Placed {
     }
 }
 
-/// A placed mesh producing its rays slab by slab for [`stack_to_file`](crate::stacking::stack_to_file)
-/// and [`stack_source`](crate::stacking::stack_source): the triangles are indexed by the buckets of
+/// A placed mesh producing its rays slab by slab for [`Builder::to_file`](crate::stacking::Builder::to_file)
+/// and [`Builder::build`](crate::stacking::Builder::build): the triangles are indexed by the buckets of
 /// columns (along axis 0, one cell of the default split depth wide) their projections overlap, and a
 /// slab's runs come from its buckets' triangles alone, by the rule of [`TriangleMesh::to_rays`] — they
 /// equal the runs of that slab in [`TriangleMesh::to_rays`]. No whole ray set is held: the source keeps

@@ -97,7 +97,7 @@ impl<const K: usize> Solid<K> {
 }
 
 /// A solid in a universe, producing its rays slab by slab for
-/// [`stack_source`](crate::stacking::stack_source): no whole ray set is held and no cap on the number of
+/// [`Builder::build`](crate::stacking::Builder::build): no whole ray set is held and no cap on the number of
 /// rays applies.
 ///
 /// ```

@@ -439,7 +439,7 @@ impl Volume {
 }
 
 /// A volume placed in a universe with a selection, producing its rays slab by slab for
-/// [`stack_to_file`](crate::stacking::stack_to_file) and [`stack_source`](crate::stacking::stack_source):
+/// [`Builder::to_file`](crate::stacking::Builder::to_file) and [`Builder::build`](crate::stacking::Builder::build):
 /// each slab's runs come from the volume's samples in that slab alone, and equal the runs of that slab in
 /// [`Volume::to_rays`]. No whole ray set is held.
 ///

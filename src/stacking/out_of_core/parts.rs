@@ -238,7 +238,7 @@ where
     })
 }
 
-/// The cells of some slabs stacked and their subtrees spilled ([`stack_part`]), and the index of the
+/// The cells of some slabs stacked and their subtrees spilled ([`Builder::stack_part`](crate::stacking::Builder::stack_part)), and the index of the
 /// parts other processes stacked ([`add_part`](Self::add_part)): all that is needed to write the tree
 /// ([`write`](Self::write)), with the levels of the other parts received as streams. The spill folder is
 /// removed when the part is dropped.
