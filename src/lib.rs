@@ -55,6 +55,7 @@
 #![deny(unsafe_code)]
 
 pub mod display;
+pub mod export;
 pub mod fs;
 pub mod io;
 pub mod ops;
