@@ -109,7 +109,12 @@ pub fn write_stl(w: &mut dyn Write, mesh: &SurfaceMesh) -> io::Result<()> {
 /// # Errors
 /// The writer's; [`io::ErrorKind::InvalidInput`] past 4 GiB.
 pub fn write_glb(w: &mut dyn Write, mesh: &SurfaceMesh) -> io::Result<()> {
-    let too_big = || io::Error::new(io::ErrorKind::InvalidInput, "the mesh exceeds 4 GiB for .glb");
+    let too_big = || {
+        io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "the mesh exceeds 4 GiB for .glb",
+        )
+    };
     let positions = mesh.vertices.len() * 12;
     let indices = mesh.triangles.len() * 12;
     let mut lo = [f32::INFINITY; 3];

@@ -378,12 +378,9 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
     let rects: Vec<Rect> = boundary_squares(tree)
         .into_iter()
         .flat_map(|((a, coord, upper), squares)| {
-            merge_rectangles(squares).into_iter().map(move |r| Rect {
-                a,
-                coord,
-                upper,
-                r,
-            })
+            merge_rectangles(squares)
+                .into_iter()
+                .map(move |r| Rect { a, coord, upper, r })
         })
         .collect();
     let mut lattice = Lattice::new(tree);

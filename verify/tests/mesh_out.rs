@@ -45,11 +45,21 @@ fn euler_6(level: u32, dense: &[bool]) -> i64 {
                 // ring in the complex).
                 for e in 0usize..4 {
                     let full = (0..8usize).filter(|&o| {
-                        at(x + (o & 1) as i64, y + (o >> 1 & 1) as i64, z + (o >> 2 & 1) as i64)
+                        at(
+                            x + (o & 1) as i64,
+                            y + (o >> 1 & 1) as i64,
+                            z + (o >> 2 & 1) as i64,
+                        )
                     });
-                    let empty: Vec<usize> = (0..8usize).filter(|&o| {
-                        !at(x + (o & 1) as i64, y + (o >> 1 & 1) as i64, z + (o >> 2 & 1) as i64)
-                    }).collect();
+                    let empty: Vec<usize> = (0..8usize)
+                        .filter(|&o| {
+                            !at(
+                                x + (o & 1) as i64,
+                                y + (o >> 1 & 1) as i64,
+                                z + (o >> 2 & 1) as i64,
+                            )
+                        })
+                        .collect();
                     if full.count() == 6 && empty == [e, 7 - e] {
                         chi += 1;
                     }
@@ -94,7 +104,10 @@ fn check_mesh(mesh: &SurfaceMesh, voxels: u128) -> i64 {
     let mut opposite: HashMap<u32, HashMap<u32, u32>> = HashMap::new();
     for t in &mesh.triangles {
         for k in 0..3 {
-            let prev = opposite.entry(t[k]).or_default().insert(t[(k + 1) % 3], t[(k + 2) % 3]);
+            let prev = opposite
+                .entry(t[k])
+                .or_default()
+                .insert(t[(k + 1) % 3], t[(k + 2) % 3]);
             assert!(prev.is_none(), "vertex {} is not a fan", t[k]);
         }
     }
@@ -111,7 +124,11 @@ fn check_mesh(mesh: &SurfaceMesh, voxels: u128) -> i64 {
         }
         assert_eq!(steps, link.len(), "vertex {v}: more than one fan");
     }
-    assert_eq!(opposite.len(), mesh.vertices.len(), "a vertex in no triangle");
+    assert_eq!(
+        opposite.len(),
+        mesh.vertices.len(),
+        "a vertex in no triangle"
+    );
     // No triangle of zero area.
     for t in &mesh.triangles {
         let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
@@ -261,7 +278,11 @@ fn two_empty_voxels_at_a_corner_amid_full_ones_split_the_sheet() {
     let dense = dense_of(2, &voxels);
     assert_eq!(euler_6(2, &dense), 1);
     let mesh = check_dense(2, &dense);
-    let at_corner = mesh.vertices.iter().filter(|v| **v == [2.0, 2.0, 2.0]).count();
+    let at_corner = mesh
+        .vertices
+        .iter()
+        .filter(|v| **v == [2.0, 2.0, 2.0])
+        .count();
     assert_eq!(at_corner, 2);
 }
 
@@ -300,7 +321,10 @@ fn a_ball_round_trips_through_every_format_in_world_units() {
     for name in ["ball.ply", "ball.obj", "ball.stl"] {
         round_trip(&tree, name, &frame);
     }
-    assert_eq!(mesh.placed(&frame).volume(), tree.voxel_count() as f64 / 64.0);
+    assert_eq!(
+        mesh.placed(&frame).volume(),
+        tree.voxel_count() as f64 / 64.0
+    );
 }
 
 #[test]
@@ -366,11 +390,13 @@ fn a_quadtree_is_written_as_outlines_and_an_octree_not_as_svg() {
 /// The Euler characteristic of a quadtree's pixels, edge-adjacent pixels connected.
 fn euler_4(level: u32, dense: &[bool]) -> i64 {
     let u = 1i64 << level;
-    let at = |x: i64, y: i64| (0..u).contains(&x) && (0..u).contains(&y) && dense[(x + u * y) as usize];
+    let at =
+        |x: i64, y: i64| (0..u).contains(&x) && (0..u).contains(&y) && dense[(x + u * y) as usize];
     let mut chi = 0;
     for y in 0..u {
         for x in 0..u {
-            chi += i64::from(at(x, y)) - i64::from(at(x, y) && at(x + 1, y))
+            chi += i64::from(at(x, y))
+                - i64::from(at(x, y) && at(x + 1, y))
                 - i64::from(at(x, y) && at(x, y + 1))
                 + i64::from(at(x, y) && at(x + 1, y) && at(x, y + 1) && at(x + 1, y + 1));
         }
