@@ -149,7 +149,7 @@ impl<'t, const K: usize> Neighbours<'t, K> {
     /// // Voxels 0 and 3 of a 2 × 2 square: its upper face on axis 0 touches voxels 1 (empty) and 3 (full).
     /// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
     /// let mut seen = Vec::new();
-    /// Neighbours::new(&tree).face_leaves(&tree.universe().root(), 0, true, |c, s| seen.push((c.origin, s)));
+    /// Neighbours::new(&tree).face_leaves(&tree.universe().root(), 0, true, |c, s| seen.push((c.origin(), s)));
     /// assert_eq!(seen, [([1, 0], NodeState::Empty), ([1, 1], NodeState::Full)]);
     /// ```
     pub fn face_leaves(

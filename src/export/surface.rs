@@ -21,7 +21,9 @@
 //! solids touching along it) gets a midpoint per touching solid, so that two sheets sharing both
 //! endpoints still have distinct edges. Solids touching along an edge or at a corner are thus separate, as
 //! in 6-connectivity: the surface's Euler characteristic is twice the solid's, counted with face-adjacent
-//! voxels connected.
+//! voxels connected. (One configuration cannot be so: where only two opposite voxels of the eight around
+//! a point are empty, a 2-manifold surface is two sheets there, so the six full voxels are joined through
+//! the point.)
 //!
 //! Coordinates are in voxels (the universe's corner at 0); [`SurfaceMesh::placed`] maps them to world
 //! units.
