@@ -16,8 +16,9 @@ pub struct Args {
     /// The input: .ktree, .rays, .binvox, .bt, .vdb, a mesh (.obj, .stl, .ply) or a volume (.json, .raw,
     /// .nii, .nii.gz).
     input: PathBuf,
-    /// The output: .ktree, .rays, .binvox, .bt, .vdb, or the tree's boundary as a mesh (.ply, .obj, .stl,
-    /// .glb; a quadtree's outline as .ply edges, .obj lines or .svg).
+    /// The output: .ktree, .rays, .binvox, .bt, .vdb, the tree's boundary as a mesh (.ply, .obj, .stl,
+    /// .glb; a quadtree's outline as .ply edges, .obj lines or .svg), or VTK for ParaView (.vtu: a cell per
+    /// full leaf; .htg: a hyper tree grid).
     output: PathBuf,
     /// Universe level (grids, volumes: default the smallest that holds the input; meshes: required).
     #[arg(long)]
@@ -101,7 +102,13 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     let out_offset = match (&a.out_offset, Format::of(&a.output), read.placement) {
         (Some(t), _, _) => parse_xyz("out-offset", t)?,
-        (None, Some(Format::Vdb | Format::Mesh | Format::Glb | Format::Svg), Some(p)) => p.offset,
+        (
+            None,
+            Some(
+                Format::Vdb | Format::Mesh | Format::Glb | Format::Svg | Format::Vtu | Format::Htg,
+            ),
+            Some(p),
+        ) => p.offset,
         _ => [0; 3],
     };
     let mut meta = read.meta.unwrap_or_default();

@@ -41,6 +41,10 @@ pub enum Format {
     Glb,
     /// `.svg`: a quadtree's outline as one path (output only).
     Svg,
+    /// `.vtu`: a VTK unstructured grid of the full leaves, for ParaView (output only).
+    Vtu,
+    /// `.htg`: a VTK hyper tree grid, for ParaView (output only).
+    Htg,
     /// `.json` (+ raw samples), `.raw`, `.nii`, `.nii.gz`: a volume (input only).
     Volume,
 }
@@ -68,6 +72,8 @@ impl Format {
             "obj" | "stl" | "ply" => Format::Mesh,
             "glb" => Format::Glb,
             "svg" => Format::Svg,
+            "vtu" => Format::Vtu,
+            "htg" => Format::Htg,
             "json" | "raw" | "nii" => Format::Volume,
             _ => return None,
         })
@@ -165,7 +171,7 @@ fn format_of(path: &Path) -> Result<Format, IoError> {
         usage(
             path,
             "unknown extension: expected .ktree, .rays, .binvox, .bt, .vdb, a mesh (.obj, .stl, .ply; \
-             .glb and .svg written only) or a volume (.json, .raw, .nii, .nii.gz)",
+             .glb and .svg written only), VTK (.vtu, .htg; written only) or a volume (.json, .raw, .nii, .nii.gz)",
         )
     })
 }
@@ -213,7 +219,7 @@ pub fn read_tree_placed(path: &Path, options: &ReadOptions) -> Result<ReadTree, 
             .map_err(|e| GridFileError::new(&name, 0, GridFileErrorKind::Io(e.into())))
     };
     match format_of(path)? {
-        Format::Glb | Format::Svg => Err(usage(
+        Format::Glb | Format::Svg | Format::Vtu | Format::Htg => Err(usage(
             path,
             "this format is written only: read .ktree, .rays, .binvox, .bt, .vdb, a mesh or a volume",
         )),
@@ -550,6 +556,13 @@ pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result
     let write = |fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
         write_atomic_with(path, |w| fill(w)).map_err(IoError::Write)
     };
+    // Meshes and VTK files: ktree voxel v is at meta.origin + (v − offset) · voxel_size.
+    let frame = crate::export::Frame {
+        voxel_size: meta.voxel_size,
+        origin: std::array::from_fn(|a| {
+            meta.origin[a] - options.offset[a] as f64 * meta.voxel_size
+        }),
+    };
     match format {
         Format::Ktree => {
             crate::with_dim!(tree, AnyTree, t => write_ktree_file(path, t)).map_err(IoError::Write)
@@ -574,23 +587,34 @@ pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result
             let t = octree()?;
             write(&|w| write_vdb(w, t, options.offset, &meta))
         }
-        Format::Mesh | Format::Glb | Format::Svg => {
-            // World position of ktree voxel v: meta.origin + (v − offset) · voxel_size.
-            let frame = crate::export::Frame {
-                voxel_size: meta.voxel_size,
-                origin: std::array::from_fn(|a| {
-                    meta.origin[a] - options.offset[a] as f64 * meta.voxel_size
-                }),
+        Format::Vtu | Format::Htg => {
+            let htg = format == Format::Htg;
+            let fill = |w: &mut dyn std::io::Write| match tree {
+                AnyTree::K2(t) if htg => crate::export::vtk::write_htg(w, t, &frame),
+                AnyTree::K3(t) if htg => crate::export::vtk::write_htg(w, t, &frame),
+                AnyTree::K2(t) => crate::export::vtk::write_vtu(w, t, &frame),
+                AnyTree::K3(t) => crate::export::vtk::write_vtu(w, t, &frame),
+                _ => unreachable!("checked above"),
             };
-            crate::export::write_mesh(path, tree, &frame)
-                .map(drop)
-                .map_err(|e| match e {
-                    crate::export::ExportError::Write(e) => IoError::Write(e),
-                    crate::export::ExportError::Usage { file, message } => {
-                        IoError::Usage { file, message }
-                    }
-                })
+            if !matches!(tree, AnyTree::K2(_) | AnyTree::K3(_)) {
+                return Err(usage(
+                    path,
+                    format!(
+                        "VTK files are written for quadtrees and octrees (K = 2, 3); this tree has K = {}",
+                        tree.k()
+                    ),
+                ));
+            }
+            write(&fill)
         }
+        Format::Mesh | Format::Glb | Format::Svg => crate::export::write_mesh(path, tree, &frame)
+            .map(drop)
+            .map_err(|e| match e {
+                crate::export::ExportError::Write(e) => IoError::Write(e),
+                crate::export::ExportError::Usage { file, message } => {
+                    IoError::Usage { file, message }
+                }
+            }),
         Format::Volume => Err(usage(
             path,
             "volumes are inputs only: write .ktree, .rays, .binvox, .bt, .vdb or a mesh",
