@@ -102,15 +102,18 @@ pub fn write_vtu<const K: usize>(
     for cell in tree.full_cells() {
         let s = cell.side() as u32;
         for o in 0..corners {
-            let mut p = [0u32; 3];
-            for a in 0..K {
-                p[a] = cell.origin[a] + if o >> a & 1 == 1 { s } else { 0 };
-            }
+            let p: [u32; 3] = std::array::from_fn(|a| {
+                if a < K {
+                    cell.origin[a] + if o >> a & 1 == 1 { s } else { 0 }
+                } else {
+                    0
+                }
+            });
             let next = ids.len() as u32;
             let id = *ids.entry(p).or_insert_with(|| {
-                for a in 0..3 {
+                for (a, &pa) in p.iter().enumerate() {
                     let x = if a < K {
-                        frame.origin[a] + frame.voxel_size * f64::from(p[a])
+                        frame.origin[a] + frame.voxel_size * f64::from(pa)
                     } else {
                         frame.origin[a]
                     };
