@@ -38,6 +38,10 @@ pub struct Args {
     /// (default: where the input grid puts it, else 0,0,0).
     #[arg(long, allow_hyphen_values = true)]
     origin: Option<String>,
+    /// 4-D trees: write the slices along this axis as a VTK time series — OUT.pvd (a collection of
+    /// OUT_NNNN.vtu slices), or OUT_NNNN.vtu / OUT_NNNN.htg files only.
+    #[arg(long)]
+    time_axis: Option<usize>,
     /// OctoMap input: how unknown cells read.
     #[arg(long, value_parser = ["empty", "full"], default_value = "empty")]
     unknown: String,
@@ -127,6 +131,29 @@ pub fn run(a: Args) -> Result<(), String> {
         offset: out_offset,
         meta: Some(meta),
     };
+    if let Some(axis) = a.time_axis {
+        let ktree::AnyTree::K4(t) = &read.tree else {
+            return Err(format!(
+                "{}: --time-axis slices 4-D trees; this tree has K = {}",
+                a.input.display(),
+                read.tree.k()
+            ));
+        };
+        let frame = ktree::export::Frame {
+            voxel_size: meta.voxel_size,
+            origin: meta.origin,
+        };
+        let files = ktree::export::vtk::write_time_slices(&a.output, t, axis, &frame)
+            .map_err(|e| e.to_string())?;
+        outln!(
+            "{}: K = 4, L = {}, {} slices along axis {axis} ({} files)",
+            a.output.display(),
+            t.level(),
+            t.universe().side(),
+            files.len()
+        );
+        return Ok(());
+    }
     if Format::of(&a.output) == Some(Format::Ktree) {
         // The version --format-version asks for, as every command that writes trees.
         ktree::with_dim!(&read.tree, AnyTree, t => crate::tree_file::write(&a.output, t))

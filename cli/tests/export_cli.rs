@@ -152,3 +152,81 @@ fn a_quadtree_is_an_svg_outline_and_bad_requests_are_errors() {
     ]);
     assert!(!ok && stderr.contains("x.glb"), "{stderr}");
 }
+
+/// The value of `NumberOfCells` in a `.vtu`.
+fn vtu_cells(path: &Path) -> usize {
+    let bytes = std::fs::read(path).unwrap();
+    let text = String::from_utf8_lossy(&bytes);
+    let key = "NumberOfCells=\"";
+    let at = text.find(key).unwrap() + key.len();
+    text[at..at + text[at..].find('"').unwrap()]
+        .parse()
+        .unwrap()
+}
+
+#[test]
+fn convert_writes_vtk_files_and_a_4d_time_series() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("ball.ktree");
+    let tree = ball();
+    save(&input, AnyTree::K3(tree.clone()));
+    let vtu = dir.path().join("ball.vtu");
+    let htg = dir.path().join("ball.htg");
+    for out in [&vtu, &htg] {
+        let (ok, _, stderr) = ktree(&["convert", input.to_str().unwrap(), out.to_str().unwrap()]);
+        assert!(ok, "{stderr}");
+    }
+    assert_eq!(vtu_cells(&vtu), tree.full_cells().count());
+    let text = std::fs::read_to_string(&htg).unwrap();
+    assert!(text.contains("type=\"HyperTreeGrid\""));
+    assert!(text.contains(&format!(
+        "NumberOfVerticesPerDepth\" NumberOfTuples=\"{}\"",
+        tree.depth_count()
+    )));
+
+    let ball4 = KTree::from_rays(&ball_rays::<4>(3, [8, 8, 8, 8], 40).unwrap());
+    let input4 = dir.path().join("ball4.ktree");
+    save(&input4, AnyTree::K4(ball4.clone()));
+    let pvd = dir.path().join("run.pvd");
+    let (ok, stdout, stderr) = ktree(&[
+        "convert",
+        input4.to_str().unwrap(),
+        pvd.to_str().unwrap(),
+        "--time-axis",
+        "3",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("8 slices"), "{stdout}");
+    let collection = std::fs::read_to_string(&pvd).unwrap();
+    assert_eq!(collection.matches("<DataSet ").count(), 8);
+    for t in 0..8u32 {
+        let slice = dir.path().join(format!("run_{t:04}.vtu"));
+        assert!(collection.contains(&format!("file=\"run_{t:04}.vtu\"")));
+        let want = ktree::display::slices::slice_4d(&ball4, 3, t).unwrap();
+        assert_eq!(vtu_cells(&slice), want.full_cells().count(), "slice {t}");
+    }
+    let (ok, _, stderr) = ktree(&[
+        "convert",
+        input4.to_str().unwrap(),
+        dir.path().join("run.htg").to_str().unwrap(),
+        "--time-axis",
+        "0",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(dir.path().join("run_0007.htg").exists());
+    // A 4-D tree needs --time-axis for VTK; a 3-D tree cannot be sliced.
+    let (ok, _, stderr) = ktree(&[
+        "convert",
+        input4.to_str().unwrap(),
+        dir.path().join("x.vtu").to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("K = 4"), "{stderr}");
+    let (ok, _, stderr) = ktree(&[
+        "convert",
+        input.to_str().unwrap(),
+        dir.path().join("y.pvd").to_str().unwrap(),
+        "--time-axis",
+        "3",
+    ]);
+    assert!(!ok && stderr.contains("K = 3"), "{stderr}");
+}

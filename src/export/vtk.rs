@@ -1,6 +1,9 @@
 //! VTK XML files for ParaView: an unstructured grid (`.vtu`) of one voxel (octrees) or pixel (quadtrees)
 //! cell per full leaf, and a hyper tree grid (`.htg`), the form VTK keeps a tree in.
 //!
+//! A 4-D tree goes out as a time series of its 3-D slices ([`write_time_slices`]), with a `.pvd`
+//! collection for ParaView's time controls.
+//!
 //! Both carry the cell data `level` (the leaf's depth in the tree, 0 at the root) and `side` (the leaf's
 //! edge in world units). Arrays are raw little-endian binary in the appended section (header UInt64).
 //!
@@ -15,8 +18,11 @@
 
 use std::collections::HashMap;
 use std::io::{self, Write};
+use std::path::{Path, PathBuf};
 
-use super::Frame;
+use super::{ExportError, Frame};
+use crate::display::slices::slice_4d;
+use crate::fs::write_atomic_with;
 use crate::tree::cursor::{walk, Visitor, Walk};
 use crate::tree::{KTree, NodeRef, NodeState};
 
@@ -316,4 +322,97 @@ pub fn write_htg<const K: usize>(
     array(w, "Int32", "level", all.len(), &levels.join(" "))?;
     array(w, "Float64", "side", all.len(), &sides.join(" "))?;
     writeln!(w, "  </CellData>\n </HyperTreeGrid>\n</VTKFile>")
+}
+
+/// A 4-D tree as a time series for ParaView: the octree of each slice along `time_axis` (the other axes
+/// in order, placed by `frame`) written beside `path` as `STEM_NNNN.vtu` (or `.htg`), atomically. With
+/// `path` ending in `.pvd`, the slices are `.vtu` files and `path` is a VTK collection listing them, the
+/// timestep being the slice's position; with `.vtu` or `.htg`, only the slices are written. Returns the
+/// files written.
+///
+/// ```
+/// use ktree::export::{vtk::write_time_slices, Frame};
+/// let dir = tempfile::tempdir().unwrap();
+/// let tree = ktree::KTree::<4>::full(1).unwrap();
+/// let files = write_time_slices(&dir.path().join("run.pvd"), &tree, 3, &Frame::default()).unwrap();
+/// assert_eq!(files.len(), 3); // two slices and the collection
+/// assert!(files[0].ends_with("run_0000.vtu"));
+/// ```
+///
+/// # Errors
+/// [`ExportError::Usage`] for another extension or an axis past 3; [`ExportError::Write`] from the file
+/// system.
+pub fn write_time_slices(
+    path: &Path,
+    tree: &KTree<4>,
+    time_axis: usize,
+    frame: &Frame,
+) -> Result<Vec<PathBuf>, ExportError> {
+    let usage = |message: String| ExportError::Usage {
+        file: path.display().to_string(),
+        message,
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let (slice_ext, collection) = match ext.as_str() {
+        "pvd" => ("vtu", true),
+        "vtu" | "htg" => (ext.as_str(), false),
+        _ => {
+            return Err(usage(
+                "a time series is written as .pvd (with .vtu slices), .vtu or .htg".into(),
+            ))
+        }
+    };
+    if time_axis > 3 {
+        return Err(usage(format!(
+            "--time-axis {time_axis}: a 4-D tree has axes 0 … 3"
+        )));
+    }
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let side = tree.universe().side();
+    let digits = side.saturating_sub(1).to_string().len().max(4);
+    let mut written = Vec::new();
+    let mut entries = String::new();
+    for t in 0..side as u32 {
+        let slice = slice_4d(tree, time_axis, t).map_err(|e| usage(e.to_string()))?;
+        let name = format!("{stem}_{t:0digits$}.{slice_ext}");
+        let file = dir.join(&name);
+        write_atomic_with(&file, |w| {
+            if slice_ext == "htg" {
+                write_htg(w, &slice, frame)
+            } else {
+                write_vtu(w, &slice, frame)
+            }
+        })
+        .map_err(ExportError::Write)?;
+        entries.push_str(&format!(
+            "  <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{}\"/>\n",
+            xml_escape(&name)
+        ));
+        written.push(file);
+    }
+    if collection {
+        let text = format!(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" \
+             byte_order=\"LittleEndian\">\n <Collection>\n{entries} </Collection>\n</VTKFile>\n"
+        );
+        crate::fs::write_atomic(path, text.as_bytes()).map_err(ExportError::Write)?;
+        written.push(path.to_path_buf());
+    }
+    Ok(written)
+}
+
+/// `text` with XML's special characters escaped, for an attribute.
+fn xml_escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('"', "&quot;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
