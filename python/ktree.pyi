@@ -149,6 +149,10 @@ class Tree:
         """Whether the objects share a voxel."""
     def collide(self, other: Tree, time_axis: Optional[int] = None) -> _Collision:
         """Interference, with the keys of `ktree collide --json`."""
+    def to_mesh(
+        self, voxel_size: float = 1.0, origin: Optional[Sequence[float]] = None
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+        """The boundary of an octree as a closed triangle mesh: vertices (n, 3) float64, faces (m, 3) int64."""
     def render(
         self,
         view: Optional[_View] = None,
