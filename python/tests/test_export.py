@@ -68,7 +68,6 @@ def test_to_mesh_in_world_units_and_two_cubes_touching_at_an_edge():
     assert m.volume == 2 * 0.125
     assert m.euler_number == 4  # two spheres
     assert m.bounds.tolist() == [[1, 2, 3], [2, 3, 3.5]]
-    assert len(m.split(only_watertight=True)) == 2
     with pytest.raises(ValueError, match="K = 2"):
         ktree.Tree.from_dense(np.ones((2, 2), dtype=bool)).to_mesh()
     with pytest.raises(ValueError, match="voxel_size"):
