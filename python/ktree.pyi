@@ -105,7 +105,7 @@ class Tree:
     def load(path: _Path) -> Tree:
         """Reads a tree file, the format chosen by the extension."""
     def save(self, path: _Path) -> None:
-        """Writes the tree atomically, the format chosen by the extension."""
+        """Writes the tree atomically, the format chosen by the extension (meshes: the tree's boundary)."""
     def to_bytes(self) -> bytes:
         """The tree in the .ktree format (version 2: 2 bits a node, checksums per level)."""
     @staticmethod
