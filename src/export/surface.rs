@@ -204,7 +204,7 @@ struct Lattice<'t> {
     near: Neighbours<'t, 3>,
     side: u64,
     level: u32,
-    masks: HashMap<[u32; 3], u8>,
+    masks: FastMap<[u32; 3], u8>,
 }
 
 impl<'t> Lattice<'t> {
@@ -213,7 +213,7 @@ impl<'t> Lattice<'t> {
             near: Neighbours::new(tree),
             side: tree.universe().side(),
             level: tree.level(),
-            masks: HashMap::new(),
+            masks: FastMap::default(),
         }
     }
 
@@ -387,7 +387,7 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
         .collect();
     let mut lattice = Lattice::new(tree);
     // Every corner on the lines of its two edges, with its link part.
-    let mut lines: HashMap<LineKey, Vec<(u32, u8)>> = HashMap::new();
+    let mut lines: FastMap<LineKey, Vec<(u32, u8)>> = FastMap::default();
     for rect in &rects {
         let (b, c) = others(rect.a);
         for (p, q) in rect.corners() {
@@ -404,7 +404,7 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
     }
     let mut mesh = SurfaceMesh::default();
     // Vertices by doubled position and tag (link part, or 16 + full octant for a midpoint).
-    let mut ids: HashMap<([u64; 3], u8), u32> = HashMap::new();
+    let mut ids: FastMap<([u64; 3], u8), u32> = FastMap::default();
     let mut vertex = |mesh: &mut SurfaceMesh, doubled: [u64; 3], tag: u8| -> u32 {
         *ids.entry((doubled, tag)).or_insert_with(|| {
             mesh.vertices.push(doubled.map(|x| x as f64 / 2.0));
@@ -459,7 +459,7 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
             let octant = (full_side << rect.a | e_side << e) as u8;
             let mut prev = t0;
             for (t, part) in stops.into_iter().chain(std::iter::once((t1, u8::MAX))) {
-                if pinched(&mut lattice, p, d, prev.min(t), prev.max(t)) {
+                if pinched(&mut lattice, p, d, prev.min(t)) {
                     let mut m = double(p);
                     m[d] = u64::from(prev) + u64::from(t);
                     ring.push(vertex(&mut mesh, m, 16 + octant));
@@ -495,25 +495,51 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
     mesh
 }
 
-/// Whether the segment `[lo, hi]` of the line along `d` through `p` has two solids touching along it:
-/// of the four voxels around its middle unit, exactly two are full and they are diagonal.
-fn pinched(lattice: &mut Lattice<'_>, p: [u32; 3], d: usize, lo: u32, hi: u32) -> bool {
-    let t = lo + (hi - lo - 1) / 2;
+/// Whether the segment from `lo` of the line along `d` through `p` has two solids touching along it: of
+/// the four voxels around the line just past `lo`, exactly two are full and they are diagonal (read from
+/// the occupancy around the lattice point at `lo`, so both rectangles along the segment decide alike).
+fn pinched(lattice: &mut Lattice<'_>, p: [u32; 3], d: usize, lo: u32) -> bool {
+    let mut at = p;
+    at[d] = lo;
+    let m = lattice.mask(at);
     let (x, y) = match d {
         0 => (1, 2),
         1 => (0, 2),
         _ => (0, 1),
     };
-    let mut full = [false; 4];
-    for (i, f) in full.iter_mut().enumerate() {
-        let mut v = [0i64; 3];
-        v[d] = i64::from(t);
-        v[x] = i64::from(p[x]) - 1 + (i & 1) as i64;
-        v[y] = i64::from(p[y]) - 1 + (i >> 1) as i64;
-        *f = lattice.full(v);
-    }
-    full == [true, false, false, true] || full == [false, true, true, false]
+    let full = |i: usize| m >> (1 << d | (i & 1) << x | (i >> 1) << y) & 1 == 1;
+    let f = [full(0), full(1), full(2), full(3)];
+    f == [true, false, false, true] || f == [false, true, true, false]
 }
+
+/// A fast hash for the lattice's small integer keys (Fx: multiply and rotate), in place of SipHash.
+#[derive(Default, Clone, Copy)]
+struct FxHasher(u64);
+
+impl std::hash::Hasher for FxHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_u8(&mut self, x: u8) {
+        self.write_u64(u64::from(x));
+    }
+    fn write_u32(&mut self, x: u32) {
+        self.write_u64(u64::from(x));
+    }
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+type FastMap<K, V> = HashMap<K, V, std::hash::BuildHasherDefault<FxHasher>>;
 
 #[cfg(test)]
 mod tests {
