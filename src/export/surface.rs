@@ -204,7 +204,7 @@ struct Lattice<'t> {
     near: Neighbours<'t, 3>,
     side: u64,
     level: u32,
-    masks: FastMap<[u32; 3], u8>,
+    masks: HashMap<[u32; 3], u8>,
 }
 
 impl<'t> Lattice<'t> {
@@ -213,7 +213,7 @@ impl<'t> Lattice<'t> {
             near: Neighbours::new(tree),
             side: tree.universe().side(),
             level: tree.level(),
-            masks: FastMap::default(),
+            masks: HashMap::new(),
         }
     }
 
@@ -387,7 +387,7 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
         .collect();
     let mut lattice = Lattice::new(tree);
     // Every corner on the lines of its two edges, with its link part.
-    let mut lines: FastMap<LineKey, Vec<(u32, u8)>> = FastMap::default();
+    let mut lines: HashMap<LineKey, Vec<(u32, u8)>> = HashMap::new();
     for rect in &rects {
         let (b, c) = others(rect.a);
         for (p, q) in rect.corners() {
@@ -404,7 +404,7 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
     }
     let mut mesh = SurfaceMesh::default();
     // Vertices by doubled position and tag (link part, or 16 + full octant for a midpoint).
-    let mut ids: FastMap<([u64; 3], u8), u32> = FastMap::default();
+    let mut ids: HashMap<([u64; 3], u8), u32> = HashMap::new();
     let mut vertex = |mesh: &mut SurfaceMesh, doubled: [u64; 3], tag: u8| -> u32 {
         *ids.entry((doubled, tag)).or_insert_with(|| {
             mesh.vertices.push(doubled.map(|x| x as f64 / 2.0));
@@ -511,35 +511,6 @@ fn pinched(lattice: &mut Lattice<'_>, p: [u32; 3], d: usize, lo: u32) -> bool {
     let f = [full(0), full(1), full(2), full(3)];
     f == [true, false, false, true] || f == [false, true, true, false]
 }
-
-/// A fast hash for the lattice's small integer keys (Fx: multiply and rotate), in place of SipHash.
-#[derive(Default, Clone, Copy)]
-struct FxHasher(u64);
-
-impl std::hash::Hasher for FxHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-    fn write_u8(&mut self, x: u8) {
-        self.write_u64(u64::from(x));
-    }
-    fn write_u32(&mut self, x: u32) {
-        self.write_u64(u64::from(x));
-    }
-    fn write_usize(&mut self, x: usize) {
-        self.write_u64(x as u64);
-    }
-    fn write_u64(&mut self, x: u64) {
-        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-}
-
-type FastMap<K, V> = HashMap<K, V, std::hash::BuildHasherDefault<FxHasher>>;
 
 #[cfg(test)]
 mod tests {
