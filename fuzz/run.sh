@@ -2,7 +2,8 @@
 # Runs every fuzz target (or the TARGETs given) for SECONDS each (default 60) or FUZZ_RUNS executions
 # (default 10^7), whichever comes first, one after the other, and writes results/reliability.md:
 # executions, time, crashes, coverage and peak memory per target. Each target's latest run is kept in
-# fuzz/target/rows/, so a run of some targets updates their rows and keeps the others'.
+# fuzz/target/rows/, so a run of some targets updates their rows and keeps the others' (a target this
+# machine has not run keeps its row from the committed results/reliability.md).
 #
 #   fuzz/run.sh [SECONDS] [TARGET...]
 #
@@ -67,6 +68,13 @@ if [ "${FUZZ_NO_REPORT:-0}" = 1 ]; then
   exit $failed
 fi
 out=../results/reliability.md
+# A target this machine has not run keeps the row the committed record has for it.
+for t in $(cargo fuzz list); do
+  if [ ! -f "$rows_dir/$t.md" ] && [ -f "$out" ]; then
+    grep -F "| \`$t\` |" "$out" | grep -v "| not run |" >"$rows_dir/$t.md.tmp" && mv "$rows_dir/$t.md.tmp" "$rows_dir/$t.md"
+    rm -f "$rows_dir/$t.md.tmp"
+  fi
+done
 {
   echo "# Reliability: fuzzing"
   echo

@@ -14,7 +14,9 @@
 //!
 //! * [`space`]: the universe (level `L`, side `U = 2^L`), aligned cells, Morton keys.
 //! * [`rays`]: [`RaySet`], an object as sorted disjoint runs along the last axis, and maximal rows.
-//! * [`stacking`]: [`stacking::stack`], Akman & Franklin's stacking.
+//! * [`stacking`]: building trees — [`stacking::Builder`], the one entry point ([`KTree::from_rays`] runs it:
+//!   cells stacked apart on all threads, each through a bitmap pyramid by default, in memory or out of core
+//!   to a file), and [`stacking::paper`], Akman & Franklin's stacking as the paper gives it.
 //! * [`reference`](mod@reference): the reference builders the tests compare against (naive insertion, dense pyramid).
 //! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
@@ -35,18 +37,19 @@
 //!                     meshes written through export/)
 //!  export/            boundaries as meshes and outlines, and their files (over display's neighbours)
 //!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink
-//!  stacking/          the builders (the paper's list stacking; the partition, in memory or out of core)
+//!  stacking/          Builder (cells on all threads, in memory or out of core; KTree::from_rays), paper/
 //!  solid/             quadrics, meshes, volumes → rays, slab by slab
 //!  tree/              KTree, AnyTree, the storage trait, the walks, the level sink, packed 2-bit words
 //!  rays/   space   fs (atomic writes, spill folders)
 //! ```
-//! Not yet so: `KTree::from_rays` calls the builder (tree → stacking); the ray sources of `solid/` implement
-//! `stacking::RaySource` (solid → stacking); the out-of-core builder and the streamed Booleans write their
-//! output through `io::KtreeWriter` and read their inputs through `io::KtreeView` (stacking, ops → io).
+//! Not yet so: the ray sources of `solid/` implement `stacking::RaySource` (solid → stacking); the
+//! out-of-core builder and the streamed Booleans write their output through `io::KtreeWriter` and read their
+//! inputs through `io::KtreeView` (stacking, ops → io). (`KTree::from_rays` and `KTree::from_dense` are
+//! defined beside their builders, in `stacking/` and `reference/`: the tree knows no builder.)
 //!
 //! # Example
 //! ```
-//! use ktree::{stacking::stack, Ray, RaySet};
+//! use ktree::{stacking::paper::stack, Ray, RaySet};
 //! // Akman & Franklin's Fig. 3 ray in an octree universe of level 7.
 //! let rays = RaySet::<3>::from_rays(7, [Ray::new([1, 1, 17], 93)]).unwrap();
 //! let tree = stack(&rays);

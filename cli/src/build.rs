@@ -1,14 +1,16 @@
 //! `ktree build --rays FILE --out FILE.ktree [--threads N] [--max-memory SIZE] [--temp-dir DIR]
-//! [--progress]`: stack a ray file into a tree file (out of core: see [`crate::memory`]).
+//! [--progress]`: stack a ray file into a tree file (out of core: see [`crate::common::memory`]).
 
 use crate::outln;
 
 use std::path::PathBuf;
 
 use ktree::io::{open_rays_file, read_rays_file, RaysFile, RaysFileSource};
-use ktree::stacking::{default_split_depth, stack_partitioned, RaySource};
+use ktree::stacking::RaySource;
 use ktree::{AnyRaySet, AnyTree};
 use ktree::{KTree, LevelCounts, RaySet};
+
+use crate::common::threads::with_threads;
 
 /// Arguments of `ktree build`.
 #[derive(Debug, clap::Args)]
@@ -23,37 +25,13 @@ pub struct Args {
     #[arg(long)]
     threads: Option<usize>,
     #[command(flatten)]
-    build: crate::memory::BuildArgs,
-}
-
-/// Runs `work` on a pool of `threads` worker threads (all cores when `None`).
-pub fn with_threads<T: Send>(
-    threads: Option<usize>,
-    work: impl FnOnce() -> T + Send,
-) -> Result<T, String> {
-    Ok(thread_pool(threads)?.install(work))
-}
-
-/// A pool of `threads` worker threads (all cores when `None`).
-pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
-    if threads == Some(0) {
-        return Err("--threads 0: at least one thread is needed".into());
-    }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))
-}
-
-/// Stacks rays cell by cell on the current thread pool (see [`ktree::stacking::stack_partitioned`]).
-pub fn stack_cells<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
-    stack_partitioned(rays, default_split_depth(K, rays.level()))
+    build: crate::common::memory::BuildArgs,
 }
 
 /// Reads the rays, stacks them, writes the tree, and prints a one-line summary (in a run over several
 /// MPI ranks, every rank reads the whole ray file; rank 0 alone writes and prints).
 pub fn run(args: Args) -> Result<(), String> {
-    if crate::memory::out_of_core() {
+    if crate::common::memory::out_of_core() {
         // A sorted file is read slab by slab as the cells are stacked; another is read whole.
         let summary = match open_rays_file(&args.rays).map_err(|e| e.to_string())? {
             RaysFile::Sorted(source) => {
@@ -63,18 +41,19 @@ pub fn run(args: Args) -> Result<(), String> {
                 ktree::with_dim!(&rays, AnyRaySet, r => build_out_of_core(r, &args))?
             }
         };
-        return crate::rays::print_summary(&summary);
+        return crate::common::output::print_summary(&summary);
     }
-    crate::rays::one_process_for_version_1()?;
+    crate::common::output::one_process_for_version_1()?;
     let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
     let threads = args.threads;
     let tree = match &rays {
-        AnyRaySet::K1(r) => AnyTree::K1(with_threads(threads, || stack_cells(r))?),
-        AnyRaySet::K2(r) => AnyTree::K2(with_threads(threads, || stack_cells(r))?),
-        AnyRaySet::K3(r) => AnyTree::K3(with_threads(threads, || stack_cells(r))?),
-        AnyRaySet::K4(r) => AnyTree::K4(with_threads(threads, || stack_cells(r))?),
+        AnyRaySet::K1(r) => AnyTree::K1(with_threads(threads, || KTree::from_rays(r))?),
+        AnyRaySet::K2(r) => AnyTree::K2(with_threads(threads, || KTree::from_rays(r))?),
+        AnyRaySet::K3(r) => AnyTree::K3(with_threads(threads, || KTree::from_rays(r))?),
+        AnyRaySet::K4(r) => AnyTree::K4(with_threads(threads, || KTree::from_rays(r))?),
     };
-    let write = ktree::with_dim!(&tree, AnyTree, t => crate::tree_file::write(&args.out, t));
+    let write =
+        ktree::with_dim!(&tree, AnyTree, t => crate::common::tree_file::write_tree(&args.out, t));
     write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
     let c = tree.counts();
     outln!(
@@ -98,7 +77,7 @@ fn build_out_of_core<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<St
     let budget = args
         .build
         .budget
-        .left_after(&what, crate::memory::ray_bytes(rays))?;
+        .left_after(&what, crate::common::memory::ray_bytes(rays))?;
     let Some(report) =
         crate::distributed::build_to_file(rays, &args.out, args.threads, &args.build, budget)?
     else {

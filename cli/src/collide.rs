@@ -1,16 +1,11 @@
 //! `ktree collide A B [--time-axis N] [--json]`: interference detection between two `.ktree` files, with
-//! the minimum separation when they do not overlap.
+//! the minimum separation when they do not overlap (JSON keys: those of [`ktree::ops::Collision`]).
 
 use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::ops;
-use ktree::AnyTree;
-use ktree::KTree;
-use serde::Serialize;
-
-use crate::op::{read, with_pair};
+use crate::common::tree_file::{pair_error, read};
 
 /// Arguments of `ktree collide`.
 #[derive(Debug, clap::Args)]
@@ -28,46 +23,12 @@ pub struct Args {
     json: bool,
 }
 
-/// What is reported, with these JSON keys.
-#[derive(Debug, Serialize)]
-struct Report {
-    collide: bool,
-    overlap_cells: usize,
-    overlap_voxels: u128,
-    first_contact: Option<u32>,
-    /// Smallest distance between voxel centres of the two objects (voxels); null if one is empty.
-    min_separation: Option<f64>,
-}
-
-fn report<const K: usize>(
-    a: &KTree<K>,
-    b: &KTree<K>,
-    time_axis: Option<usize>,
-) -> Result<Report, String> {
-    let collide = ops::interferes(a, b).map_err(|e| e.to_string())?;
-    let overlap = ops::intersection(a, b).map_err(|e| e.to_string())?;
-    let first_contact = match time_axis {
-        Some(axis) => ops::first_contact(a, b, axis).map_err(|e| e.to_string())?,
-        None => None,
-    };
-    let min_separation = if collide {
-        Some(0.0)
-    } else {
-        ops::min_separation(a, b).map_err(|e| e.to_string())?
-    };
-    Ok(Report {
-        min_separation,
-        collide,
-        overlap_cells: overlap.full_cells().count(),
-        overlap_voxels: overlap.voxel_count(),
-        first_contact,
-    })
-}
-
 /// Prints whether the objects overlap, and where.
 pub fn run(args: Args) -> Result<(), String> {
     let (ta, tb) = (read(&args.a)?, read(&args.b)?);
-    let r = with_pair!(&ta, &tb, (&args.a, &args.b), (x, y) => report(x, y, args.time_axis))?;
+    let r = ta
+        .collision(&tb, args.time_axis)
+        .map_err(|e| pair_error(&args.a, &args.b, e))?;
     if args.json {
         outln!(
             "{}",

@@ -7,7 +7,7 @@ use crate::outln;
 use std::path::PathBuf;
 
 use ktree::io::{read_tree_placed, write_tree, Format, ReadOptions, WriteOptions};
-use ktree::solid::mesh::Placement;
+use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
 
 /// Arguments of `ktree convert`.
@@ -91,7 +91,7 @@ pub fn run(a: Args) -> Result<(), String> {
         mesh_placement: a
             .transform
             .as_deref()
-            .map(Placement::parse)
+            .map(MeshTransform::parse)
             .transpose()
             .map_err(|e| e.to_string())?,
         select: match (a.threshold, a.label) {
@@ -156,7 +156,7 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     if Format::of(&a.output) == Some(Format::Ktree) {
         // The version --format-version asks for, as every command that writes trees.
-        ktree::with_dim!(&read.tree, AnyTree, t => crate::tree_file::write(&a.output, t))
+        ktree::with_dim!(&read.tree, AnyTree, t => crate::common::tree_file::write_tree(&a.output, t))
             .map_err(|e| format!("cannot write {}: {e}", a.output.display()))?;
     } else {
         write_tree(&a.output, &read.tree, &write_options).map_err(|e| e.to_string())?;

@@ -9,7 +9,8 @@ use ktree::display::{line_drawing_with_progress, png, svg, HiddenLineMethod};
 use ktree::io::read_ktree_file;
 use ktree::AnyTree;
 
-use crate::render::{parse_size, parse_view, progress_bar};
+use crate::common::picture::{parse_size, parse_view};
+use crate::common::progress::progress_bar;
 
 /// Arguments of `ktree lines`.
 #[derive(Debug, clap::Args)]

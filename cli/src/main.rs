@@ -7,18 +7,17 @@ use clap::{Parser, Subcommand};
 
 mod build;
 mod collide;
+mod common;
 mod convert;
 mod distributed;
 mod lines;
 mod mass;
-mod memory;
 mod op;
 mod rays;
 mod render;
 mod repro;
 mod stats;
 mod transform;
-mod tree_file;
 mod voxelize;
 
 /// k-trees (bintrees, quadtrees, octrees, 4-D trees) from rays by stacking.
@@ -28,7 +27,7 @@ struct Cli {
     #[command(subcommand)]
     command: Command,
     #[command(flatten)]
-    format: tree_file::FormatArgs,
+    format: common::tree_file::FormatArgs,
 }
 
 #[derive(Debug, Subcommand)]
@@ -84,7 +83,7 @@ const BROKEN_PIPE: &str = "standard output closed";
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let _mpi = distributed::init();
-    tree_file::set(&cli.format);
+    common::tree_file::set(&cli.format);
     let outcome = match cli.command {
         Command::Build(args) => build::run(args),
         Command::Stats(args) => stats::run(args),

@@ -12,7 +12,7 @@ use ktree::ops;
 use ktree::KTree;
 use serde::Serialize;
 
-use crate::op::read;
+use crate::common::tree_file::read;
 
 /// Arguments of `ktree mass`.
 #[derive(Debug, clap::Args)]

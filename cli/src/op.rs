@@ -6,21 +6,18 @@
 //! files in `--temp-dir`; it is also faster than loading the trees. Otherwise (a version 1 file) the trees
 //! are read into memory, if they and the result fit in the budget (`--max-memory`).
 
-use crate::outln;
+use std::path::PathBuf;
 
-use std::path::{Path, PathBuf};
-
-use ktree::io::{ktree_file_version, read_ktree_file};
+use ktree::io::ktree_file_version;
 use ktree::ops::{self, BoolOp, BooleanFileReport};
-use ktree::AnyTree;
-use ktree::{KTree, LevelCounts};
+
+use crate::common::tree_file::{pair_error, print_summary, read, write};
 
 /// Arguments of `ktree op`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The operation: union, intersect, diff (A minus B), xor, or not (complement of A).
-    #[arg(value_parser = ["union", "intersect", "diff", "xor", "not"])]
-    operation: String,
+    operation: Operation,
     /// The input tree files: two for union/intersect/diff/xor, one for not.
     #[arg(required = true, num_args = 1..=2)]
     inputs: Vec<PathBuf>,
@@ -31,59 +28,40 @@ pub struct Args {
     #[arg(long)]
     threads: Option<usize>,
     #[command(flatten)]
-    budget: crate::memory::BudgetArgs,
+    budget: crate::common::memory::BudgetArgs,
     /// Folder for the temporary spill files of an operation streamed out of core (default: the output's
     /// folder).
     #[arg(long, value_name = "DIR")]
     temp_dir: Option<PathBuf>,
 }
 
-/// Reads a tree file, with the path in any error.
-pub fn read(path: &Path) -> Result<AnyTree, String> {
-    read_ktree_file(path).map_err(|e| e.to_string())
+/// The operations `ktree op` runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Operation {
+    /// A ∪ B.
+    Union,
+    /// A ∩ B.
+    Intersect,
+    /// A ∖ B.
+    Diff,
+    /// A △ B.
+    Xor,
+    /// The complement of A.
+    Not,
 }
 
-/// Writes a tree file and prints a one-line summary.
-pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> Result<(), String> {
-    crate::tree_file::write(path, tree)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    print_summary(path, K, tree.level(), &tree.counts_per_level())
-}
-
-/// Prints the one-line summary of a tree written to `path`, from its counts per level.
-fn print_summary(path: &Path, k: usize, level: u32, counts: &[LevelCounts]) -> Result<(), String> {
-    let c = LevelCounts::total(level, counts);
-    let voxels = crate::memory::voxels(k, level, counts);
-    outln!(
-        "{}: K = {k}, L = {level}, {} nodes ({} full, {} empty, {} partial), {voxels} voxels",
-        path.display(),
-        c.nodes(),
-        c.full,
-        c.empty,
-        c.partial,
-    );
-    Ok(())
-}
-
-/// Pairs two trees of the same dimension, or explains the mismatch.
-macro_rules! with_pair {
-    ($a:expr, $b:expr, $names:expr, ($x:ident, $y:ident) => $body:expr) => {
-        match ($a, $b) {
-            (AnyTree::K1($x), AnyTree::K1($y)) => $body,
-            (AnyTree::K2($x), AnyTree::K2($y)) => $body,
-            (AnyTree::K3($x), AnyTree::K3($y)) => $body,
-            (AnyTree::K4($x), AnyTree::K4($y)) => $body,
-            (x, y) => Err(format!(
-                "{} is a K = {} tree but {} is K = {}: both must have the same dimension",
-                $names.0.display(),
-                x.k(),
-                $names.1.display(),
-                y.k()
-            )),
+impl Operation {
+    /// The Boolean of two trees, or `None` for the complement.
+    fn binary(self) -> Option<BoolOp> {
+        match self {
+            Self::Union => Some(BoolOp::Union),
+            Self::Intersect => Some(BoolOp::Intersection),
+            Self::Diff => Some(BoolOp::Difference),
+            Self::Xor => Some(BoolOp::SymmetricDifference),
+            Self::Not => None,
         }
-    };
+    }
 }
-pub(crate) use with_pair;
 
 /// Checks that the operation fits in the budget: it holds its input trees (about as large in memory as in
 /// their files) and a result at most as large as them together.
@@ -113,7 +91,7 @@ fn check_budget(args: &Args) -> Result<(), String> {
 /// The operation streamed from the inputs' memory maps to the output, if the inputs and the output are
 /// `.ktree` version 2 files (`None` otherwise).
 fn stream_op(args: &Args) -> Option<Result<(), String>> {
-    let all_v2 = crate::tree_file::version() == 2
+    let all_v2 = crate::common::tree_file::version() == 2
         && args
             .inputs
             .iter()
@@ -123,13 +101,8 @@ fn stream_op(args: &Args) -> Option<Result<(), String>> {
     }
     let temp = args.temp_dir.as_deref();
     let report: Result<BooleanFileReport, _> = match args.inputs.as_slice() {
-        [a] if args.operation == "not" => ops::complement_file(a, &args.out, temp),
-        [a, b] => {
-            let op = BoolOp::ALL
-                .into_iter()
-                .find(|o| o.name() == args.operation)?;
-            ops::boolean_files(a, b, op, &args.out, temp)
-        }
+        [a] if args.operation == Operation::Not => ops::complement_file(a, &args.out, temp),
+        [a, b] => ops::boolean_files(a, b, args.operation.binary()?, &args.out, temp),
         _ => return None,
     };
     Some(
@@ -142,7 +115,7 @@ fn stream_op(args: &Args) -> Option<Result<(), String>> {
 /// Runs the operation and writes the result, on a pool of `--threads` worker threads.
 pub fn run(args: Args) -> Result<(), String> {
     let threads = args.threads;
-    crate::build::with_threads(threads, || run_op(args))?
+    crate::common::threads::with_threads(threads, || run_op(args))?
 }
 
 fn run_op(args: Args) -> Result<(), String> {
@@ -150,26 +123,20 @@ fn run_op(args: Args) -> Result<(), String> {
         return streamed;
     }
     check_budget(&args)?;
-    if args.operation == "not" {
+    let Some(op) = args.operation.binary() else {
         let [a] = args.inputs.as_slice() else {
             return Err("`ktree op not` takes exactly one input tree".into());
         };
-        let tree = read(a)?;
-        return ktree::with_dim!(&tree, AnyTree, t => write(&args.out, &ops::complement(t)));
-    }
+        let out = read(a)?.complement();
+        return ktree::with_dim!(&out, AnyTree, t => write(&args.out, t));
+    };
     let [a, b] = args.inputs.as_slice() else {
         return Err(format!(
             "`ktree op {}` takes exactly two input trees",
-            args.operation
+            op.name()
         ));
     };
-    let op = BoolOp::ALL
-        .into_iter()
-        .find(|o| o.name() == args.operation)
-        .ok_or_else(|| format!("unknown operation {}", args.operation))?;
     let (ta, tb) = (read(a)?, read(b)?);
-    with_pair!(&ta, &tb, (a, b), (x, y) => {
-        let out = ops::boolean(x, y, op).map_err(|e| format!("{} and {}: {e}", a.display(), b.display()))?;
-        write(&args.out, &out)
-    })
+    let out = ta.boolean(&tb, op).map_err(|e| pair_error(a, b, e))?;
+    ktree::with_dim!(&out, AnyTree, t => write(&args.out, t))
 }

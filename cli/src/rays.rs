@@ -5,13 +5,13 @@ use crate::outln;
 use std::path::{Path, PathBuf};
 
 use ktree::fs::write_atomic_with;
-use ktree::io::{write_rays_file, write_rays_source};
+use ktree::io::write_rays_source;
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{default_split_depth, stack_source};
-use ktree::{LevelCounts, RaySet};
+use ktree::stacking::{default_split_depth, Builder};
+use ktree::LevelCounts;
 
-use crate::build::with_threads;
-use crate::memory::BuildArgs;
+use crate::common::output::{is_tree_file, one_process_for_version_1};
+use crate::common::threads::with_threads;
 
 /// Arguments of `ktree rays`.
 #[derive(Debug, clap::Args)]
@@ -69,7 +69,7 @@ pub struct Args {
     #[arg(long)]
     threads: Option<usize>,
     #[command(flatten)]
-    build: crate::memory::BuildArgs,
+    build: crate::common::memory::BuildArgs,
 }
 
 fn numbers(text: &str, n: usize, what: &str) -> Result<Vec<Rational>, String> {
@@ -147,84 +147,13 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
     Ok(Solid::Quadric(q))
 }
 
-/// Writes rays as text, or stacks them into a `.ktree` file, by the output's extension; returns a summary.
-/// A tree of format version 2 is built out of core in the budget of `build` less what the rays hold (see
-/// [`crate::memory`]), across the MPI ranks of the run if several: every rank holds the rays whole, rank 0
-/// alone writes and returns the summary (the others return an empty one). Version 1 is built in memory by
-/// one process.
-pub fn write_output<const K: usize>(
-    rays: &RaySet<K>,
-    out: &Path,
-    threads: Option<usize>,
-    build: &BuildArgs,
-) -> Result<String, String> {
-    if is_tree_file(out) {
-        let counts = if crate::memory::out_of_core() {
-            let budget = build
-                .budget
-                .left_after("the rays", crate::memory::ray_bytes(rays))?;
-            match crate::distributed::build_to_file(rays, out, threads, build, budget)? {
-                Some(report) => report.counts_per_level,
-                None => return Ok(String::new()),
-            }
-        } else {
-            one_process_for_version_1()?;
-            let tree = with_threads(threads, || crate::build::stack_cells(rays))?;
-            crate::tree_file::write(out, &tree)
-                .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
-            tree.counts_per_level()
-        };
-        let c = LevelCounts::total(rays.level(), &counts);
-        Ok(format!(
-            "{}: K = {K}, L = {}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
-            out.display(),
-            rays.level(),
-            rays.len(),
-            rays.voxel_count(),
-            c.nodes(),
-            c.full,
-            c.empty,
-            c.partial
-        ))
-    } else if !crate::distributed::ranks().is_root() {
-        Ok(String::new())
-    } else {
-        write_rays_file(out, rays).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
-        Ok(format!(
-            "{}: K = {K}, L = {}, {} rays, {} voxels",
-            out.display(),
-            rays.level(),
-            rays.len(),
-            rays.voxel_count()
-        ))
-    }
-}
-
-/// Trees of format version 1 are built in memory by one process: an error in a run over several MPI
-/// ranks.
-pub fn one_process_for_version_1() -> Result<(), String> {
-    if crate::distributed::ranks().size > 1 {
-        return Err(
-            "--format-version 1: trees of version 1 are written by one process; across MPI ranks, \
-             write version 2 (and convert it with `ktree convert` if needed)"
-                .into(),
-        );
-    }
-    Ok(())
-}
-
-/// Whether an output path names a tree file (`.ktree`) rather than a ray file.
-pub fn is_tree_file(out: &Path) -> bool {
-    out.extension().is_some_and(|e| e == "ktree")
-}
-
 /// The summary of a tree written to `out`, from its counts per level.
 fn tree_summary<const K: usize>(out: &Path, level: u32, counts: &[LevelCounts]) -> String {
     let c = LevelCounts::total(level, counts);
     format!(
         "{}: K = {K}, L = {level}, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
         out.display(),
-        crate::memory::voxels(K, level, counts),
+        crate::common::memory::voxels(K, level, counts),
         c.nodes(),
         c.full,
         c.empty,
@@ -243,7 +172,7 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole
         // (across MPI ranks, each rank makes the rays of its own slabs only).
         let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
-        let counts = if crate::memory::out_of_core() {
+        let counts = if crate::common::memory::out_of_core() {
             let budget = a.build.budget.budget();
             match crate::distributed::build_to_file(&source, &a.out, a.threads, &a.build, budget)? {
                 Some(report) => report.counts_per_level,
@@ -251,10 +180,9 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
             }
         } else {
             one_process_for_version_1()?;
-            let depth = default_split_depth(K, a.level);
-            let tree = with_threads(a.threads, || stack_source(&source, depth))?
+            let tree = with_threads(a.threads, || Builder::new(&source).build())?
                 .map_err(|e| e.to_string())?;
-            crate::tree_file::write(&a.out, &tree)
+            crate::common::tree_file::write_tree(&a.out, &tree)
                 .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
             tree.counts_per_level()
         };
@@ -267,7 +195,7 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
     }
     // A ray file, written slab by slab: one slab's runs held at a time, no cap on their number.
     let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
-    let bar = crate::render::progress_bar(a.build.progress, "writing slabs");
+    let bar = crate::common::progress::progress_bar(a.build.progress, "writing slabs");
     let progress = |done: u64, total: u64| {
         if let Some(bar) = &bar {
             bar.set_length(total);
@@ -291,14 +219,6 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
         written.0,
         written.1
     );
-    Ok(())
-}
-
-/// Prints a command's summary line, if it has one (ranks other than 0 of an MPI run have none).
-pub fn print_summary(summary: &str) -> Result<(), String> {
-    if !summary.is_empty() {
-        outln!("{summary}");
-    }
     Ok(())
 }
 

@@ -6,10 +6,13 @@ use crate::outln;
 
 use std::path::{Path, PathBuf};
 
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
+
+use crate::common::picture::{parse_size, parse_vec3, parse_view};
+use crate::common::progress::progress_bar;
 use ktree::display::{
     default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
-    RenderOptions, ISO_TOWARD_EYE,
+    RenderOptions,
 };
 use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, MappedTree};
 use ktree::tree::cursor::LevelOrder;
@@ -60,76 +63,6 @@ pub struct Args {
     /// Show a progress bar.
     #[arg(long)]
     progress: bool,
-}
-
-/// Parses `WxH`.
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("size '{s}' must be WIDTHxHEIGHT, e.g. 800x600"))?;
-    let p = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("size '{s}' must be WIDTHxHEIGHT with whole numbers"))
-    };
-    let (w, h) = (p(w)?, p(h)?);
-    ktree::display::check_size(w, h).map_err(|e| e.to_string())?;
-    Ok((w, h))
-}
-
-/// Parses `X,Y,Z`.
-pub fn parse_vec3(s: &str, what: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    let bad = || format!("{what} '{s}' must be three numbers X,Y,Z");
-    if parts.len() != 3 {
-        return Err(bad());
-    }
-    let mut v = [0.0f64; 3];
-    for (x, p) in v.iter_mut().zip(parts) {
-        *x = p.trim().parse().map_err(|_| bad())?;
-        if !x.is_finite() {
-            return Err(bad());
-        }
-    }
-    Ok(v)
-}
-
-/// A named view or a direction `X,Y,Z`, from the object towards the eye.
-pub fn parse_view(s: &str) -> Result<[f64; 3], String> {
-    Ok(match s {
-        "iso" => ISO_TOWARD_EYE,
-        "top" => [0.0, 0.0, 1.0],
-        "bottom" => [0.0, 0.0, -1.0],
-        "front" => [0.0, -1.0, 0.0],
-        "back" => [0.0, 1.0, 0.0],
-        "right" => [1.0, 0.0, 0.0],
-        "left" => [-1.0, 0.0, 0.0],
-        other => {
-            let v = parse_vec3(other, "view").map_err(|_| {
-                format!(
-                    "view '{other}' must be iso, top, bottom, front, back, left, right or X,Y,Z"
-                )
-            })?;
-            if v.iter().all(|&x| x == 0.0) {
-                return Err("the view direction must not be zero".into());
-            }
-            v
-        }
-    })
-}
-
-/// A progress bar that the library's callbacks can drive, or none.
-pub fn progress_bar(enabled: bool, what: &str) -> Option<ProgressBar> {
-    enabled.then(|| {
-        let bar = ProgressBar::new(1);
-        bar.set_style(
-            ProgressStyle::with_template("{msg} [{bar:40}] {percent}% {elapsed}")
-                .expect("valid template")
-                .progress_chars("=> "),
-        );
-        bar.set_message(what.to_string());
-        bar
-    })
 }
 
 fn default_out(file: &Path) -> PathBuf {

@@ -54,7 +54,7 @@ pub fn run(args: Args) -> Result<(), String> {
             .stats(None),
         (None, Some(path)) => {
             let rays = read_rays_file(path).map_err(|e| e.to_string())?;
-            rays.stack().stats(Some(rays.len() as u64))
+            rays.build().stats(Some(rays.len() as u64))
         }
         _ => return Err("give either a .ktree file or --rays FILE".into()),
     };

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use ktree::ops::{self, Affine, AxisMap, Projective};
 use ktree::KTree;
 
-use crate::op::{read, write};
+use crate::common::tree_file::{read, write};
 
 /// Arguments of `ktree transform`.
 #[derive(Debug, clap::Args)]

@@ -9,13 +9,13 @@ use std::path::{Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
 use ktree::io::{voxel_source, voxelize, Format, ReadOptions, VoxelSource};
-use ktree::solid::mesh::Placement;
+use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
 use ktree::stacking::{RaySource, SlabRuns};
 use ktree::{LevelCounts, Universe};
 
-use crate::build::with_threads;
-use crate::rays::{is_tree_file, write_output};
+use crate::common::output::{is_tree_file, write_output};
+use crate::common::threads::with_threads;
 
 /// Arguments of `ktree voxelize`.
 #[derive(Debug, clap::Args)]
@@ -47,7 +47,7 @@ pub struct Args {
     #[arg(long)]
     threads: Option<usize>,
     #[command(flatten)]
-    build: crate::memory::BuildArgs,
+    build: crate::common::memory::BuildArgs,
 }
 
 /// Voxelizes the input and writes it.
@@ -61,7 +61,7 @@ pub fn run(a: Args) -> Result<(), String> {
             return Err("--level L is required for a mesh".into());
         }
         options.mesh_placement = match (&a.transform, a.fit) {
-            (Some(t), _) => Some(Placement::parse(t).map_err(|e| e.to_string())?),
+            (Some(t), _) => Some(MeshTransform::parse(t).map_err(|e| e.to_string())?),
             (None, true) => None,
             (None, false) => return Err("a mesh needs --fit or --transform s,tx,ty,tz".into()),
         };
@@ -89,7 +89,9 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     // In a run over several MPI ranks, rank 0 alone reports.
     let root = crate::distributed::ranks().is_root();
-    if is_tree_file(&a.out) && crate::memory::out_of_core() && crate::distributed::ranks().size == 1
+    if is_tree_file(&a.out)
+        && crate::common::memory::out_of_core()
+        && crate::distributed::ranks().size == 1
     {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
         // (Across MPI ranks, every rank makes the rays whole and keeps its slabs: `write_output`.)
@@ -100,7 +102,7 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     let v = voxelize(&a.input, &options).map_err(|e| e.to_string())?;
     remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
-    crate::rays::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?)?;
+    crate::common::output::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?)?;
     Ok(())
 }
 
@@ -135,7 +137,7 @@ fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
     let budget = a.build.budget.left_after(&what, source.heap_bytes())?;
     let counted = CountedRuns::new(source);
     let report = with_threads(a.threads, || {
-        crate::memory::build_to_file(&counted, &a.out, &a.build, budget)
+        crate::common::memory::build_to_file(&counted, &a.out, &a.build, budget)
     })??;
     let level = source.universe().level();
     let c = LevelCounts::total(level, &report.counts_per_level);
@@ -143,7 +145,7 @@ fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
         "{}: K = 3, L = {level}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
         a.out.display(),
         counted.runs(),
-        crate::memory::voxels(3, level, &report.counts_per_level),
+        crate::common::memory::voxels(3, level, &report.counts_per_level),
         c.nodes(),
         c.full,
         c.empty,

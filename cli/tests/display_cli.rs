@@ -7,7 +7,7 @@ use common::ktree;
 
 use ktree::io::write_ktree_file;
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 
 fn is_png(path: &std::path::Path) -> bool {
     std::fs::read(path).is_ok_and(|b| b.starts_with(b"\x89PNG"))

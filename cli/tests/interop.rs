@@ -10,7 +10,7 @@ use std::process::{Command, Stdio};
 use common::{data_dir, ktree};
 use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::AnyTree;
 use ktree::{KTree, NodeState};
 

@@ -10,7 +10,7 @@ use std::path::Path;
 use ktree::io::{read_ktree_file, write_ktree_file};
 use ktree::ops::{self, Affine, AxisMap};
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::KTree;
 
 fn load3(path: &Path) -> KTree<3> {

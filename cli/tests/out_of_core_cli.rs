@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use common::{entries, ktree, SmallDisk};
 use ktree::io::{read_rays_file, write_ktree};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::AnyRaySet;
 
 /// The bytes of the tree of a ray file built in memory, as `.ktree` version 2.

@@ -44,7 +44,7 @@ fn rays_writes_the_library_result() {
     assert!(ok, "{err}");
     assert_eq!(
         read_ktree_file(&tree).unwrap().counts().full as usize,
-        ktree::stacking::stack(&want).counts().full as usize
+        ktree::stacking::paper::stack(&want).counts().full as usize
     );
 }
 

@@ -8,9 +8,9 @@ use std::path::Path;
 
 use common::ktree;
 use ktree::io::{read_rays_file, voxelize, write_ktree, ReadOptions};
-use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::solid::volume::Select;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::AnyRaySet;
 
 /// The bytes of the tree of a ray set built in memory, as `.ktree` version 2.
@@ -50,8 +50,8 @@ fn voxelize_builds_meshes_and_volumes_slab_by_slab() {
         brain.to_str().unwrap(),
     );
     // The bunny smaller, shifted along x and partly below the universe (crossings clamped to its face).
-    let fit = Placement::fit(&TriangleMesh::read(Path::new(bunny)).unwrap(), 6).unwrap();
-    let bunny_transform = Placement {
+    let fit = MeshTransform::fit(&TriangleMesh::read(Path::new(bunny)).unwrap(), 6).unwrap();
+    let bunny_transform = MeshTransform {
         scale: fit.scale * 0.75,
         translate: [
             fit.translate[0] + 21.0,
@@ -79,7 +79,7 @@ fn voxelize_builds_meshes_and_volumes_slab_by_slab() {
             ],
             ReadOptions {
                 level: Some(6),
-                mesh_placement: Some(Placement::parse(&bunny_transform).unwrap()),
+                mesh_placement: Some(MeshTransform::parse(&bunny_transform).unwrap()),
                 ..ReadOptions::default()
             },
         ),

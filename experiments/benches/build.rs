@@ -9,7 +9,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use ktree::rays::ball_rays;
 use ktree::{
     reference::{DensePyramid, NaiveTree},
-    stacking::stack,
+    stacking::paper::stack,
 };
 
 fn builders(c: &mut Criterion) {

@@ -12,7 +12,7 @@ use ktree::display::{
     RenderOptions, ISO_TOWARD_EYE,
 };
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::Octree;
 
 fn ball(level: u32) -> Octree {

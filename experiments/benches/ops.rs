@@ -10,7 +10,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use ktree::ops::{self, Affine, AxisMap, BoolOp};
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::KTree;
 
 fn spheres(level: u32) -> (KTree<3>, KTree<3>) {

@@ -8,7 +8,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{default_split_depth, stack, stack_source};
+use ktree::stacking::{default_split_depth, paper::stack, Builder};
 
 fn sphere(level: u32) -> Solid<3> {
     let u = 1i64 << level;
@@ -30,13 +30,16 @@ fn partitioned(c: &mut Criterion) {
         let source = SolidSource::new(&solid, level, Sample::Centre).unwrap();
         let depth = default_split_depth(3, level);
         let whole = stack(&solid.to_rays(level, Sample::Centre, false).unwrap());
-        assert_eq!(one.install(|| stack_source(&source, depth).unwrap()), whole);
+        assert_eq!(
+            one.install(|| Builder::new(&source).split_depth(depth).build().unwrap()),
+            whole
+        );
         group.throughput(Throughput::Elements(whole.node_count()));
         group.bench_function(BenchmarkId::new("cells-1-thread", level), |b| {
-            b.iter(|| one.install(|| stack_source(&source, depth).unwrap()))
+            b.iter(|| one.install(|| Builder::new(&source).split_depth(depth).build().unwrap()))
         });
         group.bench_function(BenchmarkId::new("cells-all-cores", level), |b| {
-            b.iter(|| all.install(|| stack_source(&source, depth).unwrap()))
+            b.iter(|| all.install(|| Builder::new(&source).split_depth(depth).build().unwrap()))
         });
         group.bench_function(BenchmarkId::new("whole-set", level), |b| {
             b.iter(|| stack(&solid.to_rays(level, Sample::Centre, false).unwrap()))

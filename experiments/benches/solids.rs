@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use ktree::rays::ball_rays;
-use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample};
 
 fn quadrics(c: &mut Criterion) {
@@ -39,7 +39,7 @@ fn meshes(c: &mut Criterion) {
     for name in ["bunny_npm.obj", "armadillo.obj"] {
         let mesh = TriangleMesh::read(&dir.join(name)).expect("mesh");
         let level = 10;
-        let p = Placement::fit(&mesh, level).expect("fit");
+        let p = MeshTransform::fit(&mesh, level).expect("fit");
         group.bench_with_input(BenchmarkId::new(name, level), &mesh, |b, m| {
             b.iter(|| m.to_rays(level, &p).expect("rays"))
         });

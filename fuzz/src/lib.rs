@@ -5,7 +5,7 @@ use std::path::Path;
 use arbitrary::Arbitrary;
 use ktree::io::{read_ktree_any, read_rays, write_ktree, write_ktree_v1, write_rays, KtreeFileError, KtreeView};
 use ktree::{AnyRaySet, AnyTree};
-use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
 use ktree::{max_level, KTree, Universe};
 
@@ -140,7 +140,7 @@ pub fn check_accepted_rays(rays: &AnyRaySet) {
     // about one node a voxel: stacked only when the voxels are few too.
     let voxels: u128 = ktree::with_dim!(rays, AnyRaySet, r => r.voxel_count());
     if rays.level() <= CHECK_LEVEL + 1 || (rays.len() <= 64 && voxels <= 1 << 16) {
-        let tree = rays.stack();
+        let tree = rays.build();
         check_tree(&tree);
         let bytes = ktree_bytes(&tree);
         let reread = read_ktree_any(&bytes, "stacked").expect("a stacked tree reads back");
@@ -154,9 +154,9 @@ pub fn check_mesh(bytes: &[u8], format: &str) {
     let Ok(mesh) = TriangleMesh::from_bytes(bytes, format, Path::new("fuzz")) else {
         return;
     };
-    if let Ok(placement) = Placement::fit(&mesh, CHECK_LEVEL) {
+    if let Ok(placement) = MeshTransform::fit(&mesh, CHECK_LEVEL) {
         if let Ok(r) = mesh.to_rays(CHECK_LEVEL, &placement) {
-            let _ = ktree::stacking::stack(&r.rays);
+            let _ = ktree::stacking::paper::stack(&r.rays);
         }
     }
     let _ = (mesh.signed_volume(), mesh.surface_area(), mesh.open_edges());

@@ -18,7 +18,7 @@ use ktree::solid::{Frame, Quadric, Rational, Sample};
 use ktree::Ray;
 use ktree::{
     reference::{DensePyramid, NaiveTree},
-    stacking::{stack, stack_with_stats},
+    stacking::paper::{stack, stack_with_stats},
 };
 use plots::{Plot, Series};
 use search::{search, Convention, Family, Hit, Shape};

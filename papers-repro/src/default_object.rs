@@ -7,7 +7,7 @@ use std::path::Path;
 
 use ktree::fs::write_atomic;
 use ktree::rays::ball_rays;
-use ktree::stacking::stack_with_stats;
+use ktree::stacking::paper::stack_with_stats;
 
 /// Universe level of the default object.
 pub const LEVEL: u32 = 5;

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 use ktree::display::{self, HiddenLineMethod, RenderOptions, ISO_TOWARD_EYE};
 use ktree::ops::{self, BoolOp};
-use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
 use ktree::space::{Universe, DENSE_LIMIT};
 use ktree::AnyTree;
@@ -30,23 +30,6 @@ mod rays;
 
 use failure::Failure;
 use geometry::Factor;
-
-/// Runs `$body` on two trees of the same dimension, or fails naming both dimensions.
-macro_rules! with_pair {
-    ($a:expr, $b:expr, ($x:ident, $y:ident) => $body:expr) => {
-        match ($a, $b) {
-            (AnyTree::K1($x), AnyTree::K1($y)) => $body,
-            (AnyTree::K2($x), AnyTree::K2($y)) => $body,
-            (AnyTree::K3($x), AnyTree::K3($y)) => $body,
-            (AnyTree::K4($x), AnyTree::K4($y)) => $body,
-            (x, y) => Err(Failure::Value(format!(
-                "a K = {} tree and a K = {} tree: both must have the same dimension",
-                x.k(),
-                y.k()
-            ))),
-        }
-    };
-}
 
 /// Runs `$body` with `K` bound as a constant, for `$k` in 1…4, or fails.
 macro_rules! with_k {
@@ -141,33 +124,18 @@ fn array_of_tree<const K: usize>(tree: &KTree<K>) -> Result<ArrayD<bool>, Failur
 /// A view direction from the object towards the viewer: a name or three numbers.
 fn view_direction(view: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
     if let Ok(name) = view.cast::<PyString>() {
-        let name = name.to_str()?;
-        let v = match name {
-            "iso" => ISO_TOWARD_EYE,
-            "top" => [0.0, 0.0, 1.0],
-            "bottom" => [0.0, 0.0, -1.0],
-            "front" => [0.0, -1.0, 0.0],
-            "back" => [0.0, 1.0, 0.0],
-            "right" => [1.0, 0.0, 0.0],
-            "left" => [-1.0, 0.0, 0.0],
-            other => {
-                return Err(Failure::Value(format!(
-                    "view '{other}' must be iso, top, bottom, front, back, left, right or three numbers"
-                ))
-                .into())
-            }
-        };
-        return Ok(v);
+        let view: display::View = name
+            .to_str()?
+            .parse()
+            .map_err(|e: display::ViewError| Failure::Value(e.to_string()))?;
+        return Ok(view.toward_eye());
     }
     let v: [f64; 3] = view.extract().map_err(|_| {
         Failure::Value("a view is a name or three numbers (x, y, z) towards the viewer".into())
     })?;
-    if v.iter().any(|x| !x.is_finite()) || v.iter().all(|&x| x == 0.0) {
-        return Err(
-            Failure::Value(format!("view direction {v:?} must be finite and not zero")).into(),
-        );
-    }
-    Ok(v)
+    display::View::new(v)
+        .map(|v| v.toward_eye())
+        .map_err(|e| Failure::Value(e.to_string()).into())
 }
 
 /// The plane of a rotation: an axis name in 3-D or a pair of axes.
@@ -193,7 +161,7 @@ fn placement(
     mesh: &TriangleMesh,
     level: u32,
     transform: Option<[f64; 4]>,
-) -> Result<Placement, Failure> {
+) -> Result<MeshTransform, Failure> {
     match transform {
         Some([scale, tx, ty, tz]) => {
             if !(scale.is_finite() && tx.is_finite() && ty.is_finite() && tz.is_finite()) {
@@ -202,12 +170,12 @@ fn placement(
                     [scale, tx, ty, tz]
                 )));
             }
-            Ok(Placement {
+            Ok(MeshTransform {
                 scale,
                 translate: [tx, ty, tz],
             })
         }
-        None => Ok(Placement::fit(mesh, level)?),
+        None => Ok(MeshTransform::fit(mesh, level)?),
     }
 }
 
@@ -222,7 +190,7 @@ fn mesh_tree(
     let (tree, open_edges) = py.detach(|| -> Result<_, Failure> {
         let placed = placement(&mesh, level, transform)?;
         let r = mesh.to_rays(level, &placed)?;
-        Ok((ktree::stacking::stack(&r.rays), r.open_edges))
+        Ok((KTree::from_rays(&r.rays), r.open_edges))
     })?;
     if open_edges > 0 {
         let message = format!(
@@ -237,9 +205,7 @@ fn mesh_tree(
 
 /// Runs a Boolean operation without the interpreter lock.
 fn boolean(py: Python<'_>, a: &Tree, b: &Tree, op: BoolOp) -> PyResult<Tree> {
-    let out = py.detach(|| {
-        with_pair!(&a.inner, &b.inner, (x, y) => ops::boolean(x, y, op).map(AnyTree::from).map_err(Failure::from))
-    })?;
+    let out = py.detach(|| a.inner.boolean(&b.inner, op).map_err(Failure::from))?;
     Ok(Tree { inner: out })
 }
 
@@ -295,7 +261,7 @@ impl Tree {
         );
         let tree = with_k!(view.ncols().wrapping_sub(1), what, K => {
             let set = rays::rays_of_array::<K>(view, level)?;
-            Ok(AnyTree::from(py.detach(|| ktree::stacking::stack(&set))))
+            Ok(AnyTree::from(py.detach(|| KTree::from_rays(&set))))
         })?;
         Ok(Self { inner: tree })
     }
@@ -393,7 +359,7 @@ impl Tree {
             let v = Volume::read(&path)?;
             let level = level.unwrap_or_else(|| v.fitting_level());
             let rays = v.to_rays(level, [offset.0, offset.1, offset.2], select)?;
-            Ok(ktree::stacking::stack(&rays))
+            Ok(KTree::from_rays(&rays))
         })?;
         Ok(Self::wrap(tree))
     }
@@ -642,7 +608,7 @@ impl Tree {
 
     /// Whether the two objects share a voxel (same K and level).
     fn interferes(&self, py: Python<'_>, other: &Tree) -> PyResult<bool> {
-        Ok(py.detach(|| with_pair!(&self.inner, &other.inner, (a, b) => ops::interferes(a, b).map_err(Failure::from)))?)
+        Ok(py.detach(|| self.inner.interferes(&other.inner).map_err(Failure::from))?)
     }
 
     /// Interference as a dict with the keys of `ktree collide --json`: collide, overlap_cells,
@@ -656,24 +622,17 @@ impl Tree {
         other: &Tree,
         time_axis: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (collide, cells, voxels, first, separation) = py.detach(|| {
-            with_pair!(&self.inner, &other.inner, (a, b) => (|| -> Result<_, Failure> {
-                let collide = ops::interferes(a, b)?;
-                let overlap = ops::intersection(a, b)?;
-                let first = match time_axis {
-                    Some(axis) => ops::first_contact(a, b, axis)?,
-                    None => None,
-                };
-                let separation = if collide { Some(0.0) } else { ops::min_separation(a, b)? };
-                Ok((collide, overlap.full_cells().count(), overlap.voxel_count(), first, separation))
-            })())
+        let c = py.detach(|| {
+            self.inner
+                .collision(&other.inner, time_axis)
+                .map_err(Failure::from)
         })?;
         let d = PyDict::new(py);
-        d.set_item("collide", collide)?;
-        d.set_item("overlap_cells", cells)?;
-        d.set_item("overlap_voxels", voxels)?;
-        d.set_item("first_contact", first)?;
-        d.set_item("min_separation", separation)?;
+        d.set_item("collide", c.collide)?;
+        d.set_item("overlap_cells", c.overlap_cells)?;
+        d.set_item("overlap_voxels", c.overlap_voxels)?;
+        d.set_item("first_contact", c.first_contact)?;
+        d.set_item("min_separation", c.min_separation)?;
         Ok(d)
     }
 

@@ -7,7 +7,7 @@
 //!
 //! ```
 //! use ktree::display::{default_camera, ISO_TOWARD_EYE};
-//! use ktree::{rays::ball_rays, stacking::stack};
+//! use ktree::{rays::ball_rays, stacking::paper::stack};
 //! let ball = stack(&ball_rays::<3>(5, [32, 32, 32], 28).unwrap());
 //! let camera = default_camera(&ball, ISO_TOWARD_EYE, None, 100, 100).unwrap();
 //! assert!(!camera.is_perspective());

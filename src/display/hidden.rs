@@ -16,7 +16,7 @@
 //!
 //! ```
 //! use ktree::display::{line_drawing, HiddenLineMethod};
-//! use ktree::{rays::ball_rays, stacking::stack};
+//! use ktree::{rays::ball_rays, stacking::paper::stack};
 //! let ball = stack(&ball_rays::<3>(4, [16, 16, 16], 20).unwrap());
 //! let dir = [0.6, -1.0, 0.8];
 //! let pairwise = line_drawing(&ball, dir, HiddenLineMethod::Pairwise).unwrap();

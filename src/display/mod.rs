@@ -8,11 +8,12 @@
 //! * [`neighbours`]: face neighbours in the compact tree, without pointers.
 //! * [`lines`]: line drawings — visible edges with cracks, hidden lines and dots removed ([`hidden`] holds
 //!   the paper's pairwise hidden-line step and a faster bucketed one).
+//! * [`View`]: named views (`iso`, `top`, …, or `X,Y,Z`); [`render_png`]: an octree to a PNG in one call.
 //! * [`svg`], [`png`]: writers; [`plane`]: 2-D quadtree images; [`slices`]: 4-D trees as strips of frames.
 //!
 //! ```
 //! use ktree::display::{line_drawing, HiddenLineMethod, ISO_TOWARD_EYE};
-//! use ktree::{rays::ball_rays, stacking::stack};
+//! use ktree::{rays::ball_rays, stacking::paper::stack};
 //! let ball = stack(&ball_rays::<3>(4, [16, 16, 16], 20).unwrap());
 //! let drawing = line_drawing(&ball, ISO_TOWARD_EYE, HiddenLineMethod::Bucketed).unwrap();
 //! assert!(!drawing.lines.is_empty());
@@ -32,6 +33,7 @@ pub mod raster;
 mod sightline;
 pub mod slices;
 pub mod svg;
+mod view;
 
 pub use camera::{default_camera, object_bounds, Camera, Projection, ISO_TOWARD_EYE};
 pub use coverage::Coverage;
@@ -39,7 +41,10 @@ pub use error::{check_size, CameraProblem, DisplayError, MAX_IMAGE_SIDE, MAX_PIX
 pub use hidden::HiddenLineMethod;
 pub use lines::{line_drawing, line_drawing_with_progress, Edge3, LineDrawing, LineStats};
 pub use order::{near_child, ordered_full_cells, walk_ordered, Order, Viewer, Walk};
+#[cfg(feature = "png")]
+pub use raster::render_png;
 pub use raster::{
     render, render_back_to_front, render_with_progress, render_zbuffer, RenderOptions, RenderStats,
     Rendered,
 };
+pub use view::{View, ViewError, NAMED_VIEWS};

@@ -92,7 +92,7 @@ pub fn child_at<const K: usize>(near: usize, j: usize, order: Order) -> usize {
 ///
 /// ```
 /// use ktree::display::{walk_ordered, Order, Viewer, Walk};
-/// use ktree::{rays::ball_rays, stacking::stack};
+/// use ktree::{rays::ball_rays, stacking::paper::stack};
 /// let tree = stack(&ball_rays::<3>(4, [16, 16, 16], 14).unwrap());
 /// let mut full = 0;
 /// walk_ordered(&tree, Viewer::Direction([1.0, 0.5, -0.2]), Order::FrontToBack, |n| {

@@ -1,7 +1,7 @@
 //! 2-D quadtrees as pictures: full cells filled, every leaf's boundary drawn, so the decomposition shows.
 //!
 //! ```
-//! use ktree::{display::plane::quadtree_svg, rays::ball_rays, stacking::stack};
+//! use ktree::{display::plane::quadtree_svg, rays::ball_rays, stacking::paper::stack};
 //! let disk = stack(&ball_rays::<2>(4, [16, 16], 20).unwrap());
 //! let svg = quadtree_svg(&disk, 256);
 //! assert!(svg.starts_with("<svg") && svg.contains("<rect"));
@@ -23,7 +23,7 @@ const GRID: [u8; 3] = [150, 150, 150];
 /// detail stays readable).
 ///
 /// ```
-/// use ktree::{stacking::stack, rays::ball_rays, display::plane::quadtree_canvas};
+/// use ktree::{stacking::paper::stack, rays::ball_rays, display::plane::quadtree_canvas};
 /// let disk = stack(&ball_rays::<2>(5, [32, 32], 26).unwrap());
 /// let canvas = quadtree_canvas(&disk, 128).unwrap();
 /// assert_eq!(canvas.rgb.len(), 3 * 128 * 128);

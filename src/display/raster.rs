@@ -15,7 +15,7 @@
 //!
 //! ```
 //! use ktree::display::{default_camera, render, render_zbuffer, RenderOptions, ISO_TOWARD_EYE};
-//! use ktree::{rays::ball_rays, stacking::stack};
+//! use ktree::{rays::ball_rays, stacking::paper::stack};
 //! let ball = stack(&ball_rays::<3>(4, [16, 16, 16], 24).unwrap());
 //! let options = RenderOptions { width: 48, height: 48, ..Default::default() };
 //! let camera = default_camera(&ball, ISO_TOWARD_EYE, None, 48, 48).unwrap();
@@ -422,7 +422,7 @@ fn ray_normal(rays: &RaySet<3>, v: [u32; 3], axis: usize, dir: [f64; 3]) -> Opti
 ///
 /// ```
 /// use ktree::display::{default_camera, render, RenderOptions, ISO_TOWARD_EYE};
-/// use ktree::{stacking::stack, rays::ball_rays};
+/// use ktree::{stacking::paper::stack, rays::ball_rays};
 /// let tree = stack(&ball_rays::<3>(5, [32, 32, 32], 28).unwrap());
 /// let options = RenderOptions { width: 64, height: 64, ..Default::default() };
 /// let camera = default_camera(&tree, ISO_TOWARD_EYE, None, 64, 64).unwrap();
@@ -451,6 +451,40 @@ pub fn render_with_progress<T: LevelOrder<3>>(
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<Rendered, DisplayError> {
     front_to_back(tree, camera, options, Some(progress))
+}
+
+/// Renders the object in `tree` seen from `view` (orthographic, framed by [`default_camera`](super::default_camera)),
+/// `width × height` pixels, and writes it to `path` as a PNG (atomically); returns what was drawn.
+///
+/// ```
+/// use ktree::{display::{render_png, View}, rays::ball_rays, KTree};
+/// let ball = KTree::from_rays(&ball_rays::<3>(5, [32, 32, 32], 28).unwrap());
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("ball.png");
+/// let stats = render_png(&ball, View::default(), 64, 48, &path).unwrap();
+/// assert!(stats.painted > 500);
+/// assert_eq!(&std::fs::read(&path).unwrap()[1..4], b"PNG");
+/// ```
+///
+/// # Errors
+/// [`DisplayError::BadSize`], [`DisplayError::BadCamera`], or the PNG's encoding and writing errors.
+#[cfg(feature = "png")]
+pub fn render_png<T: LevelOrder<3>>(
+    tree: &T,
+    view: super::View,
+    width: u32,
+    height: u32,
+    path: &std::path::Path,
+) -> Result<RenderStats, DisplayError> {
+    let camera = super::default_camera(tree, view.toward_eye(), None, width, height)?;
+    let options = RenderOptions {
+        width,
+        height,
+        ..Default::default()
+    };
+    let image = render(tree, &camera, &options)?;
+    super::png::write_rgb_png(path, width, height, &image.rgb)?;
+    Ok(image.stats)
 }
 
 fn front_to_back<T: LevelOrder<3>>(

@@ -3,7 +3,7 @@
 //! camera, shows the motion.
 //!
 //! ```
-//! use ktree::{display::slices::slice_4d, rays::ball_rays, stacking::stack};
+//! use ktree::{display::slices::slice_4d, rays::ball_rays, stacking::paper::stack};
 //! // A 4-D ball; its slice at the middle of the fourth axis is a 3-D ball.
 //! let ball4 = stack(&ball_rays::<4>(3, [8, 8, 8, 8], 8).unwrap());
 //! let middle = slice_4d(&ball4, 3, 4).unwrap();
@@ -22,7 +22,7 @@ use crate::tree::{KTree, NodeRef, NodeState, Octree, Tree4};
 /// The octree of the 4-D tree's slice at `position` along `axis` (the remaining axes keep their order).
 ///
 /// ```
-/// use ktree::{stacking::stack, rays::ball_rays, display::slices::slice_4d};
+/// use ktree::{stacking::paper::stack, rays::ball_rays, display::slices::slice_4d};
 /// let ball4 = stack(&ball_rays::<4>(3, [8, 8, 8, 8], 8).unwrap());
 /// let middle = slice_4d(&ball4, 3, 4).unwrap();
 /// middle.assert_well_formed();

@@ -19,7 +19,7 @@ use super::rays::{read_rays_file, write_rays_file, RaysTextError};
 use crate::fs::write_atomic_with;
 use crate::rays::RaySet;
 use crate::solid::SolidError;
-use crate::tree::AnyTree;
+use crate::tree::{AnyTree, DimensionMismatch, KTree};
 
 /// A file format known to [`read_tree`] and [`write_tree`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -94,7 +94,7 @@ pub struct ReadOptions {
     /// Meshes: voxel = s·v + t. Default: the mesh scaled and centred into the universe with one voxel of
     /// margin.
     #[cfg(feature = "mesh")]
-    pub mesh_placement: Option<crate::solid::mesh::Placement>,
+    pub mesh_placement: Option<crate::solid::mesh::MeshTransform>,
     /// Volumes: which samples are inside (required for a volume).
     #[cfg(feature = "volume")]
     pub select: Option<crate::solid::volume::Select>,
@@ -157,6 +157,14 @@ pub enum IoError {
     /// Writing failed (the message names the file).
     #[error("{0}")]
     Write(#[source] std::io::Error),
+    /// The file holds a tree of another dimension than the one asked for.
+    #[error("{file}: {source}")]
+    Dimension {
+        /// The file.
+        file: String,
+        /// The dimensions.
+        source: DimensionMismatch,
+    },
 }
 
 fn usage(path: &Path, message: impl Into<String>) -> IoError {
@@ -182,7 +190,7 @@ fn format_of(path: &Path) -> Result<Format, IoError> {
 /// use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions};
 /// use ktree::AnyTree;
 /// let dir = tempfile::tempdir().unwrap();
-/// let tree = AnyTree::K3(ktree::stacking::stack(&ktree::rays::ball_rays::<3>(4, [8, 8, 8], 6).unwrap()));
+/// let tree = AnyTree::K3(ktree::stacking::paper::stack(&ktree::rays::ball_rays::<3>(4, [8, 8, 8], 6).unwrap()));
 /// for name in ["ball.ktree", "ball.rays", "ball.binvox", "ball.bt", "ball.vdb"] {
 ///     let path = dir.path().join(name);
 ///     write_tree(&path, &tree, &WriteOptions::default()).unwrap();
@@ -224,7 +232,7 @@ pub fn read_tree_placed(path: &Path, options: &ReadOptions) -> Result<ReadTree, 
             "this format is written only: read .ktree, .rays, .binvox, .bt, .vdb, a mesh or a volume",
         )),
         Format::Ktree => Ok(plain(read_ktree_file(path)?)),
-        Format::Rays => Ok(plain(read_rays_file(path)?.stack())),
+        Format::Rays => Ok(plain(read_rays_file(path)?.build())),
         Format::Binvox => Ok(grid(read_binvox(
             &bytes()?,
             &name,
@@ -259,7 +267,7 @@ pub fn read_tree_placed(path: &Path, options: &ReadOptions) -> Result<ReadTree, 
             }
             Ok(ReadTree {
                 remarks,
-                ..plain(AnyTree::K3(crate::stacking::stack(&v.rays)))
+                ..plain(AnyTree::K3(crate::KTree::from_rays(&v.rays)))
             })
         }
     }
@@ -388,14 +396,14 @@ pub struct VoxelizedSource {
 ///
 /// ```
 /// use ktree::io::{voxel_source, voxelize, ReadOptions};
-/// use ktree::stacking::{stack, stack_source};
+/// use ktree::stacking::{paper::stack, Builder};
 /// use std::path::Path;
 /// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/meshes/fandisk.obj");
 /// let options = ReadOptions { level: Some(5), ..ReadOptions::default() };
 /// let slabs = voxel_source(&path, &options).unwrap();
 /// let whole = voxelize(&path, &options).unwrap();
 /// assert_eq!((&slabs.fitted, slabs.open_edges), (&whole.fitted, whole.open_edges));
-/// assert_eq!(stack_source(&slabs.source, 2).unwrap(), stack(&whole.rays));
+/// assert_eq!(Builder::new(&slabs.source).split_depth(2).build().unwrap(), stack(&whole.rays));
 /// ```
 ///
 /// # Errors
@@ -443,12 +451,12 @@ fn mesh_input(
     (
         crate::solid::mesh::TriangleMesh,
         u32,
-        crate::solid::mesh::Placement,
+        crate::solid::mesh::MeshTransform,
         Option<String>,
     ),
     IoError,
 > {
-    use crate::solid::mesh::{Placement, TriangleMesh};
+    use crate::solid::mesh::{MeshTransform, TriangleMesh};
     let solid = solid_error(path);
     readable(path).map_err(&solid)?;
     let level = options
@@ -458,7 +466,7 @@ fn mesh_input(
     let (placement, fitted) = match options.mesh_placement {
         Some(p) => (p, None),
         None => {
-            let p = Placement::fit(&mesh, level).map_err(&solid)?;
+            let p = MeshTransform::fit(&mesh, level).map_err(&solid)?;
             (p, Some(p.to_arg()))
         }
     };
@@ -541,17 +549,26 @@ fn voxelize_volume(path: &Path, _: &ReadOptions) -> Result<Voxelized, IoError> {
 /// hold octrees; meshes octrees and quadtrees); [`IoError::Write`] for the file system or a placement the
 /// format cannot express.
 pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result<(), IoError> {
+    crate::with_dim!(tree, AnyTree, t => write_typed(path, t, options))
+}
+
+/// [`write_tree`] of a tree whose dimension is known.
+fn write_typed<const K: usize>(
+    path: &Path,
+    tree: &KTree<K>,
+    options: &WriteOptions,
+) -> Result<(), IoError> {
     let format = format_of(path)?;
     let meta = options.meta.unwrap_or_default();
-    let octree = || match tree {
-        AnyTree::K3(t) => Ok(t),
-        other => Err(usage(
-            path,
-            format!(
-                "this format holds octrees (K = 3), the tree has K = {}",
-                other.k()
-            ),
-        )),
+    let octree = || {
+        (tree as &dyn std::any::Any)
+            .downcast_ref::<KTree<3>>()
+            .ok_or_else(|| {
+                usage(
+                    path,
+                    format!("this format holds octrees (K = 3), the tree has K = {K}"),
+                )
+            })
     };
     let write = |fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
         write_atomic_with(path, |w| fill(w)).map_err(IoError::Write)
@@ -564,11 +581,8 @@ pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result
         }),
     };
     match format {
-        Format::Ktree => {
-            crate::with_dim!(tree, AnyTree, t => write_ktree_file(path, t)).map_err(IoError::Write)
-        }
-        Format::Rays => crate::with_dim!(tree, AnyTree, t => write_rays_file(path, &t.to_rays()))
-            .map_err(IoError::Write),
+        Format::Ktree => write_ktree_file(path, tree).map_err(IoError::Write),
+        Format::Rays => write_rays_file(path, &tree.to_rays()).map_err(IoError::Write),
         Format::Binvox => {
             let t = octree()?;
             if options.offset != [0; 3] {
@@ -619,5 +633,40 @@ pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result
             path,
             "volumes are inputs only: write .ktree, .rays, .binvox, .bt, .vdb or a mesh",
         )),
+    }
+}
+
+impl<const K: usize> KTree<K> {
+    /// Reads a tree of dimension `K` from a file of any format ([`read_tree`] with default options).
+    ///
+    /// ```
+    /// use ktree::{rays::ball_rays, KTree};
+    /// let ball = KTree::from_rays(&ball_rays::<3>(4, [8, 8, 8], 6).unwrap());
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let path = dir.path().join("ball.ktree");
+    /// ball.save(&path).unwrap();
+    /// assert_eq!(KTree::<3>::load(&path).unwrap(), ball);
+    /// assert!(KTree::<2>::load(&path).is_err()); // an octree is not a quadtree
+    /// ```
+    ///
+    /// # Errors
+    /// As [`read_tree`], and [`IoError::Dimension`] for a tree of another dimension.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, IoError> {
+        let path = path.as_ref();
+        read_tree(path, &ReadOptions::default())?
+            .try_into()
+            .map_err(|source| IoError::Dimension {
+                file: path.display().to_string(),
+                source,
+            })
+    }
+
+    /// Writes the tree to a file of the format its extension names, atomically ([`write_tree`] with
+    /// default options; a `.ktree` is always of the current version).
+    ///
+    /// # Errors
+    /// As [`write_tree`].
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), IoError> {
+        write_typed(path.as_ref(), self, &WriteOptions::default())
     }
 }

@@ -12,7 +12,7 @@
 //!
 //! ```
 //! use ktree::io::{read_ktree, read_rays, write_ktree, write_rays};
-//! use ktree::{stacking::stack, AnyRaySet, Ray, RaySet};
+//! use ktree::{stacking::paper::stack, AnyRaySet, Ray, RaySet};
 //! let rays = RaySet::<3>::from_rays(4, [Ray::new([1, 1, 2], 9)]).unwrap();
 //! let mut text = Vec::new();
 //! write_rays(&mut text, &rays).unwrap();

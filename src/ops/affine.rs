@@ -18,7 +18,7 @@
 //!
 //! ```
 //! use ktree::ops::{rotate_axes, transform, Affine, AxisMap};
-//! use ktree::{rays::ball_rays, stacking::stack};
+//! use ktree::{rays::ball_rays, stacking::paper::stack};
 //! let ball = stack(&ball_rays::<2>(4, [12, 16], 10).unwrap());
 //! // A quarter turn about the universe's centre, by an affine map and by reordering children: the same tree.
 //! let m = Affine::rotation_about(0, 1, 90.0, Affine::<2>::universe_centre(4)).unwrap();

@@ -50,7 +50,7 @@ use crate::tree::{LevelCounts, NodeState};
 const NODES_PER_WORD: u64 = words::NODES_PER_WORD as u64;
 
 /// Bytes of each I/O buffer (one per output level, one for the output).
-pub const BUFFER_BYTES: usize = 1 << 16;
+pub(crate) const BUFFER_BYTES: usize = 1 << 16;
 
 /// Why a streamed Boolean failed. The target file is untouched and the spill files are removed.
 #[derive(Debug, thiserror::Error)]

@@ -6,6 +6,9 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum OpsError {
+    /// Two trees of different dimensions were combined.
+    #[error("{0}: both trees must have the same dimension")]
+    DimensionMismatch(crate::tree::DimensionMismatch),
     /// Two trees of different universe levels were combined. Re-level one of them first (for example with
     /// [`crate::ops::grow`], which adds root levels, or [`crate::ops::zoom`], which removes them).
     #[error("the trees have different universe levels ({left} and {right}); re-level one with grow/zoom first")]

@@ -136,7 +136,7 @@ impl<const K: usize> IncrementalPreimage<K> for FixedAffine<K> {
 /// shifts. The output equals [`FixedAffine::source_voxel`] at every voxel and is reduced.
 ///
 /// ```
-/// use ktree::{stacking::stack, rays::ball_rays, ops::{transform, transform_fixed, Affine}};
+/// use ktree::{stacking::paper::stack, rays::ball_rays, ops::{transform, transform_fixed, Affine}};
 /// let ball = stack(&ball_rays::<3>(6, [70, 60, 64], 40).unwrap());
 /// let m = Affine::rotation_about(0, 1, 30.0, Affine::<3>::universe_centre(6)).unwrap();
 /// let fixed = transform_fixed(&ball, &m, 32).unwrap();

@@ -112,3 +112,61 @@ impl<const K: usize> PairVisitor<K> for Earliest {
         self.order
     }
 }
+
+/// How two objects meet: whether they share a voxel, how much, when (along a time axis) and, apart,
+/// how far (the keys of `ktree collide --json`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Collision {
+    /// Whether the objects share a voxel.
+    pub collide: bool,
+    /// The leaves of their intersection.
+    pub overlap_cells: usize,
+    /// The voxels they share.
+    pub overlap_voxels: u128,
+    /// The first position along the time axis (if one was given) at which they overlap.
+    pub first_contact: Option<u32>,
+    /// The smallest distance between voxel centres of the two objects, in voxels: 0 when they overlap,
+    /// `None` when one is empty.
+    pub min_separation: Option<f64>,
+}
+
+/// How `a` and `b` meet ([`Collision`]); `time_axis`, if given, is the axis whose first overlapping
+/// position is reported.
+///
+/// ```
+/// use ktree::{ops::collision, KTree};
+/// let a = KTree::<1>::from_dense(3, &[true, true, false, false, false, false, false, false]).unwrap();
+/// let b = KTree::<1>::from_dense(3, &[false, false, false, false, false, true, false, false]).unwrap();
+/// let c = collision(&a, &b, None).unwrap();
+/// assert!(!c.collide);
+/// assert_eq!(c.min_separation, Some(4.0));
+/// assert_eq!(collision(&a, &a, Some(0)).unwrap().first_contact, Some(0));
+/// ```
+///
+/// # Errors
+/// [`OpsError::LevelMismatch`]; a time axis not below `K`.
+pub fn collision<const K: usize>(
+    a: &KTree<K>,
+    b: &KTree<K>,
+    time_axis: Option<usize>,
+) -> Result<Collision, OpsError> {
+    let collide = interferes(a, b)?;
+    let overlap = super::intersection(a, b)?;
+    let first_contact = match time_axis {
+        Some(axis) => first_contact(a, b, axis)?,
+        None => None,
+    };
+    let min_separation = if collide {
+        Some(0.0)
+    } else {
+        super::min_separation(a, b)?
+    };
+    Ok(Collision {
+        collide,
+        overlap_cells: overlap.full_cells().count(),
+        overlap_voxels: overlap.voxel_count(),
+        first_contact,
+        min_separation,
+    })
+}

@@ -273,7 +273,7 @@ pub struct ProgressiveMass<const K: usize> {
 /// estimate), reporting how many nodes were touched. With tolerance 0 it visits every node and is exact.
 ///
 /// ```
-/// use ktree::{stacking::stack, rays::ball_rays, ops::{mass_progressive, mass_properties}};
+/// use ktree::{stacking::paper::stack, rays::ball_rays, ops::{mass_progressive, mass_properties}};
 /// let tree = stack(&ball_rays::<3>(8, [256, 256, 256], 240).unwrap());
 /// let p = mass_progressive(&tree, 0.05);
 /// let exact = mass_properties(&tree).volume as f64;

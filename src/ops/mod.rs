@@ -22,7 +22,7 @@
 //! | complexity (M9) | [`complexity`], [`over_translations`], [`over_placements`], [`over_maps`], [`bounding_box`], [`normalise_to_origin`] | node counts | one operation per placement |
 //!
 //! ```
-//! use ktree::{stacking::stack, rays::ball_rays, ops};
+//! use ktree::{stacking::paper::stack, rays::ball_rays, ops};
 //! let a = stack(&ball_rays::<3>(5, [24, 32, 32], 20).unwrap());
 //! let b = stack(&ball_rays::<3>(5, [40, 32, 32], 20).unwrap());
 //! let lens = ops::intersection(&a, &b).unwrap();
@@ -32,6 +32,7 @@
 //! ```
 
 pub mod affine;
+mod any;
 mod boolean;
 mod boolean_files;
 mod complexity;
@@ -61,7 +62,7 @@ pub use complexity::{
 };
 pub use error::OpsError;
 pub use fixed::{transform_fixed, FixedAffine};
-pub use interference::{first_contact, interferes, overlap_cells};
+pub use interference::{collision, first_contact, interferes, overlap_cells, Collision};
 pub use mass::{
     mass_of_leaves, mass_progressive, mass_properties, LevelBounds, MassProperties, ProgressiveMass,
 };

@@ -203,7 +203,7 @@ impl<const K: usize> Preimage<K> for Inverse<K> {
 /// are cut off. Target voxel `q` is full iff source voxel `m⁻¹`-[`Projective::source_voxel`]`(q)` is.
 ///
 /// ```
-/// use ktree::{stacking::stack, rays::ball_rays, ops::{transform_projective, Projective}};
+/// use ktree::{stacking::paper::stack, rays::ball_rays, ops::{transform_projective, Projective}};
 /// let ball = stack(&ball_rays::<3>(6, [64, 64, 64], 40).unwrap());
 /// let p = Projective::<3>::perspective(6, 2, 64.0).unwrap();
 /// let seen = transform_projective(&ball, &p).unwrap();

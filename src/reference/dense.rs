@@ -112,3 +112,14 @@ impl<const K: usize> DensePyramid<K> {
         }
     }
 }
+
+impl<const K: usize> KTree<K> {
+    /// The tree of a dense boolean array (axis 0 fastest, see [`Universe::dense_index`]), reduced.
+    ///
+    /// # Errors
+    /// [`SpaceError::LevelTooLarge`]; [`SpaceError::TooLargeForDense`] if `dense.len() != U^K` or the
+    /// universe exceeds [`DENSE_LIMIT`](crate::space::DENSE_LIMIT).
+    pub fn from_dense(level: u32, dense: &[bool]) -> Result<Self, SpaceError> {
+        DensePyramid::<K>::from_dense(level, dense).map(|p| p.to_tree())
+    }
+}

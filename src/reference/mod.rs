@@ -4,7 +4,7 @@
 //!
 //! ```
 //! use ktree::reference::{DensePyramid, NaiveTree};
-//! use ktree::{stacking::stack, Ray, RaySet};
+//! use ktree::{stacking::paper::stack, Ray, RaySet};
 //! let rays = RaySet::<3>::from_rays(3, [Ray::new([1, 2, 0], 8), Ray::new([2, 2, 3], 5)]).unwrap();
 //! let fast = stack(&rays);
 //! assert_eq!(NaiveTree::from_rays(&rays).unwrap().to_tree(), fast);

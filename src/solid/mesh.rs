@@ -1,8 +1,8 @@
 //! Triangle meshes to rays: OBJ (tobj), STL ASCII and binary (stl_io) and PLY (ply-rs).
 //!
-//! **Placement.** A vertex `v` goes to voxel coordinates `s·v + t` ([`Placement`]), computed in `f64` and then
+//! **Placement.** A vertex `v` goes to voxel coordinates `s·v + t` ([`MeshTransform`]), computed in `f64` and then
 //! rounded to the nearest multiple of 2^−16 voxel; every later step is exact integer arithmetic, so a result
-//! is reproducible bit for bit. [`Placement::fit`] scales and centres a mesh into the universe with a one-voxel
+//! is reproducible bit for bit. [`MeshTransform::fit`] scales and centres a mesh into the universe with a one-voxel
 //! margin.
 //!
 //! **Inside rule.** A voxel is inside when its centre is: the column through the centre `(x+½, y+½)` is
@@ -29,11 +29,11 @@
 //! its index lists for the slab, for building trees out of core without holding the whole ray set.
 //!
 //! ```
-//! use ktree::solid::mesh::{Placement, TriangleMesh};
+//! use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 //! use std::path::Path;
 //! let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/meshes/bunny_npm.obj");
 //! let bunny = TriangleMesh::read(&path).unwrap();
-//! let placement = Placement::fit(&bunny, 6).unwrap(); // scaled and centred into a 64³ universe
+//! let placement = MeshTransform::fit(&bunny, 6).unwrap(); // scaled and centred into a 64³ universe
 //! let voxels = bunny.to_rays(6, &placement).unwrap();
 //! assert_eq!(voxels.open_edges, bunny.open_edges());
 //! assert!(voxels.rays.voxel_count() > 1000);
@@ -47,7 +47,8 @@ use std::path::Path;
 use super::SolidError;
 use crate::rays::RaySet;
 use crate::space::Universe;
-use crate::stacking::{default_split_depth, radix_sort, RaySource, SlabRuns};
+use crate::stacking::radix::radix_sort;
+use crate::stacking::{default_split_depth, RaySource, SlabRuns};
 
 /// Bits of sub-voxel precision of placed vertices.
 const FRAC: u32 = 16;
@@ -78,14 +79,14 @@ pub struct TriangleMesh {
 
 /// Where a mesh goes in the universe: voxel coordinate = `scale · v + translate`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Placement {
+pub struct MeshTransform {
     /// Uniform scale.
     pub scale: f64,
     /// Translation, in voxels.
     pub translate: [f64; 3],
 }
 
-impl Placement {
+impl MeshTransform {
     /// Parses `s,tx,ty,tz`.
     ///
     /// # Errors
@@ -130,7 +131,7 @@ impl Placement {
         Ok(Self { scale, translate })
     }
 
-    /// `s,tx,ty,tz` (what [`Placement::parse`] reads).
+    /// `s,tx,ty,tz` (what [`MeshTransform::parse`] reads).
     pub fn to_arg(&self) -> String {
         format!(
             "{},{},{},{}",
@@ -141,6 +142,29 @@ impl Placement {
     /// The voxel coordinates of `v`.
     pub fn apply(&self, v: [f64; 3]) -> [f64; 3] {
         std::array::from_fn(|a| self.scale * v[a] + self.translate[a])
+    }
+}
+
+/// Where a mesh goes in the universe, for [`KTree::from_mesh`](crate::KTree::from_mesh).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Placement {
+    /// Scaled uniformly and centred into the universe with one voxel of margin each side
+    /// ([`MeshTransform::fit`]).
+    Fit,
+    /// Voxel coordinate = `scale · v + translate`.
+    Transform(MeshTransform),
+}
+
+impl Placement {
+    /// The transform this placement gives `mesh` in a universe of level `level`.
+    ///
+    /// # Errors
+    /// As [`MeshTransform::fit`].
+    pub fn transform(&self, mesh: &TriangleMesh, level: u32) -> Result<MeshTransform, SolidError> {
+        match self {
+            Self::Fit => MeshTransform::fit(mesh, level),
+            Self::Transform(t) => Ok(*t),
+        }
     }
 }
 
@@ -364,7 +388,7 @@ impl TriangleMesh {
     /// # Errors
     /// [`SolidError::Space`] for a bad level, [`SolidError::BadParameter`] above [`MAX_LEVEL`];
     /// [`SolidError::BadParameter`] when a placed vertex lies farther than 2^22 voxels from the origin.
-    pub fn to_rays(&self, level: u32, placement: &Placement) -> Result<MeshRays, SolidError> {
+    pub fn to_rays(&self, level: u32, placement: &MeshTransform) -> Result<MeshRays, SolidError> {
         let placed = Placed::new(self, level, placement)?;
         let mut events = Vec::new();
         let mut vertical = 0;
@@ -403,7 +427,7 @@ struct Prepared {
 }
 
 impl Placed {
-    fn new(mesh: &TriangleMesh, level: u32, placement: &Placement) -> Result<Self, SolidError> {
+    fn new(mesh: &TriangleMesh, level: u32, placement: &MeshTransform) -> Result<Self, SolidError> {
         let universe = Universe::<3>::new(level)?;
         if level > MAX_LEVEL {
             return Err(SolidError::BadParameter(format!(
@@ -579,15 +603,15 @@ impl Placed {
 /// the placed vertices, the triangles and the index.
 ///
 /// ```
-/// use ktree::solid::mesh::{MeshSource, Placement, TriangleMesh};
-/// use ktree::stacking::{stack, stack_source};
+/// use ktree::solid::mesh::{MeshSource, MeshTransform, TriangleMesh};
+/// use ktree::stacking::{paper::stack, Builder};
 /// use std::path::Path;
 /// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/meshes/bunny_npm.obj");
 /// let bunny = TriangleMesh::read(&path).unwrap();
-/// let placement = Placement::fit(&bunny, 6).unwrap();
+/// let placement = MeshTransform::fit(&bunny, 6).unwrap();
 /// let source = MeshSource::new(&bunny, 6, &placement).unwrap();
 /// let whole = bunny.to_rays(6, &placement).unwrap().rays;
-/// assert_eq!(stack_source(&source, 2).unwrap(), stack(&whole));
+/// assert_eq!(Builder::new(&source).split_depth(2).build().unwrap(), stack(&whole));
 /// ```
 #[derive(Debug, Clone)]
 pub struct MeshSource {
@@ -606,7 +630,11 @@ impl MeshSource {
     ///
     /// # Errors
     /// As [`TriangleMesh::to_rays`].
-    pub fn new(mesh: &TriangleMesh, level: u32, placement: &Placement) -> Result<Self, SolidError> {
+    pub fn new(
+        mesh: &TriangleMesh,
+        level: u32,
+        placement: &MeshTransform,
+    ) -> Result<Self, SolidError> {
         let placed = Placed::new(mesh, level, placement)?;
         let bucket_bits = level - default_split_depth(3, level);
         let buckets = 1usize << (level - bucket_bits);

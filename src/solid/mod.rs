@@ -10,7 +10,7 @@
 //!
 //! ```
 //! use ktree::solid::{BoxSolid, Frame, Sample};
-//! use ktree::stacking::stack;
+//! use ktree::stacking::paper::stack;
 //! // The box [0, 4] × [0, 2] in voxel units: the voxel centres inside are x in 0..4, y in 0..2.
 //! let b = BoxSolid::<2>::new([0.into(), 0.into()], [4.into(), 2.into()], Frame::Voxel).unwrap();
 //! let rays = b.to_rays(3, Sample::Centre, false).unwrap();
@@ -102,10 +102,10 @@ impl<const K: usize> Solid<K> {
 ///
 /// ```
 /// use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-/// use ktree::stacking::{stack, stack_source};
+/// use ktree::stacking::{paper::stack, Builder};
 /// let ball = Solid::Quadric(Quadric::<3>::ball([Rational::int(16); 3], Rational::int(11), Frame::Voxel).unwrap());
 /// let source = SolidSource::new(&ball, 5, Sample::Centre).unwrap();
-/// let tree = stack_source(&source, 2).unwrap();
+/// let tree = Builder::new(&source).split_depth(2).build().unwrap();
 /// assert_eq!(tree, stack(&ball.to_rays(5, Sample::Centre, false).unwrap()));
 /// ```
 #[derive(Debug, Clone)]

@@ -445,11 +445,11 @@ impl Volume {
 ///
 /// ```
 /// use ktree::solid::volume::{Select, Volume, VolumeSource};
-/// use ktree::stacking::{stack, stack_source};
+/// use ktree::stacking::{paper::stack, Builder};
 /// let v = Volume::new([3, 2, 2], vec![0.0, 9.0, 9.0, 9.0, 0.0, 9.0, 9.0, 9.0, 9.0, 0.0, 0.0, 9.0], [1.0; 3]).unwrap();
 /// let whole = v.to_rays(3, [1, 2, 3], Select::AtLeast(5.0)).unwrap();
 /// let source = VolumeSource::new(v, 3, [1, 2, 3], Select::AtLeast(5.0)).unwrap();
-/// assert_eq!(stack_source(&source, 1).unwrap(), stack(&whole));
+/// assert_eq!(Builder::new(&source).split_depth(1).build().unwrap(), stack(&whole));
 /// ```
 #[derive(Debug, Clone)]
 pub struct VolumeSource {

@@ -106,22 +106,15 @@ fn coarsen<const K: usize>(fine: &Level) -> Level {
 }
 
 /// Universes of at most this many voxels (2^22: two bitmaps of 512 KiB) go through the bitmap pyramid.
-pub const MAX_BITMAP_VOXELS: u64 = 1 << 22;
+pub(crate) const MAX_BITMAP_VOXELS: u64 = 1 << 22;
 
-/// The tree of `rays`, equal node for node to [`stack`](super::stack): built through a bitmap pyramid of
+/// The tree of `rays`, equal node for node to [`stack`](super::paper::stack): built through a bitmap pyramid of
 /// its universe when that has at most [`MAX_BITMAP_VOXELS`] voxels (memory: two bits a voxel and a third
 /// more for the coarser levels — the cells of a partitioned build), stacked otherwise.
-///
-/// ```
-/// use ktree::stacking::{stack, stack_bitmap};
-/// use ktree::rays::ball_rays;
-/// let ball = ball_rays::<3>(6, [64, 64, 64], 50).unwrap();
-/// assert_eq!(stack_bitmap(&ball), stack(&ball));
-/// ```
-pub fn stack_bitmap<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
+pub(crate) fn stack_bitmap<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
     let level = rays.level();
     if K as u64 * u64::from(level) > u64::from(MAX_BITMAP_VOXELS.trailing_zeros()) {
-        return super::stack(rays);
+        return super::paper::stack(rays);
     }
     let mut voxels = Level::new::<K>(level);
     for (&column, &(z1, z2)) in rays.column_keys().iter().zip(rays.runs()) {
@@ -178,7 +171,7 @@ pub fn stack_bitmap<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
 mod tests {
     use super::*;
     use crate::rays::{ball_rays, Ray};
-    use crate::stacking::stack;
+    use crate::stacking::paper::stack;
 
     #[test]
     fn even_bits_packs_every_other_bit() {

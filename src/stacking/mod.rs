@@ -1,42 +1,96 @@
-//! Akman & Franklin's stacking: the fast path from a [`RaySet`](crate::RaySet) to the minimal reduced
-//! [`KTree`](crate::KTree), through maximal rows and the dimension-level lists — in memory ([`stack`]), with
-//! the lists as sequential disk files ([`stack_with_file_lists`]), or as a pipeline of one thread per stage
-//! ([`stack_pipelined`]); all three build the same tree from the same combine and split steps. The same
-//! tree is also built cell by cell ([`stack_partitioned`], [`stack_source`]): cache-sized subtrees on all
-//! threads, joined level by level; or out of core, straight to a `.ktree` file in bounded memory with the
-//! subtrees spilled to temporary files ([`stack_to_file`]) — also in parts that run apart, as the ranks of
-//! a distributed run do, each stacking its share of the slabs ([`balanced_parts`], [`stack_part`]) and one
-//! writing the file from all of them ([`SpilledPart`]).
+//! Building a tree from rays. [`Builder`] is the one entry point, and [`KTree::from_rays`] runs it: the
+//! universe is cut into cells stacked apart on all threads (by default each through a bitmap pyramid of
+//! its voxels) and joined level by level — in memory ([`Builder::build`]) or straight to a `.ktree` file in
+//! bounded memory, the subtrees spilled to temporary files ([`Builder::to_file`]), also in parts that run
+//! apart, as the ranks of a distributed run do ([`Builder::stack_part`], [`SpilledPart`]).
+//!
+//! Akman & Franklin's stacking itself — rays to maximal rows, combined and split through the
+//! dimension-level lists — is in [`paper`], in memory, with the lists as files, and as a pipeline; the
+//! builder can stack each cell with it ([`CellStacking::Lists`]). Every way builds the same tree, node for
+//! node.
 //!
 //! ```
-//! use ktree::{rays::ball_rays, reference::DensePyramid, stacking::stack_with_stats};
+//! use ktree::{rays::ball_rays, reference::DensePyramid, stacking::Builder};
 //! let ball = ball_rays::<3>(5, [32, 32, 32], 40).unwrap(); // radius 20 in a 32³ universe
-//! let (tree, stats) = stack_with_stats(&ball);
+//! let tree = Builder::new(&ball).build().unwrap();
 //! assert_eq!(tree, DensePyramid::from_rays(&ball).unwrap().to_tree());
-//! assert_eq!(stats.rays, ball.len() as u64);
 //! assert_eq!(tree.voxel_count(), ball.voxel_count());
 //! ```
+//!
+//! # Out of core
+//! ## How it runs
+//! The cells of depth `m` are stacked slab by slab exactly as in [`Builder::build`],
+//! but no finished subtree is kept: the levels `1, 2, …` of each partial cell's subtree are appended to
+//! one temporary *spill file* per level (word-aligned, in the order the slabs finish), and only a small
+//! index (the cell's Morton index and its node count per level) and the states of the cells of depth `m`
+//! (see *Memory*) stay in memory. At the end the file is written level by level through a [`KtreeWriter`](crate::io::KtreeWriter): the
+//! top levels `0 … m` (from the cells' states; a uniform top collapses), then each level `m + j` as the
+//! concatenation, in Morton order of the cells, of the subtrees' levels `j` read back from spill file `j`
+//! (the writer shifts each piece into place). The file goes to a temporary file renamed over the target
+//! ([`write_atomic_with`](crate::fs::write_atomic_with)), so the bytes are exactly those of the tree built in memory and written by
+//! [`write_ktree`](crate::io::write_ktree), for any number of threads.
+//!
+//! ## In parts
+//! The two phases also run apart, as the ranks of a distributed run do: [`Builder::stack_part`] stacks some of the
+//! slabs (a share cut by [`balanced_parts`] from the costs [`Builder::slab_cost`] estimates) into spill files of its
+//! own; one part takes the others' indexes ([`SpilledPart::index_words`], [`SpilledPart::add_part`]: the
+//! cells' states and the stacked cells' Morton indexes and node counts) and writes the file
+//! ([`SpilledPart::write`]), walking the stacked cells of all parts in Morton order and taking each
+//! piece from its own spill files or from the stream of words the owning part sends in its own Morton
+//! order ([`SpilledPart::stream_levels`]). The bytes are those of [`Builder::to_file`], which is one part
+//! of every slab.
+//!
+//! ## Memory
+//! The budget (`max_memory` of [`Builder::to_file`]) is kept by accounting, not by measuring the process:
+//! 64 bytes per run of each slab being stacked (its copies and the subtrees made from it, until
+//! they are spilled), 48 bytes per block of the full cells of depth `m` — kept reduced, as the top of the
+//! tree is: `2^K` full siblings are one block of their parent, so a solid's interior costs a few blocks,
+//! not one entry per cell — 24 plus 8 per level for each stacked cell, and the I/O
+//! buffers (64 KiB per spill file and two more). A budget below the buffers fails before any
+//! slab is made. The first slab runs alone; then rounds of up to as many slabs as the rayon pool has
+//! threads run at once, as many as the largest slab seen so far allows in what is left of the budget; a
+//! slab whose rays turn out not to fit beside those already admitted is set aside (its rays dropped) for
+//! the next round. Only these rays, made before their size is known, are held beyond the accounted
+//! figure. A slab that does not fit even alone ends the build at once with
+//! [`BuildError::BudgetTooSmall`], naming what is known to be needed then (what is held plus the
+//! largest slab seen): a build given it gets at least as far, and a later, larger slab may ask for more.
+//! When the stacking ends, the index of the stacked cells is checked against the budget; the budget it
+//! names then (what the build holds at its end plus its largest slab) is enough for the whole build.
+//!
+//! ## Temporary files
+//! The spill files live in a hidden folder `.NAME.XXXXXX.PID.ktree-spill` in [`Builder::temp_dir`] (by
+//! default the output's folder), removed when the build ends, whether it succeeds or fails; a process
+//! killed mid-build leaves it behind, and the next build of the same output removes the folders of
+//! processes that no longer run.
+//!
+//! ```
+//! use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
+//! use ktree::stacking::Builder;
+//! let ball = Solid::Quadric(Quadric::<3>::ball([Rational::int(16); 3], Rational::int(11), Frame::Voxel).unwrap());
+//! let source = SolidSource::new(&ball, 5, Sample::Centre).unwrap();
+//! let dir = tempfile::tempdir().unwrap();
+//! let out = dir.path().join("ball.ktree");
+//! let builder = Builder::new(&source).split_depth(2);
+//! let report = builder.to_file(&out, 1 << 30).unwrap();
+//! let tree = builder.build().unwrap();
+//! assert_eq!(ktree::io::read_ktree_file(&out).unwrap(), ktree::AnyTree::K3(tree.clone()));
+//! assert_eq!(report.counts_per_level, tree.counts_per_level());
+//! ```
+//!
+//! [`KTree::from_rays`]: crate::KTree::from_rays
 
 mod any;
 mod bitmap;
+mod builder;
 mod cells;
 mod out_of_core;
+pub mod paper;
 mod partition;
-mod pipeline;
-mod radix;
-mod sequential;
-mod stack;
+pub(crate) mod radix;
+mod solids;
 
-pub use bitmap::{stack_bitmap, MAX_BITMAP_VOXELS};
+pub use builder::{Builder, CellStacking};
 pub use out_of_core::{
-    balanced_parts, build_slabs, slab_cost, stack_part, stack_to_file, OutOfCore, OutOfCoreError,
-    OutOfCoreReport, Progress, SpilledPart, Stage, BUFFER_BYTES, MAX_PARTS, RUN_BYTES,
-    SUBTREE_BYTES,
+    balanced_parts, BuildError, OutOfCoreReport, Progress, SpilledPart, Stage, MAX_PARTS,
 };
-pub use partition::{
-    default_split_depth, join_subtrees, stack_partitioned, stack_source, RaySource, SlabRuns,
-};
-pub use pipeline::stack_pipelined;
-pub use radix::radix_sort;
-pub use sequential::{stack_with_file_lists, FileListStats};
-pub use stack::{stack, stack_with_stats, StackingStats};
+pub use partition::{default_split_depth, RaySource, SlabRuns};

@@ -27,8 +27,10 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
+use super::bitmap::stack_bitmap;
 use super::cells::{top_levels_of_blocks, CellBlock};
-use super::stack_bitmap;
+use super::paper::stack;
+use super::CellStacking;
 use crate::rays::RaySet;
 use crate::space::{morton_encode, Universe};
 use crate::tree::words::LevelWords;
@@ -105,30 +107,16 @@ pub fn default_split_depth(k: usize, level: u32) -> u32 {
     level.saturating_sub(subtree_level)
 }
 
-/// Builds the tree of a ray set from the subtrees of its cells of depth `depth` (clamped to `L`), each
-/// stacked apart, on the threads of the current rayon pool. Equal, node for node, to [`stack`](super::stack).
-///
-/// ```
-/// use ktree::{stacking::{stack, stack_partitioned}, Ray, RaySet};
-/// let rays = RaySet::<3>::from_rays(5, [Ray::new([1, 1, 3], 29), Ray::new([20, 7, 0], 32)]).unwrap();
-/// for depth in 0..=5 {
-///     assert_eq!(stack_partitioned(&rays, depth), stack(&rays));
-/// }
-/// ```
-pub fn stack_partitioned<const K: usize>(rays: &RaySet<K>, depth: u32) -> KTree<K> {
-    match stack_source(rays, depth) {
-        Ok(tree) => tree,
-        Err(never) => match never {},
-    }
-}
-
-/// Like [`stack_partitioned`], with the rays produced slab by slab by `source`.
+/// Builds the tree of `source` from the subtrees of its cells of depth `depth` (clamped to `L`), each
+/// stacked apart as `cells` says, on the threads of the current rayon pool. Equal, node for node, to
+/// [`paper::stack`](super::paper::stack) of the same rays.
 ///
 /// # Errors
 /// The first error of the source (in slab order).
-pub fn stack_source<const K: usize, S: RaySource<K>>(
+pub(crate) fn stack_source<const K: usize, S: RaySource<K>>(
     source: &S,
     depth: u32,
+    cells: CellStacking,
 ) -> Result<KTree<K>, S::Error> {
     let universe = source.universe();
     let level = universe.level();
@@ -140,7 +128,7 @@ pub fn stack_source<const K: usize, S: RaySource<K>>(
     };
     let pieces = slabs
         .into_par_iter()
-        .map(|b0| stack_slab(source, m, b0))
+        .map(|b0| stack_slab(source, m, b0, cells))
         .collect::<Result<Vec<_>, _>>()?;
     let mut pieces: Vec<(u64, Piece<K>)> = pieces.into_iter().flatten().collect();
     pieces.sort_unstable_by_key(|p| p.0);
@@ -160,12 +148,13 @@ fn stack_slab<const K: usize, S: RaySource<K>>(
     source: &S,
     m: u32,
     b0: u32,
+    cells: CellStacking,
 ) -> Result<Vec<(u64, Piece<K>)>, S::Error> {
     let level = source.universe().level();
     let t = level - m;
     let side = 1u32 << t;
     let slab = source.slab(b0 * side..(b0 + 1) * side)?;
-    Ok(slab_pieces(&slab, level, m, b0))
+    Ok(slab_pieces(&slab, level, m, b0, cells))
 }
 
 /// The non-empty cells of slab `b0` (all cells for `K = 1`) from its runs, with their Morton index among
@@ -175,6 +164,7 @@ pub(super) fn slab_pieces<const K: usize>(
     level: u32,
     m: u32,
     b0: u32,
+    cells: CellStacking,
 ) -> Vec<(u64, Piece<K>)> {
     let t = level - m;
     let side = 1u32 << t;
@@ -188,7 +178,7 @@ pub(super) fn slab_pieces<const K: usize>(
             keys: vec![0; runs.len()],
             runs: runs.to_vec(),
         };
-        split_block::<K>(&block, m, t, [0; K], &mut out);
+        split_block::<K>(&block, m, t, [0; K], cells, &mut out);
         return out;
     }
     // Bucket the slab's runs by block (the cell coordinates along axes 1 … K−2), keeping their order, with
@@ -197,7 +187,7 @@ pub(super) fn slab_pieces<const K: usize>(
     let local_mask = u64::from(side) - 1;
     let blocks_per_slab = 1usize << ((K - 2) as u32 * m);
     if blocks_per_slab > runs.len().max(64) {
-        return stack_sparse_slab(keys, runs, level, m, b0);
+        return stack_sparse_slab(keys, runs, level, m, b0, cells);
     }
     let mut block_of = Vec::with_capacity(runs.len());
     let mut counts = vec![0usize; blocks_per_slab + 1];
@@ -240,7 +230,7 @@ pub(super) fn slab_pieces<const K: usize>(
         for a in (1..K - 1).rev() {
             cell[a] = ((b >> ((K - 2 - a) as u32 * m)) & ((1 << m) - 1)) as u32;
         }
-        split_block::<K>(&block, m, t, cell, &mut out);
+        split_block::<K>(&block, m, t, cell, cells, &mut out);
     }
     out
 }
@@ -253,6 +243,7 @@ fn stack_sparse_slab<const K: usize>(
     level: u32,
     m: u32,
     b0: u32,
+    cells: CellStacking,
 ) -> Vec<(u64, Piece<K>)> {
     let t = level - m;
     let mask = (1u64 << level) - 1;
@@ -290,7 +281,7 @@ fn stack_sparse_slab<const K: usize>(
         for a in (1..K - 1).rev() {
             cell[a] = ((b >> ((K - 2 - a) as u32 * m)) & ((1 << m) - 1)) as u32;
         }
-        split_block::<K>(&block, m, t, cell, &mut out);
+        split_block::<K>(&block, m, t, cell, cells, &mut out);
     }
     out
 }
@@ -308,6 +299,7 @@ fn split_block<const K: usize>(
     m: u32,
     t: u32,
     mut cell: [u32; K],
+    cells: CellStacking,
     out: &mut Vec<(u64, Piece<K>)>,
 ) {
     let columns = 1u64 << (t as usize * (K - 1));
@@ -338,7 +330,10 @@ fn split_block<const K: usize>(
     let universe = Universe::<K>::new(t).expect("a cell's level is a valid level");
     for (&j, part) in mixed.iter().zip(parts) {
         let rays = RaySet::from_sorted_parts(universe, part.keys, part.runs, None);
-        let tree = stack_bitmap(&rays);
+        let tree = match cells {
+            CellStacking::Bitmap => stack_bitmap(&rays),
+            CellStacking::Lists => stack(&rays),
+        };
         cell[K - 1] = j as u32;
         out.push((morton_encode(cell), Piece::Tree(tree)));
     }
@@ -426,45 +421,6 @@ fn classify_cells(runs: &[(u32, u32)], m: u32, t: u32, columns: u64) -> (Vec<usi
         }
     }
     (full, mixed)
-}
-
-/// Joins subtrees of the cells of depth `depth` into the tree of `universe`: `subtrees` are given for every
-/// cell, in Morton order (`2^(K·depth)` of them), each in a universe of level `L − depth`.
-///
-/// ```
-/// use ktree::{stacking::{join_subtrees, stack}, Ray, RaySet, Universe};
-/// let rays = RaySet::<2>::from_rays(3, [Ray::new([1, 2], 7)]).unwrap();
-/// let u = Universe::<2>::new(3).unwrap();
-/// let cells: Vec<_> = (0..4).map(|code| u.root().child(code)).collect();
-/// let subtrees = cells.iter().map(|&c| stack(&rays.cell_rays(c))).collect();
-/// assert_eq!(join_subtrees(u, 1, subtrees), stack(&rays));
-/// ```
-///
-/// # Panics
-/// If the number of subtrees is not `2^(K·depth)` or a subtree's level is not `L − depth`.
-pub fn join_subtrees<const K: usize>(
-    universe: Universe<K>,
-    depth: u32,
-    subtrees: Vec<KTree<K>>,
-) -> KTree<K> {
-    assert_eq!(
-        subtrees.len() as u128,
-        1u128 << (K as u32 * depth),
-        "one subtree per cell of depth {depth}"
-    );
-    let pieces = subtrees
-        .into_iter()
-        .enumerate()
-        .filter_map(|(i, t)| {
-            assert_eq!(t.level() + depth, universe.level(), "subtree level");
-            match t.root_state() {
-                NodeState::Empty => None,
-                NodeState::Full => Some((i as u64, Piece::Full)),
-                NodeState::Partial => Some((i as u64, Piece::Tree(t))),
-            }
-        })
-        .collect();
-    join_pieces(universe, depth, pieces)
 }
 
 /// The tree from its non-empty cells of depth `m` (sorted by Morton index).

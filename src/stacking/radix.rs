@@ -8,13 +8,7 @@ const SMALL: usize = 192;
 ///
 /// Cost: `O(passes · (n + 2^digit))` with passes = ⌈bits / 10⌉ (⌈bits / 12⌉ for 65 536 keys or more); passes in which every key has the same
 /// digit are skipped.
-///
-/// ```
-/// let mut v = vec![5u64, 1, 900, 3, 3];
-/// ktree::stacking::radix_sort(&mut v, 10, &mut Vec::new());
-/// assert_eq!(v, [1, 3, 3, 5, 900]);
-/// ```
-pub fn radix_sort(keys: &mut Vec<u64>, bits: u32, scratch: &mut Vec<u64>) {
+pub(crate) fn radix_sort(keys: &mut Vec<u64>, bits: u32, scratch: &mut Vec<u64>) {
     let n = keys.len();
     if n < SMALL || bits == 0 {
         keys.sort_unstable();

@@ -73,6 +73,35 @@ macro_rules! with_dim {
     };
 }
 
+/// A tree of another dimension than the one asked for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("a tree of dimension K = {expected} was expected, this one has K = {found}")]
+pub struct DimensionMismatch {
+    /// The dimension asked for.
+    pub expected: usize,
+    /// The tree's dimension.
+    pub found: usize,
+}
+
+impl<const K: usize> TryFrom<AnyTree> for KTree<K> {
+    type Error = DimensionMismatch;
+
+    /// The tree as `KTree<K>`.
+    ///
+    /// ```
+    /// use ktree::{AnyTree, KTree};
+    /// let any = AnyTree::from(KTree::<2>::full(3).unwrap());
+    /// assert!(KTree::<2>::try_from(any.clone()).is_ok());
+    /// let e = KTree::<3>::try_from(any).unwrap_err();
+    /// assert_eq!((e.expected, e.found), (3, 2));
+    /// ```
+    fn try_from(tree: AnyTree) -> Result<Self, DimensionMismatch> {
+        let found = tree.k();
+        tree.into_dim::<K>()
+            .map_err(|_| DimensionMismatch { expected: K, found })
+    }
+}
+
 impl AnyTree {
     /// The tree as `KTree<K>`, or `self` back if it has another dimension.
     ///

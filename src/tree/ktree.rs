@@ -5,7 +5,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use super::cursor::Leaves;
 use super::states::{node_out_of_range, NodeState, PackedStates};
 use super::TreeError;
-use crate::rays::RaySet;
+
 use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
 
 /// Node counts of one level (or of a whole tree): Meagher's complexity metric.
@@ -282,19 +282,6 @@ impl<const K: usize> KTree<K> {
         self.id
     }
 
-    /// The tree of a ray set, by stacking ([`crate::stacking::stack`]); also `KTree::from(&rays)`.
-    ///
-    /// ```
-    /// use ktree::{KTree, Ray, RaySet};
-    /// let rays = RaySet::<2>::from_rays(3, [Ray::new([0, 0], 8)]).unwrap();
-    /// let tree = KTree::from_rays(&rays);
-    /// assert_eq!(tree.voxel_count(), 8);
-    /// assert_eq!(tree, KTree::from(&rays));
-    /// ```
-    pub fn from_rays(rays: &RaySet<K>) -> Self {
-        crate::stacking::stack(rays)
-    }
-
     /// The universe.
     pub fn universe(&self) -> Universe<K> {
         self.universe
@@ -471,15 +458,6 @@ impl<const K: usize> KTree<K> {
         n
     }
 
-    /// The tree of a dense boolean array (axis 0 fastest, see [`Universe::dense_index`]), reduced.
-    ///
-    /// # Errors
-    /// [`SpaceError::LevelTooLarge`]; [`SpaceError::TooLargeForDense`] if `dense.len() != U^K` or the
-    /// universe exceeds [`DENSE_LIMIT`].
-    pub fn from_dense(level: u32, dense: &[bool]) -> Result<Self, SpaceError> {
-        crate::reference::dense::DensePyramid::<K>::from_dense(level, dense).map(|p| p.to_tree())
-    }
-
     /// The object as a dense boolean array (axis 0 fastest).
     ///
     /// # Errors
@@ -511,13 +489,6 @@ impl<const K: usize> KTree<K> {
         if let Err(e) = self.check() {
             panic!("malformed KTree<{K}> (level {}): {e}", self.level());
         }
-    }
-}
-
-impl<const K: usize> From<&RaySet<K>> for KTree<K> {
-    /// [`KTree::from_rays`].
-    fn from(rays: &RaySet<K>) -> Self {
-        Self::from_rays(rays)
     }
 }
 
@@ -595,7 +566,7 @@ fn check_levels<const K: usize>(level: u32, levels: &[PackedStates]) -> Result<(
 /// building it — e.g. for a tree read through a memory map.
 ///
 /// ```
-/// use ktree::{rays::ball_rays, stacking::stack, tree::heap_bytes_for_levels};
+/// use ktree::{rays::ball_rays, stacking::paper::stack, tree::heap_bytes_for_levels};
 /// let tree = stack(&ball_rays::<3>(6, [64, 64, 64], 50).unwrap());
 /// assert_eq!(heap_bytes_for_levels(&tree.counts_per_level()), tree.heap_bytes());
 /// ```

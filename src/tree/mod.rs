@@ -2,7 +2,7 @@
 //! nodes or from full cells, and its Boolean operators.
 //!
 //! ```
-//! use ktree::{stacking::stack, NodeState, Ray, RaySet};
+//! use ktree::{stacking::paper::stack, NodeState, Ray, RaySet};
 //! // The lower half (z < 4) of column x = 0 of an 8 × 8 quadtree universe.
 //! let tree = stack(&RaySet::<2>::from_rays(3, [Ray::new([0, 0], 4)]).unwrap());
 //! assert_eq!(tree.root_state(), NodeState::Partial);
@@ -26,7 +26,7 @@ mod to_rays;
 pub(crate) mod words;
 
 pub(crate) use any::from_typed;
-pub use any::{AnyTree, TreeStats};
+pub use any::{AnyTree, DimensionMismatch, TreeStats};
 pub(crate) use assemble::{LevelWriter, TreeAssembler};
 pub use cursor::Leaves;
 pub use error::TreeError;

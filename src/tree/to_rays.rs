@@ -7,7 +7,7 @@ impl<const K: usize> KTree<K> {
     /// The runs along the last axis of a tree's full voxels: the ray set that stacks back to the tree.
     ///
     /// ```
-    /// use ktree::{stacking::stack, rays::ball_rays};
+    /// use ktree::{stacking::paper::stack, rays::ball_rays};
     /// let rays = ball_rays::<3>(5, [16, 16, 16], 11).unwrap();
     /// assert_eq!(stack(&rays).to_rays(), rays);
     /// ```

@@ -8,7 +8,7 @@ use ktree_verify::cases;
 use cases::ray_sets;
 use ktree::display::{ordered_full_cells, Order, Viewer};
 use ktree::space::Cell;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use proptest::prelude::*;
 
 /// Whether box `j` occludes box `i` seen along `d` (exact for axis-aligned open boxes, any K): some point

@@ -9,7 +9,7 @@ use cases::ray_sets;
 use ktree::display::plane::{quadtree_canvas, quadtree_svg};
 use ktree::display::slices::{slice_4d, time_strip};
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use proptest::prelude::*;
 
 proptest! {

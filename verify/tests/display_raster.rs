@@ -11,7 +11,7 @@ use ktree::display::{
     RenderOptions,
 };
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::{Ray, RaySet};
 use proptest::prelude::*;
 

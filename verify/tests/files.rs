@@ -5,7 +5,7 @@ use ktree_verify::cases;
 
 use cases::{ray_sets, Case};
 use ktree::io::{read_ktree, read_ktree_any, read_rays, write_ktree_v1, write_rays};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::AnyRaySet;
 use proptest::prelude::*;
 

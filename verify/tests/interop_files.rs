@@ -8,7 +8,7 @@ use cases::{ray_sets, Case};
 use ktree::io::{
     read_binvox, read_bt, read_vdb, write_binvox, write_bt, write_vdb, GridMeta, PlacedTree,
 };
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::KTree;
 use proptest::prelude::*;
 

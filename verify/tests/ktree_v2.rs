@@ -10,7 +10,7 @@ use ktree::io::{
     read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file, write_ktree_v1,
     KtreeFileErrorKind, KtreeView, KtreeWriter,
 };
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::tree::PackedStates;
 use ktree::KTree;
 use proptest::prelude::*;

@@ -4,7 +4,7 @@
 use ktree::display::{default_camera, render, RenderOptions, ISO_TOWARD_EYE};
 use ktree::io::{write_ktree, KtreeView, MappedTree};
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::tree::cursor::LevelOrder;
 use ktree::KTree;
 use ktree_verify::objects::object;

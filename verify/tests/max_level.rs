@@ -8,7 +8,7 @@ use ktree_verify::sparse;
 
 use ktree::io::{read_ktree, read_rays, write_ktree, write_rays};
 use ktree::ops::{self, AxisMap, BoolOp};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::AnyRaySet;
 use ktree::{KTree, RaySet};
 use proptest::prelude::*;

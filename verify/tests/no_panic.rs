@@ -7,7 +7,7 @@ use std::path::Path;
 use ktree::io::{read_ktree, read_ktree_any, read_rays};
 use ktree::ops::{Affine, AxisMap, FixedAffine, Projective};
 use ktree::rays::ball_rays;
-use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample};
 use ktree::{KTree, Ray, RaySet, Universe};
@@ -85,7 +85,7 @@ fn mesh_checks(mesh: &TriangleMesh) {
         mesh.open_edges(),
     );
     for level in [0, 1, 4] {
-        if let Ok(p) = Placement::fit(mesh, level) {
+        if let Ok(p) = MeshTransform::fit(mesh, level) {
             let _ = mesh.to_rays(level, &p);
         }
     }
@@ -119,7 +119,7 @@ fn rays_and_trees<const K: usize>(
     if let Ok(set) = RaySet::<K>::from_rays(small, rays) {
         let _ = set.translated(offset);
         let _ = set.complement();
-        let tree = ktree::stacking::stack(&set);
+        let tree = ktree::stacking::paper::stack(&set);
         tree.assert_well_formed();
     }
 }
@@ -152,7 +152,7 @@ proptest! {
         if let Ok(v) = Volume::from_nifti_bytes(&data, Path::new("arbitrary")) {
             volume_checks(&v);
         }
-        let _ = Placement::parse(&String::from_utf8_lossy(&data));
+        let _ = MeshTransform::parse(&String::from_utf8_lossy(&data));
     }
 
     #[test]
@@ -218,7 +218,7 @@ proptest! {
             let _ = p.inverse();
         }
         let _ = Projective::<3>::perspective(level, ints[0] as usize, floats.first().copied().unwrap_or(1.0));
-        let _ = Placement::parse(&format!("{},{},{},{}", floats.first().unwrap_or(&1.0), ints[0], ints[1], hi[0].to_f64()));
+        let _ = MeshTransform::parse(&format!("{},{},{},{}", floats.first().unwrap_or(&1.0), ints[0], ints[1], hi[0].to_f64()));
         let _ = ktree::display::png::Canvas::new(ints[0] as u32, ints[1] as u32, [0, 0, 0]);
     }
 }

@@ -204,13 +204,14 @@ fn placements_rebuild_the_object_at_each_offset() {
             20 + i64::from(o[1]),
             20 + i64::from(o[2]),
         ];
-        Ok(ktree::stacking::stack(
+        Ok(ktree::stacking::paper::stack(
             &ktree::rays::ball_rays::<3>(5, c, 13).expect("valid level"),
         ))
     })
     .unwrap();
     assert_eq!(n.counts.len(), 8);
-    let direct = ktree::stacking::stack(&ktree::rays::ball_rays::<3>(5, [21, 20, 21], 13).unwrap());
+    let direct =
+        ktree::stacking::paper::stack(&ktree::rays::ball_rays::<3>(5, [21, 20, 21], 13).unwrap());
     assert_eq!(n.counts[0b101], direct.node_count());
     assert!(n.min <= n.max);
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 use ktree::io::{read_ktree_file, write_ktree, write_ktree_file, KtreeView};
 use ktree::ops::{self, BoolOp, BooleanFileError, ViewOperation};
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::AnyTree;
 use ktree::KTree;
 use ktree_verify::objects::pair;

@@ -11,10 +11,7 @@ use std::path::Path;
 
 use ktree::io::write_ktree;
 use ktree::reference::{Dim, Fanout, NaiveTree};
-use ktree::stacking::{
-    balanced_parts, build_slabs, slab_cost, stack, stack_part, stack_to_file, OutOfCore,
-    OutOfCoreError, RaySource,
-};
+use ktree::stacking::{balanced_parts, paper::stack, BuildError, Builder, RaySource};
 use ktree::RaySet;
 use ktree_verify::cases::{ray_sets, Case};
 use proptest::prelude::*;
@@ -36,9 +33,9 @@ fn entries(dir: &Path) -> Vec<String> {
     names
 }
 
-fn needed_of<E: std::fmt::Debug>(e: OutOfCoreError<E>) -> Result<u64, TestCaseError> {
+fn needed_of<E: std::fmt::Debug>(e: BuildError<E>) -> Result<u64, TestCaseError> {
     match e {
-        OutOfCoreError::BudgetTooSmall { needed, .. } => Ok(needed),
+        BuildError::BudgetTooSmall { needed, .. } => Ok(needed),
         other => Err(TestCaseError::fail(format!(
             "expected a budget error, got {other:?}"
         ))),
@@ -54,7 +51,9 @@ where
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tree.ktree");
     for depth in 0..=level {
-        let report = stack_to_file(source, &out, &OutOfCore::new(depth, u64::MAX), &|_| {})
+        let report = Builder::new(source)
+            .split_depth(depth)
+            .to_file(&out, u64::MAX)
             .map_err(|e| TestCaseError::fail(format!("depth {depth}: {e}")))?;
         let written = std::fs::read(&out).unwrap();
         prop_assert!(
@@ -68,7 +67,10 @@ where
         std::fs::write(&out, b"old").unwrap();
         let mut budget = 0u64;
         let (report, needed) = loop {
-            match stack_to_file(source, &out, &OutOfCore::new(depth, budget), &|_| {}) {
+            match Builder::new(source)
+                .split_depth(depth)
+                .to_file(&out, budget)
+            {
                 Ok(report) => break (report, budget),
                 Err(e) => {
                     let needed = needed_of(e)?;
@@ -110,11 +112,11 @@ where
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tree.ktree");
     for depth in 0..=level {
-        let options = OutOfCore::new(depth, u64::MAX);
-        let slabs = build_slabs(source, depth);
+        let builder = Builder::new(source).split_depth(depth);
+        let slabs = builder.slabs();
         let costs: Vec<u64> = slabs
             .iter()
-            .map(|&b0| slab_cost(source, depth, b0).unwrap())
+            .map(|&b0| builder.slab_cost(b0).unwrap())
             .collect();
         let ranges = balanced_parts(&costs, parts);
         prop_assert_eq!(ranges.len(), parts);
@@ -136,7 +138,11 @@ where
         }
         let mut stacked: Vec<_> = ranges
             .iter()
-            .map(|r| stack_part(source, &slabs[r.clone()], &out, &options, &|_| {}).unwrap())
+            .map(|r| {
+                builder
+                    .stack_part(&slabs[r.clone()], &out, u64::MAX)
+                    .unwrap()
+            })
             .collect();
         let mut writer = stacked.remove(0);
         let mut streams = Vec::new();
@@ -254,7 +260,7 @@ fn any_thread_count_and_budget_give_the_same_file() {
         for depth in [1, 3, 5] {
             for budget in [u64::MAX, 4 << 20] {
                 let report = pool
-                    .install(|| stack_to_file(&rays, &out, &OutOfCore::new(depth, budget), &|_| {}))
+                    .install(|| Builder::new(&rays).split_depth(depth).to_file(&out, budget))
                     .unwrap();
                 assert_eq!(
                     std::fs::read(&out).unwrap(),
@@ -273,13 +279,12 @@ fn progress_counts_slabs_then_levels() {
     let rays = ktree::rays::ball_rays::<3>(6, [64, 64, 64], 50).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let seen = std::sync::Mutex::new(Vec::new());
-    let report = stack_to_file(
-        &rays,
-        &dir.path().join("b.ktree"),
-        &OutOfCore::new(3, u64::MAX),
-        &|p| seen.lock().unwrap().push(p),
-    )
-    .unwrap();
+    let progress = |p| seen.lock().unwrap().push(p);
+    let report = Builder::new(&rays)
+        .split_depth(3)
+        .progress(&progress)
+        .to_file(&dir.path().join("b.ktree"), u64::MAX)
+        .unwrap();
     let seen = seen.into_inner().unwrap();
     use ktree::stacking::Stage;
     let stacking: Vec<_> = seen.iter().filter(|p| p.stage == Stage::Stacking).collect();
@@ -305,13 +310,13 @@ fn an_unusable_temporary_folder_is_a_clear_error() {
     // A plain file where the folder should be: no one, not even root, can create files in it.
     let not_a_folder = dir.path().join("not-a-folder");
     std::fs::write(&not_a_folder, b"").unwrap();
-    let options = OutOfCore {
-        temp_dir: Some(not_a_folder.clone()),
-        ..OutOfCore::new(3, u64::MAX)
-    };
-    let e = stack_to_file(&rays, &out, &options, &|_| {}).unwrap_err();
+    let e = Builder::new(&rays)
+        .split_depth(3)
+        .temp_dir(&not_a_folder)
+        .to_file(&out, u64::MAX)
+        .unwrap_err();
     assert!(
-        matches!(e, OutOfCoreError::TempDir { .. }),
+        matches!(e, BuildError::TempDir { .. }),
         "unexpected error {e:?}"
     );
     let message = e.to_string();
@@ -346,7 +351,10 @@ fn extreme_levels_split_anywhere() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("t.ktree");
         for depth in [0, 1, level / 2, level - 1, level] {
-            stack_to_file(&set, &out, &OutOfCore::new(depth, u64::MAX), &|_| {}).unwrap();
+            Builder::new(&set)
+                .split_depth(depth)
+                .to_file(&out, u64::MAX)
+                .unwrap();
             assert_eq!(
                 std::fs::read(&out).unwrap(),
                 expected,
@@ -376,13 +384,10 @@ fn the_next_build_removes_the_spill_folders_of_killed_builds() {
         std::fs::create_dir(folder).unwrap();
         std::fs::write(folder.join("level-1"), b"spilled").unwrap();
     }
-    stack_to_file(
-        &rays,
-        &dir.path().join("b.ktree"),
-        &OutOfCore::new(3, u64::MAX),
-        &|_| {},
-    )
-    .unwrap();
+    Builder::new(&rays)
+        .split_depth(3)
+        .to_file(&dir.path().join("b.ktree"), u64::MAX)
+        .unwrap();
     assert!(!dead.exists(), "a killed build's spill folder stays");
     assert!(live.exists() && other.exists());
     assert_eq!(
@@ -402,12 +407,13 @@ fn a_foreign_or_damaged_part_index_is_refused() {
     let other = ktree::rays::ball_rays::<3>(6, [16, 16, 16], 20).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tree.ktree");
-    let options = OutOfCore::new(2, u64::MAX);
-    let slabs = build_slabs(&ball, 2);
+    let builder = Builder::new(&ball).split_depth(2);
+    let slabs = builder.slabs();
     let (first, second) = slabs.split_at(slabs.len() / 2);
-    let mut writer = stack_part(&ball, first, &out, &options, &|_| {}).unwrap();
-    let part = stack_part(&ball, second, &out, &options, &|_| {}).unwrap();
-    let foreign = stack_part(&other, &build_slabs(&other, 2), &out, &options, &|_| {}).unwrap();
+    let mut writer = builder.stack_part(first, &out, u64::MAX).unwrap();
+    let part = builder.stack_part(second, &out, u64::MAX).unwrap();
+    let other = Builder::new(&other).split_depth(2);
+    let foreign = other.stack_part(&other.slabs(), &out, u64::MAX).unwrap();
     let words = part.index_words();
     let mut damaged = vec![
         foreign.index_words(),
@@ -437,11 +443,11 @@ fn a_stream_that_breaks_off_fails_the_write_and_keeps_the_target() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tree.ktree");
     std::fs::write(&out, b"old").unwrap();
-    let options = OutOfCore::new(3, u64::MAX);
-    let slabs = build_slabs(&ball, 3);
+    let builder = Builder::new(&ball).split_depth(3);
+    let slabs = builder.slabs();
     let (first, second) = slabs.split_at(slabs.len() / 2);
-    let mut writer = stack_part(&ball, first, &out, &options, &|_| {}).unwrap();
-    let mut part = stack_part(&ball, second, &out, &options, &|_| {}).unwrap();
+    let mut writer = builder.stack_part(first, &out, u64::MAX).unwrap();
+    let mut part = builder.stack_part(second, &out, u64::MAX).unwrap();
     let words = writer.add_part(&part.index_words()).unwrap();
     let mut stream = Vec::new();
     part.stream_levels(16, &mut |c| {
@@ -469,7 +475,7 @@ fn a_stream_that_breaks_off_fails_the_write_and_keeps_the_target() {
             &|_| {},
         )
         .unwrap_err();
-    assert!(matches!(e, OutOfCoreError::Output { .. }), "{e:?}");
+    assert!(matches!(e, BuildError::Output { .. }), "{e:?}");
     assert!(e.to_string().contains("the sender stopped"), "{e}");
     assert_eq!(std::fs::read(&out).unwrap(), b"old".to_vec());
     assert_eq!(entries(dir.path()), vec!["tree.ktree".to_string()]);
@@ -504,7 +510,9 @@ fn a_solid_interior_does_not_fill_the_budget() {
         );
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("ball.ktree");
-        let report = stack_to_file(&rays, &out, &OutOfCore::new(depth, budget), &|_| {})
+        let report = Builder::new(&rays)
+            .split_depth(depth)
+            .to_file(&out, budget)
             .unwrap_or_else(|e| panic!("K = {K}, L = {level}: {e}"));
         assert!(report.peak_accounted_bytes <= budget);
         let mut expected = Vec::new();

@@ -1,13 +1,13 @@
-//! Morton-partitioned stacking is cross-checked, for K = 1 … 4 and every split depth, against whole-set
-//! stacking and naive voxel insertion node for node; the cell split of the rays against the rays' own
-//! point test; joining stacked subtrees against stacking the whole set; and the result against the number
-//! of threads.
+//! The builder (Morton-partitioned stacking) is cross-checked, for K = 1 … 4, every split depth and both
+//! ways of stacking a cell, against the paper's stacking of the whole set and naive voxel insertion node
+//! for node; the cell split of the rays against the rays' own point test; the stacked subtrees of the
+//! cells, put together, against stacking the whole set; and the result against the number of threads.
 
 use ktree_verify::cases;
 
 use cases::{ray_sets, Case};
 use ktree::reference::{Dim, Fanout, NaiveTree};
-use ktree::stacking::{join_subtrees, stack, stack_partitioned};
+use ktree::stacking::{paper::stack, Builder, CellStacking};
 use ktree::{Cell, KTree};
 use proptest::prelude::*;
 
@@ -20,15 +20,22 @@ where
     let naive = NaiveTree::from_rays(rays).unwrap().to_tree();
     prop_assert!(whole == naive, "stacking and naive differ");
     for depth in 0..=rays.level() {
-        let parted = stack_partitioned(rays, depth);
-        parted
-            .check()
-            .map_err(|e| TestCaseError::fail(format!("depth {depth}: malformed: {e}")))?;
-        prop_assert!(
-            parted == whole,
-            "split depth {}: partitioned and whole stacking differ",
-            depth
-        );
+        for cells in [CellStacking::Bitmap, CellStacking::Lists] {
+            let parted = Builder::new(rays)
+                .split_depth(depth)
+                .cells(cells)
+                .build()
+                .unwrap();
+            parted
+                .check()
+                .map_err(|e| TestCaseError::fail(format!("depth {depth}: malformed: {e}")))?;
+            prop_assert!(
+                parted == whole,
+                "split depth {}, cells {:?}: partitioned and whole stacking differ",
+                depth,
+                cells
+            );
+        }
     }
     Ok(())
 }
@@ -50,7 +57,7 @@ fn split_and_join_agree<const K: usize>(case: &Case<K>, depth: u32) -> Result<()
     let rays = &case.rays;
     let depth = depth.min(rays.level());
     let u = rays.universe();
-    let mut subtrees = Vec::new();
+    let mut moved = Vec::new();
     for cell in cells::<K>(rays.level(), depth) {
         let inner = rays.cell_rays(cell);
         prop_assert_eq!(inner.level(), rays.level() - depth);
@@ -66,11 +73,15 @@ fn split_and_join_agree<const K: usize>(case: &Case<K>, depth: u32) -> Result<()
             }
         });
         prop_assert_eq!(inner.voxel_count(), count);
-        subtrees.push(stack(&inner));
+        // The cell's subtree, its full leaves moved to the cell's place.
+        for leaf in stack(&inner).full_cells() {
+            let origin: [u32; K] = std::array::from_fn(|a| leaf.origin()[a] + cell.origin()[a]);
+            moved.push(Cell::new(u, origin, leaf.level() + depth).unwrap());
+        }
     }
     prop_assert!(
-        join_subtrees(u, depth, subtrees) == stack(rays),
-        "joined subtrees differ from stacking at depth {}",
+        KTree::from_cells(u, &moved).unwrap() == stack(rays),
+        "the cells' subtrees, joined, differ from stacking at depth {}",
         depth
     );
     Ok(())
@@ -104,17 +115,17 @@ fn any_thread_count_gives_the_same_tree() {
     let level = 7;
     let u = 1i64 << level;
     let rays = ktree::rays::ball_rays::<3>(level, [u, u, u], u - 3).unwrap();
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap();
-    let three = rayon::ThreadPoolBuilder::new()
-        .num_threads(3)
-        .build()
-        .unwrap();
     for depth in [1, 3, 5] {
-        let a: KTree<3> = one.install(|| stack_partitioned(&rays, depth));
-        let b = three.install(|| stack_partitioned(&rays, depth));
+        let a: KTree<3> = Builder::new(&rays)
+            .threads(1)
+            .split_depth(depth)
+            .build()
+            .unwrap();
+        let b = Builder::new(&rays)
+            .threads(3)
+            .split_depth(depth)
+            .build()
+            .unwrap();
         assert_eq!(a, b);
         assert_eq!(a, stack(&rays));
     }
@@ -143,7 +154,11 @@ fn extreme_levels_split_anywhere() {
         let set = ktree::RaySet::from_rays(level, rays).unwrap();
         let whole = stack(&set);
         for depth in [1, level / 2, level - 1, level] {
-            assert_eq!(stack_partitioned(&set, depth), whole, "K={K} depth {depth}");
+            assert_eq!(
+                Builder::new(&set).split_depth(depth).build().unwrap(),
+                whole,
+                "K={K} depth {depth}"
+            );
         }
     }
     check::<1>();
@@ -159,11 +174,11 @@ fn solid_agrees<const K: usize>(
     level: u32,
 ) -> Result<(), TestCaseError> {
     use ktree::solid::{Sample, SolidSource};
-    use ktree::stacking::stack_source;
+    use ktree::stacking::Builder;
     let whole = stack(&solid.to_rays(level, Sample::Centre, false).unwrap());
     let source = SolidSource::new(solid, level, Sample::Centre).unwrap();
     for depth in 0..=level {
-        let parted = stack_source(&source, depth).unwrap();
+        let parted = Builder::new(&source).split_depth(depth).build().unwrap();
         prop_assert!(parted == whole, "solid at split depth {}", depth);
     }
     Ok(())

@@ -4,7 +4,7 @@
 
 use ktree::io::{read_ktree_any, write_ktree, write_ktree_v1};
 use ktree::rays::RayError;
-use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
 use ktree::space::SpaceError;
 use ktree::tree::PackedStates;
@@ -327,8 +327,8 @@ fn meshes_are_checked() {
                 mesh.open_edges(),
             );
             let placements = [
-                Placement::fit(&mesh, level).ok(),
-                Some(Placement { scale, translate }),
+                MeshTransform::fit(&mesh, level).ok(),
+                Some(MeshTransform { scale, translate }),
             ];
             let mut voxelized = false;
             for p in placements.iter().flatten() {

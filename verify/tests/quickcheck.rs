@@ -3,7 +3,7 @@
 //! with aligned, unmergeable rows.
 
 use ktree::rays::maximal_rows;
-use ktree::{reference::DensePyramid, stacking::stack};
+use ktree::{reference::DensePyramid, stacking::paper::stack};
 use ktree::{Ray, RaySet};
 use quickcheck::{Arbitrary, Gen, QuickCheck};
 

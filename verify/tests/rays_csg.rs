@@ -1,7 +1,7 @@
 //! Boolean operations and translation on ray sets = the same operations on dense boolean arrays, K = 1 … 4;
 //! results are canonical ray sets and stack into the dense reference tree.
 
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::{KTree, Ray, RaySet, Universe};
 use proptest::prelude::*;
 

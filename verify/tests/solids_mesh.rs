@@ -5,8 +5,8 @@
 
 use ktree_verify::cases;
 
-use ktree::solid::mesh::{Placement, TriangleMesh};
-use ktree::stacking::stack;
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
+use ktree::stacking::paper::stack;
 use ktree::{KTree, Universe};
 use proptest::prelude::*;
 
@@ -57,7 +57,7 @@ fn cube(lo: [f64; 3], hi: [f64; 3]) -> TriangleMesh {
     TriangleMesh::new(vertices, triangles).unwrap()
 }
 
-fn rays_dense(mesh: &TriangleMesh, level: u32, p: &Placement) -> Vec<bool> {
+fn rays_dense(mesh: &TriangleMesh, level: u32, p: &MeshTransform) -> Vec<bool> {
     let r = mesh.to_rays(level, p).unwrap();
     let u = Universe::<3>::new(level).unwrap();
     let dense: Vec<bool> = (0..u.voxels() as usize)
@@ -81,7 +81,7 @@ fn octahedron_rule(d: [f64; 3], r: f64) -> bool {
     d[2] != 0.0 || d[0] < 0.0
 }
 
-const ID: Placement = Placement {
+const ID: MeshTransform = MeshTransform {
     scale: 1.0,
     translate: [0.0; 3],
 };
@@ -126,7 +126,7 @@ proptest! {
         let level = 4;
         let u = Universe::<3>::new(level).unwrap();
         let centre = c.map(|x| f64::from(x) / 2.0);
-        let p = Placement { scale: f64::from(s), translate: [0.5, -1.0, 0.0] };
+        let p = MeshTransform { scale: f64::from(s), translate: [0.5, -1.0, 0.0] };
         let got = rays_dense(&octahedron(centre, f64::from(r) / 2.0), level, &p);
         for (i, &g) in got.iter().enumerate() {
             let v = u.dense_point(i);
@@ -168,7 +168,7 @@ fn real_meshes_match_brute_force_and_volume() {
         let mesh = TriangleMesh::read(&dir.join(name)).unwrap();
         assert_eq!(mesh.open_edges(), 0, "{name} is closed");
         if brute_level > 0 {
-            let p = Placement::fit(&mesh, brute_level).unwrap();
+            let p = MeshTransform::fit(&mesh, brute_level).unwrap();
             let got = rays_dense(&mesh, brute_level, &p);
             // The brute force uses the same rounding of vertices to 1/65536 voxel as the ray generator.
             let placed: Vec<[f64; 3]> = mesh
@@ -189,7 +189,7 @@ fn real_meshes_match_brute_force_and_volume() {
         }
         // Volume within the discretisation bound: misclassified centres lie within √3/2 of the surface.
         let level = 7;
-        let p = Placement::fit(&mesh, level).unwrap();
+        let p = MeshTransform::fit(&mesh, level).unwrap();
         let r = mesh.to_rays(level, &p).unwrap();
         let s = p.scale;
         let volume = mesh.signed_volume() * s.powi(3);
@@ -262,10 +262,10 @@ fn formats_read_alike() {
     assert!(e.contains("bad.obj"), "{e}");
     assert!(TriangleMesh::read(&dir.path().join("none.stl")).is_err());
     assert!(TriangleMesh::read(&dir.path().join("m.xyz")).is_err());
-    assert!(Placement::parse("1,2,3").is_err() && Placement::parse("2,0,0,0").is_ok());
+    assert!(MeshTransform::parse("1,2,3").is_err() && MeshTransform::parse("2,0,0,0").is_ok());
     // Levels beyond what the crossing packing holds, and placements far outside, are errors.
     assert!(mesh.to_rays(21, &ID).is_err());
-    let far = Placement {
+    let far = MeshTransform {
         scale: 1e9,
         translate: [0.0; 3],
     };

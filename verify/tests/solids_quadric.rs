@@ -2,7 +2,7 @@
 //! well-formed tree equal to the dense reference.
 
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::{KTree, RaySet, Universe};
 use proptest::prelude::*;
 

@@ -4,7 +4,7 @@
 use ktree_verify::cases;
 
 use ktree::solid::volume::{Select, Volume};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use proptest::prelude::*;
 
 proptest! {

@@ -7,9 +7,9 @@ use ktree::io::{
     open_rays_file, read_rays_file, write_ktree, write_rays, write_rays_file, AnyRaysFileSource,
     RaysFile, RaysFileSource,
 };
-use ktree::solid::mesh::{MeshSource, Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshSource, MeshTransform, TriangleMesh};
 use ktree::solid::volume::{Select, Volume, VolumeSource};
-use ktree::stacking::{stack, stack_to_file, OutOfCore, RaySource};
+use ktree::stacking::{paper::stack, Builder, RaySource};
 use ktree::AnyRaySet;
 use ktree::{Ray, RaySet};
 use ktree_verify::cases::{self, ray_sets, Case};
@@ -64,7 +64,9 @@ where
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tree.ktree");
     for depth in depths {
-        stack_to_file(source, &out, &OutOfCore::new(depth, u64::MAX), &|_| {})
+        Builder::new(source)
+            .split_depth(depth)
+            .to_file(&out, u64::MAX)
             .map_err(|e| TestCaseError::fail(format!("depth {depth}: {e}")))?;
         prop_assert!(
             std::fs::read(&out).unwrap() == expected,
@@ -113,7 +115,7 @@ fn cube(lo: [f64; 3], hi: [f64; 3]) -> TriangleMesh {
 fn mesh_agrees(
     mesh: &TriangleMesh,
     level: u32,
-    placement: &Placement,
+    placement: &MeshTransform,
 ) -> Result<(), TestCaseError> {
     let whole = mesh.to_rays(level, placement).unwrap();
     let source = MeshSource::new(mesh, level, placement).unwrap();
@@ -132,7 +134,7 @@ proptest! {
         scale in 1i32..4,
         shift in prop::array::uniform3(-6i32..6),
     ) {
-        let placement = Placement { scale: f64::from(scale) / 2.0, translate: shift.map(f64::from) };
+        let placement = MeshTransform { scale: f64::from(scale) / 2.0, translate: shift.map(f64::from) };
         mesh_agrees(&mesh, level, &placement)?;
     }
 
@@ -145,7 +147,7 @@ proptest! {
         shift in prop::array::uniform3(-40i32..40),
     ) {
         let scale = f64::from(1u32 << (level - 4)) / 1.5;
-        let placement = Placement { scale, translate: shift.map(f64::from) };
+        let placement = MeshTransform { scale, translate: shift.map(f64::from) };
         let whole = mesh.to_rays(level, &placement).unwrap();
         let source = MeshSource::new(&mesh, level, &placement).unwrap();
         slabs_agree(&source, &whole.rays)?;
@@ -159,7 +161,7 @@ proptest! {
     ) {
         let lo = lo.map(|c| f64::from(c) / 2.0);
         let hi = std::array::from_fn(|a| lo[a] + f64::from(size[a]) / 2.0);
-        let id = Placement { scale: 1.0, translate: [0.0; 3] };
+        let id = MeshTransform { scale: 1.0, translate: [0.0; 3] };
         mesh_agrees(&cube(lo, hi), 4, &id)?;
     }
 
@@ -186,7 +188,7 @@ fn bundled_meshes_equal_their_whole_rays() {
     for name in ["bunny_npm.obj", "fandisk.obj", "armadillo.obj"] {
         let mesh = TriangleMesh::read(&dir.join(name)).unwrap();
         for level in [5, 7] {
-            let placement = Placement::fit(&mesh, level).unwrap();
+            let placement = MeshTransform::fit(&mesh, level).unwrap();
             let whole = mesh.to_rays(level, &placement).unwrap();
             let source = MeshSource::new(&mesh, level, &placement).unwrap();
             slabs_agree(&source, &whole.rays).unwrap();

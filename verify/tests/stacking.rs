@@ -7,7 +7,7 @@ use ktree_verify::cases;
 use cases::{ray_sets, Case};
 use ktree::{
     reference::{DensePyramid, Dim, Fanout, NaiveTree},
-    stacking::stack,
+    stacking::paper::stack,
 };
 use ktree::{KTree, NodeState};
 use proptest::prelude::*;

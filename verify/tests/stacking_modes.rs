@@ -7,7 +7,8 @@ use ktree_verify::cases;
 
 use cases::{ray_sets, Case};
 use ktree::stacking::{
-    stack, stack_bitmap, stack_pipelined, stack_with_file_lists, stack_with_stats,
+    paper::stack, paper::stack_pipelined, paper::stack_with_file_lists, paper::stack_with_stats,
+    Builder,
 };
 use proptest::prelude::*;
 
@@ -62,7 +63,7 @@ fn modes_agree<const K: usize>(case: &Case<K>) -> Result<(), TestCaseError> {
         .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert!(stack(rays) == tree);
     prop_assert!(
-        stack_bitmap(rays) == tree,
+        Builder::new(rays).split_depth(0).build().unwrap() == tree,
         "bitmap pyramid and stacking differ node for node"
     );
     Ok(())

@@ -2,7 +2,7 @@
 //! rank index agrees with a plain count of the partial nodes on them.
 
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::NodeState;
 
 #[test]

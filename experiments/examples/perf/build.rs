@@ -1,5 +1,6 @@
 //! Build performance: stacking vs naive voxel insertion vs the dense pyramid on voxel-centre balls of
-//! radius U/2 centred in the universe, L = 6 … 10 (octrees).
+//! radius U/2 centred in the universe, L = 6 … 10 (octrees); and the builder with each cell stacked
+//! through a bitmap pyramid vs by the paper's lists, side by side.
 
 use std::fmt::Write as _;
 
@@ -7,7 +8,7 @@ use ktree::rays::ball_rays;
 use ktree::RaySet;
 use ktree::{
     reference::{DensePyramid, NaiveTree},
-    stacking::stack,
+    stacking::{paper::stack, Builder, CellStacking},
 };
 
 use crate::measure::{best_of, machine_line, results_path, run_child, Measured};
@@ -23,7 +24,8 @@ fn sphere(level: u32) -> RaySet<3> {
     ball_rays::<3>(level, [u, u, u], u).expect("level in range")
 }
 
-/// Runs one case in this (child) process: `stack-L`, `naive-L` or `dense-L`.
+/// Runs one case in this (child) process: `stack-L`, `naive-L`, `dense-L`, or the builder on one thread
+/// with each cell through a bitmap (`bitmap-L`) or the paper's lists (`lists-L`).
 pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
     let (what, level) = case.split_once('-').ok_or("case must be WHAT-LEVEL")?;
     let level: u32 = level.parse().map_err(|_| "bad level")?;
@@ -45,6 +47,20 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             facts.push(("nodes".into(), nodes.to_string()));
             facts.push(("tree_heap_bytes".into(), heap.to_string()));
             s
+        }
+        "bitmap" | "lists" => {
+            let cells = if what == "bitmap" {
+                CellStacking::Bitmap
+            } else {
+                CellStacking::Lists
+            };
+            let builder = Builder::new(&rays).threads(1).cells(cells);
+            let want = stack(&rays);
+            best_of(
+                repeats,
+                || builder.build().expect("the ball's rays"),
+                |t| assert_eq!(t, want, "the builder and stacking differ"),
+            )
         }
         "naive" => best_of(
             1,
@@ -133,6 +149,33 @@ pub fn report() -> Result<String, String> {
          Naive insertion is not run above L = {NAIVE_MAX} and the dense pyramid above L = {DENSE_MAX} \
          (U^3 voxels in memory)."
     );
+    let _ = writeln!(
+        md,
+        "\n## The builder: each cell through a bitmap pyramid or by the paper's lists\n\n\
+         `ktree::stacking::Builder` (what `KTree::from_rays`, the CLI and Python run) on one thread, cells \
+         of depth L − 6 (2^18 voxels), each cell the sphere's boundary passes through stacked through a \
+         bitmap pyramid of its voxels (`CellStacking::Bitmap`) or by Akman & Franklin's list stacking of its \
+         rays (`CellStacking::Lists`); beside them the paper's stacking of the whole set (the table above). \
+         Interleaved per level, best of 3–5 runs each, a fresh process per case. The faster per-cell way \
+         is the builder's default.\n\n\
+         | L | paper's stacking s | builder, bitmap cells s | builder, list cells s | lists / bitmap | bitmap peak MiB | lists peak MiB |\n\
+         |---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for level in LEVELS {
+        let s: Measured = run_child("build", &format!("stack-{level}"))?;
+        let b: Measured = run_child("build", &format!("bitmap-{level}"))?;
+        let l: Measured = run_child("build", &format!("lists-{level}"))?;
+        let _ = writeln!(
+            md,
+            "| {level} | {:.4} | {:.4} | {:.4} | {:.2} | {} | {} |",
+            s.seconds,
+            b.seconds,
+            l.seconds,
+            l.seconds / b.seconds,
+            mib(b.peak_bytes),
+            mib(l.peak_bytes),
+        );
+    }
     let path = results_path("build");
     ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())

@@ -8,7 +8,7 @@ use ktree::display::{
     ISO_TOWARD_EYE,
 };
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::Octree;
 
 use crate::measure::{best_of, machine_line, results_path, run_child, Measured};

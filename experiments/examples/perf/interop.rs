@@ -11,7 +11,7 @@ use std::process::Command;
 use ktree::io::{read_tree, voxelize, write_ktree_file, write_tree, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
 use ktree::solid::volume::Select;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::AnyTree;
 
 const LEVEL: u32 = 8;

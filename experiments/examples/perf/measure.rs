@@ -105,5 +105,12 @@ pub fn machine_line() -> String {
         })
         .unwrap_or_else(|| "unknown CPU".into());
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
-    format!("{cpu}, {cores} cores; one thread used; release build")
+    // The machine is shared: the load when the report began says how quiet it was.
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_string))
+        .map_or(String::new(), |l| {
+            format!("; load average {l} at the start")
+        });
+    format!("{cpu}, {cores} cores; one thread used; release build{load}")
 }

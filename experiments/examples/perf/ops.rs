@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use ktree::ops::{self, Affine, AxisMap, BoolOp};
 use ktree::rays::ball_rays;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::{KTree, Ray, RaySet};
 
 use crate::measure::{best_of, machine_line, results_path, run_child, Measured};

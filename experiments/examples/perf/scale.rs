@@ -8,9 +8,7 @@ use std::fmt::Write as _;
 
 use ktree::io::KtreeView;
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{
-    default_split_depth, stack, stack_source, stack_to_file, OutOfCore, RaySource,
-};
+use ktree::stacking::{default_split_depth, paper::stack, Builder, RaySource};
 use ktree::LevelCounts;
 
 use crate::measure::{best_of, machine_line, results_path, run_child, Measured};
@@ -67,7 +65,10 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
                     pool.install(|| {
                         let source = SolidSource::new(&solid, level, Sample::Centre)
                             .expect("level in range");
-                        stack_source(&source, depth).expect("the sphere's rays")
+                        Builder::new(&source)
+                            .split_depth(depth)
+                            .build()
+                            .expect("the sphere's rays")
                     })
                 },
                 |t| tree = Some(t),
@@ -131,10 +132,10 @@ fn out_of_core_case(
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let out = dir.path().join("sphere.ktree");
     let source = SolidSource::new(solid, level, Sample::Centre).map_err(|e| e.to_string())?;
-    let options = OutOfCore::new(default_split_depth(3, level), OUT_OF_CORE_BUDGET);
+    let budget = OUT_OF_CORE_BUDGET;
     let start = std::time::Instant::now();
     let report = pool
-        .install(|| stack_to_file(&source, &out, &options, &|_| {}))
+        .install(|| Builder::new(&source).to_file(&out, budget))
         .map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     let build_peak = ktree_repro::peak_rss_bytes().unwrap_or(0);
@@ -248,7 +249,7 @@ pub fn report() -> Result<String, String> {
     }
     let _ = writeln!(
         md,
-        "\n## Out of core\n\nThe same sphere built by `ktree::stacking::stack_to_file` (what `ktree rays|build|voxelize \
+        "\n## Out of core\n\nThe same sphere built by `ktree::stacking::Builder::to_file` (what `ktree rays|build|voxelize \
          … --out FILE.ktree` run): the subtrees of the cells of depth L − 6 spilled to per-level temporary \
          files as slabs finish, then the `.ktree` version 2 written level by level into a temporary folder, \
          on {OUT_OF_CORE_THREADS} threads in a budget of {} MiB. One run per level. Peak: the process's \

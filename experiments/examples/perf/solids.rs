@@ -5,10 +5,10 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use ktree::rays::ball_rays;
-use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
 use ktree::solid::{Frame, Quadric, Rational, Sample};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::RaySet;
 
 use crate::measure::{best_of, machine_line, results_path, run_child};
@@ -31,9 +31,9 @@ fn ball(level: u32) -> Quadric<3> {
     Quadric::ball([h, h, h], h, Frame::Voxel).expect("valid ball")
 }
 
-fn mesh_rays(name: &str) -> Result<(TriangleMesh, Placement), String> {
+fn mesh_rays(name: &str) -> Result<(TriangleMesh, MeshTransform), String> {
     let mesh = TriangleMesh::read(&data(&format!("meshes/{name}"))?).map_err(|e| e.to_string())?;
-    let p = Placement::fit(&mesh, LEVEL).map_err(|e| e.to_string())?;
+    let p = MeshTransform::fit(&mesh, LEVEL).map_err(|e| e.to_string())?;
     Ok((mesh, p))
 }
 

@@ -16,7 +16,7 @@ use ktree::io::{
 };
 use ktree::solid::volume::Select;
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{default_split_depth, stack_to_file, OutOfCore, RaySource};
+use ktree::stacking::{default_split_depth, Builder, RaySource};
 use ktree::AnyRaySet;
 
 use crate::measure::{machine_line, results_path, run_child};
@@ -77,10 +77,9 @@ where
         .map_err(|e| e.to_string())?;
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let out = dir.path().join("tree.ktree");
-    let level = source.universe().level();
-    let options = OutOfCore::new(default_split_depth(3, level), u64::MAX);
+    let budget = u64::MAX;
     let report = pool
-        .install(|| stack_to_file(source, &out, &options, &|_| {}))
+        .install(|| Builder::new(source).to_file(&out, budget))
         .map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     let peak = ktree_repro::peak_rss_bytes().unwrap_or(0);
@@ -201,7 +200,7 @@ pub fn report() -> Result<String, String> {
     let _ = writeln!(
         md,
         "Regenerate with `cargo run --release --example perf -- sources`. Each case builds a `.ktree` out of \
-         core (`ktree::stacking::stack_to_file`, cells of depth L − 6, no budget limit, one thread) in a fresh \
+         core (`ktree::stacking::Builder::to_file`, cells of depth L − 6, no budget limit, one thread) in a fresh \
          process, as `ktree voxelize IN --out X.ktree` and `ktree build --rays IN --out X.ktree` do: *whole* \
          makes (or reads) the whole ray set first, as these commands did before; *slabs* makes (or reads) the \
          rays slab by slab as the cells are stacked (`MeshSource`, `VolumeSource`, `RaysFileSource`). Peak: \

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use ktree::io::{read_ktree_file, write_ktree_file};
 use ktree::ops::{self, BoolOp};
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{default_split_depth, stack_to_file, OutOfCore};
+use ktree::stacking::Builder;
 use ktree::AnyTree;
 use ktree::LevelCounts;
 
@@ -183,8 +183,10 @@ pub fn report() -> Result<String, String> {
             let solid = sphere(level, which);
             let source =
                 SolidSource::new(&solid, level, Sample::Centre).map_err(|e| e.to_string())?;
-            let options = OutOfCore::new(default_split_depth(3, level), 4 << 30);
-            stack_to_file(&source, &path, &options, &|_| {}).map_err(|e| e.to_string())?;
+            let budget = 4 << 30;
+            Builder::new(&source)
+                .to_file(&path, budget)
+                .map_err(|e| e.to_string())?;
             inputs += std::fs::metadata(&path).map_err(|e| e.to_string())?.len();
         }
         for op in OPS {

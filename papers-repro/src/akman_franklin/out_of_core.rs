@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use ktree::rays::RaySet;
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{stack, stack_pipelined, stack_with_file_lists, stack_with_stats};
+use ktree::stacking::paper::{stack, stack_pipelined, stack_with_file_lists, stack_with_stats};
 
 use super::{best_time, centred_ball};
 
@@ -51,9 +51,9 @@ pub(super) fn af8(write: &dyn Fn(&str, &str) -> Result<(), String>) -> Result<[S
     );
     let mut md = format!(
         "# AF8: the dimension-level lists as sequential disk files\n\n\
-         Ball of radius U/2 centred in an octree universe (voxel centres). *In memory* is `stacking::stack`: it \
+         Ball of radius U/2 centred in an octree universe (voxel centres). *In memory* is `stacking::paper::stack`: it \
          holds the input rays, per slab of rays the lists of that slab, and the last stage's lists whole. \
-         *File lists* is `stacking::stack_with_file_lists` on the ball's quadric (its rays made slab by slab, \
+         *File lists* is `stacking::paper::stack_with_file_lists` on the ball's quadric (its rays made slab by slab, \
          never held whole): every list ι(D, l) is a file, written only by appending, read from start to end, \
          at most three open at a time (ι(D, l) read, ι(D+1, l) and ι(D, l+1) appended), in the paper's order \
          (all levels of D = 1, then D = 2). A list of more than {AF8_MAX_ITEMS} keys is sorted on disk: sorted \
@@ -127,7 +127,7 @@ pub(super) fn af8(write: &dyn Fn(&str, &str) -> Result<(), String>) -> Result<[S
         .iter()
         .all(|r| r.2 <= AF8_MAX_ITEMS as u64 + (1u64 << r.0));
     let ours = format!(
-        "`stacking::stack_with_file_lists` on the ball's quadric (rays made slab by slab): every list a file, at most {max_open} open, read in order, appended to; lists longer than {AF8_MAX_ITEMS} keys sorted on disk in runs merged two at a time; same tree as in memory for L = {}…{} ({}); items held in memory at most {} (L = {}) against {} in memory, peak RSS {:.0} against {:.0} MiB (the file-list figure includes the tree it returns)",
+        "`stacking::paper::stack_with_file_lists` on the ball's quadric (rays made slab by slab): every list a file, at most {max_open} open, read in order, appended to; lists longer than {AF8_MAX_ITEMS} keys sorted on disk in runs merged two at a time; same tree as in memory for L = {}…{} ({}); items held in memory at most {} (L = {}) against {} in memory, peak RSS {:.0} against {:.0} MiB (the file-list figure includes the tree it returns)",
         first.0,
         last.0,
         if all_same { "node for node" } else { "NOT equal" },
@@ -157,8 +157,8 @@ pub(super) fn af9(write: &dyn Fn(&str, &str) -> Result<(), String>) -> Result<[S
     let mut csv = String::from("level,rays,nodes,one_thread_s,pipeline_s,speedup,same_tree\n");
     let mut md = format!(
         "# AF9: the data-flow boxes as a pipeline of threads\n\n\
-         Ball of radius U/2 centred in an octree universe. *One thread* is `stacking::stack`; *pipeline* is \
-         `stacking::stack_pipelined`: a producer thread cuts maximal rows, one thread per stage D = 1, 2 combines \
+         Ball of radius U/2 centred in an octree universe. *One thread* is `stacking::paper::stack`; *pipeline* is \
+         `stacking::paper::stack_pipelined`: a producer thread cuts maximal rows, one thread per stage D = 1, 2 combines \
          and splits its lists and sends what it combines on through a bounded channel, and the calling thread \
          collects the full leaves and assembles the tree (4 threads for K = 3). Times are the best of 3 runs, \
          interleaved, on a machine with {threads} hardware threads shared with other work; throughput is rays \
@@ -208,7 +208,7 @@ pub(super) fn af9(write: &dyn Fn(&str, &str) -> Result<(), String>) -> Result<[S
         "AF9".into(),
         "one processor per box of the data flow (pipeline)".into(),
         format!(
-            "`stacking::stack_pipelined`: a thread per stage, bounded channels between; same tree ({}); throughput against one thread ({threads} hardware threads): {speedups}",
+            "`stacking::paper::stack_pipelined`: a thread per stage, bounded channels between; same tree ({}); throughput against one thread ({threads} hardware threads): {speedups}",
             if all_same { "node for node, L = 8…11" } else { "NOT equal" }
         ),
         if all_same { "reproduced (speed-up as measured)" } else { "differs" }.into(),

@@ -10,7 +10,7 @@
 
 use ktree::rays::RaySet;
 use ktree::solid::{Frame, Quadric, Sample};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 
 /// A rational `num / den` with `den ≥ 0`; `den = 0` is +∞.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -4,7 +4,7 @@
 
 use ktree::rays::RaySet;
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::tree::KTree;
 
 fn half(v: i64) -> Rational {

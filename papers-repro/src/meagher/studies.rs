@@ -10,7 +10,7 @@ use super::Out;
 use crate::common::{fit_line, LineFit};
 use ktree::ops::{self, Affine, AxisMap};
 use ktree::rays::{ball_rays, Ray, RaySet};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::tree::KTree;
 
 fn e(x: impl std::fmt::Display) -> String {

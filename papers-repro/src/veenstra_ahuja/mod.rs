@@ -15,7 +15,7 @@ use ktree::display::{
     ISO_TOWARD_EYE,
 };
 use ktree::fs::write_atomic;
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::tree::Octree;
 
 /// Level of the figures' octrees (the paper's trees had up to about 12 000 nodes).

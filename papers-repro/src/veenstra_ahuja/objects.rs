@@ -6,7 +6,7 @@
 use ktree::ops;
 use ktree::rays::{Ray, RaySet};
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample};
-use ktree::stacking::stack;
+use ktree::stacking::paper::stack;
 use ktree::tree::Octree;
 
 /// A figure's object: its name, the paper's figure number and how to build it at a level.

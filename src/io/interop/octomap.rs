@@ -317,7 +317,7 @@ fn write_node(
 mod tests {
     use super::*;
     use crate::rays::ball_rays;
-    use crate::stacking::stack;
+    use crate::stacking::paper::stack;
 
     fn sample() -> (KTree<3>, Vec<u8>) {
         let tree = stack(&ball_rays::<3>(4, [7, 8, 9], 6).unwrap());

@@ -136,7 +136,7 @@ fn put_mask(out: &mut Vec<u8>, bits: impl Iterator<Item = bool>, words: usize) {
 ///
 /// ```
 /// use ktree::io::{read_vdb, write_vdb, GridMeta};
-/// let tree = ktree::stacking::stack(&ktree::rays::ball_rays::<3>(5, [16, 16, 16], 12).unwrap());
+/// let tree = ktree::stacking::paper::stack(&ktree::rays::ball_rays::<3>(5, [16, 16, 16], 12).unwrap());
 /// let mut bytes = Vec::new();
 /// write_vdb(&mut bytes, &tree, [0; 3], &GridMeta::default()).unwrap();
 /// assert_eq!(read_vdb(&bytes, "mem", Some([0; 3]), Some(5)).unwrap().tree, tree);
@@ -666,7 +666,7 @@ pub fn read_vdb(
 mod tests {
     use super::*;
     use crate::rays::ball_rays;
-    use crate::stacking::stack;
+    use crate::stacking::paper::stack;
 
     #[test]
     fn round_trip_keeps_the_universe_and_tiles_cover_whole_nodes() {

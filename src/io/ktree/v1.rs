@@ -237,7 +237,7 @@ mod tests {
     use super::*;
     use crate::io::read_ktree;
     use crate::rays::ball_rays;
-    use crate::stacking::stack;
+    use crate::stacking::paper::stack;
 
     fn sample() -> Vec<u8> {
         let tree = stack(&ball_rays::<3>(4, [10, 12, 14], 9).unwrap());

@@ -11,7 +11,7 @@
 //!
 //! ```
 //! use ktree::io::{open_rays_file, write_rays_file, AnyRaysFileSource, RaysFile};
-//! use ktree::stacking::{stack, stack_source};
+//! use ktree::stacking::{paper::stack, Builder};
 //! use ktree::{Ray, RaySet};
 //! let rays = RaySet::<3>::from_rays(4, [Ray::new([1, 2, 3], 9), Ray::new([9, 0, 0], 16)]).unwrap();
 //! let dir = tempfile::tempdir().unwrap();
@@ -19,7 +19,7 @@
 //! write_rays_file(&path, &rays).unwrap();
 //! let RaysFile::Sorted(AnyRaysFileSource::K3(source)) = open_rays_file(&path).unwrap() else { panic!() };
 //! assert_eq!(source.runs(), 2);
-//! assert_eq!(stack_source(&source, 2).unwrap(), stack(&rays));
+//! assert_eq!(Builder::new(&source).split_depth(2).build().unwrap(), stack(&rays));
 //! ```
 
 use std::borrow::Cow;

@@ -116,7 +116,7 @@ impl<const K: usize> LevelOrder<K> for MappedTree<'_, K> {
 mod tests {
     use super::*;
     use crate::rays::ball_rays;
-    use crate::stacking::stack;
+    use crate::stacking::paper::stack;
 
     /// A file rewritten in place (same inode) with a smaller, different tree after it was opened: walks
     /// and queries give errors naming offsets inside the file, never a panic.

@@ -22,7 +22,7 @@ mod tests {
     use super::*;
     use crate::io::KtreeFileErrorKind;
     use crate::rays::ball_rays;
-    use crate::stacking::stack;
+    use crate::stacking::paper::stack;
     use crate::tree::{KTree, NodeState, PackedStates};
 
     fn sample() -> (KTree<3>, Vec<u8>) {

@@ -1,242 +1,25 @@
-//! Out-of-core stacking: a tree written straight to a `.ktree` version 2 file in bounded memory, its
-//! subtrees spilled to temporary files as they are stacked.
-//!
-//! # How it runs
-//! The cells of depth `m` are stacked slab by slab exactly as in [`stack_source`](super::stack_source),
-//! but no finished subtree is kept: the levels `1, 2, …` of each partial cell's subtree are appended to
-//! one temporary *spill file* per level (word-aligned, in the order the slabs finish), and only a small
-//! index (the cell's Morton index and its node count per level) and the states of the cells of depth `m`
-//! (see *Memory*) stay in memory. At the end the file is written level by level through a [`KtreeWriter`]: the
-//! top levels `0 … m` (from the cells' states; a uniform top collapses), then each level `m + j` as the
-//! concatenation, in Morton order of the cells, of the subtrees' levels `j` read back from spill file `j`
-//! (the writer shifts each piece into place). The file goes to a temporary file renamed over the target
-//! ([`write_atomic_with`]), so the bytes are exactly those of the tree built in memory and written by
-//! [`write_ktree`](crate::io::write_ktree), for any number of threads.
-//!
-//! # In parts
-//! The two phases also run apart, as the ranks of a distributed run do: [`stack_part`] stacks some of the
-//! slabs (a share cut by [`balanced_parts`] from the costs [`slab_cost`] estimates) into spill files of its
-//! own; one part takes the others' indexes ([`SpilledPart::index_words`], [`SpilledPart::add_part`]: the
-//! cells' states and the stacked cells' Morton indexes and node counts) and writes the file
-//! ([`SpilledPart::write`]), walking the stacked cells of all parts in Morton order and taking each
-//! piece from its own spill files or from the stream of words the owning part sends in its own Morton
-//! order ([`SpilledPart::stream_levels`]). The bytes are those of [`stack_to_file`], which is one part
-//! of every slab.
-//!
-//! # Memory
-//! The budget ([`OutOfCore::max_memory`]) is kept by accounting, not by measuring the process:
-//! [`RUN_BYTES`] bytes per run of each slab being stacked (its copies and the subtrees made from it, until
-//! they are spilled), 48 bytes per block of the full cells of depth `m` — kept reduced, as the top of the
-//! tree is: `2^K` full siblings are one block of their parent, so a solid's interior costs a few blocks,
-//! not one entry per cell — [`SUBTREE_BYTES`] plus 8 per level for each stacked cell, and the I/O
-//! buffers ([`BUFFER_BYTES`] per spill file and two more). A budget below the buffers fails before any
-//! slab is made. The first slab runs alone; then rounds of up to as many slabs as the rayon pool has
-//! threads run at once, as many as the largest slab seen so far allows in what is left of the budget; a
-//! slab whose rays turn out not to fit beside those already admitted is set aside (its rays dropped) for
-//! the next round. Only these rays, made before their size is known, are held beyond the accounted
-//! figure. A slab that does not fit even alone ends the build at once with
-//! [`OutOfCoreError::BudgetTooSmall`], naming what is known to be needed then (what is held plus the
-//! largest slab seen): a build given it gets at least as far, and a later, larger slab may ask for more.
-//! When the stacking ends, the index of the stacked cells is checked against the budget; the budget it
-//! names then (what the build holds at its end plus its largest slab) is enough for the whole build.
-//!
-//! # Temporary files
-//! The spill files live in a hidden folder `.NAME.XXXXXX.PID.ktree-spill` in [`OutOfCore::temp_dir`] (by
-//! default the output's folder), removed when the build ends, whether it succeeds or fails; a process
-//! killed mid-build leaves it behind, and the next build of the same output removes the folders of
-//! processes that no longer run.
-//!
-//! ```
-//! use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-//! use ktree::stacking::{stack_source, stack_to_file, OutOfCore};
-//! let ball = Solid::Quadric(Quadric::<3>::ball([Rational::int(16); 3], Rational::int(11), Frame::Voxel).unwrap());
-//! let source = SolidSource::new(&ball, 5, Sample::Centre).unwrap();
-//! let dir = tempfile::tempdir().unwrap();
-//! let out = dir.path().join("ball.ktree");
-//! let report = stack_to_file(&source, &out, &OutOfCore::new(2, 1 << 30), &|_| {}).unwrap();
-//! let tree = stack_source(&source, 2).unwrap();
-//! assert_eq!(ktree::io::read_ktree_file(&out).unwrap(), ktree::AnyTree::K3(tree.clone()));
-//! assert_eq!(report.counts_per_level, tree.counts_per_level());
-//! ```
+//! A build in parts: some slabs stacked and spilled by each part ([`stack_part`]), the parts' indexes
+//! gathered by one of them, which writes the file ([`SpilledPart::write`]) — as the ranks of a distributed
+//! run do, and as a build in one process does with one part of every slab.
 
 use std::collections::VecDeque;
 use std::fmt::Display;
 use std::fs::File;
-use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use super::cells::{CellBlock, CellStates};
-use super::partition::{slab_pieces, Piece, RaySource};
-
+use super::budget::{Budget, RUN_BYTES};
+use super::error::BuildError;
+use super::progress::{Progress, Stage};
+use super::spill::{level_offsets, open_spill, spill_piece, Spill, SpillReader, SubtreeIndex};
+use super::{OutOfCore, OutOfCoreReport};
 use crate::fs::write_atomic_with;
 use crate::io::KtreeWriter;
-use crate::tree::{LevelCounts, NodeState};
-
-/// Bytes accounted for each run of a slab being stacked: the runs and their copies while they are cut
-/// into cells, and the subtrees made from them until they are spilled.
-pub const RUN_BYTES: u64 = 64;
-/// Bytes accounted for each stacked cell, besides 8 per level of its subtree (its place in the index and
-/// in the order the levels are written in).
-pub const SUBTREE_BYTES: u64 = 24;
-/// Bytes of each I/O buffer (one per spill file, one for the output, one for reading back).
-pub const BUFFER_BYTES: u64 = 1 << 16;
-
-/// How an out-of-core build runs.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct OutOfCore {
-    /// The depth `m` of the cells stacked apart (clamped to `L`).
-    pub depth: u32,
-    /// The memory budget in bytes (see the module's notes on how it is accounted).
-    pub max_memory: u64,
-    /// The folder of the spill files; `None`: the output's folder.
-    pub temp_dir: Option<PathBuf>,
-}
-
-impl OutOfCore {
-    /// Cells of depth `depth`, a budget of `max_memory` bytes, spill files next to the output.
-    pub fn new(depth: u32, max_memory: u64) -> Self {
-        Self {
-            depth,
-            max_memory,
-            temp_dir: None,
-        }
-    }
-}
-
-/// What an out-of-core build is doing, for progress reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Stage {
-    /// Stacking slabs of cells (`done` of `total` slabs).
-    Stacking,
-    /// Writing the output file (`done` of `total` levels).
-    Writing,
-}
-
-/// A progress report: `done` of `total` steps of a stage.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Progress {
-    /// The stage.
-    pub stage: Stage,
-    /// Steps done.
-    pub done: u64,
-    /// Steps in the stage.
-    pub total: u64,
-}
-
-/// What an out-of-core build wrote.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct OutOfCoreReport {
-    /// The tree's node counts per level (`level` = depth).
-    pub counts_per_level: Vec<LevelCounts>,
-    /// The size of the file written, in bytes.
-    pub file_bytes: u64,
-    /// Cells of depth `m` stacked (and spilled).
-    pub subtrees: u64,
-    /// Bytes written to spill files.
-    pub spilled_bytes: u64,
-    /// The most memory accounted at once, in bytes.
-    pub peak_accounted_bytes: u64,
-}
-
-/// Why an out-of-core build failed. The target file is untouched and the spill files are removed.
-#[derive(Debug, thiserror::Error)]
-pub enum OutOfCoreError<E> {
-    /// The source could not produce its rays.
-    #[error("{0}")]
-    Source(E),
-    /// Not even one slab of cells (or the index of the stacked cells, or the I/O buffers) fits in the
-    /// budget.
-    #[error(
-        "a memory budget of {} is too small for this build: it needs a budget of at least {}",
-        bytes_text(*budget),
-        bytes_text(*needed)
-    )]
-    BudgetTooSmall {
-        /// The budget given, in bytes.
-        budget: u64,
-        /// The least budget known to be needed, in bytes: what the build held when it failed plus its
-        /// largest slab so far (a budget with which the whole build runs when the index at the end is
-        /// what did not fit).
-        needed: u64,
-    },
-    /// The folder for the spill files cannot be used.
-    #[error("cannot create spill files in the temporary folder {}: {source}", path.display())]
-    TempDir {
-        /// The folder.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
-    /// A spill file cannot be written.
-    #[error("cannot write the spill file {}: {source}", path.display())]
-    Spill {
-        /// The spill file.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
-    /// The output cannot be written (the message names it).
-    #[error("{source}")]
-    Output {
-        /// The output file.
-        path: PathBuf,
-        /// The error, naming the output or the spill file read back.
-        source: std::io::Error,
-    },
-}
-
-/// A byte count with its size in MiB or GiB, for messages.
-fn bytes_text(bytes: u64) -> String {
-    const MIB: f64 = 1024.0 * 1024.0;
-    let b = bytes as f64;
-    if b >= 1024.0 * MIB {
-        format!("{bytes} bytes ({:.2} GiB)", b / (1024.0 * MIB))
-    } else {
-        format!("{bytes} bytes ({:.1} MiB)", b / MIB)
-    }
-}
-
-/// The spill files: one per subtree level `1 … t`.
-struct Spill {
-    dir: tempfile::TempDir,
-    files: Vec<BufWriter<File>>,
-    /// Words written to each file.
-    words: Vec<u64>,
-}
-
-impl Spill {
-    fn path(&self, j: usize) -> PathBuf {
-        self.dir.path().join(format!("level-{j}"))
-    }
-}
-
-/// The stacked cells, in the order they were spilled: Morton index and node count per subtree level
-/// `1 … t` (0 beyond the subtree's depth).
-#[derive(Default)]
-struct SubtreeIndex {
-    mortons: Vec<u64>,
-    counts: Vec<u64>,
-}
-
-/// The memory accounting of a build.
-struct Budget {
-    max: u64,
-    /// Levels of a subtree below its root.
-    t: u64,
-    peak: u64,
-}
-
-impl Budget {
-    /// The memory held between slabs: cells, index, buffers.
-    fn fixed(&self, cell_bytes: u64, subtrees: usize) -> u64 {
-        cell_bytes
-            + subtrees as u64 * (SUBTREE_BYTES + 8 * (self.t + 1))
-            + (self.t + 2) * BUFFER_BYTES
-    }
-}
+use crate::stacking::cells::{CellBlock, CellStates};
+use crate::stacking::partition::{slab_pieces, Piece, RaySource};
+use crate::tree::NodeState;
 
 /// What came of one slab in a round of slabs run at once.
 enum SlabOutcome<const K: usize> {
@@ -250,39 +33,9 @@ enum SlabOutcome<const K: usize> {
     TooBig { cost: u64 },
 }
 
-/// Builds the tree of `source` from its cells of depth `options.depth` and writes it to `out` as a
-/// `.ktree` version 2 file, in the memory budget `options.max_memory`, on the threads of the current rayon
-/// pool; `progress` is called (on the calling thread) as slabs are stacked and levels written. The file
-/// is byte for byte the one [`write_ktree_file`](crate::io::write_ktree_file) writes for the tree
-/// [`stack_source`](super::stack_source) builds. It is [`stack_part`] of every slab of
-/// [`build_slabs`] followed by [`SpilledPart::write`].
-///
-/// # Errors
-/// [`OutOfCoreError`]: the source's first error (in slab order), a budget too small, a temporary folder
-/// or output that cannot be written (a full disk included). The target is then untouched and no
-/// temporary file remains.
-pub fn stack_to_file<const K: usize, S>(
-    source: &S,
-    out: &Path,
-    options: &OutOfCore,
-    progress: &(dyn Fn(Progress) + Sync),
-) -> Result<OutOfCoreReport, OutOfCoreError<S::Error>>
-where
-    S: RaySource<K>,
-    S::Error: Display,
-{
-    let slabs = build_slabs(source, options.depth);
-    let part = stack_part(source, &slabs, out, options, progress)?;
-    part.write(
-        out,
-        &mut |_, _| Err(std::io::Error::other("no other part")),
-        progress,
-    )
-}
-
 /// The slabs of cells of depth `depth` (clamped to `L`) an out-of-core build stacks, numbered along axis 0
 /// in increasing order: those of [`RaySource::occupied_slabs`] (the one slab `0` for `K = 1`).
-pub fn build_slabs<const K: usize, S: RaySource<K>>(source: &S, depth: u32) -> Vec<u32> {
+pub(crate) fn build_slabs<const K: usize, S: RaySource<K>>(source: &S, depth: u32) -> Vec<u32> {
     if K == 1 {
         vec![0]
     } else {
@@ -295,7 +48,7 @@ pub fn build_slabs<const K: usize, S: RaySource<K>>(source: &S, depth: u32) -> V
 ///
 /// # Errors
 /// The source's error.
-pub fn slab_cost<const K: usize, S: RaySource<K>>(
+pub(crate) fn slab_cost<const K: usize, S: RaySource<K>>(
     source: &S,
     depth: u32,
     b0: u32,
@@ -337,20 +90,20 @@ pub fn balanced_parts(costs: &[u64], parts: usize) -> Vec<std::ops::Range<usize>
 
 /// The stacking phase of an out-of-core build run on some of its slabs (for a process that builds a
 /// share of the tree): the cells of `slabs` (numbers from [`build_slabs`], increasing) are stacked as
-/// [`stack_to_file`] does and their subtrees spilled next to `out` (or in [`OutOfCore::temp_dir`]);
+/// [`stack_to_file`](super::stack_to_file) does and their subtrees spilled next to `out` (or in [`OutOfCore::temp_dir`]);
 /// nothing is written to `out`. The part's index travels to the process that writes
 /// ([`SpilledPart::index_words`], [`SpilledPart::add_part`]) and its levels follow
 /// ([`SpilledPart::stream_levels`]).
 ///
 /// # Errors
-/// As [`stack_to_file`] (the budget covers this part alone).
-pub fn stack_part<const K: usize, S>(
+/// As [`stack_to_file`](super::stack_to_file) (the budget covers this part alone).
+pub(crate) fn stack_part<const K: usize, S>(
     source: &S,
     slabs: &[u32],
     out: &Path,
     options: &OutOfCore,
     progress: &(dyn Fn(Progress) + Sync),
-) -> Result<SpilledPart, OutOfCoreError<S::Error>>
+) -> Result<SpilledPart, BuildError<S::Error>>
 where
     S: RaySource<K>,
     S::Error: Display,
@@ -370,7 +123,7 @@ where
     // What is held before any slab is stacked (the buffers): a budget below it fails before any work.
     let before = budget.fixed(cells.bytes(), 0);
     if before > budget.max {
-        return Err(OutOfCoreError::BudgetTooSmall {
+        return Err(BuildError::BudgetTooSmall {
             budget: budget.max,
             needed: before,
         });
@@ -397,7 +150,7 @@ where
                 let side = 1u32 << t;
                 let slab = source
                     .slab(b0 * side..(b0 + 1) * side)
-                    .map_err(OutOfCoreError::Source)?;
+                    .map_err(BuildError::Source)?;
                 let cost = slab.runs.len() as u64 * RUN_BYTES;
                 if fixed.saturating_add(cost) > budget.max {
                     return Ok(SlabOutcome::TooBig { cost });
@@ -407,10 +160,10 @@ where
                     in_flight.fetch_sub(cost, Ordering::SeqCst);
                     return Ok(SlabOutcome::SetAside);
                 }
-                let pieces = slab_pieces::<K>(&slab, level, m, b0);
+                let pieces = slab_pieces::<K>(&slab, level, m, b0, options.cells);
                 Ok(SlabOutcome::Stacked { cost, pieces })
             })
-            .collect::<Vec<Result<SlabOutcome<K>, OutOfCoreError<S::Error>>>>();
+            .collect::<Vec<Result<SlabOutcome<K>, BuildError<S::Error>>>>();
         let (mut set_aside, mut too_big, mut round_cost) = (Vec::new(), false, 0u64);
         for (&b0, outcome) in round.iter().zip(outcomes) {
             match outcome? {
@@ -433,7 +186,7 @@ where
         budget.peak = budget.peak.max(fixed + round_cost);
         if too_big {
             // Fail at once, naming what is known to be needed: what is held plus the largest slab.
-            return Err(OutOfCoreError::BudgetTooSmall {
+            return Err(BuildError::BudgetTooSmall {
                 budget: budget.max,
                 needed: fixed + largest,
             });
@@ -453,7 +206,7 @@ where
     }
     let end = budget.fixed(cells.bytes(), index.mortons.len());
     if end > budget.max {
-        return Err(OutOfCoreError::BudgetTooSmall {
+        return Err(BuildError::BudgetTooSmall {
             budget: budget.max,
             needed: end + largest,
         });
@@ -464,7 +217,7 @@ where
     let mut readers = Vec::with_capacity(files.len());
     for (j, file) in files.into_iter().enumerate() {
         let path = dir.path().join(format!("level-{}", j + 1));
-        let file = file.into_inner().map_err(|e| OutOfCoreError::Spill {
+        let file = file.into_inner().map_err(|e| BuildError::Spill {
             path: path.clone(),
             source: e.into_error(),
         })?;
@@ -688,7 +441,7 @@ impl SpilledPart {
     /// the next words of that owner's [`stream_levels`](Self::stream_levels).
     ///
     /// # Errors
-    /// [`OutOfCoreError::BudgetTooSmall`] if the index of all parts does not fit in the budget; the output
+    /// [`BuildError::BudgetTooSmall`] if the index of all parts does not fit in the budget; the output
     /// or a spill file that cannot be written or read (an error of `receive` included). The target is then
     /// untouched; the spill folder is removed in any case.
     pub fn write<E>(
@@ -696,7 +449,7 @@ impl SpilledPart {
         out: &Path,
         receive: &mut dyn FnMut(usize, &mut [u64]) -> std::io::Result<()>,
         progress: &(dyn Fn(Progress) + Sync),
-    ) -> Result<OutOfCoreReport, OutOfCoreError<E>> {
+    ) -> Result<OutOfCoreReport, BuildError<E>> {
         let SpilledPart {
             k,
             level,
@@ -715,7 +468,7 @@ impl SpilledPart {
         let subtrees: usize = parts.iter().map(|p| p.mortons.len()).sum();
         let end = budget.fixed(cells.bytes(), subtrees);
         if end > budget.max {
-            return Err(OutOfCoreError::BudgetTooSmall {
+            return Err(BuildError::BudgetTooSmall {
                 budget: budget.max,
                 needed: end + largest,
             });
@@ -741,7 +494,7 @@ impl SpilledPart {
             .collect();
         let top = cells
             .into_top_levels(&partial)
-            .map_err(|_| OutOfCoreError::Output {
+            .map_err(|_| BuildError::Output {
                 path: out.to_path_buf(),
                 source: std::io::Error::new(
                     std::io::ErrorKind::InvalidData,
@@ -806,14 +559,14 @@ impl SpilledPart {
             counts = writer.counts_per_level();
             writer.finish().map(drop)
         })
-        .map_err(|source| OutOfCoreError::Output {
+        .map_err(|source| BuildError::Output {
             path: out.to_path_buf(),
             source,
         })?;
         drop(readers);
         drop(dir);
         let file_bytes = std::fs::metadata(out)
-            .map_err(|source| OutOfCoreError::Output {
+            .map_err(|source| BuildError::Output {
                 path: out.to_path_buf(),
                 source,
             })?
@@ -826,151 +579,4 @@ impl SpilledPart {
             peak_accounted_bytes: budget.peak,
         })
     }
-}
-
-/// Sets `offsets[s]` to the word offset of cell `s`'s piece in spill file `j + 1` (pieces are in the order
-/// the cells were spilled); returns the file's length in words.
-fn level_offsets(index: &SubtreeIndex, t: usize, j: usize, offsets: &mut [u64]) -> u64 {
-    let mut at = 0u64;
-    for (s, offset) in offsets.iter_mut().enumerate() {
-        *offset = at;
-        at += index.counts[s * t + j].div_ceil(32);
-    }
-    at
-}
-
-/// Reads pieces of one spill file back, one read per piece (pieces are taken out of the order they were
-/// spilled in, so a buffer ahead would mostly be wasted); errors name the file.
-struct SpillReader<'a> {
-    path: &'a Path,
-    file: &'a mut File,
-    /// The word the file is at (`u64::MAX`: unknown).
-    at: u64,
-    /// The file's length in words.
-    len: u64,
-    bytes: Vec<u8>,
-}
-
-impl<'a> SpillReader<'a> {
-    fn new(path: &'a Path, file: &'a mut File, len: u64) -> Self {
-        Self {
-            path,
-            file,
-            at: u64::MAX,
-            len,
-            bytes: Vec::new(),
-        }
-    }
-
-    fn error(&self, e: std::io::Error) -> std::io::Error {
-        std::io::Error::new(e.kind(), format!("spill file {}: {e}", self.path.display()))
-    }
-
-    /// Moves to word `word` (no system call when the file is already there).
-    fn seek(&mut self, word: u64) -> std::io::Result<()> {
-        if word != self.at {
-            self.at = u64::MAX;
-            self.file
-                .seek(SeekFrom::Start(8 * word))
-                .map_err(|e| self.error(e))?;
-            self.at = word;
-        }
-        Ok(())
-    }
-
-    /// Appends the next `count` words to `words`.
-    fn read_into(&mut self, count: usize, words: &mut Vec<u64>) -> std::io::Result<()> {
-        if self.at.saturating_add(count as u64) > self.len {
-            return Err(self.error(std::io::Error::new(
-                std::io::ErrorKind::UnexpectedEof,
-                "shorter than its index",
-            )));
-        }
-        self.bytes.resize(8 * count, 0);
-        if let Err(e) = self.file.read_exact(&mut self.bytes) {
-            self.at = u64::MAX;
-            return Err(self.error(e));
-        }
-        words.extend(
-            self.bytes
-                .chunks_exact(8)
-                .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))),
-        );
-        self.at += count as u64;
-        Ok(())
-    }
-}
-
-/// Creates the spill folder and its `t` files.
-fn open_spill<E>(
-    out: &Path,
-    temp_dir: Option<&Path>,
-    t: usize,
-) -> Result<Spill, OutOfCoreError<E>> {
-    let folder = crate::fs::spill_folder(out, temp_dir)
-        .map_err(|(path, source)| OutOfCoreError::TempDir { path, source })?;
-    let mut spill = Spill {
-        dir: folder,
-        files: Vec::with_capacity(t),
-        words: vec![0; t],
-    };
-    for j in 1..=t {
-        let path = spill.path(j);
-        let file = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create_new(true)
-            .open(&path)
-            .map_err(|source| OutOfCoreError::Spill { path, source })?;
-        spill
-            .files
-            .push(BufWriter::with_capacity(BUFFER_BYTES as usize, file));
-    }
-    Ok(spill)
-}
-
-/// Records a non-empty cell of depth `m`, spilling the levels below its root if it is partial.
-fn spill_piece<const K: usize, E>(
-    spill: &mut Spill,
-    cells: &mut CellStates,
-    index: &mut SubtreeIndex,
-    morton: u64,
-    piece: Piece<K>,
-) -> Result<(), OutOfCoreError<E>> {
-    let tree = match piece {
-        Piece::Full => {
-            cells.set_full(morton);
-            return Ok(());
-        }
-        Piece::Tree(tree) => tree,
-    };
-    match tree.root_state() {
-        NodeState::Empty => return Ok(()),
-        NodeState::Full => {
-            cells.set_full(morton);
-            return Ok(());
-        }
-        NodeState::Partial => {}
-    }
-    index.mortons.push(morton);
-    for j in 1..=spill.files.len() {
-        let nodes = if j < tree.depth_count() {
-            let states = tree.level_states(j);
-            let words = &states.words()[..states.len().div_ceil(32)];
-            let file = &mut spill.files[j - 1];
-            for w in words {
-                file.write_all(&w.to_le_bytes())
-                    .map_err(|source| OutOfCoreError::Spill {
-                        path: spill.dir.path().join(format!("level-{j}")),
-                        source,
-                    })?;
-            }
-            spill.words[j - 1] += words.len() as u64;
-            states.len() as u64
-        } else {
-            0
-        };
-        index.counts.push(nodes);
-    }
-    Ok(())
 }

@@ -31,9 +31,9 @@
 //! `O(n)` in the number of rows and items (radix sorts on keys of `(D+1)·L` bits) plus the Morton sort and
 //! assembly of the output (`O(cells · L)`). Measured figures: `results/performance/build.md`.
 
-use super::radix::radix_sort;
 use crate::rays::{maximal_rows, RaySet};
 use crate::space::{morton_encode, Universe};
+use crate::stacking::radix::radix_sort;
 use crate::tree::KTree;
 
 /// What stacking did: the traffic through each dimension-level list and the peak number of items held.
@@ -76,7 +76,7 @@ impl StackingStats {
 /// Builds the minimal reduced k-tree of a ray set by stacking.
 ///
 /// ```
-/// use ktree::{stacking::stack, Ray, RaySet, NodeState};
+/// use ktree::{stacking::paper::stack, Ray, RaySet, NodeState};
 /// // A 2×2 square in a 4×4 quadtree universe, as two rays.
 /// let rays = RaySet::<2>::from_rays(2, [Ray::new([0, 0], 2), Ray::new([1, 0], 2)]).unwrap();
 /// let tree = stack(&rays);

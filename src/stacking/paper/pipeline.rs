@@ -14,8 +14,8 @@
 
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 
-use super::sequential::for_each_row;
-use super::stack::{pack_key, unpack_key, Cells, Stage};
+use super::file_lists::for_each_row;
+use super::lists::{pack_key, unpack_key, Cells, Stage};
 use crate::rays::RaySet;
 use crate::tree::KTree;
 
@@ -32,7 +32,7 @@ type Batch<const K: usize> = Vec<([u32; K], u32)>;
 /// ```
 /// use ktree::{rays::ball_rays, stacking};
 /// let rays = ball_rays::<3>(5, [16, 16, 16], 12).unwrap();
-/// assert_eq!(stacking::stack_pipelined(&rays), stacking::stack(&rays));
+/// assert_eq!(stacking::paper::stack_pipelined(&rays), stacking::paper::stack(&rays));
 /// ```
 pub fn stack_pipelined<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
     let universe = rays.universe();

@@ -12,11 +12,8 @@
 
 use std::path::{Path, PathBuf};
 
-use indicatif::ProgressBar;
-use ktree::stacking::{
-    default_split_depth, stack_to_file, OutOfCore, OutOfCoreError, OutOfCoreReport, Progress,
-    RaySource, Stage,
-};
+use crate::common::progress::report_progress;
+use ktree::stacking::{BuildError, Builder, OutOfCoreReport, RaySource};
 use ktree::{LevelCounts, RaySet};
 
 /// The share of the machine's memory used when no `--max-memory` is given: a half.
@@ -131,56 +128,44 @@ where
     S: RaySource<K>,
     S::Error: std::fmt::Display,
 {
-    let options = options::<K>(source.universe().level(), args, budget);
-    let bar = crate::render::progress_bar(args.progress, "stacking");
-    let report = stack_to_file(source, out, &options, &|p| report_progress(bar.as_ref(), p));
+    let bar = crate::common::progress::progress_bar(args.progress, "stacking");
+    let progress = |p| report_progress(bar.as_ref(), p);
+    let report = builder(source, args)
+        .progress(&progress)
+        .to_file(out, budget);
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
     report.map_err(|e| describe(out, e, 0))
 }
 
-/// How a tree of level `level` is built out of core: cells of the default split depth, `budget` bytes,
-/// the spill folder of `args`.
-pub fn options<const K: usize>(level: u32, args: &BuildArgs, budget: u64) -> OutOfCore {
-    OutOfCore {
-        temp_dir: args.temp_dir.clone(),
-        ..OutOfCore::new(default_split_depth(K, level), budget)
+/// The build of `source` out of core: cells of the default split depth, the spill folder of `args`.
+pub fn builder<'a, const K: usize, S: RaySource<K>>(
+    source: &'a S,
+    args: &BuildArgs,
+) -> Builder<'a, K, S> {
+    let builder = Builder::new(source);
+    match &args.temp_dir {
+        Some(dir) => builder.temp_dir(dir),
+        None => builder,
     }
 }
 
 /// The message of a failed out-of-core build of `out`; `held` bytes were set apart from the budget before
 /// the build (message buffers) and are added back to the budgets it names.
-pub fn describe<E: std::fmt::Display>(out: &Path, e: OutOfCoreError<E>, held: u64) -> String {
+pub fn describe<E: std::fmt::Display>(out: &Path, e: BuildError<E>, held: u64) -> String {
     match e {
-        OutOfCoreError::BudgetTooSmall { budget, needed } => format!(
+        BuildError::BudgetTooSmall { budget, needed } => format!(
             "{}: {} (--max-memory)",
             out.display(),
-            OutOfCoreError::<E>::BudgetTooSmall {
+            BuildError::<E>::BudgetTooSmall {
                 budget: budget.saturating_add(held),
                 needed: needed.saturating_add(held),
             }
         ),
-        OutOfCoreError::Output { .. } => format!("cannot write {}: {e}", out.display()),
+        BuildError::Output { .. } => format!("cannot write {}: {e}", out.display()),
         other => format!("{}: {other}", out.display()),
     }
-}
-
-/// Shows the progress of an out-of-core build on `bar`, if any.
-pub fn report_progress(bar: Option<&ProgressBar>, p: Progress) {
-    let Some(bar) = bar else {
-        return;
-    };
-    let message = match p.stage {
-        Stage::Stacking => "stacking slabs",
-        Stage::Writing => "writing levels",
-    };
-    if bar.length() != Some(p.total) || bar.message() != message {
-        bar.set_message(message);
-        bar.set_length(p.total);
-        bar.reset_elapsed();
-    }
-    bar.set_position(p.done);
 }
 
 /// The voxels of a tree from its counts per level in a level-`level` universe of `k` dimensions.
@@ -200,7 +185,7 @@ pub fn ray_bytes<const K: usize>(rays: &RaySet<K>) -> u64 {
 /// Whether the trees written in this run are built out of core: a `.ktree` of format version 2 (by one
 /// process or across MPI ranks; version 1 is built in memory, by one process only).
 pub fn out_of_core() -> bool {
-    crate::tree_file::version() == 2
+    crate::common::tree_file::version() == 2
 }
 
 #[cfg(test)]

@@ -27,11 +27,12 @@ use std::fs::{File, OpenOptions};
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
-use super::partition::RaySource;
-use super::stack::{combine_or_split, half_offsets, pack_key, unpack_key, Cells};
-use super::{radix_sort, StackingStats};
+use super::lists::{combine_or_split, half_offsets, pack_key, unpack_key, Cells};
+use super::StackingStats;
 use crate::rays::{maximal_rows, RaySet};
 use crate::space::morton_encode;
+use crate::stacking::partition::RaySource;
+use crate::stacking::radix::radix_sort;
 use crate::tree::KTree;
 
 /// What the file lists did.
@@ -60,9 +61,9 @@ pub struct FileListStats {
 /// use ktree::{rays::ball_rays, stacking};
 /// let rays = ball_rays::<3>(5, [16, 16, 16], 12).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
-/// let (tree, stats, files) = stacking::stack_with_file_lists(&rays, dir.path(), 100).unwrap();
-/// assert_eq!(tree, stacking::stack(&rays));
-/// assert_eq!(stats.cells, stacking::stack_with_stats(&rays).1.cells);
+/// let (tree, stats, files) = stacking::paper::stack_with_file_lists(&rays, dir.path(), 100).unwrap();
+/// assert_eq!(tree, stacking::paper::stack(&rays));
+/// assert_eq!(stats.cells, stacking::paper::stack_with_stats(&rays).1.cells);
 /// assert!(files.max_open_files <= 3 && files.sorted_runs > 0);
 /// ```
 ///

@@ -1,0 +1,81 @@
+//! Trees in and out of the commands: reading `.ktree` files, writing them in the format version asked for
+//! (`--format-version`, default 2), and the one-line summary of a tree written.
+
+use crate::outln;
+
+use std::path::Path;
+use std::sync::OnceLock;
+
+use ktree::fs::write_atomic_with;
+use ktree::io::read_ktree_file;
+use ktree::io::{write_ktree_file, write_ktree_v1};
+use ktree::ops;
+use ktree::{AnyTree, KTree, LevelCounts};
+
+static VERSION: OnceLock<u16> = OnceLock::new();
+
+/// The option, shared by every subcommand.
+#[derive(Debug, clap::Args)]
+pub struct FormatArgs {
+    /// The `.ktree` format version written: 2 (a checksummed section per level; `stats` reads it through
+    /// a memory map) or 1 (one body, for older readers).
+    #[arg(long, global = true, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=2))]
+    format_version: u16,
+}
+
+/// Records the version chosen on the command line.
+pub fn set(args: &FormatArgs) {
+    let _ = VERSION.set(args.format_version);
+}
+
+/// The format version chosen (2 unless set).
+pub fn version() -> u16 {
+    VERSION.get().copied().unwrap_or(2)
+}
+
+/// Writes a tree file atomically in the chosen format version.
+///
+/// # Errors
+/// Any I/O error, naming the path.
+pub fn write_tree<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
+    match version() {
+        1 => write_atomic_with(path, |w| write_ktree_v1(w, tree)),
+        _ => write_ktree_file(path, tree),
+    }
+}
+
+/// Reads a tree file, with the path in any error.
+pub fn read(path: &Path) -> Result<AnyTree, String> {
+    read_ktree_file(path).map_err(|e| e.to_string())
+}
+
+/// Writes a tree file and prints a one-line summary.
+pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> Result<(), String> {
+    write_tree(path, tree).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    print_summary(path, K, tree.level(), &tree.counts_per_level())
+}
+
+/// Prints the one-line summary of a tree written to `path`, from its counts per level.
+pub fn print_summary(
+    path: &Path,
+    k: usize,
+    level: u32,
+    counts: &[LevelCounts],
+) -> Result<(), String> {
+    let c = LevelCounts::total(level, counts);
+    let voxels = crate::common::memory::voxels(k, level, counts);
+    outln!(
+        "{}: K = {k}, L = {level}, {} nodes ({} full, {} empty, {} partial), {voxels} voxels",
+        path.display(),
+        c.nodes(),
+        c.full,
+        c.empty,
+        c.partial,
+    );
+    Ok(())
+}
+
+/// The message for two input trees that cannot be combined.
+pub fn pair_error(a: &Path, b: &Path, e: ops::OpsError) -> String {
+    format!("{} and {}: {e}", a.display(), b.display())
+}

@@ -1,0 +1,252 @@
+//! The one way to build a tree from rays: [`Builder`], in memory ([`Builder::build`]) or straight to a
+//! `.ktree` file in a memory budget ([`Builder::to_file`]), on all threads; and the constructors of
+//! [`KTree`] that build ([`KTree::from_rays`], `From<&RaySet>`).
+//!
+//! # What runs
+//! The universe is cut into its cells of depth `m` (the *split depth*, by default
+//! [`default_split_depth`]: cells of about 2^18 voxels). A cell all of whose columns cross it entirely is
+//! a full leaf and a cell no run meets an empty one; each remaining cell — one the object's boundary
+//! passes through — is stacked apart, on the threads of the pool, by a bitmap pyramid of its voxels
+//! ([`CellStacking::Bitmap`], the default) or by the paper's list stacking ([`CellStacking::Lists`]), and
+//! the subtrees are joined level by level. Any split depth, any number of threads and either way of
+//! stacking a cell give the same tree, node for node, as the paper's stacking of the whole set
+//! ([`paper::stack`](super::paper::stack)). `results/performance/build.md` measures the two ways of
+//! stacking a cell side by side.
+
+use std::fmt::Display;
+use std::path::{Path, PathBuf};
+
+use super::out_of_core::{
+    build_slabs, slab_cost, stack_part, stack_to_file, BuildError, OutOfCore, OutOfCoreReport,
+    Progress, SpilledPart,
+};
+use super::partition::{default_split_depth, stack_source, RaySource};
+use crate::rays::RaySet;
+use crate::tree::KTree;
+
+/// How each cell the object's boundary passes through is stacked (the tree is the same either way).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub enum CellStacking {
+    /// Through a bitmap pyramid of the cell's voxels: the cell's runs are painted into a bitmap of two
+    /// bits a voxel, reduced level by level (the cell has at most 2^22 voxels; a larger one falls back
+    /// to [`Lists`](Self::Lists)).
+    #[default]
+    Bitmap,
+    /// By Akman & Franklin's stacking of the cell's rays through the dimension-level lists
+    /// ([`paper::stack`](super::paper::stack)).
+    Lists,
+}
+
+/// Builds the tree of a ray source (a [`RaySet`], a solid, a mesh, a volume or a ray file read slab by
+/// slab: anything that implements [`RaySource`]).
+///
+/// ```
+/// use ktree::{rays::ball_rays, stacking::{Builder, CellStacking}, KTree};
+/// let ball = ball_rays::<3>(6, [32, 32, 32], 20).unwrap();
+/// let tree = Builder::new(&ball).threads(2).split_depth(2).build().unwrap();
+/// assert_eq!(tree, KTree::from_rays(&ball));
+/// let lists = Builder::new(&ball).cells(CellStacking::Lists).build().unwrap();
+/// assert_eq!(lists, tree);
+///
+/// let dir = tempfile::tempdir().unwrap();
+/// let out = dir.path().join("ball.ktree");
+/// let report = Builder::new(&ball).to_file(&out, 1 << 30).unwrap();
+/// assert_eq!(report.counts_per_level, tree.counts_per_level());
+/// assert_eq!(ktree::io::read_ktree_file(&out).unwrap(), ktree::AnyTree::K3(tree));
+/// ```
+pub struct Builder<'a, const K: usize, S: RaySource<K>> {
+    source: &'a S,
+    threads: Option<usize>,
+    split_depth: Option<u32>,
+    cells: CellStacking,
+    temp_dir: Option<PathBuf>,
+    progress: Option<&'a (dyn Fn(Progress) + Sync)>,
+}
+
+impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
+    /// A build of `source` on the threads of the current rayon pool, at the default split depth, each
+    /// cell through a bitmap pyramid.
+    pub fn new(source: &'a S) -> Self {
+        Self {
+            source,
+            threads: None,
+            split_depth: None,
+            cells: CellStacking::default(),
+            temp_dir: None,
+            progress: None,
+        }
+    }
+
+    /// Runs on a pool of its own of `threads` worker threads (`0`: one per core). The tree does not
+    /// depend on it.
+    pub fn threads(mut self, threads: usize) -> Self {
+        self.threads = Some(threads);
+        self
+    }
+
+    /// Stacks apart the cells of depth `depth` (clamped to the level `L`); `0` stacks the whole universe
+    /// as one cell. The tree does not depend on it.
+    pub fn split_depth(mut self, depth: u32) -> Self {
+        self.split_depth = Some(depth);
+        self
+    }
+
+    /// How each cell is stacked. The tree does not depend on it.
+    pub fn cells(mut self, cells: CellStacking) -> Self {
+        self.cells = cells;
+        self
+    }
+
+    /// The folder of the spill files of [`to_file`](Self::to_file) and [`stack_part`](Self::stack_part)
+    /// (by default the output's folder).
+    pub fn temp_dir(mut self, dir: impl Into<PathBuf>) -> Self {
+        self.temp_dir = Some(dir.into());
+        self
+    }
+
+    /// Called on the calling thread as a build to a file stacks slabs and writes levels.
+    pub fn progress(mut self, progress: &'a (dyn Fn(Progress) + Sync)) -> Self {
+        self.progress = Some(progress);
+        self
+    }
+
+    /// The split depth the build uses: the one given, or [`default_split_depth`]; at most `L`.
+    pub fn depth(&self) -> u32 {
+        let level = self.source.universe().level();
+        self.split_depth
+            .unwrap_or_else(|| default_split_depth(K, level))
+            .min(level)
+    }
+
+    /// Builds the tree in memory.
+    ///
+    /// # Errors
+    /// [`BuildError::Source`]: the source's first error (in slab order); [`BuildError::Threads`]: the
+    /// threads asked for cannot be started.
+    pub fn build(&self) -> Result<KTree<K>, BuildError<S::Error>> {
+        let depth = self.depth();
+        self.on_threads(|| stack_source(self.source, depth, self.cells))?
+            .map_err(BuildError::Source)
+    }
+
+    /// [`build`](Self::build) on the current pool, whatever [`threads`](Self::threads) says: no error but
+    /// the source's.
+    pub(crate) fn build_on_current_pool(&self) -> Result<KTree<K>, S::Error> {
+        stack_source(self.source, self.depth(), self.cells)
+    }
+
+    /// Builds the tree straight into `out` as a `.ktree` version 2 file (atomically: a temporary file
+    /// renamed over it), holding at most about `max_memory` bytes: the subtrees of the cells are spilled
+    /// to temporary files as they are stacked (see [`stacking`](super)'s notes on memory). The file is
+    /// byte for byte what [`write_ktree_file`](crate::io::write_ktree_file) writes for the tree
+    /// [`build`](Self::build) makes.
+    ///
+    /// # Errors
+    /// [`BuildError`]: the source's first error, a budget too small (at once when what is known before
+    /// any slab is stacked does not fit), threads that cannot be started, a temporary folder or output
+    /// that cannot be written (a full disk included). The target is then untouched and no temporary file
+    /// remains.
+    pub fn to_file(
+        &self,
+        out: &Path,
+        max_memory: u64,
+    ) -> Result<OutOfCoreReport, BuildError<S::Error>>
+    where
+        S::Error: Display,
+    {
+        let options = self.options(max_memory);
+        self.on_threads(|| stack_to_file(self.source, out, &options, self.progress_or_none()))?
+    }
+
+    /// The slabs (numbered along axis 0, increasing) the build stacks: the slabs of cells of the split
+    /// depth that may hold runs. A build in parts cuts them into shares ([`balanced_parts`](super::balanced_parts)
+    /// of their [`slab_cost`](Self::slab_cost)s) for [`stack_part`](Self::stack_part).
+    pub fn slabs(&self) -> Vec<u32> {
+        build_slabs(self.source, self.depth())
+    }
+
+    /// The estimated memory cost of stacking slab `b0`, in bytes: what the build accounts for its runs
+    /// (the runs are made and dropped).
+    ///
+    /// # Errors
+    /// The source's error.
+    pub fn slab_cost(&self, b0: u32) -> Result<u64, S::Error> {
+        slab_cost(self.source, self.depth(), b0)
+    }
+
+    /// Stacks the cells of some slabs (from [`slabs`](Self::slabs), increasing) and spills their subtrees
+    /// next to `out` (or in the [`temp_dir`](Self::temp_dir)), in a budget of `max_memory` bytes for this
+    /// part alone; nothing is written to `out`. One part gathers the others' indexes and writes the file
+    /// ([`SpilledPart::add_part`], [`SpilledPart::write`]): the file is that of
+    /// [`to_file`](Self::to_file) for any cut into parts.
+    ///
+    /// # Errors
+    /// As [`to_file`](Self::to_file).
+    pub fn stack_part(
+        &self,
+        slabs: &[u32],
+        out: &Path,
+        max_memory: u64,
+    ) -> Result<SpilledPart, BuildError<S::Error>>
+    where
+        S::Error: Display,
+    {
+        let options = self.options(max_memory);
+        self.on_threads(|| stack_part(self.source, slabs, out, &options, self.progress_or_none()))?
+    }
+
+    fn options(&self, max_memory: u64) -> OutOfCore {
+        OutOfCore {
+            depth: self.depth(),
+            max_memory,
+            temp_dir: self.temp_dir.clone(),
+            cells: self.cells,
+        }
+    }
+
+    fn progress_or_none(&self) -> &(dyn Fn(Progress) + Sync) {
+        self.progress.unwrap_or(&|_| {})
+    }
+
+    /// Runs `work` on the pool asked for, or on the current one.
+    fn on_threads<T: Send>(
+        &self,
+        work: impl FnOnce() -> T + Send,
+    ) -> Result<T, BuildError<S::Error>> {
+        match self.threads {
+            None => Ok(work()),
+            Some(threads) => rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .map(|pool| pool.install(work))
+                .map_err(BuildError::Threads),
+        }
+    }
+}
+
+impl<const K: usize> KTree<K> {
+    /// The tree of a ray set, by the default build ([`Builder`]: cells of the default split depth on the
+    /// threads of the current rayon pool); also `KTree::from(&rays)`.
+    ///
+    /// ```
+    /// use ktree::{KTree, Ray, RaySet};
+    /// let rays = RaySet::<2>::from_rays(2, [Ray::new([1, 0], 4)]).unwrap();
+    /// let tree = KTree::from_rays(&rays);
+    /// assert_eq!(tree.voxel_count(), 4);
+    /// assert_eq!(tree, KTree::from(&rays));
+    /// ```
+    pub fn from_rays(rays: &RaySet<K>) -> Self {
+        let depth = default_split_depth(K, rays.level());
+        match stack_source(rays, depth, CellStacking::default()) {
+            Ok(tree) => tree,
+            Err(never) => match never {},
+        }
+    }
+}
+
+impl<const K: usize> From<&RaySet<K>> for KTree<K> {
+    /// [`KTree::from_rays`].
+    fn from(rays: &RaySet<K>) -> Self {
+        Self::from_rays(rays)
+    }
+}

@@ -1,0 +1,181 @@
+//! The spill files of an out-of-core build: the levels below the cells of depth `m`, one file per level,
+//! written as the cells are stacked and read back, piece by piece, when the tree is written.
+
+use std::fs::File;
+use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+
+use super::budget::BUFFER_BYTES;
+use super::error::BuildError;
+use crate::stacking::cells::CellStates;
+use crate::stacking::partition::Piece;
+use crate::tree::NodeState;
+
+/// The spill files: one per subtree level `1 … t`.
+pub(super) struct Spill {
+    pub(super) dir: tempfile::TempDir,
+    pub(super) files: Vec<BufWriter<File>>,
+    /// Words written to each file.
+    pub(super) words: Vec<u64>,
+}
+
+impl Spill {
+    pub(super) fn path(&self, j: usize) -> PathBuf {
+        self.dir.path().join(format!("level-{j}"))
+    }
+}
+
+/// The stacked cells, in the order they were spilled: Morton index and node count per subtree level
+/// `1 … t` (0 beyond the subtree's depth).
+#[derive(Default)]
+pub(super) struct SubtreeIndex {
+    pub(super) mortons: Vec<u64>,
+    pub(super) counts: Vec<u64>,
+}
+
+/// Sets `offsets[s]` to the word offset of cell `s`'s piece in spill file `j + 1` (pieces are in the order
+/// the cells were spilled); returns the file's length in words.
+pub(super) fn level_offsets(index: &SubtreeIndex, t: usize, j: usize, offsets: &mut [u64]) -> u64 {
+    let mut at = 0u64;
+    for (s, offset) in offsets.iter_mut().enumerate() {
+        *offset = at;
+        at += index.counts[s * t + j].div_ceil(32);
+    }
+    at
+}
+
+/// Reads pieces of one spill file back, one read per piece (pieces are taken out of the order they were
+/// spilled in, so a buffer ahead would mostly be wasted); errors name the file.
+pub(super) struct SpillReader<'a> {
+    path: &'a Path,
+    file: &'a mut File,
+    /// The word the file is at (`u64::MAX`: unknown).
+    at: u64,
+    /// The file's length in words.
+    len: u64,
+    bytes: Vec<u8>,
+}
+
+impl<'a> SpillReader<'a> {
+    pub(super) fn new(path: &'a Path, file: &'a mut File, len: u64) -> Self {
+        Self {
+            path,
+            file,
+            at: u64::MAX,
+            len,
+            bytes: Vec::new(),
+        }
+    }
+
+    fn error(&self, e: std::io::Error) -> std::io::Error {
+        std::io::Error::new(e.kind(), format!("spill file {}: {e}", self.path.display()))
+    }
+
+    /// Moves to word `word` (no system call when the file is already there).
+    pub(super) fn seek(&mut self, word: u64) -> std::io::Result<()> {
+        if word != self.at {
+            self.at = u64::MAX;
+            self.file
+                .seek(SeekFrom::Start(8 * word))
+                .map_err(|e| self.error(e))?;
+            self.at = word;
+        }
+        Ok(())
+    }
+
+    /// Appends the next `count` words to `words`.
+    pub(super) fn read_into(&mut self, count: usize, words: &mut Vec<u64>) -> std::io::Result<()> {
+        if self.at.saturating_add(count as u64) > self.len {
+            return Err(self.error(std::io::Error::new(
+                std::io::ErrorKind::UnexpectedEof,
+                "shorter than its index",
+            )));
+        }
+        self.bytes.resize(8 * count, 0);
+        if let Err(e) = self.file.read_exact(&mut self.bytes) {
+            self.at = u64::MAX;
+            return Err(self.error(e));
+        }
+        words.extend(
+            self.bytes
+                .chunks_exact(8)
+                .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes"))),
+        );
+        self.at += count as u64;
+        Ok(())
+    }
+}
+
+/// Creates the spill folder and its `t` files.
+pub(super) fn open_spill<E>(
+    out: &Path,
+    temp_dir: Option<&Path>,
+    t: usize,
+) -> Result<Spill, BuildError<E>> {
+    let folder = crate::fs::spill_folder(out, temp_dir)
+        .map_err(|(path, source)| BuildError::TempDir { path, source })?;
+    let mut spill = Spill {
+        dir: folder,
+        files: Vec::with_capacity(t),
+        words: vec![0; t],
+    };
+    for j in 1..=t {
+        let path = spill.path(j);
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create_new(true)
+            .open(&path)
+            .map_err(|source| BuildError::Spill { path, source })?;
+        spill
+            .files
+            .push(BufWriter::with_capacity(BUFFER_BYTES as usize, file));
+    }
+    Ok(spill)
+}
+
+/// Records a non-empty cell of depth `m`, spilling the levels below its root if it is partial.
+pub(super) fn spill_piece<const K: usize, E>(
+    spill: &mut Spill,
+    cells: &mut CellStates,
+    index: &mut SubtreeIndex,
+    morton: u64,
+    piece: Piece<K>,
+) -> Result<(), BuildError<E>> {
+    let tree = match piece {
+        Piece::Full => {
+            cells.set_full(morton);
+            return Ok(());
+        }
+        Piece::Tree(tree) => tree,
+    };
+    match tree.root_state() {
+        NodeState::Empty => return Ok(()),
+        NodeState::Full => {
+            cells.set_full(morton);
+            return Ok(());
+        }
+        NodeState::Partial => {}
+    }
+    index.mortons.push(morton);
+    for j in 1..=spill.files.len() {
+        let nodes = if j < tree.depth_count() {
+            let states = tree.level_states(j);
+            let words = &states.words()[..states.len().div_ceil(32)];
+            let file = &mut spill.files[j - 1];
+            for w in words {
+                file.write_all(&w.to_le_bytes())
+                    .map_err(|source| BuildError::Spill {
+                        path: spill.dir.path().join(format!("level-{j}")),
+                        source,
+                    })?;
+            }
+            spill.words[j - 1] += words.len() as u64;
+            states.len() as u64
+        } else {
+            0
+        };
+        index.counts.push(nodes);
+    }
+    Ok(())
+}
