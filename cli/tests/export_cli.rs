@@ -8,7 +8,7 @@ use std::path::Path;
 use common::ktree;
 use ktree::io::{read_tree_placed, write_tree, GridMeta, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
-use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::{AnyTree, KTree};
 
 fn ball() -> KTree<3> {
@@ -23,7 +23,7 @@ fn save(path: &Path, tree: AnyTree) {
 fn voxelized(path: &Path, level: u32, size: f64, origin: [f64; 3]) -> KTree<3> {
     let mesh = TriangleMesh::read(path).unwrap();
     assert_eq!(mesh.open_edges(), 0, "{}", path.display());
-    let placement = Placement {
+    let placement = MeshTransform {
         scale: 1.0 / size,
         translate: origin.map(|o| -o / size),
     };

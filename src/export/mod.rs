@@ -22,7 +22,7 @@ use std::path::Path;
 use thiserror::Error;
 
 use crate::fs::write_atomic_with;
-use crate::tree::AnyTree;
+use crate::tree::{AnyTree, KTree};
 
 /// Where voxels are in the world: voxel coordinate `v` is at `origin + voxel_size · v` (the universe's
 /// corner at `origin`; quadtrees use the first two coordinates).
@@ -114,6 +114,18 @@ pub enum ExportError {
 /// [`ExportError::Usage`] for an unknown extension or a format that cannot hold the tree's boundary;
 /// [`ExportError::Write`] from the file system.
 pub fn write_mesh(path: &Path, tree: &AnyTree, frame: &Frame) -> Result<Written, ExportError> {
+    crate::with_dim!(tree, AnyTree, t => write_mesh_of(path, t, frame))
+}
+
+/// [`write_mesh`] of a tree whose dimension is known.
+///
+/// # Errors
+/// As [`write_mesh`].
+pub fn write_mesh_of<const K: usize>(
+    path: &Path,
+    tree: &KTree<K>,
+    frame: &Frame,
+) -> Result<Written, ExportError> {
     let usage = |message: &str| ExportError::Usage {
         file: path.display().to_string(),
         message: message.into(),
@@ -123,8 +135,9 @@ pub fn write_mesh(path: &Path, tree: &AnyTree, frame: &Frame) -> Result<Written,
     let write = |fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
         write_atomic_with(path, |w| fill(w)).map_err(ExportError::Write)
     };
-    match tree {
-        AnyTree::K3(t) => {
+    let any = tree as &dyn std::any::Any;
+    if let Some(t) = any.downcast_ref::<KTree<3>>() {
+        {
             let mesh = surface::boundary_mesh(t).placed(frame);
             match format {
                 MeshFormat::Ply => write(&|w| files::write_ply(w, &mesh))?,
@@ -142,7 +155,8 @@ pub fn write_mesh(path: &Path, tree: &AnyTree, frame: &Frame) -> Result<Written,
                 elements: mesh.triangles.len(),
             })
         }
-        AnyTree::K2(t) => {
+    } else if let Some(t) = any.downcast_ref::<KTree<2>>() {
+        {
             let loops = place_loops(&outline::boundary_loops(t), frame);
             match format {
                 MeshFormat::Ply => write(&|w| files::write_ply_edges(w, &loops))?,
@@ -160,10 +174,10 @@ pub fn write_mesh(path: &Path, tree: &AnyTree, frame: &Frame) -> Result<Written,
                 elements: n,
             })
         }
-        other => Err(usage(&format!(
-            "meshes are written for octrees (K = 3) and outlines for quadtrees (K = 2); this tree has K = {}",
-            other.k()
-        ))),
+    } else {
+        Err(usage(&format!(
+            "meshes are written for octrees (K = 3) and outlines for quadtrees (K = 2); this tree has K = {K}"
+        )))
     }
 }
 

@@ -602,33 +602,33 @@ fn write_typed<const K: usize>(
             write(&|w| write_vdb(w, t, options.offset, &meta))
         }
         Format::Vtu | Format::Htg => {
-            let htg = format == Format::Htg;
-            let fill = |w: &mut dyn std::io::Write| match tree {
-                AnyTree::K2(t) if htg => crate::export::vtk::write_htg(w, t, &frame),
-                AnyTree::K3(t) if htg => crate::export::vtk::write_htg(w, t, &frame),
-                AnyTree::K2(t) => crate::export::vtk::write_vtu(w, t, &frame),
-                AnyTree::K3(t) => crate::export::vtk::write_vtu(w, t, &frame),
-                _ => unreachable!("checked above"),
-            };
-            if !matches!(tree, AnyTree::K2(_) | AnyTree::K3(_)) {
+            if K != 2 && K != 3 {
                 return Err(usage(
                     path,
                     format!(
-                        "VTK files are written for quadtrees and octrees (K = 2, 3); this tree has K = {}",
-                        tree.k()
+                        "VTK files are written for quadtrees and octrees (K = 2, 3); this tree has K = {K}"
                     ),
                 ));
             }
-            write(&fill)
-        }
-        Format::Mesh | Format::Glb | Format::Svg => crate::export::write_mesh(path, tree, &frame)
-            .map(drop)
-            .map_err(|e| match e {
-                crate::export::ExportError::Write(e) => IoError::Write(e),
-                crate::export::ExportError::Usage { file, message } => {
-                    IoError::Usage { file, message }
+            let htg = format == Format::Htg;
+            write(&|w| {
+                if htg {
+                    crate::export::vtk::write_htg(w, tree, &frame)
+                } else {
+                    crate::export::vtk::write_vtu(w, tree, &frame)
                 }
-            }),
+            })
+        }
+        Format::Mesh | Format::Glb | Format::Svg => {
+            crate::export::write_mesh_of(path, tree, &frame)
+                .map(drop)
+                .map_err(|e| match e {
+                    crate::export::ExportError::Write(e) => IoError::Write(e),
+                    crate::export::ExportError::Usage { file, message } => {
+                        IoError::Usage { file, message }
+                    }
+                })
+        }
         Format::Volume => Err(usage(
             path,
             "volumes are inputs only: write .ktree, .rays, .binvox, .bt, .vdb or a mesh",

@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use ktree::export::outline::{boundary_loops, signed_area};
 use ktree::export::surface::{boundary_mesh, SurfaceMesh};
 use ktree::export::{write_mesh, Frame};
-use ktree::solid::mesh::{Placement, TriangleMesh};
+use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::{AnyTree, KTree};
 use proptest::prelude::*;
 
@@ -170,7 +170,7 @@ fn round_trip(tree: &KTree<3>, name: &str, frame: &Frame) {
     let mesh = TriangleMesh::read(&path).unwrap();
     assert_eq!(mesh.open_edges(), 0, "{name}");
     let s = 1.0 / frame.voxel_size;
-    let placement = Placement {
+    let placement = MeshTransform {
         scale: s,
         translate: frame.origin.map(|o| -o * s),
     };
