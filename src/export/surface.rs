@@ -28,6 +28,10 @@
 //! Coordinates are in voxels (the universe's corner at 0); [`SurfaceMesh::placed`] maps them to world
 //! units.
 //!
+//! **Work:** a face query per full leaf face (`O(L)` lookups each), eight voxel lookups per lattice vertex,
+//! and hash maps of the vertices and of the corners on each lattice line, all held at once (about 270 bytes
+//! a vertex of the result; `results/performance/export.md`).
+//!
 //! ```
 //! use ktree::export::surface::boundary_mesh;
 //! use ktree::KTree;
