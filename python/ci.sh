@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The Python module `ktree`: installs it with `pip install ./python` into a fresh virtual environment and runs
-# its pytest suite (python/tests/) against numpy references and the command-line tool's JSON, after checking
+# its pytest suite (python/tests/) against numpy references, the command-line tool's JSON, and trimesh's and
+# VTK's readings of the meshes and VTK files written, after checking
 # the type stubs with mypy's stubtest. Exits non-zero on any failure, including a run that collected no test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,6 +23,8 @@ export PATH="$venv/bin:$PATH" # maturin, for the build without isolation below
 pip=("$venv/bin/python" -m pip)
 "${pip[@]}" install --quiet --upgrade pip
 "${pip[@]}" install --quiet maturin numpy pytest mypy
+# Other libraries' readings of the meshes and VTK files written (pinned: the tests rely on their checks).
+"${pip[@]}" install --quiet trimesh==5.2.0 vtk==9.7.2
 # The module (a release build of the extension, in the workspace's target folder).
 "${pip[@]}" install --no-build-isolation ./python
 

@@ -105,7 +105,7 @@ class Tree:
     def load(path: _Path) -> Tree:
         """Reads a tree file, the format chosen by the extension."""
     def save(self, path: _Path) -> None:
-        """Writes the tree atomically, the format chosen by the extension."""
+        """Writes the tree atomically, the format chosen by the extension (meshes: the tree's boundary)."""
     def to_bytes(self) -> bytes:
         """The tree in the .ktree format (version 2: 2 bits a node, checksums per level)."""
     @staticmethod
@@ -149,6 +149,10 @@ class Tree:
         """Whether the objects share a voxel."""
     def collide(self, other: Tree, time_axis: Optional[int] = None) -> _Collision:
         """Interference, with the keys of `ktree collide --json`."""
+    def to_mesh(
+        self, voxel_size: float = 1.0, origin: Optional[Sequence[float]] = None
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+        """The boundary of an octree as a closed triangle mesh: vertices (n, 3) float64, faces (m, 3) int64."""
     def render(
         self,
         view: Optional[_View] = None,

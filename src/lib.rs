@@ -26,12 +26,16 @@
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
 //! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
+//! * [`export`]: the boundary out to the tools that look at surfaces and volumes — an octree as a closed
+//!   triangle mesh (PLY, OBJ, STL, glTF), a quadtree as closed polylines (PLY, OBJ, SVG).
 //!
 //! # Layers
 //! Each layer imports only those below it, with the exceptions listed after the picture:
 //! ```text
 //!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text;
-//!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in)
+//!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in,
+//!                     meshes written through export/)
+//!  export/            boundaries as meshes and outlines, and their files (over display's neighbours)
 //!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink
 //!  stacking/          Builder (cells on all threads, in memory or out of core; KTree::from_rays), paper/
 //!  solid/             quadrics, meshes, volumes → rays, slab by slab
@@ -58,6 +62,7 @@
 #![deny(unsafe_code)]
 
 pub mod display;
+pub mod export;
 pub mod fs;
 pub mod io;
 pub mod ops;

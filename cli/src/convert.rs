@@ -1,5 +1,6 @@
 //! `ktree convert IN OUT`: any format to any format, chosen by extension (`.ktree`, `.rays`, `.binvox`, `.bt`,
-//! `.vdb`; meshes and volumes as inputs).
+//! `.vdb`; meshes voxelized as inputs and the tree's boundary as outputs, `.glb` and `.svg` outputs only;
+//! volumes as inputs).
 
 use crate::outln;
 
@@ -15,7 +16,9 @@ pub struct Args {
     /// The input: .ktree, .rays, .binvox, .bt, .vdb, a mesh (.obj, .stl, .ply) or a volume (.json, .raw,
     /// .nii, .nii.gz).
     input: PathBuf,
-    /// The output: .ktree, .rays, .binvox, .bt or .vdb.
+    /// The output: .ktree, .rays, .binvox, .bt, .vdb, the tree's boundary as a mesh (.ply, .obj, .stl,
+    /// .glb; a quadtree's outline as .ply edges, .obj lines or .svg), or VTK for ParaView (.vtu: a cell per
+    /// full leaf; .htg: a hyper tree grid).
     output: PathBuf,
     /// Universe level (grids, volumes: default the smallest that holds the input; meshes: required).
     #[arg(long)]
@@ -28,9 +31,17 @@ pub struct Args {
     /// indices, binvox and .bt use 0).
     #[arg(long, allow_hyphen_values = true)]
     out_offset: Option<String>,
-    /// Grid output: the edge of a voxel in world units (default: the input grid's, else 1).
+    /// Grid and mesh output: the edge of a voxel in world units (default: the input grid's, else 1).
     #[arg(long)]
     voxel_size: Option<f64>,
+    /// Grid and mesh output: the world position of the universe's corner (ktree voxel 0), as x,y,z
+    /// (default: where the input grid puts it, else 0,0,0).
+    #[arg(long, allow_hyphen_values = true)]
+    origin: Option<String>,
+    /// 4-D trees: write the slices along this axis as a VTK time series — OUT.pvd (a collection of
+    /// OUT_NNNN.vtu slices), or OUT_NNNN.vtu / OUT_NNNN.htg files only.
+    #[arg(long)]
+    time_axis: Option<usize>,
     /// OctoMap input: how unknown cells read.
     #[arg(long, value_parser = ["empty", "full"], default_value = "empty")]
     unknown: String,
@@ -53,6 +64,18 @@ fn parse_xyz(name: &str, text: &str) -> Result<[i64; 3], String> {
         .map_err(|_| format!("--{name} '{text}': expected x,y,z (integers)"))?;
     v.try_into()
         .map_err(|_| format!("--{name} '{text}': expected three integers"))
+}
+
+fn parse_point(name: &str, text: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("--{name} '{text}': expected x,y,z (numbers)"))?;
+    match <[f64; 3]>::try_from(v) {
+        Ok(p) if p.iter().all(|x| x.is_finite()) => Ok(p),
+        _ => Err(format!("--{name} '{text}': expected three finite numbers")),
+    }
 }
 
 /// Reads the input, writes the output, prints a one-line summary.
@@ -83,17 +106,54 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     let out_offset = match (&a.out_offset, Format::of(&a.output), read.placement) {
         (Some(t), _, _) => parse_xyz("out-offset", t)?,
-        (None, Some(Format::Vdb), Some(p)) => p.offset,
+        (
+            None,
+            Some(
+                Format::Vdb | Format::Mesh | Format::Glb | Format::Svg | Format::Vtu | Format::Htg,
+            ),
+            Some(p),
+        ) => p.offset,
         _ => [0; 3],
     };
     let mut meta = read.meta.unwrap_or_default();
     if let Some(v) = a.voxel_size {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(format!("--voxel-size {v}: expected a positive number"));
+        }
         meta.voxel_size = v;
+    }
+    if let Some(t) = &a.origin {
+        let origin = parse_point("origin", t)?;
+        // The grid's index 0 is ktree voxel `out_offset`.
+        meta.origin = std::array::from_fn(|i| origin[i] + out_offset[i] as f64 * meta.voxel_size);
     }
     let write_options = WriteOptions {
         offset: out_offset,
         meta: Some(meta),
     };
+    if let Some(axis) = a.time_axis {
+        let ktree::AnyTree::K4(t) = &read.tree else {
+            return Err(format!(
+                "{}: --time-axis slices 4-D trees; this tree has K = {}",
+                a.input.display(),
+                read.tree.k()
+            ));
+        };
+        let frame = ktree::export::Frame {
+            voxel_size: meta.voxel_size,
+            origin: meta.origin,
+        };
+        let files = ktree::export::vtk::write_time_slices(&a.output, t, axis, &frame)
+            .map_err(|e| e.to_string())?;
+        outln!(
+            "{}: K = 4, L = {}, {} slices along axis {axis} ({} files)",
+            a.output.display(),
+            t.level(),
+            t.universe().side(),
+            files.len()
+        );
+        return Ok(());
+    }
     if Format::of(&a.output) == Some(Format::Ktree) {
         // The version --format-version asks for, as every command that writes trees.
         ktree::with_dim!(&read.tree, AnyTree, t => crate::common::tree_file::write_tree(&a.output, t))

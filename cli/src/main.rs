@@ -54,7 +54,7 @@ enum Command {
     Rays(rays::Args),
     /// A triangle mesh (OBJ, STL, PLY) or a volume (raw + JSON, NIfTI) to rays or a .ktree.
     Voxelize(voxelize::Args),
-    /// Convert between .ktree, .rays, .binvox, OctoMap .bt and OpenVDB .vdb (meshes and volumes as inputs).
+    /// Convert between .ktree, .rays, .binvox, OctoMap .bt and OpenVDB .vdb; meshes (voxelized in, the boundary out: .ply, .obj, .stl, .glb, .svg), VTK out (.vtu, .htg, .pvd), volumes in.
     Convert(convert::Args),
 }
 

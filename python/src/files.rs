@@ -1,6 +1,7 @@
 //! Tree files in and out through the library's dispatch by extension (`ktree::io::read_tree` and
 //! `ktree::io::write_tree` with their default options): `.ktree`, `.rays`, binvox, OctoMap `.bt` and OpenVDB
-//! `.vdb`, and meshes and volumes as inputs. Errors of the file system become `OSError`, the others
+//! `.vdb`, meshes (voxelized when read; the tree's boundary when written, with `.glb` and `.svg`), VTK
+//! files (`.vtu`, `.htg`) as outputs and volumes as inputs. Errors of the file system become `OSError`, the others
 //! `ValueError`; an `OSError` is of the subclass its kind names (`FileNotFoundError`,
 //! `PermissionError`, …) with `filename` set.
 

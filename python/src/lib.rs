@@ -636,6 +636,62 @@ impl Tree {
         Ok(d)
     }
 
+    /// The boundary of an octree as a closed, outward-oriented triangle mesh: `(vertices, faces)`, a float64
+    /// array of shape (n, 3) and an int64 array of shape (m, 3), in world units (vertex = `origin` +
+    /// `voxel_size` · voxel coordinate). Where solids touch only along an edge or at a corner the vertices
+    /// are duplicated, so the mesh is 2-manifold.
+    #[pyo3(signature = (voxel_size = 1.0, origin = None))]
+    #[allow(clippy::type_complexity)]
+    fn to_mesh<'py>(
+        &self,
+        py: Python<'py>,
+        voxel_size: f64,
+        origin: Option<Vec<f64>>,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
+        let AnyTree::K3(t) = &self.inner else {
+            return Err(Failure::Value(format!(
+                "to_mesh needs an octree (K = 3); this tree has K = {}",
+                self.inner.k()
+            ))
+            .into());
+        };
+        if !(voxel_size.is_finite() && voxel_size > 0.0) {
+            return Err(Failure::Value(format!(
+                "voxel_size {voxel_size}: expected a positive number"
+            ))
+            .into());
+        }
+        let origin: [f64; 3] = match origin {
+            None => [0.0; 3],
+            Some(o) => match <[f64; 3]>::try_from(o) {
+                Ok(o) if o.iter().all(|x| x.is_finite()) => o,
+                _ => {
+                    return Err(
+                        Failure::Value("origin: expected three finite numbers".into()).into(),
+                    )
+                }
+            },
+        };
+        let frame = ktree::export::Frame { voxel_size, origin };
+        let mesh = py.detach(|| ktree::export::surface::boundary_mesh(t).placed(&frame));
+        let (n, m) = (mesh.vertices.len(), mesh.triangles.len());
+        let vertices = numpy::ndarray::Array2::from_shape_vec(
+            (n, 3),
+            mesh.vertices.into_iter().flatten().collect(),
+        )
+        .map_err(Failure::value)?;
+        let faces = numpy::ndarray::Array2::from_shape_vec(
+            (m, 3),
+            mesh.triangles
+                .into_iter()
+                .flatten()
+                .map(i64::from)
+                .collect(),
+        )
+        .map_err(Failure::value)?;
+        Ok((vertices.into_pyarray(py), faces.into_pyarray(py)))
+    }
+
     /// A picture as an RGB uint8 array of shape (height, width, 3). An octree: a hidden-surface image seen
     /// from `view` (a name: iso, top, bottom, front, back, left, right, or three numbers towards the eye),
     /// orthographic or with a vertical field of view `perspective` in degrees, framing the object. A

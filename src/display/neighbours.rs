@@ -140,6 +140,54 @@ impl<'t, const K: usize> Neighbours<'t, K> {
         query.all_full
     }
 
+    /// Calls `f` with each leaf (cell and state) of `region` that touches the region's face on `axis`
+    /// (`upper` side), in Morton order; `region` itself when it lies in a leaf (then with the leaf's state).
+    ///
+    /// ```
+    /// use ktree::display::neighbours::Neighbours;
+    /// use ktree::{KTree, NodeState};
+    /// // Voxels 0 and 3 of a 2 × 2 square: its upper face on axis 0 touches voxels 1 (empty) and 3 (full).
+    /// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
+    /// let mut seen = Vec::new();
+    /// Neighbours::new(&tree).face_leaves(&tree.universe().root(), 0, true, |c, s| seen.push((c.origin(), s)));
+    /// assert_eq!(seen, [([1, 0], NodeState::Empty), ([1, 1], NodeState::Full)]);
+    /// ```
+    pub fn face_leaves(
+        &mut self,
+        region: &Cell<K>,
+        axis: usize,
+        upper: bool,
+        f: impl FnMut(&Cell<K>, NodeState),
+    ) {
+        struct FaceLeaves<F> {
+            face: ChildOrder,
+            f: F,
+        }
+        impl<const K: usize, F: FnMut(&Cell<K>, NodeState)> Visitor<K> for FaceLeaves<F> {
+            const LEAVES: bool = false;
+            fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+                if node.state != NodeState::Partial {
+                    (self.f)(&node.cell, node.state);
+                }
+                Walk::Descend
+            }
+            fn child_order(&self, _node: &NodeRef<K>) -> ChildOrder {
+                self.face
+            }
+        }
+        let node = self.locate(region);
+        if node.state != NodeState::Partial {
+            let mut f = f;
+            f(region, node.state);
+            return;
+        }
+        let mut query = FaceLeaves {
+            face: ChildOrder::half::<K>(axis, upper),
+            f,
+        };
+        cursor::walk_from(self.tree, node, &mut query);
+    }
+
     /// As [`is_surrounded`].
     pub fn is_surrounded(&mut self, cell: &Cell<K>) -> bool {
         let side = self.tree.universe().side();

@@ -1,6 +1,7 @@
 //! Reading and writing a tree in any format, chosen by the file's extension: `.ktree`, `.rays` (the ray
-//! text), `.binvox`, `.bt` (OctoMap), `.vdb` (OpenVDB), and as inputs only meshes (`.obj`, `.stl`, `.ply`)
-//! and volumes (`.json` + raw, `.nii`, `.nii.gz`).
+//! text), `.binvox`, `.bt` (OctoMap), `.vdb` (OpenVDB); meshes (`.obj`, `.stl`, `.ply`) read by voxelizing
+//! them and written as the tree's boundary ([`crate::export`]), with `.glb` and `.svg` as outputs only;
+//! volumes (`.json` + raw, `.nii`, `.nii.gz`) as inputs only.
 //!
 //! Grid formats index voxels by integers: ktree voxel = grid index + offset (see [`GridPlacement`]).
 //! binvox, `.bt` and `.vdb` hold octrees only.
@@ -34,8 +35,16 @@ pub enum Format {
     OctomapBt,
     /// `.vdb`: an OpenVDB grid.
     Vdb,
-    /// `.obj`, `.stl`, `.ply`: a triangle mesh (input only).
+    /// `.obj`, `.stl`, `.ply`: a triangle mesh (voxelized when read; the tree's boundary when written).
     Mesh,
+    /// `.glb`: a glTF binary mesh of the tree's boundary (output only).
+    Glb,
+    /// `.svg`: a quadtree's outline as one path (output only).
+    Svg,
+    /// `.vtu`: a VTK unstructured grid of the full leaves, for ParaView (output only).
+    Vtu,
+    /// `.htg`: a VTK hyper tree grid, for ParaView (output only).
+    Htg,
     /// `.json` (+ raw samples), `.raw`, `.nii`, `.nii.gz`: a volume (input only).
     Volume,
 }
@@ -61,6 +70,10 @@ impl Format {
             "bt" => Format::OctomapBt,
             "vdb" => Format::Vdb,
             "obj" | "stl" | "ply" => Format::Mesh,
+            "glb" => Format::Glb,
+            "svg" => Format::Svg,
+            "vtu" => Format::Vtu,
+            "htg" => Format::Htg,
             "json" | "raw" | "nii" => Format::Volume,
             _ => return None,
         })
@@ -165,8 +178,8 @@ fn format_of(path: &Path) -> Result<Format, IoError> {
     Format::of(path).ok_or_else(|| {
         usage(
             path,
-            "unknown extension: expected .ktree, .rays, .binvox, .bt, .vdb, a mesh (.obj, .stl, .ply) or a \
-             volume (.json, .raw, .nii, .nii.gz)",
+            "unknown extension: expected .ktree, .rays, .binvox, .bt, .vdb, a mesh (.obj, .stl, .ply; \
+             .glb and .svg written only), VTK (.vtu, .htg; written only) or a volume (.json, .raw, .nii, .nii.gz)",
         )
     })
 }
@@ -214,6 +227,10 @@ pub fn read_tree_placed(path: &Path, options: &ReadOptions) -> Result<ReadTree, 
             .map_err(|e| GridFileError::new(&name, 0, GridFileErrorKind::Io(e.into())))
     };
     match format_of(path)? {
+        Format::Glb | Format::Svg | Format::Vtu | Format::Htg => Err(usage(
+            path,
+            "this format is written only: read .ktree, .rays, .binvox, .bt, .vdb, a mesh or a volume",
+        )),
         Format::Ktree => Ok(plain(read_ktree_file(path)?)),
         Format::Rays => Ok(plain(read_rays_file(path)?.build())),
         Format::Binvox => Ok(grid(read_binvox(
@@ -524,10 +541,13 @@ fn voxelize_volume(path: &Path, _: &ReadOptions) -> Result<Voxelized, IoError> {
 }
 
 /// Writes a tree to a file of the format its extension names, atomically ([`crate::fs::write_atomic`]).
+/// Meshes (`.ply`, `.obj`, `.stl`, `.glb`, `.svg`) are the tree's boundary ([`crate::export::write_mesh`]),
+/// ktree voxel `v` at `meta.origin + (v − offset) · meta.voxel_size`.
 ///
 /// # Errors
 /// [`IoError::Usage`] for an input-only format or a tree the format cannot hold (binvox, `.bt` and `.vdb`
-/// hold octrees); [`IoError::Write`] for the file system or a placement the format cannot express.
+/// hold octrees; meshes octrees and quadtrees); [`IoError::Write`] for the file system or a placement the
+/// format cannot express.
 pub fn write_tree(path: &Path, tree: &AnyTree, options: &WriteOptions) -> Result<(), IoError> {
     crate::with_dim!(tree, AnyTree, t => write_typed(path, t, options))
 }
@@ -553,6 +573,13 @@ fn write_typed<const K: usize>(
     let write = |fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
         write_atomic_with(path, |w| fill(w)).map_err(IoError::Write)
     };
+    // Meshes and VTK files: ktree voxel v is at meta.origin + (v − offset) · voxel_size.
+    let frame = crate::export::Frame {
+        voxel_size: meta.voxel_size,
+        origin: std::array::from_fn(|a| {
+            meta.origin[a] - options.offset[a] as f64 * meta.voxel_size
+        }),
+    };
     match format {
         Format::Ktree => write_ktree_file(path, tree).map_err(IoError::Write),
         Format::Rays => write_rays_file(path, &tree.to_rays()).map_err(IoError::Write),
@@ -574,9 +601,37 @@ fn write_typed<const K: usize>(
             let t = octree()?;
             write(&|w| write_vdb(w, t, options.offset, &meta))
         }
-        Format::Mesh | Format::Volume => Err(usage(
+        Format::Vtu | Format::Htg => {
+            if K != 2 && K != 3 {
+                return Err(usage(
+                    path,
+                    format!(
+                        "VTK files are written for quadtrees and octrees (K = 2, 3); this tree has K = {K}"
+                    ),
+                ));
+            }
+            let htg = format == Format::Htg;
+            write(&|w| {
+                if htg {
+                    crate::export::vtk::write_htg(w, tree, &frame)
+                } else {
+                    crate::export::vtk::write_vtu(w, tree, &frame)
+                }
+            })
+        }
+        Format::Mesh | Format::Glb | Format::Svg => {
+            crate::export::write_mesh_of(path, tree, &frame)
+                .map(drop)
+                .map_err(|e| match e {
+                    crate::export::ExportError::Write(e) => IoError::Write(e),
+                    crate::export::ExportError::Usage { file, message } => {
+                        IoError::Usage { file, message }
+                    }
+                })
+        }
+        Format::Volume => Err(usage(
             path,
-            "meshes and volumes are inputs only: write .ktree, .rays, .binvox, .bt or .vdb",
+            "volumes are inputs only: write .ktree, .rays, .binvox, .bt, .vdb or a mesh",
         )),
     }
 }

@@ -10,6 +10,7 @@
 mod build;
 mod compare;
 mod display;
+mod export;
 mod interop;
 mod measure;
 mod ops;
@@ -33,6 +34,7 @@ fn main() -> ExitCode {
             "scale" => measure::child(|| scale::run_case(case)),
             "streaming" => measure::child(|| streaming::run_case(case)),
             "sources" => measure::child(|| sources::run_case(case)),
+            "export" => measure::child(|| export::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -66,8 +68,9 @@ fn main() -> ExitCode {
             "interop" => interop::report(),
             "streaming" => streaming::report(),
             "sources" => sources::report(),
+            "export" => export::report(),
             other => Err(format!(
-                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming, sources)"
+                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming, sources, export)"
             )),
         };
         match result {

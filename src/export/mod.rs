@@ -1,0 +1,194 @@
+//! The boundary of a tree out to the tools that look at surfaces: an octree as a closed triangle mesh
+//! ([`surface`]), a quadtree as closed polylines ([`outline`]), written as PLY, OBJ, STL or glTF binary
+//! ([`files`]) in real-world units ([`Frame`]).
+//!
+//! ```
+//! use ktree::export::{write_mesh, Frame};
+//! use ktree::{AnyTree, KTree};
+//! let dir = tempfile::tempdir().unwrap();
+//! let tree = AnyTree::K3(KTree::<3>::full(1).unwrap());
+//! let path = dir.path().join("block.ply");
+//! let written = write_mesh(&path, &tree, &Frame::default()).unwrap();
+//! assert_eq!((written.vertices, written.elements), (8, 12));
+//! ```
+
+pub mod files;
+pub mod outline;
+pub mod surface;
+pub mod vtk;
+
+use std::path::Path;
+
+use thiserror::Error;
+
+use crate::fs::write_atomic_with;
+use crate::tree::{AnyTree, KTree};
+
+/// Where voxels are in the world: voxel coordinate `v` is at `origin + voxel_size · v` (the universe's
+/// corner at `origin`; quadtrees use the first two coordinates).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// The edge of a voxel in world units.
+    pub voxel_size: f64,
+    /// The world position of the universe's corner (voxel coordinate 0).
+    pub origin: [f64; 3],
+}
+
+impl Default for Frame {
+    /// Unit voxels, the universe's corner at the world origin.
+    fn default() -> Self {
+        Self {
+            voxel_size: 1.0,
+            origin: [0.0; 3],
+        }
+    }
+}
+
+/// A mesh file format, by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// `.ply`, binary little-endian.
+    Ply,
+    /// `.obj`.
+    Obj,
+    /// `.stl`, binary.
+    Stl,
+    /// `.glb`, glTF 2.0 binary.
+    Glb,
+    /// `.svg`: outlines only.
+    Svg,
+}
+
+impl MeshFormat {
+    /// The format of a path, by its extension (case-insensitive).
+    ///
+    /// ```
+    /// use ktree::export::MeshFormat;
+    /// assert_eq!(MeshFormat::of(std::path::Path::new("a.GLB")), Some(MeshFormat::Glb));
+    /// assert_eq!(MeshFormat::of(std::path::Path::new("a.ktree")), None);
+    /// ```
+    pub fn of(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "ply" => Self::Ply,
+            "obj" => Self::Obj,
+            "stl" => Self::Stl,
+            "glb" => Self::Glb,
+            "svg" => Self::Svg,
+            _ => return None,
+        })
+    }
+}
+
+/// What [`write_mesh`] wrote.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Written {
+    /// Vertices.
+    pub vertices: usize,
+    /// Triangles (octrees) or edges (quadtrees).
+    pub elements: usize,
+}
+
+/// An error writing a mesh.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ExportError {
+    /// The format does not fit the file or the tree.
+    #[error("{file}: {message}")]
+    Usage {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Writing failed (the message names the file).
+    #[error("{0}")]
+    Write(#[source] std::io::Error),
+}
+
+/// Writes the boundary of `tree` to `path` in the format its extension names, atomically: an octree as a
+/// closed triangle mesh (`.ply`, `.obj`, `.stl`, `.glb`), a quadtree as closed polylines (`.ply` edges,
+/// `.obj` lines, `.svg`), placed by `frame`.
+///
+/// # Errors
+/// [`ExportError::Usage`] for an unknown extension or a format that cannot hold the tree's boundary;
+/// [`ExportError::Write`] from the file system.
+pub fn write_mesh(path: &Path, tree: &AnyTree, frame: &Frame) -> Result<Written, ExportError> {
+    crate::with_dim!(tree, AnyTree, t => write_mesh_of(path, t, frame))
+}
+
+/// [`write_mesh`] of a tree whose dimension is known.
+///
+/// # Errors
+/// As [`write_mesh`].
+pub fn write_mesh_of<const K: usize>(
+    path: &Path,
+    tree: &KTree<K>,
+    frame: &Frame,
+) -> Result<Written, ExportError> {
+    let usage = |message: &str| ExportError::Usage {
+        file: path.display().to_string(),
+        message: message.into(),
+    };
+    let format = MeshFormat::of(path)
+        .ok_or_else(|| usage("unknown mesh extension: expected .ply, .obj, .stl, .glb or .svg"))?;
+    let write = |fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
+        write_atomic_with(path, |w| fill(w)).map_err(ExportError::Write)
+    };
+    let any = tree as &dyn std::any::Any;
+    if let Some(t) = any.downcast_ref::<KTree<3>>() {
+        {
+            let mesh = surface::boundary_mesh(t).placed(frame);
+            match format {
+                MeshFormat::Ply => write(&|w| files::write_ply(w, &mesh))?,
+                MeshFormat::Obj => write(&|w| files::write_obj(w, &mesh))?,
+                MeshFormat::Stl => write(&|w| files::write_stl(w, &mesh))?,
+                MeshFormat::Glb => write(&|w| files::write_glb(w, &mesh))?,
+                MeshFormat::Svg => {
+                    return Err(usage(
+                        "SVG holds the outlines of quadtrees (K = 2); this tree has K = 3",
+                    ))
+                }
+            }
+            Ok(Written {
+                vertices: mesh.vertices.len(),
+                elements: mesh.triangles.len(),
+            })
+        }
+    } else if let Some(t) = any.downcast_ref::<KTree<2>>() {
+        {
+            let loops = place_loops(&outline::boundary_loops(t), frame);
+            match format {
+                MeshFormat::Ply => write(&|w| files::write_ply_edges(w, &loops))?,
+                MeshFormat::Obj => write(&|w| files::write_obj_lines(w, &loops))?,
+                MeshFormat::Svg => write(&|w| files::write_svg(w, &loops))?,
+                MeshFormat::Stl | MeshFormat::Glb => {
+                    return Err(usage(
+                        "a quadtree's boundary is polylines: write .ply, .obj or .svg",
+                    ))
+                }
+            }
+            let n = loops.iter().map(Vec::len).sum();
+            Ok(Written {
+                vertices: n,
+                elements: n,
+            })
+        }
+    } else {
+        Err(usage(&format!(
+            "meshes are written for octrees (K = 3) and outlines for quadtrees (K = 2); this tree has K = {K}"
+        )))
+    }
+}
+
+/// Outline loops in world units (see [`Frame`]).
+pub fn place_loops(loops: &[outline::Loop], frame: &Frame) -> Vec<outline::Loop> {
+    loops
+        .iter()
+        .map(|l| {
+            l.iter()
+                .map(|v| std::array::from_fn(|a| frame.origin[a] + frame.voxel_size * v[a]))
+                .collect()
+        })
+        .collect()
+}

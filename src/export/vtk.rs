@@ -1,0 +1,418 @@
+//! VTK XML files for ParaView: an unstructured grid (`.vtu`) of one voxel (octrees) or pixel (quadtrees)
+//! cell per full leaf, and a hyper tree grid (`.htg`), the form VTK keeps a tree in.
+//!
+//! A 4-D tree goes out as a time series of its 3-D slices ([`write_time_slices`]), with a `.pvd`
+//! collection for ParaView's time controls.
+//!
+//! Both carry the cell data `level` (the leaf's depth in the tree, 0 at the root) and `side` (the leaf's
+//! edge in world units). Arrays are raw little-endian binary in the appended section (header UInt64).
+//!
+//! ```
+//! use ktree::export::{vtk::write_vtu, Frame};
+//! let tree = ktree::KTree::<3>::full(1).unwrap();
+//! let mut bytes = Vec::new();
+//! write_vtu(&mut bytes, &tree, &Frame::default()).unwrap();
+//! let text = String::from_utf8_lossy(&bytes);
+//! assert!(text.contains(r#"<Piece NumberOfPoints="8" NumberOfCells="1">"#));
+//! ```
+
+use std::collections::HashMap;
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+use super::{ExportError, Frame};
+use crate::display::slices::slice_4d;
+use crate::fs::write_atomic_with;
+use crate::tree::cursor::{walk, Visitor, Walk};
+use crate::tree::{KTree, NodeRef, NodeState};
+
+/// One array of the appended section.
+struct Array {
+    name: &'static str,
+    kind: &'static str,
+    components: usize,
+    bytes: Vec<u8>,
+}
+
+impl Array {
+    fn new(name: &'static str, kind: &'static str, components: usize) -> Self {
+        Self {
+            name,
+            kind,
+            components,
+            bytes: Vec::new(),
+        }
+    }
+
+    fn tag(&self, offset: u64) -> String {
+        let comps = if self.components > 1 {
+            format!(r#" NumberOfComponents="{}""#, self.components)
+        } else {
+            String::new()
+        };
+        format!(
+            r#"<DataArray type="{}" Name="{}"{comps} format="appended" offset="{offset}"/>"#,
+            self.kind, self.name
+        )
+    }
+}
+
+/// Writes `<AppendedData>` for `arrays` (in the order their tags were given offsets).
+fn appended(w: &mut dyn Write, arrays: &[&Array]) -> io::Result<()> {
+    write!(w, "  <AppendedData encoding=\"raw\">\n   _")?;
+    for a in arrays {
+        w.write_all(&(a.bytes.len() as u64).to_le_bytes())?;
+        w.write_all(&a.bytes)?;
+    }
+    writeln!(w, "\n  </AppendedData>\n</VTKFile>")
+}
+
+/// Offsets of each array in the appended section, in order.
+fn offsets(arrays: &[&Array]) -> Vec<u64> {
+    let mut at = 0u64;
+    arrays
+        .iter()
+        .map(|a| {
+            let o = at;
+            at += 8 + a.bytes.len() as u64;
+            o
+        })
+        .collect()
+}
+
+/// The full leaves of `tree` as an unstructured grid: `VTK_VOXEL` cells (K = 3) or `VTK_PIXEL` cells
+/// (K = 2, in the plane z = `frame.origin[2]`), corners shared between cells, placed by `frame`.
+///
+/// # Errors
+/// The writer's; [`io::ErrorKind::InvalidInput`] for K other than 2 and 3.
+pub fn write_vtu<const K: usize>(
+    w: &mut dyn Write,
+    tree: &KTree<K>,
+    frame: &Frame,
+) -> io::Result<()> {
+    if K != 2 && K != 3 {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(".vtu holds quadtrees and octrees; this tree has K = {K}"),
+        ));
+    }
+    let corners = 1usize << K;
+    let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut points = Array::new("Points", "Float64", 3);
+    let mut connectivity = Array::new("connectivity", "Int64", 1);
+    let mut offsets_a = Array::new("offsets", "Int64", 1);
+    let mut types = Array::new("types", "UInt8", 1);
+    let mut level = Array::new("level", "Int32", 1);
+    let mut side = Array::new("side", "Float64", 1);
+    let mut cells = 0u64;
+    for cell in tree.full_cells() {
+        let s = cell.side() as u32;
+        for o in 0..corners {
+            let p: [u32; 3] = std::array::from_fn(|a| {
+                if a < K {
+                    cell.origin[a] + if o >> a & 1 == 1 { s } else { 0 }
+                } else {
+                    0
+                }
+            });
+            let next = ids.len() as u32;
+            let id = *ids.entry(p).or_insert_with(|| {
+                for (a, &pa) in p.iter().enumerate() {
+                    let x = if a < K {
+                        frame.origin[a] + frame.voxel_size * f64::from(pa)
+                    } else {
+                        frame.origin[a]
+                    };
+                    points.bytes.extend_from_slice(&x.to_le_bytes());
+                }
+                next
+            });
+            connectivity
+                .bytes
+                .extend_from_slice(&i64::from(id).to_le_bytes());
+        }
+        cells += 1;
+        offsets_a
+            .bytes
+            .extend_from_slice(&((cells * corners as u64) as i64).to_le_bytes());
+        types.bytes.push(if K == 3 { 11 } else { 8 });
+        level
+            .bytes
+            .extend_from_slice(&(cell.level as i32).to_le_bytes());
+        side.bytes
+            .extend_from_slice(&(frame.voxel_size * f64::from(s)).to_le_bytes());
+    }
+    let order = [&level, &side, &points, &connectivity, &offsets_a, &types];
+    let at = offsets(&order);
+    writeln!(
+        w,
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" \
+         byte_order=\"LittleEndian\" header_type=\"UInt64\">\n <UnstructuredGrid>\n  \
+         <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{cells}\">",
+        ids.len()
+    )?;
+    writeln!(
+        w,
+        "   <CellData Scalars=\"level\">\n    {}\n    {}\n   </CellData>",
+        level.tag(at[0]),
+        side.tag(at[1])
+    )?;
+    writeln!(w, "   <Points>\n    {}\n   </Points>", points.tag(at[2]))?;
+    writeln!(
+        w,
+        "   <Cells>\n    {}\n    {}\n    {}\n   </Cells>",
+        connectivity.tag(at[3]),
+        offsets_a.tag(at[4]),
+        types.tag(at[5])
+    )?;
+    writeln!(w, "  </Piece>\n </UnstructuredGrid>")?;
+    appended(w, &order)
+}
+
+/// The nodes of a tree breadth first, as VTK's hyper tree descriptor wants them: per depth, each node's
+/// state in level order.
+struct Depths<const K: usize> {
+    /// Per depth: (state, level) of each node, in order.
+    nodes: Vec<Vec<(NodeState, u32)>>,
+}
+
+impl<const K: usize> Visitor<K> for Depths<K> {
+    const LEAVES: bool = false;
+    const ORIGINS: bool = false;
+    fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+        let d = node.cell().level as usize;
+        if self.nodes.len() <= d {
+            self.nodes.resize_with(d + 1, Vec::new);
+        }
+        self.nodes[d].push((node.state(), d as u32));
+        Walk::Descend
+    }
+}
+
+/// Bits packed most significant first, as VTK's `Bit` arrays are.
+fn pack_bits(bits: impl Iterator<Item = bool>) -> Vec<u8> {
+    let mut out = Vec::new();
+    for (i, b) in bits.enumerate() {
+        if i % 8 == 0 {
+            out.push(0);
+        }
+        if b {
+            *out.last_mut().unwrap() |= 0x80 >> (i % 8);
+        }
+    }
+    out
+}
+
+/// The tree as a VTK hyper tree grid (XML, version 2.0, ASCII arrays): one tree of branch factor 2 over
+/// the universe, refined where the tree is partial, the empty leaves masked; cell data `level` and `side`
+/// on every node. The file lists nodes breadth first, children in VTK's order (x fastest), which is the
+/// tree's level order and child code.
+///
+/// # Errors
+/// The writer's; [`io::ErrorKind::InvalidInput`] for K other than 2 and 3.
+pub fn write_htg<const K: usize>(
+    w: &mut dyn Write,
+    tree: &KTree<K>,
+    frame: &Frame,
+) -> io::Result<()> {
+    if K != 2 && K != 3 {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(".htg holds quadtrees and octrees; this tree has K = {K}"),
+        ));
+    }
+    // Level order is breadth first: each depth's nodes in index order, which a depth-first walk meets in
+    // the same order.
+    let mut depths = Depths::<K> { nodes: Vec::new() };
+    walk(tree, &mut depths);
+    let all: Vec<(NodeState, u32)> = depths.nodes.iter().flatten().copied().collect();
+    let u = tree.universe().side() as f64 * frame.voxel_size;
+    // The descriptor: one bit per node of every depth but the last, refined or not.
+    let inner = depths.nodes.len().saturating_sub(1);
+    let descriptor = pack_bits(
+        depths.nodes[..inner]
+            .iter()
+            .flatten()
+            .map(|(s, _)| *s == NodeState::Partial),
+    );
+    let described: usize = depths.nodes[..inner].iter().map(Vec::len).sum();
+    let mask = pack_bits(all.iter().map(|(s, _)| *s == NodeState::Empty));
+    let per_depth: Vec<String> = depths.nodes.iter().map(|d| d.len().to_string()).collect();
+    let top = tree.level();
+    let dims = (0..3)
+        .map(|a| if a < K { "2" } else { "1" })
+        .collect::<Vec<_>>()
+        .join(" ");
+    writeln!(
+        w,
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"HyperTreeGrid\" version=\"2.0\" \
+         byte_order=\"LittleEndian\" header_type=\"UInt32\">\n \
+         <HyperTreeGrid BranchFactor=\"2\" TransposedRootIndexing=\"0\" Dimensions=\"{dims}\">"
+    )?;
+    writeln!(w, "  <Grid>")?;
+    for (a, name) in ["XCoordinates", "YCoordinates", "ZCoordinates"]
+        .iter()
+        .enumerate()
+    {
+        let o = frame.origin[a];
+        if a < K {
+            writeln!(
+                w,
+                "   <DataArray type=\"Float64\" Name=\"{name}\" NumberOfTuples=\"2\" format=\"ascii\" \
+                 RangeMin=\"{o}\" RangeMax=\"{}\">{o} {}</DataArray>",
+                o + u,
+                o + u
+            )?;
+        } else {
+            writeln!(
+                w,
+                "   <DataArray type=\"Float64\" Name=\"{name}\" NumberOfTuples=\"1\" format=\"ascii\" \
+                 RangeMin=\"{o}\" RangeMax=\"{o}\">{o}</DataArray>"
+            )?;
+        }
+    }
+    writeln!(w, "  </Grid>\n  <Trees>")?;
+    let bits = |packed: &[u8], n: usize| -> String {
+        (0..n)
+            .map(|i| {
+                if packed[i / 8] >> (7 - i % 8) & 1 == 1 {
+                    "1"
+                } else {
+                    "0"
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let array = |w: &mut dyn Write, kind: &str, name: &str, n: usize, text: &str| {
+        writeln!(
+            w,
+            "   <DataArray type=\"{kind}\" Name=\"{name}\" NumberOfTuples=\"{n}\" format=\"ascii\">{text}</DataArray>"
+        )
+    };
+    array(
+        w,
+        "Bit",
+        "Descriptors",
+        described,
+        &bits(&descriptor, described),
+    )?;
+    array(
+        w,
+        "Int64",
+        "NumberOfVerticesPerDepth",
+        per_depth.len(),
+        &per_depth.join(" "),
+    )?;
+    array(w, "Int64", "TreeIds", 1, "0")?;
+    array(
+        w,
+        "UInt32",
+        "DepthPerTree",
+        1,
+        &depths.nodes.len().to_string(),
+    )?;
+    array(w, "Bit", "Mask", all.len(), &bits(&mask, all.len()))?;
+    writeln!(w, "  </Trees>\n  <CellData>")?;
+    let levels: Vec<String> = all.iter().map(|(_, d)| d.to_string()).collect();
+    let sides: Vec<String> = all
+        .iter()
+        .map(|(_, d)| (frame.voxel_size * (1u64 << (top - d)) as f64).to_string())
+        .collect();
+    array(w, "Int32", "level", all.len(), &levels.join(" "))?;
+    array(w, "Float64", "side", all.len(), &sides.join(" "))?;
+    writeln!(w, "  </CellData>\n </HyperTreeGrid>\n</VTKFile>")
+}
+
+/// A 4-D tree as a time series for ParaView: the octree of each slice along `time_axis` (the other axes
+/// in order, placed by `frame`) written beside `path` as `STEM_NNNN.vtu` (or `.htg`), atomically. With
+/// `path` ending in `.pvd`, the slices are `.vtu` files and `path` is a VTK collection listing them, the
+/// timestep being the slice's position; with `.vtu` or `.htg`, only the slices are written. Returns the
+/// files written.
+///
+/// ```
+/// use ktree::export::{vtk::write_time_slices, Frame};
+/// let dir = tempfile::tempdir().unwrap();
+/// let tree = ktree::KTree::<4>::full(1).unwrap();
+/// let files = write_time_slices(&dir.path().join("run.pvd"), &tree, 3, &Frame::default()).unwrap();
+/// assert_eq!(files.len(), 3); // two slices and the collection
+/// assert!(files[0].ends_with("run_0000.vtu"));
+/// ```
+///
+/// # Errors
+/// [`ExportError::Usage`] for another extension or an axis past 3; [`ExportError::Write`] from the file
+/// system.
+pub fn write_time_slices(
+    path: &Path,
+    tree: &KTree<4>,
+    time_axis: usize,
+    frame: &Frame,
+) -> Result<Vec<PathBuf>, ExportError> {
+    let usage = |message: String| ExportError::Usage {
+        file: path.display().to_string(),
+        message,
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let (slice_ext, collection) = match ext.as_str() {
+        "pvd" => ("vtu", true),
+        "vtu" | "htg" => (ext.as_str(), false),
+        _ => {
+            return Err(usage(
+                "a time series is written as .pvd (with .vtu slices), .vtu or .htg".into(),
+            ))
+        }
+    };
+    if time_axis > 3 {
+        return Err(usage(format!(
+            "--time-axis {time_axis}: a 4-D tree has axes 0 … 3"
+        )));
+    }
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let side = tree.universe().side();
+    let digits = side.saturating_sub(1).to_string().len().max(4);
+    let mut written = Vec::new();
+    let mut entries = String::new();
+    for t in 0..side as u32 {
+        let slice = slice_4d(tree, time_axis, t).map_err(|e| usage(e.to_string()))?;
+        let name = format!("{stem}_{t:0digits$}.{slice_ext}");
+        let file = dir.join(&name);
+        write_atomic_with(&file, |w| {
+            if slice_ext == "htg" {
+                write_htg(w, &slice, frame)
+            } else {
+                write_vtu(w, &slice, frame)
+            }
+        })
+        .map_err(ExportError::Write)?;
+        entries.push_str(&format!(
+            "  <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{}\"/>\n",
+            xml_escape(&name)
+        ));
+        written.push(file);
+    }
+    if collection {
+        let text = format!(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" \
+             byte_order=\"LittleEndian\">\n <Collection>\n{entries} </Collection>\n</VTKFile>\n"
+        );
+        crate::fs::write_atomic(path, text.as_bytes()).map_err(ExportError::Write)?;
+        written.push(path.to_path_buf());
+    }
+    Ok(written)
+}
+
+/// `text` with XML's special characters escaped, for an attribute.
+fn xml_escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('"', "&quot;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}

@@ -1,0 +1,273 @@
+//! VTK files read back: the `.vtu` unstructured grid (a cell per full leaf: count, bounds, volume, and the
+//! voxels its cells cover are the tree's) and the `.htg` hyper tree grid (its descriptor and mask decoded
+//! breadth first give back the tree's voxels), for random quadtrees and octrees.
+
+use ktree::export::vtk::{write_htg, write_vtu};
+use ktree::export::Frame;
+use ktree::KTree;
+use proptest::prelude::*;
+
+/// The value of attribute `name` in `tag`.
+fn attr<'a>(tag: &'a str, name: &str) -> &'a str {
+    let key = format!(" {name}=\"");
+    let start = tag
+        .find(&key)
+        .unwrap_or_else(|| panic!("no {name} in {tag}"))
+        + key.len();
+    &tag[start..start + tag[start..].find('"').unwrap()]
+}
+
+/// The `<DataArray …>` tag named `name` and its text (up to `</DataArray>`, empty for an appended one).
+fn data_array<'a>(text: &'a str, name: &str) -> (&'a str, &'a str) {
+    let key = format!("Name=\"{name}\"");
+    let at = text.find(&key).unwrap_or_else(|| panic!("no array {name}"));
+    let open = text[..at].rfind("<DataArray").unwrap();
+    let close = open + text[open..].find('>').unwrap();
+    let tag = &text[open..=close];
+    if tag.ends_with("/>") {
+        return (tag, "");
+    }
+    let end = close + text[close..].find("</DataArray>").unwrap();
+    (tag, text[close + 1..end].trim())
+}
+
+/// An appended array's bytes (header UInt64).
+fn appended<'a>(bytes: &'a [u8], text: &str, name: &str) -> &'a [u8] {
+    let (tag, _) = data_array(text, name);
+    let offset: usize = attr(tag, "offset").parse().unwrap();
+    let marker = text.find("<AppendedData encoding=\"raw\">").unwrap();
+    let base = marker + text[marker..].find('_').unwrap() + 1;
+    let at = base + offset;
+    let n = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+    &bytes[at + 8..at + 8 + n]
+}
+
+fn f64s(b: &[u8]) -> Vec<f64> {
+    b.chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+fn i64s(b: &[u8]) -> Vec<i64> {
+    b.chunks_exact(8)
+        .map(|c| i64::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+const FRAME: Frame = Frame {
+    voxel_size: 0.5,
+    origin: [1.0, -2.0, 4.0],
+};
+
+/// Reads a `.vtu` of a K-tree of `level` back into a dense array, checking its cells on the way.
+fn vtu_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
+    let text = String::from_utf8_lossy(bytes);
+    let piece = &text[text.find("<Piece").unwrap()..];
+    let cells: usize = attr(piece, "NumberOfCells").parse().unwrap();
+    let npoints: usize = attr(piece, "NumberOfPoints").parse().unwrap();
+    let points = f64s(appended(bytes, &text, "Points"));
+    assert_eq!(points.len(), 3 * npoints);
+    let conn = i64s(appended(bytes, &text, "connectivity"));
+    let offsets = i64s(appended(bytes, &text, "offsets"));
+    let types = appended(bytes, &text, "types");
+    let side = f64s(appended(bytes, &text, "side"));
+    let lv: Vec<i32> = appended(bytes, &text, "level")
+        .chunks_exact(4)
+        .map(|c| i32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let corners = 1usize << K;
+    assert_eq!(
+        (offsets.len(), types.len(), side.len(), lv.len()),
+        (cells, cells, cells, cells)
+    );
+    assert_eq!(conn.len(), cells * corners);
+    let u = 1usize << level;
+    let mut dense = vec![false; u.pow(K as u32)];
+    for c in 0..cells {
+        assert_eq!(offsets[c], ((c + 1) * corners) as i64);
+        assert_eq!(types[c], if K == 3 { 11 } else { 8 });
+        let p = |i: usize| {
+            let id = conn[c * corners + i] as usize;
+            [points[3 * id], points[3 * id + 1], points[3 * id + 2]]
+        };
+        let (lo, hi) = (p(0), p(corners - 1));
+        // Voxel order: corner o at lo + side · bits of o.
+        for o in 0..corners {
+            for a in 0..3 {
+                let want = if a < K && o >> a & 1 == 1 {
+                    hi[a]
+                } else {
+                    lo[a]
+                };
+                assert_eq!(p(o)[a], want);
+            }
+        }
+        let s = (hi[0] - lo[0]) / FRAME.voxel_size;
+        assert_eq!(side[c], hi[0] - lo[0]);
+        assert_eq!(s, (1u64 << (level - lv[c] as u32)) as f64);
+        if K == 2 {
+            assert_eq!(lo[2], FRAME.origin[2]);
+        }
+        let v0: Vec<usize> = (0..K)
+            .map(|a| ((lo[a] - FRAME.origin[a]) / FRAME.voxel_size) as usize)
+            .collect();
+        let s = s as usize;
+        for i in 0..s.pow(K as u32) {
+            let mut index = 0;
+            for a in (0..K).rev() {
+                index = index * u + v0[a] + (i / s.pow(a as u32)) % s;
+            }
+            assert!(!dense[index], "cells overlap");
+            dense[index] = true;
+        }
+    }
+    dense
+}
+
+/// Reads a `.htg` of a K-tree of `level` back into a dense array.
+fn htg_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
+    let text = String::from_utf8_lossy(bytes);
+    let bits = |name: &str| -> Vec<bool> {
+        data_array(&text, name)
+            .1
+            .split_whitespace()
+            .map(|b| b == "1")
+            .collect()
+    };
+    let descriptor = bits("Descriptors");
+    let mask = bits("Mask");
+    let per_depth: Vec<usize> = data_array(&text, "NumberOfVerticesPerDepth")
+        .1
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert_eq!(mask.len(), per_depth.iter().sum::<usize>());
+    let (x, xs) = data_array(&text, "XCoordinates");
+    assert_eq!(attr(x, "RangeMin").parse::<f64>().unwrap(), FRAME.origin[0]);
+    let extent = FRAME.voxel_size * (1u64 << level) as f64;
+    assert_eq!(
+        xs,
+        format!("{} {}", FRAME.origin[0], FRAME.origin[0] + extent)
+    );
+    let levels: Vec<i32> = data_array(&text, "level")
+        .1
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert_eq!(levels.len(), mask.len());
+    // Breadth first: each refined node's children follow at the next depth, in order.
+    let u = 1usize << level;
+    let mut dense = vec![false; u.pow(K as u32)];
+    let mut current: Vec<([usize; 3], usize)> = vec![([0; 3], u)];
+    let mut index = 0;
+    for (depth, &n) in per_depth.iter().enumerate() {
+        assert_eq!(current.len(), n, "depth {depth}");
+        let mut next = Vec::new();
+        for &(origin, s) in &current {
+            assert_eq!(levels[index], depth as i32);
+            let refined = descriptor.get(index).copied().unwrap_or(false);
+            if refined {
+                for c in 0..1usize << K {
+                    let mut o = origin;
+                    for (a, oa) in o.iter_mut().enumerate().take(K) {
+                        *oa += (c >> a & 1) * s / 2;
+                    }
+                    next.push((o, s / 2));
+                }
+            } else if !mask[index] {
+                for i in 0..s.pow(K as u32) {
+                    let mut at = 0;
+                    for a in (0..K).rev() {
+                        at = at * u + origin[a] + (i / s.pow(a as u32)) % s;
+                    }
+                    dense[at] = true;
+                }
+            }
+            index += 1;
+        }
+        current = next;
+    }
+    assert!(current.is_empty());
+    dense
+}
+
+fn dense_of<const K: usize>(tree: &KTree<K>) -> Vec<bool> {
+    let u = 1usize << tree.level();
+    let mut dense = vec![false; u.pow(K as u32)];
+    for cell in tree.full_cells() {
+        let s = cell.side() as usize;
+        let o = cell.origin();
+        for i in 0..s.pow(K as u32) {
+            let mut at = 0;
+            for a in (0..K).rev() {
+                at = at * u + o[a] as usize + (i / s.pow(a as u32)) % s;
+            }
+            dense[at] = true;
+        }
+    }
+    dense
+}
+
+fn check<const K: usize>(tree: &KTree<K>) {
+    let mut vtu = Vec::new();
+    write_vtu(&mut vtu, tree, &FRAME).unwrap();
+    let back = vtu_voxels::<K>(&vtu, tree.level());
+    assert_eq!(back, dense_of(tree), "vtu");
+    let mut htg = Vec::new();
+    write_htg(&mut htg, tree, &FRAME).unwrap();
+    assert_eq!(htg_voxels::<K>(&htg, tree.level()), dense_of(tree), "htg");
+}
+
+fn random_tree<const K: usize>(level: u32, seed: u64, density: u64) -> KTree<K> {
+    let n = 1usize << (K as u32 * level);
+    let mut state = seed | 1;
+    let dense: Vec<bool> = (0..n)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % 10 < density
+        })
+        .collect();
+    KTree::<K>::from_dense(level, &dense).unwrap()
+}
+
+#[test]
+fn a_ball_reads_back_with_its_cell_count_bounds_and_volume() {
+    let tree = KTree::from_rays(&ktree::rays::ball_rays::<3>(4, [15, 17, 16], 90).unwrap());
+    check(&tree);
+    let mut vtu = Vec::new();
+    write_vtu(&mut vtu, &tree, &FRAME).unwrap();
+    let text = String::from_utf8_lossy(&vtu);
+    let cells: usize = attr(&text, "NumberOfCells").parse().unwrap();
+    assert_eq!(cells, tree.full_cells().count());
+    let volume: f64 = f64s(appended(&vtu, &text, "side"))
+        .iter()
+        .map(|s| s * s * s)
+        .sum();
+    assert_eq!(volume, tree.voxel_count() as f64 * 0.125);
+}
+
+#[test]
+fn the_empty_and_the_full_universe() {
+    check(&KTree::<3>::from_dense(1, &[false; 8]).unwrap());
+    check(&KTree::<3>::full(2).unwrap());
+    check(&KTree::<2>::full(0).unwrap());
+    let mut out = Vec::new();
+    assert!(write_vtu(&mut out, &KTree::<1>::full(2).unwrap(), &FRAME).is_err());
+    assert!(write_htg(&mut out, &KTree::<4>::full(1).unwrap(), &FRAME).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn random_octrees_read_back(level in 1u32..=3, seed in any::<u64>(), density in 0u64..=10) {
+        check(&random_tree::<3>(level, seed, density));
+    }
+
+    #[test]
+    fn random_quadtrees_read_back(level in 1u32..=4, seed in any::<u64>(), density in 0u64..=10) {
+        check(&random_tree::<2>(level, seed, density));
+    }
+}
