@@ -25,6 +25,7 @@
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
+//! * [`shape`]: morphology (dilate, erode, opening, closing), connected components, surface area and Euler number, on the runs.
 //! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
 //!
 //! # Layers
@@ -64,6 +65,7 @@ pub mod ops;
 pub mod rays;
 pub mod reference;
 pub mod solid;
+pub mod shape;
 pub mod space;
 pub mod stacking;
 pub mod tree;
