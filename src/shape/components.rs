@@ -19,6 +19,9 @@ pub struct Component<const K: usize> {
     pub tree: KTree<K>,
 }
 
+/// One component's column keys, runs and voxel count, gathered in order.
+type Part = (Vec<u64>, Vec<(u32, u32)>, u128);
+
 fn find(parent: &mut [usize], mut x: usize) -> usize {
     while parent[x] != x {
         parent[x] = parent[parent[x]];
@@ -123,7 +126,7 @@ impl<const K: usize> KTree<K> {
         let labels = label_runs(&rays, connectivity);
         // Gather each root's runs in order (the runs of a component stay sorted).
         let mut slot = vec![usize::MAX; labels.len()];
-        let mut parts: Vec<(Vec<u64>, Vec<(u32, u32)>, u128)> = Vec::new();
+        let mut parts: Vec<Part> = Vec::new();
         for (i, &root) in labels.iter().enumerate() {
             if slot[root] == usize::MAX {
                 slot[root] = parts.len();
@@ -136,7 +139,7 @@ impl<const K: usize> KTree<K> {
             part.2 += u128::from(run.1 - run.0);
         }
         // Stable: equal sizes keep the order of their first run.
-        parts.sort_by(|a, b| b.2.cmp(&a.2));
+        parts.sort_by_key(|p| std::cmp::Reverse(p.2));
         Ok(parts
             .into_iter()
             .map(|(columns, runs, size)| Component {
@@ -171,7 +174,7 @@ impl<const K: usize> KTree<K> {
             sizes[root] += u128::from(run.1 - run.0);
         }
         let mut sizes: Vec<u128> = sizes.into_iter().filter(|&s| s > 0).collect();
-        sizes.sort_by(|a, b| b.cmp(a));
+        sizes.sort_by_key(|&s| std::cmp::Reverse(s));
         Ok(sizes)
     }
 

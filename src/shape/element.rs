@@ -178,7 +178,10 @@ mod tests {
 
     #[test]
     fn bad_radii_are_errors() {
-        assert!(matches!(slice::<2>(Element::Ball, -1.0, 8), Err(ShapeError::BadRadius(_))));
+        assert!(matches!(
+            slice::<2>(Element::Ball, -1.0, 8),
+            Err(ShapeError::BadRadius(_))
+        ));
         assert!(slice::<2>(Element::Ball, f64::NAN, 8).is_err());
         assert!(matches!(
             slice::<4>(Element::Box, 1e9, 1 << 20),

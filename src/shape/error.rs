@@ -42,9 +42,6 @@ pub(crate) fn check_connectivity<const K: usize>(connectivity: usize) -> Result<
     if (1..=K).contains(&connectivity) {
         Ok(())
     } else {
-        Err(ShapeError::Connectivity {
-            connectivity,
-            k: K,
-        })
+        Err(ShapeError::Connectivity { connectivity, k: K })
     }
 }

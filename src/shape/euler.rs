@@ -11,6 +11,14 @@ use super::error::check_connectivity;
 use super::ShapeError;
 use crate::KTree;
 
+/// [`table`] for each `K` and both complexes, made once.
+fn cached_table<const K: usize>(closed: bool) -> &'static [i64] {
+    use std::sync::OnceLock;
+    static TABLES: [OnceLock<Vec<i64>>; 2 * (crate::MAX_K + 1)] =
+        [const { OnceLock::new() }; 2 * (crate::MAX_K + 1)];
+    TABLES[2 * K + usize::from(closed)].get_or_init(|| table::<K>(closed))
+}
+
 /// `2^K ×` the Euler contribution of each window pattern (bit `Σ b_i 2^i` for the voxel at `v − 1 + b`).
 fn table<const K: usize>(closed: bool) -> Vec<i64> {
     let corners = 1usize << K;
@@ -62,12 +70,9 @@ impl<const K: usize> KTree<K> {
     pub fn euler_number(&self, connectivity: usize) -> Result<i64, ShapeError> {
         check_connectivity::<K>(connectivity)?;
         if connectivity != 1 && connectivity != K {
-            return Err(ShapeError::EulerConnectivity {
-                connectivity,
-                k: K,
-            });
+            return Err(ShapeError::EulerConnectivity { connectivity, k: K });
         }
-        let table = table::<K>(connectivity == K);
+        let table = cached_table::<K>(connectivity == K);
         let rays = self.to_rays();
         let keys = rays.column_keys();
         let runs = rays.runs();
