@@ -21,7 +21,7 @@ fi
 export PATH="$venv/bin:$PATH" # maturin, for the build without isolation below
 pip=("$venv/bin/python" -m pip)
 "${pip[@]}" install --quiet --upgrade pip
-"${pip[@]}" install --quiet maturin numpy pytest mypy
+"${pip[@]}" install --quiet maturin numpy pytest mypy scipy==1.17.1 scikit-image==0.26.0
 # The module (a release build of the extension, in the workspace's target folder).
 "${pip[@]}" install --no-build-isolation ./python
 

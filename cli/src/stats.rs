@@ -66,17 +66,21 @@ pub fn run(args: Args) -> Result<(), String> {
         _ => return Err("give either a .ktree file or --rays FILE".into()),
     };
     if args.json {
-        // The fields of `TreeStats`, then the measures.
-        let mut value = serde_json::to_value(&stats).map_err(|e| e.to_string())?;
-        if let (Some(map), serde_json::Value::Object(extra)) = (
-            value.as_object_mut(),
-            serde_json::to_value(measures).map_err(|e| e.to_string())?,
-        ) {
-            map.extend(extra);
+        // The fields of `TreeStats` in their order, then the measures.
+        #[derive(serde::Serialize)]
+        struct Out<'a> {
+            #[serde(flatten)]
+            stats: &'a TreeStats,
+            #[serde(flatten)]
+            measures: crate::shape::Measures,
         }
+        let out = Out {
+            stats: &stats,
+            measures,
+        };
         outln!(
             "{}",
-            serde_json::to_string_pretty(&value).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&out).map_err(|e| e.to_string())?
         );
         return Ok(());
     }
