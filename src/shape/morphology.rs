@@ -69,7 +69,7 @@ impl<const K: usize> KTree<K> {
     /// ```
     ///
     /// # Performance
-    /// One merge pass over the runs per column offset of the element (see [the module](self)).
+    /// One merge pass over the runs per column offset of the element (see [`crate::shape`]'s morphology notes).
     ///
     /// # Errors
     /// [`ShapeError::BadRadius`] for a negative or non-finite `r`; [`ShapeError::RadiusTooLarge`] if the
