@@ -87,7 +87,7 @@ pub(crate) fn slice<const K: usize>(
     check_radius(r)?;
     let e = (r.floor().min(bound as f64)) as i64; // the reach along any one axis
     let width = (2 * e + 1) as u128;
-    let offsets = width.pow(K as u32 - 1);
+    let offsets = width.saturating_pow(K as u32 - 1);
     if offsets > MAX_OFFSETS {
         return Err(ShapeError::RadiusTooLarge {
             radius: r,
@@ -135,6 +135,68 @@ pub(crate) fn slice<const K: usize>(
     Ok(out)
 }
 
+/// One element slice (see [`slice`]).
+pub(crate) type Slice<const K: usize> = Vec<([i64; K], i64)>;
+
+/// The element as a Minkowski sum of slices, applied one after the other (dilation by `A ⊕ B` is dilation
+/// by `A` then by `B`; erosion likewise), chosen to make the fewest passes over the runs: the element's
+/// own slice, or for the box a run along the last axis and on each other axis `{−m, 0, m}` for
+/// `m = 1, 2, 4, …` and a rest (segments by doubling: `O(K log r)` passes), or for the cross `⌊r⌋` unit
+/// crosses (`O(K r)` passes instead of `O(r^(K−1))`).
+pub(crate) fn plan<const K: usize>(
+    element: Element,
+    r: f64,
+    bound: i64,
+) -> Result<Vec<Slice<K>>, ShapeError> {
+    check_radius(r)?;
+    let e = (r.floor().min(bound as f64)) as i64;
+    let direct = ((2 * e + 1) as u128).saturating_pow(K as u32 - 1);
+    let zero = [0i64; K];
+    let unit = |axis: usize, m: i64| {
+        let mut c = zero;
+        c[axis] = m;
+        c
+    };
+    match element {
+        Element::Box if e > 0 => {
+            let (mut steps, mut m, mut reach) = (vec![vec![(zero, e)]], 1i64, 0i64);
+            let mut segments = Vec::new();
+            while reach + m <= e {
+                segments.push(m);
+                reach += m;
+                m *= 2;
+            }
+            if reach < e {
+                segments.push(e - reach);
+            }
+            for axis in 0..K - 1 {
+                for &m in &segments {
+                    steps.push(vec![(zero, 0), (unit(axis, m), 0), (unit(axis, -m), 0)]);
+                }
+            }
+            if (steps.len() as u128) * 3 < direct {
+                return Ok(steps);
+            }
+        }
+        Element::Cross if e > 0 => {
+            // Σ |d_i| reaches past one side on one axis: K sides together bound it.
+            let n = r.floor().min(K as f64 * bound as f64) as i64;
+            let e = n;
+            let passes = (e as u128) * (2 * K as u128 - 1);
+            if passes < direct && passes <= MAX_OFFSETS {
+                let mut step = vec![(zero, 1)];
+                for axis in 0..K - 1 {
+                    step.push((unit(axis, 1), 0));
+                    step.push((unit(axis, -1), 0));
+                }
+                return Ok(vec![step; e as usize]);
+            }
+        }
+        _ => {}
+    }
+    Ok(vec![slice::<K>(element, r, bound)?])
+}
+
 /// `⌊√n⌋` exactly.
 fn isqrt(n: u128) -> u128 {
     let mut x = (n as f64).sqrt() as u128;
@@ -172,6 +234,41 @@ mod tests {
                     }
                 }
                 assert_eq!(from_slice, direct, "{element} r = {r}");
+            }
+        }
+    }
+
+    #[test]
+    fn plans_sum_to_the_element() {
+        for element in Element::ALL {
+            for r in [0.0, 1.0, 2.5, 3.0, 5.0, 7.9] {
+                let mut reach: std::collections::BTreeSet<[i64; 3]> = [[0, 0, 0]].into();
+                for step in plan::<3>(element, r, 100).unwrap() {
+                    let offsets: Vec<[i64; 3]> = step
+                        .iter()
+                        .flat_map(|&(c, h)| (-h..=h).map(move |z| [c[0], c[1], z]))
+                        .collect();
+                    reach = reach
+                        .iter()
+                        .flat_map(|a| {
+                            offsets
+                                .iter()
+                                .map(move |b| [a[0] + b[0], a[1] + b[1], a[2] + b[2]])
+                        })
+                        .collect();
+                }
+                let e = r.floor() as i64;
+                let mut direct = std::collections::BTreeSet::new();
+                for x in -e..=e {
+                    for y in -e..=e {
+                        for z in -e..=e {
+                            if element.contains([x, y, z], r) {
+                                direct.insert([x, y, z]);
+                            }
+                        }
+                    }
+                }
+                assert_eq!(reach, direct, "{element} r = {r}");
             }
         }
     }

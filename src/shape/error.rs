@@ -19,6 +19,15 @@ pub enum ShapeError {
         /// The largest number allowed.
         limit: u128,
     },
+    /// A closing's radius reaches more than four universe sides past the universe: its unbounded
+    /// dilation would cover too many columns. Use a radius of at most `4 · side`.
+    #[error("a closing by radius {radius} reaches past 4 × the universe's side {side}; use a smaller radius")]
+    ClosingTooWide {
+        /// The radius asked for.
+        radius: f64,
+        /// The universe's side.
+        side: u64,
+    },
     /// The connectivity is not in `1..=K`.
     #[error("connectivity {connectivity} is not in 1..={k}")]
     Connectivity {

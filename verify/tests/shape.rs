@@ -477,13 +477,18 @@ fn named_cases() {
     // Huge radii: an answer or an error, never a panic or an overflow.
     let line = voxel_tree::<1>(4, &[[3], [9]]);
     assert_eq!(line.dilate(1e300, Element::Box).unwrap().voxel_count(), 16);
-    assert_eq!(line.closing(1e300, Element::Cross).unwrap().voxel_count(), 7);
+    assert!(matches!(
+        line.closing(1e300, Element::Cross),
+        Err(ShapeError::ClosingTooWide { side: 16, .. })
+    ));
+    assert_eq!(line.closing(64.0, Element::Cross).unwrap().voxel_count(), 7);
     assert_eq!(line.erode(1e300, Element::Ball).unwrap().voxel_count(), 0);
     assert_eq!(ring.dilate(1e9, Element::Ball).unwrap().voxel_count(), 64);
-    assert!(matches!(
-        ring.closing(1e9, Element::Ball),
-        Err(ShapeError::RadiusTooLarge { .. })
-    ));
+    for element in Element::ALL {
+        assert!(ring.closing(1e9, element).is_err());
+    }
+    // A box closing by a radius past the object's size is its bounding box.
+    assert_eq!(ring.closing(32.0, Element::Box).unwrap().voxel_count(), 25);
     // A ball dilated by a ball: the result is within the larger ball and contains the smaller.
     let ball = KTree::from_rays(&ktree::rays::ball_rays::<3>(6, [64, 64, 64], 100).unwrap());
     let grown = ball.dilate(8.0, Element::Ball).unwrap();
