@@ -114,7 +114,7 @@ pub fn run(args: Args) -> Result<(), String> {
         let tree = read(&args.tree)?;
         ktree::with_dim!(&tree, AnyTree, t => report(t, args.tolerance))
     };
-    r.measures = Some(crate::shape::measures_of_file(&args.tree)?);
+    r.measures = crate::shape::measures_of_file(&args.tree)?;
     if args.json {
         outln!(
             "{}",

@@ -158,7 +158,15 @@ pub fn measures(tree: &AnyTree) -> Measures {
     ktree::with_dim!(tree, AnyTree, t => measures_of(t))
 }
 
-/// The measures of a tree file (read into memory).
-pub fn measures_of_file(path: &Path) -> Result<Measures, String> {
-    Ok(measures(&read(path)?))
+/// The measures of a tree file, read into memory if it is small next to the memory budget (at most 1/16 of
+/// it: the runs the measures walk take more than the tree); `None` for a larger file, which `stats` and
+/// `mass` then read through its memory map alone.
+pub fn measures_of_file(path: &Path) -> Result<Option<Measures>, String> {
+    let size = std::fs::metadata(path)
+        .map_err(|e| format!("{}: {e}", path.display()))?
+        .len();
+    if size > crate::memory::default_budget() / 16 {
+        return Ok(None);
+    }
+    Ok(Some(measures(&read(path)?)))
 }

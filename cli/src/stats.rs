@@ -1,6 +1,7 @@
 //! `ktree stats FILE.ktree | --rays FILE [--json]`: node counts of a tree or of the tree a ray file stacks to.
 //! A version 2 tree file is checked and counted through a memory map; the surface area and the Euler number
-//! (`surface_area`, `euler_number`) are measured on the tree read into memory.
+//! (`surface_area`, `euler_number`) are measured on the tree read into memory, when the file is small next
+//! to the memory budget.
 
 use crate::outln;
 
@@ -53,14 +54,14 @@ pub fn run(args: Args) -> Result<(), String> {
         ),
         (Some(path), None) => {
             let tree = read_ktree_file(path).map_err(|e| e.to_string())?;
-            (tree.stats(None), crate::shape::measures(&tree))
+            (tree.stats(None), Some(crate::shape::measures(&tree)))
         }
         (None, Some(path)) => {
             let rays = read_rays_file(path).map_err(|e| e.to_string())?;
             let tree = rays.build();
             (
                 tree.stats(Some(rays.len() as u64)),
-                crate::shape::measures(&tree),
+                Some(crate::shape::measures(&tree)),
             )
         }
         _ => return Err("give either a .ktree file or --rays FILE".into()),
@@ -72,7 +73,7 @@ pub fn run(args: Args) -> Result<(), String> {
             #[serde(flatten)]
             stats: &'a TreeStats,
             #[serde(flatten)]
-            measures: crate::shape::Measures,
+            measures: Option<crate::shape::Measures>,
         }
         let out = Out {
             stats: &stats,
@@ -100,9 +101,14 @@ pub fn run(args: Args) -> Result<(), String> {
         stats.memory_bytes,
         stats.memory_bytes as f64 * 8.0 / stats.nodes as f64
     );
-    outln!("surface  {} faces", measures.surface_area);
-    if let Some(e) = measures.euler_number {
-        outln!("euler    {e} (connectivity {})", stats.k);
+    match measures {
+        Some(m) => {
+            outln!("surface  {} faces", m.surface_area);
+            if let Some(e) = m.euler_number {
+                outln!("euler    {e} (connectivity {})", stats.k);
+            }
+        }
+        None => outln!("surface  - (not measured: the file is large next to the memory budget)"),
     }
     outln!("level        full       empty     partial");
     for l in &stats.per_level {
