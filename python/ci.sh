@@ -23,8 +23,9 @@ export PATH="$venv/bin:$PATH" # maturin, for the build without isolation below
 pip=("$venv/bin/python" -m pip)
 "${pip[@]}" install --quiet --upgrade pip
 "${pip[@]}" install --quiet maturin numpy pytest mypy
-# Other libraries' readings of the meshes and VTK files written (pinned: the tests rely on their checks).
-"${pip[@]}" install --quiet trimesh==5.2.0 vtk==9.7.2
+# The references the tests check against (pinned: the tests rely on their definitions and checks): scipy
+# and scikit-image for shape operations, trimesh and VTK for the meshes and VTK files written.
+"${pip[@]}" install --quiet scipy==1.17.1 scikit-image==0.26.0 trimesh==5.2.0 vtk==9.7.2
 # The module (a release build of the extension, in the workspace's target folder).
 "${pip[@]}" install --no-build-isolation ./python
 

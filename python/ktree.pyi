@@ -8,7 +8,7 @@ system says, with ``filename`` set) with the library's message.
 
 from fractions import Fraction
 from os import PathLike
-from typing import Any, Optional, Sequence, Tuple, TypedDict, Union, final
+from typing import Any, Literal, NotRequired, Optional, Sequence, Tuple, TypedDict, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -18,6 +18,7 @@ __all__ = ["Tree", "__version__"]
 
 _Path = Union[str, PathLike[str]]
 _View = Union[str, Sequence[float]]
+_Shape = Literal["ball", "box", "cross"]
 
 class _LevelCounts(TypedDict):
     level: int
@@ -35,6 +36,8 @@ class _Stats(TypedDict):
     nodes: int
     bytes_at_2_bits: int
     per_level: list[_LevelCounts]
+    surface_area: int
+    euler_number: NotRequired[int]
 
 class _ProgressiveLevel(TypedDict):
     level: int
@@ -51,6 +54,8 @@ class _Mass(TypedDict):
     nodes: int
     progressive: Optional[list[_ProgressiveLevel]]
     estimate: Optional[float]
+    surface_area: int
+    euler_number: NotRequired[int]
 
 class _Collision(TypedDict):
     collide: bool
@@ -145,6 +150,22 @@ class Tree:
         """Mapped by a homogeneous (K + 1) x (K + 1) matrix (projective if the last row is not 0 ... 0 1)."""
     def mass(self, tolerance: Optional[float] = None) -> _Mass:
         """Volume, centroid and second moments, with the keys of `ktree mass --json`."""
+    def dilate(self, r: float, shape: _Shape = "ball") -> Tree:
+        """The voxels within the element of radius r of a full voxel (scipy's binary_dilation)."""
+    def erode(self, r: float, shape: _Shape = "ball") -> Tree:
+        """The voxels whose element lies in the object, outside empty (binary_erosion, border_value=0)."""
+    def opening(self, r: float, shape: _Shape = "ball") -> Tree:
+        """The dilation of the erosion."""
+    def closing(self, r: float, shape: _Shape = "ball") -> Tree:
+        """The erosion of the dilation, unbounded by the universe, then clipped to it."""
+    def components(self, connectivity: int = 1) -> list[Tree]:
+        """The connected components, largest first (scipy's label with generate_binary_structure)."""
+    def largest_component(self, connectivity: int = 1) -> Tree:
+        """The largest connected component (empty if there is none)."""
+    def surface_area(self) -> int:
+        """The number of (K - 1)-faces between full and empty voxels, outside empty."""
+    def euler_number(self, connectivity: Optional[int] = None) -> int:
+        """The Euler number as scikit-image's measure.euler_number (connectivity 1 or K, default K)."""
     def interferes(self, other: Tree) -> bool:
         """Whether the objects share a voxel."""
     def collide(self, other: Tree, time_axis: Optional[int] = None) -> _Collision:

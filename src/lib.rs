@@ -25,6 +25,7 @@
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
+//! * [`shape`]: morphology (dilate, erode, opening, closing), connected components, surface area and Euler number, on the runs.
 //! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
 //! * [`export`]: the boundary out to the tools that look at surfaces and volumes — an octree as a closed
 //!   triangle mesh (PLY, OBJ, STL, glTF), a quadtree as closed polylines (PLY, OBJ, SVG).
@@ -68,6 +69,7 @@ pub mod io;
 pub mod ops;
 pub mod rays;
 pub mod reference;
+pub mod shape;
 pub mod solid;
 pub mod space;
 pub mod stacking;

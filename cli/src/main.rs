@@ -16,6 +16,7 @@ mod op;
 mod rays;
 mod render;
 mod repro;
+mod shape;
 mod stats;
 mod transform;
 mod voxelize;
@@ -56,6 +57,10 @@ enum Command {
     Voxelize(voxelize::Args),
     /// Convert between .ktree, .rays, .binvox, OctoMap .bt and OpenVDB .vdb; meshes (voxelized in, the boundary out: .ply, .obj, .stl, .glb, .svg), VTK out (.vtu, .htg, .pvd), volumes in.
     Convert(convert::Args),
+    /// Dilate, erode, open or close a tree file by a ball, box or cross of any radius.
+    Morph(shape::MorphArgs),
+    /// Connected components of a tree file: count, sizes, each as its own file.
+    Components(shape::ComponentsArgs),
 }
 
 /// Writes a line to standard output, returning from the enclosing function with [`output_error`]'s message
@@ -97,6 +102,8 @@ fn main() -> ExitCode {
         Command::Rays(args) => rays::run(args),
         Command::Voxelize(args) => voxelize::run(args),
         Command::Convert(args) => convert::run(args),
+        Command::Morph(args) => shape::run_morph(args),
+        Command::Components(args) => shape::run_components(args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,

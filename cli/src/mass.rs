@@ -46,6 +46,8 @@ struct Report {
     nodes: u64,
     progressive: Option<Vec<Level>>,
     estimate: Option<f64>,
+    #[serde(flatten)]
+    measures: Option<crate::shape::Measures>,
 }
 
 /// The exact properties of a memory-mapped version 2 file, from its leaves.
@@ -67,6 +69,7 @@ impl Report {
             nodes,
             progressive: None,
             estimate: None,
+            measures: None,
         }
     }
 }
@@ -99,7 +102,7 @@ pub fn run(args: Args) -> Result<(), String> {
     }
     let mapped = args.tolerance.is_none()
         && ktree_file_version(&args.tree).map_err(|e| e.to_string())? == VERSION;
-    let r = if mapped {
+    let mut r = if mapped {
         let view = KtreeView::open(&args.tree).map_err(|e| e.to_string())?;
         match view.k() {
             1 => view_report::<1>(&view)?,
@@ -111,6 +114,7 @@ pub fn run(args: Args) -> Result<(), String> {
         let tree = read(&args.tree)?;
         ktree::with_dim!(&tree, AnyTree, t => report(t, args.tolerance))
     };
+    r.measures = crate::shape::measures_of_file(&args.tree)?;
     if args.json {
         outln!(
             "{}",
@@ -154,6 +158,12 @@ pub fn run(args: Args) -> Result<(), String> {
             if i == 0 { name } else { "          " },
             cells.join("  ")
         );
+    }
+    if let Some(m) = r.measures {
+        outln!("surface   {} faces", m.surface_area);
+        if let Some(e) = m.euler_number {
+            outln!("euler     {e} (connectivity {})", r.k);
+        }
     }
     Ok(())
 }

@@ -1,5 +1,7 @@
 //! `ktree stats FILE.ktree | --rays FILE [--json]`: node counts of a tree or of the tree a ray file stacks to.
-//! A version 2 tree file is checked and counted through a memory map, in memory independent of its size.
+//! A version 2 tree file is checked and counted through a memory map; the surface area and the Euler number
+//! (`surface_area`, `euler_number`) are measured on the tree read into memory, when the file is small next
+//! to the memory budget.
 
 use crate::outln;
 
@@ -45,23 +47,41 @@ fn view_stats(view: &KtreeView) -> TreeStats {
 /// Prints the statistics.
 pub fn run(args: Args) -> Result<(), String> {
     // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
-    let stats = match (&args.tree, &args.rays) {
-        (Some(path), None) if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION => {
-            view_stats(&KtreeView::open(path).map_err(|e| e.to_string())?)
+    let (stats, measures) = match (&args.tree, &args.rays) {
+        (Some(path), None) if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION => (
+            view_stats(&KtreeView::open(path).map_err(|e| e.to_string())?),
+            crate::shape::measures_of_file(path)?,
+        ),
+        (Some(path), None) => {
+            let tree = read_ktree_file(path).map_err(|e| e.to_string())?;
+            (tree.stats(None), Some(crate::shape::measures(&tree)))
         }
-        (Some(path), None) => read_ktree_file(path)
-            .map_err(|e| e.to_string())?
-            .stats(None),
         (None, Some(path)) => {
             let rays = read_rays_file(path).map_err(|e| e.to_string())?;
-            rays.build().stats(Some(rays.len() as u64))
+            let tree = rays.build();
+            (
+                tree.stats(Some(rays.len() as u64)),
+                Some(crate::shape::measures(&tree)),
+            )
         }
         _ => return Err("give either a .ktree file or --rays FILE".into()),
     };
     if args.json {
+        // The fields of `TreeStats` in their order, then the measures.
+        #[derive(serde::Serialize)]
+        struct Out<'a> {
+            #[serde(flatten)]
+            stats: &'a TreeStats,
+            #[serde(flatten)]
+            measures: Option<crate::shape::Measures>,
+        }
+        let out = Out {
+            stats: &stats,
+            measures,
+        };
         outln!(
             "{}",
-            serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&out).map_err(|e| e.to_string())?
         );
         return Ok(());
     }
@@ -81,6 +101,15 @@ pub fn run(args: Args) -> Result<(), String> {
         stats.memory_bytes,
         stats.memory_bytes as f64 * 8.0 / stats.nodes as f64
     );
+    match measures {
+        Some(m) => {
+            outln!("surface  {} faces", m.surface_area);
+            if let Some(e) = m.euler_number {
+                outln!("euler    {e} (connectivity {})", stats.k);
+            }
+        }
+        None => outln!("surface  - (not measured: the file is large next to the memory budget)"),
+    }
     outln!("level        full       empty     partial");
     for l in &stats.per_level {
         outln!(
