@@ -23,6 +23,8 @@
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
+//! * [`query`]: questions asked of a map — batch point queries, boxes and counts, ray casting, the
+//!   nearest full voxel — on trees in memory and on mapped files.
 //! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
 //!
 //! # Layers
@@ -30,7 +32,8 @@
 //! ```text
 //!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text;
 //!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in)
-//!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink
+//!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink;
+//!  query/             the questions asked of a map (points, boxes, rays, nearest), over the storage trait
 //!  stacking/          the builders (the paper's list stacking; the partition, in memory or out of core)
 //!  solid/             quadrics, meshes, volumes → rays, slab by slab
 //!  tree/              KTree, AnyTree, the storage trait, the walks, the level sink, packed 2-bit words
@@ -58,6 +61,7 @@ pub mod display;
 pub mod fs;
 pub mod io;
 pub mod ops;
+pub mod query;
 pub mod rays;
 pub mod reference;
 pub mod solid;
