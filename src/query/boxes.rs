@@ -2,11 +2,17 @@
 //! inside a box ([`count`]) and the object cut to a box ([`crop`]). A box is `(lo, hi)`, `hi` exclusive
 //! on every axis, clipped to the universe; a box with `hi ≤ lo` on some axis holds no voxel.
 
+// Per-axis code reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
 use crate::space::Cell;
 use crate::tree::cursor::{try_walk, Visitor, Walk};
 use crate::tree::sink::{LevelSink, MemorySink};
 use crate::tree::storage::{infallible, TreeStorage};
 use crate::tree::{KTree, NodeRef, NodeState};
+
+/// A box of voxels `(lo, hi)`, `hi` exclusive on every axis.
+pub type VoxelBox<const K: usize> = ([u32; K], [u32; K]);
 
 /// How a cell lies against a box.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -57,7 +63,7 @@ fn widen<const K: usize>(p: [u32; K]) -> [u64; K] {
 /// The storage's read error.
 pub fn bounding_box<const K: usize, T: TreeStorage<K>>(
     tree: &T,
-) -> Result<Option<([u32; K], [u32; K])>, T::Error> {
+) -> Result<Option<VoxelBox<K>>, T::Error> {
     struct Bounds<const K: usize> {
         lo: [u64; K],
         hi: [u64; K],
@@ -98,7 +104,8 @@ pub fn bounding_box<const K: usize, T: TreeStorage<K>>(
     };
     try_walk(tree, &mut b)?;
     // Every side is at most U ≤ 2^31.
-    Ok(b.any.then(|| (b.lo.map(|v| v as u32), b.hi.map(|v| v as u32))))
+    Ok(b.any
+        .then(|| (b.lo.map(|v| v as u32), b.hi.map(|v| v as u32))))
 }
 
 /// The number of full voxels inside the box `[lo, hi)`: one walk that descends only into the partial

@@ -26,7 +26,7 @@ pub mod nearest;
 pub mod points;
 pub mod ray;
 
-pub use boxes::{bounding_box, count, crop};
+pub use boxes::{bounding_box, count, crop, VoxelBox};
 pub use nearest::{distance, nearest, nearest_many, Nearest};
 pub use points::{contains, contains_many, PointCursor};
 pub use ray::{cast_ray, cast_rays, Face, RayCast, RayError, RayHit};
@@ -68,7 +68,7 @@ impl<const K: usize> KTree<K> {
     /// let tree = KTree::<1>::from_dense(2, &[false, true, true, false]).unwrap();
     /// assert_eq!(tree.bounding_box(), Some(([1], [3])));
     /// ```
-    pub fn bounding_box(&self) -> Option<([u32; K], [u32; K])> {
+    pub fn bounding_box(&self) -> Option<VoxelBox<K>> {
         infallible(bounding_box(self))
     }
 

@@ -121,7 +121,10 @@ const PARALLEL_FROM: usize = 4096;
 ///
 /// # Errors
 /// The storage's first read error.
-pub fn contains_many<const K: usize, T>(tree: &T, points: &[[u32; K]]) -> Result<Vec<bool>, T::Error>
+pub fn contains_many<const K: usize, T>(
+    tree: &T,
+    points: &[[u32; K]],
+) -> Result<Vec<bool>, T::Error>
 where
     T: TreeStorage<K> + Sync,
     T::Error: Send,
@@ -150,8 +153,14 @@ where
         answer(&order)?
     } else {
         order.par_sort_unstable();
-        let run = order.len().div_ceil(4 * rayon::current_num_threads()).max(1024);
-        let runs: Vec<Vec<bool>> = order.par_chunks(run).map(answer).collect::<Result<_, _>>()?;
+        let run = order
+            .len()
+            .div_ceil(4 * rayon::current_num_threads())
+            .max(1024);
+        let runs: Vec<Vec<bool>> = order
+            .par_chunks(run)
+            .map(answer)
+            .collect::<Result<_, _>>()?;
         runs.concat()
     };
     for (&(_, i), v) in order.iter().zip(inside) {

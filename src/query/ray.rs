@@ -212,7 +212,11 @@ impl<const K: usize> Visitor<K> for Caster<'_, K> {
             t,
             face: axis.map(|axis| Face {
                 axis,
-                sign: if self.ray.direction[axis] > 0.0 { -1 } else { 1 },
+                sign: if self.ray.direction[axis] > 0.0 {
+                    -1
+                } else {
+                    1
+                },
             }),
         });
         Walk::Stop

@@ -4,12 +4,12 @@
 use super::KtreeView;
 use crate::io::KtreeFileError;
 use crate::query;
-use crate::tree::storage::infallible;
-use crate::KTree;
-use std::convert::Infallible;
 use crate::space::Universe;
 use crate::tree::cursor::LevelOrder;
+use crate::tree::storage::infallible;
 use crate::tree::NodeState;
+use crate::KTree;
+use std::convert::Infallible;
 use std::sync::OnceLock;
 
 /// A `K`-dimensional tree read through a [`KtreeView`]: what the walks need, with each first child found
@@ -94,7 +94,7 @@ impl<const K: usize> MappedTree<'_, K> {
     ///
     /// # Errors
     /// The first failed read's error.
-    pub fn bounding_box(&self) -> Result<Option<([u32; K], [u32; K])>, KtreeFileError> {
+    pub fn bounding_box(&self) -> Result<Option<query::VoxelBox<K>>, KtreeFileError> {
         self.answer(query::bounding_box(self))
     }
 
