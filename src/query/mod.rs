@@ -27,7 +27,7 @@ pub mod points;
 pub mod ray;
 
 pub use boxes::{bounding_box, count, crop, VoxelBox};
-pub use nearest::{distance, nearest, nearest_many, Nearest};
+pub use nearest::{distance, nearest, nearest_many, nearest_many_signed, nearest_signed, Nearest};
 pub use points::{contains, contains_many, PointCursor};
 pub use ray::{cast_ray, cast_rays, Face, RayCast, RayError, RayHit};
 

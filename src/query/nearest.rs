@@ -1,5 +1,6 @@
-//! The nearest full voxel to a voxel and its distance ([`nearest`], [`distance`]; many on all threads:
-//! [`nearest_many`]), Euclidean between voxel centres as scipy's `distance_transform_edt` measures it.
+//! The nearest full voxel to a voxel and its distance ([`nearest`], [`distance`], from anywhere:
+//! [`nearest_signed`]; many on all threads: [`nearest_many`], [`nearest_many_signed`]), Euclidean
+//! between voxel centres as scipy's `distance_transform_edt` measures it.
 //!
 //! Exact branch and bound: a cell's lower bound is the integer squared distance from the query voxel to
 //! the nearest voxel of the cell, so no rounding decides anything; a full leaf's bound is attained by its
@@ -36,7 +37,7 @@ impl<const K: usize> Nearest<K> {
 }
 
 struct Search<const K: usize> {
-    point: [u64; K],
+    point: [i64; K],
     /// The best so far: squared distance, voxel, its Morton key.
     best: Option<(u128, [u32; K], u64)>,
 }
@@ -55,10 +56,12 @@ impl<const K: usize> Visitor<K> for Search<K> {
         let mut near = [0u32; K];
         let mut bound = 0u128;
         for a in 0..K {
-            let (lo, p) = (u64::from(cell.origin[a]), self.point[a]);
-            let c = p.clamp(lo, lo + side - 1);
+            let (lo, p) = (i64::from(cell.origin[a]), self.point[a]);
+            let c = p.clamp(lo, lo + side as i64 - 1);
             near[a] = c as u32;
-            bound += u128::from(c.abs_diff(p)).pow(2);
+            // Exact for coordinates within ±2^61; saturating beyond.
+            let gap = u128::from(c.abs_diff(p));
+            bound = bound.saturating_add(gap.saturating_mul(gap));
         }
         if let Some((best, _, key)) = self.best {
             if bound > best || (bound == best && cell.morton() >= key) {
@@ -89,7 +92,7 @@ impl<const K: usize> Visitor<K> for Search<K> {
         let cell = node.cell();
         let half = cell.side() / 2;
         let mask = (0..K).fold(0, |m, a| {
-            m | usize::from(self.point[a] >= u64::from(cell.origin[a]) + half) << a
+            m | usize::from(self.point[a] >= i64::from(cell.origin[a]) + half as i64) << a
         });
         ChildOrder::xor::<K>(mask)
     }
@@ -113,10 +116,26 @@ pub fn nearest<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     point: [u32; K],
 ) -> Result<Option<Nearest<K>>, T::Error> {
-    let mut search = Search {
-        point: point.map(u64::from),
-        best: None,
-    };
+    nearest_signed(tree, point.map(i64::from))
+}
+
+/// [`nearest`] from a voxel anywhere, negative coordinates included (as numpy users give them). Exact for
+/// coordinates within `±2^61`; beyond, squared distances saturate at `u128::MAX`.
+///
+/// ```
+/// use ktree::query::nearest_signed;
+/// use ktree::KTree;
+/// let tree = KTree::<2>::from_dense(1, &[true, false, false, false]).unwrap();
+/// assert_eq!(nearest_signed(&tree, [-3, 0]).unwrap().unwrap().squared, 9);
+/// ```
+///
+/// # Errors
+/// The storage's read error.
+pub fn nearest_signed<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    point: [i64; K],
+) -> Result<Option<Nearest<K>>, T::Error> {
+    let mut search = Search { point, best: None };
     try_walk(tree, &mut search)?;
     Ok(search
         .best
@@ -141,6 +160,25 @@ pub fn distance<const K: usize, T: TreeStorage<K>>(
     point: [u32; K],
 ) -> Result<f64, T::Error> {
     Ok(nearest(tree, point)?.map_or(f64::INFINITY, |n| n.distance()))
+}
+
+/// [`nearest_signed`] for each point, on all threads, in the order given.
+///
+/// # Errors
+/// The storage's first read error.
+pub fn nearest_many_signed<const K: usize, T>(
+    tree: &T,
+    points: &[[i64; K]],
+) -> Result<Vec<Option<Nearest<K>>>, T::Error>
+where
+    T: TreeStorage<K> + Sync,
+    T::Error: Send,
+{
+    points
+        .par_iter()
+        .with_min_len(256)
+        .map(|&p| nearest_signed(tree, p))
+        .collect()
 }
 
 /// [`nearest`] for each point, on all threads, in the order given.

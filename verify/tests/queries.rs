@@ -297,6 +297,25 @@ fn check_nearest<const K: usize>(o: &Obj<K>, points: &[[u32; K]]) -> Result<(), 
             "from {:?}",
             p
         );
+        // The same point moved by −U on every axis, below the universe.
+        let side = i64::from(u.side() as u32);
+        let q = p.map(|v| i64::from(v) - side);
+        let below = query::nearest_signed(&tree, q).unwrap();
+        let expect_below = full
+            .iter()
+            .map(|v| {
+                let d: u128 = (0..K)
+                    .map(|a| u128::from(i64::from(v[a]).abs_diff(q[a])).pow(2))
+                    .sum();
+                (d, morton_encode(*v), *v)
+            })
+            .min();
+        prop_assert_eq!(
+            below.map(|n| (n.squared, n.voxel)),
+            expect_below.map(|(d, _, v)| (d, v)),
+            "from {:?}",
+            q
+        );
         let dist = tree.distance(*p);
         match expect {
             None => prop_assert_eq!(dist, f64::INFINITY),
