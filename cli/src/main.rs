@@ -13,10 +13,12 @@ mod lines;
 mod mass;
 mod memory;
 mod op;
+mod query;
 mod rays;
 mod render;
 mod repro;
 mod stats;
+mod table;
 mod transform;
 mod tree_file;
 mod voxelize;
@@ -55,6 +57,10 @@ enum Command {
     Rays(rays::Args),
     /// A triangle mesh (OBJ, STL, PLY) or a volume (raw + JSON, NIfTI) to rays or a .ktree.
     Voxelize(voxelize::Args),
+    /// Point queries on a tree file: inside or not, with --distance and --nearest the nearest full voxel.
+    Query(query::QueryArgs),
+    /// Cast rays (origin, direction) into a tree file: the first full voxel each enters.
+    Raycast(query::RaycastArgs),
     /// Convert between .ktree, .rays, .binvox, OctoMap .bt and OpenVDB .vdb (meshes and volumes as inputs).
     Convert(convert::Args),
 }
@@ -98,6 +104,8 @@ fn main() -> ExitCode {
         Command::Rays(args) => rays::run(args),
         Command::Voxelize(args) => voxelize::run(args),
         Command::Convert(args) => convert::run(args),
+        Command::Query(args) => query::run_query(args),
+        Command::Raycast(args) => query::run_raycast(args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
