@@ -115,10 +115,16 @@ fn answer_points<const K: usize, T: LevelOrder<K> + Sync>(
             o.insert("inside".into(), inside[i].into());
             if args.distance {
                 // JSON has no infinity: null when the object is empty.
-                o.insert("distance".into(), serde_json::json!(n.map(|n| n.distance())));
+                o.insert(
+                    "distance".into(),
+                    serde_json::json!(n.map(|n| n.distance())),
+                );
             }
             if args.nearest {
-                o.insert("nearest".into(), serde_json::json!(n.map(|n| n.voxel.to_vec())));
+                o.insert(
+                    "nearest".into(),
+                    serde_json::json!(n.map(|n| n.voxel.to_vec())),
+                );
             }
             let sep = if i == 0 { "\n" } else { ",\n" };
             write!(w, "{sep}{}", serde_json::Value::Object(o)).map_err(io)?;

@@ -79,7 +79,9 @@ pub fn read<T: Number>(path: &Path, columns: usize) -> Result<Table<T>, String> 
         std::fs::File::open(path).and_then(|mut f| f.read_to_end(&mut bytes).map(|_| ()))
     };
     read.map_err(|e| format!("cannot read {name}: {e}"))?;
-    let npy_name = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy"));
+    let npy_name = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
     if bytes.starts_with(MAGIC) || npy_name {
         read_npy(&bytes, name, columns)
     } else {
@@ -89,7 +91,10 @@ pub fn read<T: Number>(path: &Path, columns: usize) -> Result<Table<T>, String> 
 
 fn read_text<T: Number>(bytes: &[u8], name: String, columns: usize) -> Result<Table<T>, String> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
-        let line = 1 + bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count();
+        let line = 1 + bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count();
         format!("{name}:{line}: not text (UTF-8)")
     })?;
     let (mut rows, mut lines) = (Vec::new(), Vec::new());
@@ -170,7 +175,10 @@ fn read_npy<T: Number>(bytes: &[u8], name: String, columns: usize) -> Result<Tab
         .split(',')
         .map(str::trim)
         .filter(|s| !s.is_empty())
-        .map(|s| s.parse().map_err(|_| bad(start, &format!("'{s}' in the shape is not a size"))))
+        .map(|s| {
+            s.parse()
+                .map_err(|_| bad(start, &format!("'{s}' in the shape is not a size")))
+        })
         .collect::<Result<_, _>>()?;
     let (n, c) = match shape[..] {
         [n, c] => (n, c),
@@ -199,7 +207,10 @@ fn read_npy<T: Number>(bytes: &[u8], name: String, columns: usize) -> Result<Tab
         '>' => true,
         _ => return Err(bad(start, &format!("unsupported dtype '{descr}'"))),
     };
-    let ok = matches!((kind, size), ('i' | 'u', 1 | 2 | 4 | 8) | ('f', 4 | 8) | ('b', 1));
+    let ok = matches!(
+        (kind, size),
+        ('i' | 'u', 1 | 2 | 4 | 8) | ('f', 4 | 8) | ('b', 1)
+    );
     if !ok {
         return Err(bad(start, &format!("unsupported dtype '{descr}'")));
     }
