@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The Python module `ktree`: installs it with `pip install ./python` into a fresh virtual environment and runs
-# its pytest suite (python/tests/) against numpy references and the command-line tool's JSON, after checking
-# the type stubs with mypy's stubtest. Exits non-zero on any failure, including a run that collected no test.
+# its pytest suite (python/tests/) against numpy and scipy references and the command-line tool's JSON, after
+# checking the type stubs with mypy's stubtest. Exits non-zero on any failure, including a run that collected no test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -21,7 +21,7 @@ fi
 export PATH="$venv/bin:$PATH" # maturin, for the build without isolation below
 pip=("$venv/bin/python" -m pip)
 "${pip[@]}" install --quiet --upgrade pip
-"${pip[@]}" install --quiet maturin numpy pytest mypy
+"${pip[@]}" install --quiet maturin numpy scipy pytest mypy
 # The module (a release build of the extension, in the workspace's target folder).
 "${pip[@]}" install --no-build-isolation ./python
 
