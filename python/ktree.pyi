@@ -149,7 +149,7 @@ class Tree:
     def contains(self, points: npt.ArrayLike) -> Union[bool, npt.NDArray[np.bool_]]:
         """Whether voxels are inside: one point (K integers) or an (N, K) array."""
     def __getitem__(
-        self, key: Union[_Index, Tuple[_Index, ...]]
+        self, key: Union[_Index, Tuple[_Index, ...]], /
     ) -> Union[bool, npt.NDArray[np.bool_]]:
         """tree[x, y, z]: one voxel; with slices, the dense window of those voxels."""
     def bounding_box(self) -> Optional[Tuple[list[int], list[int]]]:

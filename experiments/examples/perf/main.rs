@@ -13,6 +13,7 @@ mod display;
 mod interop;
 mod measure;
 mod ops;
+mod queries;
 mod scale;
 mod solids;
 mod sources;
@@ -33,6 +34,7 @@ fn main() -> ExitCode {
             "scale" => measure::child(|| scale::run_case(case)),
             "streaming" => measure::child(|| streaming::run_case(case)),
             "sources" => measure::child(|| sources::run_case(case)),
+            "queries" => measure::child(|| queries::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -66,8 +68,9 @@ fn main() -> ExitCode {
             "interop" => interop::report(),
             "streaming" => streaming::report(),
             "sources" => sources::report(),
+            "queries" => queries::report(),
             other => Err(format!(
-                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming, sources)"
+                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming, sources, queries)"
             )),
         };
         match result {
