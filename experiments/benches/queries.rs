@@ -82,7 +82,10 @@ fn benches(c: &mut Criterion) {
         let one: Vec<bool> = points.iter().map(|&p| tree.contains(p)).collect();
         assert_eq!(tree.contains_many(points), one);
         let mut cursor = tree.cursor();
-        assert!(points.iter().zip(&one).all(|(&p, &e)| cursor.contains(p) == Ok(e)));
+        assert!(points
+            .iter()
+            .zip(&one)
+            .all(|(&p, &e)| cursor.contains(p) == Ok(e)));
     }
     for hit in tree.cast_rays(&rays).into_iter().flatten() {
         assert!(tree.contains(hit.voxel));
@@ -103,7 +106,9 @@ fn benches(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("cursor", name), points, |b, p| {
             b.iter(|| {
                 let mut cursor = tree.cursor();
-                p.iter().filter(|&&q| cursor.contains(q) == Ok(true)).count()
+                p.iter()
+                    .filter(|&&q| cursor.contains(q) == Ok(true))
+                    .count()
             })
         });
         group.bench_with_input(BenchmarkId::new("contains_many", name), points, |b, p| {
@@ -114,11 +119,17 @@ fn benches(c: &mut Criterion) {
     group.bench_function("cast_ray/one-thread", |b| {
         b.iter(|| {
             rays.iter()
-                .filter(|r| query::cast_ray(&tree, r).unwrap_or_else(|e| match e {}).is_some())
+                .filter(|r| {
+                    query::cast_ray(&tree, r)
+                        .unwrap_or_else(|e| match e {})
+                        .is_some()
+                })
                 .count()
         })
     });
-    group.bench_function("cast_rays/all-threads", |b| b.iter(|| tree.cast_rays(&rays)));
+    group.bench_function("cast_rays/all-threads", |b| {
+        b.iter(|| tree.cast_rays(&rays))
+    });
     group.throughput(Throughput::Elements(near.len() as u64));
     group.bench_function("nearest/one-thread", |b| {
         b.iter(|| near.iter().filter_map(|&p| tree.nearest(p)).count())

@@ -1,6 +1,6 @@
 //! Questions asked of a map, for every `K` and on every storage (a tree in memory, a `.ktree` file read
 //! through its map): batch point queries and a cached cursor ([`points`]), bounding boxes, counts and
-//! crops of boxes ([`boxes`]), ray casting ([`ray`]) and the nearest full voxel ([`nearest`]).
+//! crops of boxes ([`boxes`]), ray casting ([`ray`]) and the nearest full voxel ([`nearest`](mod@nearest)).
 //!
 //! Conventions: voxel `v` is the box `[v, v + 1)` in continuous coordinates and the universe is
 //! `[0, U)^K`; points outside the universe are outside the object (a query answers, it does not fail).
@@ -121,7 +121,7 @@ impl<const K: usize> KTree<K> {
         infallible(cast_rays(self, rays))
     }
 
-    /// A nearest full voxel to voxel `point` and its squared distance; `None` when empty ([`nearest`];
+    /// A nearest full voxel to voxel `point` and its squared distance; `None` when empty ([`nearest()`];
     /// ties: the smallest Morton key).
     ///
     /// ```

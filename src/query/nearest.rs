@@ -8,7 +8,7 @@
 //! best found is skipped.
 //!
 //! Ties: among equally near full voxels, the one with the smallest Morton key
-//! ([`morton_encode`](crate::space::morton_encode)) is returned.
+//! ([`crate::space::morton_encode`]) is returned.
 
 // Per-axis code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]

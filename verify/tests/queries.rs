@@ -419,13 +419,21 @@ proptest! {
 proptest! {
     #![proptest_config(ktree_verify::config(32))]
     #[test]
-    fn mapped_k1((o, (p, r)) in obj_and::<1, _>(|l| (probes::<1>(l), rays::<1>(l)))) { check_mapped(&o, &p, &r)?; }
+    fn mapped_k1((o, (p, r)) in obj_and::<1, _>(|l| (probes::<1>(l), rays::<1>(l)))) {
+        check_mapped(&o, &p, &r)?;
+    }
     #[test]
-    fn mapped_k2((o, (p, r)) in obj_and::<2, _>(|l| (probes::<2>(l), rays::<2>(l)))) { check_mapped(&o, &p, &r)?; }
+    fn mapped_k2((o, (p, r)) in obj_and::<2, _>(|l| (probes::<2>(l), rays::<2>(l)))) {
+        check_mapped(&o, &p, &r)?;
+    }
     #[test]
-    fn mapped_k3((o, (p, r)) in obj_and::<3, _>(|l| (probes::<3>(l), rays::<3>(l)))) { check_mapped(&o, &p, &r)?; }
+    fn mapped_k3((o, (p, r)) in obj_and::<3, _>(|l| (probes::<3>(l), rays::<3>(l)))) {
+        check_mapped(&o, &p, &r)?;
+    }
     #[test]
-    fn mapped_k4((o, (p, r)) in obj_and::<4, _>(|l| (probes::<4>(l), rays::<4>(l)))) { check_mapped(&o, &p, &r)?; }
+    fn mapped_k4((o, (p, r)) in obj_and::<4, _>(|l| (probes::<4>(l), rays::<4>(l)))) {
+        check_mapped(&o, &p, &r)?;
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------

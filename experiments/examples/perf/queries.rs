@@ -18,18 +18,58 @@ const NEAREST: usize = 1_000_000;
 
 /// The cases: name, what is measured, queries.
 const CASES: [(&str, &str, usize); 12] = [
-    ("contains-random", "`KTree::contains`, random points, 1 thread", POINTS),
-    ("contains-coherent", "`KTree::contains`, random walk, 1 thread", POINTS),
-    ("cursor-random", "`PointCursor::contains`, random points, 1 thread", POINTS),
-    ("cursor-coherent", "`PointCursor::contains`, random walk, 1 thread", POINTS),
-    ("batch-random-1", "`contains_many`, random points, 1 thread", POINTS),
-    ("batch-random-all", "`contains_many`, random points, all threads", POINTS),
-    ("batch-coherent-1", "`contains_many`, random walk, 1 thread", POINTS),
-    ("batch-coherent-all", "`contains_many`, random walk, all threads", POINTS),
+    (
+        "contains-random",
+        "`KTree::contains`, random points, 1 thread",
+        POINTS,
+    ),
+    (
+        "contains-coherent",
+        "`KTree::contains`, random walk, 1 thread",
+        POINTS,
+    ),
+    (
+        "cursor-random",
+        "`PointCursor::contains`, random points, 1 thread",
+        POINTS,
+    ),
+    (
+        "cursor-coherent",
+        "`PointCursor::contains`, random walk, 1 thread",
+        POINTS,
+    ),
+    (
+        "batch-random-1",
+        "`contains_many`, random points, 1 thread",
+        POINTS,
+    ),
+    (
+        "batch-random-all",
+        "`contains_many`, random points, all threads",
+        POINTS,
+    ),
+    (
+        "batch-coherent-1",
+        "`contains_many`, random walk, 1 thread",
+        POINTS,
+    ),
+    (
+        "batch-coherent-all",
+        "`contains_many`, random walk, all threads",
+        POINTS,
+    ),
     ("rays-1", "`cast_rays`, random rays, 1 thread", RAYS),
     ("rays-all", "`cast_rays`, random rays, all threads", RAYS),
-    ("nearest-1", "`nearest_many`, random points, 1 thread", NEAREST),
-    ("nearest-all", "`nearest_many`, random points, all threads", NEAREST),
+    (
+        "nearest-1",
+        "`nearest_many`, random points, 1 thread",
+        NEAREST,
+    ),
+    (
+        "nearest-all",
+        "`nearest_many`, random points, all threads",
+        NEAREST,
+    ),
 ];
 
 /// xorshift64*: deterministic inputs.
@@ -177,7 +217,12 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             best_of(
                 3,
                 || tree.nearest_many(&points),
-                |found| answers = found.iter().filter(|n| n.is_some_and(|n| n.squared == 0)).count(),
+                |found| {
+                    answers = found
+                        .iter()
+                        .filter(|n| n.is_some_and(|n| n.squared == 0))
+                        .count()
+                },
             )
         })
     } else {
@@ -201,7 +246,10 @@ pub fn report() -> Result<String, String> {
          nearest: at distance 0) or the rays that hit.\n\nMachine: {}.\n",
         machine_line().replace("; one thread used", "")
     );
-    let _ = writeln!(md, "| case | queries | best time (s) | ns / query | answers |");
+    let _ = writeln!(
+        md,
+        "| case | queries | best time (s) | ns / query | answers |"
+    );
     let _ = writeln!(md, "|---|---:|---:|---:|---:|");
     for (case, what, n) in CASES {
         let m: Measured = run_child("queries", case)?;
