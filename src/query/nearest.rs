@@ -2,10 +2,11 @@
 //! [`nearest_signed`]; many on all threads: [`nearest_many`], [`nearest_many_signed`]), Euclidean
 //! between voxel centres as scipy's `distance_transform_edt` measures it.
 //!
-//! Exact branch and bound: a cell's lower bound is the integer squared distance from the query voxel to
-//! the nearest voxel of the cell, so no rounding decides anything; a full leaf's bound is attained by its
-//! voxel nearest the query. Children are visited near half first; a subtree whose bound cannot beat the
-//! best found is skipped.
+//! Exact best-first branch and bound: a cell's lower bound is the integer squared distance from the query
+//! voxel to the nearest voxel of the cell, so no rounding decides anything; a full leaf's bound is
+//! attained by its voxel nearest the query. Cells wait in a queue ordered by bound; the search ends when
+//! the best voxel found is no farther than every cell still waiting, so only cells nearer than the answer
+//! are opened.
 //!
 //! Ties: among equally near full voxels, the one with the smallest Morton key
 //! ([`crate::space::morton_encode`]) is returned.
@@ -15,10 +16,11 @@
 
 use rayon::prelude::*;
 
-use crate::space::morton_encode;
-use crate::tree::cursor::{try_walk, ChildOrder, Visitor, Walk};
+use std::collections::BinaryHeap;
+
+use crate::space::{morton_encode, Cell};
 use crate::tree::storage::TreeStorage;
-use crate::tree::{NodeRef, NodeState};
+use crate::tree::NodeState;
 
 /// A nearest full voxel and its squared distance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -36,66 +38,53 @@ impl<const K: usize> Nearest<K> {
     }
 }
 
-struct Search<const K: usize> {
-    point: [i64; K],
-    /// The best so far: squared distance, voxel, its Morton key.
-    best: Option<(u128, [u32; K], u64)>,
+/// A cell waiting in the search: its lower bound and the Morton key of its origin (the smallest key of
+/// its voxels) order the queue.
+#[derive(Debug, Clone, Copy)]
+struct Waiting<const K: usize> {
+    bound: u128,
+    key: u64,
+    cell: Cell<K>,
+    index: usize,
+    state: NodeState,
 }
 
-impl<const K: usize> Visitor<K> for Search<K> {
-    const LEAVES: bool = false;
-
-    #[inline]
-    fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-        if node.state() == NodeState::Empty {
-            return Walk::Skip;
-        }
-        let cell = node.cell();
-        let side = cell.side();
-        // The voxel of the cell nearest the point, and its squared distance: the cell's lower bound.
-        let mut near = [0u32; K];
-        let mut bound = 0u128;
-        for a in 0..K {
-            let (lo, p) = (i64::from(cell.origin[a]), self.point[a]);
-            let c = p.clamp(lo, lo + side as i64 - 1);
-            near[a] = c as u32;
-            // Exact for coordinates within ±2^61; saturating beyond.
-            let gap = u128::from(c.abs_diff(p));
-            bound = bound.saturating_add(gap.saturating_mul(gap));
-        }
-        if let Some((best, _, key)) = self.best {
-            if bound > best || (bound == best && cell.morton() >= key) {
-                return Walk::Skip;
-            }
-        }
-        if node.state() == NodeState::Partial {
-            return Walk::Descend;
-        }
-        // A full leaf: its nearest voxel is unique; it beats the best (checked above, its key being at
-        // least the cell's).
-        let key = morton_encode(near);
-        match self.best {
-            Some((best, _, k)) if (bound, key) >= (best, k) => Walk::Skip,
-            _ => {
-                self.best = Some((bound, near, key));
-                if bound == 0 {
-                    Walk::Stop
-                } else {
-                    Walk::Skip
-                }
-            }
-        }
+impl<const K: usize> PartialEq for Waiting<K> {
+    fn eq(&self, other: &Self) -> bool {
+        (self.bound, self.key) == (other.bound, other.key)
     }
+}
 
-    #[inline]
-    fn child_order(&self, node: &NodeRef<K>) -> ChildOrder {
-        let cell = node.cell();
-        let half = cell.side() / 2;
-        let mask = (0..K).fold(0, |m, a| {
-            m | usize::from(self.point[a] >= i64::from(cell.origin[a]) + half as i64) << a
-        });
-        ChildOrder::xor::<K>(mask)
+impl<const K: usize> Eq for Waiting<K> {}
+
+impl<const K: usize> PartialOrd for Waiting<K> {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
     }
+}
+
+impl<const K: usize> Ord for Waiting<K> {
+    /// Reversed: the max-heap pops the smallest bound (then the smallest key) first.
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        (other.bound, other.key).cmp(&(self.bound, self.key))
+    }
+}
+
+/// The voxel of `cell` nearest `point` and its squared distance (exact for coordinates within ±2^61;
+/// saturating beyond).
+#[inline]
+fn nearest_in<const K: usize>(cell: &Cell<K>, point: &[i64; K]) -> ([u32; K], u128) {
+    let side = cell.side() as i64;
+    let mut near = [0u32; K];
+    let mut bound = 0u128;
+    for a in 0..K {
+        let lo = i64::from(cell.origin[a]);
+        let c = point[a].clamp(lo, lo + side - 1);
+        near[a] = c as u32;
+        let gap = u128::from(c.abs_diff(point[a]));
+        bound = bound.saturating_add(gap.saturating_mul(gap));
+    }
+    (near, bound)
 }
 
 /// A nearest full voxel to voxel `point` (which may lie outside the universe) and its squared distance;
@@ -135,11 +124,62 @@ pub fn nearest_signed<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     point: [i64; K],
 ) -> Result<Option<Nearest<K>>, T::Error> {
-    let mut search = Search { point, best: None };
-    try_walk(tree, &mut search)?;
-    Ok(search
-        .best
-        .map(|(squared, voxel, _)| Nearest { voxel, squared }))
+    let root = tree.root_state()?;
+    if root == NodeState::Empty {
+        return Ok(None);
+    }
+    let cell = tree.universe().root();
+    let mut queue = BinaryHeap::new();
+    queue.push(Waiting {
+        bound: nearest_in(&cell, &point).1,
+        key: cell.morton(),
+        cell,
+        index: 0,
+        state: root,
+    });
+    // The best so far: squared distance, Morton key, voxel.
+    let mut best: Option<(u128, u64, [u32; K])> = None;
+    let beats = |best: &Option<(u128, u64, [u32; K])>, bound: u128, key: u64| {
+        match best {
+            None => true,
+            Some((d, k, _)) => (bound, key) < (*d, *k),
+        }
+    };
+    while let Some(w) = queue.pop() {
+        // Every cell still waiting has a bound (and key) at least this one's: none holds a better voxel.
+        if !beats(&best, w.bound, w.key) {
+            break;
+        }
+        if w.state == NodeState::Full {
+            let (near, d) = nearest_in(&w.cell, &point);
+            let key = morton_encode(near);
+            if beats(&best, d, key) {
+                best = Some((d, key, near));
+            }
+            continue;
+        }
+        let depth = w.cell.level as usize;
+        let first = tree.first_child(depth, w.index)?;
+        let codes = tree.block_codes(depth + 1, first)?;
+        for code in 0..1usize << K {
+            let state = NodeState::from_bits(codes >> (2 * code));
+            if state == NodeState::Empty {
+                continue;
+            }
+            let cell = w.cell.child(code);
+            let (bound, key) = (nearest_in(&cell, &point).1, cell.morton());
+            if beats(&best, bound, key) {
+                queue.push(Waiting {
+                    bound,
+                    key,
+                    cell,
+                    index: first + code,
+                    state,
+                });
+            }
+        }
+    }
+    Ok(best.map(|(squared, _, voxel)| Nearest { voxel, squared }))
 }
 
 /// The distance from voxel `point` to the nearest full voxel: `0` inside the object, infinite for an

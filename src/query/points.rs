@@ -105,12 +105,13 @@ pub fn contains<const K: usize, T: TreeStorage<K>>(
     PointCursor::new(tree)?.contains(point)
 }
 
-/// Below this many points, one thread answers them all.
-const PARALLEL_FROM: usize = 4096;
+/// The points of one run of a batch, ordered by Morton key and answered by one [`PointCursor`].
+const RUN: usize = 1 << 14;
 
-/// Whether each voxel of `points` is inside the object, in the order given. The points are ordered by
-/// Morton key and split into runs answered on all threads, each run by one [`PointCursor`], so that
-/// the tree is walked once; points outside the universe are `false`.
+/// Whether each voxel of `points` is inside the object, in the order given. The points are cut into runs
+/// of 16 384 answered on all threads; within a run they are ordered by Morton key and answered by one
+/// [`PointCursor`], so that each run walks the tree once, in order, in cache. Points outside the universe
+/// are `false`.
 ///
 /// ```
 /// use ktree::query::contains_many;
@@ -121,50 +122,30 @@ const PARALLEL_FROM: usize = 4096;
 ///
 /// # Errors
 /// The storage's first read error.
-pub fn contains_many<const K: usize, T>(
-    tree: &T,
-    points: &[[u32; K]],
-) -> Result<Vec<bool>, T::Error>
+pub fn contains_many<const K: usize, T>(tree: &T, points: &[[u32; K]]) -> Result<Vec<bool>, T::Error>
 where
     T: TreeStorage<K> + Sync,
     T::Error: Send,
 {
-    if points.len() > u32::MAX as usize {
-        // Indices do not fit the compact order: answer in the order given.
-        let mut cursor = PointCursor::new(tree)?;
-        return points.iter().map(|&p| cursor.contains(p)).collect();
-    }
     let side = 1u64 << tree.level();
-    let mut order: Vec<(u64, u32)> = Vec::with_capacity(points.len());
     let mut out = vec![false; points.len()];
-    for (i, p) in points.iter().enumerate() {
-        if p.iter().all(|&c| u64::from(c) < side) {
-            order.push((morton_encode(*p), i as u32));
-        }
-    }
-    let answer = |run: &[(u64, u32)]| -> Result<Vec<bool>, T::Error> {
-        let mut cursor = PointCursor::new(tree)?;
-        run.iter()
-            .map(|&(_, i)| cursor.contains(points[i as usize]))
-            .collect()
-    };
-    let inside = if order.len() < PARALLEL_FROM {
+    let answer = |(points, out): (&[[u32; K]], &mut [bool])| -> Result<(), T::Error> {
+        let mut order: Vec<(u64, u32)> = points
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.iter().all(|&c| u64::from(c) < side))
+            .map(|(i, p)| (morton_encode(*p), i as u32))
+            .collect();
         order.sort_unstable();
-        answer(&order)?
-    } else {
-        order.par_sort_unstable();
-        let run = order
-            .len()
-            .div_ceil(4 * rayon::current_num_threads())
-            .max(1024);
-        let runs: Vec<Vec<bool>> = order
-            .par_chunks(run)
-            .map(answer)
-            .collect::<Result<_, _>>()?;
-        runs.concat()
+        let mut cursor = PointCursor::new(tree)?;
+        for (_, i) in order {
+            out[i as usize] = cursor.contains(points[i as usize])?;
+        }
+        Ok(())
     };
-    for (&(_, i), v) in order.iter().zip(inside) {
-        out[i as usize] = v;
-    }
+    points
+        .par_chunks(RUN)
+        .zip(out.par_chunks_mut(RUN))
+        .try_for_each(answer)?;
     Ok(out)
 }

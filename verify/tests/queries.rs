@@ -59,7 +59,7 @@ fn check_points<const K: usize>(o: &Obj<K>, points: &[[u32; K]]) -> Result<(), T
     let (u, dense, tree) = (o.universe(), o.dense(), o.tree());
     let expect: Vec<bool> = points.iter().map(|&p| dense_at(&u, &dense, p)).collect();
     prop_assert_eq!(tree.contains_many(points), expect.clone());
-    // Many points inside the universe (and the others): the parallel, sorted path.
+    // Many points inside the universe (and the others): several runs, on all threads.
     let inside: Vec<[u32; K]> = points
         .iter()
         .copied()
@@ -68,7 +68,7 @@ fn check_points<const K: usize>(o: &Obj<K>, points: &[[u32; K]]) -> Result<(), T
     let many: Vec<[u32; K]> = inside
         .iter()
         .cycle()
-        .take(5000)
+        .take(40_000)
         .chain(points)
         .copied()
         .collect();
