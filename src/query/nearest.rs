@@ -139,11 +139,9 @@ pub fn nearest_signed<const K: usize, T: TreeStorage<K>>(
     });
     // The best so far: squared distance, Morton key, voxel.
     let mut best: Option<(u128, u64, [u32; K])> = None;
-    let beats = |best: &Option<(u128, u64, [u32; K])>, bound: u128, key: u64| {
-        match best {
-            None => true,
-            Some((d, k, _)) => (bound, key) < (*d, *k),
-        }
+    let beats = |best: &Option<(u128, u64, [u32; K])>, bound: u128, key: u64| match best {
+        None => true,
+        Some((d, k, _)) => (bound, key) < (*d, *k),
     };
     while let Some(w) = queue.pop() {
         // Every cell still waiting has a bound (and key) at least this one's: none holds a better voxel.

@@ -122,7 +122,10 @@ const RUN: usize = 1 << 14;
 ///
 /// # Errors
 /// The storage's first read error.
-pub fn contains_many<const K: usize, T>(tree: &T, points: &[[u32; K]]) -> Result<Vec<bool>, T::Error>
+pub fn contains_many<const K: usize, T>(
+    tree: &T,
+    points: &[[u32; K]],
+) -> Result<Vec<bool>, T::Error>
 where
     T: TreeStorage<K> + Sync,
     T::Error: Send,

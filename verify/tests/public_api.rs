@@ -42,7 +42,10 @@ fn exercise<const K: usize>(tree: &KTree<K>) {
     assert_eq!(tree.count([0; K], [u32::MAX; K]), tree.voxel_count());
     assert_eq!(tree.crop([0; K], [u32::MAX; K]), *tree);
     assert_eq!(tree.bounding_box().is_some(), tree.voxel_count() > 0);
-    assert_eq!(tree.nearest([u32::MAX; K]).is_some(), tree.voxel_count() > 0);
+    assert_eq!(
+        tree.nearest([u32::MAX; K]).is_some(),
+        tree.voxel_count() > 0
+    );
     for (o, d) in [(-1e300, 1.0), (0.5, -1e-300), (1e9, -1e9), (0.0, 0.0)] {
         let _ = tree.cast_ray([o; K], [d; K], f64::MAX).unwrap();
     }

@@ -213,9 +213,10 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         s
     } else if case.starts_with("nearest-") {
         let points = random_points(NEAREST, &mut rng);
+        // One run: a second of these would double the report's time for little.
         on_threads(one, || {
             best_of(
-                3,
+                1,
                 || tree.nearest_many(&points),
                 |found| {
                     answers = found
@@ -240,7 +241,7 @@ pub fn report() -> Result<String, String> {
         md,
         "Regenerate with `cargo run --release --example perf -- queries`. Object: the octree of the voxels \
          whose centres lie in the ball of radius U/2 centred in the universe, L = {LEVEL}, stacked. Times \
-         are the best of 3 runs in a fresh process per case, excluding building the tree and making the \
+         are the best of 3 runs (1 for nearest voxels) in a fresh process per case, excluding building the tree and making the \
          inputs (random points uniform in the universe; a random walk of unit steps; rays from uniform \
          origins in uniform directions of the cube [-1, 1]^3). \"answers\" counts the points inside (for \
          nearest: at distance 0) or the rays that hit.\n\nMachine: {}.\n",
