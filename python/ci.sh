@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The Python module `ktree`: installs it with `pip install ./python` into a fresh virtual environment and runs
-# its pytest suite (python/tests/) against numpy references, the command-line tool's JSON, and trimesh's and
-# VTK's readings of the meshes and VTK files written, after checking
-# the type stubs with mypy's stubtest. Exits non-zero on any failure, including a run that collected no test.
+# its pytest suite (python/tests/) against numpy, scipy and scikit-image references, the command-line tool's
+# JSON, and trimesh's and VTK's readings of the meshes and VTK files written, after checking the type stubs
+# with mypy's stubtest. Exits non-zero on any failure, including a run that collected no test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)

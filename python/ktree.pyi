@@ -8,17 +8,30 @@ system says, with ``filename`` set) with the library's message.
 
 from fractions import Fraction
 from os import PathLike
-from typing import Any, Literal, NotRequired, Optional, Sequence, Tuple, TypedDict, Union, final
+from typing import Any, Literal, NamedTuple, NotRequired, Optional, Sequence, Tuple, TypedDict, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
-__all__ = ["Tree", "__version__"]
+__all__ = ["RayHits", "Tree", "__version__"]
 
 _Path = Union[str, PathLike[str]]
 _View = Union[str, Sequence[float]]
 _Shape = Literal["ball", "box", "cross"]
+
+_Index = Union[int, slice]
+
+class RayHits(NamedTuple):
+    """What Tree.cast_rays returns: per ray, whether it hit, the first full voxel entered (-1s for a
+    miss), t (inf for a miss), and the axis and sign of the face entered (-1 and 0 for a miss or an
+    origin inside a full voxel; sign -1 is the face at voxel[axis], entered moving up the axis)."""
+
+    hit: npt.NDArray[np.bool_]
+    voxel: npt.NDArray[np.int64]
+    t: npt.NDArray[np.float64]
+    axis: npt.NDArray[np.int8]
+    sign: npt.NDArray[np.int8]
 
 class _LevelCounts(TypedDict):
     level: int
@@ -132,12 +145,31 @@ class Tree:
     @property
     def node_count(self) -> int:
         """Nodes of the tree."""
-    def to_dense(self) -> npt.NDArray[np.bool_]:
-        """The voxels as a boolean array of shape (side,) * K indexed [x, y, z, ...]."""
+    def to_dense(
+        self, origin: Optional[Sequence[int]] = None, shape: Optional[Sequence[int]] = None
+    ) -> npt.NDArray[np.bool_]:
+        """The voxels of a window (`shape` from `origin`; default the bounding box, not the universe)
+        as a boolean array indexed [x, y, z, ...]; voxels outside the universe are False."""
     def to_rays(self) -> npt.NDArray[np.int64]:
         """The voxels as maximal runs: an (n, K + 1) array as from_rays reads."""
-    def contains(self, point: Sequence[int]) -> bool:
-        """Whether the voxel at `point` is inside."""
+    def contains(self, points: npt.ArrayLike) -> Union[bool, npt.NDArray[np.bool_]]:
+        """Whether voxels are inside: one point (K integers) or an (N, K) array."""
+    def __getitem__(
+        self, key: Union[_Index, Tuple[_Index, ...]], /
+    ) -> Union[bool, npt.NDArray[np.bool_]]:
+        """tree[x, y, z]: one voxel; with slices, the dense window of those voxels."""
+    def bounding_box(self) -> Optional[Tuple[list[int], list[int]]]:
+        """(lo, hi) of the full voxels, hi exclusive; None when empty."""
+    def cells(self) -> npt.NDArray[np.int64]:
+        """The full leaves as an (n, K + 1) array: corner coordinates, then side."""
+    def cast_rays(
+        self, origins: npt.ArrayLike, directions: npt.ArrayLike, max_t: float = ...
+    ) -> RayHits:
+        """The first full voxel each ray origin + t * direction (0 <= t <= max_t) enters."""
+    def distance(self, points: npt.ArrayLike) -> Union[float, npt.NDArray[np.float64]]:
+        """Distance between voxel centres to the nearest full voxel: 0 inside, inf when empty."""
+    def nearest(self, points: npt.ArrayLike) -> npt.NDArray[np.int64]:
+        """A nearest full voxel per point (rows of -1 when empty; ties: the smallest Morton key)."""
     def stats(self) -> _Stats:
         """Node counts, with the keys of `ktree stats --json`."""
     def translate(self, offset: Sequence[float]) -> Tree:

@@ -25,6 +25,8 @@
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
+//! * [`query`]: questions asked of a map — batch point queries, boxes and counts, ray casting, the
+//!   nearest full voxel — on trees in memory and on mapped files.
 //! * [`shape`]: morphology (dilate, erode, opening, closing), connected components, surface area and Euler number, on the runs.
 //! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
 //! * [`export`]: the boundary out to the tools that look at surfaces and volumes — an octree as a closed
@@ -38,6 +40,8 @@
 //!                     meshes written through export/)
 //!  export/            boundaries as meshes and outlines, and their files (over display's neighbours)
 //!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink
+//!  query/  shape/     questions asked of a map (points, boxes, rays, nearest), over the storage trait;
+//!                     morphology, components, surface area, Euler number, on the runs
 //!  stacking/          Builder (cells on all threads, in memory or out of core; KTree::from_rays), paper/
 //!  solid/             quadrics, meshes, volumes → rays, slab by slab
 //!  tree/              KTree, AnyTree, the storage trait, the walks, the level sink, packed 2-bit words
@@ -67,6 +71,7 @@ pub mod export;
 pub mod fs;
 pub mod io;
 pub mod ops;
+pub mod query;
 pub mod rays;
 pub mod reference;
 pub mod shape;

@@ -13,11 +13,13 @@ mod distributed;
 mod lines;
 mod mass;
 mod op;
+mod query;
 mod rays;
 mod render;
 mod repro;
 mod shape;
 mod stats;
+mod table;
 mod transform;
 mod voxelize;
 
@@ -55,6 +57,10 @@ enum Command {
     Rays(rays::Args),
     /// A triangle mesh (OBJ, STL, PLY) or a volume (raw + JSON, NIfTI) to rays or a .ktree.
     Voxelize(voxelize::Args),
+    /// Point queries on a tree file: inside or not, with --distance and --nearest the nearest full voxel.
+    Query(query::QueryArgs),
+    /// Cast rays (origin, direction) into a tree file: the first full voxel each enters.
+    Raycast(query::RaycastArgs),
     /// Convert between .ktree, .rays, .binvox, OctoMap .bt and OpenVDB .vdb; meshes (voxelized in, the boundary out: .ply, .obj, .stl, .glb, .svg), VTK out (.vtu, .htg, .pvd), volumes in.
     Convert(convert::Args),
     /// Dilate, erode, open or close a tree file by a ball, box or cross of any radius.
@@ -104,6 +110,8 @@ fn main() -> ExitCode {
         Command::Convert(args) => convert::run(args),
         Command::Morph(args) => shape::run_morph(args),
         Command::Components(args) => shape::run_components(args),
+        Command::Query(args) => query::run_query(args),
+        Command::Raycast(args) => query::run_raycast(args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,

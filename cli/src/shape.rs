@@ -10,7 +10,7 @@ use ktree::shape::Element;
 use ktree::{AnyTree, KTree};
 use serde::Serialize;
 
-use crate::op::{read, write};
+use crate::common::tree_file::{read, write};
 
 /// Arguments of `ktree morph`.
 #[derive(Debug, clap::Args)]
@@ -98,7 +98,7 @@ fn components<const K: usize>(
     let mut files = Vec::new();
     for (i, part) in parts.iter().enumerate() {
         let path = dir.join(format!("component-{}.ktree", i + 1));
-        crate::tree_file::write(&path, &part.tree)
+        crate::common::tree_file::write_tree(&path, &part.tree)
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         files.push(path);
     }
@@ -165,7 +165,7 @@ pub fn measures_of_file(path: &Path) -> Result<Option<Measures>, String> {
     let size = std::fs::metadata(path)
         .map_err(|e| format!("{}: {e}", path.display()))?
         .len();
-    if size > crate::memory::default_budget() / 16 {
+    if size > crate::common::memory::default_budget() / 16 {
         return Ok(None);
     }
     Ok(Some(measures(&read(path)?)))

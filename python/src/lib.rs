@@ -16,7 +16,7 @@ use ktree::solid::volume::{Select, Volume};
 use ktree::space::{Universe, DENSE_LIMIT};
 use ktree::AnyTree;
 use ktree::{with_dim, KTree};
-use numpy::ndarray::{Array3, ArrayD, ArrayViewD, IxDyn, ShapeBuilder};
+use numpy::ndarray::{Array3, ArrayViewD};
 use numpy::{
     AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayDyn, PyArrayLike2, PyArrayLikeDyn,
 };
@@ -27,6 +27,7 @@ use pyo3::types::{PyBytes, PyDict, PyString};
 mod failure;
 mod files;
 mod geometry;
+mod queries;
 mod rays;
 
 use failure::Failure;
@@ -113,13 +114,6 @@ fn dense_of_view<const K: usize>(
         }
     }
     Ok(dense)
-}
-
-/// A tree's voxels as an array indexed `[x, y, z, …]` (memory in Fortran order: axis 0 fastest).
-fn array_of_tree<const K: usize>(tree: &KTree<K>) -> Result<ArrayD<bool>, Failure> {
-    let dense = tree.to_dense()?;
-    let side = tree.universe().side() as usize;
-    ArrayD::from_shape_vec(IxDyn(&[side; K]).f(), dense).map_err(Failure::value)
 }
 
 /// A view direction from the object towards the viewer: a name or three numbers.
@@ -460,29 +454,206 @@ impl Tree {
         self.inner.counts().nodes()
     }
 
-    /// The voxels as a boolean array of shape (side,) * K, indexed `[x, y, z, ...]`.
-    fn to_dense<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<bool>>> {
-        let array = py.detach(|| with_dim!(&self.inner, AnyTree, t => array_of_tree(t)))?;
+    /// The voxels of a window as a boolean array indexed `[x, y, z, ...]`: `shape` voxels from `origin` (K
+    /// integers each; voxels outside the universe are False). By default the window is the bounding box
+    /// of the full voxels (from `origin` when only it is given), not the universe: an empty tree gives an
+    /// array of shape (0,) * K. `to_dense((0,) * k, (side,) * k)` is the whole universe.
+    #[pyo3(signature = (origin = None, shape = None))]
+    fn to_dense<'py>(
+        &self,
+        py: Python<'py>,
+        origin: Option<Vec<i64>>,
+        shape: Option<Vec<usize>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<bool>>> {
+        let k = self.inner.k();
+        for (name, len) in [
+            ("origin", origin.as_ref().map(Vec::len)),
+            ("shape", shape.as_ref().map(Vec::len)),
+        ] {
+            if let Some(len) = len.filter(|&n| n != k) {
+                return Err(Failure::Value(format!(
+                    "to_dense: {name} of a K = {k} tree has {k} numbers, got {len}"
+                ))
+                .into());
+            }
+        }
+        let array = py.detach(|| {
+            with_dim!(&self.inner, AnyTree, t => {
+                let (o, s) = queries::default_window(
+                    t,
+                    origin.as_ref().map(|o| std::array::from_fn(|a| o[a])),
+                    shape.as_ref().map(|s| std::array::from_fn(|a| s[a])),
+                );
+                queries::window(t, o, s)
+            })
+        })?;
         Ok(array.into_pyarray(py))
     }
 
-    /// Whether the voxel at `point` (K integers) is inside.
-    fn contains(&self, point: Vec<u64>) -> PyResult<bool> {
+    /// Whether voxels are inside: one point (K integers) gives a bool, an `(N, K)` integer array an
+    /// `(N,)` bool array (answered on all threads, ordered by Morton key, without the interpreter lock).
+    /// Points outside the universe (negative ones too) are outside.
+    fn contains<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyArrayLikeDyn<'py, i64, AllowTypeChange>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let rows = queries::rows(&points.as_array(), self.inner.k(), "contains: the points")?;
+        let inside =
+            py.detach(|| with_dim!(&self.inner, AnyTree, t => queries::contains(t, &rows.flat)));
+        if rows.single {
+            return Ok(pyo3::types::PyBool::new(py, inside[0])
+                .to_owned()
+                .into_any());
+        }
+        Ok(inside.into_pyarray(py).into_any())
+    }
+
+    /// `tree[x, y, z]`: whether that voxel is inside (False outside the universe). With slices,
+    /// `tree[x0:x1, y0:y1, z0:z1]` is the dense window of those voxels (as numpy slices the universe: negative
+    /// bounds count from its side, bounds are clipped to it, steps must be 1; an integer drops its axis).
+    fn __getitem__<'py>(
+        &self,
+        py: Python<'py>,
+        key: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let k = self.inner.k();
-        if point.len() != k {
-            return Err(Failure::Value(format!(
-                "a point of a K = {k} tree has {k} coordinates, got {}",
-                point.len()
+        let items: Vec<Bound<'py, PyAny>> = match key.cast::<pyo3::types::PyTuple>() {
+            Ok(t) => t.iter().collect(),
+            Err(_) => vec![key.clone()],
+        };
+        if items.len() != k {
+            return Err(pyo3::exceptions::PyIndexError::new_err(format!(
+                "a K = {k} tree is indexed by {k} integers or slices, got {}",
+                items.len()
+            )));
+        }
+        let side = 1i64 << self.inner.level();
+        let mut origin = vec![0i64; k];
+        let mut shape = vec![1usize; k];
+        let mut dropped = Vec::new();
+        for (a, item) in items.iter().enumerate() {
+            if let Ok(slice) = item.cast::<pyo3::types::PySlice>() {
+                let ix = slice.indices(side as isize)?;
+                if ix.step != 1 {
+                    return Err(Failure::Value(format!(
+                        "tree[...]: slice steps must be 1, got {} on axis {a}",
+                        ix.step
+                    ))
+                    .into());
+                }
+                origin[a] = ix.start as i64;
+                shape[a] = (ix.stop - ix.start).max(0) as usize;
+            } else {
+                origin[a] = item.extract::<i64>().map_err(|_| {
+                    pyo3::exceptions::PyTypeError::new_err(format!(
+                        "tree[...]: axis {a} takes an integer or a slice"
+                    ))
+                })?;
+                dropped.push(a);
+            }
+        }
+        if dropped.len() == k {
+            let inside = with_dim!(&self.inner, AnyTree, t => queries::contains(t, &origin));
+            return Ok(pyo3::types::PyBool::new(py, inside[0])
+                .to_owned()
+                .into_any());
+        }
+        let mut array = py.detach(|| {
+            with_dim!(&self.inner, AnyTree, t => queries::window(
+                t,
+                std::array::from_fn(|a| origin[a]),
+                std::array::from_fn(|a| shape[a]),
             ))
-            .into());
+        })?;
+        for &a in dropped.iter().rev() {
+            array = array.index_axis_move(numpy::ndarray::Axis(a), 0);
         }
-        let side = 1u64 << self.inner.level();
-        if point.iter().any(|&c| c >= side) {
-            return Ok(false);
+        Ok(array.into_pyarray(py).into_any())
+    }
+
+    /// The bounding box of the full voxels as `(lo, hi)` (K integers each, hi exclusive), or None when
+    /// the tree is empty.
+    fn bounding_box(&self, py: Python<'_>) -> Option<(Vec<u32>, Vec<u32>)> {
+        py.detach(|| {
+            with_dim!(&self.inner, AnyTree, t => t.bounding_box().map(|(lo, hi)| (lo.to_vec(), hi.to_vec())))
+        })
+    }
+
+    /// The full leaves as an `(n, K + 1)` int64 array: each row a cell's corner coordinates (its smallest
+    /// voxel), then its side; rows in Morton order.
+    fn cells<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
+        py.detach(|| with_dim!(&self.inner, AnyTree, t => queries::cells(t)))
+            .into_pyarray(py)
+    }
+
+    /// Casts rays `origin + t * direction` (`(N, K)` float arrays, or one ray as K numbers each) for
+    /// `0 <= t <= max_t`: a `RayHits` named tuple of `hit` (N,) bool, `voxel` (N, K) int64 (the first full
+    /// voxel entered; -1s for a miss), `t` (N,) float64 (inf for a miss; 0 when the origin is in a full
+    /// voxel), `axis` and `sign` (N,) int8 of the face entered (sign -1: the face at voxel[axis], entered
+    /// moving up the axis; -1 and 0 for a miss or an origin inside). Where a ray passes exactly through an
+    /// edge or corner shared by full voxels, the voxel is the one the ray is inside just after. Infinite or
+    /// NaN coordinates are a ValueError.
+    #[pyo3(signature = (origins, directions, max_t = f64::INFINITY))]
+    fn cast_rays<'py>(
+        &self,
+        py: Python<'py>,
+        origins: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+        directions: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+        max_t: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let k = self.inner.k();
+        let o = queries::rows(&origins.as_array(), k, "cast_rays: the origins")?;
+        let d = queries::rows(&directions.as_array(), k, "cast_rays: the directions")?;
+        let casts = py.detach(
+            || with_dim!(&self.inner, AnyTree, t => queries::cast(t, &o.flat, &d.flat, max_t)),
+        )?;
+        let hits = py.import("ktree")?.getattr("RayHits")?;
+        hits.call1((
+            casts.hit.into_pyarray(py),
+            casts.voxel.into_pyarray(py),
+            casts.t.into_pyarray(py),
+            casts.axis.into_pyarray(py),
+            casts.sign.into_pyarray(py),
+        ))
+    }
+
+    /// The distance from each voxel's centre to the nearest full voxel's (as scipy's
+    /// `distance_transform_edt(~dense)` measures it): 0 inside, inf for an empty tree. One point gives a
+    /// float, an `(N, K)` integer array an `(N,)` float64 array. Points may lie outside the universe.
+    fn distance<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyArrayLikeDyn<'py, i64, AllowTypeChange>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let rows = queries::rows(&points.as_array(), self.inner.k(), "distance: the points")?;
+        let (distance, _) =
+            py.detach(|| with_dim!(&self.inner, AnyTree, t => queries::nearest(t, &rows.flat)));
+        if rows.single {
+            return Ok(pyo3::types::PyFloat::new(py, distance[0]).into_any());
         }
-        Ok(
-            with_dim!(&self.inner, AnyTree, t => t.contains(std::array::from_fn(|a| point[a] as u32))),
-        )
+        Ok(distance.into_pyarray(py).into_any())
+    }
+
+    /// A nearest full voxel to each point: one point gives a (K,) int64 array, an `(N, K)` array an
+    /// `(N, K)` int64 array; rows of -1 for an empty tree. Among equally near voxels, the one with the
+    /// smallest Morton key.
+    fn nearest<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyArrayLikeDyn<'py, i64, AllowTypeChange>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let k = self.inner.k();
+        let rows = queries::rows(&points.as_array(), k, "nearest: the points")?;
+        let (_, voxel) =
+            py.detach(|| with_dim!(&self.inner, AnyTree, t => queries::nearest(t, &rows.flat)));
+        if rows.single {
+            return Ok(voxel.into_pyarray(py).into_any());
+        }
+        let n = voxel.len() / k;
+        let array =
+            numpy::ndarray::Array2::from_shape_vec((n, k), voxel).map_err(Failure::value)?;
+        Ok(array.into_pyarray(py).into_any())
     }
 
     /// The statistics as a dict with the keys of `ktree stats --json`: k, level, rays (None), full, empty,
@@ -969,6 +1140,15 @@ impl Tree {
 #[pyo3(name = "ktree")]
 fn ktree_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Tree>()?;
+    // What `Tree.cast_rays` returns.
+    let fields = ["hit", "voxel", "t", "axis", "sign"];
+    let hits = m
+        .py()
+        .import("collections")?
+        .getattr("namedtuple")?
+        .call1(("RayHits", fields))?;
+    hits.setattr("__module__", "ktree")?;
+    m.add("RayHits", hits)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -30,6 +30,11 @@ def random_object(rng, k, level, density=0.5):
     return a
 
 
+def whole(t):
+    """The tree's whole universe as a dense array (to_dense's default is the bounding box)."""
+    return t.to_dense((0,) * t.k, (t.side,) * t.k)
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(1234)
@@ -44,7 +49,7 @@ def test_dense_round_trip(rng, k):
         a = random_object(rng, k, LEVELS[k])
         t = ktree.Tree.from_dense(a)
         assert (t.k, t.level, t.side) == (k, LEVELS[k], 2 ** LEVELS[k])
-        out = t.to_dense()
+        out = whole(t)
         assert out.dtype == np.bool_ and out.shape == a.shape
         np.testing.assert_array_equal(out, a)
         assert t.voxel_count == int(a.sum())
@@ -69,7 +74,7 @@ def test_dense_non_square_is_placed_at_the_origin(rng):
     a = rng.random((5, 3, 7)) < 0.5
     t = ktree.Tree.from_dense(a)
     assert t.level == 3
-    out = t.to_dense()
+    out = whole(t)
     np.testing.assert_array_equal(out[:5, :3, :7], a)
     assert out.sum() == a.sum()
     assert ktree.Tree.from_dense(a, level=5).level == 5
@@ -79,7 +84,7 @@ def test_dense_non_square_is_placed_at_the_origin(rng):
 
 def test_dense_accepts_non_boolean_arrays():
     a = np.array([[0, 2], [0, 0]])
-    np.testing.assert_array_equal(ktree.Tree.from_dense(a).to_dense(), a != 0)
+    np.testing.assert_array_equal(whole(ktree.Tree.from_dense(a)), a != 0)
 
 
 @pytest.mark.parametrize("shape", [(2,) * 5, ()])
@@ -90,7 +95,7 @@ def test_dense_rejects_unsupported_dimensions(shape):
 
 def test_dense_too_large_is_an_error_not_an_allocation():
     with pytest.raises(ValueError):
-        ktree.Tree.full(3, 20).to_dense()
+        whole(ktree.Tree.full(3, 20))
 
 
 # --- node counts against a numpy pooling --------------------------------------------------------------------
@@ -150,11 +155,11 @@ def test_booleans_against_numpy(rng, k):
         a = random_object(rng, k, LEVELS[k])
         b = random_object(rng, k, LEVELS[k])
         ta, tb = ktree.Tree.from_dense(a), ktree.Tree.from_dense(b)
-        np.testing.assert_array_equal((ta | tb).to_dense(), np.logical_or(a, b))
-        np.testing.assert_array_equal((ta & tb).to_dense(), np.logical_and(a, b))
-        np.testing.assert_array_equal((ta - tb).to_dense(), np.logical_and(a, np.logical_not(b)))
-        np.testing.assert_array_equal((ta ^ tb).to_dense(), np.logical_xor(a, b))
-        np.testing.assert_array_equal((~ta).to_dense(), np.logical_not(a))
+        np.testing.assert_array_equal(whole(ta | tb), np.logical_or(a, b))
+        np.testing.assert_array_equal(whole(ta & tb), np.logical_and(a, b))
+        np.testing.assert_array_equal(whole(ta - tb), np.logical_and(a, np.logical_not(b)))
+        np.testing.assert_array_equal(whole(ta ^ tb), np.logical_xor(a, b))
+        np.testing.assert_array_equal(whole(~ta), np.logical_not(a))
         assert (ta | tb) == ktree.Tree.from_dense(a | b)
         assert ta.interferes(tb) == bool((a & b).any())
 
@@ -184,7 +189,7 @@ def test_rays_against_dense(rng, k):
     for row in rays:
         a[tuple(row[: k - 1]) + (slice(row[k - 1], row[k]),)] = True
     t = ktree.Tree.from_rays(rays, level)
-    np.testing.assert_array_equal(t.to_dense(), a)
+    np.testing.assert_array_equal(whole(t), a)
     # Runs back out: maximal, so the round trip gives the same tree.
     assert ktree.Tree.from_rays(t.to_rays(), level) == t
     assert t.to_rays().shape[1] == k + 1
@@ -251,7 +256,7 @@ def test_translate_against_numpy(rng, k):
     t = ktree.Tree.from_dense(a)
     for _ in range(5):
         offset = [int(x) for x in rng.integers(-3, 4, size=k)]
-        np.testing.assert_array_equal(t.translate(offset).to_dense(), shifted(a, offset))
+        np.testing.assert_array_equal(whole(t.translate(offset)), shifted(a, offset))
     with pytest.raises(ValueError, match=f"needs {k} numbers"):
         t.translate([1] * (k + 1))
 
@@ -263,7 +268,7 @@ def test_quarter_turns_against_rot90(rng, k):
     for axes in [(0, 1), (1, 0), (0, k - 1)]:
         for turns in range(-1, 5):
             np.testing.assert_array_equal(
-                t.rotate(90 * turns, axes).to_dense(), np.rot90(a, turns, axes=axes)
+                whole(t.rotate(90 * turns, axes)), np.rot90(a, turns, axes=axes)
             )
 
 
@@ -291,7 +296,7 @@ def test_scale_against_repeat(rng):
     a = random_object(rng, 3, 3)
     t = ktree.Tree.from_dense(a)
     doubled = a.repeat(2, axis=0).repeat(2, axis=1).repeat(2, axis=2)[:8, :8, :8]
-    np.testing.assert_array_equal(t.scale(2).to_dense(), doubled)
+    np.testing.assert_array_equal(whole(t.scale(2)), doubled)
     assert t.scale(Fraction(2, 1)) == t.scale(2) == t.scale(2.0)
     assert t.scale(1) == t
     with pytest.raises(ValueError):
@@ -303,7 +308,7 @@ def test_affine_matrices(rng):
     t = ktree.Tree.from_dense(a)
     assert t.affine(np.eye(3)) == t
     move = np.array([[1, 0, 3], [0, 1, -2], [0, 0, 1]], dtype=float)
-    np.testing.assert_array_equal(t.affine(move).to_dense(), shifted(a, [3, -2]))
+    np.testing.assert_array_equal(whole(t.affine(move)), shifted(a, [3, -2]))
     with pytest.raises(ValueError, match="3 x 3"):
         t.affine(np.eye(4))
     # A last row other than 0 0 1 is a projective map; it still gives a tree of the same universe.
@@ -412,7 +417,7 @@ def test_mesh_arrays_against_a_box():
     t = ktree.Tree.from_mesh_arrays(CUBE_VERTICES, CUBE_FACES, 3, transform=(4, 2, 1, 3))
     expected = np.zeros((8, 8, 8), dtype=bool)
     expected[2:6, 1:5, 3:7] = True  # voxels whose centres are inside [2, 6] x [1, 5] x [3, 7]
-    np.testing.assert_array_equal(t.to_dense(), expected)
+    np.testing.assert_array_equal(whole(t), expected)
     fitted = ktree.Tree.from_mesh_arrays(CUBE_VERTICES, CUBE_FACES, 3)
     assert fitted.voxel_count == 6**3  # scaled into the universe with one voxel of margin
     with pytest.raises(ValueError, match="face 0"):
@@ -448,10 +453,10 @@ def test_volume_against_threshold(tmp_path, rng):
     (tmp_path / "v.raw").write_bytes(values.tobytes(order="F"))  # samples x fastest
     t = ktree.Tree.from_volume(tmp_path / "v.json", 60)
     assert t.level == 3
-    np.testing.assert_array_equal(t.to_dense()[:5, :6, :7], values >= 60)
+    np.testing.assert_array_equal(whole(t)[:5, :6, :7], values >= 60)
     assert t.voxel_count == int((values >= 60).sum())
     moved = ktree.Tree.from_volume(tmp_path / "v.json", label=7, level=4, offset=(1, 2, 3))
-    np.testing.assert_array_equal(moved.to_dense()[1:6, 2:8, 3:10], values == 7)
+    np.testing.assert_array_equal(whole(moved)[1:6, 2:8, 3:10], values == 7)
     with pytest.raises(ValueError, match="exactly one"):
         ktree.Tree.from_volume(tmp_path / "v.json")
     with pytest.raises(OSError):
@@ -511,7 +516,7 @@ def test_every_format_saves_and_loads_the_same_tree(tmp_path):
         path = tmp_path / f"t.{ext}"
         t.save(path)
         back = ktree.Tree.load(path)
-        assert np.array_equal(back.to_dense(), a), ext
+        assert np.array_equal(whole(back), a), ext
 
 
 # --- the command-line tool's JSON ------------------------------------------------------------------------
@@ -645,7 +650,7 @@ def test_calls_from_threads_agree_with_serial_calls(rng):
 
     def work(a):
         t = ktree.Tree.from_dense(a)
-        return (t | t.rotate(90, "z")).to_dense(), t.render(width=24, height=24)
+        return whole(t | t.rotate(90, "z")), t.render(width=24, height=24)
 
     serial = [work(a) for a in arrays]
     with ThreadPoolExecutor(max_workers=4) as pool:

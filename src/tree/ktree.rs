@@ -447,15 +447,22 @@ impl<const K: usize> KTree<K> {
             .filter_map(|(cell, state)| (state == NodeState::Full).then_some(cell))
     }
 
-    /// The number of voxels inside the object.
+    /// The number of voxels inside the object, from the full-node counts of each level (no walk: a
+    /// pop-count of each level's words).
+    ///
+    /// ```
+    /// use ktree::KTree;
+    /// let tree = KTree::<2>::from_dense(2, &(0..16).map(|i| i < 9).collect::<Vec<_>>()).unwrap();
+    /// assert_eq!(tree.voxel_count(), 9);
+    /// assert_eq!(KTree::<3>::full(21).unwrap().voxel_count(), 1 << 63);
+    /// ```
     pub fn voxel_count(&self) -> u128 {
-        let mut n = 0u128;
-        self.for_each_leaf(|c, s| {
-            if s == NodeState::Full {
-                n += c.volume()
-            }
-        });
-        n
+        let level = self.level();
+        self.levels
+            .iter()
+            .enumerate()
+            .map(|(depth, l)| (l.full_count() as u128) << (K * (level as usize - depth)))
+            .sum()
     }
 
     /// The object as a dense boolean array (axis 0 fastest).
@@ -560,6 +567,23 @@ fn check_levels<const K: usize>(level: u32, levels: &[PackedStates]) -> Result<(
         }
     }
     Ok(())
+}
+
+/// The number of voxels of a `k`-dimensional object of universe level `level` whose full nodes per level
+/// (from the root) are `per_level`: what [`KTree::voxel_count`] gives, for counts read from a file.
+///
+/// ```
+/// use ktree::tree::voxels_of_levels;
+/// use ktree::KTree;
+/// let tree = KTree::<1>::from_dense(2, &[true, true, false, true]).unwrap();
+/// assert_eq!(voxels_of_levels(1, 2, &tree.counts_per_level()), 3);
+/// ```
+pub fn voxels_of_levels(k: usize, level: u32, per_level: &[LevelCounts]) -> u128 {
+    per_level
+        .iter()
+        .enumerate()
+        .map(|(depth, l)| u128::from(l.full) << (k * (level as usize).saturating_sub(depth)))
+        .sum()
 }
 
 /// The bytes a navigable tree with these per-level counts holds in memory ([`KTree::heap_bytes`]), without

@@ -31,7 +31,8 @@ pub(crate) use assemble::{LevelWriter, TreeAssembler};
 pub use cursor::Leaves;
 pub use error::TreeError;
 pub use ktree::{
-    heap_bytes_for_levels, Bintree, KTree, LevelCounts, NodeRef, Octree, Quadtree, Tree4,
+    heap_bytes_for_levels, voxels_of_levels, Bintree, KTree, LevelCounts, NodeRef, Octree,
+    Quadtree, Tree4,
 };
 pub use states::{NodeState, PackedStates};
 pub use storage::TreeStorage;

@@ -37,6 +37,18 @@ fn exercise<const K: usize>(tree: &KTree<K>) {
     assert!(tree.leaves().count() as u64 <= tree.node_count());
     let _ = tree.contains([0; K]);
     let _ = tree.contains([u32::MAX; K]);
+    // The queries answer on any tree, at any point, box or ray.
+    assert!(!tree.contains_many(&[[0; K], [u32::MAX; K]])[1]);
+    assert_eq!(tree.count([0; K], [u32::MAX; K]), tree.voxel_count());
+    assert_eq!(tree.crop([0; K], [u32::MAX; K]), *tree);
+    assert_eq!(tree.bounding_box().is_some(), tree.voxel_count() > 0);
+    assert_eq!(
+        tree.nearest([u32::MAX; K]).is_some(),
+        tree.voxel_count() > 0
+    );
+    for (o, d) in [(-1e300, 1.0), (0.5, -1e-300), (1e9, -1e9), (0.0, 0.0)] {
+        let _ = tree.cast_ray([o; K], [d; K], f64::MAX).unwrap();
+    }
     let not = !tree;
     not.assert_well_formed();
     let union = (tree | &not).unwrap();

@@ -14,6 +14,7 @@ mod export;
 mod interop;
 mod measure;
 mod ops;
+mod queries;
 mod scale;
 mod solids;
 mod sources;
@@ -35,6 +36,7 @@ fn main() -> ExitCode {
             "streaming" => measure::child(|| streaming::run_case(case)),
             "sources" => measure::child(|| sources::run_case(case)),
             "export" => measure::child(|| export::run_case(case)),
+            "queries" => measure::child(|| queries::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -69,8 +71,9 @@ fn main() -> ExitCode {
             "streaming" => streaming::report(),
             "sources" => sources::report(),
             "export" => export::report(),
+            "queries" => queries::report(),
             other => Err(format!(
-                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming, sources, export)"
+                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming, sources, export, queries)"
             )),
         };
         match result {

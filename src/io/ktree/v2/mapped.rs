@@ -3,9 +3,13 @@
 
 use super::KtreeView;
 use crate::io::KtreeFileError;
+use crate::query;
 use crate::space::Universe;
 use crate::tree::cursor::LevelOrder;
+use crate::tree::storage::infallible;
 use crate::tree::NodeState;
+use crate::KTree;
+use std::convert::Infallible;
 use std::sync::OnceLock;
 
 /// A `K`-dimensional tree read through a [`KtreeView`]: what the walks need, with each first child found
@@ -61,6 +65,75 @@ impl<'a, const K: usize> MappedTree<'a, K> {
             let _ = self.failure.set(e);
             fallback
         })
+    }
+}
+
+/// The queries of [`crate::query`] read through the map; each checks [`MappedTree::failure`] after its
+/// walk, so a file changed underneath gives an error naming the file and an offset, not a wrong answer.
+impl<const K: usize> MappedTree<'_, K> {
+    /// The query's answer, or the first failed read's error.
+    fn answer<T>(&self, value: Result<T, Infallible>) -> Result<T, KtreeFileError> {
+        let value = infallible(value);
+        self.failure().map(|()| value)
+    }
+
+    /// The number of voxels inside the object, from the file's per-level counts (no walk).
+    pub fn voxel_count(&self) -> u128 {
+        self.view.voxel_count()
+    }
+
+    /// As [`KTree::contains_many`](crate::KTree::contains_many).
+    ///
+    /// # Errors
+    /// The first failed read's error.
+    pub fn contains_many(&self, points: &[[u32; K]]) -> Result<Vec<bool>, KtreeFileError> {
+        self.answer(query::contains_many(self, points))
+    }
+
+    /// As [`KTree::bounding_box`](crate::KTree::bounding_box).
+    ///
+    /// # Errors
+    /// The first failed read's error.
+    pub fn bounding_box(&self) -> Result<Option<query::VoxelBox<K>>, KtreeFileError> {
+        self.answer(query::bounding_box(self))
+    }
+
+    /// As [`KTree::count`](crate::KTree::count).
+    ///
+    /// # Errors
+    /// The first failed read's error.
+    pub fn count(&self, lo: [u32; K], hi: [u32; K]) -> Result<u128, KtreeFileError> {
+        self.answer(query::count(self, lo, hi))
+    }
+
+    /// As [`KTree::crop`](crate::KTree::crop): the cropped tree, in memory.
+    ///
+    /// # Errors
+    /// The first failed read's error.
+    pub fn crop(&self, lo: [u32; K], hi: [u32; K]) -> Result<KTree<K>, KtreeFileError> {
+        self.answer(query::crop(self, lo, hi))
+    }
+
+    /// As [`query::cast_rays`] (ties as [`query::ray`] says).
+    ///
+    /// # Errors
+    /// The first failed read's error.
+    pub fn cast_rays(
+        &self,
+        rays: &[query::RayCast<K>],
+    ) -> Result<Vec<Option<query::RayHit<K>>>, KtreeFileError> {
+        self.answer(query::cast_rays(self, rays))
+    }
+
+    /// As [`KTree::nearest_many`](crate::KTree::nearest_many).
+    ///
+    /// # Errors
+    /// The first failed read's error.
+    pub fn nearest_many(
+        &self,
+        points: &[[u32; K]],
+    ) -> Result<Vec<Option<query::Nearest<K>>>, KtreeFileError> {
+        self.answer(query::nearest_many(self, points))
     }
 }
 

@@ -133,6 +133,12 @@ impl KtreeView {
         LevelCounts::total(self.level(), &self.counts_per_level())
     }
 
+    /// The number of voxels inside the object, from the directory's full-node counts (no walk), as
+    /// [`KTree::voxel_count`].
+    pub fn voxel_count(&self) -> u128 {
+        crate::tree::voxels_of_levels(self.k(), self.level(), &self.counts_per_level())
+    }
+
     /// The total number of nodes.
     pub fn node_count(&self) -> u64 {
         self.layout.sections.iter().map(|s| s.nodes).sum()

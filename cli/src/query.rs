@@ -1,0 +1,285 @@
+//! `ktree query FILE --points P [--distance] [--nearest] [--json]` and
+//! `ktree raycast FILE --rays R [--max-t T] [--json]`: point queries, nearest full voxels and ray casts
+//! on a tree file. A version 2 file is read through its memory map (so a tree larger than memory is
+//! queried without being loaded); others are loaded.
+
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use ktree::io::{ktree_file_version, KtreeView, MappedTree, VERSION};
+use ktree::query::{self, RayCast, RayHit};
+use ktree::tree::cursor::LevelOrder;
+use ktree::AnyTree;
+
+use crate::table;
+
+/// Arguments of `ktree query`.
+#[derive(Debug, clap::Args)]
+pub struct QueryArgs {
+    /// The tree file.
+    tree: PathBuf,
+    /// The points: a `.csv` or `.txt` of K integers a line, or a `.npy` `(N, K)` integer array; `-` for
+    /// standard input.
+    #[arg(long)]
+    points: PathBuf,
+    /// Also print the distance to the nearest full voxel (between voxel centres; 0 inside).
+    #[arg(long)]
+    distance: bool,
+    /// Also print the nearest full voxel.
+    #[arg(long)]
+    nearest: bool,
+    /// Print a JSON array of objects (`point`, `inside`, and `distance`, `nearest` when asked).
+    #[arg(long)]
+    json: bool,
+}
+
+/// Arguments of `ktree raycast`.
+#[derive(Debug, clap::Args)]
+pub struct RaycastArgs {
+    /// The tree file.
+    tree: PathBuf,
+    /// The rays: a `.csv` or `.txt` of 2K numbers a line (origin, then direction), or a `.npy` `(N, 2K)`
+    /// array; `-` for standard input.
+    #[arg(long)]
+    rays: PathBuf,
+    /// The largest ray parameter `t` (default: no limit).
+    #[arg(long, default_value_t = f64::INFINITY)]
+    max_t: f64,
+    /// Print a JSON array of objects (`hit`, `voxel`, `t`, `axis`, `sign`).
+    #[arg(long)]
+    json: bool,
+}
+
+/// The tree of a file: mapped (version 2) or loaded, and the queries run on either.
+fn with_tree<R>(
+    path: &Path,
+    mut mapped: impl FnMut(&KtreeView) -> Result<R, String>,
+    mut loaded: impl FnMut(&AnyTree) -> Result<R, String>,
+) -> Result<R, String> {
+    if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION {
+        let view = KtreeView::open(path).map_err(|e| e.to_string())?;
+        mapped(&view)
+    } else {
+        loaded(&crate::common::tree_file::read(path)?)
+    }
+}
+
+/// The mapped tree of `view`, of dimension `K`.
+fn mapped_tree<const K: usize>(view: &KtreeView) -> Result<MappedTree<'_, K>, String> {
+    MappedTree::<K>::new(view).map_err(|e| e.to_string())
+}
+
+/// Standard output, buffered; writes end the command quietly on a closed pipe.
+fn out() -> BufWriter<std::io::StdoutLock<'static>> {
+    BufWriter::with_capacity(1 << 16, std::io::stdout().lock())
+}
+
+/// The points of a table, each of `K` integers.
+fn points<const K: usize>(t: &table::Table<i64>) -> Vec<[i64; K]> {
+    t.rows
+        .iter()
+        .map(|r| std::array::from_fn(|a| r[a]))
+        .collect()
+}
+
+/// Answers the point queries on `tree` and prints them.
+fn answer_points<const K: usize, T: LevelOrder<K> + Sync>(
+    tree: &T,
+    args: &QueryArgs,
+    check: impl Fn() -> Result<(), String>,
+) -> Result<(), String> {
+    let table = table::read::<i64>(&args.points, K)?;
+    let pts = points::<K>(&table);
+    // Points beyond the u32 range are outside every universe.
+    let voxels: Vec<[u32; K]> = pts
+        .iter()
+        .map(|p| p.map(|v| u32::try_from(v).unwrap_or(u32::MAX)))
+        .collect();
+    let inside = query::contains_many(tree, &voxels).unwrap_or_else(|e| match e {});
+    let near = if args.distance || args.nearest {
+        query::nearest_many_signed(tree, &pts).unwrap_or_else(|e| match e {})
+    } else {
+        Vec::new()
+    };
+    check()?;
+    let mut w = out();
+    let io = crate::output_error;
+    if args.json {
+        w.write_all(b"[").map_err(io)?;
+    }
+    for (i, p) in pts.iter().enumerate() {
+        let n = near.get(i).copied().flatten();
+        if args.json {
+            let mut o = serde_json::Map::new();
+            o.insert("point".into(), serde_json::json!(p.to_vec()));
+            o.insert("inside".into(), inside[i].into());
+            if args.distance {
+                // JSON has no infinity: null when the object is empty.
+                o.insert(
+                    "distance".into(),
+                    serde_json::json!(n.map(|n| n.distance())),
+                );
+            }
+            if args.nearest {
+                o.insert(
+                    "nearest".into(),
+                    serde_json::json!(n.map(|n| n.voxel.to_vec())),
+                );
+            }
+            let sep = if i == 0 { "\n" } else { ",\n" };
+            write!(w, "{sep}{}", serde_json::Value::Object(o)).map_err(io)?;
+            continue;
+        }
+        let coords: Vec<String> = p.iter().map(i64::to_string).collect();
+        write!(
+            w,
+            "{} {}",
+            coords.join(" "),
+            if inside[i] { "inside" } else { "outside" }
+        )
+        .map_err(io)?;
+        if args.distance {
+            match n {
+                Some(n) => write!(w, " distance {}", n.distance()),
+                None => write!(w, " distance inf"),
+            }
+            .map_err(io)?;
+        }
+        if args.nearest {
+            match n {
+                Some(n) => {
+                    let v: Vec<String> = n.voxel.iter().map(u32::to_string).collect();
+                    write!(w, " nearest {}", v.join(" "))
+                }
+                None => write!(w, " nearest none"),
+            }
+            .map_err(io)?;
+        }
+        writeln!(w).map_err(io)?;
+    }
+    if args.json {
+        writeln!(w, "{}]", if pts.is_empty() { "" } else { "\n" }).map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
+
+/// Runs `ktree query`.
+pub fn run_query(args: QueryArgs) -> Result<(), String> {
+    with_tree(
+        &args.tree,
+        |view| match view.k() {
+            1 => {
+                let t = mapped_tree::<1>(view)?;
+                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string()))
+            }
+            2 => {
+                let t = mapped_tree::<2>(view)?;
+                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string()))
+            }
+            3 => {
+                let t = mapped_tree::<3>(view)?;
+                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string()))
+            }
+            _ => {
+                let t = mapped_tree::<4>(view)?;
+                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string()))
+            }
+        },
+        |tree| ktree::with_dim!(tree, AnyTree, t => answer_points(t, &args, || Ok(()))),
+    )
+}
+
+/// The rays of a table, each of `2K` numbers, checked.
+fn rays<const K: usize>(t: &table::Table<f64>, max_t: f64) -> Result<Vec<RayCast<K>>, String> {
+    t.rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            RayCast::new(
+                std::array::from_fn(|a| r[a]),
+                std::array::from_fn(|a| r[K + a]),
+                max_t,
+            )
+            .map_err(|e| format!("{}: {e}", t.place(i)))
+        })
+        .collect()
+}
+
+/// Casts the rays on `tree` and prints the hits.
+fn answer_rays<const K: usize, T: LevelOrder<K> + Sync>(
+    tree: &T,
+    args: &RaycastArgs,
+    check: impl Fn() -> Result<(), String>,
+) -> Result<(), String> {
+    if args.max_t.is_nan() || args.max_t < 0.0 {
+        return Err(format!(
+            "--max-t must be a number >= 0 (inf for no limit), got {}",
+            args.max_t
+        ));
+    }
+    let table = table::read::<f64>(&args.rays, 2 * K)?;
+    let casts = rays::<K>(&table, args.max_t)?;
+    let hits: Vec<Option<RayHit<K>>> =
+        query::cast_rays(tree, &casts).unwrap_or_else(|e| match e {});
+    check()?;
+    let mut w = out();
+    let io = crate::output_error;
+    if args.json {
+        w.write_all(b"[").map_err(io)?;
+    }
+    for (i, h) in hits.iter().enumerate() {
+        if args.json {
+            let o = serde_json::json!({
+                "hit": h.is_some(),
+                "voxel": h.map(|h| h.voxel.to_vec()),
+                "t": h.map(|h| h.t),
+                "axis": h.and_then(|h| h.face).map(|f| f.axis),
+                "sign": h.and_then(|h| h.face).map(|f| f.sign),
+            });
+            let sep = if i == 0 { "\n" } else { ",\n" };
+            write!(w, "{sep}{o}").map_err(io)?;
+            continue;
+        }
+        match h {
+            None => writeln!(w, "miss"),
+            Some(h) => {
+                let v: Vec<String> = h.voxel.iter().map(u32::to_string).collect();
+                let face = h.face.map_or("inside".to_string(), |f| {
+                    format!("face {}{}", if f.sign < 0 { '-' } else { '+' }, f.axis)
+                });
+                writeln!(w, "hit {} t {} {face}", v.join(" "), h.t)
+            }
+        }
+        .map_err(io)?;
+    }
+    if args.json {
+        writeln!(w, "{}]", if hits.is_empty() { "" } else { "\n" }).map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
+
+/// Runs `ktree raycast`.
+pub fn run_raycast(args: RaycastArgs) -> Result<(), String> {
+    with_tree(
+        &args.tree,
+        |view| match view.k() {
+            1 => {
+                let t = mapped_tree::<1>(view)?;
+                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string()))
+            }
+            2 => {
+                let t = mapped_tree::<2>(view)?;
+                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string()))
+            }
+            3 => {
+                let t = mapped_tree::<3>(view)?;
+                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string()))
+            }
+            _ => {
+                let t = mapped_tree::<4>(view)?;
+                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string()))
+            }
+        },
+        |tree| ktree::with_dim!(tree, AnyTree, t => answer_rays(t, &args, || Ok(()))),
+    )
+}
