@@ -203,7 +203,7 @@ pub fn run(results: &Path) -> Result<String, String> {
             a.combined[0][1], a.split[0][1], b.combined[0][1], b.split[0][1]
         ),
         if a.combined[0][1] == 1 && b.combined[0][1] == 0 && b.split[0][1] > 0 { "reproduced" } else { "differs" }.into(),
-        "`StackingStats` of the two inputs; unit tests `fig4_*`, `fig5_*` in src/stacking/stack.rs".into(),
+        "`StackingStats` of the two inputs; unit tests `fig4_*`, `fig5_*` in src/stacking/paper/lists.rs".into(),
     ]);
 
     // AF5–AF7: the search.
