@@ -71,7 +71,7 @@ out=../results/reliability.md
 # A target this machine has not run keeps the row the committed record has for it.
 for t in $(cargo fuzz list); do
   if [ ! -f "$rows_dir/$t.md" ] && [ -f "$out" ]; then
-    grep -F "| \`$t\` |" "$out" | grep -v "| not run |" >"$rows_dir/$t.md.tmp" && mv "$rows_dir/$t.md.tmp" "$rows_dir/$t.md"
+    grep -m1 -F "| \`$t\` |" "$out" | grep -v "| not run |" >"$rows_dir/$t.md.tmp" && mv "$rows_dir/$t.md.tmp" "$rows_dir/$t.md"
     rm -f "$rows_dir/$t.md.tmp"
   fi
 done
