@@ -151,8 +151,8 @@ pub fn collision<const K: usize>(
     b: &KTree<K>,
     time_axis: Option<usize>,
 ) -> Result<Collision, OpsError> {
-    let collide = interferes(a, b)?;
     let overlap = super::intersection(a, b)?;
+    let collide = overlap.root_state() != crate::NodeState::Empty;
     let first_contact = match time_axis {
         Some(axis) => first_contact(a, b, axis)?,
         None => None,

@@ -236,8 +236,7 @@ impl<const K: usize> KTree<K> {
     /// assert_eq!(tree, KTree::from(&rays));
     /// ```
     pub fn from_rays(rays: &RaySet<K>) -> Self {
-        let depth = default_split_depth(K, rays.level());
-        match stack_source(rays, depth, CellStacking::default()) {
+        match Builder::new(rays).build_on_current_pool() {
             Ok(tree) => tree,
             Err(never) => match never {},
         }

@@ -66,7 +66,8 @@ impl<const K: usize> Obj<K> {
     }
 }
 
-fn obj_at<const K: usize>(level: u32) -> impl Strategy<Value = Obj<K>> {
+/// Objects in a universe of level `level`: up to 3 boxes and 11 voxels.
+pub fn obj_at<const K: usize>(level: u32) -> impl Strategy<Value = Obj<K>> {
     let side = 1u32 << level;
     let bx = prop::array::uniform::<_, K>((0..side, 1..=side)).prop_map(move |b| {
         let lo: [u32; K] = std::array::from_fn(|i| b[i].0);

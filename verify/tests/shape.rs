@@ -5,7 +5,7 @@
 
 use ktree::shape::{Element, ShapeError};
 use ktree::{ops, KTree, Ray, RaySet, Universe};
-use ktree_verify::objects::Obj;
+use ktree_verify::objects::{obj_at, Obj};
 use proptest::prelude::*;
 
 /// Levels small enough for brute force over every offset of every voxel.
@@ -19,23 +19,7 @@ const fn top_level(k: usize) -> u32 {
 }
 
 fn obj<const K: usize>() -> impl Strategy<Value = Obj<K>> {
-    (0..=top_level(K)).prop_flat_map(|level| {
-        let side = 1u32 << level;
-        let bx = prop::array::uniform::<_, K>((0..side, 1..=side)).prop_map(move |b| {
-            let lo: [u32; K] = std::array::from_fn(|i| b[i].0);
-            let hi: [u32; K] = std::array::from_fn(|i| (b[i].0 + b[i].1).min(side));
-            (lo, hi)
-        });
-        (
-            prop::collection::vec(bx, 0..4),
-            prop::collection::vec(prop::array::uniform::<_, K>(0..side), 0..12),
-        )
-            .prop_map(move |(boxes, voxels)| Obj {
-                level,
-                boxes,
-                voxels,
-            })
-    })
+    (0..=top_level(K)).prop_flat_map(obj_at::<K>)
 }
 
 fn element() -> impl Strategy<Value = Element> {
