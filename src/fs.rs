@@ -147,6 +147,36 @@ pub(crate) fn remove_stale(dir: &Path, name: &str, suffix: &str) {
     }
 }
 
+/// Why the temporary files of a job that spills to disk (an out-of-core build, a streamed Boolean) or its
+/// output could not be written. The target is then untouched and the spill files are removed.
+#[derive(Debug, thiserror::Error)]
+pub enum SpillError {
+    /// The folder for the spill files cannot be used.
+    #[error("cannot create spill files in the temporary folder {}: {source}", path.display())]
+    TempDir {
+        /// The folder.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// A spill file cannot be written or read back.
+    #[error("spill file {}: {source}", path.display())]
+    Spill {
+        /// The spill file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// The output cannot be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Output {
+        /// The output file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+}
+
 /// An I/O failure kept whole inside a file error, so that its [`source`](std::error::Error::source) is the
 /// [`std::io::Error`] and a caller can act on its [`kind`](IoCause::kind) (Python raises `FileNotFoundError`,
 /// `PermissionError`, …). Cloneable, and equal when kind and message are.

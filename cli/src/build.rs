@@ -1,16 +1,13 @@
 //! `ktree build --rays FILE --out FILE.ktree [--threads N] [--max-memory SIZE] [--temp-dir DIR]
 //! [--progress]`: stack a ray file into a tree file (out of core: see [`crate::common::memory`]).
 
-use crate::outln;
+use crate::common::error::CliResult;
 
 use std::path::PathBuf;
 
-use ktree::io::{open_rays_file, read_rays_file, RaysFile, RaysFileSource};
+use ktree::io::{open_rays_file, RaysFile, RaysFileSource};
 use ktree::stacking::RaySource;
-use ktree::{AnyRaySet, AnyTree};
-use ktree::{KTree, LevelCounts, RaySet};
-
-use crate::common::threads::with_threads;
+use ktree::{LevelCounts, RaySet};
 
 /// Arguments of `ktree build`.
 #[derive(Debug, clap::Args)]
@@ -30,44 +27,17 @@ pub struct Args {
 
 /// Reads the rays, stacks them, writes the tree, and prints a one-line summary (in a run over several
 /// MPI ranks, every rank reads the whole ray file; rank 0 alone writes and prints).
-pub fn run(args: Args) -> Result<(), String> {
-    if crate::common::memory::out_of_core() {
-        // A sorted file is read slab by slab as the cells are stacked; another is read whole.
-        let summary = match open_rays_file(&args.rays).map_err(|e| e.to_string())? {
-            RaysFile::Sorted(source) => {
-                ktree::with_dim!(&source, AnyRaysFileSource, s => build_source(s, &args))?
-            }
-            RaysFile::Whole(rays) => {
-                ktree::with_dim!(&rays, AnyRaySet, r => build_out_of_core(r, &args))?
-            }
-        };
-        return crate::common::output::print_summary(&summary);
-    }
-    crate::common::output::one_process_for_version_1()?;
-    let rays = read_rays_file(&args.rays).map_err(|e| e.to_string())?;
-    let threads = args.threads;
-    let tree = match &rays {
-        AnyRaySet::K1(r) => AnyTree::K1(with_threads(threads, || KTree::from_rays(r))?),
-        AnyRaySet::K2(r) => AnyTree::K2(with_threads(threads, || KTree::from_rays(r))?),
-        AnyRaySet::K3(r) => AnyTree::K3(with_threads(threads, || KTree::from_rays(r))?),
-        AnyRaySet::K4(r) => AnyTree::K4(with_threads(threads, || KTree::from_rays(r))?),
+pub fn run(args: Args) -> CliResult {
+    // A sorted file is read slab by slab as the cells are stacked; another is read whole.
+    let summary = match open_rays_file(&args.rays).map_err(|e| e.to_string())? {
+        RaysFile::Sorted(source) => {
+            ktree::with_dim!(&source, AnyRaysFileSource, s => build_source(s, &args))?
+        }
+        RaysFile::Whole(rays) => {
+            ktree::with_dim!(&rays, AnyRaySet, r => build_out_of_core(r, &args))?
+        }
     };
-    let write =
-        ktree::with_dim!(&tree, AnyTree, t => crate::common::tree_file::write_tree(&args.out, t));
-    write.map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
-    let c = tree.counts();
-    outln!(
-        "{}",
-        summary(
-            &args.out,
-            tree.k(),
-            tree.level(),
-            rays.len(),
-            c,
-            tree.bytes_at_two_bits()
-        )
-    );
-    Ok(())
+    crate::common::output::print_summary(&summary)
 }
 
 /// Stacks the rays straight into the output, out of core (across the MPI ranks of the run, if several);

@@ -1,6 +1,7 @@
 //! `ktree collide A B [--time-axis N] [--json]`: interference detection between two `.ktree` files, with
 //! the minimum separation when they do not overlap (JSON keys: those of [`ktree::ops::Collision`]).
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::PathBuf;
@@ -24,7 +25,7 @@ pub struct Args {
 }
 
 /// Prints whether the objects overlap, and where.
-pub fn run(args: Args) -> Result<(), String> {
+pub fn run(args: Args) -> CliResult {
     let (ta, tb) = (read(&args.a)?, read(&args.b)?);
     let r = ta
         .collision(&tb, args.time_axis)

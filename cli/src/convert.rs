@@ -2,6 +2,7 @@
 //! `.vdb`; meshes voxelized as inputs and the tree's boundary as outputs, `.glb` and `.svg` outputs only;
 //! volumes as inputs).
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::PathBuf;
@@ -79,7 +80,7 @@ fn parse_point(name: &str, text: &str) -> Result<[f64; 3], String> {
 }
 
 /// Reads the input, writes the output, prints a one-line summary.
-pub fn run(a: Args) -> Result<(), String> {
+pub fn run(a: Args) -> CliResult {
     let options = ReadOptions {
         level: a.level,
         offset: a
@@ -118,7 +119,7 @@ pub fn run(a: Args) -> Result<(), String> {
     let mut meta = read.meta.unwrap_or_default();
     if let Some(v) = a.voxel_size {
         if !(v.is_finite() && v > 0.0) {
-            return Err(format!("--voxel-size {v}: expected a positive number"));
+            return Err(format!("--voxel-size {v}: expected a positive number").into());
         }
         meta.voxel_size = v;
     }
@@ -137,7 +138,8 @@ pub fn run(a: Args) -> Result<(), String> {
                 "{}: --time-axis slices 4-D trees; this tree has K = {}",
                 a.input.display(),
                 read.tree.k()
-            ));
+            )
+            .into());
         };
         let frame = ktree::export::Frame {
             voxel_size: meta.voxel_size,

@@ -1,6 +1,7 @@
 //! `ktree lines FILE.ktree [--view VIEW] [--out drawing.svg]`: a line drawing of an octree with hidden
 //! lines removed (Veenstra & Ahuja), as SVG (vector) or PNG (by the output's extension).
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::PathBuf;
@@ -39,13 +40,13 @@ pub struct Args {
 }
 
 /// Draws the file.
-pub fn run(args: Args) -> Result<(), String> {
+pub fn run(args: Args) -> CliResult {
     let (w, h) = parse_size(&args.size)?;
     let toward = parse_view(&args.view)?;
     let method = match args.method.as_str() {
         "bucketed" => HiddenLineMethod::Bucketed,
         "pairwise" => HiddenLineMethod::Pairwise,
-        other => return Err(format!("method '{other}' must be bucketed or pairwise")),
+        other => return Err(format!("method '{other}' must be bucketed or pairwise").into()),
     };
     if !(args.stroke.is_finite() && args.stroke > 0.0) {
         return Err("--stroke must be a positive number".into());
@@ -57,7 +58,8 @@ pub fn run(args: Args) -> Result<(), String> {
                 "line drawings need an octree (K = 3); {} is a K = {} tree (try ktree render)",
                 args.file.display(),
                 other.k()
-            ))
+            )
+            .into())
         }
     };
     let out = args

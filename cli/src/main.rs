@@ -4,6 +4,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use common::error::CliError;
 
 mod build;
 mod collide;
@@ -16,6 +17,7 @@ mod op;
 mod query;
 mod rays;
 mod render;
+#[cfg(feature = "repro")]
 mod repro;
 mod shape;
 mod stats;
@@ -52,6 +54,7 @@ enum Command {
     /// Draw an octree as lines with hidden lines removed (SVG or PNG).
     Lines(lines::Args),
     /// Regenerate the paper reproductions into results/ (all of them by default).
+    #[cfg(feature = "repro")]
     Repro(repro::Args),
     /// An analytic solid (ball, ellipsoid, paraboloid, cylinder, cone, half-space, box, quadric) to rays.
     Rays(rays::Args),
@@ -69,27 +72,16 @@ enum Command {
     Components(shape::ComponentsArgs),
 }
 
-/// Writes a line to standard output, returning from the enclosing function with [`output_error`]'s message
-/// if that fails (`ktree stats A | head` closes the pipe early: that ends the command quietly, not in a panic).
+/// Writes a line to standard output, returning from the enclosing function with a [`CliError`] if that
+/// fails (`ktree stats A | head` closes the pipe early: that ends the command quietly, not in a panic).
 macro_rules! outln {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        writeln!(std::io::stdout(), $($arg)*).map_err(crate::output_error)?;
+        writeln!(std::io::stdout(), $($arg)*)
+            .map_err(crate::common::error::CliError::from_output)?;
     }};
 }
 pub(crate) use outln;
-
-/// What a failed write to standard output is reported as: a closed pipe ends the command quietly.
-pub(crate) fn output_error(e: std::io::Error) -> String {
-    if e.kind() == std::io::ErrorKind::BrokenPipe {
-        BROKEN_PIPE.to_string()
-    } else {
-        format!("cannot write to standard output: {e}")
-    }
-}
-
-/// The error of a write to a closed pipe (the reader has all it wanted).
-const BROKEN_PIPE: &str = "standard output closed";
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -104,6 +96,7 @@ fn main() -> ExitCode {
         Command::Mass(args) => mass::run(args),
         Command::Render(args) => render::run(args),
         Command::Lines(args) => lines::run(args),
+        #[cfg(feature = "repro")]
         Command::Repro(args) => repro::run(args),
         Command::Rays(args) => rays::run(args),
         Command::Voxelize(args) => voxelize::run(args),
@@ -114,10 +107,9 @@ fn main() -> ExitCode {
         Command::Raycast(args) => query::run_raycast(args),
     };
     match outcome {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e == BROKEN_PIPE => ExitCode::SUCCESS,
-        Err(e) => {
-            distributed::report_failure(&e);
+        Ok(()) | Err(CliError::OutputClosed) => ExitCode::SUCCESS,
+        Err(CliError::Failed(message)) => {
+            distributed::report_failure(&message);
             ExitCode::FAILURE
         }
     }

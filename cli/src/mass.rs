@@ -3,6 +3,7 @@
 //! exact properties of a version 2 file are summed from its memory map, leaf by leaf, so a tree larger
 //! than memory is measured without being loaded.
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::PathBuf;
@@ -94,10 +95,10 @@ fn report<const K: usize>(t: &KTree<K>, tolerance: Option<f64>) -> Report {
 }
 
 /// Prints the mass properties.
-pub fn run(args: Args) -> Result<(), String> {
+pub fn run(args: Args) -> CliResult {
     if let Some(t) = args.tolerance {
         if !(t.is_finite() && t >= 0.0) {
-            return Err(format!("--tolerance must be a number ≥ 0, got {t}"));
+            return Err(format!("--tolerance must be a number ≥ 0, got {t}").into());
         }
     }
     let mapped = args.tolerance.is_none()

@@ -6,6 +6,7 @@
 //! files in `--temp-dir`; it is also faster than loading the trees. Otherwise (a version 1 file) the trees
 //! are read into memory, if they and the result fit in the budget (`--max-memory`).
 
+use crate::common::error::{CliError, CliResult};
 use std::path::PathBuf;
 
 use ktree::io::ktree_file_version;
@@ -65,7 +66,7 @@ impl Operation {
 
 /// Checks that the operation fits in the budget: it holds its input trees (about as large in memory as in
 /// their files) and a result at most as large as them together.
-fn check_budget(args: &Args) -> Result<(), String> {
+fn check_budget(args: &Args) -> CliResult {
     let mut files = 0u64;
     for input in &args.inputs {
         files += std::fs::metadata(input)
@@ -77,20 +78,19 @@ fn check_budget(args: &Args) -> Result<(), String> {
         .iter()
         .map(|p| p.display().to_string())
         .collect();
-    args.budget
-        .left_after(
-            &format!(
-                "the trees of {} and the result (held in memory)",
-                names.join(" and ")
-            ),
-            files.saturating_mul(2),
-        )
-        .map(drop)
+    args.budget.left_after(
+        &format!(
+            "the trees of {} and the result (held in memory)",
+            names.join(" and ")
+        ),
+        files.saturating_mul(2),
+    )?;
+    Ok(())
 }
 
 /// The operation streamed from the inputs' memory maps to the output, if the inputs and the output are
 /// `.ktree` version 2 files (`None` otherwise).
-fn stream_op(args: &Args) -> Option<Result<(), String>> {
+fn stream_op(args: &Args) -> Option<CliResult> {
     let all_v2 = crate::common::tree_file::version() == 2
         && args
             .inputs
@@ -107,18 +107,18 @@ fn stream_op(args: &Args) -> Option<Result<(), String>> {
     };
     Some(
         report
-            .map_err(|e| e.to_string())
+            .map_err(|e| CliError::from(e.to_string()))
             .and_then(|r| print_summary(&args.out, r.k, r.level, &r.counts_per_level)),
     )
 }
 
 /// Runs the operation and writes the result, on a pool of `--threads` worker threads.
-pub fn run(args: Args) -> Result<(), String> {
+pub fn run(args: Args) -> CliResult {
     let threads = args.threads;
     crate::common::threads::with_threads(threads, || run_op(args))?
 }
 
-fn run_op(args: Args) -> Result<(), String> {
+fn run_op(args: Args) -> CliResult {
     if let Some(streamed) = stream_op(&args) {
         return streamed;
     }
@@ -131,10 +131,7 @@ fn run_op(args: Args) -> Result<(), String> {
         return ktree::with_dim!(&out, AnyTree, t => write(&args.out, t));
     };
     let [a, b] = args.inputs.as_slice() else {
-        return Err(format!(
-            "`ktree op {}` takes exactly two input trees",
-            op.name()
-        ));
+        return Err(format!("`ktree op {}` takes exactly two input trees", op.name()).into());
     };
     let (ta, tb) = (read(a)?, read(b)?);
     let out = ta.boolean(&tb, op).map_err(|e| pair_error(a, b, e))?;

@@ -3,6 +3,7 @@
 //! on a tree file. A version 2 file is read through its memory map (so a tree larger than memory is
 //! queried without being loaded); others are loaded.
 
+use crate::common::error::CliResult;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -53,9 +54,9 @@ pub struct RaycastArgs {
 /// The tree of a file: mapped (version 2) or loaded, and the queries run on either.
 fn with_tree<R>(
     path: &Path,
-    mut mapped: impl FnMut(&KtreeView) -> Result<R, String>,
-    mut loaded: impl FnMut(&AnyTree) -> Result<R, String>,
-) -> Result<R, String> {
+    mut mapped: impl FnMut(&KtreeView) -> CliResult<R>,
+    mut loaded: impl FnMut(&AnyTree) -> CliResult<R>,
+) -> CliResult<R> {
     if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION {
         let view = KtreeView::open(path).map_err(|e| e.to_string())?;
         mapped(&view)
@@ -86,8 +87,8 @@ fn points<const K: usize>(t: &table::Table<i64>) -> Vec<[i64; K]> {
 fn answer_points<const K: usize, T: LevelOrder<K> + Sync>(
     tree: &T,
     args: &QueryArgs,
-    check: impl Fn() -> Result<(), String>,
-) -> Result<(), String> {
+    check: impl Fn() -> CliResult,
+) -> CliResult {
     let table = table::read::<i64>(&args.points, K)?;
     let pts = points::<K>(&table);
     // Points beyond the u32 range are outside every universe.
@@ -103,7 +104,7 @@ fn answer_points<const K: usize, T: LevelOrder<K> + Sync>(
     };
     check()?;
     let mut w = out();
-    let io = crate::output_error;
+    let io = crate::common::error::CliError::from_output;
     if args.json {
         w.write_all(b"[").map_err(io)?;
     }
@@ -164,25 +165,25 @@ fn answer_points<const K: usize, T: LevelOrder<K> + Sync>(
 }
 
 /// Runs `ktree query`.
-pub fn run_query(args: QueryArgs) -> Result<(), String> {
+pub fn run_query(args: QueryArgs) -> CliResult {
     with_tree(
         &args.tree,
         |view| match view.k() {
             1 => {
                 let t = mapped_tree::<1>(view)?;
-                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string()))
+                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
             }
             2 => {
                 let t = mapped_tree::<2>(view)?;
-                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string()))
+                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
             }
             3 => {
                 let t = mapped_tree::<3>(view)?;
-                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string()))
+                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
             }
             _ => {
                 let t = mapped_tree::<4>(view)?;
-                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string()))
+                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
             }
         },
         |tree| ktree::with_dim!(tree, AnyTree, t => answer_points(t, &args, || Ok(()))),
@@ -209,13 +210,14 @@ fn rays<const K: usize>(t: &table::Table<f64>, max_t: f64) -> Result<Vec<RayCast
 fn answer_rays<const K: usize, T: LevelOrder<K> + Sync>(
     tree: &T,
     args: &RaycastArgs,
-    check: impl Fn() -> Result<(), String>,
-) -> Result<(), String> {
+    check: impl Fn() -> CliResult,
+) -> CliResult {
     if args.max_t.is_nan() || args.max_t < 0.0 {
         return Err(format!(
             "--max-t must be a number >= 0 (inf for no limit), got {}",
             args.max_t
-        ));
+        )
+        .into());
     }
     let table = table::read::<f64>(&args.rays, 2 * K)?;
     let casts = rays::<K>(&table, args.max_t)?;
@@ -223,7 +225,7 @@ fn answer_rays<const K: usize, T: LevelOrder<K> + Sync>(
         query::cast_rays(tree, &casts).unwrap_or_else(|e| match e {});
     check()?;
     let mut w = out();
-    let io = crate::output_error;
+    let io = crate::common::error::CliError::from_output;
     if args.json {
         w.write_all(b"[").map_err(io)?;
     }
@@ -259,25 +261,25 @@ fn answer_rays<const K: usize, T: LevelOrder<K> + Sync>(
 }
 
 /// Runs `ktree raycast`.
-pub fn run_raycast(args: RaycastArgs) -> Result<(), String> {
+pub fn run_raycast(args: RaycastArgs) -> CliResult {
     with_tree(
         &args.tree,
         |view| match view.k() {
             1 => {
                 let t = mapped_tree::<1>(view)?;
-                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string()))
+                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
             }
             2 => {
                 let t = mapped_tree::<2>(view)?;
-                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string()))
+                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
             }
             3 => {
                 let t = mapped_tree::<3>(view)?;
-                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string()))
+                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
             }
             _ => {
                 let t = mapped_tree::<4>(view)?;
-                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string()))
+                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
             }
         },
         |tree| ktree::with_dim!(tree, AnyTree, t => answer_rays(t, &args, || Ok(()))),

@@ -1,5 +1,6 @@
 //! `ktree rays --solid NAME ... --level L --out FILE`: an analytic solid (quadric or box) to rays.
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -7,11 +8,10 @@ use std::path::{Path, PathBuf};
 use ktree::fs::write_atomic_with;
 use ktree::io::write_rays_source;
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{default_split_depth, Builder};
+use ktree::stacking::default_split_depth;
 use ktree::LevelCounts;
 
-use crate::common::output::{is_tree_file, one_process_for_version_1};
-use crate::common::threads::with_threads;
+use crate::common::output::is_tree_file;
 
 /// Arguments of `ktree rays`.
 #[derive(Debug, clap::Args)]
@@ -161,7 +161,7 @@ fn tree_summary<const K: usize>(out: &Path, level: u32, counts: &[LevelCounts]) 
     )
 }
 
-fn go<const K: usize>(a: &Args) -> Result<(), String> {
+fn go<const K: usize>(a: &Args) -> CliResult {
     let s = solid::<K>(a)?;
     let sample = if a.corner {
         Sample::Corner
@@ -172,19 +172,12 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole
         // (across MPI ranks, each rank makes the rays of its own slabs only).
         let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
-        let counts = if crate::common::memory::out_of_core() {
-            let budget = a.build.budget.budget();
-            match crate::distributed::build_to_file(&source, &a.out, a.threads, &a.build, budget)? {
-                Some(report) => report.counts_per_level,
-                None => return Ok(()),
-            }
-        } else {
-            one_process_for_version_1()?;
-            let tree = with_threads(a.threads, || Builder::new(&source).build())?
-                .map_err(|e| e.to_string())?;
-            crate::common::tree_file::write_tree(&a.out, &tree)
-                .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
-            tree.counts_per_level()
+        let budget = a.build.budget.budget();
+        let counts = match crate::distributed::build_to_file(
+            &source, &a.out, a.threads, &a.build, budget,
+        )? {
+            Some(report) => report.counts_per_level,
+            None => return Ok(()),
         };
         outln!("{}", tree_summary::<K>(&a.out, a.level, &counts));
         return Ok(());
@@ -223,12 +216,12 @@ fn go<const K: usize>(a: &Args) -> Result<(), String> {
 }
 
 /// Builds the solid's rays and writes them.
-pub fn run(args: Args) -> Result<(), String> {
+pub fn run(args: Args) -> CliResult {
     match args.dim {
         1 => go::<1>(&args),
         2 => go::<2>(&args),
         3 => go::<3>(&args),
         4 => go::<4>(&args),
-        k => Err(format!("--dim {k}: K must be 1, 2, 3 or 4")),
+        k => Err(format!("--dim {k}: K must be 1, 2, 3 or 4").into()),
     }
 }

@@ -2,6 +2,7 @@
 //! hidden-surface image of an octree; a quadtree is drawn as a picture of its cells, a 4-D tree as a strip
 //! of time slices.
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -70,7 +71,7 @@ fn default_out(file: &Path) -> PathBuf {
 }
 
 /// Renders the file.
-pub fn run(args: Args) -> Result<(), String> {
+pub fn run(args: Args) -> CliResult {
     let (w, h) = parse_size(&args.size)?;
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.file));
     let bar = progress_bar(args.progress, "render");
@@ -139,7 +140,7 @@ fn render_octree<T: LevelOrder<3>>(
     h: u32,
     bar: Option<&ProgressBar>,
     tick: &mut dyn FnMut(u64, u64),
-) -> Result<(), String> {
+) -> CliResult {
     let toward = parse_view(&args.camera)?;
     let mut camera =
         default_camera(tree, toward, args.perspective, w, h).map_err(|e| e.to_string())?;
@@ -180,20 +181,23 @@ fn render_octree<T: LevelOrder<3>>(
                     path.display(),
                     r.level(),
                     tree.level()
-                ))
+                )
+                .into())
             }
             AnyRaySet::K3(r) if r.has_normals() => Some(r),
             AnyRaySet::K3(_) => {
                 return Err(format!(
                     "{}: the rays carry no normals to shade with",
                     path.display()
-                ))
+                )
+                .into())
             }
             _ => {
                 return Err(format!(
                     "{}: normals for an octree need a K = 3 ray file",
                     path.display()
-                ))
+                )
+                .into())
             }
         },
     };

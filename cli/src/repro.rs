@@ -1,5 +1,6 @@
 //! `ktree repro [NAME]`: regenerate reproductions into results/.
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::PathBuf;
@@ -16,7 +17,7 @@ pub struct Args {
 }
 
 /// Runs the chosen reproductions and prints what each wrote.
-pub fn run(args: Args) -> Result<(), String> {
+pub fn run(args: Args) -> CliResult {
     let names: Vec<&str> = if args.name == "all" {
         ktree_repro::NAMES.to_vec()
     } else if ktree_repro::NAMES.contains(&args.name.as_str()) {
@@ -26,7 +27,8 @@ pub fn run(args: Args) -> Result<(), String> {
             "unknown reproduction '{}': choose one of all, {}",
             args.name,
             ktree_repro::NAMES.join(", ")
-        ));
+        )
+        .into());
     };
     for name in names {
         let report = ktree_repro::run(name, &args.out).map_err(|e| format!("{name}: {e}"))?;

@@ -2,6 +2,7 @@
 //! `ktree components FILE [--connectivity C] [--out-dir D] [--json]`: morphology and connected components
 //! of a `.ktree` file; and the measures (`surface_area`, `euler_number`) that `stats` and `mass` report.
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -31,7 +32,7 @@ pub struct MorphArgs {
     out: PathBuf,
 }
 
-fn morph<const K: usize>(t: &KTree<K>, args: &MorphArgs) -> Result<(), String> {
+fn morph<const K: usize>(t: &KTree<K>, args: &MorphArgs) -> CliResult {
     let (r, e) = (args.radius, args.shape);
     let out = match args.operation.as_str() {
         "dilate" => t.dilate(r, e),
@@ -44,12 +45,9 @@ fn morph<const K: usize>(t: &KTree<K>, args: &MorphArgs) -> Result<(), String> {
 }
 
 /// Runs `ktree morph`.
-pub fn run_morph(args: MorphArgs) -> Result<(), String> {
+pub fn run_morph(args: MorphArgs) -> CliResult {
     if !(args.radius.is_finite() && args.radius >= 0.0) {
-        return Err(format!(
-            "--radius must be a number ≥ 0, got {}",
-            args.radius
-        ));
+        return Err(format!("--radius must be a number ≥ 0, got {}", args.radius).into());
     }
     let tree = read(&args.tree)?;
     ktree::with_dim!(&tree, AnyTree, t => morph(t, &args))
@@ -111,7 +109,7 @@ fn components<const K: usize>(
 }
 
 /// Runs `ktree components`.
-pub fn run_components(args: ComponentsArgs) -> Result<(), String> {
+pub fn run_components(args: ComponentsArgs) -> CliResult {
     let tree = read(&args.tree)?;
     let report = ktree::with_dim!(&tree, AnyTree, t => components(t, &args))?;
     if args.json {

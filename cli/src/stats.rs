@@ -3,6 +3,7 @@
 //! (`surface_area`, `euler_number`) are measured on the tree read into memory, when the file is small next
 //! to the memory budget.
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::PathBuf;
@@ -45,7 +46,7 @@ fn view_stats(view: &KtreeView) -> TreeStats {
 }
 
 /// Prints the statistics.
-pub fn run(args: Args) -> Result<(), String> {
+pub fn run(args: Args) -> CliResult {
     // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
     let (stats, measures) = match (&args.tree, &args.rays) {
         (Some(path), None) if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION => (

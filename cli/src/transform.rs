@@ -6,6 +6,7 @@
 //! the exact integer operations (rational overlays, child reordering, translation overlays). Otherwise all
 //! steps are concatenated into one affine matrix applied in a single overlay pass (Meagher's M6).
 
+use crate::common::error::CliResult;
 use std::path::PathBuf;
 
 use ktree::ops::{self, Affine, AxisMap, Projective};
@@ -197,7 +198,7 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
 }
 
 /// Applies the transforms and writes the result.
-pub fn run(args: Args) -> Result<(), String> {
+pub fn run(args: Args) -> CliResult {
     if args.translate.is_none()
         && args.rotate.is_none()
         && args.scale.is_none()

@@ -1,6 +1,7 @@
 //! `ktree voxelize MESH|VOLUME --level L (--fit | --transform s,tx,ty,tz) --out FILE`: a triangle mesh (OBJ,
 //! STL, PLY) or a volume (raw + JSON sidecar, NIfTI) to rays or a tree.
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::collections::BTreeMap;
@@ -15,7 +16,6 @@ use ktree::stacking::{RaySource, SlabRuns};
 use ktree::{LevelCounts, Universe};
 
 use crate::common::output::{is_tree_file, write_output};
-use crate::common::threads::with_threads;
 
 /// Arguments of `ktree voxelize`.
 #[derive(Debug, clap::Args)]
@@ -51,7 +51,7 @@ pub struct Args {
 }
 
 /// Voxelizes the input and writes it.
-pub fn run(a: Args) -> Result<(), String> {
+pub fn run(a: Args) -> CliResult {
     let mut options = ReadOptions {
         level: a.level,
         ..ReadOptions::default()
@@ -89,10 +89,7 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     // In a run over several MPI ranks, rank 0 alone reports.
     let root = crate::distributed::ranks().is_root();
-    if is_tree_file(&a.out)
-        && crate::common::memory::out_of_core()
-        && crate::distributed::ranks().size == 1
-    {
+    if is_tree_file(&a.out) && crate::distributed::ranks().size == 1 {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
         // (Across MPI ranks, every rank makes the rays whole and keeps its slabs: `write_output`.)
         let v = voxel_source(&a.input, &options).map_err(|e| e.to_string())?;
@@ -108,12 +105,7 @@ pub fn run(a: Args) -> Result<(), String> {
 
 /// Prints the transform `--fit` chose and warns about a mesh that is not closed (`root`: this process
 /// reports).
-fn remarks(
-    input: &Path,
-    fitted: Option<&str>,
-    open_edges: usize,
-    root: bool,
-) -> Result<(), String> {
+fn remarks(input: &Path, fitted: Option<&str>, open_edges: usize, root: bool) -> CliResult {
     if let (Some(t), true) = (fitted, root) {
         outln!("--fit chose --transform {t}");
     }
@@ -136,9 +128,11 @@ fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
     };
     let budget = a.build.budget.left_after(&what, source.heap_bytes())?;
     let counted = CountedRuns::new(source);
-    let report = with_threads(a.threads, || {
-        crate::common::memory::build_to_file(&counted, &a.out, &a.build, budget)
-    })??;
+    let Some(report) =
+        crate::distributed::build_to_file(&counted, &a.out, a.threads, &a.build, budget)?
+    else {
+        return Ok(String::new());
+    };
     let level = source.universe().level();
     let c = LevelCounts::total(level, &report.counts_per_level);
     Ok(format!(

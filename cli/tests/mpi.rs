@@ -283,27 +283,25 @@ fn a_failure_while_rank_0_writes_leaves_no_output_and_no_spill_folder() {
 }
 
 #[test]
-fn format_version_1_over_ranks_is_a_clear_error() {
+fn format_version_1_over_ranks_is_the_one_process_file() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("v1.ktree");
+    let one = dir.path().join("one.ktree");
+    let solid = ["rays", "--solid", "ball", "--level", "5", "--radius", "10"];
+    let version = ["--format-version", "1", "--out"];
     let run = mpirun(
         2,
-        &[
-            "rays",
-            "--solid",
-            "ball",
-            "--level",
-            "5",
-            "--radius",
-            "10",
-            "--format-version",
-            "1",
-            "--out",
-            out.to_str().unwrap(),
-        ],
+        &[&solid[..], &version[..], &[out.to_str().unwrap()]].concat(),
     );
-    assert!(!run.status.success());
-    let err = String::from_utf8_lossy(&run.stderr);
-    assert!(err.contains("--format-version 1"), "{err}");
-    assert!(entries(dir.path()).is_empty());
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let (ok, _, err) = ktree(&[&solid[..], &version[..], &[one.to_str().unwrap()]].concat());
+    assert!(ok, "{err}");
+    assert_eq!(ktree::io::ktree_file_version(&out).unwrap(), 1);
+    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&one).unwrap());
+    // The version 2 file it was streamed from is gone.
+    assert_eq!(entries(dir.path()), vec!["one.ktree", "v1.ktree"]);
 }

@@ -26,6 +26,7 @@
 mod dispatch;
 pub mod interop;
 pub mod ktree;
+mod location;
 #[allow(unsafe_code)]
 mod mmap;
 pub mod rays;
@@ -40,11 +41,12 @@ pub use interop::{
     read_binvox, read_bt, read_vdb, write_binvox, write_bt, write_vdb, GridFileError,
     GridFileErrorKind, GridMeta, GridPlacement, PlacedTree, BINVOX_MAX_DIM, BT_DEPTH, BT_HEADER,
 };
-pub use ktree::v1::write_ktree_v1;
+pub use ktree::v1::{write_ktree_v1, write_ktree_v1_view};
 pub use ktree::{
     ktree_file_version, read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file,
     KtreeFileError, KtreeFileErrorKind, KtreeView, KtreeWriter, MappedTree, MAGIC, VERSION,
 };
+pub use location::{FileError, Location, Place, ProblemKind};
 pub use rays::{
     open_rays_file, read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source,
     AnyRaysFileSource, RaysFile, RaysFileSource, RaysTextError, RaysTextErrorKind,

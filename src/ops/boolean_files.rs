@@ -33,6 +33,7 @@
 //! assert_eq!(io::read_ktree_file(&pc).unwrap(), ktree::AnyTree::K2(ops::difference(&a, &b).unwrap()));
 //! ```
 
+use crate::fs::SpillError;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
@@ -74,30 +75,9 @@ pub enum BooleanFileError {
         /// Its `L`.
         lb: u32,
     },
-    /// The folder for the spill files cannot be used.
-    #[error("cannot create spill files in the temporary folder {}: {source}", path.display())]
-    TempDir {
-        /// The folder.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
-    /// A spill file cannot be written or read back.
-    #[error("spill file {}: {source}", path.display())]
-    Spill {
-        /// The spill file.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
-    /// The output cannot be written.
-    #[error("cannot write {}: {source}", path.display())]
-    Output {
-        /// The output file.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
+    /// A temporary file or the output could not be written.
+    #[error(transparent)]
+    Files(#[from] SpillError),
 }
 
 /// What a streamed Boolean wrote.
@@ -212,7 +192,7 @@ fn boolean_views_k<const K: usize>(
     };
     let depths = a.depth_count().max(sb.map_or(0, |b| b.view.depth_count()));
     let folder = crate::fs::spill_folder(out, temp_dir)
-        .map_err(|(path, source)| BooleanFileError::TempDir { path, source })?;
+        .map_err(|(path, source)| BooleanFileError::Files(SpillError::TempDir { path, source }))?;
     let sink = SpillLevels::create(folder.path(), depths, K, a.level(), out)?;
     let report = match (operation, sb) {
         (ViewOperation::Binary(op, _), Some(sb)) => boolean_into(&sa, &sb, op, sink),
@@ -341,9 +321,11 @@ impl SpillLevels {
         let levels = (1..depths)
             .map(|d| {
                 let path = folder.join(format!("level-{d}"));
-                let file = File::create(&path).map_err(|source| BooleanFileError::Spill {
-                    path: path.clone(),
-                    source,
+                let file = File::create(&path).map_err(|source| {
+                    BooleanFileError::Files(SpillError::Spill {
+                        path: path.clone(),
+                        source,
+                    })
                 })?;
                 Ok(OutputLevel {
                     path,
@@ -369,9 +351,11 @@ impl SpillLevels {
             level
                 .file
                 .write_all(&whole.to_le_bytes())
-                .map_err(|source| BooleanFileError::Spill {
-                    path: level.path.clone(),
-                    source,
+                .map_err(|source| {
+                    BooleanFileError::Files(SpillError::Spill {
+                        path: level.path.clone(),
+                        source,
+                    })
                 })?;
         }
         Ok(())
@@ -385,15 +369,17 @@ impl SpillLevels {
         for mut l in self.levels {
             if let Some(word) = l.packer.flush() {
                 l.file.write_all(&word.to_le_bytes()).map_err(|source| {
-                    BooleanFileError::Spill {
+                    BooleanFileError::Files(SpillError::Spill {
                         path: l.path.clone(),
                         source,
-                    }
+                    })
                 })?;
             }
-            let spill_err = |source| BooleanFileError::Spill {
-                path: l.path.clone(),
-                source,
+            let spill_err = |source| {
+                BooleanFileError::Files(SpillError::Spill {
+                    path: l.path.clone(),
+                    source,
+                })
             };
             let file = l.file.into_inner().map_err(|e| spill_err(e.into_error()))?;
             spilled_bytes += 8 * l.nodes.div_ceil(NODES_PER_WORD);
@@ -430,9 +416,11 @@ impl SpillLevels {
             counts = writer.counts_per_level();
             writer.finish()?.flush()
         })
-        .map_err(|source| BooleanFileError::Output {
-            path: out.to_path_buf(),
-            source,
+        .map_err(|source| {
+            BooleanFileError::Files(SpillError::Output {
+                path: out.to_path_buf(),
+                source,
+            })
         })?;
         Ok(BooleanFileReport {
             k,

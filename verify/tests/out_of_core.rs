@@ -7,6 +7,7 @@
 //! and their levels streamed to it in chunks), the file is the same, for 1 … 5 parts and any chunk size;
 //! a damaged index or a stream that breaks off is an error that leaves the target and no temporary file.
 
+use ktree::fs::SpillError;
 use std::path::Path;
 
 use ktree::io::write_ktree;
@@ -316,7 +317,7 @@ fn an_unusable_temporary_folder_is_a_clear_error() {
         .to_file(&out, u64::MAX)
         .unwrap_err();
     assert!(
-        matches!(e, BuildError::TempDir { .. }),
+        matches!(e, BuildError::Files(SpillError::TempDir { .. })),
         "unexpected error {e:?}"
     );
     let message = e.to_string();
@@ -475,7 +476,10 @@ fn a_stream_that_breaks_off_fails_the_write_and_keeps_the_target() {
             &|_| {},
         )
         .unwrap_err();
-    assert!(matches!(e, BuildError::Output { .. }), "{e:?}");
+    assert!(
+        matches!(e, BuildError::Files(SpillError::Output { .. })),
+        "{e:?}"
+    );
     assert!(e.to_string().contains("the sender stopped"), "{e}");
     assert_eq!(std::fs::read(&out).unwrap(), b"old".to_vec());
     assert_eq!(entries(dir.path()), vec!["tree.ktree".to_string()]);

@@ -1,15 +1,18 @@
 //! `--max-memory SIZE`, `--temp-dir DIR` and `--progress`: trees written out of core, in a memory budget.
 //! (`ktree op` streams version 2 files in bounded memory, and checks that trees it must load fit.)
 //!
-//! A command that writes a `.ktree` (version 2) from rays builds it with
-//! [`ktree::stacking::stack_to_file`]: the subtrees of the cells are spilled to temporary files as they
+//! A command that writes a `.ktree` from rays builds it with
+//! [`ktree::stacking::Builder::to_file`]: the subtrees of the cells are spilled to temporary files as they
 //! are stacked and streamed into the output, so only the top of the tree and the slabs being stacked are
 //! held. The file is byte for byte the one the in-memory build writes. The budget covers what the command
 //! holds besides: a solid, a sorted ray file, a mesh or a volume makes its rays slab by slab, and only its
 //! own data (the ray file's index, the placed triangles, the samples) counts against it; rays read whole (an
-//! unsorted ray file) count whole.
+//! unsorted ray file) count whole. A file of format version 1 is built the same way, as a version 2 file that
+//! is then streamed into version 1 ([`crate::common::tree_file::as_version_1`]): the format version never
+//! chooses how a tree is built.
 //! Across MPI ranks the budget applies to each rank (see [`crate::distributed`]).
 
+use ktree::fs::SpillError;
 use std::path::{Path, PathBuf};
 
 use crate::common::progress::report_progress;
@@ -163,7 +166,7 @@ pub fn describe<E: std::fmt::Display>(out: &Path, e: BuildError<E>, held: u64) -
                 needed: needed.saturating_add(held),
             }
         ),
-        BuildError::Output { .. } => format!("cannot write {}: {e}", out.display()),
+        BuildError::Files(output @ SpillError::Output { .. }) => output.to_string(),
         other => format!("{}: {other}", out.display()),
     }
 }
@@ -182,10 +185,13 @@ pub fn ray_bytes<const K: usize>(rays: &RaySet<K>) -> u64 {
     rays.len() as u64 * per_run
 }
 
-/// Whether the trees written in this run are built out of core: a `.ktree` of format version 2 (by one
-/// process or across MPI ranks; version 1 is built in memory, by one process only).
-pub fn out_of_core() -> bool {
-    crate::common::tree_file::version() == 2
+/// The process's peak resident memory (VmHWM in `/proc/self/status`), in bytes; `None` where the system does
+/// not report it.
+#[cfg_attr(not(feature = "mpi"), allow(dead_code))]
+pub fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib = status.lines().find_map(|l| l.strip_prefix("VmHWM:"))?;
+    Some(kib.split_whitespace().next()?.parse::<u64>().ok()? * 1024)
 }
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! Trees in and out of the commands: reading `.ktree` files, writing them in the format version asked for
 //! (`--format-version`, default 2), and the one-line summary of a tree written.
 
+use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::Path;
@@ -8,7 +9,7 @@ use std::sync::OnceLock;
 
 use ktree::fs::write_atomic_with;
 use ktree::io::read_ktree_file;
-use ktree::io::{write_ktree_file, write_ktree_v1};
+use ktree::io::{write_ktree_file, write_ktree_v1, write_ktree_v1_view, KtreeView};
 use ktree::ops;
 use ktree::{AnyTree, KTree, LevelCounts};
 
@@ -44,24 +45,46 @@ pub fn write_tree<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Resu
     }
 }
 
+/// Runs `build`, which writes a version 2 file at the path it is given, to write `out` in version 1: the
+/// version 2 file is a hidden sibling of `out`, streamed into version 1 word by word through its memory map
+/// ([`write_ktree_v1_view`]) by the process that wrote it (rank 0 of an MPI run), then removed. The build is
+/// the same whatever the version: out of core, in the memory budget.
+pub fn as_version_1<R>(
+    out: &Path,
+    build: impl FnOnce(&Path) -> Result<Option<R>, String>,
+) -> Result<Option<R>, String> {
+    let name = out
+        .file_name()
+        .map_or_else(|| "tree".into(), |n| n.to_string_lossy());
+    let v2 = out.with_file_name(format!(".{name}.version-2.ktree"));
+    let built = build(&v2);
+    let written = match &built {
+        Ok(Some(_)) => KtreeView::open(&v2)
+            .map_err(|e| e.to_string())
+            .and_then(|view| {
+                write_atomic_with(out, |w| write_ktree_v1_view(w, &view))
+                    .map_err(|e| format!("cannot write {}: {e}", out.display()))
+            }),
+        _ => Ok(()),
+    };
+    let _ = std::fs::remove_file(&v2);
+    written?;
+    built
+}
+
 /// Reads a tree file, with the path in any error.
 pub fn read(path: &Path) -> Result<AnyTree, String> {
     read_ktree_file(path).map_err(|e| e.to_string())
 }
 
 /// Writes a tree file and prints a one-line summary.
-pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> Result<(), String> {
+pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> CliResult {
     write_tree(path, tree).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     print_summary(path, K, tree.level(), &tree.counts_per_level())
 }
 
 /// Prints the one-line summary of a tree written to `path`, from its counts per level.
-pub fn print_summary(
-    path: &Path,
-    k: usize,
-    level: u32,
-    counts: &[LevelCounts],
-) -> Result<(), String> {
+pub fn print_summary(path: &Path, k: usize, level: u32, counts: &[LevelCounts]) -> CliResult {
     let c = LevelCounts::total(level, counts);
     let voxels = crate::common::memory::voxels(k, level, counts);
     outln!(

@@ -69,6 +69,26 @@ where
     S: RaySource<K>,
     S::Error: std::fmt::Display,
 {
+    if crate::common::tree_file::version() == 1 {
+        return crate::common::tree_file::as_version_1(out, |v2| {
+            build_to_file_v2(source, v2, threads, args, budget)
+        });
+    }
+    build_to_file_v2(source, out, threads, args, budget)
+}
+
+/// [`build_to_file`] of a version 2 file.
+fn build_to_file_v2<const K: usize, S>(
+    source: &S,
+    out: &Path,
+    threads: Option<usize>,
+    args: &BuildArgs,
+    budget: u64,
+) -> Result<Option<OutOfCoreReport>, String>
+where
+    S: RaySource<K>,
+    S::Error: std::fmt::Display,
+{
     if ranks().size == 1 {
         return crate::common::threads::with_threads(threads, || {
             crate::common::memory::build_to_file(source, out, args, budget)

@@ -165,7 +165,7 @@ where
             w,
             streamed.map_err(|e| format!("{}: sending the levels: {e}", out.display())),
         )?;
-        root.gather_into(&ktree_repro::peak_rss_bytes().unwrap_or(0));
+        root.gather_into(&crate::common::memory::peak_rss_bytes().unwrap_or(0));
         return Ok(None);
     }
     let mut moved = 0u64;
@@ -177,7 +177,7 @@ where
         moved += 8 * words.len() as u64;
         match part.add_part(&words) {
             Ok(total) => streams.push(Stream::new(from, total)),
-            Err(e) if added.is_ok() => added = Err(format!("rank {r}: {e}")),
+            Err(e) if added.is_ok() => added = Err(format!("rank {r}: {e}").into()),
             Err(_) => {}
         }
     }
@@ -200,7 +200,7 @@ where
         written.map_err(|e| crate::common::memory::describe(out, e, held)),
     )?;
     let mut peaks = vec![0u64; size];
-    let own = ktree_repro::peak_rss_bytes().unwrap_or(0);
+    let own = crate::common::memory::peak_rss_bytes().unwrap_or(0);
     root.gather_into_root(&own, &mut peaks[..]);
     eprintln!(
         "ktree: {size} ranks; {moved} bytes sent to rank 0; peak memory per rank (MiB): {}",

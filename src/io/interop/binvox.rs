@@ -411,12 +411,12 @@ mod tests {
         let mut bad = bytes.clone();
         bad[data_at] = 7;
         let e = read_binvox(&bad, "s", None, None).unwrap_err();
-        assert_eq!(e.offset, data_at as u64, "{e}");
+        assert_eq!(e.offset(), Some(data_at as u64), "{e}");
         let mut bad = bytes.clone();
         bad[data_at + 1] = 0;
         assert_eq!(
-            read_binvox(&bad, "s", None, None).unwrap_err().offset,
-            data_at as u64 + 1
+            read_binvox(&bad, "s", None, None).unwrap_err().offset(),
+            Some(data_at as u64 + 1)
         );
         let mut padded = bytes.clone();
         padded.extend_from_slice(&[0, 1]);

@@ -5,8 +5,6 @@
 //! power of two. ktree voxel `v` is grid index `i` with `v = i + offset`; the offset and the universe level
 //! are chosen by [`GridPlacement::choose`] unless the caller fixes them.
 
-use std::fmt;
-
 use thiserror::Error;
 
 use crate::space::max_level;
@@ -38,26 +36,12 @@ pub enum GridFileErrorKind {
 }
 
 /// An error reading or writing a grid file, with the file and the byte offset where it was found.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct GridFileError {
-    /// The file (or a name for the input).
-    pub file: String,
-    /// Byte offset of the problem (0 for a problem with the whole file).
-    pub offset: u64,
-    /// What was wrong.
-    pub kind: GridFileErrorKind,
-}
+pub type GridFileError = crate::io::FileError<GridFileErrorKind>;
 
-impl fmt::Display for GridFileError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: byte {}: {}", self.file, self.offset, self.kind)
-    }
-}
-
-impl std::error::Error for GridFileError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match &self.kind {
-            GridFileErrorKind::Io(cause) => Some(cause.error()),
+impl crate::io::ProblemKind for GridFileErrorKind {
+    fn io_cause(&self) -> Option<&std::io::Error> {
+        match self {
+            Self::Io(cause) => Some(cause.error()),
             _ => None,
         }
     }
@@ -65,11 +49,7 @@ impl std::error::Error for GridFileError {
 
 impl GridFileError {
     pub(crate) fn new(file: &str, offset: usize, kind: GridFileErrorKind) -> Self {
-        Self {
-            file: file.to_string(),
-            offset: offset as u64,
-            kind,
-        }
+        Self::at_byte(file, offset as u64, kind)
     }
 }
 

@@ -17,7 +17,6 @@
 //! assert!(io::read_ktree::<2>(&bytes, "mem").is_err());
 //! ```
 
-use std::fmt;
 use std::fs::File;
 use std::io::Write;
 use std::path::Path;
@@ -95,26 +94,12 @@ pub enum KtreeFileErrorKind {
 }
 
 /// An error reading a `.ktree` file, with the file and the byte offset.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct KtreeFileError {
-    /// The file (or a name for the input).
-    pub file: String,
-    /// Byte offset where the problem was found.
-    pub offset: u64,
-    /// What was wrong.
-    pub kind: KtreeFileErrorKind,
-}
+pub type KtreeFileError = crate::io::FileError<KtreeFileErrorKind>;
 
-impl fmt::Display for KtreeFileError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: byte {}: {}", self.file, self.offset, self.kind)
-    }
-}
-
-impl std::error::Error for KtreeFileError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match &self.kind {
-            KtreeFileErrorKind::Io(cause) => Some(cause.error()),
+impl crate::io::ProblemKind for KtreeFileErrorKind {
+    fn io_cause(&self) -> Option<&std::io::Error> {
+        match self {
+            Self::Io(cause) => Some(cause.error()),
             _ => None,
         }
     }
@@ -143,10 +128,12 @@ pub fn write_ktree_file<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io
 pub fn read_ktree<const K: usize>(bytes: &[u8], file: &str) -> Result<KTree<K>, KtreeFileError> {
     let any = read_ktree_any(bytes, file)?;
     let found = any.k();
-    any.into_dim::<K>().map_err(|_| KtreeFileError {
-        file: file.to_string(),
-        offset: 8,
-        kind: KtreeFileErrorKind::Dimension { expected: K, found },
+    any.into_dim::<K>().map_err(|_| {
+        KtreeFileError::at_byte(
+            file.to_string(),
+            8,
+            KtreeFileErrorKind::Dimension { expected: K, found },
+        )
     })
 }
 
@@ -156,11 +143,8 @@ pub fn read_ktree<const K: usize>(bytes: &[u8], file: &str) -> Result<KTree<K>, 
 /// As [`read_ktree_any`]; an unreadable file is [`KtreeFileErrorKind::Io`].
 pub fn read_ktree_file(path: &Path) -> Result<AnyTree, KtreeFileError> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| KtreeFileError {
-        file: name.clone(),
-        offset: 0,
-        kind: KtreeFileErrorKind::Io(e.into()),
-    })?;
+    let bytes = std::fs::read(path)
+        .map_err(|e| KtreeFileError::at_byte(name.clone(), 0, KtreeFileErrorKind::Io(e.into())))?;
     read_ktree_any(&bytes, &name)
 }
 
@@ -169,11 +153,7 @@ pub fn read_ktree_file(path: &Path) -> Result<AnyTree, KtreeFileError> {
 /// # Errors
 /// [`KtreeFileError`] naming the byte offset of the first inconsistency.
 pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileError> {
-    let fail = |offset: u64, kind| KtreeFileError {
-        file: file.to_string(),
-        offset,
-        kind,
-    };
+    let fail = |offset: u64, kind| KtreeFileError::at_byte(file.to_string(), offset, kind);
     if bytes.len() < 6 || &bytes[..6] != MAGIC {
         return Err(fail(0, KtreeFileErrorKind::BadMagic));
     }
@@ -204,17 +184,13 @@ pub fn ktree_file_version(path: &Path) -> Result<u16, KtreeFileError> {
             let len = f.metadata()?.len().min(8) as usize;
             v2::read_at(&f, 0, len)
         })
-        .map_err(|e| KtreeFileError {
-            file: name.clone(),
-            offset: 0,
-            kind: KtreeFileErrorKind::Io(e.into()),
-        })?;
+        .map_err(|e| KtreeFileError::at_byte(name.clone(), 0, KtreeFileErrorKind::Io(e.into())))?;
     if head.len() < 8 || &head[..6] != MAGIC {
-        return Err(KtreeFileError {
-            file: name,
-            offset: 0,
-            kind: KtreeFileErrorKind::BadMagic,
-        });
+        return Err(KtreeFileError::at_byte(
+            name,
+            0,
+            KtreeFileErrorKind::BadMagic,
+        ));
     }
     Ok(u16::from_le_bytes([head[6], head[7]]))
 }

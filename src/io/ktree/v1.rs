@@ -21,8 +21,10 @@
 
 use std::io::Write;
 
+use super::KtreeView;
 use super::{KtreeFileError, KtreeFileErrorKind, MAGIC};
 use crate::space::{max_level, Universe, MAX_K};
+use crate::tree::words::{slots_mask, WordPacker, NODES_PER_WORD};
 use crate::tree::{AnyTree, KTree, NodeState, PackedStates};
 
 /// The format version of this layout.
@@ -80,14 +82,86 @@ pub fn write_ktree_v1<const K: usize>(mut w: impl Write, tree: &KTree<K>) -> std
     w.write_all(&bytes)
 }
 
+/// Writes the tree of a version 2 file ([`KtreeView`], memory-mapped) as a version 1 file, streamed: word by
+/// word, in memory of a few words whatever the tree's size. The bytes are those [`write_ktree_v1`] writes for
+/// the same tree, so a tree built out of core can be written in the old layout.
+///
+/// ```
+/// use ktree::io::{write_ktree, write_ktree_v1, write_ktree_v1_view, KtreeView};
+/// use ktree::KTree;
+/// let tree = KTree::<2>::from_dense(2, &[true, false, true, true, false, false, true, true,
+///                                        true, true, true, true, false, true, false, false]).unwrap();
+/// let mut v2 = Vec::new();
+/// write_ktree(&mut v2, &tree).unwrap();
+/// let view = KtreeView::from_bytes(v2, "mem").unwrap();
+/// let (mut streamed, mut whole) = (Vec::new(), Vec::new());
+/// write_ktree_v1_view(&mut streamed, &view).unwrap();
+/// write_ktree_v1(&mut whole, &tree).unwrap();
+/// assert_eq!(streamed, whole);
+/// ```
+///
+/// # Errors
+/// Any I/O error; [`std::io::ErrorKind::InvalidData`] (with the file and byte offset) if the mapped file
+/// was changed after it was opened.
+pub fn write_ktree_v1_view(w: impl Write, view: &KtreeView) -> std::io::Result<()> {
+    let mut out = Checksummed {
+        w,
+        crc: crc32fast::Hasher::new(),
+    };
+    let mut head = Vec::with_capacity(40 + 8 * view.depth_count());
+    head.extend_from_slice(MAGIC);
+    head.extend_from_slice(&VERSION.to_le_bytes());
+    head.push(view.k() as u8);
+    head.push(view.level() as u8);
+    head.extend_from_slice(&[0, 0]);
+    head.extend_from_slice(&(view.depth_count() as u32).to_le_bytes());
+    for d in 0..view.depth_count() {
+        head.extend_from_slice(&view.level_nodes(d).to_le_bytes());
+    }
+    let c = view.counts();
+    for v in [c.full, c.empty, c.partial] {
+        head.extend_from_slice(&v.to_le_bytes());
+    }
+    out.write(&head)?;
+    // The levels continue one another with no padding: each level's words are shifted into place.
+    let mut packer = WordPacker::default();
+    for d in 0..view.depth_count() {
+        let nodes = view.level_nodes(d);
+        for j in 0..nodes.div_ceil(NODES_PER_WORD as u64) {
+            let word = view
+                .level_word(d, j)
+                .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
+            let n = (nodes - j * NODES_PER_WORD as u64).min(NODES_PER_WORD as u64) as usize;
+            if let Some(whole) = packer.push(word & slots_mask(n), n) {
+                out.write(&whole.to_le_bytes())?;
+            }
+        }
+    }
+    let pending = packer.pending_nodes();
+    if let Some(last) = packer.flush() {
+        out.write(&last.to_le_bytes()[..pending.div_ceil(4)])?;
+    }
+    let crc = out.crc.finalize();
+    out.w.write_all(&crc.to_le_bytes())
+}
+
+/// A writer that keeps the CRC-32 of what went through it.
+struct Checksummed<W> {
+    w: W,
+    crc: crc32fast::Hasher,
+}
+
+impl<W: Write> Checksummed<W> {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.crc.update(bytes);
+        self.w.write_all(bytes)
+    }
+}
+
 /// Reads a version 1 file's bytes (called by [`read_ktree_any`](crate::io::read_ktree_any) once the magic
 /// and version are read).
 pub(super) fn read_v1_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileError> {
-    let fail = |offset: usize, kind| KtreeFileError {
-        file: file.to_string(),
-        offset: offset as u64,
-        kind,
-    };
+    let fail = |offset: usize, kind| KtreeFileError::at_byte(file.to_string(), offset as u64, kind);
     let truncated = |offset: usize| {
         fail(
             offset,

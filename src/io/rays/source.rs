@@ -156,11 +156,7 @@ impl<const K: usize> RaysFileSource<K> {
     }
 
     fn error(&self, line: usize, kind: RaysTextErrorKind) -> RaysTextError {
-        RaysTextError {
-            file: self.name.clone(),
-            line,
-            kind,
-        }
+        RaysTextError::at_line(self.name.clone(), line, kind)
     }
 }
 

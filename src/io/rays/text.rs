@@ -74,31 +74,13 @@ pub enum RaysTextErrorKind {
     Io(crate::fs::IoCause),
 }
 
-/// An error in a ray file, with where it happened.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct RaysTextError {
-    /// The file (or a name for the input).
-    pub file: String,
-    /// The 1-based line, 0 when the error is about the whole file.
-    pub line: usize,
-    /// What was wrong.
-    pub kind: RaysTextErrorKind,
-}
+/// An error in a ray file, with the file and the line (or the whole file) where it happened.
+pub type RaysTextError = crate::io::FileError<RaysTextErrorKind>;
 
-impl fmt::Display for RaysTextError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.line > 0 {
-            write!(f, "{}:{}: {}", self.file, self.line, self.kind)
-        } else {
-            write!(f, "{}: {}", self.file, self.kind)
-        }
-    }
-}
-
-impl std::error::Error for RaysTextError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match &self.kind {
-            RaysTextErrorKind::Io(cause) => Some(cause.error()),
+impl crate::io::ProblemKind for RaysTextErrorKind {
+    fn io_cause(&self) -> Option<&std::io::Error> {
+        match self {
+            Self::Io(cause) => Some(cause.error()),
             _ => None,
         }
     }
@@ -166,11 +148,8 @@ pub(super) fn read_header<R: BufRead>(
 /// As [`read_rays`]; a file that cannot be opened is [`RaysTextErrorKind::Io`].
 pub fn read_rays_file(path: &Path) -> Result<AnyRaySet, RaysTextError> {
     let name = path.display().to_string();
-    let file = std::fs::File::open(path).map_err(|e| RaysTextError {
-        file: name.clone(),
-        line: 0,
-        kind: RaysTextErrorKind::Io(e.into()),
-    })?;
+    let file = std::fs::File::open(path)
+        .map_err(|e| RaysTextError::at_line(name.clone(), 0, RaysTextErrorKind::Io(e.into())))?;
     read_rays(std::io::BufReader::new(file), &name)
 }
 
@@ -301,11 +280,7 @@ impl<'a, R: BufRead> NumberedLines<'a, R> {
     }
 
     pub(super) fn error(&self, line: usize, kind: RaysTextErrorKind) -> RaysTextError {
-        RaysTextError {
-            file: self.file.to_string(),
-            line,
-            kind,
-        }
+        RaysTextError::at_line(self.file.to_string(), line, kind)
     }
 
     /// The next line that is not blank or a comment, trimmed.
@@ -447,9 +422,9 @@ mod tests {
         ));
         let e = err("# c\n3 4\n1 2 3 4\n1 2 3\n");
         assert_eq!(
-            (e.line, e.kind.clone()),
+            (e.line(), e.kind.clone()),
             (
-                4,
+                Some(4),
                 RaysTextErrorKind::FieldCount {
                     expected: 4,
                     found: 3,
@@ -458,17 +433,17 @@ mod tests {
             )
         );
         let e = err("3 4\n1 2 x 4\n");
-        assert_eq!(e.line, 2);
+        assert_eq!(e.line(), Some(2));
         assert!(matches!(
             e.kind,
             RaysTextErrorKind::NotANumber { field: 3, .. }
         ));
         let e = err("3 4\n1 2 3 4\n1 16 3 4\n");
-        assert_eq!(e.line, 3);
+        assert_eq!(e.line(), Some(3));
         assert!(e.to_string().starts_with("t.rays:3: "), "{e}");
-        assert_eq!(err("3 4\n1 2 3 17\n").line, 2);
-        assert_eq!(err("3 4\n1 2 -3 7\n").line, 2);
-        assert_eq!(err("1 4\n5 5\n").line, 2);
+        assert_eq!(err("3 4\n1 2 3 17\n").line(), Some(2));
+        assert_eq!(err("3 4\n1 2 -3 7\n").line(), Some(2));
+        assert_eq!(err("1 4\n5 5\n").line(), Some(2));
     }
 
     #[test]

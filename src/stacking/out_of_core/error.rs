@@ -1,7 +1,5 @@
 //! Why a build failed.
 
-use std::path::PathBuf;
-
 use super::budget::bytes_text;
 
 /// Why a build failed. A build to a file leaves the target untouched and removes its spill files.
@@ -29,28 +27,7 @@ pub enum BuildError<E> {
         /// what did not fit).
         needed: u64,
     },
-    /// The folder for the spill files cannot be used.
-    #[error("cannot create spill files in the temporary folder {}: {source}", path.display())]
-    TempDir {
-        /// The folder.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
-    /// A spill file cannot be written.
-    #[error("cannot write the spill file {}: {source}", path.display())]
-    Spill {
-        /// The spill file.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
-    /// The output cannot be written (the message names it).
-    #[error("{source}")]
-    Output {
-        /// The output file.
-        path: PathBuf,
-        /// The error, naming the output or the spill file read back.
-        source: std::io::Error,
-    },
+    /// A temporary file or the output could not be written.
+    #[error(transparent)]
+    Files(#[from] crate::fs::SpillError),
 }

@@ -2,6 +2,7 @@
 //! gathered by one of them, which writes the file ([`SpilledPart::write`]) — as the ranks of a distributed
 //! run do, and as a build in one process does with one part of every slab.
 
+use crate::fs::SpillError;
 use std::collections::VecDeque;
 use std::fmt::Display;
 use std::fs::File;
@@ -217,9 +218,11 @@ where
     let mut readers = Vec::with_capacity(files.len());
     for (j, file) in files.into_iter().enumerate() {
         let path = dir.path().join(format!("level-{}", j + 1));
-        let file = file.into_inner().map_err(|e| BuildError::Spill {
-            path: path.clone(),
-            source: e.into_error(),
+        let file = file.into_inner().map_err(|e| {
+            BuildError::Files(SpillError::Spill {
+                path: path.clone(),
+                source: e.into_error(),
+            })
         })?;
         readers.push((path, file));
     }
@@ -494,13 +497,13 @@ impl SpilledPart {
             .collect();
         let top = cells
             .into_top_levels(&partial)
-            .map_err(|_| BuildError::Output {
+            .map_err(|_| BuildError::Files(SpillError::Output {
                 path: out.to_path_buf(),
                 source: std::io::Error::new(
                     std::io::ErrorKind::InvalidData,
                     "the indexes of the parts overlap: a cell of depth m was stacked twice or is also full",
                 ),
-            })?;
+            }))?;
         drop(partial);
         let deepest = (1..=t)
             .rev()
@@ -559,16 +562,20 @@ impl SpilledPart {
             counts = writer.counts_per_level();
             writer.finish().map(drop)
         })
-        .map_err(|source| BuildError::Output {
-            path: out.to_path_buf(),
-            source,
+        .map_err(|source| {
+            BuildError::Files(SpillError::Output {
+                path: out.to_path_buf(),
+                source,
+            })
         })?;
         drop(readers);
         drop(dir);
         let file_bytes = std::fs::metadata(out)
-            .map_err(|source| BuildError::Output {
-                path: out.to_path_buf(),
-                source,
+            .map_err(|source| {
+                BuildError::Files(SpillError::Output {
+                    path: out.to_path_buf(),
+                    source,
+                })
             })?
             .len();
         Ok(OutOfCoreReport {

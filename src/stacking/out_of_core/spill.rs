@@ -1,6 +1,7 @@
 //! The spill files of an out-of-core build: the levels below the cells of depth `m`, one file per level,
 //! written as the cells are stacked and read back, piece by piece, when the tree is written.
 
+use crate::fs::SpillError;
 use std::fs::File;
 use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
@@ -113,7 +114,7 @@ pub(super) fn open_spill<E>(
     t: usize,
 ) -> Result<Spill, BuildError<E>> {
     let folder = crate::fs::spill_folder(out, temp_dir)
-        .map_err(|(path, source)| BuildError::TempDir { path, source })?;
+        .map_err(|(path, source)| BuildError::Files(SpillError::TempDir { path, source }))?;
     let mut spill = Spill {
         dir: folder,
         files: Vec::with_capacity(t),
@@ -126,7 +127,7 @@ pub(super) fn open_spill<E>(
             .write(true)
             .create_new(true)
             .open(&path)
-            .map_err(|source| BuildError::Spill { path, source })?;
+            .map_err(|source| BuildError::Files(SpillError::Spill { path, source }))?;
         spill
             .files
             .push(BufWriter::with_capacity(BUFFER_BYTES as usize, file));
@@ -164,11 +165,12 @@ pub(super) fn spill_piece<const K: usize, E>(
             let words = &states.words()[..states.len().div_ceil(32)];
             let file = &mut spill.files[j - 1];
             for w in words {
-                file.write_all(&w.to_le_bytes())
-                    .map_err(|source| BuildError::Spill {
+                file.write_all(&w.to_le_bytes()).map_err(|source| {
+                    BuildError::Files(SpillError::Spill {
                         path: spill.dir.path().join(format!("level-{j}")),
                         source,
-                    })?;
+                    })
+                })?;
             }
             spill.words[j - 1] += words.len() as u64;
             states.len() as u64

@@ -79,11 +79,11 @@ impl<'a> SectionScan<'a> {
     }
 
     fn fail(&self, offset: u64, message: String) -> KtreeFileError {
-        KtreeFileError {
-            file: self.file.to_string(),
+        KtreeFileError::at_byte(
+            self.file.to_string(),
             offset,
-            kind: KtreeFileErrorKind::Tree(message),
-        }
+            KtreeFileErrorKind::Tree(message),
+        )
     }
 
     /// Scans the next words of the section (a multiple of 8 bytes).
@@ -160,15 +160,15 @@ impl<'a> SectionScan<'a> {
         }
         let computed = std::mem::take(&mut self.hasher).finalize();
         if computed != self.section.crc {
-            return Err(KtreeFileError {
-                file: self.file.to_string(),
-                offset: self.section.offset,
-                kind: KtreeFileErrorKind::SectionChecksum {
+            return Err(KtreeFileError::at_byte(
+                self.file.to_string(),
+                self.section.offset,
+                KtreeFileErrorKind::SectionChecksum {
                     level: self.depth,
                     stored: self.section.crc,
                     computed,
                 },
-            });
+            ));
         }
         if (self.full, self.partial) != (self.section.full, self.section.partial) {
             return Err(self.fail(
@@ -215,10 +215,12 @@ pub(crate) fn read_v2_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFile
         _ => AnyTree::K4(assemble::<4>(layout.level, levels)),
     };
     let check = crate::with_dim!(&tree, AnyTree, t => t.check());
-    check.map_err(|e| KtreeFileError {
-        file: file.to_string(),
-        offset: HEADER_BYTES as u64,
-        kind: KtreeFileErrorKind::Tree(e.to_string()),
+    check.map_err(|e| {
+        KtreeFileError::at_byte(
+            file.to_string(),
+            HEADER_BYTES as u64,
+            KtreeFileErrorKind::Tree(e.to_string()),
+        )
     })?;
     Ok(tree)
 }

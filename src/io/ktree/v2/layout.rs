@@ -132,11 +132,7 @@ impl Layout {
         len: u64,
         mut tail: impl FnMut(usize) -> Result<Vec<u8>, KtreeFileError>,
     ) -> Result<Self, KtreeFileError> {
-        let fail = |offset: u64, kind| KtreeFileError {
-            file: file.to_string(),
-            offset,
-            kind,
-        };
+        let fail = |offset: u64, kind| KtreeFileError::at_byte(file.to_string(), offset, kind);
         let header_error =
             |offset: u64, message: String| fail(offset, KtreeFileErrorKind::Header(message));
         if head.len() < 6 || &head[..6] != MAGIC {

@@ -91,7 +91,7 @@ mod tests {
             .unwrap();
         bytes[at..at + 8].copy_from_slice(&swapped.to_le_bytes());
         let e = read_v2_any(&bytes, "s").unwrap_err();
-        assert_eq!(e.offset, offset);
+        assert_eq!(e.offset(), Some(offset));
         assert!(
             matches!(e.kind, KtreeFileErrorKind::SectionChecksum { level, .. } if level == last),
             "{e}"

@@ -6,6 +6,7 @@ use std::path::Path;
 use super::super::{KtreeFileError, KtreeFileErrorKind};
 use super::check::check_bytes;
 use super::layout::*;
+use super::mapped::MappedTree;
 use crate::io::mmap::FileMap;
 use crate::space::{Cell, Universe};
 use crate::tree::{KTree, LevelCounts, NodeState, PackedStates};
@@ -52,10 +53,8 @@ impl KtreeView {
     /// [`read_ktree_file`](crate::io::read_ktree_file)).
     pub fn open(path: &Path) -> Result<Self, KtreeFileError> {
         let name = path.display().to_string();
-        let io_error = |offset: u64, e: std::io::Error| KtreeFileError {
-            file: name.clone(),
-            offset,
-            kind: KtreeFileErrorKind::Io(e.into()),
+        let io_error = |offset: u64, e: std::io::Error| {
+            KtreeFileError::at_byte(name.clone(), offset, KtreeFileErrorKind::Io(e.into()))
         };
         let file = File::open(path).map_err(|e| io_error(0, e))?;
         let len = file.metadata().map_err(|e| io_error(0, e))?.len();
@@ -187,13 +186,9 @@ impl KtreeView {
         // The offset named is that of the last word read inside the level, so it lies within the file.
         let section = &self.layout.sections[depth.min(self.layout.sections.len() - 1)];
         let inside = index.min(section.nodes.saturating_sub(1));
-        KtreeFileError {
-            file: self.name.clone(),
-            offset: section.offset + 8 * (inside / NODES_PER_WORD),
-            kind: KtreeFileErrorKind::Tree(format!(
+        KtreeFileError::at_byte(self.name.clone(), section.offset + 8 * (inside / NODES_PER_WORD), KtreeFileErrorKind::Tree(format!(
                 "node {index} of level {depth} is missing or has the code 11: the file was changed after it was opened"
-            )),
-        }
+            )))
     }
 
     /// The state of a node the tree's shape says exists, or the error of a file changed since opening.
@@ -234,14 +229,14 @@ impl KtreeView {
 
     fn dimension<const K: usize>(&self) -> Result<Universe<K>, KtreeFileError> {
         if K != self.k() {
-            return Err(KtreeFileError {
-                file: self.name.clone(),
-                offset: 8,
-                kind: KtreeFileErrorKind::Dimension {
+            return Err(KtreeFileError::at_byte(
+                self.name.clone(),
+                8,
+                KtreeFileErrorKind::Dimension {
                     expected: K,
                     found: self.k(),
                 },
-            });
+            ));
         }
         Ok(Universe::new(self.level()).expect("level checked when opened"))
     }
@@ -250,68 +245,30 @@ impl KtreeView {
     /// pop-counts). Points outside the universe are outside the object.
     ///
     /// # Errors
-    /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`.
+    /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`; the failed read's error if the file
+    /// was changed after it was opened.
     pub fn contains<const K: usize>(&self, point: [u32; K]) -> Result<bool, KtreeFileError> {
-        let universe = self.dimension::<K>()?;
-        if universe.check_point(point).is_err() {
-            return Ok(false);
-        }
-        let mut index = 0u64;
-        for depth in 0..self.depth_count() {
-            match self.checked_state(depth, index)? {
-                NodeState::Empty => return Ok(false),
-                NodeState::Full => return Ok(true),
-                NodeState::Partial if depth + 1 >= self.depth_count() => {
-                    return Err(self.changed(depth, index))
-                }
-                NodeState::Partial => {
-                    let bit = self.level() - 1 - depth as u32;
-                    let code = point
-                        .iter()
-                        .enumerate()
-                        .fold(0u64, |c, (axis, &x)| c | u64::from(x >> bit & 1) << axis);
-                    // Saturating: a rank sample changed underneath must not overflow (the node is then
-                    // missing, an error).
-                    index = self
-                        .partial_rank(depth, index)?
-                        .saturating_mul(1 << K)
-                        .saturating_add(code);
-                }
-            }
-        }
-        Ok(false)
+        let tree = MappedTree::<K>::new(self)?;
+        let inside = crate::tree::storage::infallible(crate::query::contains(&tree, point));
+        tree.failure().map(|()| inside)
     }
 
-    /// Visits every leaf (empty and full) in Morton (depth-first) order, as [`KTree::for_each_leaf`].
-    /// Needs no rank: in depth-first order the partial nodes of each level are met in level order, so the
-    /// children of the next one are the next `2^K` nodes of the level below.
+    /// Visits every leaf (empty and full) in Morton (depth-first) order, as [`KTree::for_each_leaf`],
+    /// through the one walk over any storage ([`Leaves`](crate::tree::cursor::Leaves) over the map).
     ///
     /// # Errors
-    /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`.
+    /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`; the first failed read's error if the
+    /// file was changed after it was opened (the leaves visited until then are as read).
     pub fn for_each_leaf<const K: usize>(
         &self,
         mut visit: impl FnMut(Cell<K>, NodeState),
     ) -> Result<(), KtreeFileError> {
-        let universe = self.dimension::<K>()?;
-        let mut next_child = vec![0u64; self.depth_count() + 1];
-        let mut stack = vec![(universe.root(), 0u64)];
-        while let Some((cell, index)) = stack.pop() {
-            let depth = cell.level as usize;
-            match self.checked_state(depth, index)? {
-                NodeState::Partial if depth + 1 >= self.depth_count() => {
-                    return Err(self.changed(depth, index))
-                }
-                NodeState::Partial => {
-                    let first = next_child[depth + 1];
-                    next_child[depth + 1] += 1 << K;
-                    for code in (0..1usize << K).rev() {
-                        stack.push((cell.child(code), first + code as u64));
-                    }
-                }
-                state => visit(cell, state),
-            }
+        let tree = MappedTree::<K>::new(self)?;
+        for (cell, state) in crate::tree::cursor::Leaves::new(&tree) {
+            tree.failure()?;
+            visit(cell, state);
         }
-        Ok(())
+        tree.failure()
     }
 
     /// Visits the full leaves in Morton order: the object's linear tree.
@@ -347,10 +304,12 @@ impl KtreeView {
             })
             .collect::<Result<_, _>>()?;
         let tree = KTree::from_levels(universe, levels);
-        tree.check().map_err(|e| KtreeFileError {
-            file: self.name.clone(),
-            offset: HEADER_BYTES as u64,
-            kind: KtreeFileErrorKind::Tree(e.to_string()),
+        tree.check().map_err(|e| {
+            KtreeFileError::at_byte(
+                self.name.clone(),
+                HEADER_BYTES as u64,
+                KtreeFileErrorKind::Tree(e.to_string()),
+            )
         })?;
         Ok(tree)
     }
