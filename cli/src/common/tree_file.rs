@@ -57,19 +57,19 @@ pub fn as_version_1<R>(
         .file_name()
         .map_or_else(|| "tree".into(), |n| n.to_string_lossy());
     let v2 = out.with_file_name(format!(".{name}.version-2.ktree"));
-    let built = build(&v2);
-    let written = match &built {
-        Ok(Some(_)) => KtreeView::open(&v2)
+    let built = build(&v2)?;
+    if built.is_some() {
+        // This process wrote the version 2 file (the other ranks of an MPI run return `None` and leave it).
+        let written = KtreeView::open(&v2)
             .map_err(|e| e.to_string())
             .and_then(|view| {
                 write_atomic_with(out, |w| write_ktree_v1_view(w, &view))
                     .map_err(|e| format!("cannot write {}: {e}", out.display()))
-            }),
-        _ => Ok(()),
-    };
-    let _ = std::fs::remove_file(&v2);
-    written?;
-    built
+            });
+        let _ = std::fs::remove_file(&v2);
+        written?;
+    }
+    Ok(built)
 }
 
 /// Reads a tree file, with the path in any error.

@@ -177,7 +177,7 @@ where
         moved += 8 * words.len() as u64;
         match part.add_part(&words) {
             Ok(total) => streams.push(Stream::new(from, total)),
-            Err(e) if added.is_ok() => added = Err(format!("rank {r}: {e}").into()),
+            Err(e) if added.is_ok() => added = Err(format!("rank {r}: {e}")),
             Err(_) => {}
         }
     }
