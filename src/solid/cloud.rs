@@ -658,6 +658,11 @@ fn read_ply(bytes: &[u8]) -> Result<Vec<[f64; 3]>, String> {
             "PLY: the file has {count} faces: it is a mesh, not a point cloud"
         ));
     }
+    if let Some((name, count, _)) = elements.iter().find(|e| e.1 > 0 && e.2.is_empty()) {
+        return Err(format!(
+            "PLY: element '{name}' has {count} entries but no property"
+        ));
+    }
     let Some(vertex) = elements.iter().position(|e| e.0 == "vertex") else {
         return Err("PLY: no 'vertex' element".into());
     };

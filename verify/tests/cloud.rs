@@ -298,6 +298,11 @@ fn malformed_files_name_the_line_or_byte() {
             b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec(),
             "it is a mesh",
         ),
+        (
+            "ply",
+            b"ply\nformat binary_little_endian 1.0\nelement junk 99999999999\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n".to_vec(),
+            "element 'junk' has 99999999999 entries but no property",
+        ),
         ("pcd", bad_pcd_binary, "points of 28 bytes need 56 bytes but the file has 53"),
         (
             "pcd",
