@@ -4,7 +4,8 @@
 Their inputs are decoded by the `arbitrary` crate (1.x), so each seed is the encoding of an input: integers
 and floats little-endian, a bool or an Option's tag one byte, an enum's variant a u32 (variant
 `(v · count) >> 32`), a Vec each element after a byte 1 and ended by a byte 0. Files that the round-trip
-targets read are taken from the plain targets' seeds.
+targets read are taken from the plain targets' seeds. The point cloud targets' seeds are small files of each
+format (PLY ASCII and binary, PCD ASCII and binary, XYZ, CSV, LAS 1.2 with point format 0).
 
     fuzz/make_seeds.py        # from anywhere; rewrites the seeds it owns
 """
@@ -166,6 +167,51 @@ SEEDS = {
         + vec([]),
     },
 }
+
+CLOUD = [(0.0, 0.0, 0.0), (1.5, -2.25, 3.0), (0.5, 0.5, 0.5), (-4.0, 8.0, 2.0)]
+
+
+def ply_cloud(binary):
+    head = "ply\nformat %s 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n" \
+        "property uchar red\nend_header\n" % ("binary_little_endian" if binary else "ascii", len(CLOUD))
+    if binary:
+        return head.encode() + b"".join(struct.pack("<fffB", *p, 200) for p in CLOUD)
+    return (head + "".join("%g %g %g 200\n" % p for p in CLOUD)).encode()
+
+
+def pcd_cloud(binary):
+    head = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 2\nTYPE F F F U\nCOUNT 1 1 1 1\n" \
+        "WIDTH %d\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA %s\n" \
+        % (len(CLOUD), len(CLOUD), "binary" if binary else "ascii")
+    if binary:
+        return head.encode() + b"".join(struct.pack("<fffH", *p, 7) for p in CLOUD)
+    return (head + "".join("%g %g %g 7\n" % p for p in CLOUD)).encode()
+
+
+def las_cloud():
+    """LAS 1.2, point format 0 (20-byte records), scale 0.01, no VLR."""
+    scale = 0.01
+    xs = [[p[a] for p in CLOUD] for a in range(3)]
+    header = b"LASF" + struct.pack("<HH", 0, 0) + bytes(16) + bytes([1, 2]) + b"ktree".ljust(32, b"\0") \
+        + b"make_seeds.py".ljust(32, b"\0") + struct.pack("<HHHIIBHI", 1, 2026, 227, 227, 0, 0, 20, len(CLOUD)) \
+        + struct.pack("<5I", len(CLOUD), 0, 0, 0, 0) + struct.pack("<3d", scale, scale, scale) \
+        + struct.pack("<3d", 0, 0, 0) \
+        + struct.pack("<6d", max(xs[0]), min(xs[0]), max(xs[1]), min(xs[1]), max(xs[2]), min(xs[2]))
+    assert len(header) == 227
+    points = b"".join(struct.pack("<iiiHBBbBH", *(round(c / scale) for c in p), 0, 0x09, 2, 0, 0, 0)
+                      for p in CLOUD)
+    return header + points
+
+
+SEEDS.update({
+    "cloud_ply": {"ascii.ply": ply_cloud(False), "binary.ply": ply_cloud(True)},
+    "cloud_pcd": {"ascii.pcd": pcd_cloud(False), "binary.pcd": pcd_cloud(True)},
+    "cloud_xyz": {
+        "points.xyz": ("# x y z\n" + "".join("%g %g %g 1\n" % p for p in CLOUD)).encode(),
+        "points.csv": ("x,y,z\n" + "".join("%g,%g,%g\n" % p for p in CLOUD)).encode(),
+    },
+    "cloud_las": {"format0.las": las_cloud()},
+})
 
 for target, seeds in SEEDS.items():
     folder = os.path.join(HERE, "corpus", target)

@@ -109,6 +109,15 @@ class Tree:
     ) -> Tree:
         """The octree of a mesh given as (n, 3) vertices and (m, 3) triangle indices."""
     @staticmethod
+    def from_points(
+        points: npt.ArrayLike,
+        voxel_size: float,
+        origin: Optional[Tuple[float, float, float]] = None,
+        level: Optional[int] = None,
+    ) -> Tree:
+        """The octree of the voxels holding points of an (n, 3) array: voxel floor((p - origin) / voxel_size),
+        origin default the points' minimum corner, level default the smallest holding every voxel."""
+    @staticmethod
     def from_volume(
         path: _Path,
         threshold: Optional[float] = None,

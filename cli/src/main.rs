@@ -58,7 +58,7 @@ enum Command {
     Repro(repro::Args),
     /// An analytic solid (ball, ellipsoid, paraboloid, cylinder, cone, half-space, box, quadric) to rays.
     Rays(rays::Args),
-    /// A triangle mesh (OBJ, STL, PLY) or a volume (raw + JSON, NIfTI) to rays or a .ktree.
+    /// A triangle mesh (OBJ, STL, PLY), a volume (raw + JSON, NIfTI) or a point cloud (PLY, PCD, XYZ/CSV, LAS/LAZ) to rays or a .ktree.
     Voxelize(voxelize::Args),
     /// Point queries on a tree file: inside or not, with --distance and --nearest the nearest full voxel.
     Query(query::QueryArgs),

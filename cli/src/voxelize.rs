@@ -1,5 +1,8 @@
 //! `ktree voxelize MESH|VOLUME --level L (--fit | --transform s,tx,ty,tz) --out FILE`: a triangle mesh (OBJ,
 //! STL, PLY) or a volume (raw + JSON sidecar, NIfTI) to rays or a tree.
+//!
+//! `ktree voxelize CLOUD --voxel-size S [--origin x,y,z] [--level L] [--min-points N] [--crop] --out FILE`: a
+//! point cloud (PLY without faces, PCD, XYZ/CSV, LAS/LAZ) to the voxels holding at least N points.
 
 use crate::common::error::CliResult;
 use crate::outln;
@@ -20,9 +23,10 @@ use crate::common::output::{is_tree_file, write_output};
 /// Arguments of `ktree voxelize`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The input: a mesh (.obj, .stl, .ply) or a volume (.json sidecar or its .raw, .nii, .nii.gz).
+    /// The input: a mesh (.obj, .stl, .ply), a volume (.json sidecar or its .raw, .nii, .nii.gz) or a point
+    /// cloud (.ply without faces, .pcd, .xyz, .csv, .txt, .las, .laz).
     input: PathBuf,
-    /// Universe level L (meshes: required; volumes: default the smallest level that holds the volume).
+    /// Universe level L (meshes: required; volumes and clouds: default the smallest level that holds them).
     #[arg(long)]
     level: Option<u32>,
     /// Mesh: scale uniformly and centre into the universe with a one-voxel margin (prints the transform).
@@ -40,6 +44,18 @@ pub struct Args {
     /// Volume: where the volume's sample (0, 0, 0) goes in the universe, as x,y,z.
     #[arg(long, default_value = "0,0,0")]
     offset: String,
+    /// Point cloud: the side of a voxel; a point p is in voxel floor((p - origin) / S).
+    #[arg(long)]
+    voxel_size: Option<f64>,
+    /// Point cloud: the corner of voxel (0, 0, 0), as x,y,z (default: the minimum corner of the points).
+    #[arg(long)]
+    origin: Option<String>,
+    /// Point cloud: the points a voxel must hold to be full.
+    #[arg(long, default_value_t = 1)]
+    min_points: u64,
+    /// Point cloud with --level: drop the points outside the universe (default: they are an error).
+    #[arg(long)]
+    crop: bool,
     /// Output: rays in the text format, or a tree if the name ends in .ktree.
     #[arg(long)]
     out: PathBuf,
@@ -52,6 +68,16 @@ pub struct Args {
 
 /// Voxelizes the input and writes it.
 pub fn run(a: Args) -> CliResult {
+    if ktree::solid::cloud::is_cloud_file(&a.input).unwrap_or(false) {
+        return run_cloud(&a);
+    }
+    if a.voxel_size.is_some() || a.origin.is_some() || a.crop {
+        return Err(format!(
+            "{}: --voxel-size, --origin and --crop are for point clouds (.ply without faces, .pcd, .xyz, .csv, .txt, .las, .laz)",
+            a.input.display()
+        )
+        .into());
+    }
     let mut options = ReadOptions {
         level: a.level,
         ..ReadOptions::default()
@@ -100,6 +126,72 @@ pub fn run(a: Args) -> CliResult {
     let v = voxelize(&a.input, &options).map_err(|e| e.to_string())?;
     remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
     crate::common::output::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?)?;
+    Ok(())
+}
+
+/// Voxelizes a point cloud and writes it.
+fn run_cloud(a: &Args) -> CliResult {
+    use ktree::solid::cloud::{CloudVoxelizer, PointCloud};
+    let size = a
+        .voxel_size
+        .ok_or_else(|| format!("{}: a point cloud needs --voxel-size S", a.input.display()))?;
+    let mut v = CloudVoxelizer::new(size)
+        .map_err(|e| format!("--voxel-size: {e}"))?
+        .min_points(a.min_points)
+        .crop(a.crop);
+    if a.crop && a.level.is_none() {
+        return Err("--crop needs --level L (without it the universe holds every point)".into());
+    }
+    if let Some(text) = &a.origin {
+        let o: Vec<f64> = text
+            .split(',')
+            .map(|x| x.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| format!("--origin '{text}': expected x,y,z"))?;
+        let o: [f64; 3] = o
+            .try_into()
+            .map_err(|_| format!("--origin '{text}': expected three numbers"))?;
+        v = v.origin(o);
+    }
+    if let Some(l) = a.level {
+        v = v.level(l);
+    }
+    let cloud = PointCloud::read(&a.input).map_err(|e| e.to_string())?;
+    let voxels = v
+        .voxelize(cloud.points())
+        .map_err(|e| format!("{}: {e}", a.input.display()))?;
+    let root = crate::distributed::ranks().is_root();
+    if root {
+        let o = voxels.origin;
+        let chosen = if a.origin.is_none() {
+            " (the minimum corner of the points)"
+        } else {
+            ""
+        };
+        outln!(
+            "{}: {} points, origin {},{},{}{chosen}, level {}, {} voxels with at least {} point{}{}",
+            a.input.display(),
+            cloud.len(),
+            o[0],
+            o[1],
+            o[2],
+            voxels.rays.level(),
+            voxels.rays.voxel_count(),
+            a.min_points.max(1),
+            if a.min_points > 1 { "s" } else { "" },
+            if voxels.cropped > 0 {
+                format!(", {} points outside the universe dropped", voxels.cropped)
+            } else {
+                String::new()
+            }
+        );
+    }
+    crate::common::output::print_summary(&write_output(
+        &voxels.rays,
+        &a.out,
+        a.threads,
+        &a.build,
+    )?)?;
     Ok(())
 }
 

@@ -5,6 +5,7 @@ use std::path::Path;
 use arbitrary::Arbitrary;
 use ktree::io::{read_ktree_any, read_rays, write_ktree, write_ktree_v1, write_rays, KtreeFileError, KtreeView};
 use ktree::{AnyRaySet, AnyTree};
+use ktree::solid::cloud::{bounds as cloud_bounds, CloudVoxelizer, PointCloud};
 use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::solid::volume::{Select, Volume};
 use ktree::{max_level, KTree, Universe};
@@ -160,6 +161,38 @@ pub fn check_mesh(bytes: &[u8], format: &str) {
         }
     }
     let _ = (mesh.signed_volume(), mesh.surface_area(), mesh.open_edges());
+}
+
+/// Parses a point cloud and, when accepted, voxelizes it: at a voxel size that puts it in a universe of
+/// level ≤ [`CHECK_LEVEL`], and cropped to a level-3 universe
+/// at the origin 0; errors are fine, panics are not.
+pub fn check_cloud(bytes: &[u8], format: &str) {
+    let Ok(cloud) = PointCloud::from_bytes(bytes, format, Path::new("fuzz")) else {
+        return;
+    };
+    let points = cloud.points();
+    if let Some((lo, hi)) = cloud_bounds(points) {
+        let extent = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+        let size = if extent.is_finite() && extent > 0.0 {
+            extent / 15.0
+        } else {
+            1.0
+        };
+        if let Ok(v) = CloudVoxelizer::new(size).and_then(|v| v.voxelize(points)) {
+            assert!(v.rays.level() <= CHECK_LEVEL);
+            assert!(v.rays.voxel_count() <= points.len() as u128);
+            KTree::from_rays(&v.rays).assert_well_formed();
+        }
+    }
+    let cropped = CloudVoxelizer::new(0.5)
+        .expect("a positive voxel size")
+        .origin([0.0; 3])
+        .level(3)
+        .crop(true)
+        .min_points(2)
+        .voxelize(points)
+        .expect("cropping accepts every finite point");
+    assert!(cropped.rays.voxel_count() * 2 + u128::from(cropped.cropped) <= points.len() as u128);
 }
 
 /// A volume that was accepted: its samples become rays in the smallest universe that holds it (when that

@@ -356,6 +356,30 @@ impl Tree {
         mesh_tree(py, mesh, level, transform, "from_mesh_arrays")
     }
 
+    /// The octree of the voxels holding points of an `(n, 3)` float array: point p is in voxel
+    /// `floor((p - origin) / voxel_size)` (as numpy computes it), `origin` defaults to the points' minimum
+    /// corner and `level` to the smallest that holds every voxel; with `level` given, points outside the
+    /// universe are a `ValueError`.
+    #[staticmethod]
+    #[pyo3(signature = (points, voxel_size, origin = None, level = None))]
+    fn from_points(
+        py: Python<'_>,
+        points: PyArrayLike2<'_, f64, AllowTypeChange>,
+        voxel_size: f64,
+        origin: Option<[f64; 3]>,
+        level: Option<u32>,
+    ) -> PyResult<Self> {
+        let p = points.as_array();
+        if p.ncols() != 3 {
+            return Err(
+                Failure::Value(format!("points must be (n, 3), got {:?}", p.shape())).into(),
+            );
+        }
+        let points: Vec<[f64; 3]> = p.outer_iter().map(|r| [r[0], r[1], r[2]]).collect();
+        let tree = py.detach(|| KTree::from_points(&points, voxel_size, origin, level));
+        Ok(Tree::wrap(tree.map_err(Failure::value)?))
+    }
+
     /// The octree of a volume file (a .json sidecar or its .raw, .nii, .nii.gz): samples with value
     /// `>= threshold` (or `== label`) are inside. The volume's sample (0, 0, 0) goes to voxel `offset`
     /// (default (0, 0, 0)); `level` defaults to the smallest that holds the volume.

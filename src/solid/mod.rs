@@ -4,6 +4,7 @@
 //! * [`Quadric`]: `Vᵀ Ξ V ≤ 0` with named constructors (ball, ellipsoid, paraboloid, cylinder, cone,
 //!   half-space) and [`BoxSolid`]; exact integer inside tests at voxel centres (or corners).
 //! * [`mesh`]: OBJ, STL and PLY triangle meshes, inside by the winding number along each column.
+//! * [`cloud`]: point clouds (PLY, PCD, XYZ/CSV, LAS/LAZ), the voxels holding points.
 //! * [`volume`]: dense 3-D scalar volumes (raw + JSON sidecar, NIfTI) by threshold or label.
 //!
 //! Boolean operations and translation on the resulting rays are in [`crate::rays`] (`union`, …).
@@ -19,6 +20,8 @@
 //! ```
 
 mod boxsolid;
+#[cfg(feature = "cloud")]
+pub mod cloud;
 mod error;
 #[cfg(feature = "mesh")]
 pub mod mesh;

@@ -1,0 +1,205 @@
+//! `ktree voxelize CLOUD --voxel-size S …` from the outside: the tree written holds the voxels that numpy's
+//! `floor((p − origin) / s)` gives with at least `--min-points` points (brute force here), for a PLY without
+//! faces, a PCD, an XYZ and a CSV; points outside a given level fail or are cropped; bad files are one-line
+//! errors naming the file and line.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use common::ktree;
+use ktree::io::read_ktree_file;
+use ktree::{AnyTree, KTree, Universe};
+
+/// Points on a helix, on a grid of 1/64 (exact in every text format).
+fn helix() -> Vec<[f64; 3]> {
+    (0..400)
+        .map(|i| {
+            let t = f64::from(i) * 0.21;
+            [t.cos() * 3.0 + 1.0, t.sin() * 3.0 - 2.0, t * 0.05].map(|c| (c * 64.0).round() / 64.0)
+        })
+        .collect()
+}
+
+/// The tree of the voxels with at least `min` points, by brute force; voxel `floor((p − origin) / s)`.
+fn reference(points: &[[f64; 3]], s: f64, origin: [f64; 3], min: u64, level: u32) -> KTree<3> {
+    let mut counts = BTreeMap::new();
+    for p in points {
+        let k: [i64; 3] = std::array::from_fn(|a| ((p[a] - origin[a]) / s).floor() as i64);
+        *counts.entry(k).or_insert(0u64) += 1;
+    }
+    let u = Universe::<3>::new(level).unwrap();
+    let cells: Vec<_> = counts
+        .iter()
+        .filter(|(k, &c)| c >= min && k.iter().all(|&v| v >= 0 && v < 1 << level))
+        .map(|(k, _)| u.cell(k.map(|v| v as u32), level).unwrap())
+        .collect();
+    KTree::from_cells(u, &cells).unwrap()
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+fn files(dir: &Path, points: &[[f64; 3]]) -> Vec<String> {
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nend_header\n",
+        points.len()
+    );
+    let mut pcd = format!(
+        "VERSION .7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {n}\nHEIGHT 1\nPOINTS {n}\nDATA ascii\n",
+        n = points.len()
+    );
+    let mut xyz = String::new();
+    let mut csv = String::from("X;Y;Z\n");
+    for p in points {
+        writeln!(ply, "{} {} {}", p[0], p[1], p[2]).unwrap();
+        writeln!(pcd, "{} {} {}", p[0], p[1], p[2]).unwrap();
+        writeln!(xyz, "{} {} {} 1 2 3", p[0], p[1], p[2]).unwrap();
+        writeln!(csv, "{};{};{}", p[0], p[1], p[2]).unwrap();
+    }
+    vec![
+        write(dir, "c.ply", &ply),
+        write(dir, "c.pcd", &pcd),
+        write(dir, "c.xyz", &xyz),
+        write(dir, "c.csv", &csv),
+    ]
+}
+
+fn tree(path: &Path) -> KTree<3> {
+    match read_ktree_file(path).unwrap() {
+        AnyTree::K3(t) => t,
+        _ => panic!("not an octree"),
+    }
+}
+
+#[test]
+fn clouds_voxelize_to_the_floored_voxels() {
+    let dir = tempfile::tempdir().unwrap();
+    let points = helix();
+    let lo = points.iter().fold([f64::INFINITY; 3], |m, p| {
+        std::array::from_fn(|a| m[a].min(p[a]))
+    });
+    let out = dir.path().join("o.ktree");
+    let o = out.to_str().unwrap();
+    for f in files(dir.path(), &points) {
+        // Default origin and level.
+        let (ok, stdout, err) = ktree(&[
+            "voxelize",
+            &f,
+            "--voxel-size",
+            "0.25",
+            "--min-points",
+            "2",
+            "--out",
+            o,
+        ]);
+        assert!(ok, "{f}: {err}");
+        assert!(
+            stdout.contains("(the minimum corner of the points)"),
+            "{stdout}"
+        );
+        let got = tree(&out);
+        assert_eq!(got, reference(&points, 0.25, lo, 2, got.level()), "{f}");
+        // A given origin and level, every point inside.
+        let (ok, _, err) = ktree(&[
+            "voxelize",
+            &f,
+            "--voxel-size",
+            "0.5",
+            "--origin=-3,-6,-1",
+            "--level",
+            "5",
+            "--out",
+            o,
+        ]);
+        assert!(ok, "{f}: {err}");
+        assert_eq!(
+            tree(&out),
+            reference(&points, 0.5, [-3.0, -6.0, -1.0], 1, 5)
+        );
+        // Points outside the universe: an error naming how many, or dropped with --crop.
+        let args = [
+            "voxelize",
+            &f,
+            "--voxel-size",
+            "0.5",
+            "--origin",
+            "0,0,0",
+            "--level",
+            "3",
+            "--out",
+            o,
+        ];
+        let (ok, _, err) = ktree(&args);
+        assert!(!ok);
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(
+            err.contains("points lie outside the universe of level 3"),
+            "{err}"
+        );
+        let (ok, stdout, err) = ktree(&[&args[..], &["--crop"]].concat());
+        assert!(ok, "{err}");
+        assert!(
+            stdout.contains("points outside the universe dropped"),
+            "{stdout}"
+        );
+        assert_eq!(tree(&out), reference(&points, 0.5, [0.0; 3], 1, 3));
+    }
+}
+
+#[test]
+fn bad_clouds_are_one_line_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.ktree");
+    let o = out.to_str().unwrap();
+    let bad = write(dir.path(), "bad.xyz", "1 2 3\n4 5\n");
+    let good = write(dir.path(), "good.xyz", "1 2 3\n");
+    for (args, want) in [
+        (
+            vec!["voxelize", &bad, "--voxel-size", "1", "--out", o],
+            "bad.xyz: line 2: expected 3 numbers",
+        ),
+        (vec!["voxelize", &good, "--out", o], "needs --voxel-size"),
+        (
+            vec!["voxelize", &good, "--voxel-size", "0", "--out", o],
+            "voxel size",
+        ),
+        (
+            vec![
+                "voxelize",
+                &good,
+                "--voxel-size",
+                "1",
+                "--origin",
+                "1,2",
+                "--out",
+                o,
+            ],
+            "--origin",
+        ),
+        (
+            vec!["voxelize", &good, "--voxel-size", "1", "--crop", "--out", o],
+            "--crop needs --level",
+        ),
+    ] {
+        let (ok, _, err) = ktree(&args);
+        assert!(!ok, "{args:?}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(want), "{err} (wanted {want})");
+    }
+    // A PLY with faces is still a mesh.
+    let mesh = write(
+        dir.path(),
+        "m.ply",
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
+    );
+    let (ok, _, err) = ktree(&["voxelize", &mesh, "--voxel-size", "1", "--out", o]);
+    assert!(!ok && err.contains("are for point clouds"), "{err}");
+    let (ok, _, err) = ktree(&["voxelize", &mesh, "--level", "3", "--fit", "--out", o]);
+    assert!(ok, "{err}");
+}

@@ -1,0 +1,357 @@
+//! Point clouds: every format written here (PLY ASCII and binary, PCD ASCII and binary, XYZ, CSV, LAS, LAZ)
+//! reads back the points written, and the voxels equal numpy's `floor((p − origin) / s)` computed by brute
+//! force (a set of floored keys, counted for the minimum points), for random clouds; malformed files are
+//! errors naming the file and the line or byte.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use ktree::solid::cloud::{CloudVoxelizer, PointCloud};
+use ktree::{KTree, Universe};
+use proptest::prelude::*;
+
+/// The voxels of `points` by brute force: `floor((p − origin) / s)` per point, counted; those with at least
+/// `min` points; and the smallest level holding them (`None`: a negative index).
+fn reference(
+    points: &[[f64; 3]],
+    s: f64,
+    origin: [f64; 3],
+    min: u64,
+) -> (BTreeMap<[i64; 3], u64>, u32) {
+    let mut counts = BTreeMap::new();
+    for p in points {
+        let key: [i64; 3] = std::array::from_fn(|a| ((p[a] - origin[a]) / s).floor() as i64);
+        *counts.entry(key).or_insert(0u64) += 1;
+    }
+    let top = counts.keys().flatten().copied().max().unwrap_or(0);
+    let level = (0..).find(|&l| top < 1i64 << l).unwrap();
+    counts.retain(|_, c| *c >= min);
+    (counts, level)
+}
+
+/// The tree of a set of voxels, through `KTree::from_cells` (not the cloud's path).
+fn tree_of(voxels: &BTreeMap<[i64; 3], u64>, level: u32) -> KTree<3> {
+    let u = Universe::<3>::new(level).unwrap();
+    let cells: Vec<_> = voxels
+        .keys()
+        .map(|k| u.cell(k.map(|c| c as u32), level).unwrap())
+        .collect();
+    KTree::from_cells(u, &cells).unwrap()
+}
+
+fn minimum(points: &[[f64; 3]]) -> [f64; 3] {
+    points.iter().fold([f64::INFINITY; 3], |m, p| {
+        std::array::from_fn(|a| m[a].min(p[a]))
+    })
+}
+
+// ---- Writers of each format (small and plain, for the tests) ----
+
+fn ply_ascii(points: &[[f64; 3]]) -> Vec<u8> {
+    let mut s = format!(
+        "ply\nformat ascii 1.0\ncomment made by a test\nelement vertex {}\nproperty double x\nproperty double y\nproperty uchar red\nproperty double z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
+        points.len()
+    );
+    for p in points {
+        writeln!(s, "{} {} 7 {}", p[0], p[1], p[2]).unwrap();
+    }
+    s.into_bytes()
+}
+
+fn ply_binary(points: &[[f64; 3]], big: bool) -> Vec<u8> {
+    let mut b = format!(
+        "ply\nformat binary_{}_endian 1.0\nelement vertex {}\nproperty float64 x\nproperty float64 y\nproperty float64 z\nproperty list uchar int extra\nend_header\n",
+        if big { "big" } else { "little" },
+        points.len()
+    )
+    .into_bytes();
+    for p in points {
+        for c in p {
+            b.extend(if big {
+                c.to_be_bytes()
+            } else {
+                c.to_le_bytes()
+            });
+        }
+        b.push(1);
+        b.extend(if big {
+            5i32.to_be_bytes()
+        } else {
+            5i32.to_le_bytes()
+        });
+    }
+    b
+}
+
+fn pcd_header(points: &[[f64; 3]], data: &str) -> String {
+    format!(
+        "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 8 8 8 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {data}\n",
+        n = points.len()
+    )
+}
+
+fn pcd_ascii(points: &[[f64; 3]]) -> Vec<u8> {
+    let mut s = pcd_header(points, "ascii");
+    for p in points {
+        writeln!(s, "{} {} {} 4278190080", p[0], p[1], p[2]).unwrap();
+    }
+    s.into_bytes()
+}
+
+fn pcd_binary(points: &[[f64; 3]]) -> Vec<u8> {
+    let mut b = pcd_header(points, "binary").into_bytes();
+    for p in points {
+        for c in p {
+            b.extend(c.to_le_bytes());
+        }
+        b.extend(7u32.to_le_bytes());
+    }
+    b
+}
+
+fn xyz(points: &[[f64; 3]]) -> Vec<u8> {
+    let mut s = String::from("# x y z intensity\n\n");
+    for p in points {
+        writeln!(s, "{}\t{} {}  0.5", p[0], p[1], p[2]).unwrap();
+    }
+    s.into_bytes()
+}
+
+fn csv(points: &[[f64; 3]]) -> Vec<u8> {
+    let mut s = String::from("x,y,z,label\n");
+    for p in points {
+        writeln!(s, "{},{},{},ground", p[0], p[1], p[2]).unwrap();
+    }
+    s.into_bytes()
+}
+
+/// LAS (or LAZ when `compressed`) with a scale of 1/1024, so that the points written on that grid read back
+/// exactly.
+fn las(points: &[[f64; 3]], compressed: bool) -> Vec<u8> {
+    let mut b = las::Builder::from((1, 2));
+    let t = las::Transform {
+        scale: 1.0 / 1024.0,
+        offset: 0.0,
+    };
+    b.transforms = las::Vector { x: t, y: t, z: t };
+    b.point_format.is_compressed = compressed;
+    let mut w =
+        las::Writer::new(std::io::Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
+    for p in points {
+        w.write_point(las::Point {
+            x: p[0],
+            y: p[1],
+            z: p[2],
+            ..Default::default()
+        })
+        .unwrap();
+    }
+    w.into_inner().unwrap().into_inner()
+}
+
+/// Every format: (extension, bytes).
+fn all_formats(points: &[[f64; 3]]) -> Vec<(&'static str, Vec<u8>)> {
+    vec![
+        ("ply", ply_ascii(points)),
+        ("ply", ply_binary(points, false)),
+        ("ply", ply_binary(points, true)),
+        ("pcd", pcd_ascii(points)),
+        ("pcd", pcd_binary(points)),
+        ("xyz", xyz(points)),
+        ("csv", csv(points)),
+        ("las", las(points, false)),
+        ("laz", las(points, true)),
+    ]
+}
+
+/// Random clouds of up to `n` points on a grid of 1/1024 (so LAS holds them exactly), within ±`r`.
+fn cloud(n: usize, r: i32) -> impl Strategy<Value = Vec<[f64; 3]>> {
+    prop::collection::vec(
+        prop::array::uniform3(-r * 1024..r * 1024).prop_map(|p| p.map(|c| f64::from(c) / 1024.0)),
+        1..n,
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn every_format_reads_back_the_points(points in cloud(60, 40)) {
+        for (ext, bytes) in all_formats(&points) {
+            let read = PointCloud::from_bytes(&bytes, ext, Path::new("t")).unwrap();
+            prop_assert_eq!(read.points(), &points[..], "{}", ext);
+        }
+    }
+
+    #[test]
+    fn voxels_equal_the_floored_keys(
+        points in cloud(300, 30),
+        s in prop::sample::select(vec![0.1, 0.25, 0.7, 1.0, 3.0, 9.5]),
+        min in 1u64..4,
+        given in prop::option::of(prop::array::uniform3(-40i32..-30).prop_map(|o| o.map(f64::from))),
+    ) {
+        let origin = given.unwrap_or_else(|| minimum(&points));
+        let (want, level) = reference(&points, s, origin, min);
+        let mut v = CloudVoxelizer::new(s).unwrap().min_points(min);
+        if let Some(o) = given {
+            v = v.origin(o);
+        }
+        let got = v.voxelize(&points).unwrap();
+        prop_assert_eq!(got.origin, origin);
+        prop_assert_eq!(got.rays.level(), level);
+        let tree = KTree::from_rays(&got.rays);
+        tree.assert_well_formed();
+        prop_assert_eq!(&tree, &tree_of(&want, level));
+        if min == 1 {
+            prop_assert_eq!(KTree::from_points(&points, s, given, None).unwrap(), tree);
+        }
+    }
+
+    #[test]
+    fn a_level_given_crops_or_fails(points in cloud(200, 30), level in 0u32..6, crop: bool) {
+        let origin = [-8.0, -8.0, -8.0];
+        let (mut want, _) = reference(&points, 1.0, origin, 1);
+        let side = 1i64 << level;
+        let outside: u64 = want
+            .iter()
+            .filter(|(k, _)| k.iter().any(|&c| c < 0 || c >= side))
+            .map(|(_, c)| c)
+            .sum();
+        want.retain(|k, _| k.iter().all(|&c| c >= 0 && c < side));
+        let got = CloudVoxelizer::new(1.0).unwrap().origin(origin).level(level).crop(crop).voxelize(&points);
+        match got {
+            Ok(v) => {
+                prop_assert!(crop || outside == 0);
+                prop_assert_eq!(v.cropped, outside);
+                prop_assert_eq!(KTree::from_rays(&v.rays), tree_of(&want, level));
+            }
+            Err(e) => {
+                prop_assert!(!crop && outside > 0);
+                let text = e.to_string();
+                prop_assert!(text.starts_with(&format!("{outside} points lie outside")), "{}", text);
+            }
+        }
+    }
+}
+
+/// The voxels of every format's file equal the reference, through the file.
+#[test]
+fn files_of_every_format_voxelize_as_the_reference() {
+    let points: Vec<[f64; 3]> = (0..500)
+        .map(|i| {
+            let t = f64::from(i) * 0.37;
+            [t.sin() * 5.0, t.cos() * 5.0, t * 0.1].map(|c| (c * 1024.0).round() / 1024.0)
+        })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let (want, level) = reference(&points, 0.5, minimum(&points), 2);
+    for (i, (ext, bytes)) in all_formats(&points).into_iter().enumerate() {
+        let path = dir.path().join(format!("c{i}.{ext}"));
+        std::fs::write(&path, bytes).unwrap();
+        assert!(ktree::solid::cloud::is_cloud_file(&path).unwrap());
+        let cloud = PointCloud::read(&path).unwrap();
+        let v = CloudVoxelizer::new(0.5)
+            .unwrap()
+            .min_points(2)
+            .voxelize(cloud.points())
+            .unwrap();
+        assert_eq!(KTree::from_rays(&v.rays), tree_of(&want, level), "{ext}");
+    }
+}
+
+/// A malformed file is an error naming the file and the line (text) or byte (binary).
+#[test]
+fn malformed_files_name_the_line_or_byte() {
+    let p = [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]];
+    let mut bad_pcd_binary = pcd_binary(&p);
+    bad_pcd_binary.truncate(bad_pcd_binary.len() - 3);
+    let mut bad_ply_binary = ply_binary(&p, false);
+    bad_ply_binary.truncate(bad_ply_binary.len() - 30);
+    let mut nan_ply_binary = ply_binary(&p, false);
+    let at = nan_ply_binary.len() - 29 + 8; // y of the second vertex (records of 29 bytes)
+    nan_ply_binary[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+    let mut huge_las = las(&p, false);
+    huge_las[107..111].copy_from_slice(&u32::MAX.to_le_bytes()); // legacy point count
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("xyz", b"1 2 3\n4 five 6\n".to_vec(), "line 2: 'five' is not a number"),
+        ("xyz", b"x y z\n1 2 3\n".to_vec(), "line 1: 'x' is not a number"),
+        ("xyz", b"1 2 3\n\n1 2\n".to_vec(), "line 3: expected 3 numbers"),
+        ("xyz", b"1 2 3\n1 nan 2\n".to_vec(), "line 2: coordinate not finite"),
+        ("csv", b"x,y,z\n1,2,3\n4,5,inf\n".to_vec(), "line 3: coordinate not finite"),
+        ("csv", b"x,y,z\n1,2,3\nx,y,z\n".to_vec(), "line 3: 'x' is not a number"),
+        ("ply", ply_ascii(&p)[..150].to_vec(), "no end line"),
+        (
+            "ply",
+            String::from_utf8(ply_ascii(&p)).unwrap().replace("4 5 7 6", "4 5 7 nan").into_bytes(),
+            "line 13: vertex 1 has a coordinate that is not finite",
+        ),
+        (
+            "ply",
+            String::from_utf8(ply_ascii(&p)).unwrap().replace("4 5 7 6", "4 5").into_bytes(),
+            "line 13: vertex 1 has too few values",
+        ),
+        ("ply", bad_ply_binary, "byte 151: PLY vertices: 2 points of 25 bytes need 50 bytes"),
+        ("ply", nan_ply_binary, "byte 180: PLY vertex 1 has a coordinate that is not finite"),
+        (
+            "ply",
+            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec(),
+            "it is a mesh",
+        ),
+        (
+            "ply",
+            b"ply\nformat binary_little_endian 1.0\nelement junk 99999999999\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n".to_vec(),
+            "element 'junk' has 99999999999 entries but no property",
+        ),
+        ("pcd", bad_pcd_binary, "points of 28 bytes need 56 bytes but the file has 53"),
+        (
+            "pcd",
+            String::from_utf8(pcd_ascii(&p)).unwrap().replace("4 5 6 ", "4 5 ").into_bytes(),
+            "line 13: expected 4 values, found 3",
+        ),
+        (
+            "pcd",
+            String::from_utf8(pcd_ascii(&p)).unwrap().replace("4 5 6 ", "4 -inf 6 ").into_bytes(),
+            "line 13: point 1 has a coordinate that is not finite",
+        ),
+        (
+            "pcd",
+            String::from_utf8(pcd_ascii(&p)).unwrap().replace("POINTS 2", "POINTS 99999999999").into_bytes(),
+            "99999999999 points declared but only",
+        ),
+        (
+            "pcd",
+            String::from_utf8(pcd_ascii(&p)).unwrap().replace("DATA ascii", "DATA binary_compressed").into_bytes(),
+            "line 11: PCD 'DATA binary_compressed' is not read",
+        ),
+        ("las", huge_las, "byte 0: LAS: the header declares 4294967295 points"),
+        ("las", b"LASF".to_vec(), "LAS header"),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (i, (ext, bytes, want)) in cases.into_iter().enumerate() {
+        let path = dir.path().join(format!("bad{i}.{ext}"));
+        std::fs::write(&path, &bytes).unwrap();
+        let e = PointCloud::read(&path).unwrap_err().to_string();
+        assert!(e.contains(&format!("bad{i}.{ext}")), "{e}");
+        assert!(e.contains(want), "case {i}: {e} (wanted: {want})");
+        assert!(!e.contains('\n'), "{e}");
+    }
+}
+
+#[test]
+fn nan_points_and_bad_voxel_sizes_are_errors() {
+    for s in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(CloudVoxelizer::new(s).is_err());
+    }
+    let e = KTree::from_points(&[[0.0; 3], [1.0, f64::NAN, 0.0]], 1.0, None, None).unwrap_err();
+    assert!(e.to_string().contains("point 1"), "{e}");
+    // Below a given origin, without a level: an error naming the point.
+    let e =
+        KTree::from_points(&[[0.0; 3], [-1.0, 0.0, 0.0]], 1.0, Some([0.0; 3]), None).unwrap_err();
+    assert!(e.to_string().contains("point 1"), "{e}");
+    // Too wide for the largest universe.
+    assert!(KTree::from_points(&[[0.0; 3], [1e9, 0.0, 0.0]], 1e-3, None, None).is_err());
+    // An empty cloud is the empty universe of level 0.
+    let t = KTree::from_points(&[], 1.0, None, None).unwrap();
+    assert_eq!((t.level(), t.voxel_count()), (0, 0));
+}
