@@ -21,6 +21,7 @@ mod shape;
 mod stats;
 mod table;
 mod transform;
+mod view;
 mod voxelize;
 
 /// k-trees (bintrees, quadtrees, octrees, 4-D trees) from rays by stacking.
@@ -51,6 +52,8 @@ enum Command {
     Render(render::Args),
     /// Draw an octree as lines with hidden lines removed (SVG or PNG).
     Lines(lines::Args),
+    /// An interactive 3-D view of a tree in one self-contained HTML page (WebGL2, no network).
+    View(view::Args),
     /// Regenerate the paper reproductions into results/ (all of them by default).
     Repro(repro::Args),
     /// An analytic solid (ball, ellipsoid, paraboloid, cylinder, cone, half-space, box, quadric) to rays.
@@ -104,6 +107,7 @@ fn main() -> ExitCode {
         Command::Mass(args) => mass::run(args),
         Command::Render(args) => render::run(args),
         Command::Lines(args) => lines::run(args),
+        Command::View(args) => view::run(args),
         Command::Repro(args) => repro::run(args),
         Command::Rays(args) => rays::run(args),
         Command::Voxelize(args) => voxelize::run(args),

@@ -15,6 +15,7 @@
 pub mod files;
 pub mod outline;
 pub mod surface;
+pub mod view;
 pub mod vtk;
 
 use std::path::Path;
