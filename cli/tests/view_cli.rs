@@ -305,6 +305,47 @@ fn every_dimension_opens_without_errors_and_nothing_is_requested() {
             "{name}: {status:?}"
         );
     }
+    // The time slider shows one slice of a 4-D tree: a ball moving along the time axis is elsewhere at
+    // another time.
+    let mut dense = vec![false; 1 << 16];
+    for (i, voxel) in dense.iter_mut().enumerate() {
+        let [x, y, z, t] = [0, 4, 8, 12].map(|s| ((i >> s) & 15) as f64 + 0.5);
+        *voxel = (x - 4.0 - 0.5 * t).powi(2) + (y - 8.0).powi(2) + (z - 8.0).powi(2) <= 9.0;
+    }
+    write_ktree_file(&p("run.ktree"), &KTree::<4>::from_dense(4, &dense).unwrap()).unwrap();
+    let (ok, _, err) = ktree(&[
+        "view",
+        &s(&p("run.ktree")),
+        "--camera",
+        "top",
+        "--out",
+        &s(&p("run.html")),
+    ]);
+    assert!(ok, "{err}");
+    let mut masks = Vec::new();
+    for time in [1, 14] {
+        let (status, errors) = page_status(&browser, &p("run.html"), &format!("#time={time}"));
+        assert_eq!(get(&status, "errors"), "0", "{errors}");
+        let shot = p(&format!("run-{time}.png"));
+        run_chromium(
+            &browser,
+            &format!("file://{}#bare&time={time}", p("run.html").display()),
+            &[
+                "--window-size=320,240",
+                &format!("--screenshot={}", shot.display()),
+            ],
+        );
+        let (.., mask) = silhouette(&shot);
+        assert!(
+            mask.iter().filter(|&&m| m).count() > 100,
+            "time {time}: nothing drawn"
+        );
+        masks.push(mask);
+    }
+    assert!(
+        iou(&masks[0], &masks[1]) < 0.5,
+        "the slices at times 1 and 14 must differ"
+    );
     // The check itself catches a request: a page that tries one records the blocked request as an error.
     let html = std::fs::read_to_string(p("disk.ktree.html")).unwrap();
     let leaky = html.replace(

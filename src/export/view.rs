@@ -8,7 +8,13 @@
 //! time chosen with a slider. The mouse orbits (left button), pans (right button or shift) and zooms
 //! (wheel); sliders clip along each axis; a toggle colours by face normal or by depth in the tree. The
 //! first camera is the one `ktree render --camera NAME` takes (the same orthographic projection and
-//! framing); the URL hash `#camera=NAME` chooses another, `&bare` hides the controls.
+//! framing). The URL hash sets the start: `#camera=NAME` another camera, `colour=depth` or `colour=normal`,
+//! `time=T` the slice of a 4-D tree, `bare` no controls (the key `h` hides and shows them).
+//!
+//! The drawing is plain WebGL2 (about 200 lines in `view/page.html`, no library): one instanced unit cube,
+//! clipping and colouring in the fragment shader, an orthographic matrix built from the same frame as
+//! [`Camera::framing`](crate::display::Camera::framing). A 3-D library would add several hundred kilobytes
+//! to every page and a module loader to make it work offline, for nothing the page needs.
 //!
 //! # Level of detail
 //! [`select_boxes`] refines breadth first from the root: each partial node taken off the queue is replaced
