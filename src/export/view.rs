@@ -50,8 +50,8 @@ use crate::tree::{NodeRef, NodeState};
 /// The page template: markup, style and the WebGL2 program; the header and data are put in its slots.
 const TEMPLATE: &str = include_str!("view/page.html");
 
-/// The default box budget: about 2 MB of page, drawn at interactive rates by a laptop's GPU.
-pub const DEFAULT_BUDGET: usize = 200_000;
+/// The default box budget: about 0.8 MB of page (8 bytes of base64 a box for an octree).
+pub const DEFAULT_BUDGET: usize = 100_000;
 
 /// The boxes of a view: visible full leaves and the coarse partial cells left unrefined.
 #[derive(Debug, Clone, PartialEq, Eq)]
