@@ -30,7 +30,8 @@
 //! * [`shape`]: morphology (dilate, erode, opening, closing), connected components, surface area and Euler number, on the runs.
 //! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
 //! * [`export`]: the boundary out to the tools that look at surfaces and volumes — an octree as a closed
-//!   triangle mesh (PLY, OBJ, STL, glTF), a quadtree as closed polylines (PLY, OBJ, SVG).
+//!   triangle mesh (PLY, OBJ, STL, glTF), a quadtree as closed polylines (PLY, OBJ, SVG); any tree as an
+//!   interactive 3-D view in one self-contained HTML page ([`export::view`]).
 //!
 //! # Layers
 //! Each layer imports only those below it, with the exceptions listed after the picture:
@@ -38,7 +39,8 @@
 //!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text;
 //!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in,
 //!                     meshes written through export/)
-//!  export/            boundaries as meshes and outlines, and their files (over display's neighbours)
+//!  export/            boundaries as meshes and outlines, and their files (over display's neighbours);
+//!                     the 3-D view page (over the storage trait and display's named views)
 //!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink
 //!  query/  shape/     questions asked of a map (points, boxes, rays, nearest), over the storage trait;
 //!                     morphology, components, surface area, Euler number, on the runs

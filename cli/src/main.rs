@@ -23,6 +23,7 @@ mod shape;
 mod stats;
 mod table;
 mod transform;
+mod view;
 mod voxelize;
 
 /// k-trees (bintrees, quadtrees, octrees, 4-D trees) from rays by stacking.
@@ -53,6 +54,8 @@ enum Command {
     Render(render::Args),
     /// Draw an octree as lines with hidden lines removed (SVG or PNG).
     Lines(lines::Args),
+    /// An interactive 3-D view of a tree in one self-contained HTML page (WebGL2, no network).
+    View(view::Args),
     /// Regenerate the paper reproductions into results/ (all of them by default).
     #[cfg(feature = "repro")]
     Repro(repro::Args),
@@ -96,6 +99,7 @@ fn main() -> ExitCode {
         Command::Mass(args) => mass::run(args),
         Command::Render(args) => render::run(args),
         Command::Lines(args) => lines::run(args),
+        Command::View(args) => view::run(args),
         #[cfg(feature = "repro")]
         Command::Repro(args) => repro::run(args),
         Command::Rays(args) => rays::run(args),

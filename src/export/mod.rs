@@ -1,6 +1,7 @@
 //! The boundary of a tree out to the tools that look at surfaces: an octree as a closed triangle mesh
 //! ([`surface`]), a quadtree as closed polylines ([`outline`]), written as PLY, OBJ, STL or glTF binary
-//! ([`files`]) in real-world units ([`Frame`]).
+//! ([`files`]) in real-world units ([`Frame`]); any tree as an interactive 3-D view in one HTML page
+//! ([`view`]).
 //!
 //! ```
 //! use ktree::export::{write_mesh, Frame};
@@ -15,6 +16,7 @@
 pub mod files;
 pub mod outline;
 pub mod surface;
+pub mod view;
 pub mod vtk;
 
 use std::path::Path;

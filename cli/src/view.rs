@@ -1,0 +1,155 @@
+//! `ktree view FILE [--out view.html] [--budget N] [--camera VIEW] [--time-axis A] [--open]`: an
+//! interactive 3-D view of a tree in one self-contained HTML page (see `ktree::export::view`).
+
+use crate::common::error::CliResult;
+use crate::outln;
+
+use std::path::{Path, PathBuf};
+
+use ktree::display::View;
+use ktree::export::view::{write_view, Page, ViewOptions, DEFAULT_BUDGET};
+use ktree::io::{ktree_file_version, KtreeView, MappedTree};
+use ktree::tree::cursor::TreeStorage;
+use ktree::AnyTree;
+
+use crate::common::tree_file;
+
+/// Arguments of `ktree view`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The tree: a `.ktree` file or any format `ktree convert` reads (K = 2: flat squares; K = 3: boxes;
+    /// K = 4: a slider over the time axis).
+    file: PathBuf,
+    /// The page to write (default: a new file in the temporary folder, its path printed).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// The most boxes in the page: coarser levels are drawn as boxes of their partial cells where the
+    /// budget does not reach.
+    #[arg(long, default_value_t = DEFAULT_BUDGET, value_name = "N")]
+    budget: usize,
+    /// The first camera, as `ktree render --camera` takes it: iso, top, bottom, front, back, left, right
+    /// or X,Y,Z (default: iso; top for a quadtree).
+    #[arg(long)]
+    camera: Option<String>,
+    /// 4-D trees: the axis the slider moves along.
+    #[arg(long, default_value_t = 3)]
+    time_axis: usize,
+    /// Open the page in the system's browser (xdg-open), when there is one.
+    #[arg(long)]
+    open: bool,
+}
+
+/// Writes the page.
+pub fn run(args: Args) -> CliResult {
+    let camera = match &args.camera {
+        Some(name) => Some(name.parse::<View>().map_err(|e| e.to_string())?),
+        None => None,
+    };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| temporary_page(&args.file));
+    let options = ViewOptions {
+        budget: args.budget,
+        camera,
+        time_axis: args.time_axis,
+        title: args
+            .file
+            .file_name()
+            .map_or_else(|| "ktree".into(), |n| n.to_string_lossy().into_owned()),
+    };
+    // A version 2 file is read through its memory map, whatever its size.
+    let page = if ktree_file_version(&args.file).is_ok_and(|v| v == 2) {
+        let view = KtreeView::open(&args.file).map_err(|e| e.to_string())?;
+        match view.k() {
+            2 => mapped::<2>(&view, &out, &options)?,
+            3 => mapped::<3>(&view, &out, &options)?,
+            4 => mapped::<4>(&view, &out, &options)?,
+            _ => write(&tree_file::read_any(&args.file)?, &out, &options)?,
+        }
+    } else {
+        write(&tree_file::read_any(&args.file)?, &out, &options)?
+    };
+    outln!(
+        "wrote {} ({} boxes{}, {} bytes)",
+        out.display(),
+        page.boxes,
+        if page.complete {
+            String::new()
+        } else {
+            format!(
+                ", {} of them coarse: the budget of {} was reached",
+                page.coarse, args.budget
+            )
+        },
+        page.html.len()
+    );
+    if args.open {
+        open(&out)?;
+    }
+    Ok(())
+}
+
+/// The page of a memory-mapped tree of dimension `K`.
+fn mapped<const K: usize>(
+    view: &KtreeView,
+    out: &Path,
+    options: &ViewOptions,
+) -> Result<Page, String> {
+    let tree = MappedTree::<K>::new(view).map_err(|e| e.to_string())?;
+    let page = page_of(&tree, out, options);
+    // A file changed while it was read: its error, not a page of what was read.
+    tree.failure().map_err(|e| e.to_string())?;
+    page
+}
+
+fn page_of<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    out: &Path,
+    options: &ViewOptions,
+) -> Result<Page, String>
+where
+    T::Error: std::error::Error + Send + Sync + 'static,
+{
+    write_view(out, tree, options).map_err(|e| e.to_string())
+}
+
+fn write(tree: &AnyTree, out: &Path, options: &ViewOptions) -> Result<Page, String> {
+    ktree::with_dim!(tree, AnyTree, t => page_of(t, out, options))
+}
+
+/// A new page's path in the temporary folder, named after the input.
+fn temporary_page(file: &Path) -> PathBuf {
+    let stem = file
+        .file_stem()
+        .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    std::env::temp_dir().join(format!(
+        "ktree-view-{stem}-{}-{nanos:09}.html",
+        std::process::id()
+    ))
+}
+
+/// Opens the page with `xdg-open` when it is on the `PATH`; says so when it is not (never an error).
+fn open(page: &Path) -> CliResult {
+    let found = std::env::var_os("PATH").is_some_and(|paths| {
+        std::env::split_paths(&paths).any(|dir| dir.join("xdg-open").is_file())
+    });
+    if !found {
+        outln!(
+            "no browser to open it with (xdg-open is not installed): open {} in a browser",
+            page.display()
+        );
+        return Ok(());
+    }
+    match std::process::Command::new("xdg-open").arg(page).spawn() {
+        Ok(_) => outln!("opening {} with xdg-open", page.display()),
+        Err(e) => outln!(
+            "could not run xdg-open ({e}): open {} in a browser",
+            page.display()
+        ),
+    }
+    Ok(())
+}

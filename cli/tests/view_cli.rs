@@ -1,0 +1,421 @@
+//! `ktree view` end to end, in a real browser: the page opens in headless Chromium with no error and no
+//! request, draws the tree, and its first frame's silhouette agrees with `ktree render` of the same tree and
+//! camera on at least 95 % of the pixels of their union. Where Chromium is missing the browser checks print
+//! `SKIPPED: chromium not installed` and pass.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::ktree;
+
+use ktree::io::write_ktree_file;
+use ktree::rays::ball_rays;
+use ktree::KTree;
+
+/// The Chromium binary, if one is installed.
+fn chromium() -> Option<PathBuf> {
+    let paths = std::env::var_os("PATH")?;
+    ["chromium", "chromium-browser", "google-chrome"]
+        .iter()
+        .flat_map(|name| std::env::split_paths(&paths).map(move |dir| dir.join(name)))
+        .find(|p| p.is_file())
+}
+
+/// Runs headless Chromium on `url` with `extra` flags (its own new profile, offline, software WebGL);
+/// returns its standard output. Ends it after two minutes.
+fn run_chromium(browser: &Path, url: &str, extra: &[&str]) -> String {
+    let profile = tempfile::tempdir().unwrap();
+    let mut child = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--hide-scrollbars",
+            "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .args(extra)
+        .arg(url)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start chromium");
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            panic!("chromium did not finish on {url}");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let out = child.wait_with_output().unwrap();
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// The page's own record of its first frame (`key=value` lines of `#ktree-status`) and its errors, read
+/// from the DOM after load.
+fn page_status(browser: &Path, page: &Path, hash: &str) -> (Vec<(String, String)>, String) {
+    let url = format!("file://{}{hash}", page.display());
+    let dom = run_chromium(browser, &url, &["--window-size=320,240", "--dump-dom"]);
+    let between = |open: &str, close: &str| {
+        let at = dom
+            .find(open)
+            .unwrap_or_else(|| panic!("no {open} in {dom:.2000}"))
+            + open.len();
+        dom[at..].split(close).next().unwrap().to_string()
+    };
+    let status = between("<pre id=\"ktree-status\">", "</pre>")
+        .lines()
+        .filter_map(|l| l.split_once('='))
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let errors = between("id=\"ktree-errors\"", "</ol>");
+    (status, errors)
+}
+
+fn get<'a>(status: &'a [(String, String)], key: &str) -> &'a str {
+    status
+        .iter()
+        .find(|(k, _)| k == key)
+        .map(|(_, v)| v.as_str())
+        .unwrap_or_else(|| panic!("no {key} in {status:?}"))
+}
+
+/// Object pixels (anything but the white background) of a PNG.
+fn silhouette(path: &Path) -> (u32, u32, Vec<bool>) {
+    let image = image::open(path).unwrap().to_rgb8();
+    let mask = image.pixels().map(|p| p.0 != [255, 255, 255]).collect();
+    (image.width(), image.height(), mask)
+}
+
+/// Intersection over union of two masks.
+fn iou(a: &[bool], b: &[bool]) -> f64 {
+    let both = a.iter().zip(b).filter(|(x, y)| **x && **y).count();
+    let either = a.iter().zip(b).filter(|(x, y)| **x || **y).count();
+    both as f64 / either.max(1) as f64
+}
+
+/// A ball and a box beside it, off-centre: no symmetry hides a mirrored or turned view.
+fn lopsided() -> KTree<3> {
+    let n = 32u32;
+    let mut dense = vec![false; (n * n * n) as usize];
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let (fx, fy, fz) = (
+                    f64::from(x) - 11.5,
+                    f64::from(y) - 13.5,
+                    f64::from(z) - 15.5,
+                );
+                let ball = fx * fx + fy * fy + fz * fz <= 81.0;
+                let slab = (16..30).contains(&x) && (4..12).contains(&y) && (2..27).contains(&z);
+                dense[(x + n * (y + n * z)) as usize] = ball || slab;
+            }
+        }
+    }
+    KTree::<3>::from_dense(5, &dense).unwrap()
+}
+
+fn s(path: &Path) -> String {
+    path.display().to_string()
+}
+
+#[test]
+fn the_page_matches_ktree_render_in_a_browser() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    let ball = KTree::from_rays(&ball_rays::<3>(6, [64, 64, 64], 50).unwrap());
+    write_ktree_file(&p("ball.ktree"), &ball).unwrap();
+    write_ktree_file(&p("lopsided.ktree"), &lopsided()).unwrap();
+    // The page is written (and the budget respected) whether or not a browser is there.
+    for (tree, camera) in [("ball", "iso"), ("lopsided", "front"), ("lopsided", "iso")] {
+        let page = p(&format!("{tree}-{camera}.html"));
+        let (ok, out, err) = ktree(&[
+            "view",
+            &s(&p(&format!("{tree}.ktree"))),
+            "--camera",
+            camera,
+            "--out",
+            &s(&page),
+        ]);
+        assert!(ok, "{err}");
+        assert!(out.contains("boxes"), "{out}");
+        let (ok, _, err) = ktree(&[
+            "render",
+            &s(&p(&format!("{tree}.ktree"))),
+            "--camera",
+            camera,
+            "--size",
+            "320x240",
+            "--out",
+            &s(&p(&format!("{tree}-{camera}.png"))),
+        ]);
+        assert!(ok, "{err}");
+    }
+    let Some(browser) = chromium() else {
+        println!("SKIPPED: chromium not installed");
+        return;
+    };
+    for (tree, camera) in [("ball", "iso"), ("lopsided", "front"), ("lopsided", "iso")] {
+        let page = p(&format!("{tree}-{camera}.html"));
+        let (status, errors) = page_status(&browser, &page, "#bare");
+        assert_eq!(get(&status, "errors"), "0", "{tree} {camera}: {errors}");
+        assert!(
+            get(&status, "painted").parse::<u64>().unwrap() > 1000,
+            "{status:?}"
+        );
+        let shot = p(&format!("{tree}-{camera}-page.png"));
+        run_chromium(
+            &browser,
+            &format!("file://{}#bare", page.display()),
+            &[
+                "--window-size=320,240",
+                &format!("--screenshot={}", shot.display()),
+            ],
+        );
+        let (w, h, page_mask) = silhouette(&shot);
+        let (rw, rh, render_mask) = silhouette(&p(&format!("{tree}-{camera}.png")));
+        assert_eq!((w, h), (rw, rh));
+        let agree = iou(&page_mask, &render_mask);
+        println!(
+            "{tree} {camera}: silhouettes agree on {:.2} % of their union",
+            100.0 * agree
+        );
+        assert!(agree >= 0.95, "{tree} {camera}: IoU {agree}");
+    }
+    // The camera named in the URL's hash overrides the page's: the lopsided object's front page seen
+    // from iso is the iso picture.
+    let shot = p("hash.png");
+    run_chromium(
+        &browser,
+        &format!(
+            "file://{}#camera=iso&bare",
+            p("lopsided-front.html").display()
+        ),
+        &[
+            "--window-size=320,240",
+            &format!("--screenshot={}", shot.display()),
+        ],
+    );
+    let (.., hash_mask) = silhouette(&shot);
+    let (.., iso_mask) = silhouette(&p("lopsided-iso.png"));
+    let (.., front_mask) = silhouette(&p("lopsided-front.png"));
+    assert!(iou(&hash_mask, &iso_mask) >= 0.95);
+    assert!(
+        iou(&hash_mask, &front_mask) < 0.9,
+        "the front and iso views must differ"
+    );
+}
+
+#[test]
+fn every_dimension_opens_without_errors_and_nothing_is_requested() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    write_ktree_file(
+        &p("disk.ktree"),
+        &KTree::from_rays(&ball_rays::<2>(6, [64, 64], 50).unwrap()),
+    )
+    .unwrap();
+    write_ktree_file(
+        &p("moving.ktree"),
+        &KTree::from_rays(&ball_rays::<4>(4, [16, 16, 16, 16], 12).unwrap()),
+    )
+    .unwrap();
+    write_ktree_file(
+        &p("ball.ktree"),
+        &KTree::from_rays(&ball_rays::<3>(7, [128, 128, 128], 100).unwrap()),
+    )
+    .unwrap();
+    // Other formats are read through the common layer: the ball as a ray file.
+    let (ok, _, err) = ktree(&["convert", &s(&p("ball.ktree")), &s(&p("ball.rays"))]);
+    assert!(ok, "{err}");
+    let pages = [
+        ("disk.ktree", vec![]),
+        ("moving.ktree", vec!["--time-axis", "2"]),
+        ("ball.rays", vec!["--budget", "300"]),
+    ];
+    for (name, extra) in &pages {
+        let page = p(&format!("{name}.html"));
+        let mut args = vec!["view", &s(&p(name))]
+            .into_iter()
+            .map(String::from)
+            .collect::<Vec<_>>();
+        args.extend(extra.iter().map(|x| x.to_string()));
+        args.extend(["--out".to_string(), s(&page)]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (ok, out, err) = ktree(&args);
+        assert!(ok, "{name}: {err}");
+        let html = std::fs::read_to_string(&page).unwrap();
+        // Nothing in the page points outside it, and the page forbids every request.
+        assert!(
+            !html.contains("http://") && !html.contains("https://"),
+            "{name}"
+        );
+        assert!(html.contains("content=\"default-src 'none';"), "{name}");
+        // The boxes in the page (the header's counts) are within the budget.
+        let header: serde_json::Value = serde_json::from_str(
+            html.split("id=\"ktree-header\">")
+                .nth(1)
+                .unwrap()
+                .split("</script>")
+                .next()
+                .unwrap(),
+        )
+        .unwrap();
+        let boxes = header["full"].as_u64().unwrap() + header["coarse"].as_u64().unwrap();
+        let groups: u64 = header["groups"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|g| g["count"].as_u64().unwrap())
+            .sum();
+        assert_eq!(boxes, groups);
+        let budget = header["budget"].as_u64().unwrap();
+        assert!(
+            boxes <= budget && boxes > 0,
+            "{name}: {boxes} boxes, budget {budget}"
+        );
+        if *name == "ball.rays" {
+            assert_eq!(budget, 300);
+            assert!(
+                header["coarse"].as_u64().unwrap() > 0,
+                "a level-7 ball does not fit in 300 boxes"
+            );
+            assert!(out.contains("coarse"), "{out}");
+        }
+    }
+    let Some(browser) = chromium() else {
+        println!("SKIPPED: chromium not installed");
+        return;
+    };
+    for (name, _) in &pages {
+        let (status, errors) = page_status(&browser, &p(&format!("{name}.html")), "");
+        assert_eq!(get(&status, "errors"), "0", "{name}: {errors}");
+        assert!(
+            get(&status, "painted").parse::<u64>().unwrap() > 100,
+            "{name}: {status:?}"
+        );
+    }
+    // The time slider shows one slice of a 4-D tree: a ball moving along the time axis is elsewhere at
+    // another time.
+    let mut dense = vec![false; 1 << 16];
+    for (i, voxel) in dense.iter_mut().enumerate() {
+        let [x, y, z, t] = [0, 4, 8, 12].map(|s| ((i >> s) & 15) as f64 + 0.5);
+        *voxel = (x - 4.0 - 0.5 * t).powi(2) + (y - 8.0).powi(2) + (z - 8.0).powi(2) <= 9.0;
+    }
+    write_ktree_file(&p("run.ktree"), &KTree::<4>::from_dense(4, &dense).unwrap()).unwrap();
+    let (ok, _, err) = ktree(&[
+        "view",
+        &s(&p("run.ktree")),
+        "--camera",
+        "top",
+        "--out",
+        &s(&p("run.html")),
+    ]);
+    assert!(ok, "{err}");
+    let mut masks = Vec::new();
+    for time in [1, 14] {
+        let (status, errors) = page_status(&browser, &p("run.html"), &format!("#time={time}"));
+        assert_eq!(get(&status, "errors"), "0", "{errors}");
+        let shot = p(&format!("run-{time}.png"));
+        run_chromium(
+            &browser,
+            &format!("file://{}#bare&time={time}", p("run.html").display()),
+            &[
+                "--window-size=320,240",
+                &format!("--screenshot={}", shot.display()),
+            ],
+        );
+        let (.., mask) = silhouette(&shot);
+        assert!(
+            mask.iter().filter(|&&m| m).count() > 100,
+            "time {time}: nothing drawn"
+        );
+        masks.push(mask);
+    }
+    assert!(
+        iou(&masks[0], &masks[1]) < 0.5,
+        "the slices at times 1 and 14 must differ"
+    );
+    // The check itself catches a request: a page that tries one records the blocked request as an error.
+    let html = std::fs::read_to_string(p("disk.ktree.html")).unwrap();
+    let leaky = html.replace(
+        "</body>",
+        "<script>fetch(\"https://example.com/x\");</script></body>",
+    );
+    std::fs::write(p("leaky.html"), leaky).unwrap();
+    let (status, errors) = page_status(&browser, &p("leaky.html"), "");
+    assert_ne!(
+        get(&status, "errors"),
+        "0",
+        "a blocked request must be recorded"
+    );
+    assert!(errors.contains("example.com"), "{errors}");
+}
+
+#[test]
+fn bad_input_is_a_one_line_error_and_the_default_page_is_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    std::fs::write(p("junk.ktree"), b"not a tree at all").unwrap();
+    write_ktree_file(&p("line.ktree"), &KTree::<1>::full(3).unwrap()).unwrap();
+    write_ktree_file(&p("moving.ktree"), &KTree::<4>::full(2).unwrap()).unwrap();
+    write_ktree_file(&p("cube.ktree"), &KTree::<3>::full(2).unwrap()).unwrap();
+    let page = s(&p("page.html"));
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["missing.ktree", "--out", &page],
+        vec!["junk.ktree", "--out", &page],
+        vec!["line.ktree", "--out", &page],
+        vec!["moving.ktree", "--time-axis", "4", "--out", &page],
+        vec!["cube.ktree", "--budget", "0", "--out", &page],
+        vec!["cube.ktree", "--camera", "sideways", "--out", &page],
+        // A file where the page's folder would be.
+        vec!["cube.ktree", "--out", "/dev/null/page.html"],
+    ];
+    for case in cases {
+        let file = s(&p(case[0]));
+        let mut args = vec!["view", &file];
+        args.extend(&case[1..]);
+        let (ok, _, err) = ktree(&args);
+        assert!(!ok, "{args:?} should fail");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+    }
+    assert!(!p("page.html").exists());
+    // Without --out: a new page in the temporary folder, its path printed; --open without a browser to
+    // open it with says so and succeeds.
+    let out = Command::new(env!("CARGO_BIN_EXE_ktree"))
+        .args(["view", &s(&p("cube.ktree")), "--open"])
+        .env("PATH", dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("no browser"), "{text}");
+    let written = text
+        .split_whitespace()
+        .find(|w| w.ends_with(".html"))
+        .map(PathBuf::from)
+        .unwrap();
+    assert!(
+        written.starts_with(std::env::temp_dir()),
+        "{}",
+        written.display()
+    );
+    assert!(std::fs::read_to_string(&written)
+        .unwrap()
+        .contains("ktree-header"));
+    std::fs::remove_file(written).unwrap();
+}
