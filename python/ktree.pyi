@@ -159,6 +159,11 @@ class Tree:
     ) -> npt.NDArray[np.bool_]:
         """The voxels of a window (`shape` from `origin`; default the bounding box, not the universe)
         as a boolean array indexed [x, y, z, ...]; voxels outside the universe are False."""
+    def signed_distance(
+        self, origin: Optional[Sequence[int]] = None, shape: Optional[Sequence[int]] = None
+    ) -> npt.NDArray[np.float32]:
+        """Signed distances of a window (default the bounding box) as a float32 array indexed
+        [x, y, z, ...]: scipy's edt(~a) - edt(a) on the whole universe, negative inside."""
     def to_rays(self) -> npt.NDArray[np.int64]:
         """The voxels as maximal runs: an (n, K + 1) array as from_rays reads."""
     def contains(self, points: npt.ArrayLike) -> Union[bool, npt.NDArray[np.bool_]]:

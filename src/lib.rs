@@ -27,7 +27,8 @@
 //!   mass properties, complexity.
 //! * [`query`]: questions asked of a map — batch point queries, boxes and counts, ray casting, the
 //!   nearest full voxel — on trees in memory and on mapped files.
-//! * [`shape`]: morphology (dilate, erode, opening, closing), connected components, surface area and Euler number, on the runs.
+//! * [`shape`]: morphology (dilate, erode, opening, closing), connected components, surface area and Euler number, on the runs;
+//!   signed distance fields and narrow bands ([`shape::distance`]).
 //! * [`display`]: hidden-surface images, line drawings with hidden lines removed, quadtree and 4-D pictures.
 //! * [`export`]: the boundary out to the tools that look at surfaces and volumes — an octree as a closed
 //!   triangle mesh (PLY, OBJ, STL, glTF), a quadtree as closed polylines (PLY, OBJ, SVG); any tree as an

@@ -10,6 +10,7 @@ mod build;
 mod collide;
 mod common;
 mod convert;
+mod distance;
 mod distributed;
 mod lines;
 mod mass;
@@ -73,6 +74,8 @@ enum Command {
     Morph(shape::MorphArgs),
     /// Connected components of a tree file: count, sizes, each as its own file.
     Components(shape::ComponentsArgs),
+    /// Signed distances of an octree file: the narrow band as an OpenVDB level set (FloatGrid).
+    Distance(distance::DistanceArgs),
 }
 
 /// Writes a line to standard output, returning from the enclosing function with a [`CliError`] if that
@@ -107,6 +110,7 @@ fn main() -> ExitCode {
         Command::Convert(args) => convert::run(args),
         Command::Morph(args) => shape::run_morph(args),
         Command::Components(args) => shape::run_components(args),
+        Command::Distance(args) => distance::run(args),
         Command::Query(args) => query::run_query(args),
         Command::Raycast(args) => query::run_raycast(args),
     };

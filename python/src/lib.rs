@@ -514,6 +514,44 @@ impl Tree {
         Ok(array.into_pyarray(py))
     }
 
+    /// Signed distances of a window as a float32 array indexed `[x, y, z, ...]`: Euclidean between voxel
+    /// centres, positive outside (to the nearest full voxel), negative inside (to the nearest empty voxel)
+    /// — scipy's `distance_transform_edt(~a) - distance_transform_edt(a)` on the whole universe as `a`
+    /// (the window sees the whole tree, not only itself); inf for an empty tree, -inf for a full universe.
+    /// The window is `shape` voxels from `origin`, inside the universe; by default the bounding box of the
+    /// full voxels (from `origin` when only it is given).
+    #[pyo3(signature = (origin = None, shape = None))]
+    fn signed_distance<'py>(
+        &self,
+        py: Python<'py>,
+        origin: Option<Vec<i64>>,
+        shape: Option<Vec<usize>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+        let k = self.inner.k();
+        for (name, len) in [
+            ("origin", origin.as_ref().map(Vec::len)),
+            ("shape", shape.as_ref().map(Vec::len)),
+        ] {
+            if let Some(len) = len.filter(|&n| n != k) {
+                return Err(Failure::Value(format!(
+                    "signed_distance: {name} of a K = {k} tree has {k} numbers, got {len}"
+                ))
+                .into());
+            }
+        }
+        let array = py.detach(|| {
+            with_dim!(&self.inner, AnyTree, t => {
+                let (o, s) = queries::default_window(
+                    t,
+                    origin.as_ref().map(|o| std::array::from_fn(|a| o[a])),
+                    shape.as_ref().map(|s| std::array::from_fn(|a| s[a])),
+                );
+                queries::signed_distance(t, o, s)
+            })
+        })?;
+        Ok(array.into_pyarray(py))
+    }
+
     /// Whether voxels are inside: one point (K integers) gives a bool, an `(N, K)` integer array an
     /// `(N,)` bool array (answered on all threads, ordered by Morton key, without the interpreter lock).
     /// Points outside the universe (negative ones too) are outside.

@@ -128,6 +128,25 @@ pub(crate) fn window<const K: usize>(
     ArrayD::from_shape_vec(IxDyn(&shape).f(), data).map_err(Failure::value)
 }
 
+/// The signed distances of a window (inside the universe), C order: an array indexed `[x, y, z, …]`.
+pub(crate) fn signed_distance<const K: usize>(
+    tree: &KTree<K>,
+    origin: [i64; K],
+    shape: [usize; K],
+) -> Result<ArrayD<f32>, Failure> {
+    let side = tree.universe().side() as i64;
+    let lo: [u32; K] = std::array::from_fn(|a| origin[a].clamp(0, side) as u32);
+    if (0..K).any(|a| i64::from(lo[a]) != origin[a]) {
+        return Err(Failure::Value(format!(
+            "signed_distance: origin {origin:?} is outside the universe (side {side})"
+        )));
+    }
+    let data = tree
+        .signed_distance_window(lo, shape)
+        .map_err(Failure::value)?;
+    ArrayD::from_shape_vec(IxDyn(&shape), data).map_err(Failure::value)
+}
+
 /// The default window: the bounding box (from `origin` when given), empty for an empty tree.
 pub(crate) fn default_window<const K: usize>(
     tree: &KTree<K>,

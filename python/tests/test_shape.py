@@ -153,3 +153,48 @@ def test_held_data_skull_and_mesh():
     )
     assert bunny.euler_number(3) == measure.euler_number(b, connectivity=3)
     assert len(bunny.components(1)) == ndimage.label(b)[1]
+
+
+def signed_distance_ref(a):
+    """scipy's signed distance of a whole universe: + to the nearest full voxel, - to the nearest empty."""
+    inf = np.full(a.shape, np.inf)
+    out = ndimage.distance_transform_edt(~a) if a.any() else inf
+    inside = ndimage.distance_transform_edt(a) if (~a).any() else inf
+    return np.where(a, -inside, out).astype(np.float32)
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 4])
+def test_signed_distance_matches_scipy(rng, k):
+    for _ in range(3):
+        a = random_array(rng, k, LEVELS[k])
+        t = ktree.Tree.from_dense(a)
+        sd = t.signed_distance((0,) * k, (t.side,) * k)
+        assert sd.dtype == np.float32 and sd.shape == a.shape
+        np.testing.assert_array_equal(sd, signed_distance_ref(a))
+        # A window sees the whole tree: it equals the universe's values there.
+        lo = rng.integers(0, t.side, size=k)
+        n = rng.integers(0, t.side - lo + 1)
+        w = t.signed_distance(tuple(int(x) for x in lo), tuple(int(x) for x in n))
+        np.testing.assert_array_equal(w, sd[tuple(slice(l, l + m) for l, m in zip(lo, n))])
+        # The default window is the bounding box.
+        lo, hi = t.bounding_box()
+        np.testing.assert_array_equal(
+            t.signed_distance(), sd[tuple(slice(l, h) for l, h in zip(lo, hi))]
+        )
+
+
+def test_signed_distance_held_data():
+    skull = ktree.Tree.from_volume(ROOT / "data/volumes/skull_grey.json", 29000)
+    a = universe(skull)
+    np.testing.assert_array_equal(
+        skull.signed_distance((0,) * 3, (skull.side,) * 3), signed_distance_ref(a)
+    )
+    bunny = ktree.Tree.from_mesh(ROOT / "data/meshes/bunny_npm.obj", 6)
+    b = universe(bunny)
+    np.testing.assert_array_equal(
+        bunny.signed_distance((0,) * 3, (bunny.side,) * 3), signed_distance_ref(b)
+    )
+    with pytest.raises(ValueError):
+        bunny.signed_distance((-1, 0, 0), (2, 2, 2))
+    with pytest.raises(ValueError):
+        bunny.signed_distance((0, 0), (2, 2))

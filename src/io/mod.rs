@@ -38,8 +38,9 @@ pub use dispatch::{
 #[cfg(any(feature = "mesh", feature = "volume"))]
 pub use dispatch::{voxel_source, VoxelSource, VoxelizedSource};
 pub use interop::{
-    read_binvox, read_bt, read_vdb, write_binvox, write_bt, write_vdb, GridFileError,
-    GridFileErrorKind, GridMeta, GridPlacement, PlacedTree, BINVOX_MAX_DIM, BT_DEPTH, BT_HEADER,
+    read_binvox, read_bt, read_vdb, write_binvox, write_bt, write_vdb, write_vdb_level_set,
+    GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree, BINVOX_MAX_DIM,
+    BT_DEPTH, BT_HEADER,
 };
 pub use ktree::v1::{write_ktree_v1, write_ktree_v1_view};
 pub use ktree::{

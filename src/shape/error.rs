@@ -28,6 +28,28 @@ pub enum ShapeError {
         /// The universe's side.
         side: u64,
     },
+    /// A band's width is negative, NaN or infinite: give a finite number ≥ 0.
+    #[error("band width {0} is not a finite number >= 0")]
+    BadWidth(f64),
+    /// A point of a distance query lies outside the universe: give voxels in `0..side` on every axis.
+    #[error("point {point:?} is outside the universe (side {side})")]
+    PointOutside {
+        /// The point.
+        point: Vec<u32>,
+        /// The universe's side.
+        side: u64,
+    },
+    /// A window leaves the universe or holds more than 2^31 voxels: give `origin + shape ≤ side` on every
+    /// axis and a smaller window.
+    #[error("window at {origin:?} of shape {shape:?} leaves the universe (side {side}) or holds more than 2^31 voxels")]
+    Window {
+        /// The window's first voxel.
+        origin: Vec<u32>,
+        /// Its extent along each axis.
+        shape: Vec<usize>,
+        /// The universe's side.
+        side: u64,
+    },
     /// The connectivity is not in `1..=K`.
     #[error("connectivity {connectivity} is not in 1..={k}")]
     Connectivity {

@@ -24,6 +24,7 @@
 //! [`KTree::to_rays`]: crate::KTree::to_rays
 
 mod components;
+pub mod distance;
 mod element;
 mod error;
 mod euler;
@@ -32,5 +33,7 @@ mod runs;
 mod surface;
 
 pub use components::Component;
+pub use distance::NarrowBand;
 pub use element::Element;
 pub use error::ShapeError;
+pub use morphology::BALL_BY_DISTANCE_FROM;

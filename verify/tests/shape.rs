@@ -154,6 +154,21 @@ fn check_morphology<const K: usize>(
     prop_assert_eq!(dense(&dil), dilate_ref(&a, element, r), "dilate");
     let ero = tree.erode(r, element).unwrap();
     prop_assert_eq!(dense(&ero), erode_ref(&a, element, r), "erode");
+    if element == Element::Ball {
+        // Both ball paths, whichever `dilate` and `erode` chose.
+        let by_distance = tree.dilate_ball_by_distance(r).unwrap();
+        prop_assert_eq!(
+            dense(&by_distance),
+            dilate_ref(&a, element, r),
+            "dilate by distance"
+        );
+        let by_distance = tree.erode_ball_by_distance(r).unwrap();
+        prop_assert_eq!(
+            dense(&by_distance),
+            erode_ref(&a, element, r),
+            "erode by distance"
+        );
+    }
     let open = tree.opening(r, element).unwrap();
     prop_assert_eq!(
         dense(&open),

@@ -6,8 +6,10 @@ mod binvox;
 mod grid;
 mod octomap;
 mod vdb;
+mod vdb_level_set;
 
 pub use binvox::{read_binvox, write_binvox, BINVOX_MAX_DIM};
 pub use grid::{GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree};
 pub use octomap::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
 pub use vdb::{read_vdb, write_vdb};
+pub use vdb_level_set::write_vdb_level_set;

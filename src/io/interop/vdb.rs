@@ -23,17 +23,17 @@ use super::grid::{
 };
 use crate::tree::{KTree, NodeState};
 
-const MAGIC: i64 = 0x5644_4220;
-const FILE_VERSION: u32 = 224;
+pub(super) const MAGIC: i64 = 0x5644_4220;
+pub(super) const FILE_VERSION: u32 = 224;
 const BOOL_TREE: &str = "Tree_bool_5_4_3";
 const MASK_TREE: &str = "Tree_mask_5_4_3";
 /// Grid metadata written by ktree: the universe level and the offset, read back as defaults.
 const LEVEL_KEY: &str = "ktree_level";
 const OFFSET_KEY: &str = "ktree_offset";
 /// Words of a leaf mask (8³ bits), of a lower node mask (16³), of an upper node mask (32³).
-const LEAF_WORDS: usize = 8;
-const LOWER_WORDS: usize = 64;
-const UPPER_WORDS: usize = 512;
+pub(super) const LEAF_WORDS: usize = 8;
+pub(super) const LOWER_WORDS: usize = 64;
+pub(super) const UPPER_WORDS: usize = 512;
 
 /// A 16³ internal node: 8³ tiles that are fully active, and leaves (8³ bit masks) by slot.
 #[derive(Default)]
@@ -49,13 +49,13 @@ struct Upper {
     lowers: BTreeMap<u32, Lower>,
 }
 
-fn slot(p: [i64; 3], log_dim: u32, child_log: u32) -> u32 {
+pub(super) fn slot(p: [i64; 3], log_dim: u32, child_log: u32) -> u32 {
     let m = (1i64 << (log_dim + child_log)) - 1;
     let c = |a: usize| ((p[a] & m) >> child_log) as u32;
     (c(0) << (2 * log_dim)) | (c(1) << log_dim) | c(2)
 }
 
-fn origin_of(p: [i64; 3], log_side: u32) -> [i64; 3] {
+pub(super) fn origin_of(p: [i64; 3], log_side: u32) -> [i64; 3] {
     p.map(|c| c & !((1i64 << log_side) - 1))
 }
 
@@ -109,11 +109,11 @@ fn add_box(root: &mut BTreeMap<[i64; 3], Upper>, lo: [i64; 3], side: i64) {
     }
 }
 
-fn put_u32(out: &mut Vec<u8>, v: u32) {
+pub(super) fn put_u32(out: &mut Vec<u8>, v: u32) {
     out.extend_from_slice(&v.to_le_bytes());
 }
 
-fn put_str(out: &mut Vec<u8>, s: &str) {
+pub(super) fn put_str(out: &mut Vec<u8>, s: &str) {
     put_u32(out, s.len() as u32);
     out.extend_from_slice(s.as_bytes());
 }
@@ -418,7 +418,7 @@ fn ones(words: &[u64]) -> impl Iterator<Item = usize> + '_ {
     })
 }
 
-fn corner_of(origin: [i64; 3], n: usize, log_dim: u32, child_log: u32) -> [i64; 3] {
+pub(super) fn corner_of(origin: [i64; 3], n: usize, log_dim: u32, child_log: u32) -> [i64; 3] {
     let m = (1usize << log_dim) - 1;
     let c = [n >> (2 * log_dim), n >> log_dim & m, n & m];
     std::array::from_fn(|a| origin[a] + ((c[a] as i64) << child_log))

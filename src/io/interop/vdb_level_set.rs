@@ -1,0 +1,322 @@
+//! OpenVDB narrow-band level sets (`FloatGrid`, `Tree_float_5_4_3`, grid class `level set`) out of an
+//! octree's signed distances ([`KTree::narrow_band`]).
+//!
+//! What is written, in OpenVDB's terms (see `openvdb/tools/LevelSetUtil.h` for how OpenVDB reads a level
+//! set): the active voxels are the band, the voxels with `|sd| ≤ W` (`W` the half-width in voxels), their
+//! values the signed distances in world units (`sd · S`, `S` the voxel size, negative inside); every
+//! inactive value — a leaf's other voxels, the tiles of the internal nodes and of the root — is `−W · S`
+//! inside the object and `+W · S` outside; the background is `W · S` (OpenVDB's `halfWidth · voxelSize`).
+//! The transform is a uniform scale by `S` (`UniformScaleMap`: index `(i, j, k)` at world `S · (i, j, k)`),
+//! and OpenVDB index = ktree voxel. The universe is the array: outside it is outside the object, and a full
+//! voxel on the universe's border measures to the nearest empty voxel inside the universe (the surface is
+//! open there). Values are stored uncompressed (compression flags 0), which every OpenVDB reads.
+
+use std::collections::BTreeMap;
+use std::io::Write;
+
+use super::vdb::{
+    corner_of, origin_of, put_str, put_u32, slot, FILE_VERSION, LEAF_WORDS, LOWER_WORDS, MAGIC,
+    UPPER_WORDS,
+};
+use crate::tree::{KTree, NodeState};
+
+const FLOAT_TREE: &str = "Tree_float_5_4_3";
+/// Most root tiles (4096³ blocks wholly inside) written.
+const MAX_ROOT_TILES: u64 = 1 << 20;
+
+/// An 8³ leaf: active voxels and all 512 values.
+struct Leaf {
+    mask: [u64; LEAF_WORDS],
+    values: Vec<f32>,
+}
+
+type Lower = BTreeMap<u32, Leaf>;
+type Upper = BTreeMap<u32, Lower>;
+
+fn put_f32s(out: &mut Vec<u8>, values: impl IntoIterator<Item = f32>) {
+    for v in values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+fn put_words(out: &mut Vec<u8>, words: &[u64]) {
+    for w in words {
+        out.extend_from_slice(&w.to_le_bytes());
+    }
+}
+
+fn put_origin(out: &mut Vec<u8>, origin: [i64; 3]) {
+    for c in origin {
+        out.extend_from_slice(&(c as i32).to_le_bytes());
+    }
+}
+
+/// Writes the narrow band of half-width `width` voxels of an octree as an OpenVDB level set (a
+/// `FloatGrid` named `ktree`, see the [module docs](self)) with voxel size `voxel_size`.
+///
+/// ```
+/// use ktree::io::{read_vdb, write_vdb_level_set};
+/// use ktree::{rays::ball_rays, KTree};
+/// let tree = KTree::from_rays(&ball_rays::<3>(5, [16, 16, 16], 12).unwrap());
+/// let mut bytes = Vec::new();
+/// write_vdb_level_set(&mut bytes, &tree, 3.0, 0.5).unwrap();
+/// assert!(bytes.len() > 8 * 512);
+/// ```
+///
+/// # Errors
+/// [`std::io::ErrorKind::InvalidInput`] for a width below 1 (a band that may miss the surface) or not
+/// finite, a voxel size that is not a positive number, an index outside OpenVDB's 32-bit range (levels
+/// over 31 cannot occur for an octree), or more than 2^20 root tiles; any I/O error.
+pub fn write_vdb_level_set(
+    mut w: impl Write,
+    tree: &KTree<3>,
+    width: f64,
+    voxel_size: f64,
+) -> std::io::Result<()> {
+    let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, m);
+    if !(width.is_finite() && width >= 1.0) {
+        return Err(invalid(format!(
+            "band half-width {width} is not a number >= 1"
+        )));
+    }
+    if !(voxel_size.is_finite() && voxel_size > 0.0) {
+        return Err(invalid(format!(
+            "voxel size {voxel_size} is not a positive number"
+        )));
+    }
+    let band = tree
+        .narrow_band(width)
+        .map_err(|e| invalid(e.to_string()))?;
+    let background = (width * voxel_size) as f32;
+    let side = tree.universe().side() as i64;
+    // The nodes holding the band, leaves' values NaN until filled.
+    let mut root: BTreeMap<[i64; 3], Upper> = BTreeMap::new();
+    for (v, d) in band.iter() {
+        let p = v.map(i64::from);
+        let leaf = root
+            .entry(origin_of(p, 12))
+            .or_default()
+            .entry(slot(p, 5, 7))
+            .or_default()
+            .entry(slot(p, 4, 3))
+            .or_insert_with(|| Leaf {
+                mask: [0; LEAF_WORDS],
+                values: vec![f32::NAN; 512],
+            });
+        let n = slot(p, 3, 0) as usize;
+        leaf.mask[n / 64] |= 1 << (n % 64);
+        leaf.values[n] = (d * voxel_size) as f32;
+    }
+    // Inactive values: ±background by inside/outside, asked of the tree in one batch.
+    let in_universe = |p: [i64; 3]| p.iter().all(|&c| (0..side).contains(&c));
+    let mut asked: Vec<[u32; 3]> = Vec::new();
+    let visit_unset = |f: &mut dyn FnMut([i64; 3])| {
+        for (&o, upper) in &root {
+            for (&us, lower) in upper {
+                let lo = corner_of(o, us as usize, 5, 7);
+                for n in 0..4096usize {
+                    if !lower.contains_key(&(n as u32)) {
+                        f(corner_of(lo, n, 4, 3));
+                    }
+                }
+                for (&ls, leaf) in lower {
+                    let leaf_lo = corner_of(lo, ls as usize, 4, 3);
+                    for n in 0..512usize {
+                        if leaf.values[n].is_nan() {
+                            f(corner_of(leaf_lo, n, 3, 0));
+                        }
+                    }
+                }
+            }
+            for n in 0..UPPER_WORDS * 64 {
+                if !upper.contains_key(&(n as u32)) {
+                    f(corner_of(o, n, 5, 7));
+                }
+            }
+        }
+    };
+    visit_unset(&mut |p| {
+        if in_universe(p) {
+            asked.push(p.map(|c| c as u32));
+        }
+    });
+    let answers = tree.contains_many(&asked);
+    let mut answers = answers.into_iter();
+    let mut signs = Vec::new();
+    visit_unset(&mut |p| {
+        let inside = in_universe(p) && answers.next().expect("one answer a point");
+        signs.push(if inside { -background } else { background });
+    });
+    // Root tiles: the 4096³ blocks wholly inside, which hold no band voxel.
+    let mut tiles = Vec::new();
+    let mut too_many = false;
+    tree.for_each_leaf(|cell, state| {
+        if state != NodeState::Full || cell.side() < 4096 || too_many {
+            return;
+        }
+        let n = cell.side() / 4096;
+        if tiles.len() as u64 + n * n * n > MAX_ROOT_TILES {
+            too_many = true;
+            return;
+        }
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let o = cell.origin.map(i64::from);
+                    tiles.push([
+                        o[0] + 4096 * i as i64,
+                        o[1] + 4096 * j as i64,
+                        o[2] + 4096 * k as i64,
+                    ]);
+                }
+            }
+        }
+    });
+    if too_many {
+        return Err(invalid(format!(
+            "more than {MAX_ROOT_TILES} root tiles of 4096³ voxels wholly inside"
+        )));
+    }
+
+    let mut out = Vec::new();
+    out.extend_from_slice(&MAGIC.to_le_bytes());
+    put_u32(&mut out, FILE_VERSION);
+    put_u32(&mut out, 10);
+    put_u32(&mut out, 0);
+    out.push(1); // the grid descriptors carry offsets
+    let crc = crc32fast::hash(
+        &band
+            .values
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect::<Vec<u8>>(),
+    );
+    let uuid = format!(
+        "{crc:08x}-0000-4000-8000-{:012x}",
+        band.len() as u64 & 0xFFFF_FFFF_FFFF
+    );
+    out.extend_from_slice(uuid.as_bytes());
+    put_u32(&mut out, 0); // file metadata: none
+    put_u32(&mut out, 1); // one grid
+    put_str(&mut out, "ktree");
+    put_str(&mut out, FLOAT_TREE);
+    put_str(&mut out, ""); // not an instance
+    let positions_at = out.len();
+    out.extend_from_slice(&[0; 24]); // grid, block and end positions, filled in below
+    let grid_at = out.len();
+    put_u32(&mut out, 0); // compression: none
+    put_u32(&mut out, 2); // grid metadata
+    for (name, value) in [("class", "level set"), ("name", "ktree")] {
+        put_str(&mut out, name);
+        put_str(&mut out, "string");
+        put_str(&mut out, value);
+    }
+    put_str(&mut out, "UniformScaleMap");
+    let s = voxel_size;
+    for v in [
+        [s; 3],
+        [s; 3],
+        [1.0 / s; 3],
+        [1.0 / (s * s); 3],
+        [0.5 / s; 3],
+    ] {
+        for x in v {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    // Topology: the root, then each internal node's masks and values, each leaf's value mask.
+    put_u32(&mut out, 1); // buffer count
+    put_f32s(&mut out, [background]);
+    put_u32(&mut out, tiles.len() as u32);
+    put_u32(&mut out, root.len() as u32);
+    for t in &tiles {
+        put_origin(&mut out, *t);
+        put_f32s(&mut out, [-background]);
+        out.push(0); // inactive
+    }
+    let mut sign = signs.into_iter();
+    let mut filled = Vec::new();
+    // Leaf values are taken from `sign` in the order `visit_unset` saw them: lower tiles, then leaves,
+    // per lower node; then the upper node's tiles. Collect them per node first.
+    for (&o, upper) in &root {
+        let mut lower_parts = Vec::new();
+        for lower in upper.values() {
+            let tiles: Vec<f32> = (0..4096usize)
+                .map(|n| {
+                    if lower.contains_key(&(n as u32)) {
+                        0.0
+                    } else {
+                        sign.next().expect("a sign a tile")
+                    }
+                })
+                .collect();
+            let leaves: Vec<Vec<f32>> = lower
+                .values()
+                .map(|leaf| {
+                    leaf.values
+                        .iter()
+                        .map(|&v| {
+                            if v.is_nan() {
+                                sign.next().expect("a sign a voxel")
+                            } else {
+                                v
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            lower_parts.push((tiles, leaves));
+        }
+        let upper_tiles: Vec<f32> = (0..UPPER_WORDS * 64)
+            .map(|n| {
+                if upper.contains_key(&(n as u32)) {
+                    0.0
+                } else {
+                    sign.next().expect("a sign a tile")
+                }
+            })
+            .collect();
+        put_origin(&mut out, o);
+        let mut children = [0u64; UPPER_WORDS];
+        for &n in upper.keys() {
+            children[n as usize / 64] |= 1 << (n % 64);
+        }
+        put_words(&mut out, &children);
+        put_words(&mut out, &[0; UPPER_WORDS]); // no active tile
+        out.push(6); // all values follow, uncompressed
+        put_f32s(&mut out, upper_tiles);
+        for (lower, (tiles, _)) in upper.values().zip(&lower_parts) {
+            let mut children = [0u64; LOWER_WORDS];
+            for &n in lower.keys() {
+                children[n as usize / 64] |= 1 << (n % 64);
+            }
+            put_words(&mut out, &children);
+            put_words(&mut out, &[0; LOWER_WORDS]);
+            out.push(6);
+            put_f32s(&mut out, tiles.iter().copied());
+            for leaf in lower.values() {
+                put_words(&mut out, &leaf.mask);
+            }
+        }
+        // Keep the leaves' filled values for the buffers, in the same order.
+        filled.push(lower_parts);
+    }
+    // Buffers: each leaf's value mask and its 512 values, in topology order.
+    let block_at = out.len();
+    for (upper, parts) in root.values().zip(filled) {
+        for (lower, (_, leaves)) in upper.values().zip(parts) {
+            for (leaf, values) in lower.values().zip(leaves) {
+                put_words(&mut out, &leaf.mask);
+                out.push(6);
+                put_f32s(&mut out, values);
+            }
+        }
+    }
+    let end_at = out.len();
+    for (i, p) in [grid_at, block_at, end_at].into_iter().enumerate() {
+        out[positions_at + 8 * i..positions_at + 8 * i + 8]
+            .copy_from_slice(&(p as i64).to_le_bytes());
+    }
+    w.write_all(&out)?;
+    w.flush()
+}
