@@ -4,6 +4,8 @@
 
 use std::path::PathBuf;
 
+use crate::common::error::CliResult;
+
 use ktree::io::write_vdb_level_set;
 use ktree::AnyTree;
 
@@ -26,30 +28,34 @@ pub struct DistanceArgs {
 }
 
 /// Runs `ktree distance`.
-pub fn run(args: DistanceArgs) -> Result<(), String> {
+pub fn run(args: DistanceArgs) -> CliResult {
     if !(args.band.is_finite() && args.band >= 1.0) {
-        return Err(format!("--band must be a number ≥ 1, got {}", args.band));
+        return Err(format!("--band must be a number ≥ 1, got {}", args.band).into());
     }
     if !(args.voxel_size.is_finite() && args.voxel_size > 0.0) {
         return Err(format!(
             "--voxel-size must be a positive number, got {}",
             args.voxel_size
-        ));
+        )
+        .into());
     }
     if args.out.extension().and_then(|e| e.to_str()) != Some("vdb") {
         return Err(format!(
             "{}: the level set is written as OpenVDB (.vdb)",
             args.out.display()
-        ));
+        )
+        .into());
     }
     let AnyTree::K3(tree) = read(&args.tree)? else {
         return Err(format!(
             "{}: level sets are written for octrees (K = 3) only",
             args.tree.display()
-        ));
+        )
+        .into());
     };
     let mut bytes = Vec::new();
     write_vdb_level_set(&mut bytes, &tree, args.band, args.voxel_size)
         .map_err(|e| format!("{}: {e}", args.out.display()))?;
-    ktree::fs::write_atomic(&args.out, &bytes).map_err(|e| format!("{}: {e}", args.out.display()))
+    ktree::fs::write_atomic(&args.out, &bytes)
+        .map_err(|e| format!("{}: {e}", args.out.display()).into())
 }
