@@ -1,8 +1,9 @@
 //! Criterion benchmarks of the questions asked of a map ([`ktree::query`]) on the octree of a ball at
 //! L = 10: random and coherent (random-walk) point queries — one at a time, through a cached cursor and in
 //! a batch on all threads —, random rays and nearest full voxels, one thread and all threads. Before
-//! timing, the answers are checked: the batch against one-at-a-time queries, every ray hit and every
-//! nearest voxel against membership (a benchmark of a wrong answer is worthless).
+//! timing, the answers are checked: the batches against one-at-a-time queries, every ray hit and every
+//! nearest voxel against membership, and nearest voxels against brute force over every full voxel of an
+//! L = 6 ball (a benchmark of a wrong answer is worthless).
 //!
 //! `cargo bench --bench queries`.
 
@@ -87,13 +88,39 @@ fn benches(c: &mut Criterion) {
             .zip(&one)
             .all(|(&p, &e)| cursor.contains(p) == Ok(e)));
     }
-    for hit in tree.cast_rays(&rays).into_iter().flatten() {
+    let casts = tree.cast_rays(&rays);
+    for (r, hit) in rays.iter().zip(&casts) {
+        assert_eq!(
+            *hit,
+            query::cast_ray(&tree, r).unwrap_or_else(|e| match e {})
+        );
+    }
+    for hit in casts.into_iter().flatten() {
         assert!(tree.contains(hit.voxel));
     }
     for (p, n) in near.iter().zip(tree.nearest_many(&near)) {
         let n = n.expect("a full ball");
         assert!(tree.contains(n.voxel));
         assert_eq!(n.squared == 0, tree.contains(*p));
+        assert_eq!(Some(n), tree.nearest(*p));
+    }
+    // Nearest voxels against brute force over every full voxel, on a smaller ball.
+    let small = ball(6);
+    let full: Vec<[u32; 3]> = (0..1u32 << 18)
+        .map(|i| [i & 63, i >> 6 & 63, i >> 12])
+        .filter(|&v| small.contains(v))
+        .collect();
+    let probes = random_points(500, 64, &mut rng);
+    for (p, n) in probes.iter().zip(small.nearest_many(&probes)) {
+        let expect = full
+            .iter()
+            .map(|v| {
+                let d: u128 = (0..3).map(|a| u128::from(v[a].abs_diff(p[a])).pow(2)).sum();
+                (d, ktree::space::morton_encode(*v), *v)
+            })
+            .min()
+            .map(|(d, _, v)| (d, v));
+        assert_eq!(n.map(|n| (n.squared, n.voxel)), expect, "from {p:?}");
     }
 
     let mut group = c.benchmark_group("queries-ball-L10");

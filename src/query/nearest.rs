@@ -2,11 +2,13 @@
 //! [`nearest_signed`]; many on all threads: [`nearest_many`], [`nearest_many_signed`]), Euclidean
 //! between voxel centres as scipy's `distance_transform_edt` measures it.
 //!
-//! Exact best-first branch and bound: a cell's lower bound is the integer squared distance from the query
+//! Exact depth-first branch and bound: a cell's lower bound is the integer squared distance from the query
 //! voxel to the nearest voxel of the cell, so no rounding decides anything; a full leaf's bound is
-//! attained by its voxel nearest the query. Cells wait in a queue ordered by bound; the search ends when
-//! the best voxel found is no farther than every cell still waiting, so only cells nearer than the answer
-//! are opened.
+//! attained by its voxel nearest the query. A node's non-empty children are visited nearest first, and a
+//! cell is opened only while its bound could still beat the best voxel found, so the search ends with the
+//! exact answer once every cell that could hold a nearer voxel has been ruled out. The batch forms order
+//! their points by Morton key and start each search from the previous point's answer (a full voxel, so
+//! its distance is an exact upper bound): the cells farther than it are never opened.
 //!
 //! Ties: among equally near full voxels, the one with the smallest Morton key
 //! ([`crate::space::morton_encode`]) is returned.
@@ -16,8 +18,7 @@
 
 use rayon::prelude::*;
 
-use std::collections::BinaryHeap;
-
+use super::points::sort_by_key;
 use crate::space::{morton_encode, Cell};
 use crate::tree::storage::TreeStorage;
 use crate::tree::NodeState;
@@ -35,38 +36,6 @@ impl<const K: usize> Nearest<K> {
     /// The Euclidean distance (`√squared`, rounded once).
     pub fn distance(&self) -> f64 {
         (self.squared as f64).sqrt()
-    }
-}
-
-/// A cell waiting in the search: its lower bound and the Morton key of its origin (the smallest key of
-/// its voxels) order the queue.
-#[derive(Debug, Clone, Copy)]
-struct Waiting<const K: usize> {
-    bound: u128,
-    key: u64,
-    cell: Cell<K>,
-    index: usize,
-    state: NodeState,
-}
-
-impl<const K: usize> PartialEq for Waiting<K> {
-    fn eq(&self, other: &Self) -> bool {
-        (self.bound, self.key) == (other.bound, other.key)
-    }
-}
-
-impl<const K: usize> Eq for Waiting<K> {}
-
-impl<const K: usize> PartialOrd for Waiting<K> {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl<const K: usize> Ord for Waiting<K> {
-    /// Reversed: the max-heap pops the smallest bound (then the smallest key) first.
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        (other.bound, other.key).cmp(&(self.bound, self.key))
     }
 }
 
@@ -124,60 +93,126 @@ pub fn nearest_signed<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     point: [i64; K],
 ) -> Result<Option<Nearest<K>>, T::Error> {
+    Ok(search(tree, point, None, &mut Vec::new())?
+        .map(|(squared, _, voxel)| Nearest { voxel, squared }))
+}
+
+/// The best candidate so far: squared distance, Morton key, voxel.
+type Best<const K: usize> = (u128, u64, [u32; K]);
+
+/// A cell to open: its bound, the cell, its node index and state.
+type Frame<const K: usize> = (u128, Cell<K>, usize, NodeState);
+
+/// Whether a cell with lower bound `bound` may hold a voxel that beats `best` (nearer, or as near with a
+/// smaller key: the cell's keys are at least its origin's).
+#[inline]
+fn may_beat<const K: usize>(best: &Option<Best<K>>, bound: u128, cell: &Cell<K>) -> bool {
+    match best {
+        None => true,
+        Some((d, k, _)) => bound < *d || (bound == *d && cell.morton() < *k),
+    }
+}
+
+/// The exact nearest full voxel to `point`: depth-first, children nearest first, starting from `seed` (a
+/// full voxel, whose distance bounds the answer) if given. `stack` is scratch space, reused by batches.
+fn search<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    point: [i64; K],
+    seed: Option<[u32; K]>,
+    stack: &mut Vec<Frame<K>>,
+) -> Result<Option<Best<K>>, T::Error> {
     let root = tree.root_state()?;
     if root == NodeState::Empty {
         return Ok(None);
     }
-    let cell = tree.universe().root();
-    let mut queue = BinaryHeap::new();
-    queue.push(Waiting {
-        bound: nearest_in(&cell, &point).1,
-        key: cell.morton(),
-        cell,
-        index: 0,
-        state: root,
+    let mut best: Option<Best<K>> = seed.map(|v| {
+        let d = (0..K).fold(0u128, |d, a| {
+            let gap = u128::from(i64::from(v[a]).abs_diff(point[a]));
+            d.saturating_add(gap.saturating_mul(gap))
+        });
+        (d, morton_encode(v), v)
     });
-    // The best so far: squared distance, Morton key, voxel.
-    let mut best: Option<(u128, u64, [u32; K])> = None;
-    let beats = |best: &Option<(u128, u64, [u32; K])>, bound: u128, key: u64| match best {
-        None => true,
-        Some((d, k, _)) => (bound, key) < (*d, *k),
-    };
-    while let Some(w) = queue.pop() {
-        // Every cell still waiting has a bound (and key) at least this one's: none holds a better voxel.
-        if !beats(&best, w.bound, w.key) {
-            break;
+    let cell = tree.universe().root();
+    stack.clear();
+    stack.push((nearest_in(&cell, &point).1, cell, 0, root));
+    // The children of one node, to be pushed farthest first (popped nearest first).
+    let mut children: Vec<Frame<K>> = Vec::with_capacity(1 << K);
+    while let Some((bound, cell, index, state)) = stack.pop() {
+        if !may_beat(&best, bound, &cell) {
+            continue;
         }
-        if w.state == NodeState::Full {
-            let (near, d) = nearest_in(&w.cell, &point);
+        if state == NodeState::Full {
+            let (near, d) = nearest_in(&cell, &point);
             let key = morton_encode(near);
-            if beats(&best, d, key) {
+            if best.map_or(true, |(bd, bk, _)| (d, key) < (bd, bk)) {
                 best = Some((d, key, near));
             }
             continue;
         }
-        let depth = w.cell.level as usize;
-        let first = tree.first_child(depth, w.index)?;
+        let depth = cell.level as usize;
+        let first = tree.first_child(depth, index)?;
         let codes = tree.block_codes(depth + 1, first)?;
+        children.clear();
         for code in 0..1usize << K {
             let state = NodeState::from_bits(codes >> (2 * code));
             if state == NodeState::Empty {
                 continue;
             }
-            let cell = w.cell.child(code);
-            let (bound, key) = (nearest_in(&cell, &point).1, cell.morton());
-            if beats(&best, bound, key) {
-                queue.push(Waiting {
-                    bound,
-                    key,
-                    cell,
-                    index: first + code,
-                    state,
-                });
+            let child = cell.child(code);
+            let bound = nearest_in(&child, &point).1;
+            if may_beat(&best, bound, &child) {
+                children.push((bound, child, first + code, state));
             }
         }
+        // Farthest first onto the stack, so the nearest is opened first (the order only matters for
+        // speed: every cell that may beat the best is opened whatever the order).
+        children.sort_unstable_by_key(|c| std::cmp::Reverse(c.0));
+        stack.extend_from_slice(&children);
     }
-    Ok(best.map(|(squared, _, voxel)| Nearest { voxel, squared }))
+    Ok(best)
+}
+
+/// The fewest points of one run of a batch, searched one after the other on one thread.
+const RUN: usize = 1 << 12;
+
+/// Answers `points` on all threads: the whole batch ordered by Morton key (of the voxel nearest each point
+/// in the universe), cut into runs, each run's points searched in order, each from the previous answer.
+fn search_many<const K: usize, T>(
+    tree: &T,
+    points: &[[i64; K]],
+) -> Result<Vec<Option<Nearest<K>>>, T::Error>
+where
+    T: TreeStorage<K> + Sync,
+    T::Error: Send,
+{
+    let top = tree.universe().side() as i64 - 1;
+    let mut order: Vec<(u64, u32)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (morton_encode(p.map(|c| c.clamp(0, top) as u32)), i as u32))
+        .collect();
+    sort_by_key(&mut order, K * tree.level() as usize);
+    // A few runs a thread, so that uneven runs even out.
+    let run = RUN.max(points.len() / (4 * rayon::current_num_threads()) + 1);
+    let found: Vec<Vec<Option<Best<K>>>> = order
+        .par_chunks(run)
+        .map(|run| {
+            let mut stack = Vec::new();
+            let mut seed = None;
+            run.iter()
+                .map(|&(_, i)| {
+                    let found = search(tree, points[i as usize], seed, &mut stack)?;
+                    seed = found.map(|(_, _, v)| v).or(seed);
+                    Ok(found)
+                })
+                .collect()
+        })
+        .collect::<Result<_, T::Error>>()?;
+    let mut out = vec![None; points.len()];
+    for (&(_, i), found) in order.iter().zip(found.into_iter().flatten()) {
+        out[i as usize] = found.map(|(squared, _, voxel)| Nearest { voxel, squared });
+    }
+    Ok(out)
 }
 
 /// The distance from voxel `point` to the nearest full voxel: `0` inside the object, infinite for an
@@ -200,7 +235,8 @@ pub fn distance<const K: usize, T: TreeStorage<K>>(
     Ok(nearest(tree, point)?.map_or(f64::INFINITY, |n| n.distance()))
 }
 
-/// [`nearest_signed`] for each point, on all threads, in the order given.
+/// [`nearest_signed`] for each point, on all threads, in the order given (the points searched in Morton
+/// order, each search from the previous answer).
 ///
 /// # Errors
 /// The storage's first read error.
@@ -212,14 +248,10 @@ where
     T: TreeStorage<K> + Sync,
     T::Error: Send,
 {
-    points
-        .par_iter()
-        .with_min_len(256)
-        .map(|&p| nearest_signed(tree, p))
-        .collect()
+    search_many(tree, points)
 }
 
-/// [`nearest`] for each point, on all threads, in the order given.
+/// [`nearest`] for each point, on all threads, in the order given (as [`nearest_many_signed`]).
 ///
 /// # Errors
 /// The storage's first read error.
@@ -231,9 +263,6 @@ where
     T: TreeStorage<K> + Sync,
     T::Error: Send,
 {
-    points
-        .par_iter()
-        .with_min_len(256)
-        .map(|&p| nearest(tree, p))
-        .collect()
+    let points: Vec<[i64; K]> = points.iter().map(|p| p.map(i64::from)).collect();
+    search_many(tree, &points)
 }

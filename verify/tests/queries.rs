@@ -333,6 +333,18 @@ fn check_nearest<const K: usize>(o: &Obj<K>, points: &[[u32; K]]) -> Result<(), 
             Some((d, _, _)) => prop_assert_eq!(dist, (d as f64).sqrt()),
         }
     }
+    // The signed batch (Morton-ordered, each search from the previous answer) as one search at a time,
+    // on points inside, below and above the universe.
+    let side = i64::from(u.side() as u32);
+    let signed: Vec<[i64; K]> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p.map(|v| i64::from(v) + side * (i as i64 % 3 - 1)))
+        .collect();
+    let batch = query::nearest_many_signed(&tree, &signed).unwrap();
+    for (q, n) in signed.iter().zip(batch) {
+        prop_assert_eq!(n, query::nearest_signed(&tree, *q).unwrap(), "from {:?}", q);
+    }
     Ok(())
 }
 

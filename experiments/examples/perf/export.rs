@@ -15,7 +15,7 @@ use crate::measure::{best_of, machine_line, results_path, run_child};
 /// The cases: `ball-L` and `armadillo-L`.
 pub const CASES: [&str; 5] = ["ball-6", "ball-8", "ball-10", "armadillo-8", "armadillo-10"];
 
-fn tree_of(case: &str) -> Result<Octree, String> {
+pub fn tree_of(case: &str) -> Result<Octree, String> {
     let (what, level) = case.split_once('-').ok_or("case must be WHAT-L")?;
     let level: u32 = level.parse().map_err(|_| "bad level")?;
     match what {

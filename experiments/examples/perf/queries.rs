@@ -1,12 +1,14 @@
 //! Queries asked of a map ([`ktree::query`]) on the octree of the voxel-centre ball of radius U/2 at
 //! L = 10: 10^7 random and 10^7 coherent (random-walk) point queries — one at a time, through the cached
 //! cursor, and in a batch ordered by Morton key —, 10^6 random rays and 10^6 nearest full voxels; batches
-//! on one thread and on all threads.
+//! on one thread and on all threads. The cases also run on other objects (`OBJECT:CASE`, e.g.
+//! `armadillo-10:rays-1`) and write their inputs for the peers of `experiments/queries.sh`
+//! (`OBJECT:write-inputs:DIR`).
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 use ktree::query::{self, RayCast};
-use ktree::rays::ball_rays;
 use ktree::KTree;
 
 use crate::measure::{best_of, machine_line, results_path, run_child, Measured};
@@ -75,6 +77,13 @@ const CASES: [(&str, &str, usize); 12] = [
 /// xorshift64*: deterministic inputs.
 struct Rng(u64);
 
+/// The seed every case starts from: each case's inputs are the first draws, so the inputs written for the
+/// peers (`write-inputs`) are the ones ktree's cases answer.
+const SEED: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// Rays whose casts are checked against OctoMap's `castRay` (the first of the batch): facts `*_head`.
+const RAY_HEAD: usize = 100_000;
+
 impl Rng {
     fn next(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
@@ -90,20 +99,20 @@ impl Rng {
     }
 }
 
-fn ball() -> KTree<3> {
-    let u = 1i64 << LEVEL;
-    KTree::from_rays(&ball_rays::<3>(LEVEL, [u, u, u], u).expect("level in range"))
+/// The object of a case: `ball-L` or `armadillo-L` (as in the export area); the default, `ball-10`.
+fn object(name: &str) -> Result<KTree<3>, String> {
+    crate::export::tree_of(name)
 }
 
-fn random_points(n: usize, rng: &mut Rng) -> Vec<[u32; 3]> {
-    let side = 1u64 << LEVEL;
+fn random_points(level: u32, n: usize, rng: &mut Rng) -> Vec<[u32; 3]> {
+    let side = 1u64 << level;
     (0..n)
         .map(|_| std::array::from_fn(|_| rng.below(side) as u32))
         .collect()
 }
 
-fn walk_points(n: usize, rng: &mut Rng) -> Vec<[u32; 3]> {
-    let side = 1u32 << LEVEL;
+fn walk_points(level: u32, n: usize, rng: &mut Rng) -> Vec<[u32; 3]> {
+    let side = 1u32 << level;
     let mut p = [side / 2; 3];
     (0..n)
         .map(|_| {
@@ -118,8 +127,8 @@ fn walk_points(n: usize, rng: &mut Rng) -> Vec<[u32; 3]> {
         .collect()
 }
 
-fn random_rays(n: usize, rng: &mut Rng) -> Vec<RayCast<3>> {
-    let side = (1u64 << LEVEL) as f64;
+fn random_rays(level: u32, n: usize, rng: &mut Rng) -> Vec<RayCast<3>> {
+    let side = (1u64 << level) as f64;
     (0..n)
         .map(|_| {
             let origin = std::array::from_fn(|_| rng.unit() * side);
@@ -127,6 +136,16 @@ fn random_rays(n: usize, rng: &mut Rng) -> Vec<RayCast<3>> {
             RayCast::new(origin, direction, f64::INFINITY).expect("finite")
         })
         .collect()
+}
+
+/// Timed runs in one process: `REPEATS` from the environment (`experiments/queries.sh` sets 1 and
+/// interleaves processes instead), 3 by default.
+fn repeats() -> usize {
+    std::env::var("REPEATS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .filter(|&r| r > 0)
+        .unwrap_or(3)
 }
 
 /// Runs `work` on a pool of one thread, or on the global pool.
@@ -142,29 +161,103 @@ fn on_threads<T: Send>(one: bool, work: impl FnOnce() -> T + Send) -> T {
     }
 }
 
-/// Runs one case in this (child) process.
+/// Writes the inputs of every case of `object` into folder `dir` for the peers of
+/// `experiments/queries.sh`: the voxels as `tree.vdb` (a BoolGrid, index = voxel) and `tree.bt` (OctoMap,
+/// key = voxel + 32768, unit resolution, so world coordinates are ktree's), the queries as little-endian
+/// arrays (`random.bin`, `walk.bin`, `nearest.bin`: 3 × u32 a point; `rays.bin`: origin and direction,
+/// 6 × f64 a ray), and for L ≤ 9 the voxels as a dense `dense.npy` (u8, shape (U, U, U), index [z, y, x]).
+fn write_inputs(tree: &KTree<3>, dir: &Path) -> Result<(), String> {
+    let level = tree.level();
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot make {}: {e}", dir.display()))?;
+    let write = |name: &str, bytes: &[u8]| {
+        let path = dir.join(name);
+        ktree::fs::write_atomic(&path, bytes)
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))
+    };
+    for name in ["tree.vdb", "tree.bt"] {
+        tree.save(dir.join(name))
+            .map_err(|e| format!("cannot write {name}: {e}"))?;
+    }
+    let points = |p: Vec<[u32; 3]>| -> Vec<u8> {
+        p.iter()
+            .flat_map(|v| v.iter().flat_map(|c| c.to_le_bytes()))
+            .collect()
+    };
+    write(
+        "random.bin",
+        &points(random_points(level, POINTS, &mut Rng(SEED))),
+    )?;
+    write(
+        "walk.bin",
+        &points(walk_points(level, POINTS, &mut Rng(SEED))),
+    )?;
+    write(
+        "nearest.bin",
+        &points(random_points(level, NEAREST, &mut Rng(SEED))),
+    )?;
+    let rays: Vec<u8> = random_rays(level, RAYS, &mut Rng(SEED))
+        .iter()
+        .flat_map(|r| {
+            r.origin()
+                .into_iter()
+                .chain(r.direction())
+                .flat_map(f64::to_le_bytes)
+        })
+        .collect();
+    write("rays.bin", &rays)?;
+    if level <= 9 {
+        let dense = tree.to_dense().map_err(|e| e.to_string())?;
+        let side = 1usize << level;
+        let mut header = format!(
+            "{{'descr': '|u1', 'fortran_order': False, 'shape': ({side}, {side}, {side}), }}"
+        );
+        // The header, padded with spaces and a newline to a multiple of 64 bytes (npy format 1.0).
+        while (10 + header.len() + 1) % 64 != 0 {
+            header.push(' ');
+        }
+        header.push('\n');
+        let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+        npy.extend_from_slice(&(header.len() as u16).to_le_bytes());
+        npy.extend_from_slice(header.as_bytes());
+        npy.extend(dense.iter().map(|&b| u8::from(b)));
+        write("dense.npy", &npy)?;
+    }
+    Ok(())
+}
+
+/// Runs one case in this (child) process: `CASE` on the L = 10 ball, `OBJECT:CASE` on another object
+/// (`ball-L`, `armadillo-L`), or `OBJECT:write-inputs:DIR` (see [`write_inputs`]).
 pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
-    let tree = ball();
-    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
-    let mut facts = vec![("nodes".to_string(), tree.node_count().to_string())];
+    let (name, case) = case.split_once(':').unwrap_or(("ball-10", case));
+    let tree = object(name)?;
+    if let Some(dir) = case.strip_prefix("write-inputs:") {
+        write_inputs(&tree, Path::new(dir))?;
+        return Ok((0.0, vec![("voxels".into(), tree.voxel_count().to_string())]));
+    }
+    let level = tree.level();
+    let mut rng = Rng(SEED);
+    let mut facts = vec![
+        ("nodes".to_string(), tree.node_count().to_string()),
+        ("voxels".to_string(), tree.voxel_count().to_string()),
+    ];
     let one = case.ends_with("-1");
     let coherent = case.contains("coherent");
     let mut answers = 0usize;
     let seconds = if case.starts_with("contains-") || case.starts_with("cursor-") {
         let points = if coherent {
-            walk_points(POINTS, &mut rng)
+            walk_points(level, POINTS, &mut rng)
         } else {
-            random_points(POINTS, &mut rng)
+            random_points(level, POINTS, &mut rng)
         };
         if case.starts_with("contains-") {
             best_of(
-                3,
+                repeats(),
                 || points.iter().filter(|&&p| tree.contains(p)).count(),
                 |n| answers = n,
             )
         } else {
             best_of(
-                3,
+                repeats(),
                 || {
                     let mut cursor = tree.cursor();
                     points
@@ -177,14 +270,14 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         }
     } else if case.starts_with("batch-") {
         let points = if coherent {
-            walk_points(POINTS, &mut rng)
+            walk_points(level, POINTS, &mut rng)
         } else {
-            random_points(POINTS, &mut rng)
+            random_points(level, POINTS, &mut rng)
         };
         let expect = points.iter().filter(|&&p| tree.contains(p)).count();
         let s = on_threads(one, || {
             best_of(
-                3,
+                repeats(),
                 || tree.contains_many(&points),
                 |v| answers = v.iter().filter(|&&b| b).count(),
             )
@@ -194,38 +287,49 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         }
         s
     } else if case.starts_with("rays-") {
-        let rays = random_rays(RAYS, &mut rng);
+        let rays = random_rays(level, RAYS, &mut rng);
+        let mut hits = Vec::new();
         let s = on_threads(one, || {
-            best_of(
-                3,
-                || tree.cast_rays(&rays),
-                |hits| answers = hits.iter().flatten().count(),
-            )
+            best_of(repeats(), || tree.cast_rays(&rays), |h| hits = h)
         });
+        answers = hits.iter().flatten().count();
+        // A checksum of the voxels hit, to compare with the peers' (all rays, and the first RAY_HEAD).
+        let voxel_sum = |hits: &[Option<query::RayHit<3>>]| -> u64 {
+            hits.iter()
+                .flatten()
+                .map(|h| h.voxel.iter().map(|&c| u64::from(c)).sum::<u64>())
+                .sum()
+        };
+        facts.push(("voxel_sum".into(), voxel_sum(&hits).to_string()));
+        let head = &hits[..RAY_HEAD.min(hits.len())];
+        facts.push((
+            "hits_head".into(),
+            head.iter().flatten().count().to_string(),
+        ));
+        facts.push(("voxel_sum_head".into(), voxel_sum(head).to_string()));
         let single = rays
             .iter()
             .take(1000)
             .map(|r| query::cast_ray(&tree, r).unwrap_or_else(|e| match e {}))
             .collect::<Vec<_>>();
-        if single != tree.cast_rays(&rays[..1000]) {
+        if single != hits[..1000] {
             return Err(format!("{case}: batch and single casts differ"));
         }
         s
     } else if case.starts_with("nearest-") {
-        let points = random_points(NEAREST, &mut rng);
-        // One run: a second of these would double the report's time for little.
-        on_threads(one, || {
-            best_of(
-                1,
-                || tree.nearest_many(&points),
-                |found| {
-                    answers = found
-                        .iter()
-                        .filter(|n| n.is_some_and(|n| n.squared == 0))
-                        .count()
-                },
-            )
-        })
+        let points = random_points(level, NEAREST, &mut rng);
+        let mut found = Vec::new();
+        let s = on_threads(one, || {
+            best_of(repeats(), || tree.nearest_many(&points), |f| found = f)
+        });
+        answers = found
+            .iter()
+            .filter(|n| n.is_some_and(|n| n.squared == 0))
+            .count();
+        // The sum of the squared distances, to compare with scipy's transform at the same voxels.
+        let sum: u128 = found.iter().flatten().map(|n| n.squared).sum();
+        facts.push(("sum_squared".into(), sum.to_string()));
+        s
     } else {
         return Err(format!("unknown case {case}"));
     };
@@ -233,15 +337,16 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
     Ok((seconds, facts))
 }
 
-/// Measures every case in a child process and writes `results/performance/queries.md`.
+/// Measures every case in a child process and writes `results/performance/queries-ktree.md` (ktree
+/// alone; `experiments/queries.sh` writes `queries.md`, ktree and its peers).
 pub fn report() -> Result<String, String> {
     let mut md = String::new();
     let _ = writeln!(md, "# Queries: points, rays, nearest voxels\n");
     let _ = writeln!(
         md,
-        "Regenerate with `cargo run --release --example perf -- queries`. Object: the octree of the voxels \
+        "Regenerate with `cargo run --release --example perf -- queries`. ktree alone. Object: the octree of the voxels \
          whose centres lie in the ball of radius U/2 centred in the universe, L = {LEVEL}, stacked. Times \
-         are the best of 3 runs (1 for nearest voxels) in a fresh process per case, excluding building the tree and making the \
+         are the best of 3 runs in a fresh process per case, excluding building the tree and making the \
          inputs (random points uniform in the universe; a random walk of unit steps; rays from uniform \
          origins in uniform directions of the cube [-1, 1]^3). \"answers\" counts the points inside (for \
          nearest: at distance 0) or the rays that hit.\n\nMachine: {}.\n",
@@ -264,10 +369,10 @@ pub fn report() -> Result<String, String> {
     }
     let _ = writeln!(
         md,
-        "\nThe peers of the same questions (OpenVDB's `ValueAccessor` and ray intersector, OctoMap's \
-         `search` and `castRay`, scipy's `distance_transform_edt`) are not in this table yet."
+        "\nThe same questions side by side with OpenVDB, OctoMap and scipy: `queries.md`, written by \
+         `experiments/queries.sh`."
     );
-    let path = results_path("queries");
+    let path = results_path("queries-ktree");
     ktree::fs::write_atomic(&path, md.as_bytes())
         .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     Ok(path.display().to_string())
