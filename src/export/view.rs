@@ -21,8 +21,8 @@
 //! by its partial children (queued) and its visible full children, as long as the number of boxes stays
 //! within the budget. What is left in the queue is drawn as coarse boxes of the partial cells. A full leaf
 //! is visible unless each of its faces (on the drawn axes) touches a full region of its own size — the
-//! leaves buried inside full regions need no box. Each refinement is a one-level [`cursor`] walk and each
-//! neighbour question a [`cursor`] walk towards one cell, so the selection works on any storage (a tree in
+//! leaves buried inside full regions need no box. Each refinement is a one-level [`cursor`](crate::tree::cursor) walk and each
+//! neighbour question a [`cursor`](crate::tree::cursor) walk towards one cell, so the selection works on any storage (a tree in
 //! memory, a mapped file) and reads only the nodes it draws and their neighbours' paths.
 //!
 //! ```

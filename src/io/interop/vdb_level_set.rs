@@ -52,7 +52,13 @@ fn put_origin(out: &mut Vec<u8>, origin: [i64; 3]) {
 }
 
 /// Writes the narrow band of half-width `width` voxels of an octree as an OpenVDB level set (a
-/// `FloatGrid` named `ktree`, see the [module docs](self)) with voxel size `voxel_size`.
+/// `FloatGrid` named `ktree`) with voxel size `voxel_size`.
+///
+/// What is written, in OpenVDB's terms: the active voxels are the band, the voxels with `|sd| ≤ W` (`W` =
+/// `width`), their values the signed distances in world units (`sd · S`, `S` = `voxel_size`, negative
+/// inside); every inactive value (a leaf's other voxels, the tiles of the internal nodes and of the root) is
+/// `−W · S` inside the object and `+W · S` outside; the background is `W · S`. The transform is a uniform
+/// scale by `S`, and OpenVDB index = ktree voxel. Values are stored uncompressed.
 ///
 /// ```
 /// use ktree::io::{read_vdb, write_vdb_level_set};
