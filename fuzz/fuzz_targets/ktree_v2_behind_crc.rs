@@ -253,7 +253,7 @@ fuzz_target!(|input: Input| {
     let mapped = ktree_fuzz::open_mapped(&bytes);
     match (&view, &mapped) {
         (Ok(v), Ok(m)) => assert_eq!(v.counts_per_level(), m.counts_per_level()),
-        (Err(v), Err(m)) => assert_eq!((v.offset, &v.kind), (m.offset, &m.kind)),
+        (Err(v), Err(m)) => assert_eq!((v.offset(), &v.kind), (m.offset(), &m.kind)),
         _ => panic!("the views of bytes and of a map disagree: {view:?} {mapped:?}"),
     }
     let version = u16::from_le_bytes([
