@@ -78,24 +78,11 @@ impl<const K: usize> KTree<K> {
         let runs = rays.runs();
         let side = rays.universe().side() as i64;
         let columns = 1usize << (K - 1);
-        // The window corners (first K − 1 coordinates of the grid vertex v) next to a non-empty column.
-        let mut corners: Vec<[i64; K]> = Vec::new();
-        for (key, _) in rays.column_groups() {
-            let col = rays.column_of_key(key).map(i64::from);
-            for b in 0..columns {
-                let mut v = col;
-                for (axis, x) in v[..K - 1].iter_mut().enumerate() {
-                    *x += (b >> axis & 1) as i64;
-                }
-                corners.push(v);
-            }
-        }
-        corners.sort_unstable();
-        corners.dedup();
         let mut total: i128 = 0;
         let mut column_runs: Vec<&[(u32, u32)]> = Vec::with_capacity(columns);
         let mut breaks: Vec<i64> = Vec::new();
-        for v in corners {
+        // Adds the windows at the grid vertices of one corner (first K − 1 coordinates of the vertex v).
+        let mut count = |v: [i64; K]| {
             column_runs.clear();
             breaks.clear();
             for b in 0..columns {
@@ -139,7 +126,48 @@ impl<const K: usize> KTree<K> {
                 }
                 total += i128::from(table[pattern]) * i128::from(w[1] - w[0]);
             }
+        };
+        // The window corners next to a non-empty column, row by row along the first axis: the corners of
+        // row x come from the columns of rows x − 1 and x, so two rows' corners are held at a time.
+        let mut flush = |row: &mut Vec<[i64; K]>| {
+            row.sort_unstable();
+            row.dedup();
+            for &v in row.iter() {
+                count(v);
+            }
+            row.clear();
+        };
+        let (mut row, mut current, mut next) = (None, Vec::new(), Vec::new());
+        for (key, _) in rays.column_groups() {
+            let col = rays.column_of_key(key).map(i64::from);
+            let x = col[0];
+            match row {
+                Some(r) if r == x => {}
+                Some(r) if r + 1 == x => {
+                    flush(&mut current);
+                    std::mem::swap(&mut current, &mut next);
+                }
+                _ => {
+                    flush(&mut current);
+                    flush(&mut next);
+                }
+            }
+            row = Some(x);
+            for b in 0..columns {
+                let mut v = col;
+                for (axis, x) in v[..K - 1].iter_mut().enumerate() {
+                    *x += (b >> axis & 1) as i64;
+                }
+                // For K ≥ 2, bit 0 of b moves the corner to the next row (for K = 1, b is 0).
+                if b & 1 == 1 {
+                    next.push(v);
+                } else {
+                    current.push(v);
+                }
+            }
         }
+        flush(&mut current);
+        flush(&mut next);
         Ok((total >> K) as i64)
     }
 }

@@ -1,7 +1,16 @@
 //! A tree back to rays: the runs of its full voxels along the last axis.
+//!
+//! The runs are gathered slab by slab along the first axis (up to [`SLABS`] slabs): a walk that skips the
+//! subtrees outside the slab lists each full leaf's column pieces, which are sorted and joined into the
+//! slab's runs. Only one slab's pieces are held at a time, so the memory is that of the runs plus a slab's
+//! share of the pieces (a column crosses a piece per full leaf above it, many more than it has runs).
 
-use crate::rays::{Ray, RaySet};
-use crate::tree::{KTree, NodeState};
+use crate::rays::RaySet;
+use crate::tree::cursor::{walk, Visitor, Walk};
+use crate::tree::{KTree, NodeRef, NodeState};
+
+/// At most this many slabs along the first axis.
+const SLABS: u64 = 64;
 
 impl<const K: usize> KTree<K> {
     /// The runs along the last axis of a tree's full voxels: the ray set that stacks back to the tree.
@@ -12,32 +21,95 @@ impl<const K: usize> KTree<K> {
     /// assert_eq!(stack(&rays).to_rays(), rays);
     /// ```
     pub fn to_rays(&self) -> RaySet<K> {
-        let tree = self;
-        let mut rays = Vec::new();
-        tree.for_each_leaf(|cell, state| {
-            if state != NodeState::Full {
-                return;
-            }
-            let side = cell.side() as u32;
-            let origin = cell.origin;
-            // Every column of the cell: an odometer over the first K − 1 axes.
-            let mut start = origin;
-            loop {
-                rays.push(Ray::new(start, origin[K - 1] + side));
-                let mut axis = 0;
-                while axis + 1 < K {
-                    start[axis] += 1;
-                    if start[axis] < origin[axis] + side {
-                        break;
-                    }
-                    start[axis] = origin[axis];
-                    axis += 1;
+        let universe = self.universe();
+        let level = universe.level();
+        let side = universe.side();
+        // K = 1 has one column, the last axis itself: one slab.
+        let width = if K == 1 { side } else { (side / SLABS).max(1) };
+        let mut columns = Vec::new();
+        let mut runs: Vec<(u32, u32)> = Vec::new();
+        let mut pieces = Vec::new();
+        let mut start = 0;
+        while start < side {
+            let end = (start + width).min(side);
+            pieces.clear();
+            let mut slab = SlabPieces::<K> {
+                slab: (start as u32, end as u32),
+                level,
+                pieces: &mut pieces,
+            };
+            walk(self, &mut slab);
+            pieces.sort_unstable();
+            for &(column, z1, z2) in pieces.iter() {
+                let last = runs.len();
+                if last > 0 && columns[last - 1] == column && z1 <= runs[last - 1].1 {
+                    // Touching the previous piece of the same column (leaves never overlap): extend it.
+                    runs[last - 1].1 = runs[last - 1].1.max(z2);
+                    continue;
                 }
-                if axis + 1 >= K {
+                columns.push(column);
+                runs.push((z1, z2));
+            }
+            start = end;
+        }
+        RaySet::from_sorted_parts(universe, columns, runs, None)
+    }
+}
+
+/// Lists, as `(column key, z1, z2)`, the column pieces of the full leaves within a slab `x0 ≤ x < x1` of
+/// the first axis (the whole universe for K = 1).
+struct SlabPieces<'a, const K: usize> {
+    slab: (u32, u32),
+    level: u32,
+    pieces: &'a mut Vec<(u64, u32, u32)>,
+}
+
+impl<const K: usize> Visitor<K> for SlabPieces<'_, K> {
+    const LEAVES: bool = false;
+
+    fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+        let cell = node.cell;
+        let side = 1u32 << cell.log_side;
+        let origin = cell.origin;
+        let (x0, x1) = if K == 1 {
+            (0, u32::MAX)
+        } else {
+            (
+                origin[0].max(self.slab.0),
+                (origin[0] + side).min(self.slab.1),
+            )
+        };
+        if x0 >= x1 {
+            return Walk::Skip;
+        }
+        if node.state != NodeState::Full {
+            return Walk::Descend;
+        }
+        let (z1, z2) = (origin[K - 1], origin[K - 1] + side);
+        // Every column of the cell within the slab: an odometer over the first K − 1 axes.
+        let mut column = origin;
+        if K > 1 {
+            column[0] = x0;
+        }
+        loop {
+            let key = column[..K - 1]
+                .iter()
+                .fold(0u64, |key, &c| (key << self.level) | u64::from(c));
+            self.pieces.push((key, z1, z2));
+            let mut axis = 0;
+            while axis + 1 < K {
+                column[axis] += 1;
+                let end = if axis == 0 { x1 } else { origin[axis] + side };
+                if column[axis] < end {
                     break;
                 }
+                column[axis] = if axis == 0 { x0 } else { origin[axis] };
+                axis += 1;
             }
-        });
-        RaySet::from_rays(tree.level(), rays).expect("the cells of a tree lie in its universe")
+            if axis + 1 >= K {
+                break;
+            }
+        }
+        Walk::Skip
     }
 }

@@ -316,6 +316,12 @@ fn euler_ref<const K: usize>(a: &Grid<K>, connectivity: usize) -> i64 {
 fn check_measures<const K: usize>(o: &Obj<K>) -> Result<(), TestCaseError> {
     let tree = o.tree();
     let a = Grid::<K>::of(o.level, &o.dense());
+    // The runs the measures walk: one ray per full voxel, joined by the ray set.
+    let voxels = (0..a.data.len()).filter(|&i| a.data[i]).map(|i| {
+        let p = a.point(i).map(|c| c as u32);
+        Ray::new(p, p[K - 1] + 1)
+    });
+    prop_assert_eq!(tree.to_rays(), RaySet::from_rays(o.level, voxels).unwrap());
     prop_assert_eq!(tree.surface_area(), surface_ref(&a));
     for connectivity in 1..=K {
         let comps = tree.components(connectivity).unwrap();
@@ -406,6 +412,18 @@ fn check_largest_level<const K: usize>() {
         let closed = tree.closing(r, element).unwrap();
         assert_eq!(closed, tree, "{element}");
         assert_eq!(grown.components(1).unwrap().len(), 2);
+    }
+}
+
+/// Trees of many slabs (the runs are gathered slab by slab along the first axis): the runs come back.
+#[test]
+fn runs_come_back_from_large_trees() {
+    for level in [7, 9] {
+        let c = 1i64 << (level - 1);
+        let rays = ktree::rays::ball_rays::<3>(level, [c - 3, c + 1, c], c - 5).unwrap();
+        assert_eq!(KTree::from_rays(&rays).to_rays(), rays, "ball, L = {level}");
+        let rays = ktree::rays::ball_rays::<2>(level, [c, c - 7], c - 2).unwrap();
+        assert_eq!(KTree::from_rays(&rays).to_rays(), rays, "disc, L = {level}");
     }
 }
 
