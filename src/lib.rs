@@ -75,6 +75,7 @@ pub mod fs;
 pub mod io;
 pub mod ops;
 pub mod query;
+pub(crate) mod radix;
 pub mod rays;
 pub mod reference;
 pub mod shape;

@@ -18,7 +18,7 @@
 
 use rayon::prelude::*;
 
-use super::points::sort_by_key;
+use crate::radix::sort_by_key;
 use crate::space::{morton_encode, Cell};
 use crate::tree::storage::TreeStorage;
 use crate::tree::NodeState;
@@ -191,7 +191,9 @@ where
         .enumerate()
         .map(|(i, p)| (morton_encode(p.map(|c| c.clamp(0, top) as u32)), i as u32))
         .collect();
-    sort_by_key(&mut order, K * tree.level() as usize);
+    sort_by_key(&mut order, K as u32 * tree.level(), &mut Vec::new(), |p| {
+        p.0
+    });
     // A few runs a thread, so that uneven runs even out.
     let run = RUN.max(points.len() / (4 * rayon::current_num_threads()) + 1);
     let found: Vec<Vec<Option<Best<K>>>> = order

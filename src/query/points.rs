@@ -4,6 +4,7 @@
 
 use rayon::prelude::*;
 
+use crate::radix::sort_by_key;
 use crate::space::morton_encode;
 use crate::tree::storage::TreeStorage;
 use crate::tree::NodeState;
@@ -105,41 +106,6 @@ pub fn contains<const K: usize, T: TreeStorage<K>>(
     PointCursor::new(tree)?.contains(point)
 }
 
-/// The bits of a radix sort's digit.
-const DIGIT: usize = 11;
-
-/// Sorts `(key, index)` pairs by key, then index (as `sort_unstable` would, the pairs being distinct by
-/// index), where every key is below `2^bits`: a least-significant-digit radix sort, stable pass by pass
-/// over the key's digits, of pairs that start in index order.
-pub(crate) fn sort_by_key(order: &mut Vec<(u64, u32)>, bits: usize) {
-    debug_assert!(order.windows(2).all(|w| w[0].1 < w[1].1));
-    if order.len() < 64 {
-        order.sort_unstable();
-        return;
-    }
-    let mut from = std::mem::take(order);
-    let mut to = vec![(0u64, 0u32); from.len()];
-    let mut shift = 0;
-    while shift < bits {
-        let mut start = [0usize; 1 << DIGIT];
-        for &(key, _) in &from {
-            start[(key >> shift) as usize & ((1 << DIGIT) - 1)] += 1;
-        }
-        let mut sum = 0;
-        for s in start.iter_mut() {
-            (*s, sum) = (sum, sum + *s);
-        }
-        for &pair in &from {
-            let digit = (pair.0 >> shift) as usize & ((1 << DIGIT) - 1);
-            to[start[digit]] = pair;
-            start[digit] += 1;
-        }
-        std::mem::swap(&mut from, &mut to);
-        shift += DIGIT;
-    }
-    *order = from;
-}
-
 /// The points of one run of a batch, ordered by Morton key and answered by one [`PointCursor`].
 const RUN: usize = 1 << 14;
 
@@ -174,7 +140,9 @@ where
             .filter(|(_, p)| p.iter().all(|&c| u64::from(c) < side))
             .map(|(i, p)| (morton_encode(*p), i as u32))
             .collect();
-        sort_by_key(&mut order, K * tree.level() as usize);
+        sort_by_key(&mut order, K as u32 * tree.level(), &mut Vec::new(), |p| {
+            p.0
+        });
         let mut cursor = PointCursor::new(tree)?;
         for (_, i) in order {
             out[i as usize] = cursor.contains(points[i as usize])?;
@@ -186,42 +154,4 @@ where
         .zip(out.par_chunks_mut(RUN))
         .try_for_each(answer)?;
     Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::sort_by_key;
-
-    #[test]
-    fn radix_sort_orders_as_a_comparison_sort() {
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        for (len, bits) in [
-            (0, 3),
-            (10, 64),
-            (63, 5),
-            (64, 1),
-            (1000, 12),
-            (5000, 30),
-            (3000, 64),
-        ] {
-            let order: Vec<(u64, u32)> = (0..len)
-                .map(|i| {
-                    state = state
-                        .wrapping_mul(6_364_136_223_846_793_005)
-                        .wrapping_add(1);
-                    let key = if bits == 64 {
-                        state
-                    } else {
-                        state >> (64 - bits)
-                    };
-                    (key, i)
-                })
-                .collect();
-            let mut expect = order.clone();
-            expect.sort_unstable();
-            let mut got = order;
-            sort_by_key(&mut got, bits);
-            assert_eq!(got, expect, "{len} pairs of {bits}-bit keys");
-        }
-    }
 }

@@ -45,9 +45,9 @@ use std::ops::Range;
 use std::path::Path;
 
 use super::SolidError;
+use crate::radix::radix_sort;
 use crate::rays::RaySet;
 use crate::space::Universe;
-use crate::stacking::radix::radix_sort;
 use crate::stacking::{default_split_depth, RaySource, SlabRuns};
 
 /// Bits of sub-voxel precision of placed vertices.

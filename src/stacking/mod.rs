@@ -86,7 +86,6 @@ mod cells;
 mod out_of_core;
 pub mod paper;
 mod partition;
-pub(crate) mod radix;
 mod solids;
 
 pub use builder::{Builder, CellStacking};

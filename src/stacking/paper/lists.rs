@@ -31,9 +31,9 @@
 //! `O(n)` in the number of rows and items (radix sorts on keys of `(D+1)·L` bits) plus the Morton sort and
 //! assembly of the output (`O(cells · L)`). Measured figures: `results/performance/build.md`.
 
+use crate::radix::radix_sort;
 use crate::rays::{maximal_rows, RaySet};
 use crate::space::{morton_encode, Universe};
-use crate::stacking::radix::radix_sort;
 use crate::tree::KTree;
 
 /// What stacking did: the traffic through each dimension-level list and the peak number of items held.
