@@ -3,10 +3,12 @@
 //! ([`GridMeta`]).
 
 mod binvox;
+mod blosc;
 mod grid;
 mod octomap;
 mod vdb;
 mod vdb_level_set;
+mod vdb_values;
 
 pub use binvox::{read_binvox, write_binvox, BINVOX_MAX_DIM};
 pub use grid::{GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree};
