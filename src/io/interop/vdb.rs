@@ -1,5 +1,7 @@
-//! OpenVDB files (`.vdb`) holding one `BoolGrid` (`Tree_bool_5_4_3`), the grid type OpenVDB's Python module
-//! reads as a voxel set: active voxels are the object.
+//! OpenVDB files (`.vdb`): octrees written as one `BoolGrid` (`Tree_bool_5_4_3`), the grid type OpenVDB's
+//! Python module reads as a voxel set — active voxels are the object — and read from a `BoolGrid` or
+//! `MaskGrid` (its active voxels) or a level set (a `FloatGrid` or `DoubleGrid` of class `level set`: its
+//! interior, see [`super`]).
 //!
 //! The layout (file format version 224, OpenVDB 10): a header (magic `0x56444220` as `i64`, versions, a
 //! UUID), file metadata, the grid count, and per grid its descriptor (name, type, positions), its compression
@@ -7,12 +9,14 @@
 //! 128³ voxels → 16³ internal nodes of 8³ → 8³ leaves; masks are `u64` words, bit `n` of word `n / 64`,
 //! with `n = x·D² + y·D + z` inside a node of side `D` (x slowest). All values little-endian.
 //!
-//! Written files are uncompressed (compression flags 0), which every OpenVDB reads. Reading accepts
-//! uncompressed values and, from OpenVDB's own writer, active-mask compression with values stored raw or
-//! in uncompressed Blosc chunks (what a `BoolGrid` whose nodes hold few tiles gets); a Blosc- or
-//! zlib-compressed chunk is reported as unsupported. OpenVDB index `(x, y, z)` is ktree voxel `(x, y, z)`
-//! minus the offset written with, and the transform's voxel size and translation (the world centre of index
-//! 0) become the [`GridMeta`].
+//! Written files are uncompressed (compression flags 0), which every OpenVDB reads. Reading takes what
+//! OpenVDB writes (`vdb_values`): values raw or with active-mask compression, in zlib or Blosc
+//! chunks (Blosc 1 frames with the LZ4 codec and byte shuffle, OpenVDB's default, decoded by
+//! `blosc`); other Blosc codecs are reported as unsupported), and half floats. The first grid of a
+//! type read is taken; a `FloatGrid` or `DoubleGrid` of another class (fog volume, unknown, staggered) is
+//! passed over, and refused with its class when no other grid is read. OpenVDB index `(x, y, z)` is ktree
+//! voxel `(x, y, z)` minus the offset written with, and the transform's voxel size and translation (the
+//! world centre of index 0) become the [`GridMeta`].
 
 use std::collections::BTreeMap;
 use std::io::Write;

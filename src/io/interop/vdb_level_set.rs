@@ -1,5 +1,6 @@
 //! OpenVDB narrow-band level sets (`FloatGrid`, `Tree_float_5_4_3`, grid class `level set`) out of an
-//! octree's signed distances ([`KTree::narrow_band`]).
+//! octree's signed distances ([`KTree::narrow_band`]), and the interior of a level set read back (see
+//! [`super`] for what is read and how it compares with OpenVDB's `tools::sdfInteriorMask`).
 //!
 //! What is written, in OpenVDB's terms (see `openvdb/tools/LevelSetUtil.h` for how OpenVDB reads a level
 //! set): the active voxels are the band, the voxels with `|sd| ≤ W` (`W` the half-width in voxels), their
@@ -7,9 +8,12 @@
 //! inactive value — a leaf's other voxels, the tiles of the internal nodes and of the root — is `−W · S`
 //! inside the object and `+W · S` outside; the background is `W · S` (OpenVDB's `halfWidth · voxelSize`).
 //! The transform is a uniform scale by `S` (`UniformScaleMap`: index `(i, j, k)` at world `S · (i, j, k)`),
-//! and OpenVDB index = ktree voxel. The universe is the array: outside it is outside the object, and a full
-//! voxel on the universe's border measures to the nearest empty voxel inside the universe (the surface is
-//! open there). Values are stored uncompressed (compression flags 0), which every OpenVDB reads.
+//! and OpenVDB index = ktree voxel; the universe's level and offset 0 are grid metadata (`ktree_level`,
+//! `ktree_offset`). The universe is the array: outside it is outside the object, and a full voxel on the
+//! universe's border measures to the nearest empty voxel inside the universe (the surface is open there);
+//! a tree filling its universe has no band, and its inside is carried by the inactive values of a leaf at
+//! the origin (or by root tiles from 4096³ on). Values are stored uncompressed (compression flags 0), which
+//! every OpenVDB reads.
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -59,7 +63,8 @@ fn put_origin(out: &mut Vec<u8>, origin: [i64; 3]) {
 /// `width`), their values the signed distances in world units (`sd · S`, `S` = `voxel_size`, negative
 /// inside); every inactive value (a leaf's other voxels, the tiles of the internal nodes and of the root) is
 /// `−W · S` inside the object and `+W · S` outside; the background is `W · S`. The transform is a uniform
-/// scale by `S`, and OpenVDB index = ktree voxel. Values are stored uncompressed.
+/// scale by `S`, and OpenVDB index = ktree voxel; the universe's level is grid metadata. Values are stored
+/// uncompressed. [`read_vdb`](crate::io::read_vdb) reads the interior back: the same tree.
 ///
 /// ```
 /// use ktree::io::{read_vdb, write_vdb_level_set};
@@ -68,6 +73,7 @@ fn put_origin(out: &mut Vec<u8>, origin: [i64; 3]) {
 /// let mut bytes = Vec::new();
 /// write_vdb_level_set(&mut bytes, &tree, 3.0, 0.5).unwrap();
 /// assert!(bytes.len() > 8 * 512);
+/// assert_eq!(read_vdb(&bytes, "sdf.vdb", None, None).unwrap().tree, tree);
 /// ```
 ///
 /// # Errors
@@ -440,6 +446,39 @@ mod tests {
                 assert_eq!(back.tree, tree, "level {}", tree.level());
                 assert_eq!(back.placement.offset, [0; 3]);
             }
+        }
+    }
+
+    #[test]
+    fn openvdb_files_of_every_compression_read_as_the_spheres_inside() {
+        // The fuzz seeds written by OpenVDB 10 (pyopenvdb's createLevelSetSphere(radius=2.6,
+        // center=(10.5, 10, 11), halfWidth=2), then rewritten by OpenVDB with other compressions): Blosc and
+        // active mask, half floats, a DoubleGrid, active mask only, and sdfInteriorMask's BoolGrid in zlib.
+        // The sphere's values are |p − c| − r: the inside is the voxels whose centre is nearer than r.
+        let dir =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/vdb_level_set");
+        let (c, r) = ([10.5f64, 10.0, 11.0], 2.6f64);
+        let mut want = Vec::new();
+        for x in 0..32u32 {
+            for y in 0..32u32 {
+                for z in 0..32u32 {
+                    let d2: f64 = [x, y, z]
+                        .iter()
+                        .zip(c)
+                        .map(|(&p, c)| (f64::from(p) - c).powi(2))
+                        .sum();
+                    if d2.sqrt() < r {
+                        want.push(crate::Ray::new([x, y, z], z + 1));
+                    }
+                }
+            }
+        }
+        let want = KTree::from_rays(&crate::RaySet::<3>::from_rays(5, want).unwrap());
+        for name in ["blosc", "half", "double", "mask", "bool_zip"] {
+            let path = dir.join(format!("openvdb_{name}.vdb"));
+            let bytes = std::fs::read(&path).unwrap();
+            let read = read_vdb(&bytes, name, Some([0; 3]), Some(5)).unwrap();
+            assert_eq!(read.tree, want, "{name}");
         }
     }
 
