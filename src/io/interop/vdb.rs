@@ -633,6 +633,7 @@ pub fn read_vdb(
     let grids = r.i32("grid count")?;
     let mut found = None;
     let mut refused = None;
+    let mut header_bytes = 0usize;
     for _ in 0..grids.max(0) {
         let _name = r.string("grid name")?;
         let kind = r.string("grid type")?;
@@ -648,11 +649,15 @@ pub fn read_vdb(
                 ))));
             }
             let after_descriptor = r.at;
-            let head = r.grid_header(if has_offsets {
+            let header_at = if has_offsets {
                 grid_at
             } else {
                 after_descriptor as i64
-            })?;
+            };
+            let head = r.grid_header(header_at)?;
+            // The headers of grids passed over are read at most about twice the file's length in all:
+            // descriptors pointing at one long header again and again would otherwise take quadratic time.
+            header_bytes += r.at.saturating_sub(usize::try_from(header_at).unwrap_or(0));
             let class = head.class.as_ref().map(|(c, _)| c.as_str());
             if matches!(grid, GridType::Real { .. }) && class != Some("level set") {
                 refused.get_or_insert_with(|| {
@@ -668,6 +673,9 @@ pub fn read_vdb(
                     )
                 });
                 r.at = after_descriptor;
+                if header_bytes > 2 * bytes.len() {
+                    break;
+                }
             } else {
                 found = Some((grid, head));
                 break;
@@ -778,6 +786,59 @@ mod tests {
         let e = read_vdb(&b, "loop", None, None).unwrap_err();
         assert!(matches!(e.kind, GridFileErrorKind::Data(_)), "{e}");
         assert_eq!(e.offset(), Some(end_field_at as u64), "{e}");
+    }
+
+    #[test]
+    fn fog_volumes_are_passed_over_and_refused_by_their_class() {
+        // A header, then 3000 descriptors of FloatGrids, each followed by a byte and pointing at one header
+        // of 2000 metadata entries and class "fog volume": the scan stops reading that header again once
+        // twice the file's length has been read, and says why the file is refused.
+        let mut b = MAGIC.to_le_bytes().to_vec();
+        b.extend_from_slice(&FILE_VERSION.to_le_bytes());
+        b.extend_from_slice(&[0; 8]);
+        b.push(1);
+        b.extend_from_slice(&[b'0'; 36]);
+        b.extend_from_slice(&0u32.to_le_bytes());
+        let count = 3000;
+        b.extend_from_slice(&(count as i32).to_le_bytes());
+        let descriptor = |grid_at: i64, end_at: i64| {
+            let mut d = Vec::new();
+            for s in ["g", FLOAT_TREE, ""] {
+                put_str(&mut d, s);
+            }
+            for p in [grid_at, 0, end_at] {
+                d.extend_from_slice(&p.to_le_bytes());
+            }
+            d.push(0);
+            d
+        };
+        let each = descriptor(0, 0).len() as i64;
+        let header_at = b.len() as i64 + each * count;
+        for i in 0..count {
+            let end_at = b.len() as i64 + each;
+            assert_eq!(b.len() as i64, header_at - each * (count - i));
+            b.extend_from_slice(&descriptor(header_at, end_at));
+        }
+        b.extend_from_slice(&0u32.to_le_bytes()); // compression
+        put_u32(&mut b, 2001);
+        for _ in 0..2000 {
+            for s in ["a", "b"] {
+                put_str(&mut b, s);
+            }
+            put_u32(&mut b, 0);
+        }
+        let class_at = b.len() + 4 + 5 + 4 + 6;
+        for s in ["class", "string", "fog volume"] {
+            put_str(&mut b, s);
+        }
+        put_str(&mut b, "TranslationMap");
+        b.extend_from_slice(&[0; 24]);
+        let e = read_vdb(&b, "fog", None, None).unwrap_err();
+        assert!(
+            matches!(&e.kind, GridFileErrorKind::Unsupported(m) if m.contains("\"fog volume\"")),
+            "{e}"
+        );
+        assert_eq!(e.offset(), Some(class_at as u64), "{e}");
     }
 
     #[test]
