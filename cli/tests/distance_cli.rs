@@ -9,6 +9,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::OnceLock;
 
 use common::ktree;
 use ktree::io::{write_tree, WriteOptions};
@@ -122,29 +123,36 @@ fn pyopenvdb_reads_the_level_set_with_the_band_values() {
     }
 }
 
-/// Builds `vdb_level_set_check` against the installed OpenVDB into `dir`, or says why it cannot.
+/// Builds `vdb_level_set_check` against the installed OpenVDB into `dir`, or says why it cannot. Built once
+/// a test run: the tests running side by side share the program.
 fn level_set_check(dir: &Path) -> Option<PathBuf> {
-    if !Path::new("/usr/include/openvdb/openvdb.h").exists() {
-        println!("SKIPPED: libopenvdb-dev not installed (OpenVDB's headers)");
-        return None;
-    }
-    let exe = dir.join("vdb_level_set_check");
-    let src =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/interop/vdb_level_set_check.cpp");
-    let built = Command::new("g++")
-        .args(["-std=c++17", "-O1", "-o"])
-        .arg(&exe)
-        .arg(&src)
-        .args(["-lopenvdb", "-ltbb", "-lImath"])
-        .output();
+    static BUILT: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    let built = BUILT.get_or_init(|| {
+        if !Path::new("/usr/include/openvdb/openvdb.h").exists() {
+            return Err("libopenvdb-dev not installed (OpenVDB's headers)".into());
+        }
+        let exe = dir.join("vdb_level_set_check");
+        let src =
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/interop/vdb_level_set_check.cpp");
+        let built = Command::new("g++")
+            .args(["-std=c++17", "-O1", "-o"])
+            .arg(&exe)
+            .arg(&src)
+            .args(["-lopenvdb", "-ltbb", "-lImath"])
+            .output();
+        match built {
+            Ok(o) if o.status.success() => Ok(exe),
+            Ok(o) => panic!(
+                "vdb_level_set_check does not build: {}",
+                String::from_utf8_lossy(&o.stderr)
+            ),
+            Err(e) => Err(format!("g++ not found ({e})")),
+        }
+    });
     match built {
-        Ok(o) if o.status.success() => Some(exe),
-        Ok(o) => panic!(
-            "vdb_level_set_check does not build: {}",
-            String::from_utf8_lossy(&o.stderr)
-        ),
-        Err(e) => {
-            println!("SKIPPED: g++ not found ({e})");
+        Ok(exe) => Some(exe.clone()),
+        Err(why) => {
+            println!("SKIPPED: {why}");
             None
         }
     }
