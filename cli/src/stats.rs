@@ -1,5 +1,6 @@
-//! `ktree stats FILE.ktree | --rays FILE [--json]`: node counts of a tree or of the tree a ray file stacks to.
-//! A version 2 tree file is checked and counted through a memory map; the surface area and the Euler number
+//! `ktree stats FILE | --rays FILE [--json]`: node counts of a tree or of the tree a ray file stacks to.
+//! A version 2 tree file is checked and counted through a memory map; a file of another format `ktree`
+//! reads (`.vdb`, `.bt`, binvox, …) is read into memory; the surface area and the Euler number
 //! (`surface_area`, `euler_number`) are measured on the tree read into memory, when the file is small next
 //! to the memory budget.
 
@@ -8,7 +9,7 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, VERSION};
+use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, Format, KtreeView, VERSION};
 use ktree::tree::heap_bytes_for_levels;
 use ktree::tree::TreeStats;
 
@@ -16,7 +17,7 @@ use ktree::tree::TreeStats;
 #[derive(Debug, clap::Args)]
 #[command(group(clap::ArgGroup::new("input").required(true).args(["tree", "rays"])))]
 pub struct Args {
-    /// A `.ktree` file.
+    /// A `.ktree` file, or a file of another format `ktree` reads (`.vdb`, `.bt`, `.binvox`, …).
     tree: Option<PathBuf>,
     /// A ray file instead: it is stacked into a tree first.
     #[arg(long)]
@@ -49,6 +50,10 @@ fn view_stats(view: &KtreeView) -> TreeStats {
 pub fn run(args: Args) -> CliResult {
     // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
     let (stats, measures) = match (&args.tree, &args.rays) {
+        (Some(path), None) if Format::of(path).is_some_and(|f| f != Format::Ktree) => {
+            let tree = crate::common::tree_file::read_any(path)?;
+            (tree.stats(None), Some(crate::shape::measures(&tree)))
+        }
         (Some(path), None) if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION => (
             view_stats(&KtreeView::open(path).map_err(|e| e.to_string())?),
             crate::shape::measures_of_file(path)?,

@@ -1,12 +1,15 @@
 //! `ktree distance`: the narrow band written as an OpenVDB level set, checked against OpenVDB itself —
 //! Debian's `pyopenvdb` reads it as a `FloatGrid` of class level set with the band's values, and OpenVDB's
 //! `tools::sdfInteriorMask` (C++, `vdb_level_set_check.cpp` here built against `libopenvdb-dev`) gives back
-//! the tree's voxels. A test whose tool is missing prints a visible `SKIPPED:` line and passes.
+//! the tree's voxels — and level sets read back: ktree's own, and OpenVDB's (written by `pyopenvdb` and
+//! rewritten by the C++ check with each compression) as their interior. A test whose tool is missing prints
+//! a visible `SKIPPED:` line and passes.
 
 mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::OnceLock;
 
 use common::ktree;
 use ktree::io::{write_tree, WriteOptions};
@@ -120,29 +123,36 @@ fn pyopenvdb_reads_the_level_set_with_the_band_values() {
     }
 }
 
-/// Builds `vdb_level_set_check` against the installed OpenVDB into `dir`, or says why it cannot.
+/// Builds `vdb_level_set_check` against the installed OpenVDB into `dir`, or says why it cannot. Built once
+/// a test run: the tests running side by side share the program.
 fn level_set_check(dir: &Path) -> Option<PathBuf> {
-    if !Path::new("/usr/include/openvdb/openvdb.h").exists() {
-        println!("SKIPPED: libopenvdb-dev not installed (OpenVDB's headers)");
-        return None;
-    }
-    let exe = dir.join("vdb_level_set_check");
-    let src =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/interop/vdb_level_set_check.cpp");
-    let built = Command::new("g++")
-        .args(["-std=c++17", "-O1", "-o"])
-        .arg(&exe)
-        .arg(&src)
-        .args(["-lopenvdb", "-ltbb"])
-        .output();
+    static BUILT: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    let built = BUILT.get_or_init(|| {
+        if !Path::new("/usr/include/openvdb/openvdb.h").exists() {
+            return Err("libopenvdb-dev not installed (OpenVDB's headers)".into());
+        }
+        let exe = dir.join("vdb_level_set_check");
+        let src =
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/interop/vdb_level_set_check.cpp");
+        let built = Command::new("g++")
+            .args(["-std=c++17", "-O1", "-o"])
+            .arg(&exe)
+            .arg(&src)
+            .args(["-lopenvdb", "-ltbb", "-lImath"])
+            .output();
+        match built {
+            Ok(o) if o.status.success() => Ok(exe),
+            Ok(o) => panic!(
+                "vdb_level_set_check does not build: {}",
+                String::from_utf8_lossy(&o.stderr)
+            ),
+            Err(e) => Err(format!("g++ not found ({e})")),
+        }
+    });
     match built {
-        Ok(o) if o.status.success() => Some(exe),
-        Ok(o) => panic!(
-            "vdb_level_set_check does not build: {}",
-            String::from_utf8_lossy(&o.stderr)
-        ),
-        Err(e) => {
-            println!("SKIPPED: g++ not found ({e})");
+        Ok(exe) => Some(exe.clone()),
+        Err(why) => {
+            println!("SKIPPED: {why}");
             None
         }
     }
@@ -223,4 +233,206 @@ fn bad_arguments_are_one_line_errors() {
         assert!(!ok && err.trim().lines().count() == 1, "{args:?}: {err}");
     }
     assert!(!Path::new(&out).exists());
+}
+
+/// The voxels of a tree, sorted.
+fn voxels_of(tree: &KTree<3>) -> Vec<[i64; 3]> {
+    let mut out = Vec::new();
+    tree.for_each_leaf(|c, s| {
+        if s == ktree::NodeState::Full {
+            let o = c.origin().map(i64::from);
+            let n = c.side() as i64;
+            for x in 0..n {
+                for y in 0..n {
+                    for z in 0..n {
+                        out.push([o[0] + x, o[1] + y, o[2] + z]);
+                    }
+                }
+            }
+        }
+    });
+    out.sort();
+    out
+}
+
+#[test]
+fn a_level_set_written_by_ktree_converts_back_to_the_same_tree() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, tree) in objects() {
+        let src = write(dir.path(), name, &tree);
+        let sdf = dir.path().join(format!("{name}.vdb")).display().to_string();
+        let back = dir.path().join(format!("{name}_back.ktree"));
+        let (ok, _, err) = ktree(&["distance", &src, "--band", "3", "--out", &sdf]);
+        assert!(ok, "{err}");
+        let (ok, _, err) = ktree(&["convert", &sdf, &back.display().to_string()]);
+        assert!(ok, "{err}");
+        assert_eq!(KTree::<3>::load(&back).unwrap(), tree, "{name}");
+        // Every command reading a .vdb takes it: the same statistics as the tree's own file.
+        let (ok, from_vdb, err) = ktree(&["stats", &sdf, "--json"]);
+        assert!(ok, "{err}");
+        let (_, from_ktree, _) = ktree(&["stats", &src, "--json"]);
+        assert_eq!(from_vdb, from_ktree, "{name}");
+    }
+    // A fog volume is refused with a sentence naming the file and the byte.
+    let fog = dir.path().join("fog.vdb");
+    let mut bytes = std::fs::read(dir.path().join("ball.vdb")).unwrap();
+    let at = bytes
+        .windows(9)
+        .position(|w| w == b"level set")
+        .expect("the class");
+    bytes.splice(at..at + 9, *b"fog  vol ");
+    std::fs::write(&fog, bytes).unwrap();
+    let (ok, _, err) = ktree(&["stats", &fog.display().to_string()]);
+    assert!(
+        !ok && err.contains("fog.vdb: byte") && err.contains("level set"),
+        "{err}"
+    );
+}
+
+/// Reads a `.vdb` with ktree (`ktree convert` at offset 16 in a level-6 universe): its voxels in OpenVDB's
+/// indices.
+fn ktree_voxels(vdb: &Path) -> Vec<[i64; 3]> {
+    let out = vdb.with_extension("ktree");
+    let (ok, _, err) = ktree(&[
+        "convert",
+        &vdb.display().to_string(),
+        &out.display().to_string(),
+        "--offset",
+        "16,16,16",
+        "--level",
+        "6",
+    ]);
+    assert!(ok, "{}: {err}", vdb.display());
+    voxels_of(&KTree::<3>::load(&out).unwrap())
+        .into_iter()
+        .map(|v| v.map(|c| c - 16))
+        .collect()
+}
+
+/// The voxels a C++ check prints after its four report lines.
+fn check_voxels(report: &str) -> Vec<[i64; 3]> {
+    let mut v: Vec<[i64; 3]> = report
+        .lines()
+        .skip(4)
+        .map(|l| {
+            let c: Vec<i64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [c[0], c[1], c[2]]
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn level_sets_written_by_openvdb_read_as_their_interior() {
+    let dir = tempfile::tempdir().unwrap();
+    // Two boxes of known voxels (faces halfway between voxel centres, far enough apart for their bands not
+    // to meet: OpenVDB then signs a few voxels between them as inside) and a sphere, as pyopenvdb makes
+    // them and writes them: Blosc and active-mask compression, and half floats.
+    let boxes = [([0i64, 0, 0], [4i64, 3, 2]), ([-13, 2, -12], [-10, 5, -9])];
+    let mut known: Vec<[i64; 3]> = Vec::new();
+    for (lo, hi) in boxes {
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    known.push([x, y, z]);
+                }
+            }
+        }
+    }
+    known.sort();
+    let box_list: Vec<String> = boxes
+        .iter()
+        .map(|(lo, hi)| format!("({lo:?}, {hi:?})"))
+        .collect();
+    let d = |n: &str| dir.path().join(n);
+    let script = format!(
+        r#"
+import numpy as np, pyopenvdb as vdb
+points, quads = [], []
+for lo, hi in [{boxes}]:
+    b = len(points)
+    for i in range(8):
+        points.append([(hi if i >> a & 1 else lo)[a] + (0.5 if i >> a & 1 else -0.5) for a in range(3)])
+    quads += [[b + q for q in f] for f in [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]]
+grids = {{
+    "boxes": vdb.FloatGrid.createLevelSetFromPolygons(np.array(points, dtype=np.float32), quads=np.array(quads, dtype=np.int32), halfWidth=3.0),
+    "sphere": vdb.createLevelSetSphere(radius=6.3, center=(1.5, -2.0, 3.0), voxelSize=1.0, halfWidth=3.0),
+}}
+for name, g in grids.items():
+    for half in [False, True]:
+        g.name = name
+        g.saveFloatAsHalf = half
+        path = {dir:?} + "/" + name + ("_half" if half else "") + ".vdb"
+        vdb.write(path, grids=[g])
+        # The voxels below zero, active or not, by OpenVDB's accessor over the leaves' box.
+        g = vdb.read(path, name)
+        a = g.getConstAccessor()
+        (x0, y0, z0), (x1, y1, z1) = g.evalLeafBoundingBox()
+        inside = [(x, y, z) for x in range(x0, x1 + 1) for y in range(y0, y1 + 1) for z in range(z0, z1 + 1) if a.getValue((x, y, z)) < 0]
+        print(name + ("_half" if half else ""), g.gridClass.replace(" ", "_"), len(inside), *[c for p in inside for c in p])
+"#,
+        boxes = box_list.join(", "),
+        dir = dir.path().display().to_string(),
+    );
+    let Some(text) = pyopenvdb(&script) else {
+        return;
+    };
+    let mut files = Vec::new();
+    for line in text.lines() {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(w[1], "level_set", "{line}");
+        let n: usize = w[2].parse().unwrap();
+        let c: Vec<i64> = w[3..].iter().map(|x| x.parse().unwrap()).collect();
+        let mut inside: Vec<[i64; 3]> = c.chunks(3).map(|p| [p[0], p[1], p[2]]).collect();
+        inside.sort();
+        assert_eq!(inside.len(), n);
+        if w[0].starts_with("boxes") {
+            assert_eq!(inside, known, "{}: OpenVDB's own voxels below zero", w[0]);
+        }
+        let path = d(&format!("{}.vdb", w[0]));
+        assert_eq!(ktree_voxels(&path), inside, "{}", w[0]);
+        files.push((path, inside));
+    }
+    assert_eq!(files.len(), 4);
+    // OpenVDB's sdfInteriorMask agrees, and OpenVDB writing the level sets again with every compression
+    // (zlib is not applied to level sets: it is tried on the interior written as a BoolGrid), as
+    // DoubleGrids too, gives files ktree reads as the same voxels.
+    let build_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let Some(check) = level_set_check(&build_dir) else {
+        return;
+    };
+    let mut rewritten = 0;
+    for (path, inside) in &files {
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let variants: [(&str, &str, &[&str]); 7] = [
+            ("none", "level-set", &["0"]),
+            ("mask", "level-set", &["2"]),
+            ("blosc", "level-set", &["4"]),
+            ("double_none", "level-set", &["0", "double"]),
+            ("double_blosc_mask", "level-set", &["6", "double"]),
+            ("bool_zip", "mask", &["1"]),
+            ("bool_zip_mask", "mask", &["3"]),
+        ];
+        for (suffix, mode, flags) in variants {
+            let out = d(&format!("{stem}_{suffix}.vdb"));
+            let run = Command::new(&check)
+                .arg(path)
+                .arg(mode)
+                .arg(&out)
+                .args(flags)
+                .output()
+                .unwrap();
+            assert!(
+                run.status.success(),
+                "{}",
+                String::from_utf8_lossy(&run.stderr)
+            );
+            let report = String::from_utf8(run.stdout).unwrap();
+            assert_eq!(&check_voxels(&report), inside, "{stem}: sdfInteriorMask");
+            assert_eq!(&ktree_voxels(&out), inside, "{stem}_{suffix}");
+            rewritten += 1;
+        }
+    }
+    assert_eq!(rewritten, 28);
 }

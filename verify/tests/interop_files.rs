@@ -1,12 +1,14 @@
-//! The grid formats of other tools (binvox, OctoMap `.bt`, OpenVDB `.vdb`): random octrees round-trip through
-//! each, and arbitrary or damaged bytes give an error or a tree, never a panic. (The files are checked
+//! The grid formats of other tools (binvox, OctoMap `.bt`, OpenVDB `.vdb` as a `BoolGrid` and as a level set):
+//! random octrees round-trip through each, and arbitrary or damaged bytes give an error or a tree, never a
+//! panic. (The files are checked
 //! against the real tools in `cli/tests/interop.rs`.)
 
 use ktree_verify::cases;
 
 use cases::{ray_sets, Case};
 use ktree::io::{
-    read_binvox, read_bt, read_vdb, write_binvox, write_bt, write_vdb, GridMeta, PlacedTree,
+    read_binvox, read_bt, read_vdb, write_binvox, write_bt, write_vdb, write_vdb_level_set,
+    GridMeta, PlacedTree,
 };
 use ktree::stacking::paper::stack;
 use ktree::KTree;
@@ -21,7 +23,15 @@ fn files(tree: &KTree<3>) -> Vec<(&'static str, Vec<u8>)> {
     write_bt(&mut bt, tree, [0; 3], 1.0).unwrap();
     let mut vdb = Vec::new();
     write_vdb(&mut vdb, tree, [0; 3], &meta).unwrap();
-    vec![("binvox", binvox), ("bt", bt), ("vdb", vdb)]
+    // The narrow band of half-width 3 around the tree's surface, read back as its interior.
+    let mut level_set = Vec::new();
+    write_vdb_level_set(&mut level_set, tree, 3.0, 0.5).unwrap();
+    vec![
+        ("binvox", binvox),
+        ("bt", bt),
+        ("vdb", vdb),
+        ("vdb level set", level_set),
+    ]
 }
 
 /// Reads bytes as the named format with the placement the writer used.
@@ -45,6 +55,11 @@ proptest! {
             let back = back.unwrap().tree;
             back.assert_well_formed();
             prop_assert!(back == tree, "{} changed the tree", format);
+            if format.starts_with("vdb") {
+                // ktree's .vdb files carry their universe: read without a placement, the same tree.
+                let unplaced = read_vdb(&bytes, "f", None, None).unwrap();
+                prop_assert!(unplaced.tree == tree, "{} without a placement", format);
+            }
         }
     }
 

@@ -1,5 +1,7 @@
-//! OpenVDB files (`.vdb`) holding one `BoolGrid` (`Tree_bool_5_4_3`), the grid type OpenVDB's Python module
-//! reads as a voxel set: active voxels are the object.
+//! OpenVDB files (`.vdb`): octrees written as one `BoolGrid` (`Tree_bool_5_4_3`), the grid type OpenVDB's
+//! Python module reads as a voxel set — active voxels are the object — and read from a `BoolGrid` or
+//! `MaskGrid` (its active voxels) or a level set (a `FloatGrid` or `DoubleGrid` of class `level set`: its
+//! interior, see [`super`]).
 //!
 //! The layout (file format version 224, OpenVDB 10): a header (magic `0x56444220` as `i64`, versions, a
 //! UUID), file metadata, the grid count, and per grid its descriptor (name, type, positions), its compression
@@ -7,12 +9,14 @@
 //! 128³ voxels → 16³ internal nodes of 8³ → 8³ leaves; masks are `u64` words, bit `n` of word `n / 64`,
 //! with `n = x·D² + y·D + z` inside a node of side `D` (x slowest). All values little-endian.
 //!
-//! Written files are uncompressed (compression flags 0), which every OpenVDB reads. Reading accepts
-//! uncompressed values and, from OpenVDB's own writer, active-mask compression with values stored raw or
-//! in uncompressed Blosc chunks (what a `BoolGrid` whose nodes hold few tiles gets); a Blosc- or
-//! zlib-compressed chunk is reported as unsupported. OpenVDB index `(x, y, z)` is ktree voxel `(x, y, z)`
-//! minus the offset written with, and the transform's voxel size and translation (the world centre of index
-//! 0) become the [`GridMeta`].
+//! Written files are uncompressed (compression flags 0), which every OpenVDB reads. Reading takes what
+//! OpenVDB writes (`vdb_values`): values raw or with active-mask compression, in zlib or Blosc
+//! chunks (Blosc 1 frames with the LZ4 codec and byte shuffle, OpenVDB's default, decoded by
+//! `blosc`); other Blosc codecs are reported as unsupported), and half floats. The first grid of a
+//! type read is taken; a `FloatGrid` or `DoubleGrid` of another class (fog volume, unknown, staggered) is
+//! passed over, and refused with its class when no other grid is read. OpenVDB index `(x, y, z)` is ktree
+//! voxel `(x, y, z)` minus the offset written with, and the transform's voxel size and translation (the
+//! world centre of index 0) become the [`GridMeta`].
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -21,15 +25,21 @@ use super::grid::{
     max_grid_nodes, place_boxes, GridBoxes, GridFileError, GridFileErrorKind, GridMeta,
     GridPlacement, IndexBox, PlacedTree, MAX_GRID_RUNS,
 };
+use super::vdb_level_set::read_interior;
+use super::vdb_values::{ones, Reader, ValueCoding, ValueKind};
 use crate::tree::{KTree, NodeState};
 
 pub(super) const MAGIC: i64 = 0x5644_4220;
 pub(super) const FILE_VERSION: u32 = 224;
 const BOOL_TREE: &str = "Tree_bool_5_4_3";
 const MASK_TREE: &str = "Tree_mask_5_4_3";
+pub(super) const FLOAT_TREE: &str = "Tree_float_5_4_3";
+const DOUBLE_TREE: &str = "Tree_double_5_4_3";
+/// Appended to a grid's type name when its values are saved as half floats.
+const HALF_FLOAT_SUFFIX: &str = "_HalfFloat";
 /// Grid metadata written by ktree: the universe level and the offset, read back as defaults.
-const LEVEL_KEY: &str = "ktree_level";
-const OFFSET_KEY: &str = "ktree_offset";
+pub(super) const LEVEL_KEY: &str = "ktree_level";
+pub(super) const OFFSET_KEY: &str = "ktree_offset";
 /// Words of a leaf mask (8³ bits), of a lower node mask (16³), of an upper node mask (32³).
 pub(super) const LEAF_WORDS: usize = 8;
 pub(super) const LOWER_WORDS: usize = 64;
@@ -281,141 +291,290 @@ pub fn write_vdb(
     w.flush()
 }
 
-/// A cursor over a `.vdb` file's bytes whose errors name the byte offset.
-struct Reader<'a> {
-    bytes: &'a [u8],
-    at: usize,
-    file: &'a str,
+/// The grid types read, from a descriptor's type name (`_HalfFloat` marks a grid saved with half floats).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum GridType {
+    /// `BoolGrid`: its active voxels.
+    Bool,
+    /// `MaskGrid`: its active voxels.
+    Mask,
+    /// `FloatGrid` or `DoubleGrid` of class level set: its interior.
+    Real { kind: ValueKind, half: bool },
 }
 
-impl<'a> Reader<'a> {
-    fn fail(&self, kind: GridFileErrorKind) -> GridFileError {
-        GridFileError::new(self.file, self.at, kind)
+impl GridType {
+    fn of(name: &str) -> Option<Self> {
+        let (base, half) = match name.strip_suffix(HALF_FLOAT_SUFFIX) {
+            Some(base) => (base, true),
+            None => (name, false),
+        };
+        Some(match base {
+            BOOL_TREE => Self::Bool,
+            MASK_TREE => Self::Mask,
+            FLOAT_TREE => Self::Real {
+                kind: ValueKind::F32,
+                half,
+            },
+            DOUBLE_TREE => Self::Real {
+                kind: ValueKind::F64,
+                half,
+            },
+            _ => return None,
+        })
     }
 
-    fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], GridFileError> {
-        match self.bytes.get(self.at..self.at.saturating_add(n)) {
-            Some(b) if self.at.checked_add(n).is_some() => {
-                self.at += n;
-                Ok(b)
-            }
-            _ => Err(self.fail(GridFileErrorKind::Truncated(format!(
-                "{what}: {n} bytes needed, {} left",
-                self.bytes.len() - self.at.min(self.bytes.len())
-            )))),
+    fn name(self) -> &'static str {
+        match self {
+            Self::Bool => "BoolGrid",
+            Self::Mask => "MaskGrid",
+            Self::Real {
+                kind: ValueKind::F64,
+                ..
+            } => "DoubleGrid",
+            Self::Real { .. } => "FloatGrid",
         }
     }
 
-    fn u32(&mut self, what: &str) -> Result<u32, GridFileError> {
-        Ok(u32::from_le_bytes(
-            self.take(4, what)?.try_into().expect("4 bytes"),
-        ))
+    /// How its node values are stored, under the file's compression flags.
+    fn coding(self, compression: u32) -> ValueCoding {
+        let (kind, half) = match self {
+            Self::Bool | Self::Mask => (ValueKind::Bool, false),
+            Self::Real { kind, half } => (kind, half),
+        };
+        ValueCoding {
+            compression,
+            kind,
+            half,
+        }
     }
+}
 
-    fn i32(&mut self, what: &str) -> Result<i32, GridFileError> {
-        Ok(i32::from_le_bytes(
-            self.take(4, what)?.try_into().expect("4 bytes"),
-        ))
-    }
+/// What a grid's header (compression flags, metadata, transform) says.
+struct GridHeader {
+    compression: u32,
+    /// ktree's own metadata: the universe level and offset a file was written with.
+    level: Option<u32>,
+    offset: Option<[i64; 3]>,
+    /// The grid class (`class` metadata), and where its value is.
+    class: Option<(String, usize)>,
+    meta: GridMeta,
+}
 
-    fn i64(&mut self, what: &str) -> Result<i64, GridFileError> {
-        Ok(i64::from_le_bytes(
-            self.take(8, what)?.try_into().expect("8 bytes"),
-        ))
-    }
-
-    fn f64x3(&mut self, what: &str) -> Result<[f64; 3], GridFileError> {
-        let b = self.take(24, what)?;
-        Ok(std::array::from_fn(|i| {
-            f64::from_le_bytes(b[8 * i..8 * i + 8].try_into().expect("8 bytes"))
-        }))
-    }
-
-    fn string(&mut self, what: &str) -> Result<String, GridFileError> {
-        let n = self.u32(what)? as usize;
-        let b = self.take(n, what)?;
-        Ok(String::from_utf8_lossy(b).into_owned())
-    }
-
-    /// Reads a metadata map, keeping ktree's own entries: (level, offset).
-    fn skip_metadata(&mut self) -> Result<(Option<u32>, Option<[i64; 3]>), GridFileError> {
+impl Reader<'_> {
+    /// Reads a metadata map, keeping ktree's own entries (level, offset) and the grid class.
+    fn metadata(&mut self) -> Result<GridHeader, GridFileError> {
         let count = self.u32("metadata count")?;
-        let (mut level, mut offset) = (None, None);
+        let mut head = GridHeader {
+            compression: 0,
+            level: None,
+            offset: None,
+            class: None,
+            meta: GridMeta::default(),
+        };
         for _ in 0..count {
             let name = self.string("metadata name")?;
             let kind = self.string("metadata type")?;
+            let value_at = self.at;
             let n = self.u32("metadata size")? as usize;
             let value = self.take(n, "metadata value")?;
             let int =
                 |i: usize| i32::from_le_bytes(value[4 * i..4 * i + 4].try_into().expect("4 bytes"));
             match (name.as_str(), kind.as_str(), n) {
-                (LEVEL_KEY, "int32", 4) => level = u32::try_from(int(0)).ok(),
-                (OFFSET_KEY, "vec3i", 12) => offset = Some([0, 1, 2].map(|i| i64::from(int(i)))),
+                (LEVEL_KEY, "int32", 4) => head.level = u32::try_from(int(0)).ok(),
+                (OFFSET_KEY, "vec3i", 12) => {
+                    head.offset = Some([0, 1, 2].map(|i| i64::from(int(i))));
+                }
+                ("class", "string", _) => {
+                    head.class = Some((String::from_utf8_lossy(value).into_owned(), value_at));
+                }
                 _ => {}
             }
         }
-        Ok((level, offset))
+        Ok(head)
     }
 
-    /// A node mask of `words` u64 words, as bits.
-    fn mask(&mut self, words: usize) -> Result<Vec<u64>, GridFileError> {
-        let b = self.take(8 * words, "node mask")?;
-        Ok(b.chunks_exact(8)
-            .map(|c| u64::from_le_bytes(c.try_into().expect("8 bytes")))
-            .collect())
-    }
-
-    /// Skips an internal node's values (`readCompressedValues`): only where tiles are active matters here.
-    fn skip_values(
-        &mut self,
-        compression: u32,
-        count: usize,
-        active: usize,
-    ) -> Result<(), GridFileError> {
-        let metadata = self.take(1, "value compression byte")?[0];
-        if metadata > 6 {
-            return Err(self.fail(GridFileErrorKind::Data(format!(
-                "value compression byte {metadata} is not 0 to 6"
-            ))));
-        }
-        if matches!(metadata, 2 | 4 | 5) {
-            self.take(1, "inactive value")?;
-        }
-        if metadata == 5 {
-            self.take(1, "inactive value")?;
-        }
-        if matches!(metadata, 3..=5) {
-            self.take(count / 8, "selection mask")?;
-        }
-        let n = if compression & 2 != 0 && metadata != 6 {
-            active
-        } else {
-            count
+    /// A grid's compression flags, metadata and transform, from `at`.
+    fn grid_header(&mut self, at: i64) -> Result<GridHeader, GridFileError> {
+        self.at = usize::try_from(at)
+            .ok()
+            .filter(|&p| p <= self.bytes.len())
+            .ok_or_else(|| {
+                self.fail(GridFileErrorKind::Data(format!(
+                    "grid position {at} is outside the file"
+                )))
+            })?;
+        let compression = self.u32("compression flags")?;
+        let mut head = self.metadata()?;
+        head.compression = compression;
+        let map_at = self.at;
+        let map = self.string("transform type")?;
+        head.meta = match map.as_str() {
+            "UniformScaleTranslateMap" | "ScaleTranslateMap" => {
+                let t = self.f64x3("translation")?;
+                let s = self.f64x3("scale")?;
+                self.take(4 * 24, "transform")?;
+                GridMeta {
+                    voxel_size: s[0],
+                    origin: std::array::from_fn(|a| t[a] - s[0] / 2.0),
+                }
+            }
+            "UniformScaleMap" | "ScaleMap" => {
+                let s = self.f64x3("scale")?;
+                self.take(4 * 24, "transform")?;
+                GridMeta {
+                    voxel_size: s[0],
+                    origin: [-s[0] / 2.0; 3],
+                }
+            }
+            "TranslationMap" => {
+                let t = self.f64x3("translation")?;
+                GridMeta {
+                    voxel_size: 1.0,
+                    origin: t.map(|x| x - 0.5),
+                }
+            }
+            other => {
+                self.at = map_at;
+                return Err(self.fail(GridFileErrorKind::Unsupported(format!(
+                    "transform {other:?}"
+                ))));
+            }
         };
-        if compression & 5 != 0 {
-            let size = self.i64("compressed size")?;
-            let stored = if size <= 0 {
-                size.unsigned_abs()
-            } else {
-                size as u64
-            };
-            self.take(
-                usize::try_from(stored).unwrap_or(usize::MAX),
-                "compressed values",
-            )?;
-        } else {
-            self.take(n, "values")?;
-        }
-        Ok(())
+        Ok(head)
     }
 }
 
-fn ones(words: &[u64]) -> impl Iterator<Item = usize> + '_ {
-    words.iter().enumerate().flat_map(|(i, &w)| {
-        (0..64)
-            .filter(move |b| w >> b & 1 == 1)
-            .map(move |b| i * 64 + b)
-    })
+/// Adds a box of grid indices to the object (and to the region known), at most [`MAX_GRID_RUNS`] of them.
+pub(super) fn push_box(
+    boxes: &mut GridBoxes,
+    r: &Reader,
+    origin: [i64; 3],
+    size: [u64; 3],
+) -> Result<(), GridFileError> {
+    let b = IndexBox { origin, size };
+    boxes.note_known(b);
+    boxes.inside.push(b);
+    if boxes.inside.len() as u64 > MAX_GRID_RUNS {
+        return Err(r.fail(GridFileErrorKind::Unsupported(format!(
+            "more than {MAX_GRID_RUNS} boxes"
+        ))));
+    }
+    Ok(())
+}
+
+/// Adds the voxels `n` of the 8³ leaf at `lo` for which `inside(n)` holds, as runs along z (`n = x·64 +
+/// y·8 + z`, z the fastest index).
+pub(super) fn add_leaf(
+    boxes: &mut GridBoxes,
+    r: &Reader,
+    lo: [i64; 3],
+    inside: impl Fn(usize) -> bool,
+) -> Result<(), GridFileError> {
+    for row in 0..64 {
+        let mut z = 0;
+        while z < 8 {
+            if !inside(row * 8 + z) {
+                z += 1;
+                continue;
+            }
+            let z0 = z;
+            while z < 8 && inside(row * 8 + z) {
+                z += 1;
+            }
+            let origin = [
+                lo[0] + (row / 8) as i64,
+                lo[1] + (row % 8) as i64,
+                lo[2] + z0 as i64,
+            ];
+            push_box(boxes, r, origin, [1, 1, (z - z0) as u64])?;
+        }
+    }
+    Ok(())
+}
+
+/// Checks, before anything is allocated for them, that `tiles` root tiles of `tile_bytes` bytes and
+/// `children` root children (each at least its origin, two masks and a value byte) fit in what is left.
+pub(super) fn check_root_counts(
+    r: &Reader,
+    tiles: usize,
+    tile_bytes: usize,
+    children: usize,
+) -> Result<(), GridFileError> {
+    let left = r.bytes.len() - r.at.min(r.bytes.len());
+    let child_bytes = 12 + 2 * 8 * UPPER_WORDS + 1;
+    if tiles
+        .saturating_mul(tile_bytes)
+        .saturating_add(children.saturating_mul(child_bytes))
+        > left
+    {
+        return Err(r.fail(GridFileErrorKind::Truncated(format!(
+            "{tiles} root tiles and {children} children cannot fit in {left} bytes"
+        ))));
+    }
+    Ok(())
+}
+
+/// The active voxels of a `BoolGrid` or `MaskGrid`'s tree (from its background on), as boxes. The node
+/// values are decoded (and so checked) but play no part.
+fn read_active(
+    r: &mut Reader,
+    coding: &ValueCoding,
+    is_bool: bool,
+) -> Result<GridBoxes, GridFileError> {
+    r.take(1, "background")?;
+    let tiles = r.u32("root tile count")? as usize;
+    let children = r.u32("root child count")? as usize;
+    check_root_counts(r, tiles, 14, children)?;
+    let mut boxes = GridBoxes::default();
+    for _ in 0..tiles {
+        let o = [r.i32("tile")?, r.i32("tile")?, r.i32("tile")?].map(i64::from);
+        r.take(1, "tile value")?;
+        if r.take(1, "tile state")?[0] != 0 {
+            push_box(&mut boxes, r, o, [4096; 3])?;
+        }
+    }
+    let mut leaves = 0usize;
+    for _ in 0..children {
+        let o = [
+            r.i32("node origin")?,
+            r.i32("node origin")?,
+            r.i32("node origin")?,
+        ]
+        .map(i64::from);
+        let child_mask = r.mask(UPPER_WORDS)?;
+        let value_mask = r.mask(UPPER_WORDS)?;
+        r.values(coding, UPPER_WORDS * 64, &value_mask, 0.0)?;
+        for n in ones(&value_mask) {
+            if child_mask[n / 64] >> (n % 64) & 1 == 0 {
+                push_box(&mut boxes, r, corner_of(o, n, 5, 7), [128; 3])?;
+            }
+        }
+        for n in ones(&child_mask) {
+            let lo = corner_of(o, n, 5, 7);
+            let lower_children = r.mask(LOWER_WORDS)?;
+            let lower_values = r.mask(LOWER_WORDS)?;
+            r.values(coding, LOWER_WORDS * 64, &lower_values, 0.0)?;
+            for m in ones(&lower_values) {
+                if lower_children[m / 64] >> (m % 64) & 1 == 0 {
+                    push_box(&mut boxes, r, corner_of(lo, m, 4, 3), [8; 3])?;
+                }
+            }
+            for m in ones(&lower_children) {
+                leaves += 1;
+                let leaf = r.mask(LEAF_WORDS)?;
+                add_leaf(&mut boxes, r, corner_of(lo, m, 4, 3), |i| {
+                    leaf[i / 64] >> (i % 64) & 1 == 1
+                })?;
+            }
+        }
+    }
+    if is_bool {
+        // Each bool leaf's buffer: its value mask, origin and values again.
+        for _ in 0..leaves {
+            r.take(2 * 8 * LEAF_WORDS + 12, "leaf buffer")?;
+        }
+    }
+    Ok(boxes)
 }
 
 pub(super) fn corner_of(origin: [i64; 3], n: usize, log_dim: u32, child_log: u32) -> [i64; 3] {
@@ -424,15 +583,29 @@ pub(super) fn corner_of(origin: [i64; 3], n: usize, log_dim: u32, child_log: u32
     std::array::from_fn(|a| origin[a] + ((c[a] as i64) << child_log))
 }
 
-/// Reads an OpenVDB file's first `BoolGrid` (or `MaskGrid`) into an octree: its active voxels, placed by
-/// `offset` and `level` (see [`GridPlacement::choose`]; the region chosen for is the active one). A file
+/// Reads an OpenVDB file's first `BoolGrid` or `MaskGrid` — its active voxels — or level set (a
+/// `FloatGrid` or `DoubleGrid` of class `level set`) — its interior, every voxel and tile whose value is
+/// below zero, active or not (see [`crate::io::interop`]'s notes on level sets) — into an octree, placed by
+/// `offset` and `level` (see [`GridPlacement::choose`]; the region chosen for is the one read). A file
 /// written by ktree carries its level and offset as grid metadata (`ktree_level`, `ktree_offset`), used
-/// when the caller gives none.
+/// when the caller gives none. Values may be stored raw or compressed as OpenVDB writes them: active-mask
+/// compression, zlib, Blosc (LZ4), half floats.
+///
+/// ```
+/// use ktree::io::{read_vdb, write_vdb_level_set};
+/// use ktree::{rays::ball_rays, KTree};
+/// let ball = KTree::from_rays(&ball_rays::<3>(5, [16, 16, 16], 24).unwrap());
+/// let mut sdf = Vec::new();
+/// write_vdb_level_set(&mut sdf, &ball, 3.0, 0.5).unwrap();
+/// assert_eq!(read_vdb(&sdf, "sdf.vdb", None, None).unwrap().tree, ball);
+/// ```
 ///
 /// # Errors
-/// [`GridFileError`] naming the byte offset: not a `.vdb` file, a format version before 222, no bool or mask
-/// grid, a transform other than a scale and translation, sizes beyond the file, or active voxels outside
-/// the universe asked for.
+/// [`GridFileError`] naming the byte offset: not a `.vdb` file, a format version before 222, no grid of a
+/// type read, a `FloatGrid` or `DoubleGrid` of another class than level set (a fog volume, say; when no
+/// other grid is read), a transform other than a scale and translation, sizes beyond the file, compressed
+/// data that does not decode to its size, a Blosc codec other than LZ4, or voxels outside the universe
+/// asked for.
 pub fn read_vdb(
     bytes: &[u8],
     file: &str,
@@ -456,9 +629,11 @@ pub fn read_vdb(
     r.take(8, "library version")?;
     let has_offsets = r.take(1, "grid offsets flag")?[0] != 0;
     r.take(36, "UUID")?;
-    r.skip_metadata()?;
+    r.metadata()?;
     let grids = r.i32("grid count")?;
     let mut found = None;
+    let mut refused = None;
+    let mut header_bytes = 0usize;
     for _ in 0..grids.max(0) {
         let _name = r.string("grid name")?;
         let kind = r.string("grid type")?;
@@ -466,18 +641,45 @@ pub fn read_vdb(
         let grid_at = r.i64("grid position")?;
         r.i64("block position")?;
         let end_at = r.i64("end position")?;
-        if (kind == BOOL_TREE || kind == MASK_TREE) && parent.is_empty() {
+        if let Some(grid) = GridType::of(&kind).filter(|_| parent.is_empty()) {
             if has_offsets && usize::try_from(end_at).map_or(true, |e| e > bytes.len()) {
                 return Err(r.fail(GridFileErrorKind::Truncated(format!(
                     "the grid ends at byte {end_at}, the file has {}",
                     bytes.len()
                 ))));
             }
-            found = Some((
-                kind == BOOL_TREE,
-                if has_offsets { grid_at } else { r.at as i64 },
-            ));
-            break;
+            let after_descriptor = r.at;
+            let header_at = if has_offsets {
+                grid_at
+            } else {
+                after_descriptor as i64
+            };
+            let head = r.grid_header(header_at)?;
+            // The headers of grids passed over are read at most about twice the file's length in all:
+            // descriptors pointing at one long header again and again would otherwise take quadratic time.
+            header_bytes += r.at.saturating_sub(usize::try_from(header_at).unwrap_or(0));
+            let class = head.class.as_ref().map(|(c, _)| c.as_str());
+            if matches!(grid, GridType::Real { .. }) && class != Some("level set") {
+                refused.get_or_insert_with(|| {
+                    let at = head.class.as_ref().map_or(after_descriptor, |(_, at)| *at);
+                    r.fail_at(
+                        at,
+                        GridFileErrorKind::Unsupported(format!(
+                            "a {} of class {:?}: of a FloatGrid or DoubleGrid only a level set's \
+                             interior (values below 0) is read",
+                            grid.name(),
+                            class.unwrap_or("unknown")
+                        )),
+                    )
+                });
+                r.at = after_descriptor;
+                if header_bytes > 2 * bytes.len() {
+                    break;
+                }
+            } else {
+                found = Some((grid, head));
+                break;
+            }
         }
         if !has_offsets {
             break;
@@ -494,163 +696,26 @@ pub fn read_vdb(
             .unwrap_or(usize::MAX)
             .min(bytes.len());
     }
-    let Some((is_bool, grid_at)) = found else {
-        return Err(r.fail(GridFileErrorKind::Unsupported(
-            "no BoolGrid or MaskGrid in the file".into(),
-        )));
+    let Some((grid, head)) = found else {
+        return Err(refused.unwrap_or_else(|| {
+            r.fail(GridFileErrorKind::Unsupported(
+                "no BoolGrid, MaskGrid or level set (FloatGrid, DoubleGrid) in the file".into(),
+            ))
+        }));
     };
-    r.at = usize::try_from(grid_at)
-        .ok()
-        .filter(|&p| p <= bytes.len())
-        .ok_or_else(|| {
-            r.fail(GridFileErrorKind::Data(format!(
-                "grid position {grid_at} is outside the file"
-            )))
-        })?;
-    let compression = r.u32("compression flags")?;
-    let (written_level, written_offset) = r.skip_metadata()?;
-    let level = level.or(written_level);
-    let offset = offset.or(written_offset);
-    let map_at = r.at;
-    let map = r.string("transform type")?;
-    let meta = match map.as_str() {
-        "UniformScaleTranslateMap" | "ScaleTranslateMap" => {
-            let t = r.f64x3("translation")?;
-            let s = r.f64x3("scale")?;
-            r.take(4 * 24, "transform")?;
-            GridMeta {
-                voxel_size: s[0],
-                origin: std::array::from_fn(|a| t[a] - s[0] / 2.0),
-            }
-        }
-        "UniformScaleMap" | "ScaleMap" => {
-            let s = r.f64x3("scale")?;
-            r.take(4 * 24, "transform")?;
-            GridMeta {
-                voxel_size: s[0],
-                origin: [-s[0] / 2.0; 3],
-            }
-        }
-        "TranslationMap" => {
-            let t = r.f64x3("translation")?;
-            GridMeta {
-                voxel_size: 1.0,
-                origin: t.map(|x| x - 0.5),
-            }
-        }
-        other => {
-            r.at = map_at;
-            return Err(r.fail(GridFileErrorKind::Unsupported(format!(
-                "transform {other:?}"
-            ))));
-        }
-    };
+    let level = level.or(head.level);
+    let offset = offset.or(head.offset);
     if r.i32("buffer count")? != 1 {
+        r.at -= 4;
         return Err(r.fail(GridFileErrorKind::Unsupported(
             "more than one buffer".into(),
         )));
     }
-    r.take(1, "background")?;
-    let tiles = r.u32("root tile count")? as usize;
-    let children = r.u32("root child count")? as usize;
-    // Sizes before allocating: a root tile is 14 bytes, a child at least 12 + 8192.
-    let left = bytes.len() - r.at;
-    if tiles
-        .saturating_mul(14)
-        .saturating_add(children.saturating_mul(8204))
-        > left
-    {
-        return Err(r.fail(GridFileErrorKind::Truncated(format!(
-            "{tiles} root tiles and {children} children cannot fit in {left} bytes"
-        ))));
-    }
-    let mut boxes = GridBoxes::default();
-    let add = |boxes: &mut GridBoxes, origin: [i64; 3], size: [u64; 3]| {
-        let b = IndexBox { origin, size };
-        boxes.note_known(b);
-        boxes.inside.push(b);
-        boxes.inside.len() as u64 <= MAX_GRID_RUNS
+    let coding = grid.coding(head.compression);
+    let boxes = match grid {
+        GridType::Bool | GridType::Mask => read_active(&mut r, &coding, grid == GridType::Bool)?,
+        GridType::Real { .. } => read_interior(&mut r, &coding)?,
     };
-    let too_many = |r: &Reader| {
-        r.fail(GridFileErrorKind::Unsupported(format!(
-            "more than {MAX_GRID_RUNS} boxes"
-        )))
-    };
-    for _ in 0..tiles {
-        let o = [r.i32("tile")?, r.i32("tile")?, r.i32("tile")?].map(i64::from);
-        r.take(1, "tile value")?;
-        if r.take(1, "tile state")?[0] != 0 && !add(&mut boxes, o, [4096; 3]) {
-            return Err(too_many(&r));
-        }
-    }
-    let mut leaves = 0usize;
-    for _ in 0..children {
-        let o = [
-            r.i32("node origin")?,
-            r.i32("node origin")?,
-            r.i32("node origin")?,
-        ]
-        .map(i64::from);
-        let child_mask = r.mask(UPPER_WORDS)?;
-        let value_mask = r.mask(UPPER_WORDS)?;
-        let active = ones(&value_mask).count();
-        r.skip_values(compression, UPPER_WORDS * 64, active)?;
-        for n in ones(&value_mask) {
-            if child_mask[n / 64] >> (n % 64) & 1 == 0
-                && !add(&mut boxes, corner_of(o, n, 5, 7), [128; 3])
-            {
-                return Err(too_many(&r));
-            }
-        }
-        for n in ones(&child_mask) {
-            let lo = corner_of(o, n, 5, 7);
-            let lower_children = r.mask(LOWER_WORDS)?;
-            let lower_values = r.mask(LOWER_WORDS)?;
-            let active = ones(&lower_values).count();
-            r.skip_values(compression, LOWER_WORDS * 64, active)?;
-            for m in ones(&lower_values) {
-                if lower_children[m / 64] >> (m % 64) & 1 == 0
-                    && !add(&mut boxes, corner_of(lo, m, 4, 3), [8; 3])
-                {
-                    return Err(too_many(&r));
-                }
-            }
-            for m in ones(&lower_children) {
-                leaves += 1;
-                let leaf_lo = corner_of(lo, m, 4, 3);
-                let leaf = r.mask(LEAF_WORDS)?;
-                // Runs along z of the leaf's active voxels (z is the fastest index).
-                for row in 0..64 {
-                    let bits = (leaf[row / 8] >> (8 * (row % 8))) & 0xff;
-                    let mut z = 0;
-                    while z < 8 {
-                        if bits >> z & 1 == 0 {
-                            z += 1;
-                            continue;
-                        }
-                        let z0 = z;
-                        while z < 8 && bits >> z & 1 == 1 {
-                            z += 1;
-                        }
-                        let origin = [
-                            leaf_lo[0] + (row / 8) as i64,
-                            leaf_lo[1] + (row % 8) as i64,
-                            leaf_lo[2] + z0 as i64,
-                        ];
-                        if !add(&mut boxes, origin, [1, 1, (z - z0) as u64]) {
-                            return Err(too_many(&r));
-                        }
-                    }
-                }
-            }
-        }
-    }
-    if is_bool {
-        // Each bool leaf's buffer: its value mask, origin and values again.
-        for _ in 0..leaves {
-            r.take(2 * 8 * LEAF_WORDS + 12, "leaf buffer")?;
-        }
-    }
     let placement = GridPlacement::choose(boxes.known, offset, level)
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;
     let tree = place_boxes(&boxes, &placement, max_grid_nodes(bytes.len()))
@@ -658,7 +723,7 @@ pub fn read_vdb(
     Ok(PlacedTree {
         tree,
         placement,
-        meta,
+        meta: head.meta,
     })
 }
 
@@ -711,7 +776,7 @@ mod tests {
         b.extend_from_slice(&0u32.to_le_bytes());
         b.extend_from_slice(&100_000i32.to_le_bytes());
         let descriptor_at = b.len() as i64;
-        for s in ["g", "Tree_float_5_4_3", ""] {
+        for s in ["g", "Tree_vec3s_5_4_3", ""] {
             put_str(&mut b, s);
         }
         let end_field_at = b.len() + 16;
@@ -721,6 +786,59 @@ mod tests {
         let e = read_vdb(&b, "loop", None, None).unwrap_err();
         assert!(matches!(e.kind, GridFileErrorKind::Data(_)), "{e}");
         assert_eq!(e.offset(), Some(end_field_at as u64), "{e}");
+    }
+
+    #[test]
+    fn fog_volumes_are_passed_over_and_refused_by_their_class() {
+        // A header, then 3000 descriptors of FloatGrids, each followed by a byte and pointing at one header
+        // of 2000 metadata entries and class "fog volume": the scan stops reading that header again once
+        // twice the file's length has been read, and says why the file is refused.
+        let mut b = MAGIC.to_le_bytes().to_vec();
+        b.extend_from_slice(&FILE_VERSION.to_le_bytes());
+        b.extend_from_slice(&[0; 8]);
+        b.push(1);
+        b.extend_from_slice(&[b'0'; 36]);
+        b.extend_from_slice(&0u32.to_le_bytes());
+        let count = 3000;
+        b.extend_from_slice(&(count as i32).to_le_bytes());
+        let descriptor = |grid_at: i64, end_at: i64| {
+            let mut d = Vec::new();
+            for s in ["g", FLOAT_TREE, ""] {
+                put_str(&mut d, s);
+            }
+            for p in [grid_at, 0, end_at] {
+                d.extend_from_slice(&p.to_le_bytes());
+            }
+            d.push(0);
+            d
+        };
+        let each = descriptor(0, 0).len() as i64;
+        let header_at = b.len() as i64 + each * count;
+        for i in 0..count {
+            let end_at = b.len() as i64 + each;
+            assert_eq!(b.len() as i64, header_at - each * (count - i));
+            b.extend_from_slice(&descriptor(header_at, end_at));
+        }
+        b.extend_from_slice(&0u32.to_le_bytes()); // compression
+        put_u32(&mut b, 2001);
+        for _ in 0..2000 {
+            for s in ["a", "b"] {
+                put_str(&mut b, s);
+            }
+            put_u32(&mut b, 0);
+        }
+        let class_at = b.len() + 4 + 5 + 4 + 6;
+        for s in ["class", "string", "fog volume"] {
+            put_str(&mut b, s);
+        }
+        put_str(&mut b, "TranslationMap");
+        b.extend_from_slice(&[0; 24]);
+        let e = read_vdb(&b, "fog", None, None).unwrap_err();
+        assert!(
+            matches!(&e.kind, GridFileErrorKind::Unsupported(m) if m.contains("\"fog volume\"")),
+            "{e}"
+        );
+        assert_eq!(e.offset(), Some(class_at as u64), "{e}");
     }
 
     #[test]
