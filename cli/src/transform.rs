@@ -155,7 +155,7 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
         && rotate.iter().all(|r| r.2 % 90.0 == 0.0)
         && translate
             .as_ref()
-            .map_or(true, |t| t.iter().all(|v| v.fract() == 0.0));
+            .is_none_or(|t| t.iter().all(|v| v.fract() == 0.0));
     if exact {
         let mut t = tree.clone();
         if let Some(Some((p, q))) = scale_ratio {

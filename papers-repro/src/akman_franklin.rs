@@ -253,7 +253,7 @@ pub fn run(results: &Path) -> Result<String, String> {
                     variants += 1;
                     if partial == (p.obels - 1) / 8 {
                         partial_hits += 1;
-                        if p.split.map_or(true, |(pf, pe, _)| pf == full && pe == st.2) {
+                        if p.split.is_none_or(|(pf, pe, _)| pf == full && pe == st.2) {
                             all_hits += 1;
                         }
                     }
@@ -300,7 +300,7 @@ pub fn run(results: &Path) -> Result<String, String> {
             );
             for (i, &n) in nodes.iter().enumerate() {
                 let d = n.abs_diff(p.obels);
-                if best.as_ref().map_or(true, |b| d < b.0) {
+                if best.as_ref().is_none_or(|b| d < b.0) {
                     best = Some((d, hit.clone(), i));
                 }
             }

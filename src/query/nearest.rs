@@ -144,7 +144,7 @@ fn search<const K: usize, T: TreeStorage<K>>(
         if state == NodeState::Full {
             let (near, d) = nearest_in(&cell, &point);
             let key = morton_encode(near);
-            if best.map_or(true, |(bd, bk, _)| (d, key) < (bd, bk)) {
+            if best.is_none_or(|(bd, bk, _)| (d, key) < (bd, bk)) {
                 best = Some((d, key, near));
             }
             continue;

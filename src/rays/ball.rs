@@ -108,7 +108,7 @@ pub(crate) fn isqrt(n: i128) -> i128 {
 /// `floor(sqrt(n))` in 64-bit arithmetic.
 fn isqrt_u64(n: u64) -> u64 {
     let mut s = (n as f64).sqrt() as u64;
-    while s.checked_mul(s).map_or(true, |sq| sq > n) {
+    while s.checked_mul(s).is_none_or(|sq| sq > n) {
         s -= 1;
     }
     while (s + 1).checked_mul(s + 1).is_some_and(|sq| sq <= n) {

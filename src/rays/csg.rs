@@ -264,7 +264,7 @@ fn merge_column<const K: usize>(
     let mut open: Option<(u32, Normal<K>)> = None;
     let end_of = |runs: &[(u32, u32)], idx: usize| {
         let r = runs[idx / 2];
-        if idx % 2 == 0 {
+        if idx.is_multiple_of(2) {
             r.0
         } else {
             r.1

@@ -142,7 +142,7 @@ impl CellStates {
             let first = out[n - fanout].first;
             // `2^K` disjoint full blocks of the top's depth from the parent's start to its end are its
             // children.
-            let siblings = first % parent_span == 0
+            let siblings = first.is_multiple_of(parent_span)
                 && top.first + self.span(top.depth) - first == parent_span
                 && out[n - fanout..]
                     .iter()

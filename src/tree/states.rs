@@ -259,7 +259,7 @@ impl PackedStates {
     /// bits `2c`: a block of children read with one load (it never straddles a word).
     #[inline(always)]
     pub(crate) fn block_codes(&self, first: usize, k: usize) -> u32 {
-        debug_assert!(k <= 4 && first % (1 << k) == 0 && first + (1 << k) <= self.len);
+        debug_assert!(k <= 4 && first.is_multiple_of(1 << k) && first + (1 << k) <= self.len);
         let codes = self.words[first / NODES_PER_WORD] >> (2 * (first % NODES_PER_WORD));
         (codes & ((1u64 << (2 << k)) - 1)) as u32
     }

@@ -146,7 +146,7 @@ pub fn read_binvox(
                 dirty = true;
             }
             pos = stop;
-            if pos % plane == 0 && dirty {
+            if pos.is_multiple_of(plane) && dirty {
                 flush(&mut slab, x, &mut boxes).map_err(|_| too_many(data_at + at))?;
                 dirty = false;
             }

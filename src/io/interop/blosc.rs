@@ -177,7 +177,7 @@ pub(super) fn decode(frame: &[u8], expected: usize) -> Result<Vec<u8>, BloscErro
     let mut shuffled = vec![0u8; if shuffle { blocksize } else { 0 }];
     for j in 0..blocks {
         let start_at = HEADER + 4 * j;
-        let last_short = j + 1 == blocks && nbytes % blocksize != 0;
+        let last_short = j + 1 == blocks && !nbytes.is_multiple_of(blocksize);
         let bsize = if last_short {
             nbytes % blocksize
         } else {
@@ -354,7 +354,7 @@ pub(super) mod tests {
     fn bytes() -> impl Strategy<Value = Vec<u8>> {
         prop::collection::vec((any::<u8>(), 1usize..40), 0..60).prop_map(|runs| {
             runs.into_iter()
-                .flat_map(|(b, n)| std::iter::repeat(b).take(n))
+                .flat_map(|(b, n)| std::iter::repeat_n(b, n))
                 .collect()
         })
     }

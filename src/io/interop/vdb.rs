@@ -128,6 +128,45 @@ pub(super) fn put_str(out: &mut Vec<u8>, s: &str) {
     out.extend_from_slice(s.as_bytes());
 }
 
+/// Writes, after the file header, the one grid's descriptor (named "ktree", of tree type `tree_type`,
+/// positions left as zeros) and its head: no compression, and the metadata `class`, `name` and the
+/// universe (`LEVEL_KEY`, `OFFSET_KEY`), so that reading gives back the same tree. Returns where the
+/// descriptor's positions are and where the grid starts, for the caller to fill in.
+pub(super) fn put_grid_head(
+    out: &mut Vec<u8>,
+    tree_type: &str,
+    class: &str,
+    level: u32,
+    offset: [i64; 3],
+) -> (usize, usize) {
+    put_u32(out, 0); // file metadata: none
+    put_u32(out, 1); // one grid
+    put_str(out, "ktree");
+    put_str(out, tree_type);
+    put_str(out, ""); // not an instance
+    let positions_at = out.len();
+    out.extend_from_slice(&[0; 24]); // grid, block and end positions, filled in by the caller
+    let grid_at = out.len();
+    put_u32(out, 0); // compression: none
+    put_u32(out, 4); // grid metadata
+    for (name, value) in [("class", class), ("name", "ktree")] {
+        put_str(out, name);
+        put_str(out, "string");
+        put_str(out, value);
+    }
+    put_str(out, LEVEL_KEY);
+    put_str(out, "int32");
+    put_u32(out, 4);
+    put_u32(out, level);
+    put_str(out, OFFSET_KEY);
+    put_str(out, "vec3i");
+    put_u32(out, 12);
+    for c in offset {
+        out.extend_from_slice(&(c as i32).to_le_bytes());
+    }
+    (positions_at, grid_at)
+}
+
 fn put_mask(out: &mut Vec<u8>, bits: impl Iterator<Item = bool>, words: usize) {
     let mut w = vec![0u64; words];
     for (n, on) in bits.enumerate() {
@@ -191,32 +230,8 @@ pub fn write_vdb(
     );
     let uuid = format!("{crc:08x}-0000-4000-8000-{:012x}", tree.node_count());
     out.extend_from_slice(uuid.as_bytes());
-    put_u32(&mut out, 0); // file metadata: none
-    put_u32(&mut out, 1); // one grid
-    put_str(&mut out, "ktree");
-    put_str(&mut out, BOOL_TREE);
-    put_str(&mut out, ""); // not an instance
-    let positions_at = out.len();
-    out.extend_from_slice(&[0; 24]); // grid, block and end positions, filled in below
-    let grid_at = out.len();
-    put_u32(&mut out, 0); // compression: none
-    put_u32(&mut out, 4); // grid metadata
-    for (name, value) in [("class", "unknown"), ("name", "ktree")] {
-        put_str(&mut out, name);
-        put_str(&mut out, "string");
-        put_str(&mut out, value);
-    }
-    // The universe, so that reading gives back the same tree.
-    put_str(&mut out, LEVEL_KEY);
-    put_str(&mut out, "int32");
-    put_u32(&mut out, 4);
-    put_u32(&mut out, tree.level());
-    put_str(&mut out, OFFSET_KEY);
-    put_str(&mut out, "vec3i");
-    put_u32(&mut out, 12);
-    for c in offset {
-        out.extend_from_slice(&(c as i32).to_le_bytes());
-    }
+    let (positions_at, grid_at) =
+        put_grid_head(&mut out, BOOL_TREE, "unknown", tree.level(), offset);
     put_str(&mut out, "UniformScaleTranslateMap");
     let centre = meta.origin.map(|o| o + s / 2.0);
     for v in [

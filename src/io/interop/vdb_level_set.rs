@@ -20,8 +20,8 @@ use std::io::Write;
 
 use super::grid::{GridBoxes, GridFileError};
 use super::vdb::{
-    add_leaf, check_root_counts, corner_of, origin_of, push_box, put_str, put_u32, slot,
-    FILE_VERSION, FLOAT_TREE, LEAF_WORDS, LEVEL_KEY, LOWER_WORDS, MAGIC, OFFSET_KEY, UPPER_WORDS,
+    add_leaf, check_root_counts, corner_of, origin_of, push_box, put_grid_head, put_str, put_u32,
+    slot, FILE_VERSION, FLOAT_TREE, LEAF_WORDS, LOWER_WORDS, MAGIC, UPPER_WORDS,
 };
 use super::vdb_values::{ones, Reader, ValueCoding, ValueKind};
 use crate::tree::{KTree, NodeState};
@@ -222,30 +222,8 @@ pub fn write_vdb_level_set(
         band.len() as u64 & 0xFFFF_FFFF_FFFF
     );
     out.extend_from_slice(uuid.as_bytes());
-    put_u32(&mut out, 0); // file metadata: none
-    put_u32(&mut out, 1); // one grid
-    put_str(&mut out, "ktree");
-    put_str(&mut out, FLOAT_TREE);
-    put_str(&mut out, ""); // not an instance
-    let positions_at = out.len();
-    out.extend_from_slice(&[0; 24]); // grid, block and end positions, filled in below
-    let grid_at = out.len();
-    put_u32(&mut out, 0); // compression: none
-    put_u32(&mut out, 4); // grid metadata
-    for (name, value) in [("class", "level set"), ("name", "ktree")] {
-        put_str(&mut out, name);
-        put_str(&mut out, "string");
-        put_str(&mut out, value);
-    }
-    // The universe (index = voxel), so that reading gives back the same tree.
-    put_str(&mut out, LEVEL_KEY);
-    put_str(&mut out, "int32");
-    put_u32(&mut out, 4);
-    put_u32(&mut out, tree.level());
-    put_str(&mut out, OFFSET_KEY);
-    put_str(&mut out, "vec3i");
-    put_u32(&mut out, 12);
-    out.extend_from_slice(&[0; 12]);
+    let (positions_at, grid_at) =
+        put_grid_head(&mut out, FLOAT_TREE, "level set", tree.level(), [0; 3]);
     put_str(&mut out, "UniformScaleMap");
     let s = voxel_size;
     for v in [

@@ -68,13 +68,13 @@ pub fn write_ktree_v1<const K: usize>(mut w: impl Write, tree: &KTree<K>) -> std
         for i in 0..level.len() {
             acc |= (level.get(i) as u8) << (2 * (n % 4));
             n += 1;
-            if n % 4 == 0 {
+            if n.is_multiple_of(4) {
                 bytes.push(acc);
                 acc = 0;
             }
         }
     }
-    if n % 4 != 0 {
+    if !n.is_multiple_of(4) {
         bytes.push(acc);
     }
     let crc = crc32fast::hash(&bytes);
@@ -275,7 +275,7 @@ pub(super) fn read_v1_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFile
         level_states.finish();
         levels.push(level_states);
     }
-    if nodes % 4 != 0 && body[nodes / 4] >> (2 * (nodes % 4)) != 0 {
+    if !nodes.is_multiple_of(4) && body[nodes / 4] >> (2 * (nodes % 4)) != 0 {
         return Err(fail(
             body_at + nodes / 4,
             KtreeFileErrorKind::Tree("padding bits after the last node are not 0".into()),

@@ -117,7 +117,7 @@ impl<const K: usize> RaysFileSource<K> {
                 return None;
             }
             let x = if K == 1 { 0 } else { ray.start[0] };
-            if starts.last().map_or(true, |s| s.0 != x) {
+            if starts.last().is_none_or(|s| s.0 != x) {
                 starts.push((x, lines.line_offset, lines.line));
             }
             last = Some((key, z2));

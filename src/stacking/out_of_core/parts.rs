@@ -336,7 +336,7 @@ impl SpilledPart {
         {
             return Err(bad("another K, level, split depth or cell layout"));
         }
-        if words[5] % 2 != 0 {
+        if !words[5].is_multiple_of(2) {
             return Err(bad("an odd number of cell words"));
         }
         let t = self.t();

@@ -101,7 +101,7 @@ impl<'a> SectionScan<'a> {
             let at = self.section.offset + 8 * self.word;
             let first = self.word * NODES_PER_WORD;
             let here = (nodes - first).min(NODES_PER_WORD);
-            if self.word % WORDS_PER_SAMPLE == 0 {
+            if self.word.is_multiple_of(WORDS_PER_SAMPLE) {
                 let sample = self.samples[(self.word / WORDS_PER_SAMPLE) as usize];
                 if sample != self.partial {
                     return Err(self.fail(

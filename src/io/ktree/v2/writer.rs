@@ -135,7 +135,7 @@ impl<W: Write> KtreeWriter<W> {
     /// Writes one complete word of the current level.
     fn emit(&mut self, word: u64) -> std::io::Result<()> {
         let level = &mut self.current;
-        if level.words % WORDS_PER_SAMPLE == 0 {
+        if level.words.is_multiple_of(WORDS_PER_SAMPLE) {
             level.samples.push(level.partial);
         }
         level.words += 1;
