@@ -779,16 +779,22 @@ mod tests {
         assert!(bytes.len() < 8 * 50_000, "{} bytes", bytes.len());
     }
 
-    #[test]
-    fn a_grid_end_before_its_descriptor_is_refused_at_the_first_descriptor() {
-        // A header, a grid count of 100 000, and one descriptor of another grid type whose end position
-        // points back at the descriptor itself: the scan must stop there, not read it 100 000 times.
+    /// A file's header up to its grid count: magic, versions, no file metadata.
+    fn file_head() -> Vec<u8> {
         let mut b = MAGIC.to_le_bytes().to_vec();
         b.extend_from_slice(&FILE_VERSION.to_le_bytes());
         b.extend_from_slice(&[0; 8]);
         b.push(1);
         b.extend_from_slice(&[b'0'; 36]);
         b.extend_from_slice(&0u32.to_le_bytes());
+        b
+    }
+
+    #[test]
+    fn a_grid_end_before_its_descriptor_is_refused_at_the_first_descriptor() {
+        // A header, a grid count of 100 000, and one descriptor of another grid type whose end position
+        // points back at the descriptor itself: the scan must stop there, not read it 100 000 times.
+        let mut b = file_head();
         b.extend_from_slice(&100_000i32.to_le_bytes());
         let descriptor_at = b.len() as i64;
         for s in ["g", "Tree_vec3s_5_4_3", ""] {
@@ -808,12 +814,7 @@ mod tests {
         // A header, then 3000 descriptors of FloatGrids, each followed by a byte and pointing at one header
         // of 2000 metadata entries and class "fog volume": the scan stops reading that header again once
         // twice the file's length has been read, and says why the file is refused.
-        let mut b = MAGIC.to_le_bytes().to_vec();
-        b.extend_from_slice(&FILE_VERSION.to_le_bytes());
-        b.extend_from_slice(&[0; 8]);
-        b.push(1);
-        b.extend_from_slice(&[b'0'; 36]);
-        b.extend_from_slice(&0u32.to_le_bytes());
+        let mut b = file_head();
         let count = 3000;
         b.extend_from_slice(&(count as i32).to_le_bytes());
         let descriptor = |grid_at: i64, end_at: i64| {
