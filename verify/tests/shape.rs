@@ -316,6 +316,18 @@ fn euler_ref<const K: usize>(a: &Grid<K>, connectivity: usize) -> i64 {
 fn check_measures<const K: usize>(o: &Obj<K>) -> Result<(), TestCaseError> {
     let tree = o.tree();
     let a = Grid::<K>::of(o.level, &o.dense());
+    // The runs the shape operations work on: every full voxel a unit run, joined by the ray set's build.
+    let universe = o.universe();
+    let unit = o
+        .dense()
+        .into_iter()
+        .enumerate()
+        .filter(|&(_, f)| f)
+        .map(|(i, _)| {
+            let p = universe.dense_point(i);
+            Ray::new(p, p[K - 1] + 1)
+        });
+    prop_assert_eq!(tree.to_rays(), RaySet::from_rays(o.level, unit).unwrap());
     prop_assert_eq!(tree.surface_area(), surface_ref(&a));
     for connectivity in 1..=K {
         let comps = tree.components(connectivity).unwrap();
