@@ -12,6 +12,7 @@ rounds. Where two programs compute the same set, their voxel counts must be equa
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -143,6 +144,7 @@ def main() -> None:
     os.environ["REPEATS"] = "1"
     rounds = int(os.environ.get("ROUNDS", "3"))
     load = open("/proc/loadavg").read().split()[:3]
+    began = time.monotonic()
     inputs: dict[str, dict[str, str]] = {}
     for obj in sorted(set(OBJECTS + LABEL_OBJECTS + [o for o, _ in SCIPY_DILATIONS + OFFSETS])):
         inputs[obj] = run([perf, "--child", "shape", f"{obj}:write-inputs:{INPUTS / obj}"])
@@ -158,6 +160,7 @@ def main() -> None:
                     best[(qi, ti)] = (seconds, got)
             print(f"round {r + 1}: {obj} {question} done", file=sys.stderr)
     load_end = open("/proc/loadavg").read().split()[:3]
+    minutes = (time.monotonic() - began) / 60
 
     lines: list[str] = []
     w = lines.append
@@ -201,7 +204,8 @@ def main() -> None:
     )
     w("")
     w(
-        f"Times: the best of {rounds} round{'s' if rounds != 1 else ''}; in each round every program of a "
+        f"Times: the best of {rounds} round{'s' if rounds != 1 else ''} (ROUNDS={rounds}; the default is 3, and "
+        f"this run took {minutes:.0f} minutes); in each round every program of a "
         "question runs once, in turn, in a fresh process timing one run (reading the input not timed). "
         "Memory: the process's peak resident memory (VmHWM; for scipy `ru_maxrss`) and its resident memory "
         "once the input was read; \"result\" is the result's own size (ktree `KTree::heap_bytes`, OpenVDB "
