@@ -16,6 +16,7 @@ mod measure;
 mod ops;
 mod queries;
 mod scale;
+mod shape;
 mod solids;
 mod sources;
 mod streaming;
@@ -37,6 +38,7 @@ fn main() -> ExitCode {
             "sources" => measure::child(|| sources::run_case(case)),
             "export" => measure::child(|| export::run_case(case)),
             "queries" => measure::child(|| queries::run_case(case)),
+            "shape" => measure::child(|| shape::run_case(case)),
             _ => {
                 eprintln!("perf: unknown area {area}");
                 ExitCode::FAILURE
@@ -72,6 +74,11 @@ fn main() -> ExitCode {
             "sources" => sources::report(),
             "export" => export::report(),
             "queries" => queries::report(),
+            "shape" => Err(
+                "the shape area is measured against its peers by experiments/shape.sh, which writes \
+                 results/performance/shape.md"
+                    .into(),
+            ),
             other => Err(format!(
                 "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming, sources, export, queries)"
             )),

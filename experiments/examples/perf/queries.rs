@@ -206,23 +206,27 @@ fn write_inputs(tree: &KTree<3>, dir: &Path) -> Result<(), String> {
         .collect();
     write("rays.bin", &rays)?;
     if level <= 9 {
-        let dense = tree.to_dense().map_err(|e| e.to_string())?;
-        let side = 1usize << level;
-        let mut header = format!(
-            "{{'descr': '|u1', 'fortran_order': False, 'shape': ({side}, {side}, {side}), }}"
-        );
-        // The header, padded with spaces and a newline to a multiple of 64 bytes (npy format 1.0).
-        while (10 + header.len() + 1) % 64 != 0 {
-            header.push(' ');
-        }
-        header.push('\n');
-        let mut npy = b"\x93NUMPY\x01\x00".to_vec();
-        npy.extend_from_slice(&(header.len() as u16).to_le_bytes());
-        npy.extend_from_slice(header.as_bytes());
-        npy.extend(dense.iter().map(|&b| u8::from(b)));
-        write("dense.npy", &npy)?;
+        write("dense.npy", &dense_npy(tree)?)?;
     }
     Ok(())
+}
+
+/// The voxels of `tree` as a dense `.npy` array (u8, shape (U, U, U), index [z, y, x], npy format 1.0).
+pub fn dense_npy(tree: &KTree<3>) -> Result<Vec<u8>, String> {
+    let dense = tree.to_dense().map_err(|e| e.to_string())?;
+    let side = 1usize << tree.level();
+    let mut header =
+        format!("{{'descr': '|u1', 'fortran_order': False, 'shape': ({side}, {side}, {side}), }}");
+    // The header, padded with spaces and a newline to a multiple of 64 bytes.
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+    npy.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    npy.extend_from_slice(header.as_bytes());
+    npy.extend(dense.iter().map(|&b| u8::from(b)));
+    Ok(npy)
 }
 
 /// Runs one case in this (child) process: `CASE` on the L = 10 ball, `OBJECT:CASE` on another object
