@@ -85,6 +85,13 @@ fn euler_6(level: u32, dense: &[bool]) -> i64 {
 
 /// The checks on a mesh in voxel units of a tree of `voxels` voxels; returns its Euler characteristic.
 fn check_mesh(mesh: &SurfaceMesh, voxels: u128) -> i64 {
+    let chi = check_closed_exact(mesh, voxels);
+    assert_eq!(mesh.volume(), voxels as f64);
+    chi
+}
+
+/// [`check_mesh`] but for the volume in floating point (which rounds for coordinates near 2^21).
+fn check_closed_exact(mesh: &SurfaceMesh, voxels: u128) -> i64 {
     // Closed and consistently wound: each directed edge once, and its reverse once.
     let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
     for t in &mesh.triangles {
@@ -153,7 +160,6 @@ fn check_mesh(mesh: &SurfaceMesh, voxels: u128) -> i64 {
         })
         .sum();
     assert_eq!(six_v8, 48 * voxels as i128, "volume");
-    assert_eq!(mesh.volume(), voxels as f64);
     let edges = directed.len() as i64 / 2;
     mesh.vertices.len() as i64 - edges + mesh.triangles.len() as i64
 }
@@ -325,6 +331,33 @@ fn a_ball_round_trips_through_every_format_in_world_units() {
         mesh.placed(&frame).volume(),
         tree.voxel_count() as f64 / 64.0
     );
+}
+
+#[test]
+fn far_corners_of_the_largest_universe() {
+    // At L = 21 lattice coordinates reach 2^21: voxels at both corners, two touching along an edge on the
+    // universe's middle planes, and a large cell with a voxel on one face.
+    let level = ktree::max_level(3);
+    let u = ktree::Universe::<3>::new(level).unwrap();
+    let (top, mid) = ((1u32 << level) - 1, 1u32 << (level - 1));
+    let voxel = |p: [u32; 3]| u.cell(p, level).unwrap();
+    let cells = [
+        voxel([0, 0, 0]),
+        voxel([top, top, top]),
+        voxel([mid - 1, mid - 1, 5]),
+        voxel([mid, mid, 5]),
+        u.cell([mid, 0, 0], 2).unwrap(),
+        voxel([mid + 5, mid >> 1, 7]),
+    ];
+    let tree = KTree::from_cells(u, &cells).unwrap();
+    let mesh = boundary_mesh(&tree);
+    // Five solids (the two touching along an edge are apart, as in 6-connectivity): χ = 2 · 5.
+    assert_eq!(check_closed_exact(&mesh, tree.voxel_count()), 10);
+    let corner = mesh
+        .vertices
+        .iter()
+        .filter(|v| v[0] == f64::from(top) + 1.0);
+    assert_eq!(corner.count(), 4);
 }
 
 #[test]
