@@ -109,6 +109,47 @@ fn a_grid_keeps_its_voxel_size_and_origin() {
 }
 
 #[test]
+fn smooth_writes_a_closed_surface_near_the_voxels_volume() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("ball.ktree");
+    let tree = ball();
+    save(&input, AnyTree::K3(tree.clone()));
+    let out = dir.path().join("smooth.ply");
+    let (ok, stdout, stderr) = ktree(&[
+        "convert",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--smooth",
+        "--voxel-size",
+        "0.5",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("smooth"), "{stdout}");
+    let mesh = TriangleMesh::read(&out).unwrap();
+    assert_eq!(mesh.open_edges(), 0);
+    let volume = tree.voxel_count() as f64 * 0.125;
+    assert!(
+        (mesh.signed_volume() - volume).abs() < 0.02 * volume,
+        "{}",
+        mesh.signed_volume()
+    );
+    // Not the exact boundary: the exact one holds the voxels' volume to rounding.
+    assert!((mesh.signed_volume() - volume).abs() > 1e-9 * volume);
+    let square = dir.path().join("q.ktree");
+    save(
+        &square,
+        AnyTree::K2(KTree::<2>::from_dense(1, &[true; 4]).unwrap()),
+    );
+    let (ok, _, stderr) = ktree(&[
+        "convert",
+        square.to_str().unwrap(),
+        dir.path().join("q.ply").to_str().unwrap(),
+        "--smooth",
+    ]);
+    assert!(!ok && stderr.contains("q.ktree"), "{stderr}");
+}
+
+#[test]
 fn a_quadtree_is_an_svg_outline_and_bad_requests_are_errors() {
     let dir = tempfile::tempdir().unwrap();
     let square = dir.path().join("q.ktree");

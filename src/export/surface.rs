@@ -707,8 +707,70 @@ fn part_of(point: &Point, a: usize, q: usize) -> u8 {
 /// # Panics
 /// If the mesh would need 2^32 or more vertices or rectangle corners (its indices are 32-bit).
 pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
-    let rects = boundary_rectangles(tree);
-    let mut corners = Corners::new(tree, &rects);
+    mesh_of(tree, &boundary_rectangles(tree))
+}
+
+/// A smooth surface over the voxels of `tree`, for display (not for round trips: voxelizing it does not
+/// give the tree back): naive surface nets. The boundary is made one unit face at a time (two triangles
+/// a face, with the vertices and pinch splits of [`boundary_mesh`], so it is closed and 2-manifold), then
+/// relaxed `iterations` times: each vertex moves towards the mean of its neighbours and then away from it
+/// a little more (Taubin's λ = 0.5, μ = −0.53, which keeps the volume where plain averaging shrinks it),
+/// kept within half a voxel of where it started on every axis (its cell of the dual grid). In voxel coordinates, as
+/// [`boundary_mesh`].
+///
+/// ```
+/// use ktree::export::surface::smooth_mesh;
+/// let u = 16;
+/// let ball = ktree::KTree::from_rays(&ktree::rays::ball_rays::<3>(4, [u, u, u], u).unwrap());
+/// let mesh = smooth_mesh(&ball, 10);
+/// let voxels = ball.voxel_count() as f64;
+/// assert!((mesh.volume() - voxels).abs() < 0.01 * voxels);
+/// ```
+///
+/// # Panics
+/// As [`boundary_mesh`].
+pub fn smooth_mesh(tree: &KTree<3>, iterations: usize) -> SurfaceMesh {
+    let squares = boundary_squares(tree);
+    let mut units = Vec::new();
+    for &(key, c0, b0, side) in &squares {
+        let (a, coord, upper) = ((key >> 33) as usize, (key >> 1) as u32, key & 1 == 1);
+        for c in c0..c0 + side {
+            for b in b0..b0 + side {
+                units.push(Rect {
+                    a,
+                    coord,
+                    upper,
+                    r: [b, b + 1, c, c + 1],
+                });
+            }
+        }
+    }
+    let mut mesh = mesh_of(tree, &units);
+    let start = mesh.vertices.clone();
+    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); mesh.vertices.len()];
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            neighbours[t[k] as usize].push(t[(k + 1) % 3]);
+        }
+    }
+    // Taubin's two steps, shrinking then inflating, so that the surface keeps its volume.
+    for step in (0..iterations).flat_map(|_| [0.5, -0.53]) {
+        let now = mesh.vertices.clone();
+        for (v, around) in neighbours.iter().enumerate() {
+            let n = around.len() as f64;
+            mesh.vertices[v] = std::array::from_fn(|a| {
+                let mean = around.iter().map(|&w| now[w as usize][a]).sum::<f64>() / n;
+                let moved = now[v][a] + step * (mean - now[v][a]);
+                moved.clamp(start[v][a] - 0.5, start[v][a] + 0.5)
+            });
+        }
+    }
+    mesh
+}
+
+/// The mesh of boundary rectangles `rects` (see [`boundary_mesh`]).
+fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {
+    let mut corners = Corners::new(tree, rects);
     let mut mesh = SurfaceMesh::default();
     // Midpoints of segments where two solids touch, by doubled position and the full octant bounded.
     let mut midpoints: HashMap<([u64; 3], u8), u32> = HashMap::new();

@@ -489,3 +489,48 @@ proptest! {
         check_outline(level, &cells[..n]);
     }
 }
+
+#[test]
+fn smooth_meshes_are_closed_near_the_voxels_volume_and_not_the_exact_mesh() {
+    use ktree::export::surface::smooth_mesh;
+    for level in [4u32, 5, 6] {
+        let u = 1i64 << level;
+        let tree = KTree::from_rays(&ktree::rays::ball_rays::<3>(level, [u, u, u], u).unwrap());
+        let voxels = tree.voxel_count() as f64;
+        let exact = boundary_mesh(&tree);
+        let smooth = smooth_mesh(&tree, 10);
+        // Closed and consistently wound: each directed edge once, and its reverse once.
+        let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
+        for t in &smooth.triangles {
+            for k in 0..3 {
+                *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+            }
+        }
+        for (&(a, b), &n) in &directed {
+            assert_eq!(n, 1);
+            assert_eq!(directed.get(&(b, a)), Some(&1), "edge {a}→{b} has no twin");
+        }
+        // Within 1 % of the voxel count (the ball's own volume, nearly); not the staircase.
+        let volume = smooth.volume();
+        assert!(
+            (volume - voxels).abs() < 0.01 * voxels,
+            "L = {level}: {volume} for {voxels}"
+        );
+        assert!(smooth
+            .vertices
+            .iter()
+            .any(|v| v.iter().any(|x| (2.0 * x).fract() != 0.0)));
+        assert_ne!(smooth.triangles.len(), exact.triangles.len());
+        // Every vertex within half a voxel of the exact surface's lattice.
+        let (lo, hi) = exact.bounds().unwrap();
+        let (slo, shi) = smooth.bounds().unwrap();
+        for a in 0..3 {
+            assert!(slo[a] >= lo[a] - 0.5 && shi[a] <= hi[a] + 0.5);
+        }
+    }
+    // Solids touching along an edge stay two closed sheets.
+    let tree = KTree::<3>::from_dense(2, &dense_of(2, &[[0, 0, 0], [1, 1, 0]])).unwrap();
+    let smooth = smooth_mesh(&tree, 5);
+    assert!(smooth.volume() > 0.0);
+    assert_eq!(smooth.triangles.len() % 2, 0);
+}
