@@ -179,7 +179,9 @@ pub fn run(a: Args) -> CliResult {
                 meta.origin[i] - out_offset[i] as f64 * meta.voxel_size
             }),
         };
-        let mesh = ktree::export::surface::smooth_mesh(t, SMOOTH_ITERATIONS).placed(&frame);
+        let mesh = ktree::export::surface::smooth_mesh(t, SMOOTH_ITERATIONS)
+            .map_err(|e| format!("{}: {e}", a.input.display()))?
+            .placed(&frame);
         let written = ktree::export::write_surface(&a.output, &mesh).map_err(|e| e.to_string())?;
         outln!(
             "{}: smooth surface of {} vertices, {} triangles",

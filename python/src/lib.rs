@@ -1031,13 +1031,16 @@ impl Tree {
             },
         };
         let frame = ktree::export::Frame { voxel_size, origin };
-        let mesh = py.detach(|| {
-            if smooth {
-                ktree::export::surface::smooth_mesh(t, 10).placed(&frame)
-            } else {
-                ktree::export::surface::boundary_mesh(t).placed(&frame)
-            }
-        });
+        let mesh = py
+            .detach(|| {
+                if smooth {
+                    ktree::export::surface::smooth_mesh(t, 10)
+                } else {
+                    Ok(ktree::export::surface::boundary_mesh(t))
+                }
+            })
+            .map_err(|e| Failure::Value(e.to_string()))?
+            .placed(&frame);
         let (n, m) = (mesh.vertices.len(), mesh.triangles.len());
         let vertices = numpy::ndarray::Array2::from_shape_vec(
             (n, 3),

@@ -106,6 +106,15 @@ pub enum ExportError {
     /// Writing failed (the message names the file).
     #[error("{0}")]
     Write(#[source] std::io::Error),
+    /// A smooth surface ([`surface::smooth_mesh`]) would have more unit faces than it makes at most; the
+    /// exact boundary ([`surface::boundary_mesh`]) merges them and has no such bound.
+    #[error("a smooth surface of {faces} unit faces is more than the {limit} made at most; write the exact boundary")]
+    TooLarge {
+        /// The unit faces of the boundary.
+        faces: u128,
+        /// [`surface::SMOOTH_FACE_LIMIT`].
+        limit: u64,
+    },
 }
 
 /// Writes the boundary of `tree` to `path` in the format its extension names, atomically: an octree as a
@@ -177,7 +186,7 @@ pub fn write_mesh_of<const K: usize>(
 /// ```
 /// use ktree::export::{surface::smooth_mesh, write_surface, Frame};
 /// let dir = tempfile::tempdir().unwrap();
-/// let mesh = smooth_mesh(&ktree::KTree::<3>::full(2).unwrap(), 5).placed(&Frame::default());
+/// let mesh = smooth_mesh(&ktree::KTree::<3>::full(2).unwrap(), 5).unwrap().placed(&Frame::default());
 /// let written = write_surface(&dir.path().join("smooth.obj"), &mesh).unwrap();
 /// assert_eq!(written.elements, mesh.triangles.len());
 /// ```

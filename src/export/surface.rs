@@ -54,7 +54,7 @@ use crate::space::Cell;
 use crate::tree::cursor::Locator;
 use crate::tree::{KTree, NodeState};
 
-use super::Frame;
+use super::{ExportError, Frame};
 
 /// A triangle mesh: vertex positions and triangles (indices into the vertices, counter-clockwise seen
 /// from outside).
@@ -722,16 +722,32 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
 /// use ktree::export::surface::smooth_mesh;
 /// let u = 16;
 /// let ball = ktree::KTree::from_rays(&ktree::rays::ball_rays::<3>(4, [u, u, u], u).unwrap());
-/// let mesh = smooth_mesh(&ball, 10);
+/// let mesh = smooth_mesh(&ball, 10).unwrap();
 /// let voxels = ball.voxel_count() as f64;
 /// assert!((mesh.volume() - voxels).abs() < 0.01 * voxels);
+/// // A unit face at a time: the full universe at L = 21 has far too many.
+/// assert!(smooth_mesh(&ktree::KTree::<3>::full(21).unwrap(), 10).is_err());
 /// ```
+///
+/// # Errors
+/// [`ExportError::TooLarge`] when the boundary has more than [`SMOOTH_FACE_LIMIT`] unit faces (counted
+/// before anything is made).
 ///
 /// # Panics
 /// As [`boundary_mesh`].
-pub fn smooth_mesh(tree: &KTree<3>, iterations: usize) -> SurfaceMesh {
+pub fn smooth_mesh(tree: &KTree<3>, iterations: usize) -> Result<SurfaceMesh, ExportError> {
     let squares = boundary_squares(tree);
-    let mut units = Vec::new();
+    let faces: u128 = squares
+        .iter()
+        .map(|s| u128::from(s.3) * u128::from(s.3))
+        .sum();
+    if faces > u128::from(SMOOTH_FACE_LIMIT) {
+        return Err(ExportError::TooLarge {
+            faces,
+            limit: SMOOTH_FACE_LIMIT,
+        });
+    }
+    let mut units = Vec::with_capacity(faces as usize);
     for &(key, c0, b0, side) in &squares {
         let (a, coord, upper) = ((key >> 33) as usize, (key >> 1) as u32, key & 1 == 1);
         for c in c0..c0 + side {
@@ -765,8 +781,11 @@ pub fn smooth_mesh(tree: &KTree<3>, iterations: usize) -> SurfaceMesh {
             });
         }
     }
-    mesh
+    Ok(mesh)
 }
+
+/// The most unit faces [`smooth_mesh`] makes a surface of (2^26: some 10 GiB of mesh and work space).
+pub const SMOOTH_FACE_LIMIT: u64 = 1 << 26;
 
 /// The mesh of boundary rectangles `rects` (see [`boundary_mesh`]).
 fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {

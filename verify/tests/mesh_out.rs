@@ -498,7 +498,7 @@ fn smooth_meshes_are_closed_near_the_voxels_volume_and_not_the_exact_mesh() {
         let tree = KTree::from_rays(&ktree::rays::ball_rays::<3>(level, [u, u, u], u).unwrap());
         let voxels = tree.voxel_count() as f64;
         let exact = boundary_mesh(&tree);
-        let smooth = smooth_mesh(&tree, 10);
+        let smooth = smooth_mesh(&tree, 10).unwrap();
         // Closed and consistently wound: each directed edge once, and its reverse once.
         let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
         for t in &smooth.triangles {
@@ -530,7 +530,7 @@ fn smooth_meshes_are_closed_near_the_voxels_volume_and_not_the_exact_mesh() {
     }
     // Solids touching along an edge stay two closed sheets.
     let tree = KTree::<3>::from_dense(2, &dense_of(2, &[[0, 0, 0], [1, 1, 0]])).unwrap();
-    let smooth = smooth_mesh(&tree, 5);
+    let smooth = smooth_mesh(&tree, 5).unwrap();
     assert!(smooth.volume() > 0.0);
     assert_eq!(smooth.triangles.len() % 2, 0);
 }
