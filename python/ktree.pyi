@@ -217,9 +217,11 @@ class Tree:
     def collide(self, other: Tree, time_axis: Optional[int] = None) -> _Collision:
         """Interference, with the keys of `ktree collide --json`."""
     def to_mesh(
-        self, voxel_size: float = 1.0, origin: Optional[Sequence[float]] = None
+        self, voxel_size: float = 1.0, origin: Optional[Sequence[float]] = None, smooth: bool = False
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
-        """The boundary of an octree as a closed triangle mesh: vertices (n, 3) float64, faces (m, 3) int64."""
+        """The boundary of an octree as a closed triangle mesh: vertices (n, 3) float64, faces (m, 3) int64.
+
+        smooth=True: a smooth surface for display (surface nets), not the exact boundary."""
     def render(
         self,
         view: Optional[_View] = None,

@@ -55,10 +55,12 @@ fn convert_writes_each_mesh_format_in_world_units() {
             continue;
         }
         let mesh = TriangleMesh::read(&out).unwrap();
-        assert_eq!(
-            mesh.signed_volume(),
-            tree.voxel_count() as f64 * 0.125,
-            "{name}"
+        // In world units the sum of the tetrahedra rounds (voxel units are exact: verify/tests/mesh_out.rs).
+        let volume = tree.voxel_count() as f64 * 0.125;
+        assert!(
+            (mesh.signed_volume() - volume).abs() <= 1e-12 * volume,
+            "{name}: volume {} for {volume}",
+            mesh.signed_volume()
         );
         assert_eq!(voxelized(&out, 4, 0.5, [1.0, -2.0, 3.0]), tree, "{name}");
         if name.ends_with(".stl") {
@@ -104,6 +106,47 @@ fn a_grid_keeps_its_voxel_size_and_origin() {
     let mesh = TriangleMesh::read(&out).unwrap();
     let (lo, _) = mesh.bounds().unwrap();
     assert!(lo[0] >= 5.0, "{lo:?}");
+}
+
+#[test]
+fn smooth_writes_a_closed_surface_near_the_voxels_volume() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("ball.ktree");
+    let tree = ball();
+    save(&input, AnyTree::K3(tree.clone()));
+    let out = dir.path().join("smooth.ply");
+    let (ok, stdout, stderr) = ktree(&[
+        "convert",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--smooth",
+        "--voxel-size",
+        "0.5",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("smooth"), "{stdout}");
+    let mesh = TriangleMesh::read(&out).unwrap();
+    assert_eq!(mesh.open_edges(), 0);
+    let volume = tree.voxel_count() as f64 * 0.125;
+    assert!(
+        (mesh.signed_volume() - volume).abs() < 0.02 * volume,
+        "{}",
+        mesh.signed_volume()
+    );
+    // Not the exact boundary: the exact one holds the voxels' volume to rounding.
+    assert!((mesh.signed_volume() - volume).abs() > 1e-9 * volume);
+    let square = dir.path().join("q.ktree");
+    save(
+        &square,
+        AnyTree::K2(KTree::<2>::from_dense(1, &[true; 4]).unwrap()),
+    );
+    let (ok, _, stderr) = ktree(&[
+        "convert",
+        square.to_str().unwrap(),
+        dir.path().join("q.ply").to_str().unwrap(),
+        "--smooth",
+    ]);
+    assert!(!ok && stderr.contains("q.ktree"), "{stderr}");
 }
 
 #[test]

@@ -995,14 +995,16 @@ impl Tree {
     /// The boundary of an octree as a closed, outward-oriented triangle mesh: `(vertices, faces)`, a float64
     /// array of shape (n, 3) and an int64 array of shape (m, 3), in world units (vertex = `origin` +
     /// `voxel_size` · voxel coordinate). Where solids touch only along an edge or at a corner the vertices
-    /// are duplicated, so the mesh is 2-manifold.
-    #[pyo3(signature = (voxel_size = 1.0, origin = None))]
+    /// are duplicated, so the mesh is 2-manifold. `smooth=True`: a smooth surface for display instead
+    /// (surface nets relaxed within half a voxel, `ktree convert --smooth`), not the exact boundary.
+    #[pyo3(signature = (voxel_size = 1.0, origin = None, smooth = false))]
     #[allow(clippy::type_complexity)]
     fn to_mesh<'py>(
         &self,
         py: Python<'py>,
         voxel_size: f64,
         origin: Option<Vec<f64>>,
+        smooth: bool,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
         let AnyTree::K3(t) = &self.inner else {
             return Err(Failure::Value(format!(
@@ -1029,7 +1031,16 @@ impl Tree {
             },
         };
         let frame = ktree::export::Frame { voxel_size, origin };
-        let mesh = py.detach(|| ktree::export::surface::boundary_mesh(t).placed(&frame));
+        let mesh = py
+            .detach(|| {
+                if smooth {
+                    ktree::export::surface::smooth_mesh(t, 10)
+                } else {
+                    Ok(ktree::export::surface::boundary_mesh(t))
+                }
+            })
+            .map_err(|e| Failure::Value(e.to_string()))?
+            .placed(&frame);
         let (n, m) = (mesh.vertices.len(), mesh.triangles.len());
         let vertices = numpy::ndarray::Array2::from_shape_vec(
             (n, 3),

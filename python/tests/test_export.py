@@ -132,3 +132,15 @@ def test_vtk_reads_the_vtu_and_htg_back(tmp_path, k):
         # Bounds of the cells: the full voxels' box (to_dense's axes are the tree's axes).
         assert bounds[:k, 0].tolist() == lo.tolist() or bounds[:k, 0].tolist() == lo[::-1].tolist()
         assert sorted(bounds[:k, 1].tolist()) == sorted(hi.tolist())
+
+
+def test_to_mesh_smooth_is_watertight_near_the_voxels_volume():
+    side = 32
+    centres = np.indices((side,) * 3) + 0.5 - side / 2
+    a = (centres**2).sum(axis=0) <= (side / 2) ** 2
+    t = ktree.Tree.from_dense(a)
+    m = trimesh.Trimesh(*t.to_mesh(smooth=True), process=False)
+    assert m.is_watertight and m.is_winding_consistent
+    assert abs(m.volume - t.voxel_count) < 0.01 * t.voxel_count
+    exact = trimesh.Trimesh(*t.to_mesh(), process=False)
+    assert m.volume != exact.volume

@@ -106,6 +106,15 @@ pub enum ExportError {
     /// Writing failed (the message names the file).
     #[error("{0}")]
     Write(#[source] std::io::Error),
+    /// A smooth surface ([`surface::smooth_mesh`]) would have more unit faces than it makes at most; the
+    /// exact boundary ([`surface::boundary_mesh`]) merges them and has no such bound.
+    #[error("a smooth surface of {faces} unit faces is more than the {limit} made at most; write the exact boundary")]
+    TooLarge {
+        /// The unit faces of the boundary.
+        faces: u128,
+        /// [`surface::SMOOTH_FACE_LIMIT`].
+        limit: u64,
+    },
 }
 
 /// Writes the boundary of `tree` to `path` in the format its extension names, atomically: an octree as a
@@ -139,24 +148,12 @@ pub fn write_mesh_of<const K: usize>(
     };
     let any = tree as &dyn std::any::Any;
     if let Some(t) = any.downcast_ref::<KTree<3>>() {
-        {
-            let mesh = surface::boundary_mesh(t).placed(frame);
-            match format {
-                MeshFormat::Ply => write(&|w| files::write_ply(w, &mesh))?,
-                MeshFormat::Obj => write(&|w| files::write_obj(w, &mesh))?,
-                MeshFormat::Stl => write(&|w| files::write_stl(w, &mesh))?,
-                MeshFormat::Glb => write(&|w| files::write_glb(w, &mesh))?,
-                MeshFormat::Svg => {
-                    return Err(usage(
-                        "SVG holds the outlines of quadtrees (K = 2); this tree has K = 3",
-                    ))
-                }
-            }
-            Ok(Written {
-                vertices: mesh.vertices.len(),
-                elements: mesh.triangles.len(),
-            })
+        if format == MeshFormat::Svg {
+            return Err(usage(
+                "SVG holds the outlines of quadtrees (K = 2); this tree has K = 3",
+            ));
         }
+        write_surface(path, &surface::boundary_mesh(t).placed(frame))
     } else if let Some(t) = any.downcast_ref::<KTree<2>>() {
         {
             let loops = place_loops(&outline::boundary_loops(t), frame);
@@ -181,6 +178,42 @@ pub fn write_mesh_of<const K: usize>(
             "meshes are written for octrees (K = 3) and outlines for quadtrees (K = 2); this tree has K = {K}"
         )))
     }
+}
+
+/// Writes a triangle mesh (already placed in the world) to `path` as `.ply`, `.obj`, `.stl` or `.glb`, by
+/// its extension, atomically — for instance a [`surface::smooth_mesh`].
+///
+/// ```
+/// use ktree::export::{surface::smooth_mesh, write_surface, Frame};
+/// let dir = tempfile::tempdir().unwrap();
+/// let mesh = smooth_mesh(&ktree::KTree::<3>::full(2).unwrap(), 5).unwrap().placed(&Frame::default());
+/// let written = write_surface(&dir.path().join("smooth.obj"), &mesh).unwrap();
+/// assert_eq!(written.elements, mesh.triangles.len());
+/// ```
+///
+/// # Errors
+/// [`ExportError::Usage`] for an extension that is not one of these; [`ExportError::Write`] from the file
+/// system.
+pub fn write_surface(path: &Path, mesh: &surface::SurfaceMesh) -> Result<Written, ExportError> {
+    let write = |fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
+        write_atomic_with(path, |w| fill(w)).map_err(ExportError::Write)
+    };
+    match MeshFormat::of(path) {
+        Some(MeshFormat::Ply) => write(&|w| files::write_ply(w, mesh))?,
+        Some(MeshFormat::Obj) => write(&|w| files::write_obj(w, mesh))?,
+        Some(MeshFormat::Stl) => write(&|w| files::write_stl(w, mesh))?,
+        Some(MeshFormat::Glb) => write(&|w| files::write_glb(w, mesh))?,
+        _ => {
+            return Err(ExportError::Usage {
+                file: path.display().to_string(),
+                message: "a triangle mesh is written as .ply, .obj, .stl or .glb".into(),
+            })
+        }
+    }
+    Ok(Written {
+        vertices: mesh.vertices.len(),
+        elements: mesh.triangles.len(),
+    })
 }
 
 /// Outline loops in world units (see [`Frame`]).

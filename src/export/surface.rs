@@ -1,8 +1,9 @@
 //! The boundary of an octree as a closed, outward-oriented triangle mesh.
 //!
-//! **Faces.** Each full leaf asks, for each of its six faces, which leaves lie across it
-//! ([`Neighbours::face_leaves`]); the empty ones (and the universe's boundary) are where the surface is.
-//! The boundary squares of each axis-aligned plane and orientation are merged into rectangles: a sweep
+//! **Faces.** One walk over the tree meets every pair of face-adjacent leaves (as octree dual contouring
+//! does: the children across each partial node's inner faces, then the children along each such face, a
+//! leaf standing for its own children); a full leaf against an empty one (or the outside of the universe)
+//! bounds the object by the face of the smaller. The boundary squares of each axis-aligned plane and orientation are merged into rectangles: a sweep
 //! across the plane cuts it into strips, each strip's covered stretch into maximal intervals, and an
 //! interval goes on as one rectangle through the following strips while it stays the same.
 //!
@@ -28,9 +29,13 @@
 //! Coordinates are in voxels (the universe's corner at 0); [`SurfaceMesh::placed`] maps them to world
 //! units.
 //!
-//! **Work:** a face query per full leaf face (`O(L)` lookups each), eight voxel lookups per lattice vertex,
-//! and hash maps of the vertices and of the corners on each lattice line, all held at once (about 270 bytes
-//! a vertex of the result; `results/performance/export.md`).
+//! **Work:** no face query, and no hash map but for the rare midpoints. The walk above visits each leaf a bounded number of times; the
+//! squares are sorted by plane; the rectangles' corners are sorted once by their Morton key into distinct
+//! lattice points (a vertex is a point and a link part, so its index sits in a small table per point); each
+//! point's eight voxels are read with one descent from the deepest ancestor shared with the previous
+//! point's; and the corners inside a rectangle's edge are the points between its two ends in the points'
+//! order along that edge's lines (one sort per axis). `O(n log n)` in the boundary squares; time and peak
+//! memory against OpenVDB's `volumeToMesh` in `results/performance/export.md`.
 //!
 //! ```
 //! use ktree::export::surface::boundary_mesh;
@@ -42,14 +47,14 @@
 //! assert_eq!(mesh.volume(), 8.0);
 //! ```
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 use std::sync::OnceLock;
 
-use crate::display::neighbours::{face_neighbour_cell, Neighbours};
 use crate::space::Cell;
+use crate::tree::cursor::Locator;
 use crate::tree::{KTree, NodeState};
 
-use super::Frame;
+use super::{ExportError, Frame};
 
 /// A triangle mesh: vertex positions and triangles (indices into the vertices, counter-clockwise seen
 /// from outside).
@@ -110,7 +115,7 @@ impl SurfaceMesh {
 
 /// The other two axes of `a`, in cyclic order (so that `e_b × e_c = e_a`).
 fn others(a: usize) -> (usize, usize) {
-    ((a + 1) % 3, (a + 2) % 3)
+    [(1, 2), (2, 0), (0, 1)][a]
 }
 
 /// Unit face at a lattice point: plane axis `a`, quadrant `q` (bit 0: on the upper side of the point along
@@ -203,105 +208,277 @@ fn link_parts() -> &'static [[u8; 12]; 256] {
     })
 }
 
-/// Voxel states near lattice points, read through one [`Neighbours`].
-struct Lattice<'t> {
-    near: Neighbours<'t, 3>,
-    side: u64,
-    level: u32,
-    masks: HashMap<[u32; 3], u8>,
-}
-
-impl<'t> Lattice<'t> {
-    fn new(tree: &'t KTree<3>) -> Self {
-        Self {
-            near: Neighbours::new(tree),
-            side: tree.universe().side(),
-            level: tree.level(),
-            masks: HashMap::new(),
-        }
-    }
-
-    /// Whether the voxel at `v` (possibly outside the universe, which is empty) is full.
-    fn full(&mut self, v: [i64; 3]) -> bool {
-        if v.iter().any(|&x| x < 0 || x as u64 >= self.side) {
-            return false;
-        }
-        let cell = Cell {
-            origin: v.map(|x| x as u32),
-            level: self.level,
-            log_side: 0,
-        };
-        self.near.locate(&cell).state() == NodeState::Full
-    }
-
-    /// The occupancy of the eight voxels around lattice point `p` (bit `o`: octant `o`).
-    fn mask(&mut self, p: [u32; 3]) -> u8 {
-        if let Some(&m) = self.masks.get(&p) {
-            return m;
-        }
-        let mut m = 0u8;
-        for o in 0..8 {
-            let v = std::array::from_fn(|a| i64::from(p[a]) - 1 + (o >> a & 1) as i64);
-            if self.full(v) {
-                m |= 1 << o;
-            }
-        }
-        self.masks.insert(p, m);
-        m
-    }
-
-    /// The link part at `p` of the unit face `(a, q)`.
-    fn part(&mut self, p: [u32; 3], a: usize, q: usize) -> u8 {
-        let m = self.mask(p);
-        let part = link_parts()[m as usize][face_index(a, q)];
-        debug_assert_ne!(part, u8::MAX, "a rectangle at {p:?} on a non-boundary face");
-        part
-    }
-}
-
-/// A plane of boundary: its axis, its coordinate on that axis, and whether the outward normal points up
-/// the axis.
-type PlaneKey = (usize, u32, bool);
-
-/// The boundary squares of `tree`, by plane: `(b, c, side)` in the plane's axes (see [`others`]).
-fn boundary_squares(tree: &KTree<3>) -> BTreeMap<PlaneKey, Vec<[u32; 3]>> {
+/// The occupancy of the eight voxels around lattice point `p` (bit `o`: octant `o`; voxels outside the
+/// universe are empty). The eight lie in the smallest aligned cell holding both `p − 1` and `p` on every
+/// axis, found with `locator` (from a deep ancestor shared with the previous point's, when points come in
+/// Morton order); each voxel's state is then read from that cell down, a few levels for most points.
+fn occupancy(tree: &KTree<3>, locator: &mut Locator<3>, p: [u32; 3]) -> u8 {
     let side = tree.universe().side();
-    let mut near = Neighbours::new(tree);
-    let mut planes: BTreeMap<PlaneKey, Vec<[u32; 3]>> = BTreeMap::new();
-    for cell in tree.full_cells() {
-        let s = cell.side() as u32;
-        for a in 0..3 {
-            let (b, c) = others(a);
-            for upper in [false, true] {
-                let coord = cell.origin[a] + if upper { s } else { 0 };
-                let squares = planes.entry((a, coord, upper)).or_default();
-                match face_neighbour_cell(&cell, a, upper, side) {
-                    None => squares.push([cell.origin[b], cell.origin[c], s]),
-                    Some(n) => near.face_leaves(&n, a, !upper, |leaf, state| {
-                        if state == NodeState::Empty {
-                            squares.push([leaf.origin[b], leaf.origin[c], leaf.side() as u32]);
-                        }
-                    }),
-                }
+    let level = tree.level();
+    // The cell's log side: one more than the most trailing zeros of a coordinate (a coordinate of 0 or the
+    // universe's side has voxels outside on one side: its octants there stay empty).
+    let inside = |x: u32| x > 0 && u64::from(x) < side;
+    let log_side = p
+        .iter()
+        .filter(|&&x| inside(x))
+        .map(|x| x.trailing_zeros() + 1)
+        .max()
+        .unwrap_or(level)
+        .min(level);
+    // The block's lowest voxel, kept inside the universe; octants outside are skipped below.
+    let low: [u32; 3] = p.map(|x| x.saturating_sub(1));
+    let cell = Cell {
+        origin: low.map(|x| x >> log_side << log_side),
+        level: level - log_side,
+        log_side,
+    };
+    let node = locator.locate(tree, &cell);
+    // The octants whose voxels are inside the universe.
+    let octants = (0..8u8)
+        .filter(|&o| {
+            (0..3).all(|a| (1..=side).contains(&(u64::from(p[a]) + u64::from(o >> a & 1))))
+        })
+        .fold(0u8, |set, o| set | 1 << o);
+    let mut m = 0u8;
+    fill(
+        tree,
+        (node.cell().level() as usize, node.index(), node.state()),
+        log_side,
+        p,
+        octants,
+        &mut m,
+    );
+    m
+}
+
+/// Sets in `m` the octants of `octants` (a set of bits) around `p` whose voxel is full, the voxels lying in
+/// the node `(depth, index, state)` of log side `log_side`: the octants sharing a child go down together, so
+/// each node on the way is stepped into once.
+fn fill(
+    tree: &KTree<3>,
+    (depth, index, state): (usize, usize, NodeState),
+    log_side: u32,
+    p: [u32; 3],
+    octants: u8,
+    m: &mut u8,
+) {
+    match state {
+        NodeState::Full => *m |= octants,
+        NodeState::Empty => {}
+        NodeState::Partial => {
+            let first = tree.first_child(depth, index);
+            let bit = log_side - 1;
+            // The child code of each octant's voxel `p − 1 + o`.
+            let code = |o: u8| {
+                (0..3).fold(0usize, |code, a| {
+                    let v = p[a] + u32::from(o >> a & 1) - 1;
+                    code | ((v >> bit & 1) as usize) << a
+                })
+            };
+            let mut left = octants;
+            while left != 0 {
+                let c = code(left.trailing_zeros() as u8);
+                let same = (0..8u8)
+                    .filter(|&o| left >> o & 1 == 1 && code(o) == c)
+                    .fold(0u8, |set, o| set | 1 << o);
+                left &= !same;
+                let child = (depth + 1, first + c, tree.state(depth + 1, first + c));
+                fill(tree, child, bit, p, same, m);
             }
         }
     }
-    planes.retain(|_, v| !v.is_empty());
-    planes
 }
 
-/// Disjoint squares `(b, c, side)` merged into rectangles `[b0, b1, c0, c1]` covering the same region:
-/// strips across `c` between consecutive square edges, maximal intervals along `b` in each strip, an
-/// interval carried on through the following strips while it is the same.
-fn merge_rectangles(mut squares: Vec<[u32; 3]>) -> Vec<[u32; 4]> {
-    squares.sort_unstable_by_key(|s| (s[1], s[0]));
+/// The Morton key of a lattice point (coordinates up to 2^22 − 1; bits interleaved, axis 0 lowest).
+fn morton(p: [u32; 3]) -> u128 {
+    // The low 21 bits of x spread to every third bit of a u64.
+    fn spread(x: u32) -> u64 {
+        let mut x = u64::from(x) & 0x1f_ffff;
+        x = (x | x << 32) & 0x001f_0000_0000_ffff;
+        x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+        x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+        x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+        x = (x | x << 2) & 0x1249_2492_4924_9249;
+        x
+    }
+    let low = spread(p[0]) | spread(p[1]) << 1 | spread(p[2]) << 2;
+    let high = (0..3).fold(0u128, |h, a| h | u128::from(p[a] >> 21 & 1) << a);
+    u128::from(low) | high << 63
+}
+
+/// The lattice point of a Morton key ([`morton`]'s inverse).
+fn point_of(key: u128) -> [u32; 3] {
+    // Every third bit of a u64 gathered into the low 21 bits.
+    fn gather(x: u64) -> u32 {
+        let mut x = x & 0x1249_2492_4924_9249;
+        x = (x | x >> 2) & 0x10c3_0c30_c30c_30c3;
+        x = (x | x >> 4) & 0x100f_00f0_0f00_f00f;
+        x = (x | x >> 8) & 0x001f_0000_ff00_00ff;
+        x = (x | x >> 16) & 0x001f_0000_0000_ffff;
+        x = (x | x >> 32) & 0x1f_ffff;
+        x as u32
+    }
+    let low = key as u64;
+    std::array::from_fn(|a| gather(low >> a) | ((key >> (63 + a)) as u32 & 1) << 21)
+}
+
+/// A plane of boundary (its axis, its coordinate on that axis, and whether the outward normal points up
+/// the axis) as one number ordered as the triple.
+fn plane_key(a: usize, coord: u32, upper: bool) -> u64 {
+    (a as u64) << 33 | u64::from(coord) << 1 | u64::from(upper)
+}
+
+/// A node met by the walk of [`boundary_squares`]: where it is in the tree, its cell and state.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    depth: usize,
+    index: usize,
+    state: NodeState,
+    origin: [u32; 3],
+    log_side: u32,
+}
+
+impl Node {
+    /// The eight children of a partial node, by child code.
+    fn children(&self, tree: &KTree<3>) -> [Node; 8] {
+        let first = tree.first_child(self.depth, self.index);
+        std::array::from_fn(|code| self.child(tree, first, code))
+    }
+
+    /// The child `code` of a partial node whose first child is `first`.
+    fn child(&self, tree: &KTree<3>, first: usize, code: usize) -> Node {
+        let half = 1u32 << (self.log_side - 1);
+        Node {
+            depth: self.depth + 1,
+            index: first + code,
+            state: tree.state(self.depth + 1, first + code),
+            origin: std::array::from_fn(|a| self.origin[a] + (code as u32 >> a & 1) * half),
+            log_side: self.log_side - 1,
+        }
+    }
+}
+
+/// The boundary squares of `tree`: `(plane, c, b, side)` with the plane as in [`plane_key`] and `(b, c)`
+/// in the plane's axes (see [`others`]), sorted. One walk finds every pair of face-adjacent leaves (as
+/// octree dual contouring does): inside a partial node, the pairs of children across its twelve inner
+/// faces; across a face between two nodes, the pairs of their children along it, a leaf standing for its
+/// own children; the universe's six faces against the empty outside. A pair of a full and an empty leaf
+/// bounds the object by the face of the smaller.
+fn boundary_squares(tree: &KTree<3>) -> Vec<(u64, u32, u32, u32)> {
+    let mut squares = Vec::new();
+    let root = Node {
+        depth: 0,
+        index: 0,
+        state: tree.root_state(),
+        origin: [0; 3],
+        log_side: tree.level(),
+    };
+    for a in 0..3 {
+        across(tree, None, Some(root), a, &mut squares);
+        across(tree, Some(root), None, a, &mut squares);
+    }
+    within(tree, &root, &mut squares);
+    squares.sort_unstable();
+    squares
+}
+
+/// The boundary squares inside `node`.
+fn within(tree: &KTree<3>, node: &Node, out: &mut Vec<(u64, u32, u32, u32)>) {
+    if node.state != NodeState::Partial {
+        return;
+    }
+    let children = node.children(tree);
+    for child in &children {
+        within(tree, child, out);
+    }
+    for a in 0..3 {
+        for code in (0..8).filter(|code| code >> a & 1 == 0) {
+            across(
+                tree,
+                Some(children[code]),
+                Some(children[code | 1 << a]),
+                a,
+                out,
+            );
+        }
+    }
+}
+
+/// The boundary squares on the face between `lo` and `hi` (`hi` above `lo` along axis `a`; `None` is the
+/// empty outside of the universe). The two have the same size, or one is a leaf larger than the other.
+fn across(
+    tree: &KTree<3>,
+    lo: Option<Node>,
+    hi: Option<Node>,
+    a: usize,
+    out: &mut Vec<(u64, u32, u32, u32)>,
+) {
+    let state = |n: &Option<Node>| n.map_or(NodeState::Empty, |n| n.state);
+    let (sl, sh) = (state(&lo), state(&hi));
+    if sl == NodeState::Partial || sh == NodeState::Partial {
+        // The children along the face; a leaf (or the outside) stands for its own.
+        let side = |n: Option<Node>, upper: usize| -> [Option<Node>; 4] {
+            match n {
+                Some(node) if node.state == NodeState::Partial => {
+                    let first = tree.first_child(node.depth, node.index);
+                    let (b, c) = others(a);
+                    std::array::from_fn(|q| {
+                        Some(node.child(tree, first, upper << a | (q & 1) << b | (q >> 1) << c))
+                    })
+                }
+                other => [other; 4],
+            }
+        };
+        let (below, above) = (side(lo, 1), side(hi, 0));
+        for q in 0..4 {
+            across(tree, below[q], above[q], a, out);
+        }
+        return;
+    }
+    if sl == sh {
+        return;
+    }
+    // The smaller of the two cells (the same size, or a leaf against the outside, when neither is).
+    let cell = match (lo, hi) {
+        (Some(l), Some(h)) => {
+            if l.log_side <= h.log_side {
+                l
+            } else {
+                h
+            }
+        }
+        (Some(n), None) | (None, Some(n)) => n,
+        (None, None) => return,
+    };
+    let coord = match (lo, hi) {
+        (_, Some(h)) => h.origin[a],
+        (Some(l), None) => l.origin[a] + (1u32 << l.log_side),
+        (None, None) => return,
+    };
+    let (b, c) = others(a);
+    out.push((
+        plane_key(a, coord, sl == NodeState::Full),
+        cell.origin[c],
+        cell.origin[b],
+        1u32 << cell.log_side,
+    ));
+}
+
+/// Disjoint squares `(b, c, side)`, sorted by `(c, b)`, merged into rectangles `[b0, b1, c0, c1]` covering
+/// the same region, appended to `out` sorted by `(c0, b0)`: strips across `c` between consecutive square
+/// edges, maximal intervals along `b` in each strip, an interval carried on through the following strips
+/// while it is the same.
+fn merge_rectangles(squares: &[[u32; 3]], out: &mut Vec<[u32; 4]>) {
+    debug_assert!(squares
+        .windows(2)
+        .all(|w| (w[0][1], w[0][0]) < (w[1][1], w[1][0])));
     let mut cuts: Vec<u32> = squares.iter().flat_map(|s| [s[1], s[1] + s[2]]).collect();
     cuts.sort_unstable();
     cuts.dedup();
-    let mut out = Vec::new();
-    // Open rectangles: interval (b0, b1) → c0.
-    let mut open: BTreeMap<(u32, u32), u32> = BTreeMap::new();
-    let mut active: Vec<[u32; 3]> = Vec::new();
+    let first = out.len();
+    // Open rectangles `(b0, b1, c0)`, sorted by interval; the strip's intervals; the squares across it.
+    let (mut open, mut still) = (Vec::<(u32, u32, u32)>::new(), Vec::new());
+    let (mut active, mut spans, mut intervals) = (Vec::<[u32; 3]>::new(), Vec::new(), Vec::new());
     let mut next = 0;
     for w in cuts.windows(2) {
         let c = w[0];
@@ -310,31 +487,59 @@ fn merge_rectangles(mut squares: Vec<[u32; 3]>) -> Vec<[u32; 4]> {
             active.push(squares[next]);
             next += 1;
         }
-        let mut spans: Vec<(u32, u32)> = active.iter().map(|s| (s[0], s[0] + s[2])).collect();
+        spans.clear();
+        spans.extend(active.iter().map(|s| (s[0], s[0] + s[2])));
         spans.sort_unstable();
-        let mut intervals: Vec<(u32, u32)> = Vec::new();
-        for (b0, b1) in spans {
+        intervals.clear();
+        for &(b0, b1) in &spans {
             match intervals.last_mut() {
-                Some(last) if last.1 == b0 => last.1 = b1,
+                Some((_, end)) if *end == b0 => *end = b1,
                 _ => intervals.push((b0, b1)),
             }
         }
-        let mut still: BTreeMap<(u32, u32), u32> = BTreeMap::new();
-        for iv in intervals {
-            let start = open.remove(&iv).unwrap_or(c);
-            still.insert(iv, start);
+        // Both lists sorted: an open rectangle goes on if its interval is still there, else it ends at c.
+        still.clear();
+        let mut j = 0;
+        for &(b0, b1) in &intervals {
+            while j < open.len() && (open[j].0, open[j].1) < (b0, b1) {
+                let (x0, x1, c0) = open[j];
+                out.push([x0, x1, c0, c]);
+                j += 1;
+            }
+            if j < open.len() && (open[j].0, open[j].1) == (b0, b1) {
+                still.push(open[j]);
+                j += 1;
+            } else {
+                still.push((b0, b1, c));
+            }
         }
-        for ((b0, b1), c0) in std::mem::take(&mut open) {
-            out.push([b0, b1, c0, c]);
+        for &(x0, x1, c0) in &open[j..] {
+            out.push([x0, x1, c0, c]);
         }
-        open = still;
+        std::mem::swap(&mut open, &mut still);
     }
     let last = cuts.last().copied().unwrap_or(0);
-    for ((b0, b1), c0) in open {
+    for (b0, b1, c0) in open {
         out.push([b0, b1, c0, last]);
     }
-    out.sort_unstable_by_key(|r| (r[2], r[0]));
-    out
+    out[first..].sort_unstable_by_key(|r| (r[2], r[0]));
+}
+
+/// The boundary rectangles of `tree`, by plane (in [`plane_key`] order), each plane's by `(c0, b0)`.
+fn boundary_rectangles(tree: &KTree<3>) -> Vec<Rect> {
+    let squares = boundary_squares(tree);
+    let mut rects = Vec::new();
+    let (mut plane, mut merged) = (Vec::new(), Vec::new());
+    for group in squares.chunk_by(|x, y| x.0 == y.0) {
+        plane.clear();
+        plane.extend(group.iter().map(|&(_, c, b, s)| [b, c, s]));
+        merged.clear();
+        merge_rectangles(&plane, &mut merged);
+        let key = group[0].0;
+        let (a, coord, upper) = ((key >> 33) as usize, (key >> 1) as u32, key & 1 == 1);
+        rects.extend(merged.iter().map(|&r| Rect { a, coord, upper, r }));
+    }
+    rects
 }
 
 /// A rectangle of boundary in a plane.
@@ -370,63 +575,239 @@ impl Rect {
     }
 }
 
-/// A line of the lattice: its direction and the point's coordinates on the other two axes (in axis order).
-type LineKey = (usize, u32, u32);
+/// A lattice point at rectangles' corners, and what is known of it.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    at: [u32; 3],
+    /// The occupancy of the eight voxels around the point.
+    mask: u8,
+    /// For each direction `d`, the link parts (bit set) of the corners here whose rectangle has an edge
+    /// along `d`.
+    on_lines: [u8; 3],
+    /// The vertex of each link part, once made (`u32::MAX` before).
+    ids: [u32; 4],
+    /// The point's place in each of [`Corners::order`].
+    position: [u32; 3],
+}
 
-fn line_of(d: usize, p: [u32; 3]) -> (LineKey, u32) {
-    let rest: Vec<u32> = (0..3).filter(|&x| x != d).map(|x| p[x]).collect();
-    ((d, rest[0], rest[1]), p[d])
+/// The lattice points at the rectangles' corners.
+struct Corners {
+    /// The points, in Morton order.
+    points: Vec<Point>,
+    /// The point of corner `k` of rectangle `r`, at `4r + k`.
+    of_corner: Vec<u32>,
+    /// For each lattice direction `d`, the points ordered line by line along `d` (sorted by their other two
+    /// coordinates, then along `d`).
+    order: [Vec<u32>; 3],
+    /// The rectangles in the Morton order of their first corner.
+    rects: Vec<u32>,
+}
+
+impl Corners {
+    fn new(tree: &KTree<3>, rects: &[Rect]) -> Self {
+        let corner_count = u32::try_from(4 * rects.len())
+            .expect("fewer than 2^32 rectangle corners (vertex indices are 32-bit)");
+        let mut keyed: Vec<u128> = Vec::with_capacity(corner_count as usize);
+        for (r, rect) in rects.iter().enumerate() {
+            for (k, (p, _)) in rect.corners().into_iter().enumerate() {
+                keyed.push(morton(p) << 32 | (4 * r + k) as u128);
+            }
+        }
+        keyed.sort_unstable();
+        let mut locator = Locator::new(tree);
+        let mut points: Vec<Point> = Vec::new();
+        let mut of_corner = vec![0u32; keyed.len()];
+        let mut first_corners = Vec::with_capacity(rects.len());
+        let mut last = u128::MAX;
+        for k in keyed {
+            let slot = k as u32 as usize;
+            if k >> 32 != last {
+                last = k >> 32;
+                let at = point_of(last);
+                points.push(Point {
+                    at,
+                    mask: occupancy(tree, &mut locator, at),
+                    on_lines: [0; 3],
+                    ids: [u32::MAX; 4],
+                    position: [0; 3],
+                });
+            }
+            of_corner[slot] = (points.len() - 1) as u32;
+            if slot % 4 == 0 {
+                first_corners.push((slot / 4) as u32);
+            }
+        }
+        let order: [Vec<u32>; 3] = std::array::from_fn(|d| {
+            let (x, y) = match d {
+                0 => (1, 2),
+                1 => (0, 2),
+                _ => (0, 1),
+            };
+            let mut keyed: Vec<u128> = points
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let (px, py, pd) = (p.at[x], p.at[y], p.at[d]);
+                    u128::from(px) << 96 | u128::from(py) << 64 | u128::from(pd) << 32 | i as u128
+                })
+                .collect();
+            keyed.sort_unstable();
+            keyed.into_iter().map(|k| k as u32).collect()
+        });
+        for (d, order) in order.iter().enumerate() {
+            for (j, &i) in order.iter().enumerate() {
+                points[i as usize].position[d] = j as u32;
+            }
+        }
+        for &r in &first_corners {
+            let r = r as usize;
+            let rect = &rects[r];
+            let (b, c) = others(rect.a);
+            for (k, (_, q)) in rect.corners().into_iter().enumerate() {
+                let point = &mut points[of_corner[4 * r + k] as usize];
+                let part = part_of(point, rect.a, q);
+                point.on_lines[b] |= 1 << part;
+                point.on_lines[c] |= 1 << part;
+            }
+        }
+        Self {
+            points,
+            of_corner,
+            order,
+            rects: first_corners,
+        }
+    }
+
+    /// The vertex of `part` at point `i`, made when first asked for.
+    fn vertex(&mut self, mesh: &mut SurfaceMesh, i: usize, part: u8) -> u32 {
+        let point = &mut self.points[i];
+        let id = &mut point.ids[part as usize];
+        if *id == u32::MAX {
+            mesh.vertices.push(point.at.map(f64::from));
+            *id = (mesh.vertices.len() - 1) as u32;
+        }
+        *id
+    }
+}
+
+/// The link part at `point` of the unit face `(a, q)`, which must be a boundary face.
+fn part_of(point: &Point, a: usize, q: usize) -> u8 {
+    let part = link_parts()[point.mask as usize][face_index(a, q)];
+    debug_assert!(
+        part < 4,
+        "a rectangle at {:?} on a non-boundary face",
+        point.at
+    );
+    part
 }
 
 /// The boundary of `tree` as a closed, outward-oriented triangle mesh in voxel coordinates (see the
 /// module's documentation for how it is made crack-free and 2-manifold). Empty for an empty tree.
+///
+/// # Panics
+/// If the mesh would need 2^32 or more vertices or rectangle corners (its indices are 32-bit).
 pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
-    let rects: Vec<Rect> = boundary_squares(tree)
-        .into_iter()
-        .flat_map(|((a, coord, upper), squares)| {
-            merge_rectangles(squares)
-                .into_iter()
-                .map(move |r| Rect { a, coord, upper, r })
-        })
-        .collect();
-    let mut lattice = Lattice::new(tree);
-    // Every corner on the lines of its two edges, with its link part.
-    let mut lines: HashMap<LineKey, Vec<(u32, u8)>> = HashMap::new();
-    for rect in &rects {
-        let (b, c) = others(rect.a);
-        for (p, q) in rect.corners() {
-            let part = lattice.part(p, rect.a, q);
-            for d in [b, c] {
-                let (key, t) = line_of(d, p);
-                lines.entry(key).or_default().push((t, part));
+    mesh_of(tree, &boundary_rectangles(tree))
+}
+
+/// A smooth surface over the voxels of `tree`, for display (not for round trips: voxelizing it does not
+/// give the tree back): naive surface nets. The boundary is made one unit face at a time (two triangles
+/// a face, with the vertices and pinch splits of [`boundary_mesh`], so it is closed and 2-manifold), then
+/// relaxed `iterations` times: each vertex moves towards the mean of its neighbours and then away from it
+/// a little more (Taubin's λ = 0.5, μ = −0.53, which keeps the volume where plain averaging shrinks it),
+/// kept within half a voxel of where it started on every axis (its cell of the dual grid). In voxel coordinates, as
+/// [`boundary_mesh`].
+///
+/// ```
+/// use ktree::export::surface::smooth_mesh;
+/// let u = 16;
+/// let ball = ktree::KTree::from_rays(&ktree::rays::ball_rays::<3>(4, [u, u, u], u).unwrap());
+/// let mesh = smooth_mesh(&ball, 10).unwrap();
+/// let voxels = ball.voxel_count() as f64;
+/// assert!((mesh.volume() - voxels).abs() < 0.01 * voxels);
+/// // A unit face at a time: the full universe at L = 21 has far too many.
+/// assert!(smooth_mesh(&ktree::KTree::<3>::full(21).unwrap(), 10).is_err());
+/// ```
+///
+/// # Errors
+/// [`ExportError::TooLarge`] when the boundary has more than [`SMOOTH_FACE_LIMIT`] unit faces (counted
+/// before anything is made).
+///
+/// # Panics
+/// As [`boundary_mesh`].
+pub fn smooth_mesh(tree: &KTree<3>, iterations: usize) -> Result<SurfaceMesh, ExportError> {
+    let squares = boundary_squares(tree);
+    let faces: u128 = squares
+        .iter()
+        .map(|s| u128::from(s.3) * u128::from(s.3))
+        .sum();
+    if faces > u128::from(SMOOTH_FACE_LIMIT) {
+        return Err(ExportError::TooLarge {
+            faces,
+            limit: SMOOTH_FACE_LIMIT,
+        });
+    }
+    let mut units = Vec::with_capacity(faces as usize);
+    for &(key, c0, b0, side) in &squares {
+        let (a, coord, upper) = ((key >> 33) as usize, (key >> 1) as u32, key & 1 == 1);
+        for c in c0..c0 + side {
+            for b in b0..b0 + side {
+                units.push(Rect {
+                    a,
+                    coord,
+                    upper,
+                    r: [b, b + 1, c, c + 1],
+                });
             }
         }
     }
-    for v in lines.values_mut() {
-        v.sort_unstable();
-        v.dedup();
+    let mut mesh = mesh_of(tree, &units);
+    let start = mesh.vertices.clone();
+    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); mesh.vertices.len()];
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            neighbours[t[k] as usize].push(t[(k + 1) % 3]);
+        }
     }
+    // Taubin's two steps, shrinking then inflating, so that the surface keeps its volume.
+    for step in (0..iterations).flat_map(|_| [0.5, -0.53]) {
+        let now = mesh.vertices.clone();
+        for (v, around) in neighbours.iter().enumerate() {
+            let n = around.len() as f64;
+            mesh.vertices[v] = std::array::from_fn(|a| {
+                let mean = around.iter().map(|&w| now[w as usize][a]).sum::<f64>() / n;
+                let moved = now[v][a] + step * (mean - now[v][a]);
+                moved.clamp(start[v][a] - 0.5, start[v][a] + 0.5)
+            });
+        }
+    }
+    Ok(mesh)
+}
+
+/// The most unit faces [`smooth_mesh`] makes a surface of (2^26: some 10 GiB of mesh and work space).
+pub const SMOOTH_FACE_LIMIT: u64 = 1 << 26;
+
+/// The mesh of boundary rectangles `rects` (see [`boundary_mesh`]).
+fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {
+    let mut corners = Corners::new(tree, rects);
     let mut mesh = SurfaceMesh::default();
-    // Vertices by doubled position and tag (link part, or 16 + full octant for a midpoint).
-    let mut ids: HashMap<([u64; 3], u8), u32> = HashMap::new();
-    let mut vertex = |mesh: &mut SurfaceMesh, doubled: [u64; 3], tag: u8| -> u32 {
-        *ids.entry((doubled, tag)).or_insert_with(|| {
-            mesh.vertices.push(doubled.map(|x| x as f64 / 2.0));
-            (mesh.vertices.len() - 1) as u32
-        })
-    };
-    let double = |p: [u32; 3]| p.map(|x| 2 * u64::from(x));
+    // Midpoints of segments where two solids touch, by doubled position and the full octant bounded.
+    let mut midpoints: HashMap<([u64; 3], u8), u32> = HashMap::new();
     let mut ring: Vec<u32> = Vec::new();
-    for rect in &rects {
+    let mut stops: Vec<(usize, u8)> = Vec::new();
+    for j in 0..corners.rects.len() {
+        let r = corners.rects[j] as usize;
+        let rect = &rects[r];
         let (b, c) = others(rect.a);
-        let corners = rect.corners();
+        let rect_corners = rect.corners();
+        let at: [usize; 4] = std::array::from_fn(|k| corners.of_corner[4 * r + k] as usize);
         ring.clear();
         for k in 0..4 {
-            let (p, q) = corners[k];
-            let (end, _) = corners[(k + 1) % 4];
-            let part = lattice.part(p, rect.a, q);
-            ring.push(vertex(&mut mesh, double(p), part));
-            // The edge from p to end: along b for k = 0, 2, along c for k = 1, 3.
+            let (p, q) = rect_corners[k];
+            let (from, to) = (at[k], at[(k + 1) % 4]);
+            let part = part_of(&corners.points[from], rect.a, q);
+            ring.push(corners.vertex(&mut mesh, from, part));
+            // The edge from p to the next corner: along b for k = 0, 2, along c for k = 1, 3.
             let (d, e) = if k % 2 == 0 { (b, c) } else { (c, b) };
             // The rectangle's side of the line along e, as the quadrant bit for e.
             let e_side = match k {
@@ -440,40 +821,45 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
                     e_side | d_side << 1
                 }
             };
-            let (key, t0) = line_of(d, p);
-            let t1 = end[d];
-            let (lo, hi) = (t0.min(t1), t0.max(t1));
-            let mut stops: Vec<(u32, u8)> = Vec::new();
-            if let Some(on_line) = lines.get(&key) {
-                let from = on_line.partition_point(|&(t, _)| t <= lo);
-                for &(t, part) in on_line[from..].iter().take_while(|&&(t, _)| t < hi) {
-                    let mut x = p;
-                    x[d] = t;
-                    if lattice.part(x, rect.a, quadrant(1)) == part {
-                        stops.push((t, part));
-                    }
+            // The rectangle's unit face just past each point inside the edge.
+            let face = face_index(rect.a, quadrant(1));
+            // The corners strictly inside the edge, on the same sheet as the rectangle there.
+            stops.clear();
+            let (j0, j1) = (
+                corners.points[from].position[d],
+                corners.points[to].position[d],
+            );
+            for &i in &corners.order[d][(j0.min(j1) + 1) as usize..j0.max(j1) as usize] {
+                let point = &corners.points[i as usize];
+                let part = link_parts()[point.mask as usize][face];
+                debug_assert!(part < 4, "a rectangle's edge past a non-boundary face");
+                if part < 8 && point.on_lines[d] >> part & 1 == 1 {
+                    stops.push((i as usize, part));
                 }
             }
-            stops.dedup_by_key(|s| s.0);
-            if t1 < t0 {
+            if j1 < j0 {
                 stops.reverse();
             }
             // The full octant the rectangle bounds, as bits on the axes across the line.
             let full_side = usize::from(!rect.upper);
             let octant = (full_side << rect.a | e_side << e) as u8;
-            let mut prev = t0;
-            for (t, part) in stops.into_iter().chain(std::iter::once((t1, u8::MAX))) {
-                if pinched(&mut lattice, p, d, prev.min(t)) {
-                    let mut m = double(p);
-                    m[d] = u64::from(prev) + u64::from(t);
-                    ring.push(vertex(&mut mesh, m, 16 + octant));
+            let mut prev = from;
+            for (i, part) in stops.iter().copied().chain(std::iter::once((to, u8::MAX))) {
+                let (u, w) = (&corners.points[prev], &corners.points[i]);
+                let lower = if u.at[d] < w.at[d] { u } else { w };
+                if pinched(lower.mask, d) {
+                    let mut m = p.map(|x| 2 * u64::from(x));
+                    m[d] = u64::from(u.at[d]) + u64::from(w.at[d]);
+                    let id = *midpoints.entry((m, 16 + octant)).or_insert_with(|| {
+                        mesh.vertices.push(m.map(|x| x as f64 / 2.0));
+                        (mesh.vertices.len() - 1) as u32
+                    });
+                    ring.push(id);
                 }
                 if part != u8::MAX {
-                    let mut x = p;
-                    x[d] = t;
-                    ring.push(vertex(&mut mesh, double(x), part));
+                    ring.push(corners.vertex(&mut mesh, i, part));
                 }
-                prev = t;
+                prev = i;
             }
         }
         if !rect.upper {
@@ -496,16 +882,18 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
             }
         }
     }
+    assert!(
+        u32::try_from(mesh.vertices.len()).is_ok(),
+        "fewer than 2^32 vertices (indices are 32-bit)"
+    );
     mesh
 }
 
-/// Whether the segment from `lo` of the line along `d` through `p` has two solids touching along it: of
-/// the four voxels around the line just past `lo`, exactly two are full and they are diagonal (read from
-/// the occupancy around the lattice point at `lo`, so both rectangles along the segment decide alike).
-fn pinched(lattice: &mut Lattice<'_>, p: [u32; 3], d: usize, lo: u32) -> bool {
-    let mut at = p;
-    at[d] = lo;
-    let m = lattice.mask(at);
+/// Whether the segment of the line along `d` that starts at the lattice point of occupancy `m` (and goes
+/// up `d`) has two solids touching along it: of the four voxels around the line just past the point,
+/// exactly two are full and they are diagonal (read at the segment's lower end, so both rectangles along
+/// the segment decide alike).
+fn pinched(m: u8, d: usize) -> bool {
     let (x, y) = match d {
         0 => (1, 2),
         1 => (0, 2),
@@ -523,8 +911,10 @@ mod tests {
     #[test]
     fn rectangles_cover_the_squares_once() {
         // An L of three unit squares and a 2 × 2 square beside it.
-        let squares = vec![[0, 0, 1], [1, 0, 1], [0, 1, 1], [2, 0, 2]];
-        let rects = merge_rectangles(squares);
+        let mut squares = vec![[0, 0, 1], [1, 0, 1], [0, 1, 1], [2, 0, 2]];
+        squares.sort_unstable_by_key(|s| (s[1], s[0]));
+        let mut rects = Vec::new();
+        merge_rectangles(&squares, &mut rects);
         let area: u32 = rects.iter().map(|r| (r[1] - r[0]) * (r[3] - r[2])).sum();
         assert_eq!(area, 7);
         assert!(rects.contains(&[0, 4, 0, 1]), "{rects:?}");
@@ -539,5 +929,39 @@ mod tests {
         assert_eq!(parts.len(), 2);
         // One full octant: one part of three faces.
         assert_eq!(link_parts()[1].iter().filter(|&&p| p == 0).count(), 3);
+    }
+
+    #[test]
+    fn morton_keys_order_points_and_give_them_back() {
+        let top = 1u32 << 21;
+        for p in [
+            [0, 0, 0],
+            [1, 2, 3],
+            [top, 0, top],
+            [top - 1, top, 12345],
+            [top, top, top],
+        ] {
+            assert_eq!(point_of(morton(p)), p);
+        }
+        // Bits interleaved, axis 0 lowest: the eight corners of a unit cube in child-code order.
+        let keys: Vec<u128> = (0..8u32)
+            .map(|o| morton([o & 1, o >> 1 & 1, o >> 2]))
+            .collect();
+        assert_eq!(keys, (0..8).collect::<Vec<u128>>());
+        assert!(morton([top, 0, 0]) > morton([top - 1, top - 1, top - 1]));
+    }
+
+    #[test]
+    fn a_link_has_at_most_four_parts() {
+        // Each part is a cycle of at least three unit faces: at most four parts of the twelve faces, as
+        // many as a point's vertex slots. The checkerboard of four full octants has all four.
+        let most = link_parts()
+            .iter()
+            .flat_map(|row| row.iter().copied().filter(|&p| p != u8::MAX))
+            .max();
+        assert_eq!(most, Some(3));
+        let checkerboard = link_parts()[0b1001_0110];
+        assert!(checkerboard.iter().all(|&p| p < 4));
+        assert_eq!(checkerboard.iter().max(), Some(&3));
     }
 }

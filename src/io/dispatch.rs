@@ -627,6 +627,10 @@ fn write_typed<const K: usize>(
                     crate::export::ExportError::Usage { file, message } => {
                         IoError::Usage { file, message }
                     }
+                    e @ crate::export::ExportError::TooLarge { .. } => IoError::Usage {
+                        file: path.display().to_string(),
+                        message: e.to_string(),
+                    },
                 })
         }
         Format::Volume => Err(usage(

@@ -85,6 +85,13 @@ fn euler_6(level: u32, dense: &[bool]) -> i64 {
 
 /// The checks on a mesh in voxel units of a tree of `voxels` voxels; returns its Euler characteristic.
 fn check_mesh(mesh: &SurfaceMesh, voxels: u128) -> i64 {
+    let chi = check_closed_exact(mesh, voxels);
+    assert_eq!(mesh.volume(), voxels as f64);
+    chi
+}
+
+/// [`check_mesh`] but for the volume in floating point (which rounds for coordinates near 2^21).
+fn check_closed_exact(mesh: &SurfaceMesh, voxels: u128) -> i64 {
     // Closed and consistently wound: each directed edge once, and its reverse once.
     let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
     for t in &mesh.triangles {
@@ -153,7 +160,6 @@ fn check_mesh(mesh: &SurfaceMesh, voxels: u128) -> i64 {
         })
         .sum();
     assert_eq!(six_v8, 48 * voxels as i128, "volume");
-    assert_eq!(mesh.volume(), voxels as f64);
     let edges = directed.len() as i64 / 2;
     mesh.vertices.len() as i64 - edges + mesh.triangles.len() as i64
 }
@@ -328,6 +334,33 @@ fn a_ball_round_trips_through_every_format_in_world_units() {
 }
 
 #[test]
+fn far_corners_of_the_largest_universe() {
+    // At L = 21 lattice coordinates reach 2^21: voxels at both corners, two touching along an edge on the
+    // universe's middle planes, and a large cell with a voxel on one face.
+    let level = ktree::max_level(3);
+    let u = ktree::Universe::<3>::new(level).unwrap();
+    let (top, mid) = ((1u32 << level) - 1, 1u32 << (level - 1));
+    let voxel = |p: [u32; 3]| u.cell(p, level).unwrap();
+    let cells = [
+        voxel([0, 0, 0]),
+        voxel([top, top, top]),
+        voxel([mid - 1, mid - 1, 5]),
+        voxel([mid, mid, 5]),
+        u.cell([mid, 0, 0], 2).unwrap(),
+        voxel([mid + 5, mid >> 1, 7]),
+    ];
+    let tree = KTree::from_cells(u, &cells).unwrap();
+    let mesh = boundary_mesh(&tree);
+    // Five solids (the two touching along an edge are apart, as in 6-connectivity): χ = 2 · 5.
+    assert_eq!(check_closed_exact(&mesh, tree.voxel_count()), 10);
+    let corner = mesh
+        .vertices
+        .iter()
+        .filter(|v| v[0] == f64::from(top) + 1.0);
+    assert_eq!(corner.count(), 4);
+}
+
+#[test]
 fn the_empty_and_the_full_universe() {
     let empty = KTree::<3>::from_dense(2, &[false; 64]).unwrap();
     assert!(boundary_mesh(&empty).triangles.is_empty());
@@ -455,4 +488,49 @@ proptest! {
         let n = 1usize << (2 * level);
         check_outline(level, &cells[..n]);
     }
+}
+
+#[test]
+fn smooth_meshes_are_closed_near_the_voxels_volume_and_not_the_exact_mesh() {
+    use ktree::export::surface::smooth_mesh;
+    for level in [4u32, 5, 6] {
+        let u = 1i64 << level;
+        let tree = KTree::from_rays(&ktree::rays::ball_rays::<3>(level, [u, u, u], u).unwrap());
+        let voxels = tree.voxel_count() as f64;
+        let exact = boundary_mesh(&tree);
+        let smooth = smooth_mesh(&tree, 10).unwrap();
+        // Closed and consistently wound: each directed edge once, and its reverse once.
+        let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
+        for t in &smooth.triangles {
+            for k in 0..3 {
+                *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+            }
+        }
+        for (&(a, b), &n) in &directed {
+            assert_eq!(n, 1);
+            assert_eq!(directed.get(&(b, a)), Some(&1), "edge {a}→{b} has no twin");
+        }
+        // Within 1 % of the voxel count (the ball's own volume, nearly); not the staircase.
+        let volume = smooth.volume();
+        assert!(
+            (volume - voxels).abs() < 0.01 * voxels,
+            "L = {level}: {volume} for {voxels}"
+        );
+        assert!(smooth
+            .vertices
+            .iter()
+            .any(|v| v.iter().any(|x| (2.0 * x).fract() != 0.0)));
+        assert_ne!(smooth.triangles.len(), exact.triangles.len());
+        // Every vertex within half a voxel of the exact surface's lattice.
+        let (lo, hi) = exact.bounds().unwrap();
+        let (slo, shi) = smooth.bounds().unwrap();
+        for a in 0..3 {
+            assert!(slo[a] >= lo[a] - 0.5 && shi[a] <= hi[a] + 0.5);
+        }
+    }
+    // Solids touching along an edge stay two closed sheets.
+    let tree = KTree::<3>::from_dense(2, &dense_of(2, &[[0, 0, 0], [1, 1, 0]])).unwrap();
+    let smooth = smooth_mesh(&tree, 5).unwrap();
+    assert!(smooth.volume() > 0.0);
+    assert_eq!(smooth.triangles.len() % 2, 0);
 }

@@ -1,7 +1,7 @@
 //! Mesh export performance: the boundary of balls (L = 6, 8, 10) and of the armadillo mesh voxelized at
-//! L = 8 and 10, as merged-rectangle triangle meshes, against one quad (two triangles) per voxel face.
+//! L = 8 and 10, as merged-rectangle triangle meshes. The children this program runs are timed against
+//! OpenVDB's `volumeToMesh` by `experiments/export.sh`, which writes `results/performance/export.md`.
 
-use std::fmt::Write as _;
 use std::path::Path;
 
 use ktree::export::files::write_ply;
@@ -10,10 +10,7 @@ use ktree::rays::ball_rays;
 use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::{KTree, Octree};
 
-use crate::measure::{best_of, machine_line, results_path, run_child};
-
-/// The cases: `ball-L` and `armadillo-L`.
-pub const CASES: [&str; 5] = ["ball-6", "ball-8", "ball-10", "armadillo-8", "armadillo-10"];
+use crate::measure::best_of;
 
 pub fn tree_of(case: &str) -> Result<Octree, String> {
     let (what, level) = case.split_once('-').ok_or("case must be WHAT-L")?;
@@ -36,22 +33,26 @@ pub fn tree_of(case: &str) -> Result<Octree, String> {
     }
 }
 
-/// Runs one case in this (child) process.
+/// Runs one case in this (child) process: `OBJECT` (`ball-L`, `armadillo-L`) times the export;
+/// `OBJECT:write-vdb:PATH` writes the object's voxels as an OpenVDB `BoolGrid` (as `ktree convert X.ktree
+/// X.vdb` does) for the peer of `experiments/export.sh`.
 pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
+    if let Some((object, path)) = case.split_once(":write-vdb:") {
+        let tree = tree_of(object)?;
+        tree.save(Path::new(path))
+            .map_err(|e| format!("cannot write {path}: {e}"))?;
+        return Ok((0.0, vec![("voxels".into(), tree.voxel_count().to_string())]));
+    }
     let tree = tree_of(case)?;
     let mut out = None;
     let repeats = if case.ends_with("-10") { 1 } else { 3 };
-    let seconds = best_of(
-        repeats,
-        || {
-            let mesh = boundary_mesh(&tree);
-            let mut bytes = Vec::new();
-            write_ply(&mut bytes, &mesh).expect("in memory");
-            (mesh, bytes.len())
-        },
-        |r| out = Some(r),
-    );
-    let (mesh, bytes) = out.expect("ran");
+    let seconds = best_of(repeats, || boundary_mesh(&tree), |m| out = Some(m));
+    let mesh = out.expect("ran");
+    let start = std::time::Instant::now();
+    let mut bytes = Vec::new();
+    write_ply(&mut bytes, &mesh).expect("in memory");
+    let ply_seconds = start.elapsed().as_secs_f64();
+    let bytes = bytes.len();
     // Each unit voxel face has area 1: the surface area in voxels is the number of unit faces.
     let area: f64 = mesh
         .triangles
@@ -76,6 +77,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         ("triangles", mesh.triangles.len().to_string()),
         ("vertices", mesh.vertices.len().to_string()),
         ("bytes", bytes.to_string()),
+        ("ply_seconds", ply_seconds.to_string()),
         ("chi", chi.to_string()),
     ];
     Ok((
@@ -84,53 +86,11 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
     ))
 }
 
-/// Measures every case in a child process and writes `results/performance/export.md`.
+/// `results/performance/export.md` compares ktree with OpenVDB and is written by `experiments/export.sh`
+/// (which runs this program's children, `--child export CASE`).
 pub fn report() -> Result<String, String> {
-    let mut md = String::new();
-    let _ = writeln!(
-        md,
-        "# Export: the boundary of an octree as a triangle mesh\n"
-    );
-    let _ = writeln!(
-        md,
-        "Regenerate with `cargo run --release --example perf -- export`. Objects: the voxels whose centres \
-         lie in the ball of radius U/2 centred in the universe, and the armadillo (`data/meshes/`) fitted into \
-         the universe and voxelized. Time: the best of 3 runs (1 at L = 10) in a fresh process per case of extracting the \
-         closed mesh (`export::surface::boundary_mesh`) and writing it as binary PLY into memory, excluding \
-         building the tree. One quad per face: two triangles per unit voxel face, vertices shared \
-         (V = F + χ for a closed quad mesh of F faces and Euler characteristic χ), the same PLY layout \
-         (12 bytes a vertex, 13 a triangle).\n\n\
-         Machine: {}.\n",
-        machine_line()
-    );
-    let _ = writeln!(
-        md,
-        "| case | nodes | voxels | unit faces | triangles | vertices | PLY MiB | seconds | one quad per face: triangles | PLY MiB | triangles saved |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
-    );
-    for case in CASES {
-        let m = run_child("export", case)?;
-        let num = |k: &str| m.fact(k).parse::<f64>().unwrap_or(f64::NAN);
-        let (faces, triangles, chi) = (num("faces"), num("triangles"), num("chi"));
-        let header = 200.0;
-        let quad_bytes = header + 12.0 * (faces + chi) + 13.0 * 2.0 * faces;
-        let mib = |b: f64| b / (1024.0 * 1024.0);
-        let _ = writeln!(
-            md,
-            "| {case} | {} | {} | {} | {} | {} | {:.2} | {:.3} | {} | {:.2} | {:.1}× |",
-            m.fact("nodes"),
-            m.fact("voxels"),
-            m.fact("faces"),
-            m.fact("triangles"),
-            m.fact("vertices"),
-            mib(num("bytes")),
-            m.seconds,
-            2.0 * faces,
-            mib(quad_bytes),
-            2.0 * faces / triangles
-        );
-    }
-    let path = results_path("export");
-    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
-    Ok(path.display().to_string())
+    Err(
+        "results/performance/export.md is written by experiments/export.sh (it needs OpenVDB)"
+            .into(),
+    )
 }
