@@ -633,7 +633,7 @@ impl Corners {
                 });
             }
             of_corner[slot] = (points.len() - 1) as u32;
-            if slot % 4 == 0 {
+            if slot.is_multiple_of(4) {
                 first_corners.push((slot / 4) as u32);
             }
         }
