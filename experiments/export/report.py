@@ -10,10 +10,11 @@ the table keeps each program's best over the rounds.
 """
 
 import os
-import platform
-import subprocess
 import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from report_common import cpu, dpkg_version, run  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 INPUTS = ROOT / "target" / "export-inputs"
@@ -22,23 +23,9 @@ PLY_HEADER = 200  # bytes, about: ktree's binary PLY header
 COARSE = 0.5  # the adaptivity of the extra OpenVDB run
 
 
-def run(command: list[str], env: dict[str, str] | None = None) -> dict[str, str]:
-    done = subprocess.run(command, capture_output=True, text=True, check=False, env=env)
-    if done.returncode != 0:
-        sys.exit(f"{' '.join(command)} failed: {done.stderr.strip()}")
-    return dict(line.split("=", 1) for line in done.stdout.splitlines() if "=" in line)
-
 
 def machine() -> str:
-    model = platform.processor() or "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{model}, {os.cpu_count()} cores"
+    return f"{cpu()}, {os.cpu_count()} cores"
 
 
 def load() -> str:
@@ -51,12 +38,6 @@ def load() -> str:
 def ply_mib(vertices: float, triangles: float) -> float:
     return (PLY_HEADER + 12 * vertices + 13 * triangles) / (1024 * 1024)
 
-
-def openvdb_version() -> str:
-    done = subprocess.run(
-        ["dpkg-query", "-W", "-f=${Version}", "libopenvdb-dev"], capture_output=True, text=True, check=False
-    )
-    return done.stdout.strip() or "unknown"
 
 
 def main() -> None:
@@ -99,7 +80,7 @@ def main() -> None:
         "rectangles — the exact surface of the voxels (its volume is the voxel count). Timed: extracting the mesh, "
         "from the built tree, one thread; writing it as binary PLY into memory is shown apart (one run); peak "
         "memory is the child process's high-water mark of resident memory (building the tree included). "
-        f"**OpenVDB** (libopenvdb-dev {openvdb_version()}, `experiments/export/peers.cpp`): the voxels written by "
+        f"**OpenVDB** (libopenvdb-dev {dpkg_version('libopenvdb-dev')}, `experiments/export/peers.cpp`): the voxels written by "
         "ktree as a BoolGrid (`.vdb`, as `ktree convert X.ktree X.vdb` writes), turned into a level set by "
         "`tools::topologyToLevelSet` (half width 3, no closing, dilation or smoothing; its time shown apart), "
         "then `tools::volumeToMesh` at isovalue 0 and adaptivity 0 — the only part timed, on one thread "

@@ -10,9 +10,11 @@ rounds.
 """
 
 import os
-import subprocess
 import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from report_common import cpu, dpkg_version, goal, run  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
@@ -21,12 +23,6 @@ POINTS, RAYS, NEAREST, RAY_HEAD = 10_000_000, 1_000_000, 1_000_000, 100_000
 OBJECTS = ["ball-10", "armadillo-10"]
 EDT_OBJECTS = ["ball-9", "armadillo-9"]
 
-
-def run(command: list[str]) -> dict[str, str]:
-    done = subprocess.run(command, capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        sys.exit(f"{' '.join(command)} failed: {done.stderr.strip()}")
-    return dict(line.split("=", 1) for line in done.stdout.splitlines() if "=" in line)
 
 
 def questions(perf: str, peers: str) -> list[tuple[str, str, str, int, list[tuple[str, list[str]]]]]:
@@ -226,24 +222,7 @@ def main() -> None:
     out.write_text("\n".join(lines) + "\n")
 
 
-def goal(what: str, ours: float, theirs: float, factor: float, digits: int = 1) -> str:
-    """A goal `ours < factor · theirs` (ns a query unless said): reached, or missed by how much."""
-    figures = f"{ours:.{digits}f} against {theirs:.{digits}f}"
-    if ours < factor * theirs:
-        return f"{what}: **reached** ({figures})."
-    return f"{what}: **missed**, {ours / (factor * theirs):.2f}× over the goal ({figures})."
 
-
-def dpkg_version(package: str) -> str:
-    done = subprocess.run(["dpkg-query", "-W", "-f=${Version}", package], capture_output=True, text=True, check=False)
-    return done.stdout.strip() or "unknown"
-
-
-def cpu() -> str:
-    for line in open("/proc/cpuinfo"):
-        if line.startswith("model name"):
-            return line.split(":", 1)[1].strip()
-    return "unknown CPU"
 
 
 if __name__ == "__main__":

@@ -10,10 +10,12 @@ rounds. Where two programs compute the same set, their voxel counts must be equa
 """
 
 import os
-import subprocess
 import sys
 import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from report_common import cpu, dpkg_version, goal, run  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
@@ -31,12 +33,6 @@ LABEL_OBJECTS = ["ball-8", "armadillo-8", "ball-9", "armadillo-9"]
 BAND = 3
 MIB = 1 << 20
 
-
-def run(command: list[str]) -> dict[str, str]:
-    done = subprocess.run(command, capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        sys.exit(f"{' '.join(command)} failed: {done.stderr.strip()}")
-    return dict(line.split("=", 1) for line in done.stdout.splitlines() if "=" in line)
 
 
 def level(obj: str) -> int:
@@ -386,24 +382,7 @@ def memory_goal(inputs: dict[str, dict[str, str]], peaks: dict[tuple[str, str, s
     return "\n".join(lines) if lines else "- memory: no ktree case at L = 10."
 
 
-def goal(what: str, ours: float, theirs: float, factor: float, digits: int = 1) -> str:
-    """A goal `ours < factor · theirs`: reached, or missed by how much."""
-    figures = f"{ours:.{digits}f} against {theirs:.{digits}f}"
-    if ours < factor * theirs:
-        return f"{what}: **reached** ({figures})."
-    return f"{what}: **missed**, {ours / (factor * theirs):.2f}× over the goal ({figures})."
 
-
-def dpkg_version(package: str) -> str:
-    done = subprocess.run(["dpkg-query", "-W", "-f=${Version}", package], capture_output=True, text=True, check=False)
-    return done.stdout.strip() or "unknown"
-
-
-def cpu() -> str:
-    for line in open("/proc/cpuinfo"):
-        if line.startswith("model name"):
-            return line.split(":", 1)[1].strip()
-    return "unknown CPU"
 
 
 if __name__ == "__main__":
