@@ -249,6 +249,10 @@ fn envelope(samples: &[(i64, u64)], first: i64, out: &mut [u64], hull: &mut Vec<
 /// The squared distance from each voxel of `window` to the nearest `true` voxel of the source `src`
 /// (its dense mask), row-major, [`FAR`] where the source has none.
 fn edt<const K: usize>(src: &Bx<K>, mask: &[bool], window: &Bx<K>) -> Vec<u64> {
+    if mask.is_empty() {
+        // A source box of no voxel (a side of 0): nothing to measure to.
+        return vec![FAR; window.dims.iter().map(|&d| d as usize).product()];
+    }
     let mut cur: Vec<u64> = mask.iter().map(|&m| if m { 0 } else { FAR }).collect();
     let mut dims = src.dims;
     let (mut samples, mut line, mut hull) = (Vec::new(), Vec::new(), Vec::new());
