@@ -73,6 +73,16 @@ pub fn run_child_of(exe: &std::path::Path, area: &str, case: &str) -> Result<Mea
     Ok(m)
 }
 
+/// Timed runs in one process: `REPEATS` from the environment (the experiments' scripts set 1 and
+/// interleave processes instead), 3 by default.
+pub fn repeats() -> usize {
+    std::env::var("REPEATS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .filter(|&r| r > 0)
+        .unwrap_or(3)
+}
+
 /// Best wall time of `repeats` runs of `work` (each run's result is passed to `keep` to stay observable).
 pub fn best_of<T>(repeats: usize, mut work: impl FnMut() -> T, mut keep: impl FnMut(T)) -> f64 {
     let mut best = f64::INFINITY;

@@ -11,7 +11,7 @@ use std::path::Path;
 use ktree::query::{self, RayCast};
 use ktree::KTree;
 
-use crate::measure::{best_of, machine_line, results_path, run_child, Measured};
+use crate::measure::{best_of, machine_line, repeats, results_path, run_child, Measured};
 
 const LEVEL: u32 = 10;
 const POINTS: usize = 10_000_000;
@@ -136,16 +136,6 @@ fn random_rays(level: u32, n: usize, rng: &mut Rng) -> Vec<RayCast<3>> {
             RayCast::new(origin, direction, f64::INFINITY).expect("finite")
         })
         .collect()
-}
-
-/// Timed runs in one process: `REPEATS` from the environment (`experiments/queries.sh` sets 1 and
-/// interleaves processes instead), 3 by default.
-fn repeats() -> usize {
-    std::env::var("REPEATS")
-        .ok()
-        .and_then(|r| r.parse().ok())
-        .filter(|&r| r > 0)
-        .unwrap_or(3)
 }
 
 /// Runs `work` on a pool of one thread, or on the global pool.

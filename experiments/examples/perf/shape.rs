@@ -20,17 +20,7 @@ use std::path::Path;
 use ktree::shape::Element;
 use ktree::KTree;
 
-use crate::measure::best_of;
-
-/// Timed runs in one process: `REPEATS` from the environment (`experiments/shape.sh` sets 1 and
-/// interleaves processes instead), 3 by default.
-fn repeats() -> usize {
-    std::env::var("REPEATS")
-        .ok()
-        .and_then(|r| r.parse().ok())
-        .filter(|&r| r > 0)
-        .unwrap_or(3)
-}
+use crate::measure::{best_of, repeats};
 
 /// Resident memory now (VmRSS), in bytes.
 fn rss_bytes() -> u64 {
