@@ -971,7 +971,42 @@ fn read_pcd(bytes: &[u8]) -> Result<Vec<[f64; 3]>, String> {
 // ---------------------------------------------------------------------------------------------------------
 // LAS and LAZ.
 
+/// Checks the length of a LAS 1.4 file's first extended variable-length record against the file before the
+/// `las` crate reads it: that reader allocates the length the record declares (64 bits, so a few bytes
+/// could ask for petabytes). The header gives the record's offset (`start_of_first_evlr`, a `u64` at byte
+/// 235) and count (a `u32` at byte 243); the record's length is a `u64` 20 bytes into its 60-byte header.
+fn check_las_evlr(bytes: &[u8]) -> Result<(), String> {
+    let u64_at = |at: usize| -> Option<u64> {
+        let b = bytes.get(at..at.checked_add(8)?)?;
+        Some(u64::from_le_bytes(b.try_into().ok()?))
+    };
+    if bytes.get(24..26) != Some(&[1, 4][..]) {
+        return Ok(()); // only version 1.4 has extended records
+    }
+    let (Some(start), Some(count)) = (u64_at(235), bytes.get(243..247)) else {
+        return Ok(()); // a short header: the reader reports it
+    };
+    if start == 0 || count == [0; 4] {
+        return Ok(());
+    }
+    let Some(length) = usize::try_from(start)
+        .ok()
+        .and_then(|start| u64_at(start.checked_add(20)?))
+    else {
+        return Ok(()); // the record's header is past the end: the reader reports it
+    };
+    let room = (bytes.len() as u64).saturating_sub(start.saturating_add(60));
+    if length > room {
+        return Err(format!(
+            "byte {start}: LAS: the extended variable-length record there declares {length} bytes of data, \
+             but the file has {room} bytes after its header"
+        ));
+    }
+    Ok(())
+}
+
 fn read_las(bytes: &[u8]) -> Result<Vec<[f64; 3]>, String> {
+    check_las_evlr(bytes)?;
     // The reader needs an owned input.
     let mut reader = las::Reader::new(std::io::Cursor::new(bytes.to_vec()))
         .map_err(|e| format!("LAS header: {e}"))?;

@@ -150,6 +150,35 @@ fn las(points: &[[f64; 3]], compressed: bool) -> Vec<u8> {
     w.into_inner().unwrap().into_inner()
 }
 
+/// LAS 1.4 (the version with extended records) of `points`, uncompressed, with `extended` as its
+/// extended records' data.
+fn las_1_4(points: &[[f64; 3]], extended: &[Vec<u8>]) -> Vec<u8> {
+    let mut b = las::Builder::from((1, 4));
+    b.point_format = las::point::Format::new(6).unwrap();
+    b.evlrs = extended
+        .iter()
+        .map(|data| las::Vlr {
+            user_id: "ktree".into(),
+            record_id: 1,
+            description: "test".into(),
+            data: data.clone(),
+        })
+        .collect();
+    let mut w =
+        las::Writer::new(std::io::Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
+    for p in points {
+        w.write_point(las::Point {
+            x: p[0],
+            y: p[1],
+            z: p[2],
+            gps_time: Some(0.0),
+            ..Default::default()
+        })
+        .unwrap();
+    }
+    w.into_inner().unwrap().into_inner()
+}
+
 /// Every format: (extension, bytes).
 fn all_formats(points: &[[f64; 3]]) -> Vec<(&'static str, Vec<u8>)> {
     vec![
@@ -273,7 +302,17 @@ fn malformed_files_name_the_line_or_byte() {
     nan_ply_binary[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
     let mut huge_las = las(&p, false);
     huge_las[107..111].copy_from_slice(&u32::MAX.to_le_bytes()); // legacy point count
+                                                                 // A LAS 1.4 file whose one extended record declares 2^54 bytes of data.
+    let mut huge_evlr = las_1_4(&p, &[]);
+    let start = huge_evlr.len() as u64;
+    huge_evlr[235..243].copy_from_slice(&start.to_le_bytes());
+    huge_evlr[243..247].copy_from_slice(&1u32.to_le_bytes());
+    let mut record = vec![0u8; 60];
+    record[20..28].copy_from_slice(&(1u64 << 54).to_le_bytes());
+    huge_evlr.extend_from_slice(&record);
+    let huge_evlr_error = format!("byte {start}: LAS: the extended variable-length record there declares 18014398509481984 bytes");
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("las", huge_evlr, &huge_evlr_error),
         ("xyz", b"1 2 3\n4 five 6\n".to_vec(), "line 2: 'five' is not a number"),
         ("xyz", b"x y z\n1 2 3\n".to_vec(), "line 1: 'x' is not a number"),
         ("xyz", b"1 2 3\n\n1 2\n".to_vec(), "line 3: expected 3 numbers"),
@@ -335,6 +374,25 @@ fn malformed_files_name_the_line_or_byte() {
         assert!(e.contains(&format!("bad{i}.{ext}")), "{e}");
         assert!(e.contains(want), "case {i}: {e} (wanted: {want})");
         assert!(!e.contains('\n'), "{e}");
+    }
+}
+
+#[test]
+fn las_1_4_with_extended_records_reads() {
+    let p = [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]];
+    for extended in [
+        vec![],
+        vec![vec![7u8; 100]],
+        vec![vec![1u8; 3], vec![2u8; 70_000]],
+    ] {
+        let bytes = las_1_4(&p, &extended);
+        let cloud = PointCloud::from_bytes(&bytes, "las", Path::new("x.las")).unwrap();
+        assert_eq!(
+            cloud.points(),
+            &p[..],
+            "{} extended records",
+            extended.len()
+        );
     }
 }
 
