@@ -29,13 +29,15 @@
 //! Coordinates are in voxels (the universe's corner at 0); [`SurfaceMesh::placed`] maps them to world
 //! units.
 //!
-//! **Work:** no face query, and no hash map but for the rare midpoints. The walk above visits each leaf a bounded number of times; the
-//! squares are sorted by plane; the rectangles' corners are sorted once by their Morton key into distinct
-//! lattice points (a vertex is a point and a link part, so its index sits in a small table per point); each
-//! point's eight voxels are read with one descent from the deepest ancestor shared with the previous
-//! point's; and the corners inside a rectangle's edge are the points between its two ends in the points'
-//! order along that edge's lines (one sort per axis). `O(n log n)` in the boundary squares; time and peak
-//! memory against OpenVDB's `volumeToMesh` in `results/performance/export.md`.
+//! **Work:** no face query, and no hash map but for the rare midpoints. The walk above visits each leaf a
+//! bounded number of times; the squares are radix-sorted by plane; the rectangles' corners are radix-sorted
+//! once by their Morton key into distinct lattice points, and everything the mesh needs of a corner is then
+//! worked out point by point in that order and written at the corner's place, so the final pass over the
+//! rectangles reads memory in order. Each point's eight voxels are read with one descent from the deepest
+//! ancestor shared with the previous point's; a vertex is a point and a link part, numbered point by point;
+//! and the corners inside a rectangle's edge are the points between its two ends in the points' order
+//! along that edge's lines (one radix sort per axis). Time and peak memory against OpenVDB's
+//! `volumeToMesh` in `results/performance/export.md`.
 //!
 //! ```
 //! use ktree::export::surface::boundary_mesh;
@@ -47,6 +49,7 @@
 //! assert_eq!(mesh.volume(), 8.0);
 //! ```
 
+use crate::radix;
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
@@ -268,13 +271,15 @@ fn fill(
         NodeState::Partial => {
             let first = tree.first_child(depth, index);
             let bit = log_side - 1;
-            // The child code of each octant's voxel `p − 1 + o`.
-            let code = |o: u8| {
-                (0..3).fold(0usize, |code, a| {
-                    let v = p[a] + u32::from(o >> a & 1) - 1;
-                    code | ((v >> bit & 1) as usize) << a
-                })
-            };
+            // The child code of the voxels below `p` on every axis (octant 0) and above (octant 7); octant
+            // `o` takes each axis's bit from the one or the other.
+            let child_code =
+                |x: [u32; 3]| (0..3).fold(0u8, |code, a| code | ((x[a] >> bit & 1) as u8) << a);
+            let below = child_code(p.map(|x| x.wrapping_sub(1)));
+            let above = child_code(p);
+            let code = |o: u8| below ^ ((below ^ above) & o);
+            // The eight children's states, read at once.
+            let states = tree.level_states(depth + 1).block_codes(first, 3);
             let mut left = octants;
             while left != 0 {
                 let c = code(left.trailing_zeros() as u8);
@@ -282,8 +287,19 @@ fn fill(
                     .filter(|&o| left >> o & 1 == 1 && code(o) == c)
                     .fold(0u8, |set, o| set | 1 << o);
                 left &= !same;
-                let child = (depth + 1, first + c, tree.state(depth + 1, first + c));
-                fill(tree, child, bit, p, same, m);
+                let c = usize::from(c);
+                match NodeState::from_bits(states >> (2 * c)) {
+                    NodeState::Full => *m |= same,
+                    NodeState::Empty => {}
+                    NodeState::Partial => fill(
+                        tree,
+                        (depth + 1, first + c, NodeState::Partial),
+                        bit,
+                        p,
+                        same,
+                        m,
+                    ),
+                }
             }
         }
     }
@@ -332,26 +348,52 @@ fn plane_key(a: usize, coord: u32, upper: bool) -> u64 {
 #[derive(Debug, Clone, Copy)]
 struct Node {
     depth: usize,
-    index: usize,
+    /// The index of its first child, for a partial node (0 for a leaf).
+    first: usize,
     state: NodeState,
     origin: [u32; 3],
     log_side: u32,
 }
 
 impl Node {
-    /// The eight children of a partial node, by child code.
-    fn children(&self, tree: &KTree<3>) -> [Node; 8] {
-        let first = tree.first_child(self.depth, self.index);
-        std::array::from_fn(|code| self.child(tree, first, code))
+    /// The root of `tree`.
+    fn root(tree: &KTree<3>) -> Node {
+        let state = tree.root_state();
+        Node {
+            depth: 0,
+            first: match state {
+                NodeState::Partial => tree.first_child(0, 0),
+                _ => 0,
+            },
+            state,
+            origin: [0; 3],
+            log_side: tree.level(),
+        }
     }
 
-    /// The child `code` of a partial node whose first child is `first`.
-    fn child(&self, tree: &KTree<3>, first: usize, code: usize) -> Node {
+    /// The eight children of a partial node, by child code.
+    fn children(&self, tree: &KTree<3>) -> [Node; 8] {
+        let states = self.child_states(tree);
+        std::array::from_fn(|code| self.child(tree, states, code))
+    }
+
+    /// The states of a partial node's children, child `c` at bits `2c`.
+    fn child_states(&self, tree: &KTree<3>) -> u32 {
+        tree.level_states(self.depth + 1).block_codes(self.first, 3)
+    }
+
+    /// The child `code` of a partial node whose children's states are `states`.
+    fn child(&self, tree: &KTree<3>, states: u32, code: usize) -> Node {
         let half = 1u32 << (self.log_side - 1);
+        let (depth, index) = (self.depth + 1, self.first + code);
+        let state = NodeState::from_bits(states >> (2 * code));
         Node {
-            depth: self.depth + 1,
-            index: first + code,
-            state: tree.state(self.depth + 1, first + code),
+            depth,
+            first: match state {
+                NodeState::Partial => tree.first_child(depth, index),
+                _ => 0,
+            },
+            state,
             origin: std::array::from_fn(|a| self.origin[a] + (code as u32 >> a & 1) * half),
             log_side: self.log_side - 1,
         }
@@ -366,19 +408,20 @@ impl Node {
 /// bounds the object by the face of the smaller.
 fn boundary_squares(tree: &KTree<3>) -> Vec<(u64, u32, u32, u32)> {
     let mut squares = Vec::new();
-    let root = Node {
-        depth: 0,
-        index: 0,
-        state: tree.root_state(),
-        origin: [0; 3],
-        log_side: tree.level(),
-    };
+    let root = Node::root(tree);
     for a in 0..3 {
         across(tree, None, Some(root), a, &mut squares);
         across(tree, Some(root), None, a, &mut squares);
     }
     within(tree, &root, &mut squares);
-    squares.sort_unstable();
+    // In the order of the tuples (the side never decides: the squares of a plane are disjoint).
+    let level = tree.level();
+    let key = |&(plane, c, b, _): &(u64, u32, u32, u32)| {
+        // The plane's axis (2 bits), coordinate (L + 1 bits) and orientation, then c and b (L bits each).
+        let compact = (plane >> 33) << (level + 2) | (plane & 0x1_ffff_ffff);
+        u128::from(compact) << (2 * level) | u128::from(c) << level | u128::from(b)
+    };
+    radix::sort_by_wide_key(&mut squares, 3 * level + 4, &mut Vec::new(), key);
     squares
 }
 
@@ -420,10 +463,10 @@ fn across(
         let side = |n: Option<Node>, upper: usize| -> [Option<Node>; 4] {
             match n {
                 Some(node) if node.state == NodeState::Partial => {
-                    let first = tree.first_child(node.depth, node.index);
                     let (b, c) = others(a);
+                    let states = node.child_states(tree);
                     std::array::from_fn(|q| {
-                        Some(node.child(tree, first, upper << a | (q & 1) << b | (q >> 1) << c))
+                        Some(node.child(tree, states, upper << a | (q & 1) << b | (q >> 1) << c))
                     })
                 }
                 other => [other; 4],
@@ -467,31 +510,42 @@ fn across(
 /// Disjoint squares `(b, c, side)`, sorted by `(c, b)`, merged into rectangles `[b0, b1, c0, c1]` covering
 /// the same region, appended to `out` sorted by `(c0, b0)`: strips across `c` between consecutive square
 /// edges, maximal intervals along `b` in each strip, an interval carried on through the following strips
-/// while it is the same.
+/// while it is the same. The squares across a strip are kept in `b` order (those carried on from the
+/// strip below merged with those starting), so no strip is sorted.
 fn merge_rectangles(squares: &[[u32; 3]], out: &mut Vec<[u32; 4]>) {
     debug_assert!(squares
         .windows(2)
         .all(|w| (w[0][1], w[0][0]) < (w[1][1], w[1][0])));
-    let mut cuts: Vec<u32> = squares.iter().flat_map(|s| [s[1], s[1] + s[2]]).collect();
-    cuts.sort_unstable();
-    cuts.dedup();
     let first = out.len();
-    // Open rectangles `(b0, b1, c0)`, sorted by interval; the strip's intervals; the squares across it.
-    let (mut open, mut still) = (Vec::<(u32, u32, u32)>::new(), Vec::new());
-    let (mut active, mut spans, mut intervals) = (Vec::<[u32; 3]>::new(), Vec::new(), Vec::new());
+    // The squares across the strip, by b; open rectangles `(b0, b1, c0)`, by interval; the strip's intervals.
+    let (mut active, mut carried) = (Vec::<[u32; 3]>::new(), Vec::new());
+    let (mut open, mut still, mut intervals) =
+        (Vec::<(u32, u32, u32)>::new(), Vec::new(), Vec::new());
     let mut next = 0;
-    for w in cuts.windows(2) {
-        let c = w[0];
-        active.retain(|s| s[1] + s[2] > c);
+    let Some(mut c) = squares.first().map(|s| s[1]) else {
+        return;
+    };
+    loop {
+        let start = next;
         while next < squares.len() && squares[next][1] == c {
-            active.push(squares[next]);
             next += 1;
         }
-        spans.clear();
-        spans.extend(active.iter().map(|s| (s[0], s[0] + s[2])));
-        spans.sort_unstable();
+        carried.clear();
+        carried.extend(active.iter().copied().filter(|s| s[1] + s[2] > c));
+        active.clear();
+        let (mut i, mut j) = (0, start);
+        while i < carried.len() || j < next {
+            if j == next || (i < carried.len() && carried[i][0] < squares[j][0]) {
+                active.push(carried[i]);
+                i += 1;
+            } else {
+                active.push(squares[j]);
+                j += 1;
+            }
+        }
         intervals.clear();
-        for &(b0, b1) in &spans {
+        for s in &active {
+            let (b0, b1) = (s[0], s[0] + s[2]);
             match intervals.last_mut() {
                 Some((_, end)) if *end == b0 => *end = b1,
                 _ => intervals.push((b0, b1)),
@@ -517,10 +571,14 @@ fn merge_rectangles(squares: &[[u32; 3]], out: &mut Vec<[u32; 4]>) {
             out.push([x0, x1, c0, c]);
         }
         std::mem::swap(&mut open, &mut still);
-    }
-    let last = cuts.last().copied().unwrap_or(0);
-    for (b0, b1, c0) in open {
-        out.push([b0, b1, c0, last]);
+        // The next strip starts where a square across this one ends or the next square begins.
+        let ends = active.iter().map(|s| s[1] + s[2]).min();
+        c = match (ends, squares.get(next)) {
+            (Some(e), Some(s)) => e.min(s[1]),
+            (Some(e), None) => e,
+            (None, Some(s)) => s[1],
+            (None, None) => break,
+        };
     }
     out[first..].sort_unstable_by_key(|r| (r[2], r[0]));
 }
@@ -566,14 +624,19 @@ impl Rect {
     /// The corners counter-clockwise in `(b, c)`, each with the quadrant the rectangle covers there.
     fn corners(&self) -> [([u32; 3], usize); 4] {
         let [b0, b1, c0, c1] = self.r;
+        let q = CORNER_QUADRANTS;
         [
-            (self.point(b0, c0), 0b11),
-            (self.point(b1, c0), 0b10),
-            (self.point(b1, c1), 0b00),
-            (self.point(b0, c1), 0b01),
+            (self.point(b0, c0), q[0]),
+            (self.point(b1, c0), q[1]),
+            (self.point(b1, c1), q[2]),
+            (self.point(b0, c1), q[3]),
         ]
     }
 }
+
+/// The quadrant a rectangle covers at each of its corners, counter-clockwise from `(b0, c0)` (see
+/// [`Rect::corners`]).
+const CORNER_QUADRANTS: [usize; 4] = [0b11, 0b10, 0b00, 0b01];
 
 /// A lattice point at rectangles' corners, and what is known of it.
 #[derive(Debug, Clone, Copy)]
@@ -584,120 +647,154 @@ struct Point {
     /// For each direction `d`, the link parts (bit set) of the corners here whose rectangle has an edge
     /// along `d`.
     on_lines: [u8; 3],
-    /// The vertex of each link part, once made (`u32::MAX` before).
-    ids: [u32; 4],
+    /// The vertex of the point's first link part at a corner; the others follow in order of part.
+    first_vertex: u32,
     /// The point's place in each of [`Corners::order`].
     position: [u32; 3],
 }
 
-/// The lattice points at the rectangles' corners.
+impl Point {
+    /// The vertex of link part `part` (a part of some corner at the point).
+    fn vertex(&self, part: u8) -> u32 {
+        let parts = self.on_lines[0] | self.on_lines[1] | self.on_lines[2];
+        debug_assert!(parts >> part & 1 == 1);
+        self.first_vertex + (parts & ((1u8 << part) - 1)).count_ones()
+    }
+}
+
+/// The lattice points at the rectangles' corners, and the vertices made at them.
 struct Corners {
     /// The points, in Morton order.
     points: Vec<Point>,
-    /// The point of corner `k` of rectangle `r`, at `4r + k`.
-    of_corner: Vec<u32>,
     /// For each lattice direction `d`, the points ordered line by line along `d` (sorted by their other two
     /// coordinates, then along `d`).
     order: [Vec<u32>; 3],
-    /// The rectangles in the Morton order of their first corner.
-    rects: Vec<u32>,
+    /// What the mesh needs of corner `k` of rectangle `r`, at `4r + k`.
+    corners: Vec<Corner>,
+    /// The vertex of each point and corner link part: the points' in Morton order, each point's by part.
+    vertices: Vec<[f64; 3]>,
+}
+
+/// A rectangle's corner: its point's vertex (of the corner's link part) and occupancy, and the point's
+/// places in the orders along the rectangle's axes `b` and `c`.
+#[derive(Debug, Clone, Copy, Default)]
+struct Corner {
+    vertex: u32,
+    positions: [u32; 2],
+    mask: u8,
 }
 
 impl Corners {
     fn new(tree: &KTree<3>, rects: &[Rect]) -> Self {
         let corner_count = u32::try_from(4 * rects.len())
             .expect("fewer than 2^32 rectangle corners (vertex indices are 32-bit)");
-        let mut keyed: Vec<u128> = Vec::with_capacity(corner_count as usize);
+        // Lattice coordinates run from 0 to 2^L: L + 1 bits each.
+        let bits = 3 * (tree.level() + 1);
+        // Each corner as the Morton key of its point (low 64 bits, high bits), its slot `4r + k` and its
+        // rectangle's axis, so that the loops below, in Morton order, read no rectangle (they would come in
+        // random order) and write each corner's facts at its slot.
+        let mut keyed: Vec<(u64, u32, u8, u8)> = Vec::with_capacity(corner_count as usize);
         for (r, rect) in rects.iter().enumerate() {
             for (k, (p, _)) in rect.corners().into_iter().enumerate() {
-                keyed.push(morton(p) << 32 | (4 * r + k) as u128);
+                let key = morton(p);
+                keyed.push((
+                    key as u64,
+                    (4 * r + k) as u32,
+                    (key >> 64) as u8,
+                    rect.a as u8,
+                ));
             }
         }
-        keyed.sort_unstable();
+        radix::sort_by_wide_key(&mut keyed, bits, &mut Vec::new(), |&(low, _, high, _)| {
+            u128::from(high) << 64 | u128::from(low)
+        });
+        let same_point = |x: &(u64, u32, u8, u8), y: &(u64, u32, u8, u8)| (x.0, x.2) == (y.0, y.2);
+        // The link part of each corner at a point of occupancy `mask`.
+        let part = |mask: u8, &(_, slot, _, a): &(u64, u32, u8, u8)| {
+            part_of(mask, usize::from(a), CORNER_QUADRANTS[slot as usize % 4])
+        };
         let mut locator = Locator::new(tree);
         let mut points: Vec<Point> = Vec::new();
-        let mut of_corner = vec![0u32; keyed.len()];
-        let mut first_corners = Vec::with_capacity(rects.len());
-        let mut last = u128::MAX;
-        for k in keyed {
-            let slot = k as u32 as usize;
-            if k >> 32 != last {
-                last = k >> 32;
-                let at = point_of(last);
-                points.push(Point {
-                    at,
-                    mask: occupancy(tree, &mut locator, at),
-                    on_lines: [0; 3],
-                    ids: [u32::MAX; 4],
-                    position: [0; 3],
-                });
+        let mut corners = vec![Corner::default(); keyed.len()];
+        let mut vertices = Vec::new();
+        for group in keyed.chunk_by(same_point) {
+            let (low, _, high, _) = group[0];
+            let at = point_of(u128::from(high) << 64 | u128::from(low));
+            let mask = occupancy(tree, &mut locator, at);
+            // The lines along the corners' rectangles' edges through the point, by link part.
+            let mut on_lines = [0u8; 3];
+            for corner in group {
+                let (b, c) = others(usize::from(corner.3));
+                let bit = 1 << part(mask, corner);
+                on_lines[b] |= bit;
+                on_lines[c] |= bit;
             }
-            of_corner[slot] = (points.len() - 1) as u32;
-            if slot.is_multiple_of(4) {
-                first_corners.push((slot / 4) as u32);
+            let point = Point {
+                at,
+                mask,
+                on_lines,
+                first_vertex: u32::try_from(vertices.len())
+                    .expect("fewer than 2^32 vertices (indices are 32-bit)"),
+                position: [0; 3],
+            };
+            let parts = on_lines[0] | on_lines[1] | on_lines[2];
+            vertices.extend(std::iter::repeat_n(
+                at.map(f64::from),
+                parts.count_ones() as usize,
+            ));
+            for corner in group {
+                corners[corner.1 as usize] = Corner {
+                    vertex: point.vertex(part(mask, corner)),
+                    positions: [0; 2],
+                    mask,
+                };
             }
+            points.push(point);
         }
+        let (mut lines, mut scratch) = (Vec::with_capacity(points.len()), Vec::new());
         let order: [Vec<u32>; 3] = std::array::from_fn(|d| {
             let (x, y) = match d {
                 0 => (1, 2),
                 1 => (0, 2),
                 _ => (0, 1),
             };
-            let mut keyed: Vec<u128> = points
-                .iter()
-                .enumerate()
-                .map(|(i, p)| {
-                    let (px, py, pd) = (p.at[x], p.at[y], p.at[d]);
-                    u128::from(px) << 96 | u128::from(py) << 64 | u128::from(pd) << 32 | i as u128
-                })
-                .collect();
-            keyed.sort_unstable();
-            keyed.into_iter().map(|k| k as u32).collect()
+            lines.clear();
+            lines.extend(
+                points
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| ([p.at[x], p.at[y], p.at[d]], i as u32)),
+            );
+            let width = bits / 3;
+            radix::sort_by_wide_key(&mut lines, bits, &mut scratch, |&(at, _)| {
+                u128::from(at[0]) << (2 * width) | u128::from(at[1]) << width | u128::from(at[2])
+            });
+            lines.iter().map(|&(_, i)| i).collect()
         });
         for (d, order) in order.iter().enumerate() {
             for (j, &i) in order.iter().enumerate() {
                 points[i as usize].position[d] = j as u32;
             }
         }
-        for &r in &first_corners {
-            let r = r as usize;
-            let rect = &rects[r];
-            let (b, c) = others(rect.a);
-            for (k, (_, q)) in rect.corners().into_iter().enumerate() {
-                let point = &mut points[of_corner[4 * r + k] as usize];
-                let part = part_of(point, rect.a, q);
-                point.on_lines[b] |= 1 << part;
-                point.on_lines[c] |= 1 << part;
+        for (group, point) in keyed.chunk_by(same_point).zip(&points) {
+            for &(_, slot, _, a) in group {
+                let (b, c) = others(usize::from(a));
+                corners[slot as usize].positions = [point.position[b], point.position[c]];
             }
         }
         Self {
             points,
-            of_corner,
             order,
-            rects: first_corners,
+            corners,
+            vertices,
         }
-    }
-
-    /// The vertex of `part` at point `i`, made when first asked for.
-    fn vertex(&mut self, mesh: &mut SurfaceMesh, i: usize, part: u8) -> u32 {
-        let point = &mut self.points[i];
-        let id = &mut point.ids[part as usize];
-        if *id == u32::MAX {
-            mesh.vertices.push(point.at.map(f64::from));
-            *id = (mesh.vertices.len() - 1) as u32;
-        }
-        *id
     }
 }
 
-/// The link part at `point` of the unit face `(a, q)`, which must be a boundary face.
-fn part_of(point: &Point, a: usize, q: usize) -> u8 {
-    let part = link_parts()[point.mask as usize][face_index(a, q)];
-    debug_assert!(
-        part < 4,
-        "a rectangle at {:?} on a non-boundary face",
-        point.at
-    );
+/// The link part, at a point of occupancy `mask`, of the unit face `(a, q)`, which must be a boundary face.
+fn part_of(mask: u8, a: usize, q: usize) -> u8 {
+    let part = link_parts()[mask as usize][face_index(a, q)];
+    debug_assert!(part < 4, "a rectangle on a non-boundary face");
     part
 }
 
@@ -789,24 +886,29 @@ pub const SMOOTH_FACE_LIMIT: u64 = 1 << 26;
 
 /// The mesh of boundary rectangles `rects` (see [`boundary_mesh`]).
 fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {
-    let mut corners = Corners::new(tree, rects);
-    let mut mesh = SurfaceMesh::default();
+    let Corners {
+        points,
+        order,
+        corners,
+        vertices,
+    } = Corners::new(tree, rects);
+    // The corners' vertices, then a centre for some rectangles; two triangles a rectangle at least.
+    let mut mesh = SurfaceMesh {
+        vertices,
+        triangles: Vec::with_capacity(2 * rects.len() + rects.len() / 4),
+    };
     // Midpoints of segments where two solids touch, by doubled position and the full octant bounded.
     let mut midpoints: HashMap<([u64; 3], u8), u32> = HashMap::new();
     let mut ring: Vec<u32> = Vec::new();
     let mut stops: Vec<(usize, u8)> = Vec::new();
-    for j in 0..corners.rects.len() {
-        let r = corners.rects[j] as usize;
-        let rect = &rects[r];
+    for (rect, corner) in rects.iter().zip(corners.chunks_exact(4)) {
         let (b, c) = others(rect.a);
         let rect_corners = rect.corners();
-        let at: [usize; 4] = std::array::from_fn(|k| corners.of_corner[4 * r + k] as usize);
         ring.clear();
         for k in 0..4 {
-            let (p, q) = rect_corners[k];
-            let (from, to) = (at[k], at[(k + 1) % 4]);
-            let part = part_of(&corners.points[from], rect.a, q);
-            ring.push(corners.vertex(&mut mesh, from, part));
+            let (p, _) = rect_corners[k];
+            let next = (k + 1) % 4;
+            ring.push(corner[k].vertex);
             // The edge from p to the next corner: along b for k = 0, 2, along c for k = 1, 3.
             let (d, e) = if k % 2 == 0 { (b, c) } else { (c, b) };
             // The rectangle's side of the line along e, as the quadrant bit for e.
@@ -825,12 +927,9 @@ fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {
             let face = face_index(rect.a, quadrant(1));
             // The corners strictly inside the edge, on the same sheet as the rectangle there.
             stops.clear();
-            let (j0, j1) = (
-                corners.points[from].position[d],
-                corners.points[to].position[d],
-            );
-            for &i in &corners.order[d][(j0.min(j1) + 1) as usize..j0.max(j1) as usize] {
-                let point = &corners.points[i as usize];
+            let (j0, j1) = (corner[k].positions[k % 2], corner[next].positions[k % 2]);
+            for &i in &order[d][(j0.min(j1) + 1) as usize..j0.max(j1) as usize] {
+                let point = &points[i as usize];
                 let part = link_parts()[point.mask as usize][face];
                 debug_assert!(part < 4, "a rectangle's edge past a non-boundary face");
                 if part < 8 && point.on_lines[d] >> part & 1 == 1 {
@@ -843,23 +942,32 @@ fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {
             // The full octant the rectangle bounds, as bits on the axes across the line.
             let full_side = usize::from(!rect.upper);
             let octant = (full_side << rect.a | e_side << e) as u8;
-            let mut prev = from;
-            for (i, part) in stops.iter().copied().chain(std::iter::once((to, u8::MAX))) {
-                let (u, w) = (&corners.points[prev], &corners.points[i]);
-                let lower = if u.at[d] < w.at[d] { u } else { w };
-                if pinched(lower.mask, d) {
+            // Along the edge: each stop, then the next corner, as (coordinate along d, occupancy, vertex).
+            let ends = stops
+                .iter()
+                .map(|&(i, part)| {
+                    let point = &points[i];
+                    (point.at[d], point.mask, Some(point.vertex(part)))
+                })
+                .chain(std::iter::once((
+                    rect_corners[next].0[d],
+                    corner[next].mask,
+                    None,
+                )));
+            let mut prev = (p[d], corner[k].mask);
+            for (at, mask, vertex) in ends {
+                let lower = if prev.0 < at { prev.1 } else { mask };
+                if pinched(lower, d) {
                     let mut m = p.map(|x| 2 * u64::from(x));
-                    m[d] = u64::from(u.at[d]) + u64::from(w.at[d]);
+                    m[d] = u64::from(prev.0) + u64::from(at);
                     let id = *midpoints.entry((m, 16 + octant)).or_insert_with(|| {
                         mesh.vertices.push(m.map(|x| x as f64 / 2.0));
                         (mesh.vertices.len() - 1) as u32
                     });
                     ring.push(id);
                 }
-                if part != u8::MAX {
-                    ring.push(corners.vertex(&mut mesh, i, part));
-                }
-                prev = i;
+                ring.extend(vertex);
+                prev = (at, mask);
             }
         }
         if !rect.upper {
