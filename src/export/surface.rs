@@ -745,12 +745,14 @@ impl Corners {
             for corner in group {
                 corners[corner.1 as usize] = Corner {
                     vertex: point.vertex(part(mask, corner)),
-                    positions: [0; 2],
+                    // The point, until its places are known.
+                    positions: [points.len() as u32, 0],
                     mask,
                 };
             }
             points.push(point);
         }
+        drop(keyed);
         let (mut lines, mut scratch) = (Vec::with_capacity(points.len()), Vec::new());
         let order: [Vec<u32>; 3] = std::array::from_fn(|d| {
             let (x, y) = match d {
@@ -776,10 +778,11 @@ impl Corners {
                 points[i as usize].position[d] = j as u32;
             }
         }
-        for (group, point) in keyed.chunk_by(same_point).zip(&points) {
-            for &(_, slot, _, a) in group {
-                let (b, c) = others(usize::from(a));
-                corners[slot as usize].positions = [point.position[b], point.position[c]];
+        for (rect, corners) in rects.iter().zip(corners.chunks_exact_mut(4)) {
+            let (b, c) = others(rect.a);
+            for corner in corners {
+                let point = &points[corner.positions[0] as usize];
+                corner.positions = [point.position[b], point.position[c]];
             }
         }
         Self {
