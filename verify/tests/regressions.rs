@@ -162,3 +162,17 @@ fn a_vdb_with_unaligned_tiles_stops_at_the_node_bound() {
         "{e}"
     );
 }
+
+#[test]
+fn a_las_extended_record_longer_than_the_file_is_an_error() {
+    // LAS 1.4, 399 bytes, whose extended variable-length record declares 2^54 bytes of data: the `las`
+    // crate allocated them before reading.
+    let file = include_bytes!("../../fuzz/corpus/cloud_las/evlr_of_2_54_bytes.las");
+    let e = ktree::solid::cloud::PointCloud::from_bytes(file, "las", Path::new("evlr.las"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("evlr.las") && e.contains("LAS: the extended variable-length record there declares"),
+        "{e}"
+    );
+}
