@@ -136,18 +136,7 @@ fn las(points: &[[f64; 3]], compressed: bool) -> Vec<u8> {
     };
     b.transforms = las::Vector { x: t, y: t, z: t };
     b.point_format.is_compressed = compressed;
-    let mut w =
-        las::Writer::new(std::io::Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
-    for p in points {
-        w.write_point(las::Point {
-            x: p[0],
-            y: p[1],
-            z: p[2],
-            ..Default::default()
-        })
-        .unwrap();
-    }
-    w.into_inner().unwrap().into_inner()
+    write_las(b, points)
 }
 
 /// LAS 1.4 (the version with extended records) of `points`, uncompressed, with `extended` as its
@@ -164,6 +153,12 @@ fn las_1_4(points: &[[f64; 3]], extended: &[Vec<u8>]) -> Vec<u8> {
             data: data.clone(),
         })
         .collect();
+    write_las(b, points)
+}
+
+/// The file `b` describes, holding `points`.
+fn write_las(b: las::Builder, points: &[[f64; 3]]) -> Vec<u8> {
+    let gps_time = b.point_format.has_gps_time.then_some(0.0);
     let mut w =
         las::Writer::new(std::io::Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
     for p in points {
@@ -171,7 +166,7 @@ fn las_1_4(points: &[[f64; 3]], extended: &[Vec<u8>]) -> Vec<u8> {
             x: p[0],
             y: p[1],
             z: p[2],
-            gps_time: Some(0.0),
+            gps_time,
             ..Default::default()
         })
         .unwrap();
