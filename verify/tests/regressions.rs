@@ -172,7 +172,8 @@ fn a_las_extended_record_longer_than_the_file_is_an_error() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("evlr.las") && e.contains("LAS: the extended variable-length record there declares"),
+        e.contains("evlr.las")
+            && e.contains("LAS: the extended variable-length record there declares"),
         "{e}"
     );
 }
