@@ -125,13 +125,6 @@ fn boxes_meet(a: &[f64; 4], b: &[f64; 4]) -> bool {
     a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3]
 }
 
-/// `b` grown on every side by a millionth of a unit more than its largest coordinate's size.
-fn widened(b: &[f64; 4]) -> [f64; 4] {
-    let size = b.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-    let e = size * 1e-6;
-    [b[0] - e, b[1] - e, b[2] + e, b[3] + e]
-}
-
 /// The visible parts of one segment given its hidden parts (exact, within the segment): the gaps of
 /// positive exact length between them.
 fn visible_parts(seg: &Piece, hidden: &mut [(Exact, Exact)], out: &mut Vec<Edge3>) {
@@ -186,20 +179,8 @@ pub(crate) fn remove_hidden(
                 hidden.push(h);
             }
         };
-        // Cubes whose screen box misses the segment's hide none of it: counted as tested, not computed.
-        // (The segment's box is widened by far more than the boxes' rounding, so no cube is missed by it.)
-        let mut missed = 0u64;
         match &grid {
-            None => {
-                let reach = widened(&bbox);
-                for (cube, cube_box) in cubes[..seg.owner as usize].iter().zip(&boxes) {
-                    if boxes_meet(cube_box, &reach) {
-                        test(cube);
-                    } else {
-                        missed += 1;
-                    }
-                }
-            }
+            None => cubes[..seg.owner as usize].iter().for_each(&mut test),
             Some(grid) => {
                 let (gx0, gy0, gx1, gy1) = grid.range(&bbox);
                 for gy in gy0..=gy1 {
@@ -220,7 +201,6 @@ pub(crate) fn remove_hidden(
                 }
             }
         }
-        tests += missed;
         visible_parts(seg, &mut hidden, &mut out);
         if i % 4096 == 4095 {
             if let Some(p) = progress.as_mut() {
