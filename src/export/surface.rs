@@ -344,6 +344,12 @@ fn plane_key(a: usize, coord: u32, upper: bool) -> u64 {
     (a as u64) << 33 | u64::from(coord) << 1 | u64::from(upper)
 }
 
+/// A [`plane_key`] packed into `level + 4` bits in the same order (the axis in 2 bits, the coordinate, at
+/// most `2^level`, in `level + 1`, the orientation in 1), for radix sorting.
+fn packed_plane_key(plane: u64, level: u32) -> u64 {
+    (plane >> 33) << (level + 2) | (plane & 0x1_ffff_ffff)
+}
+
 /// A node met by the walk of [`boundary_squares`]: where it is in the tree, its cell and state.
 #[derive(Debug, Clone, Copy)]
 struct Node {
@@ -417,9 +423,9 @@ fn boundary_squares(tree: &KTree<3>) -> Vec<(u64, u32, u32, u32)> {
     // In the order of the tuples (the side never decides: the squares of a plane are disjoint).
     let level = tree.level();
     let key = |&(plane, c, b, _): &(u64, u32, u32, u32)| {
-        // The plane's axis (2 bits), coordinate (L + 1 bits) and orientation, then c and b (L bits each).
-        let compact = (plane >> 33) << (level + 2) | (plane & 0x1_ffff_ffff);
-        u128::from(compact) << (2 * level) | u128::from(c) << level | u128::from(b)
+        // The plane (L + 4 bits), then c and b (L bits each).
+        let plane = packed_plane_key(plane, level);
+        u128::from(plane) << (2 * level) | u128::from(c) << level | u128::from(b)
     };
     radix::sort_by_wide_key(&mut squares, 3 * level + 4, &mut Vec::new(), key);
     squares
