@@ -15,7 +15,10 @@
 //! discards a block of columns when a conservative lower bound of the form over the block is positive; a column
 //! that is visited solves its quadratic in `z` exactly: a column holds zero, one or two runs. Blocks of at most
 //! 16 columns are not tested as a whole, so the columns visited are those meeting the solid plus a thin band
-//! around its projection. No voxel is tested on its own. The general version of the core's direct ball
+//! around its projection. Such a block lies in one row (the columns differing only on the last column axis),
+//! and along a row the quadratic's coefficients are polynomials of degree ≤ 2 in the column: they are stepped
+//! from column to column by exact finite differences, from three columns solved in full per row. No voxel is
+//! tested on its own. The general version of the core's direct ball
 //! generator [`crate::rays::ball_rays`], which gives the same rays for a ball.
 
 use super::{rational::gcd_i128, Rational, SolidError};
@@ -44,6 +47,10 @@ pub enum Sample {
 
 /// Largest matrix size (K + 1 for K ≤ 4).
 const N: usize = 5;
+
+/// Blocks of at most this many columns are not tested as a whole: a block in one row is solved column after
+/// column, stepping the quadratic in `z` by finite differences.
+const ROW_COLUMNS: i64 = 16;
 
 /// A quadric solid `Vᵀ Ξ V ≤ 0` with an integer symmetric `(K+1)×(K+1)` matrix Ξ.
 ///
@@ -249,6 +256,7 @@ impl<const K: usize> Quadric<K> {
             runs: Vec::new(),
             normals: normals.then(Vec::new),
             max_rays,
+            row_form: None,
         };
         if K == 1 {
             gen.column([0; K]);
@@ -273,6 +281,75 @@ impl<const K: usize> Quadric<K> {
     }
 }
 
+/// The quadratics in `z` of the columns of one row (the columns differing only on the last column axis), as
+/// polynomials in the column's coordinate `i` on that axis: `b(i)` and `c(i)` have constant second differences.
+#[derive(Debug, Clone, Copy)]
+struct RowForm<const K: usize> {
+    /// The row's column with coordinate 0 on the last column axis.
+    fixed: [i64; K],
+    /// At `i = 0`.
+    first: Quad,
+    /// `q(1) − q(0)` of `b` and `c`.
+    delta: (i128, i128),
+    /// The second differences of `b` and `c`.
+    second: (i128, i128),
+}
+
+/// A column's quadratic and its forward differences, stepped one column at a time.
+#[derive(Debug, Clone, Copy)]
+struct RowStep {
+    quad: Quad,
+    delta: (i128, i128),
+    second: (i128, i128),
+}
+
+impl RowStep {
+    /// To the next column of the row.
+    fn advance(&mut self) {
+        self.quad.b += self.delta.0;
+        self.quad.c += self.delta.1;
+        self.delta.0 += self.second.0;
+        self.delta.1 += self.second.1;
+    }
+}
+
+impl<const K: usize> RowForm<K> {
+    /// From the quadratics of the row's columns 0, 1 and 2.
+    fn new(fixed: [i64; K], q: [Quad; 3]) -> Self {
+        Self {
+            fixed,
+            first: q[0],
+            delta: (q[1].b - q[0].b, q[1].c - q[0].c),
+            second: (q[2].b - 2 * q[1].b + q[0].b, q[2].c - 2 * q[1].c + q[0].c),
+        }
+    }
+
+    /// The quadratic and differences at column `i` (`q(i) = q(0) + i·Δ + i(i−1)/2·Δ²`), `None` if an
+    /// intermediate product leaves `i128`.
+    fn at(&self, i: i64) -> Option<RowStep> {
+        let i = i128::from(i);
+        let pairs = (i * (i - 1)) / 2;
+        let value = |first: i128, delta: i128, second: i128| {
+            first
+                .checked_add(i.checked_mul(delta)?)?
+                .checked_add(pairs.checked_mul(second)?)
+        };
+        let slope = |delta: i128, second: i128| delta.checked_add(i.checked_mul(second)?);
+        Some(RowStep {
+            quad: Quad {
+                a: self.first.a,
+                b: value(self.first.b, self.delta.0, self.second.0)?,
+                c: value(self.first.c, self.delta.1, self.second.1)?,
+            },
+            delta: (
+                slope(self.delta.0, self.second.0)?,
+                slope(self.delta.1, self.second.1)?,
+            ),
+            second: self.second,
+        })
+    }
+}
+
 struct Generator<const K: usize> {
     xi: [[i128; N]; N],
     xf: [[f64; N]; N],
@@ -284,6 +361,8 @@ struct Generator<const K: usize> {
     runs: Vec<(u32, u32)>,
     normals: Option<Vec<[Normal<K>; 2]>>,
     max_rays: usize,
+    /// The row last solved, kept for the next block of the same row.
+    row_form: Option<RowForm<K>>,
 }
 
 impl<const K: usize> Generator<K> {
@@ -293,7 +372,11 @@ impl<const K: usize> Generator<K> {
             return; // reported by the caller
         }
         let columns: i64 = (0..K - 1).map(|a| hi[a] - lo[a] + 1).product();
-        if columns > 16 && self.misses(&lo, &hi) {
+        if columns > ROW_COLUMNS && self.misses(&lo, &hi) {
+            return;
+        }
+        if columns <= ROW_COLUMNS && (0..K - 1).all(|a| a + 2 == K || lo[a] == hi[a]) {
+            self.row(lo, hi[K - 2]);
             return;
         }
         match (0..K - 1).find(|&a| lo[a] < hi[a]) {
@@ -346,14 +429,66 @@ impl<const K: usize> Generator<K> {
         value + lower > 1e-9 * (scale + lower.abs()) + 1.0
     }
 
+    /// Solves the columns from `lo` to `last` on the last column axis (the other axes fixed), stepping their
+    /// quadratics in `z` by finite differences: along that axis `b` is linear and `c` quadratic in the column
+    /// coordinate, so their second differences are constant and the stepping is exact.
+    fn row(&mut self, lo: [i64; K], last: i64) {
+        let axis = K - 2;
+        let mut fixed = lo;
+        fixed[axis] = 0;
+        let form = match self.row_form {
+            Some(form) if form.fixed == fixed => form,
+            _ => {
+                let nth = |i: i64| {
+                    let mut col = fixed;
+                    col[axis] = i;
+                    col
+                };
+                let form = RowForm::new(fixed, [0, 1, 2].map(|i| self.column_quad(&nth(i))));
+                self.row_form = Some(form);
+                form
+            }
+        };
+        let Some(mut step) = form.at(lo[axis]) else {
+            // Beyond i128 (only for huge coefficients): solve each column on its own.
+            for z in lo[axis]..=last {
+                let mut col = lo;
+                col[axis] = z;
+                self.column(col);
+            }
+            return;
+        };
+        let mut col = lo;
+        loop {
+            self.solve_column(col, &step.quad);
+            if col[axis] == last {
+                break;
+            }
+            col[axis] += 1;
+            step.advance();
+        }
+    }
+
     /// Solves one column exactly and appends its runs.
     fn column(&mut self, col: [i64; K]) {
-        let z = K - 1;
+        let q = self.column_quad(&col);
+        self.solve_column(col, &q);
+    }
+
+    /// The sample points' homogeneous coordinates `[X, W]` of a column (its `z` entry left 0).
+    fn column_point(&self, col: &[i64; K]) -> [i128; N] {
         let mut v = [0i128; N];
         for a in 0..K - 1 {
             v[a] = i128::from(2 * col[a] + self.s);
         }
         v[K] = self.w;
+        v
+    }
+
+    /// The form along a column as an integer quadratic in its voxel coordinate `z`.
+    fn column_quad(&self, col: &[i64; K]) -> Quad {
+        let z = K - 1;
+        let v = self.column_point(col);
         let az = self.xi[z][z];
         let mut bz = 0i128;
         let mut cz = 0i128;
@@ -365,11 +500,15 @@ impl<const K: usize> Generator<K> {
         }
         let s = i128::from(self.s);
         // Z = 2z + s: q(z) = 4az z² + (4 az s + 2 bz) z + (az s² + bz s + cz).
-        let q = Quad {
+        Quad {
             a: 4 * az,
             b: 4 * az * s + 2 * bz,
             c: az * s * s + bz * s + cz,
-        };
+        }
+    }
+
+    /// Solves one column from its quadratic `q` in `z` and appends its runs.
+    fn solve_column(&mut self, col: [i64; K], q: &Quad) {
         let (lo, hi) = (0i64, self.side - 1);
         // Small coefficients (the usual case) are solved in i64: |q(z)| < 2^62 for |z| ≤ 2^21 + 1.
         let fits = q.a.unsigned_abs() < 1 << 16
@@ -399,8 +538,9 @@ impl<const K: usize> Generator<K> {
             self.columns.push(key);
             self.runs.push((z1 as u32, z2 as u32 + 1));
             if self.normals.is_some() {
-                let n1 = self.normal(&v, &q, z1, -1);
-                let n2 = self.normal(&v, &q, z2, 1);
+                let v = self.column_point(&col);
+                let n1 = self.normal(&v, q, z1, -1);
+                let n2 = self.normal(&v, q, z2, 1);
                 if let Some(ns) = self.normals.as_mut() {
                     ns.push([n1, n2]);
                 }
@@ -465,8 +605,8 @@ macro_rules! quadratic {
                 // Fast path: the rounded float roots, confirmed exactly (by convexity, q ≤ 0 at both ends of an
                 // interval means on all of it; an end is the boundary when its outer neighbour is outside).
                 if r1.is_finite() && r2.is_finite() && r1 <= r2 {
-                    let l = (r1.ceil().max(lo as f64).min(hi as f64)) as i64;
-                    let h = (r2.floor().max(lo as f64).min(hi as f64)) as i64;
+                    let l = ceil_within(r1, lo, hi);
+                    let h = floor_within(r2, lo, hi);
                     if l <= h && inside(l) && inside(h) {
                         let left = if l == lo || !inside(l - 1) {
                             l
@@ -575,6 +715,21 @@ macro_rules! quadratic {
 
 quadratic!(Quad, i128);
 quadratic!(Quad64, i64);
+
+/// `ceil(x)` clamped to `[lo, hi]`, for a finite `x` (without a call into libm: the clamped value is small,
+/// so its truncation is exact).
+fn ceil_within(x: f64, lo: i64, hi: i64) -> i64 {
+    let x = x.max(lo as f64).min(hi as f64);
+    let t = x as i64;
+    t + i64::from((t as f64) < x)
+}
+
+/// `floor(x)` clamped to `[lo, hi]`, for a finite `x`.
+fn floor_within(x: f64, lo: i64, hi: i64) -> i64 {
+    let x = x.max(lo as f64).min(hi as f64);
+    let t = x as i64;
+    t - i64::from((t as f64) > x)
+}
 
 /// Float estimates of the roots of `a z² + b z + c` (with `a > 0`, discriminant `d`), in order; the vertex
 /// twice when there is no real root.

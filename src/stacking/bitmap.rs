@@ -1,6 +1,7 @@
 //! A small universe's tree through a bitmap pyramid: the voxels set run by run (a run is a range of bits
 //! of its column), each coarser level found by merging `2^K` cells with word-wide AND and OR, and the tree
-//! written top down, level by level, reading the children of each partial node from the pyramid.
+//! written top down, level by level, reading the children of each partial node from the pyramid (the two
+//! children along the last axis from one word of each column) as one word of 2-bit codes.
 //!
 //! For the cache-sized cells of a partitioned build (about 2^18 voxels: 32 KiB of bits) this does a few
 //! word operations per 64 voxels plus a few per output node, where stacking sorts and merges lists of
@@ -147,20 +148,45 @@ pub(crate) fn stack_bitmap<const K: usize>(rays: &RaySet<K>) -> KTree<K> {
     } else {
         Vec::new()
     };
-    let mut kids = [NodeState::Empty; 16];
     for depth in 0..level as usize {
         let below = &pyramid[depth + 1];
+        let half = 1usize << (K - 1);
+        // The word offset, from the first, of each of the 2^(K−1) columns of a node's children (bit a of
+        // b: the child's half on axis a).
+        let offsets: [usize; 8] = std::array::from_fn(|b| {
+            (0..K - 1)
+                .map(|a| ((b >> a) & 1) << (below.log_side as usize * (K - 2 - a)))
+                .sum::<usize>()
+                * below.words
+        });
         let mut next = Vec::with_capacity(partial.len() * 4);
         for coords in &partial {
-            for (code, kid) in kids.iter_mut().enumerate().take(1 << K) {
-                let child: [u32; K] =
-                    std::array::from_fn(|a| 2 * coords[a] + ((code >> a) & 1) as u32);
-                *kid = below.state::<K>(&child);
-                if *kid == NodeState::Partial {
-                    next.push(child);
+            let column = coords[..K - 1]
+                .iter()
+                .fold(0usize, |c, &x| (c << below.log_side) | (2 * x as usize));
+            let z = 2 * coords[K - 1] as usize;
+            let first = column * below.words + z / 64;
+            let shift = z % 64;
+            // The children's 2-bit codes in child-code order (code b + 2^(K−1)·zb for the child in column
+            // b at the lower (zb = 0) or upper z), both z of a column read from one word.
+            let mut codes = 0u64;
+            for (b, offset) in offsets[..half].iter().enumerate() {
+                let full = (below.full[first + offset] >> shift) & 3;
+                let partly = (below.any[first + offset] >> shift) & 3 & !full;
+                for zb in 0..2 {
+                    let code = ((full >> zb) & 1) | (((partly >> zb) & 1) << 1);
+                    codes |= code << (2 * (b + zb * half));
                 }
             }
-            out.push_block(depth + 1, &kids[..1 << K]);
+            let mut partial_codes = codes & 0xAAAA_AAAA;
+            while partial_codes != 0 {
+                let code = partial_codes.trailing_zeros() as usize / 2;
+                partial_codes &= partial_codes - 1;
+                next.push(std::array::from_fn(|a| {
+                    2 * coords[a] + ((code >> a) & 1) as u32
+                }));
+            }
+            out.append_word(depth + 1, codes, 1 << K);
         }
         partial = next;
     }

@@ -244,6 +244,9 @@ fn quadric_ball_equals_the_direct_generator() {
         ([3, 40, 17], 23, 5),
         ([-5, 9, 31], 30, 5),
         ([64, 64, 64], 64, 6),
+        // Long rows: columns are solved by stepping each row's quadratic from column to column.
+        ([1024, 1024, 1024], 1023, 10),
+        ([701, 1029, 517], 611, 10),
     ] {
         let centre = c2.map(|c| Rational::new(c, 2).unwrap());
         let q = Quadric::<3>::ball(centre, Rational::new(r2, 2).unwrap(), Frame::Voxel).unwrap();
