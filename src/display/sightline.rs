@@ -134,20 +134,6 @@ impl ExactView {
         self.increasing[axis]
     }
 
-    /// The sign of `Σ_k coef[k] · w_k` for the tilted magnitudes `w_k = |D_k| + ε^{p_k}`.
-    fn sign_of_linear(&self, coef: [i128; 3]) -> Ordering {
-        let at_zero: i128 = (0..3)
-            .map(|k| coef[k] * i128::from(self.magnitude[k]))
-            .sum();
-        if at_zero != 0 {
-            return at_zero.cmp(&0);
-        }
-        // The powers of ε increase with the axis index (TILT_POWER).
-        coef.into_iter()
-            .find(|&c| c != 0)
-            .map_or(Ordering::Equal, |c| c.cmp(&0))
-    }
-
     /// The limit of `w_a / w_k` (`a ≠ k`).
     fn ratio_limit(&self, a: usize, k: usize) -> RatioLimit {
         let (ma, mk) = (self.magnitude[a], self.magnitude[k]);
@@ -176,6 +162,7 @@ impl ExactView {
     /// The part `(lo, hi)` of the lattice segment along `axis` at `fixed` (the other two axes, lower
     /// first) from `u0` to `u1` that `cube` hides in the limit of the tilted view: the points whose line
     /// along `d_ε` meets the open cube. `None` when that part is empty or shrinks to a point.
+    #[inline]
     pub(crate) fn hidden_part(
         &self,
         axis: usize,
@@ -210,19 +197,53 @@ impl ExactView {
             reflected_origin(c) - reflected(c, fixed[1]),
         ];
         let exit = entry.map(|e| e + s);
-        // Across the segment: entering slab i before leaving slab j, e_i·w_j < x_j·w_i, both ways.
-        for (i, j, ei, xj) in [(b, c, entry[0], exit[1]), (c, b, entry[1], exit[0])] {
-            let mut coef = [0i128; 3];
-            coef[j] += i128::from(ei);
-            coef[i] -= i128::from(xj);
-            if self.sign_of_linear(coef) != Ordering::Less {
-                return None;
-            }
+        // Across the segment: entering slab i before leaving slab j, e_i·w_j < x_j·w_i, both ways. Most
+        // cubes fail here, so this test is kept small and inlined.
+        if !self.negative(entry[0], c, -exit[1], b) || !self.negative(entry[1], b, -exit[0], c) {
+            return None;
         }
+        self.hidden_along(a, entry, (u0, u1), cube)
+    }
+
+    /// Whether `p · w_i + q · w_j < 0` for the tilted magnitudes `w_k = |D_k| + ε^{p_k}` (`i ≠ j`): decided
+    /// at `ε = 0` when not zero there, else by the first non-zero coefficient in axis order.
+    #[inline]
+    fn negative(&self, p: i64, i: usize, q: i64, j: usize) -> bool {
+        let at_zero = i128::from(p) * i128::from(self.magnitude[i])
+            + i128::from(q) * i128::from(self.magnitude[j]);
+        if at_zero != 0 {
+            return at_zero < 0;
+        }
+        // The first non-zero coefficient in axis order decides (TILT_POWER increases with the axis).
+        let (first, second) = if i < j { (p, q) } else { (q, p) };
+        if first != 0 {
+            first < 0
+        } else {
+            second < 0
+        }
+    }
+
+    /// The part of the segment (along `axis`, from `u0` to `u1`) hidden by `cube`, for a segment whose
+    /// sightlines cross the cube's two slabs across it (`entry`: the entry offsets on those axes).
+    fn hidden_along(
+        &self,
+        axis: usize,
+        entry: [i64; 2],
+        (u0, u1): (u32, u32),
+        cube: &Cell<3>,
+    ) -> Option<(Exact, Exact)> {
+        let a = axis;
+        let [b, c] = super::lines::other_axes(a);
+        let s = cube.side() as i64;
+        let exit = entry.map(|e| e + s);
+        let oa = if self.increasing[a] {
+            i64::from(cube.origin[a])
+        } else {
+            -(i64::from(cube.origin[a]) + s)
+        };
         // Along the segment, in the reflected coordinate v = ±u: entering slab a before leaving slab j
         // gives v > o'_a − x_j·w_a/w_j; entering slab i before leaving slab a gives
         // v < o'_a + s − e_i·w_a/w_i.
-        let oa = reflected_origin(a);
         let mut lo = Exact::NegInf;
         let mut hi = Exact::PosInf;
         for (k, (e, x)) in [(b, (entry[0], exit[0])), (c, (entry[1], exit[1]))] {
