@@ -21,7 +21,8 @@
 //! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
 //! * [`io`]: files, one module per format — `.ktree` (version 2 written, streamed and memory-mapped; version 1
-//!   read), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb`.
+//!   read), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb` — and the spill files of trees larger than
+//!   memory (one level a file), which the out-of-core builder and the streamed Booleans both write.
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
@@ -39,7 +40,8 @@
 //! ```text
 //!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text;
 //!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in,
-//!                     meshes written through export/)
+//!                     meshes written through export/); spill files, one level a file, and the level
+//!                     sink over them
 //!  export/            boundaries as meshes and outlines, and their files (over display's neighbours);
 //!                     the 3-D view page (over the storage trait and display's named views)
 //!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink
@@ -51,8 +53,9 @@
 //!  rays/   space   fs (atomic writes, spill folders)
 //! ```
 //! Not yet so: the ray sources of `solid/` implement `stacking::RaySource` (solid → stacking); the
-//! out-of-core builder and the streamed Booleans write their output through `io::KtreeWriter` and read their
-//! inputs through `io::KtreeView` (stacking, ops → io). (`KTree::from_rays` and `KTree::from_dense` are
+//! out-of-core builder and the streamed Booleans spill through `io`'s level files and write their output
+//! through `io::KtreeWriter`, and the streamed Booleans read their inputs through `io::KtreeView`
+//! (stacking, ops → io). (`KTree::from_rays` and `KTree::from_dense` are
 //! defined beside their builders, in `stacking/` and `reference/`: the tree knows no builder.)
 //!
 //! # Example

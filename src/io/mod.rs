@@ -30,6 +30,7 @@ mod location;
 #[allow(unsafe_code)]
 mod mmap;
 pub mod rays;
+pub(crate) mod spill;
 
 pub use dispatch::{
     read_tree, read_tree_placed, voxelize, write_tree, Format, IoError, ReadOptions, ReadTree,

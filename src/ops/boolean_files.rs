@@ -9,15 +9,15 @@
 //! child by child. The result is produced in *post-order*: a node's `2^K` child states are appended to the
 //! output level below once all of them are known, so a node whose children all turn out full (or empty)
 //! collapses before anything of it is written, and the blocks of every level come out in level order (a
-//! node finishes after every node before it at its depth). The output is a [`LevelSink`] that appends each
-//! level to its own temporary *spill file* ([`SpillLevels`]); at the end they are streamed, level by level,
-//! into the `.ktree` through a [`KtreeWriter`], written to a temporary file and renamed over the target.
+//! node finishes after every node before it at its depth). The output is a level sink that appends each
+//! level to its own temporary *spill file* (`io::spill::SpillLevels`); at the end they are streamed, level by level,
+//! into the `.ktree` through a [`KtreeWriter`](crate::io::KtreeWriter), written to a temporary file and renamed over the target.
 //!
 //! Child positions in the inputs come from the file's rank samples (at most 64 word pop-counts each).
 //!
 //! # Memory
 //! What the process allocates is bounded by the depth of the trees, not their size: the walk's stack, one
-//! [`BUFFER_BYTES`] buffer per output level and one for the output. The inputs' pages are read through the
+//! 64 KiB buffer per output level and one for the output. The inputs' pages are read through the
 //! memory maps, each level front to back; they are the kernel's page cache, dropped under memory pressure,
 //! so inputs larger than memory work.
 //!
@@ -34,24 +34,19 @@
 //! ```
 
 use crate::fs::SpillError;
-use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::boolean::{boolean_into, complement_into};
 use super::BoolOp;
-use crate::io::{KtreeFileError, KtreeFileErrorKind, KtreeView, KtreeWriter};
+use crate::io::spill::{SpillLevels, SpilledTree};
+use crate::io::{KtreeFileError, KtreeFileErrorKind, KtreeView};
 use crate::space::Universe;
-use crate::tree::sink::LevelSink;
 use crate::tree::storage::TreeStorage;
-use crate::tree::words::{self, WordPacker};
+use crate::tree::words;
 use crate::tree::{LevelCounts, NodeState};
 
 /// Nodes in a word, counted as the file's node counts are.
 const NODES_PER_WORD: u64 = words::NODES_PER_WORD as u64;
-
-/// Bytes of each I/O buffer (one per output level, one for the output).
-pub(crate) const BUFFER_BYTES: usize = 1 << 16;
 
 /// Why a streamed Boolean failed. The target file is untouched and the spill files are removed.
 #[derive(Debug, thiserror::Error)]
@@ -194,12 +189,18 @@ fn boolean_views_k<const K: usize>(
     let folder = crate::fs::spill_folder(out, temp_dir)
         .map_err(|(path, source)| BooleanFileError::Files(SpillError::TempDir { path, source }))?;
     let sink = SpillLevels::create(folder.path(), depths, K, a.level(), out)?;
-    let report = match (operation, sb) {
+    let written: Result<SpilledTree, BooleanFileError> = match (operation, sb) {
         (ViewOperation::Binary(op, _), Some(sb)) => boolean_into(&sa, &sb, op, sink),
         _ => complement_into(&sa, sink),
     };
     drop(folder);
-    report
+    let written = written?;
+    Ok(BooleanFileReport {
+        k: K,
+        level: a.level(),
+        counts_per_level: written.counts_per_level,
+        spilled_bytes: written.spilled_bytes,
+    })
 }
 
 /// A version 2 file read through its view as a [`TreeStorage`], every read checked against the shape
@@ -288,159 +289,5 @@ impl<const K: usize> TreeStorage<K> for ViewStorage<'_, K> {
 
     fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, KtreeFileError> {
         self.read(depth, first as u64, n as u64)
-    }
-}
-
-/// A [`LevelSink`] that appends each level `1 …` of a tree to its own spill file and, when finished,
-/// streams them into a `.ktree` version 2 file (written to a temporary file and renamed over the target):
-/// trees larger than memory, written in bounded memory.
-pub(crate) struct SpillLevels {
-    levels: Vec<OutputLevel>,
-    k: usize,
-    level: u32,
-    out: PathBuf,
-}
-
-struct OutputLevel {
-    path: PathBuf,
-    file: BufWriter<File>,
-    nodes: u64,
-    packer: WordPacker,
-}
-
-impl SpillLevels {
-    /// Spill files for the levels `1 … depths − 1` of a `K = k`, `L = level` tree in `folder`, to be
-    /// written to `out`.
-    pub(crate) fn create(
-        folder: &Path,
-        depths: usize,
-        k: usize,
-        level: u32,
-        out: &Path,
-    ) -> Result<Self, BooleanFileError> {
-        let levels = (1..depths)
-            .map(|d| {
-                let path = folder.join(format!("level-{d}"));
-                let file = File::create(&path).map_err(|source| {
-                    BooleanFileError::Files(SpillError::Spill {
-                        path: path.clone(),
-                        source,
-                    })
-                })?;
-                Ok(OutputLevel {
-                    path,
-                    file: BufWriter::with_capacity(BUFFER_BYTES, file),
-                    nodes: 0,
-                    packer: WordPacker::default(),
-                })
-            })
-            .collect::<Result<_, BooleanFileError>>()?;
-        Ok(Self {
-            levels,
-            k,
-            level,
-            out: out.to_path_buf(),
-        })
-    }
-
-    /// Appends `nodes` (≤ 32) nodes packed in `word` to level `depth`.
-    fn append_word(&mut self, depth: usize, word: u64, nodes: u64) -> Result<(), BooleanFileError> {
-        let level = &mut self.levels[depth - 1];
-        level.nodes += nodes;
-        if let Some(whole) = level.packer.push(word, nodes as usize) {
-            level
-                .file
-                .write_all(&whole.to_le_bytes())
-                .map_err(|source| {
-                    BooleanFileError::Files(SpillError::Spill {
-                        path: level.path.clone(),
-                        source,
-                    })
-                })?;
-        }
-        Ok(())
-    }
-
-    /// Writes the result (root `root`) to `out`: the root level, then each spilled level.
-    fn write(self, root: NodeState) -> Result<BooleanFileReport, BooleanFileError> {
-        let (k, level, out) = (self.k, self.level, self.out.as_path());
-        let mut spilled_bytes = 0;
-        let mut readers = Vec::new();
-        for mut l in self.levels {
-            if let Some(word) = l.packer.flush() {
-                l.file.write_all(&word.to_le_bytes()).map_err(|source| {
-                    BooleanFileError::Files(SpillError::Spill {
-                        path: l.path.clone(),
-                        source,
-                    })
-                })?;
-            }
-            let spill_err = |source| {
-                BooleanFileError::Files(SpillError::Spill {
-                    path: l.path.clone(),
-                    source,
-                })
-            };
-            let file = l.file.into_inner().map_err(|e| spill_err(e.into_error()))?;
-            spilled_bytes += 8 * l.nodes.div_ceil(NODES_PER_WORD);
-            drop(file);
-            if l.nodes > 0 {
-                readers.push((l.path, l.nodes));
-            }
-        }
-        let mut counts = Vec::new();
-        crate::fs::write_atomic_with(out, |w| {
-            let mut writer = KtreeWriter::new(BufWriter::with_capacity(BUFFER_BYTES, w), k, level)?;
-            writer.push(root)?;
-            writer.end_level()?;
-            let mut words = vec![0u64; BUFFER_BYTES / 8];
-            let mut bytes = vec![0u8; BUFFER_BYTES];
-            for (path, nodes) in &readers {
-                let with_path = |e: std::io::Error| {
-                    std::io::Error::new(e.kind(), format!("spill file {}: {e}", path.display()))
-                };
-                let mut reader = BufReader::new(File::open(path).map_err(with_path)?);
-                let mut left = *nodes;
-                while left > 0 {
-                    let n = left.min(NODES_PER_WORD * words.len() as u64);
-                    let w = n.div_ceil(NODES_PER_WORD) as usize;
-                    reader.read_exact(&mut bytes[..8 * w]).map_err(with_path)?;
-                    for (word, b) in words.iter_mut().zip(bytes.chunks_exact(8)).take(w) {
-                        *word = u64::from_le_bytes(b.try_into().expect("8 bytes"));
-                    }
-                    writer.append_words(&words[..w], n)?;
-                    left -= n;
-                }
-                writer.end_level()?;
-            }
-            counts = writer.counts_per_level();
-            writer.finish()?.flush()
-        })
-        .map_err(|source| {
-            BooleanFileError::Files(SpillError::Output {
-                path: out.to_path_buf(),
-                source,
-            })
-        })?;
-        Ok(BooleanFileReport {
-            k,
-            level,
-            counts_per_level: counts,
-            spilled_bytes,
-        })
-    }
-}
-
-impl LevelSink for SpillLevels {
-    type Error = BooleanFileError;
-    type Output = BooleanFileReport;
-
-    #[inline]
-    fn append(&mut self, depth: usize, word: u64, n: usize) -> Result<(), BooleanFileError> {
-        self.append_word(depth, word, n as u64)
-    }
-
-    fn finish(self, root: NodeState) -> Result<BooleanFileReport, BooleanFileError> {
-        self.write(root)
     }
 }

@@ -7,7 +7,7 @@ pub(crate) const RUN_BYTES: u64 = 64;
 /// in the order the levels are written in).
 pub(crate) const SUBTREE_BYTES: u64 = 24;
 /// Bytes of each I/O buffer (one per spill file, one for the output, one for reading back).
-pub(crate) const BUFFER_BYTES: u64 = 1 << 16;
+pub(crate) const BUFFER_BYTES: u64 = crate::io::spill::BUFFER_BYTES as u64;
 
 /// A byte count with its size in MiB or GiB, for messages.
 pub(crate) fn bytes_text(bytes: u64) -> String {

@@ -17,6 +17,7 @@ use super::progress::{Progress, Stage};
 use super::spill::{level_offsets, open_spill, spill_piece, Spill, SpillReader, SubtreeIndex};
 use super::{OutOfCore, OutOfCoreReport};
 use crate::fs::write_atomic_with;
+use crate::io::spill::LevelFile;
 use crate::io::KtreeWriter;
 use crate::stacking::cells::{CellBlock, CellStates};
 use crate::stacking::partition::{slab_pieces, Piece, RaySource};
@@ -213,19 +214,12 @@ where
         });
     }
     budget.peak = budget.peak.max(end);
-    let spilled_words = spill.words.iter().sum::<u64>();
-    let Spill { dir, files, .. } = spill;
-    let mut readers = Vec::with_capacity(files.len());
-    for (j, file) in files.into_iter().enumerate() {
-        let path = dir.path().join(format!("level-{}", j + 1));
-        let file = file.into_inner().map_err(|e| {
-            BuildError::Files(SpillError::Spill {
-                path: path.clone(),
-                source: e.into_error(),
-            })
-        })?;
-        readers.push((path, file));
-    }
+    let spilled_words = spill.words();
+    let Spill { dir, files } = spill;
+    let readers = files
+        .into_iter()
+        .map(LevelFile::finish)
+        .collect::<Result<Vec<_>, _>>()?;
     Ok(SpilledPart {
         k: K as u32,
         level,

@@ -2,27 +2,26 @@
 //! written as the cells are stacked and read back, piece by piece, when the tree is written.
 
 use crate::fs::SpillError;
+use crate::io::spill::LevelFile;
 use std::fs::File;
-use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
-use std::path::{Path, PathBuf};
+use std::io::{Read, Seek, SeekFrom};
+use std::path::Path;
 
-use super::budget::BUFFER_BYTES;
 use super::error::BuildError;
 use crate::stacking::cells::CellStates;
 use crate::stacking::partition::Piece;
 use crate::tree::NodeState;
 
-/// The spill files: one per subtree level `1 … t`.
+/// The spill files: one per subtree level `1 … t`, each cell's piece of a level in whole words.
 pub(super) struct Spill {
     pub(super) dir: tempfile::TempDir,
-    pub(super) files: Vec<BufWriter<File>>,
-    /// Words written to each file.
-    pub(super) words: Vec<u64>,
+    pub(super) files: Vec<LevelFile>,
 }
 
 impl Spill {
-    pub(super) fn path(&self, j: usize) -> PathBuf {
-        self.dir.path().join(format!("level-{j}"))
+    /// Words written to all the files.
+    pub(super) fn words(&self) -> u64 {
+        self.files.iter().map(LevelFile::words).sum()
     }
 }
 
@@ -113,26 +112,12 @@ pub(super) fn open_spill<E>(
     temp_dir: Option<&Path>,
     t: usize,
 ) -> Result<Spill, BuildError<E>> {
-    let folder = crate::fs::spill_folder(out, temp_dir)
+    let dir = crate::fs::spill_folder(out, temp_dir)
         .map_err(|(path, source)| BuildError::Files(SpillError::TempDir { path, source }))?;
-    let mut spill = Spill {
-        dir: folder,
-        files: Vec::with_capacity(t),
-        words: vec![0; t],
-    };
-    for j in 1..=t {
-        let path = spill.path(j);
-        let file = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create_new(true)
-            .open(&path)
-            .map_err(|source| BuildError::Files(SpillError::Spill { path, source }))?;
-        spill
-            .files
-            .push(BufWriter::with_capacity(BUFFER_BYTES as usize, file));
-    }
-    Ok(spill)
+    let files = (1..=t)
+        .map(|j| LevelFile::create(dir.path().join(format!("level-{j}"))))
+        .collect::<Result<_, _>>()?;
+    Ok(Spill { dir, files })
 }
 
 /// Records a non-empty cell of depth `m`, spilling the levels below its root if it is partial.
@@ -159,21 +144,12 @@ pub(super) fn spill_piece<const K: usize, E>(
         NodeState::Partial => {}
     }
     index.mortons.push(morton);
-    for j in 1..=spill.files.len() {
+    for (j, file) in (1..).zip(spill.files.iter_mut()) {
         let nodes = if j < tree.depth_count() {
             let states = tree.level_states(j);
-            let words = &states.words()[..states.len().div_ceil(32)];
-            let file = &mut spill.files[j - 1];
-            for w in words {
-                file.write_all(&w.to_le_bytes()).map_err(|source| {
-                    BuildError::Files(SpillError::Spill {
-                        path: spill.dir.path().join(format!("level-{j}")),
-                        source,
-                    })
-                })?;
-            }
-            spill.words[j - 1] += words.len() as u64;
-            states.len() as u64
+            let nodes = states.len() as u64;
+            file.append_words(&states.words()[..states.len().div_ceil(32)], nodes)?;
+            nodes
         } else {
             0
         };
