@@ -3,12 +3,15 @@
 # results/performance/openvdb.md. The object: the voxel-centre sphere of results/performance/scale.md.
 # ktree: `perf --child scale cells-L-1` (quadric → rays slab by slab → subtrees → tree). OpenVDB:
 # experiments/openvdb/sphere.cpp (the same sphere's runs filled into a BoolGrid and pruned; and OpenVDB's
-# narrow-band level-set sphere). Best of 3 per run, the three programs alternating, 3 rounds.
+# narrow-band level-set sphere). Best of 3 per run, the three programs alternating, 3 rounds. Then, at
+# L = 7 and 8, each program as a whole process (exec to exit: ktree's CLI writing its .ktree, OpenVDB's
+# program building once), best of 7 alternating.
 #
 # Needs Debian's libopenvdb-dev, libboost-dev and libtbb-dev (apt-get install) and a C++ compiler.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --example perf
+cargo build --release -p ktree-cli
 bin=target/openvdb-sphere
 g++ -O2 -std=c++17 -o "$bin" experiments/openvdb/sphere.cpp -lopenvdb -ltbb
 perf=target/release/examples/perf
@@ -54,6 +57,41 @@ level, voxels, k, f, l = sys.argv[1], sys.argv[2], *map(float, sys.argv[3:])
 print(f"| {level} | {voxels} | {k:.4f} | {f:.4f} | {l:.4f} | {f / k:.1f}× | {l / k:.1f}× |")
 PY
   echo "L = $level done" >&2
+done
+{
+  echo
+  echo "## As whole processes"
+  echo
+  echo "Wall time from starting the program to its exit, best of 7 runs, the three programs alternating:"
+  echo "**ktree** is the command a user runs, \`ktree rays --solid ball --radius (U−1)/2 --level L --threads 1"
+  echo "--out FILE.ktree\` (the build and writing the file); **OpenVDB** is the program above building once"
+  echo "(\`openvdb::initialize\`, the build, no file written)."
+  echo
+  echo "| L | ktree s | OpenVDB fill s | OpenVDB level set s | fill / ktree | level set / ktree |"
+  echo "|---:|---:|---:|---:|---:|---:|"
+} >>"$out.tmp"
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+for level in 7 8; do
+  python3 - "$level" "$bin" target/release/ktree "$scratch/sphere.ktree" >>"$out.tmp" <<'PY'
+import subprocess, sys, time
+level, vdb, ktree, out = int(sys.argv[1]), *sys.argv[2:]
+u = 1 << level
+programs = {
+    "ktree": [ktree, "rays", "--solid", "ball", "--radius", f"{u - 1}/2", "--level", str(level),
+              "--threads", "1", "--out", out],
+    "fill": [vdb, str(level), "fill", "1"],
+    "levelset": [vdb, str(level), "levelset", "1"],
+}
+best = {name: float("inf") for name in programs}
+for _ in range(7):
+    for name, argv in programs.items():
+        start = time.perf_counter()
+        subprocess.run(argv, check=True, stdout=subprocess.DEVNULL)
+        best[name] = min(best[name], time.perf_counter() - start)
+k, f, l = best["ktree"], best["fill"], best["levelset"]
+print(f"| {level} | {k:.4f} | {f:.4f} | {l:.4f} | {f / k:.1f}× | {l / k:.1f}× |")
+PY
 done
 mv "$out.tmp" "$out"
 echo "wrote $out"

@@ -143,9 +143,9 @@ pub fn report() -> Result<String, String> {
     let _ = writeln!(
         md,
         "\nThe tree in memory is the navigable tree (2-bit states and their rank index, `KTree::heap_bytes`). \
-         The target: at L = 10 stacking well under a second on one core, aiming for 0.2 s; OpenVDB \
-         builds the same sphere from its level-set sphere in about 1.1 s on one core of this machine, and per \
-         voxel in about 3 s (quoted figures, not measured here); peak memory far under 1 GiB. \
+         The target: at L = 10 stacking well under a second on one core, aiming for 0.2 s; peak memory \
+         far under 1 GiB. OpenVDB building the same sphere is measured side by side in \
+         `results/performance/openvdb.md` (`experiments/openvdb.sh`). \
          Naive insertion is not run above L = {NAIVE_MAX} and the dense pyramid above L = {DENSE_MAX} \
          (U^3 voxels in memory)."
     );

@@ -193,9 +193,8 @@ pub fn report() -> Result<String, String> {
     let _ = writeln!(
         md,
         "\nThe target: the ball's quadric → rays well under 0.1 s; the bunny and a 50 000-triangle mesh \
-         → rays under a second each; end to end faster than OpenVDB builds the same sphere (about 3 s per \
-         voxel, about 1 s from its level-set sphere on one core here — quoted figures, not \
-         measured here). `?` marks facts a case does not report."
+         → rays under a second each; end to end faster than OpenVDB builds the same sphere (measured side \
+         by side in `results/performance/openvdb.md`). `?` marks facts a case does not report."
     );
     let path = results_path("solids");
     ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
