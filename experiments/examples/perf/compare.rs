@@ -54,7 +54,6 @@ pub fn report(args: &[String]) -> Result<String, String> {
     };
     let before = Path::new(before);
     let after = std::env::current_exe().map_err(|e| e.to_string())?;
-    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     let mut md = String::new();
     let _ = writeln!(
         md,
@@ -67,10 +66,8 @@ pub fn report(args: &[String]) -> Result<String, String> {
          alternately from the earlier build and from this one, {rounds} times each; the table keeps the best \
          time of each side. A ratio below 1 means this build is faster. The spread is how far the median of \
          a side's {rounds} times lies above its best (the larger of the two sides): the run-to-run noise of \
-         the case on this machine.\n\nMachine: {}. Load average (1, 5, 15 min) when the comparison started: \
-         {}.\n",
+         the case on this machine.\n\nMachine: {}.\n",
         machine_line(),
-        load.split_whitespace().take(3).collect::<Vec<_>>().join(", ")
     );
     let _ = writeln!(
         md,
