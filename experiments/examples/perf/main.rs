@@ -69,6 +69,7 @@ fn main() -> ExitCode {
             "ops" => ops::report(),
             "display" => display::report(),
             "scale" => scale::report(),
+            "scale-large" => scale::report_large(),
             "interop" => interop::report(),
             "streaming" => streaming::report(),
             "sources" => sources::report(),
@@ -80,7 +81,7 @@ fn main() -> ExitCode {
                     .into(),
             ),
             other => Err(format!(
-                "unknown area '{other}' (known: build, solids, ops, display, scale, interop, streaming, sources, export, queries)"
+                "unknown area '{other}' (known: build, solids, ops, display, scale, scale-large, interop, streaming, sources, export, queries)"
             )),
         };
         match result {

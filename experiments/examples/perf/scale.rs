@@ -2,7 +2,8 @@
 //! partitioned build (cells of depth `L − 6` stacked apart, rays made slab by slab) on one and two threads,
 //! L = 10 … 13; the whole-set build (all rays, then one stacking) beside it up to L = 12; and the
 //! out-of-core build (subtrees spilled to temporary files, the `.ktree` written level by level in a memory
-//! budget) at L = 13 and 14.
+//! budget) at L = 13 and 14. Apart (`perf -- scale-large`, minutes and gigabytes of disk): the out-of-core
+//! build at L = 15 and 16 in a budget of 1 GiB.
 
 use std::fmt::Write as _;
 
@@ -22,6 +23,10 @@ const OUT_OF_CORE_LEVELS: [u32; 2] = [13, 14];
 const OUT_OF_CORE_BUDGET: u64 = 1536 << 20;
 /// Threads of the out-of-core builds.
 const OUT_OF_CORE_THREADS: usize = 2;
+/// Levels of the large out-of-core builds (`perf -- scale-large`).
+const LARGE_LEVELS: [u32; 2] = [15, 16];
+/// Their memory budget: 1 GiB.
+const LARGE_BUDGET: u64 = 1 << 30;
 
 fn sphere(level: u32) -> Solid<3> {
     let u = 1i64 << level;
@@ -111,7 +116,14 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             facts.push(("nodes".into(), nodes.to_string()));
             s
         }
-        "ooc" => out_of_core_case(&solid, level, &mut facts)?,
+        "ooc" => {
+            // `ooc-L` in the default budget, `ooc-L-MIB` in MIB MiB.
+            let budget = match parts.get(2) {
+                Some(mib) => mib.parse::<u64>().map_err(|_| "ooc-L[-MIB]")? << 20,
+                None => OUT_OF_CORE_BUDGET,
+            };
+            out_of_core_case(&solid, level, budget, &mut facts)?
+        }
         _ => return Err(format!("unknown case {case}")),
     };
     Ok((seconds, facts))
@@ -123,6 +135,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
 fn out_of_core_case(
     solid: &Solid<3>,
     level: u32,
+    budget: u64,
     facts: &mut Vec<(String, String)>,
 ) -> Result<f64, String> {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -132,7 +145,6 @@ fn out_of_core_case(
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let out = dir.path().join("sphere.ktree");
     let source = SolidSource::new(solid, level, Sample::Centre).map_err(|e| e.to_string())?;
-    let budget = OUT_OF_CORE_BUDGET;
     let start = std::time::Instant::now();
     let report = pool
         .install(|| Builder::new(&source).to_file(&out, budget))
@@ -179,6 +191,66 @@ fn out_of_core_case(
         report.peak_accounted_bytes.to_string(),
     ));
     Ok(seconds)
+}
+
+/// Runs the out-of-core case at each of `levels` (in `budget_mib`, or the default budget) and appends its
+/// table to `md`.
+fn out_of_core_table(
+    md: &mut String,
+    levels: &[u32],
+    budget_mib: Option<u64>,
+) -> Result<(), String> {
+    let _ = writeln!(
+        md,
+        "| L | rays | voxels | nodes | seconds | ns/node | peak MiB | accounted MiB | spilled MiB | file MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for &level in levels {
+        let case = match budget_mib {
+            Some(mib) => format!("ooc-{level}-{mib}"),
+            None => format!("ooc-{level}"),
+        };
+        let m: Measured = run_child("scale", &case)?;
+        let nodes: f64 = m.fact("nodes").parse().unwrap_or(f64::NAN);
+        let bytes = |key: &str| mib(m.fact(key).parse().unwrap_or(0));
+        let _ = writeln!(
+            md,
+            "| {level} | {} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {} |",
+            m.fact("rays"),
+            m.fact("voxels"),
+            m.fact("nodes"),
+            m.seconds,
+            m.seconds * 1e9 / nodes,
+            bytes("build_peak_bytes"),
+            bytes("accounted_peak_bytes"),
+            bytes("spilled_bytes"),
+            bytes("file_bytes"),
+        );
+    }
+    Ok(())
+}
+
+/// Measures the large out-of-core builds in a child process each and writes
+/// `results/performance/scale-large.md`.
+pub fn report_large() -> Result<String, String> {
+    let mut md = String::new();
+    let budget_mib = LARGE_BUDGET >> 20;
+    let _ = writeln!(
+        md,
+        "# Scale, out of core: the sphere at L = 15 and 16 in 1 GiB\n\n\
+         Regenerate with `cargo run --release --example perf -- scale-large` (about 12 minutes here and \
+         8 GB free in the temporary folder for L = 16). Object: the sphere of `scale.md`. Build: \
+         `ktree::stacking::Builder::to_file`, what `ktree rays --solid ball --radius (U−1)/2 --level L \
+         --max-memory 1G --out FILE.ktree` runs, on {OUT_OF_CORE_THREADS} threads in a budget of \
+         {budget_mib} MiB. Seconds, peak and checks as in the out-of-core table of `scale.md`: the peak is \
+         the process's high-water resident set when the file is written, the checks (not timed) open the \
+         file, verify every section and compare its counts and voxels with the build's and the runs'. The \
+         goal: L = 16 in at most 1 GiB and 10 minutes.\n\nMachine: {}.\n",
+        machine_line()
+    );
+    out_of_core_table(&mut md, &LARGE_LEVELS, Some(budget_mib))?;
+    let path = results_path("scale-large");
+    ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
+    Ok(path.display().to_string())
 }
 
 fn mib(bytes: u64) -> String {
@@ -259,28 +331,7 @@ pub fn report() -> Result<String, String> {
          lengths.\n",
         OUT_OF_CORE_BUDGET >> 20
     );
-    let _ = writeln!(
-        md,
-        "| L | rays | voxels | nodes | seconds | ns/node | peak MiB | accounted MiB | spilled MiB | file MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
-    );
-    for level in OUT_OF_CORE_LEVELS {
-        let m: Measured = run_child("scale", &format!("ooc-{level}"))?;
-        let nodes: f64 = m.fact("nodes").parse().unwrap_or(f64::NAN);
-        let bytes = |key: &str| mib(m.fact(key).parse().unwrap_or(0));
-        let _ = writeln!(
-            md,
-            "| {level} | {} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {} |",
-            m.fact("rays"),
-            m.fact("voxels"),
-            m.fact("nodes"),
-            m.seconds,
-            m.seconds * 1e9 / nodes,
-            bytes("build_peak_bytes"),
-            bytes("accounted_peak_bytes"),
-            bytes("spilled_bytes"),
-            bytes("file_bytes"),
-        );
-    }
+    out_of_core_table(&mut md, &OUT_OF_CORE_LEVELS, None)?;
     let path = results_path("scale");
     ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
