@@ -304,6 +304,22 @@ fn every_dimension_opens_without_errors_and_nothing_is_requested() {
             get(&status, "painted").parse::<u64>().unwrap() > 100,
             "{name}: {status:?}"
         );
+        // The controls, driven by DOM events (a drag with each button, the wheel, a clip slider, the
+        // camera and colour menus, the time slider of a 4-D tree): each moves the view as it should and
+        // changes the frame drawn.
+        let (status, errors) = page_status(&browser, &p(&format!("{name}.html")), "#selftest");
+        assert_eq!(get(&status, "errors"), "0", "{name}: {errors}");
+        let mut controls = vec!["rotate", "pan", "zoom", "clip", "camera", "colour"];
+        if *name == "moving.ktree" {
+            controls.push("time");
+        }
+        for control in controls {
+            assert_eq!(
+                get(&status, &format!("selftest_{control}")),
+                "1",
+                "{name}: {control} ({status:?})"
+            );
+        }
     }
     // The time slider shows one slice of a 4-D tree: a ball moving along the time axis is elsewhere at
     // another time.

@@ -9,7 +9,10 @@
 //! (wheel); sliders clip along each axis; a toggle colours by face normal or by depth in the tree. The
 //! first camera is the one `ktree render --camera NAME` takes (the same orthographic projection and
 //! framing). The URL hash sets the start: `#camera=NAME` another camera, `colour=depth` or `colour=normal`,
-//! `time=T` the slice of a 4-D tree, `bare` no controls (the key `h` hides and shows them).
+//! `time=T` the slice of a 4-D tree, `bare` no controls (the key `h` hides and shows them). `selftest`
+//! drives every control after the first frame with DOM events (drags with both buttons, the wheel, a clip
+//! slider, the camera and colour menus, the time slider) and records in the page's status, for each, whether
+//! the view moved as it should and the frame changed: how the tests check the controls in a browser.
 //!
 //! The drawing is plain WebGL2 (about 200 lines in `view/page.html`, no library): one instanced unit cube,
 //! clipping and colouring in the fragment shader, an orthographic matrix built from the same frame as
