@@ -59,15 +59,15 @@ impl<'a, const K: usize, T: TreeStorage<K>> PointCursor<'a, K, T> {
     /// # Errors
     /// The storage's read error.
     pub fn state(&mut self, point: [u32; K]) -> Result<NodeState, T::Error> {
-        let side = 1u64 << self.level;
-        if point.iter().any(|&c| u64::from(c) >= side) {
+        // Outside the universe: a coordinate with a bit at or above the level.
+        let all = point.iter().fold(0u64, |or, &c| or | u64::from(c));
+        if all >> self.level != 0 {
             return Ok(NodeState::Empty);
         }
-        // The ancestors of the last point down to depth `common` are the point's.
-        let differ = (0..K)
-            .map(|a| 32 - (self.last[a] ^ point[a]).leading_zeros())
-            .max()
-            .unwrap_or(0);
+        // The ancestors of the last point down to depth `common` are the point's: the highest bit in which
+        // any coordinate differs from the last point's is the depth where the paths part.
+        let changed = (0..K).fold(0u32, |or, a| or | (self.last[a] ^ point[a]));
+        let differ = 32 - changed.leading_zeros();
         let common = self.level.saturating_sub(differ) as usize;
         let mut depth = common.min(self.len - 1);
         let (mut index, mut state) = self.path[depth];
