@@ -202,7 +202,7 @@ impl ExactView {
         if !self.negative(entry[0], c, -exit[1], b) || !self.negative(entry[1], b, -exit[0], c) {
             return None;
         }
-        self.hidden_along(a, entry, (u0, u1), cube)
+        self.hidden_along([a, b, c], reflected_origin(a), s, entry, (u0, u1))
     }
 
     /// Whether `p · w_i + q · w_j < 0` for the tilted magnitudes `w_k = |D_k| + ε^{p_k}` (`i ≠ j`): decided
@@ -223,24 +223,18 @@ impl ExactView {
         }
     }
 
-    /// The part of the segment (along `axis`, from `u0` to `u1`) hidden by `cube`, for a segment whose
-    /// sightlines cross the cube's two slabs across it (`entry`: the entry offsets on those axes).
+    /// The part of the segment along axis `a` (from `u0` to `u1`) hidden by a cube of side `s` whose
+    /// reflected origin on `a` is `oa`, for a segment whose sightlines cross the cube's slabs on the other
+    /// two axes `b`, `c` (`entry`: the entry offsets on those axes).
     fn hidden_along(
         &self,
-        axis: usize,
+        [a, b, c]: [usize; 3],
+        oa: i64,
+        s: i64,
         entry: [i64; 2],
         (u0, u1): (u32, u32),
-        cube: &Cell<3>,
     ) -> Option<(Exact, Exact)> {
-        let a = axis;
-        let [b, c] = super::lines::other_axes(a);
-        let s = cube.side() as i64;
         let exit = entry.map(|e| e + s);
-        let oa = if self.increasing[a] {
-            i64::from(cube.origin[a])
-        } else {
-            -(i64::from(cube.origin[a]) + s)
-        };
         // Along the segment, in the reflected coordinate v = ±u: entering slab a before leaving slab j
         // gives v > o'_a − x_j·w_a/w_j; entering slab i before leaving slab a gives
         // v < o'_a + s − e_i·w_a/w_i.
