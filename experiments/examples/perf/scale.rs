@@ -245,7 +245,7 @@ pub fn report_large() -> Result<String, String> {
          the process's high-water resident set when the file is written, the checks (not timed) open the \
          file, verify every section and compare its counts and voxels with the build's and the runs'. The \
          goal: L = 16 in at most 1 GiB and 10 minutes.\n\nMachine: {}.\n",
-        machine_line()
+        machine_line().replace("; one thread used", "")
     );
     out_of_core_table(&mut md, &LARGE_LEVELS, Some(budget_mib))?;
     let path = results_path("scale-large");
