@@ -31,6 +31,9 @@ pub struct PointCursor<'a, const K: usize, T> {
     level: u32,
     /// `(index, state)` of the node at each depth of the last path.
     path: [(usize, NodeState); PATH],
+    /// For each partial node of the last path but the deepest: its first child and its children's codes,
+    /// so that a point in a sibling of the last leaf reads nothing from the tree.
+    children: [(usize, u32); PATH],
     /// Nodes on the last path (at least the root).
     len: usize,
     /// The last point located.
@@ -49,6 +52,7 @@ impl<'a, const K: usize, T: TreeStorage<K>> PointCursor<'a, K, T> {
             tree,
             level: tree.level(),
             path,
+            children: [(0, 0); PATH],
             len: 1,
             last: [0; K],
         })
@@ -71,11 +75,22 @@ impl<'a, const K: usize, T: TreeStorage<K>> PointCursor<'a, K, T> {
         let common = self.level.saturating_sub(differ) as usize;
         let mut depth = common.min(self.len - 1);
         let (mut index, mut state) = self.path[depth];
+        // A partial node above the last path's end was descended last time: its children are known.
+        let mut known = depth + 1 < self.len;
+        // Only this prefix is sure to be the last point's path should a read below fail.
+        self.len = depth + 1;
         while state == NodeState::Partial {
             let bit = self.level - 1 - depth as u32;
             let code = (0..K).fold(0usize, |c, a| c | ((point[a] >> bit & 1) as usize) << a);
-            let first = self.tree.first_child(depth, index)?;
-            let codes = self.tree.block_codes(depth + 1, first)?;
+            let (first, codes) = if known {
+                self.children[depth]
+            } else {
+                let first = self.tree.first_child(depth, index)?;
+                let read = (first, self.tree.block_codes(depth + 1, first)?);
+                self.children[depth] = read;
+                read
+            };
+            known = false;
             index = first + code;
             state = NodeState::from_bits(codes >> (2 * code));
             depth += 1;

@@ -7,6 +7,11 @@
 //! a subtree the ray misses or an empty cell costs one step whatever its size, and the first full leaf the
 //! ray meets ends the walk. Every cast terminates: it is a walk of the tree's finite nodes.
 //!
+//! A node costs `K` divisions, for its middle planes: a child's parameters along each axis are its
+//! parent's or the middle plane's. Only the children between the middle planes the ray crosses before
+//! and after them are tried (at most `K + 1` but at ties), and only those whose interval may be a single
+//! point, or that are full, go through the exact test of open and closed faces below.
+//!
 //! # Exactness and ties
 //! Each cell's parameter interval is computed from its faces in `f64` as `(c − o) / d`; one face has one
 //! value, so neighbouring cells share their boundary exactly, and the walk meets every cell the ray crosses
@@ -22,9 +27,8 @@ use rayon::prelude::*;
 use thiserror::Error;
 
 use crate::space::Cell;
-use crate::tree::cursor::{try_walk, ChildOrder, Visitor, Walk};
 use crate::tree::storage::TreeStorage;
-use crate::tree::{NodeRef, NodeState};
+use crate::tree::NodeState;
 
 /// Why a ray cannot be cast.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -106,38 +110,6 @@ impl<const K: usize> RayCast<K> {
         self.max_t
     }
 
-    /// The parameters at which the ray is in `cell` (within `[0, max_t]`): the entry `t` and the axis
-    /// of the face entered (`None` when `p(t)` is in the cell at `t = 0`), or `None` if it never is.
-    #[inline]
-    fn entry(&self, cell: &Cell<K>) -> Option<(f64, Option<usize>)> {
-        // (value, open) bounds; the lower one with the axis that gave it.
-        let (mut low, mut low_open, mut low_axis) = (0.0f64, false, None);
-        let (mut high, mut high_open) = (self.max_t, false);
-        let side = cell.side() as f64;
-        for a in 0..K {
-            let (o, d) = (self.origin[a], self.direction[a]);
-            let lo = f64::from(cell.origin[a]);
-            let hi = lo + side;
-            let (l, l_open, u, u_open) = if d > 0.0 {
-                ((lo - o) / d, false, (hi - o) / d, true)
-            } else if d < 0.0 {
-                ((hi - o) / d, true, (lo - o) / d, false)
-            } else if lo <= o && o < hi {
-                continue;
-            } else {
-                return None;
-            };
-            if l > low || (l == low && l_open && !low_open) {
-                (low, low_open, low_axis) = (l, l_open, Some(a));
-            }
-            if u < high || (u == high && u_open) {
-                (high, high_open) = (u, u_open);
-            }
-        }
-        let met = low < high || (low == high && !low_open && !high_open);
-        met.then_some((low, low_axis))
-    }
-
     /// The voxel of the full leaf `cell` that the ray is in just after entering it at `t` through a face
     /// of `axis` (or at `t = 0` when `axis` is `None`).
     fn voxel_in(&self, cell: &Cell<K>, t: f64, axis: Option<usize>) -> [u32; K] {
@@ -185,46 +157,178 @@ pub struct RayHit<const K: usize> {
     pub face: Option<Face>,
 }
 
-/// Walks front to back and stops at the first full leaf the ray is in.
-struct Caster<'r, const K: usize> {
-    ray: &'r RayCast<K>,
-    mask: usize,
-    hit: Option<RayHit<K>>,
+/// The parameters at which a ray crosses a cell's slab along each axis, in the ray's order: it enters
+/// the slab of axis `a` at `near[a]` and leaves it at `far[a]`. An axis along which the ray does not move
+/// has `(−∞, ∞)` (the ray is inside that slab, or the cell is never visited).
+#[derive(Debug, Clone, Copy)]
+struct Slabs<const K: usize> {
+    near: [f64; K],
+    far: [f64; K],
 }
 
-impl<const K: usize> Visitor<K> for Caster<'_, K> {
-    const LEAVES: bool = false;
+/// Where a ray is in a cell: from `t`, entering through a face of `axis` (`None`: in the cell at `t = 0`),
+/// to `exit`.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    t: f64,
+    exit: f64,
+    axis: Option<usize>,
+}
 
-    #[inline]
-    fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-        if node.state() == NodeState::Empty {
-            return Walk::Skip;
+/// A front-to-back walk of one ray through a tree: the children of a partial node are tried in the order
+/// the ray crosses them (child code XOR the signs of the direction), each child's slab parameters taken
+/// from its parent's and the parent's middle planes, so that a node costs `K` divisions however many
+/// children are tried.
+struct Caster<'r, const K: usize, T> {
+    tree: &'r T,
+    ray: &'r RayCast<K>,
+    /// Axes along which the ray moves down: their child bit is flipped in the ray's order, and a slab's
+    /// entry is open (the upper face is not in the cell), its exit closed.
+    down: usize,
+    /// Axes along which the ray does not move.
+    still: usize,
+}
+
+impl<const K: usize, T: TreeStorage<K>> Caster<'_, K, T> {
+    /// Where the ray is in the cell whose slab parameters are `slabs`, within `[0, max_t]`: from the
+    /// parameter of its entry, through the face of an axis (none when the ray is in the cell at `t = 0`),
+    /// to that of its exit; `None` if it never is in the cell. A slab of an axis moving up is entered through its closed lower face and
+    /// left through its open upper face; moving down, the reverse; a bound at an equal parameter that is
+    /// open wins over a closed one, so that a cell the ray only touches at its open faces is not met.
+    #[inline(always)]
+    fn entry(&self, slabs: &Slabs<K>) -> Option<Entry> {
+        // The interval [low, high] of the parameters in every slab and in [0, max_t]; an axis that does
+        // not move has (−∞, ∞). Most cells tried are missed: they are rejected on these two numbers.
+        let (mut low, mut high) = (0.0f64, self.ray.max_t);
+        for a in 0..K {
+            if slabs.near[a] > low {
+                low = slabs.near[a];
+            }
+            if slabs.far[a] < high {
+                high = slabs.far[a];
+            }
         }
-        let cell = node.cell();
-        let Some((t, axis)) = self.ray.entry(&cell) else {
-            return Walk::Skip;
-        };
-        if node.state() == NodeState::Partial {
-            return Walk::Descend;
+        if low > high {
+            return None;
         }
-        self.hit = Some(RayHit {
-            voxel: self.ray.voxel_in(&cell, t, axis),
+        // The bounds at `low` and `high`: open where an axis's open face gives them. The face entered is
+        // the first axis giving `low` through an open face, else the first giving it at all (none when
+        // `low` is 0 from a closed face: the ray starts in the cell).
+        let (mut low_open, mut low_axis, mut high_open) = (false, None, false);
+        for a in 0..K {
+            let down = self.down >> a & 1 == 1;
+            if slabs.near[a] == low && !low_open && (down || (low_axis.is_none() && low > 0.0)) {
+                (low_open, low_axis) = (down, Some(a));
+            }
+            high_open |= slabs.far[a] == high && !down && self.still >> a & 1 == 0;
+        }
+        let met = low < high || (!low_open && !high_open);
+        met.then_some(Entry {
+            t: low,
+            exit: high,
+            axis: low_axis,
+        })
+    }
+
+    /// The hit in the full leaf `cell`, entered at `t` through a face of `axis`.
+    fn hit(&self, cell: &Cell<K>, t: f64, axis: Option<usize>) -> RayHit<K> {
+        RayHit {
+            voxel: self.ray.voxel_in(cell, t, axis),
             t,
             face: axis.map(|axis| Face {
                 axis,
-                sign: if self.ray.direction[axis] > 0.0 {
-                    -1
-                } else {
-                    1
-                },
+                sign: if self.down >> axis & 1 == 1 { 1 } else { -1 },
             }),
-        });
-        Walk::Stop
+        }
     }
 
-    #[inline]
-    fn child_order(&self, _node: &NodeRef<K>) -> ChildOrder {
-        ChildOrder::xor::<K>(self.mask)
+    /// The first full voxel the ray enters in the partial node `index` at `depth`, whose cell is `cell`,
+    /// slab parameters `slabs` and parameters in the cell `within`.
+    fn partial(
+        &mut self,
+        depth: usize,
+        index: usize,
+        cell: &Cell<K>,
+        slabs: &Slabs<K>,
+        within: &Entry,
+    ) -> Result<Option<RayHit<K>>, T::Error> {
+        let first = self.tree.first_child(depth, index)?;
+        let codes = self.tree.block_codes(depth + 1, first)?;
+        let half = (cell.side() / 2) as f64;
+        let (o, d) = (self.ray.origin, self.ray.direction);
+        let mut middle = [0.0; K];
+        let mut fixed = 0usize;
+        for a in 0..K {
+            let plane = f64::from(cell.origin[a]) + half;
+            if self.still >> a & 1 == 1 {
+                fixed |= usize::from(o[a] >= plane) << a;
+            } else {
+                middle[a] = (plane - o[a]) / d[a];
+            }
+        }
+        // The children worth trying, by their place `order` in the ray's order (the child code XOR the
+        // axes moving down): not empty, on the ray's side of the still axes' middle planes, and with
+        // room between the middle planes crossed before them and those crossed after, within the
+        // parent's parameters. Every child the ray meets is one; ties make a few more, which the exact
+        // test below rejects.
+        let mut candidates = 0u32;
+        let mut bounds = [(0.0f64, 0.0f64); 16];
+        for (order, bound) in bounds.iter_mut().enumerate().take(1 << K) {
+            let (mut low, mut high) = (within.t, within.exit);
+            for (a, &m) in middle.iter().enumerate() {
+                if self.still >> a & 1 == 0 {
+                    if order >> a & 1 == 1 {
+                        low = if m > low { m } else { low };
+                    } else {
+                        high = if m < high { m } else { high };
+                    }
+                }
+            }
+            *bound = (low, high);
+            let code = order ^ self.down;
+            let filled = codes >> (2 * code) & 0b11 != 0;
+            let aside = (order ^ fixed) & self.still != 0;
+            candidates |= u32::from(low <= high && filled && !aside) << order;
+        }
+        while candidates != 0 {
+            let order = candidates.trailing_zeros() as usize;
+            candidates &= candidates - 1;
+            let mut child = *slabs;
+            for (a, &m) in middle.iter().enumerate() {
+                if self.still >> a & 1 == 0 {
+                    if order >> a & 1 == 1 {
+                        child.near[a] = m;
+                    } else {
+                        child.far[a] = m;
+                    }
+                }
+            }
+            let code = order ^ self.down;
+            let state = NodeState::from_bits(codes >> (2 * code));
+            // A child with room between its entry and exit is met; one where they are equal, or a full
+            // one (whose face entered is wanted), gets the exact test. The bounds are the same numbers
+            // either way: maxima and minima of the same parameters.
+            let (low, high) = bounds[order];
+            let entry = if low < high && state == NodeState::Partial {
+                Entry {
+                    t: low,
+                    exit: high,
+                    axis: None,
+                }
+            } else if let Some(entry) = self.entry(&child) {
+                entry
+            } else {
+                continue;
+            };
+            let cell = cell.child(code);
+            if state == NodeState::Full {
+                return Ok(Some(self.hit(&cell, entry.t, entry.axis)));
+            }
+            if let Some(hit) = self.partial(depth + 1, first + code, &cell, &child, &entry)? {
+                return Ok(Some(hit));
+            }
+        }
+        Ok(None)
     }
 }
 
@@ -249,14 +353,42 @@ pub fn cast_ray<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     ray: &RayCast<K>,
 ) -> Result<Option<RayHit<K>>, T::Error> {
-    let mask = (0..K).fold(0, |m, a| m | usize::from(ray.direction[a] < 0.0) << a);
-    let mut caster = Caster {
-        ray,
-        mask,
-        hit: None,
+    let (o, d) = (ray.origin, ray.direction);
+    let down = (0..K).fold(0, |m, a| m | usize::from(d[a] < 0.0) << a);
+    let still = (0..K).fold(0, |m, a| m | usize::from(d[a] == 0.0) << a);
+    let root = tree.universe().root();
+    let side = root.side() as f64;
+    let mut slabs = Slabs {
+        near: [f64::NEG_INFINITY; K],
+        far: [f64::INFINITY; K],
     };
-    try_walk(tree, &mut caster)?;
-    Ok(caster.hit)
+    for a in 0..K {
+        let (lower, upper) = ((0.0 - o[a]) / d[a], (side - o[a]) / d[a]);
+        if d[a] > 0.0 {
+            (slabs.near[a], slabs.far[a]) = (lower, upper);
+        } else if d[a] < 0.0 {
+            (slabs.near[a], slabs.far[a]) = (upper, lower);
+        } else if !(0.0 <= o[a] && o[a] < side) {
+            return Ok(None);
+        }
+    }
+    let mut caster = Caster {
+        tree,
+        ray,
+        down,
+        still,
+    };
+    let state = tree.root_state()?;
+    if state == NodeState::Empty {
+        return Ok(None);
+    }
+    let Some(entry) = caster.entry(&slabs) else {
+        return Ok(None);
+    };
+    if state == NodeState::Full {
+        return Ok(Some(caster.hit(&root, entry.t, entry.axis)));
+    }
+    caster.partial(0, 0, &root, &slabs, &entry)
 }
 
 /// [`cast_ray`] for each ray, on all threads, in the order given.
