@@ -192,13 +192,14 @@ struct Caster<'r, const K: usize, T> {
 impl<const K: usize, T: TreeStorage<K>> Caster<'_, K, T> {
     /// Where the ray is in the cell whose slab parameters are `slabs`, within `[0, max_t]`: from the
     /// parameter of its entry, through the face of an axis (none when the ray is in the cell at `t = 0`),
-    /// to that of its exit; `None` if it never is in the cell. A slab of an axis moving up is entered through its closed lower face and
-    /// left through its open upper face; moving down, the reverse; a bound at an equal parameter that is
-    /// open wins over a closed one, so that a cell the ray only touches at its open faces is not met.
+    /// to that of its exit; `None` if it never is in the cell. A slab of an axis moving up is entered
+    /// through its closed lower face and left through its open upper face; moving down, the reverse; a
+    /// bound at an equal parameter that is open wins over a closed one, so that a cell the ray only
+    /// touches at its open faces is not met.
     #[inline(always)]
     fn entry(&self, slabs: &Slabs<K>) -> Option<Entry> {
         // The interval [low, high] of the parameters in every slab and in [0, max_t]; an axis that does
-        // not move has (−∞, ∞). Most cells tried are missed: they are rejected on these two numbers.
+        // not move has (−∞, ∞). A cell the ray misses is rejected on these two numbers.
         let (mut low, mut high) = (0.0f64, self.ray.max_t);
         for a in 0..K {
             if slabs.near[a] > low {
