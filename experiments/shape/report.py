@@ -210,8 +210,8 @@ def main() -> None:
     w("")
     w(
         f"Machine: {cpu()}, {os.cpu_count()} cores, shared with other builds and runs: load average "
-        f"{' '.join(load)} at the start, {' '.join(load_end)} at the end — times are inflated and noisy "
-        "accordingly, ktree's and its peers' alike (they alternate)."
+        f"{' '.join(load)} at the start, {' '.join(load_end)} at the end. The programs measured add about 1; "
+        "other work above that takes time from ktree and its peers alike (they alternate)."
     )
     w("")
     w("Inputs:")
