@@ -244,14 +244,14 @@ impl<const K: usize, T: TreeStorage<K>> Caster<'_, K, T> {
     }
 
     /// The first full voxel the ray enters in the partial node `index` at `depth`, whose cell is `cell`,
-    /// slab parameters `slabs` and parameters in the cell `within`.
+    /// slab parameters `slabs` and parameters in the cell `within` (entry and exit).
     fn partial(
         &mut self,
         depth: usize,
         index: usize,
         cell: &Cell<K>,
         slabs: &Slabs<K>,
-        within: &Entry,
+        within: (f64, f64),
     ) -> Result<Option<RayHit<K>>, T::Error> {
         let first = self.tree.first_child(depth, index)?;
         let codes = self.tree.block_codes(depth + 1, first)?;
@@ -275,7 +275,7 @@ impl<const K: usize, T: TreeStorage<K>> Caster<'_, K, T> {
         let mut candidates = 0u32;
         let mut bounds = [(0.0f64, 0.0f64); 16];
         for (order, bound) in bounds.iter_mut().enumerate().take(1 << K) {
-            let (mut low, mut high) = (within.t, within.exit);
+            let (mut low, mut high) = within;
             for (a, &m) in middle.iter().enumerate() {
                 if self.still >> a & 1 == 0 {
                     if order >> a & 1 == 1 {
@@ -287,7 +287,7 @@ impl<const K: usize, T: TreeStorage<K>> Caster<'_, K, T> {
             }
             *bound = (low, high);
             let code = order ^ self.down;
-            let filled = codes >> (2 * code) & 0b11 != 0;
+            let filled = NodeState::from_bits(codes >> (2 * code)) != NodeState::Empty;
             let aside = (order ^ fixed) & self.still != 0;
             candidates |= u32::from(low <= high && filled && !aside) << order;
         }
@@ -305,27 +305,21 @@ impl<const K: usize, T: TreeStorage<K>> Caster<'_, K, T> {
                 }
             }
             let code = order ^ self.down;
-            let state = NodeState::from_bits(codes >> (2 * code));
-            // A child with room between its entry and exit is met; one where they are equal, or a full
-            // one (whose face entered is wanted), gets the exact test. The bounds are the same numbers
-            // either way: maxima and minima of the same parameters.
-            let (low, high) = bounds[order];
-            let entry = if low < high && state == NodeState::Partial {
-                Entry {
-                    t: low,
-                    exit: high,
-                    axis: None,
-                }
-            } else if let Some(entry) = self.entry(&child) {
-                entry
-            } else {
-                continue;
-            };
             let cell = cell.child(code);
-            if state == NodeState::Full {
-                return Ok(Some(self.hit(&cell, entry.t, entry.axis)));
+            // A full child gets the exact test, which also gives the face entered. A partial child with
+            // room between its entry and exit is met; where they are equal, the exact test decides. Its
+            // bounds are those of `bounds`: maxima and minima of the same parameters.
+            if NodeState::from_bits(codes >> (2 * code)) == NodeState::Full {
+                if let Some(entry) = self.entry(&child) {
+                    return Ok(Some(self.hit(&cell, entry.t, entry.axis)));
+                }
+                continue;
             }
-            if let Some(hit) = self.partial(depth + 1, first + code, &cell, &child, &entry)? {
+            let (low, high) = bounds[order];
+            if low == high && self.entry(&child).is_none() {
+                continue;
+            }
+            if let Some(hit) = self.partial(depth + 1, first + code, &cell, &child, (low, high))? {
                 return Ok(Some(hit));
             }
         }
@@ -389,7 +383,7 @@ pub fn cast_ray<const K: usize, T: TreeStorage<K>>(
     if state == NodeState::Full {
         return Ok(Some(caster.hit(&root, entry.t, entry.axis)));
     }
-    caster.partial(0, 0, &root, &slabs, &entry)
+    caster.partial(0, 0, &root, &slabs, (entry.t, entry.exit))
 }
 
 /// [`cast_ray`] for each ray, on all threads, in the order given.
