@@ -21,36 +21,61 @@ use super::runs::Runs;
 use super::{Element, ShapeError};
 use crate::KTree;
 
-fn dilate_runs<const K: usize>(runs: &Runs<K>, element: &[([i64; K], i64)]) -> Runs<K> {
-    let mut out = Runs::default();
+/// Sets `out` to the dilation of `runs` by one slice of an element; `spare` is a second buffer.
+fn dilate_runs<const K: usize>(
+    runs: &Runs<K>,
+    element: &Slice<K>,
+    out: &mut Runs<K>,
+    spare: &mut Runs<K>,
+) {
+    out.clear();
     for &(c, h) in element {
-        out = out.combine(&runs.shifted(c, h), true);
+        out.combine_into(runs.moved(c, h), true, spare);
+        std::mem::swap(out, spare);
     }
-    out
 }
 
-fn erode_runs<const K: usize>(runs: &Runs<K>, element: &[([i64; K], i64)]) -> Runs<K> {
-    let mut out: Option<Runs<K>> = None;
-    for &(c, h) in element {
-        let moved = runs.shifted(c.map(|x| -x), -h);
-        let next = match out {
-            None => moved,
-            Some(acc) => acc.combine(&moved, false),
-        };
-        if next.is_empty() {
-            return next;
+/// Sets `out` to the erosion of `runs` by one slice of an element; `spare` is a second buffer.
+fn erode_runs<const K: usize>(
+    runs: &Runs<K>,
+    element: &Slice<K>,
+    out: &mut Runs<K>,
+    spare: &mut Runs<K>,
+) {
+    out.clear();
+    let Some((&(c, h), rest)) = element.split_first() else {
+        return;
+    };
+    runs.moved(c.map(|x| -x), -h).copy_into(out);
+    for &(c, h) in rest {
+        if out.is_empty() {
+            return;
         }
-        out = Some(next);
+        out.combine_into(runs.moved(c.map(|x| -x), -h), false, spare);
+        std::mem::swap(out, spare);
     }
-    out.unwrap_or_default()
+}
+
+/// Applies `step` with each slice in turn, three buffers in all, reused from step to step.
+fn all_steps<const K: usize>(
+    runs: Runs<K>,
+    steps: &[Slice<K>],
+    step: fn(&Runs<K>, &Slice<K>, &mut Runs<K>, &mut Runs<K>),
+) -> Runs<K> {
+    let (mut acc, mut out, mut spare) = (runs, Runs::default(), Runs::default());
+    for slice in steps {
+        step(&acc, slice, &mut out, &mut spare);
+        std::mem::swap(&mut acc, &mut out);
+    }
+    acc
 }
 
 fn dilate_all<const K: usize>(runs: Runs<K>, steps: &[Slice<K>]) -> Runs<K> {
-    steps.iter().fold(runs, |acc, s| dilate_runs(&acc, s))
+    all_steps(runs, steps, dilate_runs)
 }
 
 fn erode_all<const K: usize>(runs: Runs<K>, steps: &[Slice<K>]) -> Runs<K> {
-    steps.iter().fold(runs, |acc, s| erode_runs(&acc, s))
+    all_steps(runs, steps, erode_runs)
 }
 
 /// The number of column offsets of a ball's slice, `(2⌊r⌋ + 1)^(K−1)`, from which [`KTree::dilate`] and

@@ -1,10 +1,13 @@
 //! A tree back to rays: the runs of its full voxels along the last axis.
 //!
 //! The runs are gathered slab by slab along the first axis (up to [`SLABS`] slabs): a walk that skips the
-//! subtrees outside the slab lists each full leaf's column pieces, which are sorted and joined into the
-//! slab's runs. Only one slab's pieces are held at a time, so the memory is that of the runs plus a slab's
+//! subtrees outside the slab lists each full leaf's column pieces, which are sorted by column and joined
+//! into the slab's runs. The walk goes depth first in child order, so the pieces of one column already come
+//! in order along it (two leaves over the same column part at an ancestor whose children differ only in
+//! the last axis's bit): a stable radix sort by the column alone puts them in order. Only one slab's pieces are held at a time, so the memory is that of the runs plus a slab's
 //! share of the pieces (a column crosses a piece per full leaf above it, many more than it has runs).
 
+use crate::radix;
 use crate::rays::RaySet;
 use crate::tree::cursor::{walk, Visitor, Walk};
 use crate::tree::{KTree, NodeRef, NodeState};
@@ -29,6 +32,14 @@ impl<const K: usize> KTree<K> {
         let mut columns = Vec::new();
         let mut runs: Vec<(u32, u32)> = Vec::new();
         let mut pieces = Vec::new();
+        let mut scratch = Vec::new();
+        // Within a slab, a column key less the slab's first key is below 2^key_bits.
+        let inner_bits = level * (K.max(2) as u32 - 2);
+        let key_bits = if K == 1 {
+            0
+        } else {
+            width.next_power_of_two().trailing_zeros() + inner_bits
+        };
         let mut start = 0;
         while start < side {
             let end = (start + width).min(side);
@@ -39,13 +50,17 @@ impl<const K: usize> KTree<K> {
                 pieces: &mut pieces,
             };
             walk(self, &mut slab);
-            pieces.sort_unstable();
+            let base = if K == 1 { 0 } else { start << inner_bits };
+            radix::sort_by_key(&mut pieces, key_bits, &mut scratch, |p| p.0 - base);
             for &(column, z1, z2) in pieces.iter() {
                 let last = runs.len();
-                if last > 0 && columns[last - 1] == column && z1 <= runs[last - 1].1 {
-                    // Touching the previous piece of the same column (leaves never overlap): extend it.
-                    runs[last - 1].1 = runs[last - 1].1.max(z2);
-                    continue;
+                if last > 0 && columns[last - 1] == column {
+                    debug_assert!(z1 >= runs[last - 1].1, "pieces of a column in order");
+                    if z1 == runs[last - 1].1 {
+                        // Touching the previous piece of the same column: extend it.
+                        runs[last - 1].1 = z2;
+                        continue;
+                    }
                 }
                 columns.push(column);
                 runs.push((z1, z2));
