@@ -43,6 +43,7 @@
 use rayon::prelude::*;
 
 use super::ShapeError;
+use crate::radix;
 use crate::rays::RaySet;
 use crate::tree::cursor::{walk, Visitor, Walk};
 use crate::tree::{NodeRef, NodeState};
@@ -453,19 +454,48 @@ fn runs_of<const K: usize>(tree: &KTree<K>, b: &Bx<K>, keep: &[bool]) -> Vec<(u6
     out
 }
 
-/// A tree from runs `(column key, z1, z2)` in any order: sorted, touching runs joined.
-fn tree_of_runs<const K: usize>(tree: &KTree<K>, mut runs: Vec<(u64, u32, u32)>) -> KTree<K> {
-    runs.par_sort_unstable();
+/// The tree of the runs that `runs_in` gives for each block (a block's runs `(column key, z1, z2)` in row
+/// order), the blocks in [`blocks`]' order. The blocks are taken slab by slab along the first axis, each
+/// slab's on all threads; a column's pieces then come in order along it (its blocks are consecutive, in
+/// order along the last axis), so one stable radix sort by the column puts a slab's runs in order, and they
+/// are appended, touching pieces joined. Memory holds the result's runs and one slab's pieces, never every
+/// block's at once.
+fn tree_of_blocks<const K: usize>(
+    tree: &KTree<K>,
+    blocks: &[Bx<K>],
+    side: i64,
+    runs_in: impl Fn(&Bx<K>) -> Vec<(u64, u32, u32)> + Sync,
+) -> KTree<K> {
+    let level = tree.level();
+    let inner_bits = level * (K.max(2) as u32 - 2);
+    let key_bits = if K == 1 {
+        0
+    } else {
+        side.trailing_zeros() + inner_bits
+    };
     let (mut columns, mut merged): (Vec<u64>, Vec<(u32, u32)>) = (Vec::new(), Vec::new());
-    for (key, z1, z2) in runs {
-        if let (Some(&c), Some(last)) = (columns.last(), merged.last_mut()) {
-            if c == key && z1 <= last.1 {
-                last.1 = last.1.max(z2);
-                continue;
+    let mut scratch = Vec::new();
+    for slab in blocks.chunk_by(|a, b| a.lo[0] == b.lo[0]) {
+        let mut pieces: Vec<(u64, u32, u32)> = slab.par_iter().flat_map_iter(&runs_in).collect();
+        let base = if K == 1 {
+            0
+        } else {
+            (slab[0].lo[0] as u64) << inner_bits
+        };
+        radix::sort_by_key(&mut pieces, key_bits, &mut scratch, |p| p.0 - base);
+        for (key, z1, z2) in pieces {
+            if let (Some(&c), Some(last)) = (columns.last(), merged.last_mut()) {
+                if c == key {
+                    debug_assert!(z1 >= last.1, "a column's pieces in order");
+                    if z1 == last.1 {
+                        last.1 = z2;
+                        continue;
+                    }
+                }
             }
+            columns.push(key);
+            merged.push((z1, z2));
         }
-        columns.push(key);
-        merged.push((z1, z2));
     }
     KTree::from_rays(&RaySet::from_sorted_parts(
         tree.universe(),
@@ -699,22 +729,18 @@ impl<const K: usize> KTree<K> {
         let universe = universe_box(self);
         let pad = (r.floor() as i64).min(universe.dims[0]);
         let side = block_side(self, pad);
-        let runs: Vec<(u64, u32, u32)> = blocks(self, side, 1)
-            .par_iter()
-            .flat_map_iter(|b| {
-                let src = b.grown(pad).meet(&universe);
-                if count_in(self, &src) == 0 {
-                    return Vec::new();
-                }
-                if count_in(self, b) == b.len() {
-                    return runs_of(self, b, &vec![true; b.len() as usize]);
-                }
-                let d = edt(&src, &mask(self, &src, true, false), b);
-                let keep: Vec<bool> = d.iter().map(|&d| d <= limit).collect();
-                runs_of(self, b, &keep)
-            })
-            .collect();
-        tree_of_runs(self, runs)
+        tree_of_blocks(self, &blocks(self, side, 1), side, |b| {
+            let src = b.grown(pad).meet(&universe);
+            if count_in(self, &src) == 0 {
+                return Vec::new();
+            }
+            if count_in(self, b) == b.len() {
+                return runs_of(self, b, &vec![true; b.len() as usize]);
+            }
+            let d = edt(&src, &mask(self, &src, true, false), b);
+            let keep: Vec<bool> = d.iter().map(|&d| d <= limit).collect();
+            runs_of(self, b, &keep)
+        })
     }
 
     /// Erosion by a ball through the distance transform, the outside of the universe empty (scipy's
@@ -724,23 +750,19 @@ impl<const K: usize> KTree<K> {
         let universe = universe_box(self);
         let pad = (r.floor() as i64).min(universe.dims[0]);
         let side = block_side(self, pad);
-        let runs: Vec<(u64, u32, u32)> = blocks(self, side, 0)
-            .par_iter()
-            .flat_map_iter(|b| {
-                let src = b.grown(pad);
-                let inside = src.meet(&universe) == src;
-                if count_in(self, b) == 0 {
-                    return Vec::new();
-                }
-                if inside && count_in(self, &src) == src.len() {
-                    return runs_of(self, b, &vec![true; b.len() as usize]);
-                }
-                let d = edt(&src, &mask(self, &src, false, true), b);
-                let keep: Vec<bool> = d.iter().map(|&d| d > limit).collect();
-                runs_of(self, b, &keep)
-            })
-            .collect();
-        tree_of_runs(self, runs)
+        tree_of_blocks(self, &blocks(self, side, 0), side, |b| {
+            let src = b.grown(pad);
+            let inside = src.meet(&universe) == src;
+            if count_in(self, b) == 0 {
+                return Vec::new();
+            }
+            if inside && count_in(self, &src) == src.len() {
+                return runs_of(self, b, &vec![true; b.len() as usize]);
+            }
+            let d = edt(&src, &mask(self, &src, false, true), b);
+            let keep: Vec<bool> = d.iter().map(|&d| d > limit).collect();
+            runs_of(self, b, &keep)
+        })
     }
 }
 

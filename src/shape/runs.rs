@@ -1,14 +1,47 @@
 //! Runs with signed coordinates, not clipped to a universe: the working form of the morphology, so that an
 //! intermediate result (a dilation before an erosion) may reach past the universe's faces.
+//!
+//! A column (the first `K − 1` coordinates) is kept as one packed key: each coordinate biased by half its
+//! field, in a field of `64 / (K − 1)` bits, the first coordinate highest, so that keys sort as the
+//! columns do lexicographically and a column offset moves every key by one constant. The fields hold
+//! every coordinate the morphology reaches: the universe's side plus twice the largest radius a closing
+//! accepts (four sides), that is below `2^(L + 4)` — at most 2^25 for K = 3 (fields of 32 bits) and 2^20
+//! for K = 4 (21 bits; `L ≤ 16`).
 use crate::rays::RaySet;
 use crate::space::Universe;
 
-/// Sorted columns (lexicographic, the first `K − 1` coordinates; the last is 0), each with sorted,
-/// disjoint, non-touching half-open runs `[z1, z2)`.
+/// Bits of each column coordinate's field in a packed key.
+const fn field_bits(k: usize) -> u32 {
+    if k <= 1 {
+        0
+    } else {
+        64 / (k as u32 - 1)
+    }
+}
+
+/// Packs the first `K − 1` coordinates of `col` (see the module's docs).
+fn pack<const K: usize>(col: &[i64]) -> u64 {
+    let w = field_bits(K);
+    col[..K - 1].iter().fold(0u128, |key, &x| {
+        let field = (x as i128 + (1i128 << (w - 1))) as u128 & ((1u128 << w) - 1);
+        (key << w) | field
+    }) as u64
+}
+
+/// Coordinate `axis` (`< K − 1`) of a packed key.
+fn unpack_axis<const K: usize>(key: u64, axis: usize) -> i64 {
+    let w = field_bits(K);
+    let shift = w * (K as u32 - 2 - axis as u32);
+    let field = (u128::from(key) >> shift) & ((1u128 << w) - 1);
+    (field as i128 - (1i128 << (w - 1))) as i64
+}
+
+/// Sorted columns (packed keys, see the module's docs), each with sorted, disjoint, non-touching half-open
+/// runs `[z1, z2)`.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub(crate) struct Runs<const K: usize> {
-    pub(crate) cols: Vec<[i64; K]>,
-    pub(crate) runs: Vec<(i64, i64)>,
+    cols: Vec<u64>,
+    runs: Vec<(i64, i64)>,
 }
 
 impl<const K: usize> Runs<K> {
@@ -17,7 +50,7 @@ impl<const K: usize> Runs<K> {
         let cols = set
             .column_keys()
             .iter()
-            .map(|&k| RaySet::<K>::column_of_key_at(level, k).map(i64::from))
+            .map(|&k| pack::<K>(&RaySet::<K>::column_of_key_at(level, k).map(i64::from)))
             .collect();
         let runs = set
             .runs()
@@ -43,17 +76,19 @@ impl<const K: usize> Runs<K> {
         let side = universe.side() as i64;
         let mut columns = Vec::new();
         let mut runs = Vec::new();
-        for (c, &(z1, z2)) in self.cols.iter().zip(&self.runs) {
-            if c[..K - 1].iter().any(|&x| x < 0 || x >= side) {
-                continue;
-            }
+        'runs: for (&c, &(z1, z2)) in self.cols.iter().zip(&self.runs) {
             let (z1, z2) = (z1.max(0), z2.min(side));
             if z1 >= z2 {
                 continue;
             }
-            let key = c[..K - 1]
-                .iter()
-                .fold(0u64, |key, &x| (key << level) | x as u64);
+            let mut key = 0u64;
+            for axis in 0..K - 1 {
+                let x = unpack_axis::<K>(c, axis);
+                if x < 0 || x >= side {
+                    continue 'runs;
+                }
+                key = (key << level) | x as u64;
+            }
             columns.push(key);
             runs.push((z1 as u32, z2 as u32));
         }
@@ -63,15 +98,16 @@ impl<const K: usize> Runs<K> {
     /// The runs moved by the column offset `by` and grown by `grow` at both ends (shrunk if negative), read
     /// on the fly by [`Runs::combine_into`]; a column offset keeps the columns' order.
     pub(crate) fn moved(&self, by: [i64; K], grow: i64) -> Moved<'_, K> {
+        // Packing is linear while no field overflows: the offset's key less the origin's.
         Moved {
             runs: self,
-            by,
+            by: pack::<K>(&by).wrapping_sub(pack::<K>(&[0; K])),
             grow,
         }
     }
 
     /// Appends a run at the end, merging it with the last run of the same column if they overlap or touch.
-    fn push(&mut self, col: [i64; K], z1: i64, z2: i64) {
+    fn push(&mut self, col: u64, z1: i64, z2: i64) {
         if let (Some(last_col), Some(last)) = (self.cols.last(), self.runs.last_mut()) {
             if *last_col == col && z1 <= last.1 {
                 last.1 = last.1.max(z2);
@@ -150,17 +186,15 @@ impl<const K: usize> Runs<K> {
 #[derive(Clone, Copy)]
 pub(crate) struct Moved<'a, const K: usize> {
     runs: &'a Runs<K>,
-    by: [i64; K],
+    /// The packed offset, added to a key (wrapping) to move it.
+    by: u64,
     grow: i64,
 }
 
 impl<const K: usize> Moved<'_, K> {
     /// Column `col` of the runs, moved.
-    fn column(&self, mut col: [i64; K]) -> [i64; K] {
-        for (x, d) in col[..K - 1].iter_mut().zip(&self.by[..K - 1]) {
-            *x += d;
-        }
-        col
+    fn column(&self, col: u64) -> u64 {
+        col.wrapping_add(self.by)
     }
 
     /// Sets `out` to the moved runs (emptied runs dropped).
@@ -172,5 +206,53 @@ impl<const K: usize> Moved<'_, K> {
                 out.push(self.column(col), z1, z2);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Keys round-trip, sort as their columns and move by a constant over the whole reach of the
+    /// morphology (nine sides either way) at the largest level.
+    fn keys_hold_the_reach<const K: usize>() {
+        let reach = 9 * (1i64 << crate::max_level(K));
+        let values = [-reach, -reach / 2 - 3, -1, 0, 1, 5, reach / 3, reach];
+        let cols: Vec<[i64; K]> = (0..values.len().pow(K as u32 - 1))
+            .map(|mut i| {
+                let mut col = [0i64; K];
+                for x in col[..K - 1].iter_mut().rev() {
+                    *x = values[i % values.len()];
+                    i /= values.len();
+                }
+                col
+            })
+            .collect();
+        let origin = pack::<K>(&[0; K]);
+        for a in &cols {
+            let key = pack::<K>(a);
+            for axis in 0..K - 1 {
+                assert_eq!(unpack_axis::<K>(key, axis), a[axis]);
+            }
+            for b in &cols {
+                assert_eq!(key.cmp(&pack::<K>(b)), a.cmp(b), "{a:?} against {b:?}");
+                let sum: [i64; K] = std::array::from_fn(|i| a[i] + b[i]);
+                if sum.iter().all(|x| x.abs() <= reach) {
+                    let by = pack::<K>(b).wrapping_sub(origin);
+                    assert_eq!(
+                        key.wrapping_add(by),
+                        pack::<K>(&sum),
+                        "{a:?} moved by {b:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn keys_hold_the_reach_k2_to_k4() {
+        keys_hold_the_reach::<2>();
+        keys_hold_the_reach::<3>();
+        keys_hold_the_reach::<4>();
     }
 }
