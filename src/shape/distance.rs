@@ -646,40 +646,42 @@ impl<const K: usize> KTree<K> {
         let universe = universe_box(self);
         let pad = (width.floor() as i64).min(universe.dims[0]);
         let side = block_side(self, pad);
-        let parts: Vec<(Vec<[u32; K]>, Vec<f64>)> = blocks(self, side, 1)
-            .par_iter()
-            .map(|b| {
-                let src = b.grown(pad).meet(&universe);
-                let n = count_in(self, &src);
-                if n == 0 || n == src.len() {
-                    return (Vec::new(), Vec::new());
+        let band_of = |b: &Bx<K>| {
+            let src = b.grown(pad).meet(&universe);
+            let n = count_in(self, &src);
+            if n == 0 || n == src.len() {
+                return (Vec::new(), Vec::new());
+            }
+            let full = mask(self, &src, true, false);
+            let empty: Vec<bool> = full.iter().map(|&f| !f).collect();
+            let out = edt(&src, &full, b);
+            let inn = edt(&src, &empty, b);
+            let (mut voxels, mut values) = (Vec::new(), Vec::new());
+            for i in 0..out.len() {
+                let (d, sign) = if out[i] == 0 {
+                    (inn[i], -1.0)
+                } else {
+                    (out[i], 1.0)
+                };
+                if d <= limit {
+                    voxels.push(voxel_of(b, i));
+                    values.push(sign * (d as f64).sqrt());
                 }
-                let full = mask(self, &src, true, false);
-                let empty: Vec<bool> = full.iter().map(|&f| !f).collect();
-                let out = edt(&src, &full, b);
-                let inn = edt(&src, &empty, b);
-                let (mut voxels, mut values) = (Vec::new(), Vec::new());
-                for i in 0..out.len() {
-                    let (d, sign) = if out[i] == 0 {
-                        (inn[i], -1.0)
-                    } else {
-                        (out[i], 1.0)
-                    };
-                    if d <= limit {
-                        voxels.push(voxel_of(b, i));
-                        values.push(sign * (d as f64).sqrt());
-                    }
-                }
-                (voxels, values)
-            })
-            .collect();
+            }
+            (voxels, values)
+        };
         let mut band = NarrowBand {
             width,
             ..NarrowBand::default()
         };
-        for (v, d) in parts {
-            band.voxels.extend(v);
-            band.values.extend(d);
+        // A few blocks a thread at a time, appended at once: memory is the band and those blocks' parts.
+        let chunk = 16 * rayon::current_num_threads();
+        for blocks in blocks(self, side, 1).chunks(chunk) {
+            let parts: Vec<(Vec<[u32; K]>, Vec<f64>)> = blocks.par_iter().map(band_of).collect();
+            for (v, d) in parts {
+                band.voxels.extend(v);
+                band.values.extend(d);
+            }
         }
         Ok(band)
     }

@@ -21,6 +21,12 @@ use super::runs::Runs;
 use super::{Element, ShapeError};
 use crate::KTree;
 
+/// Up to this many column offsets, a slice's dilation merges all its moved copies in one pass; beyond, it
+/// merges them one at a time (each output column would look at too many copies). Measured on the L = 10
+/// ball and armadillo, one thread: the unit cross (5 offsets) and the ball of r = 2 (13) 1.25–1.6× faster
+/// in one pass; the ball of r = 4 (49 offsets) and r = 8 (197) 1.4–1.6× slower.
+const MERGED_AT_ONCE: usize = 16;
+
 /// Sets `out` to the dilation of `runs` by one slice of an element; `spare` is a second buffer.
 fn dilate_runs<const K: usize>(
     runs: &Runs<K>,
@@ -28,6 +34,10 @@ fn dilate_runs<const K: usize>(
     out: &mut Runs<K>,
     spare: &mut Runs<K>,
 ) {
+    if element.len() <= MERGED_AT_ONCE {
+        runs.union_of_moved_into(element, out);
+        return;
+    }
     out.clear();
     for &(c, h) in element {
         out.combine_into(runs.moved(c, h), true, spare);
@@ -81,12 +91,18 @@ fn erode_all<const K: usize>(runs: Runs<K>, steps: &[Slice<K>]) -> Runs<K> {
 /// The number of column offsets of a ball's slice, `(2⌊r⌋ + 1)^(K−1)`, from which [`KTree::dilate`] and
 /// [`KTree::erode`] take the distance transform ([`KTree::dilate_ball_by_distance`]) instead of the run
 /// extension, whose cost grows with that number while the transform's grows only with the blocks' margin.
-/// Measured on the L = 9 ball of radius 200 (one run each, 2 cores shared with other builds, load about
-/// 12): the run extension was faster up to r = 16 (dilation 6.5 s against 8.1 s), the transform from r = 24
-/// (10.9 s against 27.9 s), so the switch is at r = 20 in 3-D, 41² offsets. On the L = 9 armadillo the
-/// single runs were too noisy to move it (r = 24: 37.6 s against 94.3 s; r = 12: 12.3 s against 21.8 s). Other K take the same count of
-/// offsets (not measured); in 1-D the ball is one run and the runs always win.
-pub const BALL_BY_DISTANCE_FROM: u128 = 41 * 41;
+/// Measured on the L = 9 ball (radius 256) and armadillo, dilation, one thread, one run each, load 1.4–1.7:
+///
+/// | r | ball: runs | transform | armadillo: runs | transform |
+/// |---|---:|---:|---:|---:|
+/// | 24 | 4.1 s | 8.6 s | 2.5 s | 4.3 s |
+/// | 32 | 6.2 s | 12.3 s | 4.3 s | 6.3 s |
+/// | 48 | 19.0 s | 15.4 s | 14.2 s | 11.5 s |
+///
+/// so the switch is at r = 40 in 3-D, 81² offsets. The run extension also peaks lower (27 MiB against 56 MiB
+/// at r = 32, 30 against 222 MiB at r = 48: the transform holds a block grown by r on each side). Other K
+/// take the same count of offsets (not measured); in 1-D the ball is one run and the runs always win.
+pub const BALL_BY_DISTANCE_FROM: u128 = 81 * 81;
 
 /// Whether a dilation or erosion by `element` of radius `r` takes the distance transform.
 fn by_distance<const K: usize>(r: f64, element: Element) -> bool {

@@ -118,6 +118,42 @@ impl<const K: usize> Runs<K> {
         self.runs.push((z1, z2));
     }
 
+    /// Sets `out` to the union of the runs moved and grown by every `(offset, grow)` of `element`, in one
+    /// merge pass over all the moved copies at once (for a few offsets: each output column looks at every
+    /// copy's next column).
+    pub(crate) fn union_of_moved_into(&self, element: &[([i64; K], i64)], out: &mut Self) {
+        out.clear();
+        let mut gathered = Vec::new();
+        let copies: Vec<Moved<'_, K>> = element.iter().map(|&(c, h)| self.moved(c, h)).collect();
+        let mut at = vec![0usize; copies.len()];
+        loop {
+            let mut col = None::<u64>;
+            for (copy, &i) in copies.iter().zip(&at) {
+                if let Some(&c) = self.cols.get(i) {
+                    let c = copy.column(c);
+                    col = Some(col.map_or(c, |m| m.min(c)));
+                }
+            }
+            let Some(col) = col else {
+                return;
+            };
+            gathered.clear();
+            for (copy, i) in copies.iter().zip(at.iter_mut()) {
+                while *i < self.cols.len() && copy.column(self.cols[*i]) == col {
+                    let (z1, z2) = self.runs[*i];
+                    gathered.push((z1 - copy.grow, z2 + copy.grow));
+                    *i += 1;
+                }
+            }
+            gathered.sort_unstable_by_key(|r| r.0);
+            for &(z1, z2) in gathered.iter() {
+                if z1 < z2 {
+                    out.push(col, z1, z2);
+                }
+            }
+        }
+    }
+
     /// Sets `out` to the union (`union = true`) or intersection of `self` and `other`, in one merge pass.
     /// `out`'s buffers are reused, so a chain of combinations allocates only while the runs grow.
     pub(crate) fn combine_into(&self, other: Moved<'_, K>, union: bool, out: &mut Self) {
@@ -231,8 +267,8 @@ mod tests {
         let origin = pack::<K>(&[0; K]);
         for a in &cols {
             let key = pack::<K>(a);
-            for axis in 0..K - 1 {
-                assert_eq!(unpack_axis::<K>(key, axis), a[axis]);
+            for (axis, &x) in a[..K - 1].iter().enumerate() {
+                assert_eq!(unpack_axis::<K>(key, axis), x);
             }
             for b in &cols {
                 assert_eq!(key.cmp(&pack::<K>(b)), a.cmp(b), "{a:?} against {b:?}");
