@@ -68,9 +68,12 @@ fn label_runs<const K: usize>(rays: &RaySet<K>, connectivity: usize) -> Vec<usiz
             parent[hi] = lo;
         }
     };
+    // Where each offset's neighbour columns start: the neighbours of columns in order are in order too
+    // (a fixed offset within the universe keeps the keys' order), so each cursor only moves forward.
+    let mut starts = vec![0usize; deltas.len()];
     for (key, range) in rays.column_groups() {
         let col = rays.column_of_key(key);
-        for &(delta, m) in &deltas {
+        for (&(delta, m), start) in deltas.iter().zip(starts.iter_mut()) {
             let mut other = col;
             let mut inside = true;
             for (x, dx) in other[..K - 1].iter_mut().zip(&delta[..K - 1]) {
@@ -82,8 +85,14 @@ fn label_runs<const K: usize>(rays: &RaySet<K>, connectivity: usize) -> Vec<usiz
                 continue;
             }
             let okey = rays.column_key(other);
-            let lo = keys.partition_point(|&k| k < okey);
-            let hi = keys.partition_point(|&k| k <= okey);
+            while *start < keys.len() && keys[*start] < okey {
+                *start += 1;
+            }
+            let lo = *start;
+            let mut hi = lo;
+            while hi < keys.len() && keys[hi] == okey {
+                hi += 1;
+            }
             let slack = u32::from(m < connectivity);
             let (mut p, mut q) = (range.start, lo);
             while p < range.end && q < hi {
@@ -116,7 +125,8 @@ impl<const K: usize> KTree<K> {
     /// ```
     ///
     /// # Performance
-    /// Union–find over the runs: `O(runs · 3^(K−1) · log runs)`; memory a few words per run.
+    /// Union–find over the runs: `O(runs · 3^(K−1))` and the near-constant factor of the union–find;
+    /// memory a few words per run.
     ///
     /// # Errors
     /// [`ShapeError::Connectivity`] unless `1 ≤ connectivity ≤ K`.
@@ -137,6 +147,13 @@ impl<const K: usize> KTree<K> {
             part.0.push(rays.column_keys()[i]);
             part.1.push(run);
             part.2 += u128::from(run.1 - run.0);
+        }
+        if parts.len() == 1 {
+            // One piece: the tree itself, not rebuilt.
+            return Ok(vec![Component {
+                size: parts[0].2,
+                tree: self.clone(),
+            }]);
         }
         // Stable: equal sizes keep the order of their first run.
         parts.sort_by_key(|p| std::cmp::Reverse(p.2));
