@@ -154,6 +154,62 @@ impl<const K: usize> Runs<K> {
         }
     }
 
+    /// Sets `out` to the intersection of the runs moved and shrunk by every `(offset, shrink)` of
+    /// `element` (emptied runs dropped), in one pass: the columns of the first copy, each looked up in the
+    /// other copies by cursors that only move forward, their runs intersected there.
+    pub(crate) fn intersection_of_moved_into(&self, element: &[([i64; K], i64)], out: &mut Self) {
+        out.clear();
+        let Some((&(c0, h0), rest)) = element.split_first() else {
+            return;
+        };
+        let first = self.moved(c0, -h0);
+        let others: Vec<Moved<'_, K>> = rest.iter().map(|&(c, h)| self.moved(c, -h)).collect();
+        let mut at = vec![0usize; others.len()];
+        let (mut acc, mut next) = (Vec::new(), Vec::new());
+        let mut i = 0;
+        'columns: while i < self.cols.len() {
+            let col = first.column(self.cols[i]);
+            let mut end = i;
+            acc.clear();
+            while end < self.cols.len() && self.cols[end] == self.cols[i] {
+                let (z1, z2) = self.runs[end];
+                if z1 - first.grow < z2 + first.grow {
+                    acc.push((z1 - first.grow, z2 + first.grow));
+                }
+                end += 1;
+            }
+            i = end;
+            for (copy, j) in others.iter().zip(at.iter_mut()) {
+                while *j < self.cols.len() && copy.column(self.cols[*j]) < col {
+                    *j += 1;
+                }
+                let (mut p, mut q) = (0, *j);
+                next.clear();
+                while p < acc.len() && q < self.cols.len() && copy.column(self.cols[q]) == col {
+                    let (z1, z2) = self.runs[q];
+                    let b = (z1 - copy.grow, z2 + copy.grow);
+                    let (lo, hi) = (acc[p].0.max(b.0), acc[p].1.min(b.1));
+                    if lo < hi {
+                        next.push((lo, hi));
+                    }
+                    if acc[p].1 < b.1 {
+                        p += 1;
+                    } else {
+                        q += 1;
+                    }
+                }
+                std::mem::swap(&mut acc, &mut next);
+                if acc.is_empty() {
+                    continue 'columns;
+                }
+            }
+            for &(z1, z2) in &acc {
+                out.cols.push(col);
+                out.runs.push((z1, z2));
+            }
+        }
+    }
+
     /// Sets `out` to the union (`union = true`) or intersection of `self` and `other`, in one merge pass.
     /// `out`'s buffers are reused, so a chain of combinations allocates only while the runs grow.
     pub(crate) fn combine_into(&self, other: Moved<'_, K>, union: bool, out: &mut Self) {
