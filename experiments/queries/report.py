@@ -132,7 +132,7 @@ def main() -> None:
     )
     w("")
     w(
-        "Tools. **ktree**: `contains_many` (batch, Morton-ordered runs), `PointCursor` (one point after the "
+        "Tools. **ktree**: `contains_many` (batch: a table of the top levels, then Morton-ordered runs), `PointCursor` (one point after the "
         "other, cached path), `cast_rays`, `nearest_many`. **OpenVDB** (libopenvdb-dev "
         f"{dpkg_version('libopenvdb-dev')}): `getValue` through a `ValueAccessor` (cached, one per thread) and "
         "through the tree (no cache); rays: `tools::VolumeRayIntersector` on the BoolGrid, marching the leaf "
@@ -209,9 +209,11 @@ def main() -> None:
     w("")
     w(
         "Why. Random points: each query reads a path of ~L nodes that is not in cache, in ktree a rank over "
-        "2-bit node states at every level (no pointers), in OpenVDB three fixed levels of pointer nodes; "
-        "ktree's batch also orders each run of 16 384 points by Morton key (a radix sort) so that neighbouring "
-        "queries share the top of their paths. Coherent points: a random walk stays in a few leaves, so both "
+        "2-bit node states at every level (no pointers), in OpenVDB three fixed levels of pointer nodes. "
+        "ktree's batch first reads the tree's top levels into a table of their cells (2^18 at most, a byte "
+        "each: depth 6 of an octree), as OpenVDB keeps a root table, and answers every point in an empty or "
+        "full cell of that table by one read; the rest, in each run of 16 384 points, it orders by Morton key "
+        "(a radix sort) so that neighbouring queries share the top of their paths. Coherent points: a random walk stays in a few leaves, so both "
         "answer most points from the cached path. Rays: ktree walks the tree front to back, an empty cell of "
         "any size costing one step; OpenVDB's intersector marches leaf-sized intervals, then voxels within "
         "them; OctoMap's `castRay` steps voxel by voxel at the finest level and searches each from the root. "

@@ -1,13 +1,15 @@
-//! Point queries: one voxel ([`contains`]), many at once ([`contains_many`]: ordered by Morton key and
-//! answered on all threads, each thread walking its share of the tree once), and a cursor that remembers
-//! its last path for coherent queries ([`PointCursor`]).
+//! Point queries: one voxel ([`contains`]), many at once ([`contains_many`]: most answered from a table of
+//! the tree's top levels, the rest ordered by Morton key and answered on all threads, each thread walking
+//! its share of the tree once), and a cursor that remembers its last path for coherent queries
+//! ([`PointCursor`]).
 
 use rayon::prelude::*;
 
 use crate::radix::sort_by_key;
 use crate::space::morton_encode;
+use crate::tree::cursor::{try_walk, Visitor, Walk};
 use crate::tree::storage::TreeStorage;
-use crate::tree::NodeState;
+use crate::tree::{NodeRef, NodeState};
 
 /// The depth of the deepest node a path can hold (the largest universe level) plus one.
 const PATH: usize = 33;
@@ -124,8 +126,72 @@ pub fn contains<const K: usize, T: TreeStorage<K>>(
 /// The points of one run of a batch, ordered by Morton key and answered by one [`PointCursor`].
 const RUN: usize = 1 << 14;
 
-/// Whether each voxel of `points` is inside the object, in the order given. The points are cut into runs
-/// of 16 384 answered on all threads; within a run they are ordered by Morton key and answered by one
+/// log₂ of the most cells of [`TopStates`]: a byte each, 256 KiB, held in the second-level cache.
+const TOP_CELLS_LOG2: u32 = 18;
+
+/// Batches of at least this many points first build a [`TopStates`] table (its cost, a walk of the top
+/// levels and a fill of its cells, is then a small share of the batch).
+const TOP_FROM: usize = 1 << 16;
+
+/// The state of every cell of one depth `d` of the tree (`d` levels of `K` bits: at most
+/// 2^[`TOP_CELLS_LOG2`] cells), indexed by Morton key, as OpenVDB keeps its top levels in a root table: a
+/// point in an empty or full cell of depth ≤ `d` is answered by one read, and only a point in a partial
+/// cell of depth `d` walks the tree below.
+struct TopStates {
+    /// A point's Morton key shifted right by this gives its cell.
+    shift: u32,
+    states: Vec<u8>,
+}
+
+impl TopStates {
+    fn new<const K: usize, T: TreeStorage<K>>(tree: &T) -> Result<Self, T::Error> {
+        let level = tree.level();
+        let depth = (TOP_CELLS_LOG2 / K as u32).min(level);
+        let shift = K as u32 * (level - depth);
+        let mut fill = Fill {
+            depth,
+            shift,
+            states: vec![NodeState::Empty as u8; 1 << (K as u32 * depth)],
+        };
+        try_walk(tree, &mut fill)?;
+        return Ok(Self {
+            shift,
+            states: fill.states,
+        });
+
+        /// Writes each node of depth ≤ `depth` that is a leaf or at `depth` over its cells.
+        struct Fill {
+            depth: u32,
+            shift: u32,
+            states: Vec<u8>,
+        }
+        impl<const K: usize> Visitor<K> for Fill {
+            const LEAVES: bool = false;
+            fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+                if node.state == NodeState::Partial && node.cell.level < self.depth {
+                    return Walk::Descend;
+                }
+                // A node's cells are a contiguous range in Morton order.
+                let first = (morton_encode(node.cell.origin) >> self.shift) as usize;
+                let count = 1usize << (K as u32 * (self.depth - node.cell.level));
+                self.states[first..first + count].fill(node.state as u8);
+                Walk::Skip
+            }
+        }
+    }
+
+    /// The state of the cell holding the point of Morton key `key`: [`NodeState::Partial`] where the
+    /// tree must be walked below.
+    #[inline]
+    fn state(&self, key: u64) -> NodeState {
+        NodeState::from_bits(u32::from(self.states[(key >> self.shift) as usize]))
+    }
+}
+
+/// Whether each voxel of `points` is inside the object, in the order given. A batch of 65 536 points or
+/// more first reads the tree's top levels into a table of at most 2^18 cells, which answers every point
+/// in an empty or full cell down to that depth by one read. The other points are cut into runs of 16 384
+/// answered on all threads; within a run they are ordered by Morton key and answered by one
 /// [`PointCursor`], so that each run walks the tree once, in order, in cache. Points outside the universe
 /// are `false`.
 ///
@@ -146,15 +212,38 @@ where
     T: TreeStorage<K> + Sync,
     T::Error: Send,
 {
+    let top = if points.len() >= TOP_FROM {
+        Some(TopStates::new(tree)?)
+    } else {
+        None
+    };
+    contains_many_with(tree, points, top.as_ref())
+}
+
+/// [`contains_many`] with the table `top` or none.
+fn contains_many_with<const K: usize, T>(
+    tree: &T,
+    points: &[[u32; K]],
+    top: Option<&TopStates>,
+) -> Result<Vec<bool>, T::Error>
+where
+    T: TreeStorage<K> + Sync,
+    T::Error: Send,
+{
     let side = 1u64 << tree.level();
     let mut out = vec![false; points.len()];
     let answer = |(points, out): (&[[u32; K]], &mut [bool])| -> Result<(), T::Error> {
-        let mut order: Vec<(u64, u32)> = points
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| p.iter().all(|&c| u64::from(c) < side))
-            .map(|(i, p)| (morton_encode(*p), i as u32))
-            .collect();
+        let mut order: Vec<(u64, u32)> = Vec::with_capacity(points.len());
+        for (i, p) in points.iter().enumerate() {
+            if p.iter().any(|&c| u64::from(c) >= side) {
+                continue;
+            }
+            let key = morton_encode(*p);
+            match top.map_or(NodeState::Partial, |t| t.state(key)) {
+                NodeState::Partial => order.push((key, i as u32)),
+                state => out[i] = state == NodeState::Full,
+            }
+        }
         sort_by_key(&mut order, K as u32 * tree.level(), &mut Vec::new(), |p| {
             p.0
         });

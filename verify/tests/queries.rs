@@ -59,7 +59,8 @@ fn check_points<const K: usize>(o: &Obj<K>, points: &[[u32; K]]) -> Result<(), T
     let (u, dense, tree) = (o.universe(), o.dense(), o.tree());
     let expect: Vec<bool> = points.iter().map(|&p| dense_at(&u, &dense, p)).collect();
     prop_assert_eq!(tree.contains_many(points), expect.clone());
-    // Many points inside the universe (and the others): several runs, on all threads.
+    // Many points inside the universe (and the others): enough for the table of the top levels, several
+    // runs, on all threads.
     let inside: Vec<[u32; K]> = points
         .iter()
         .copied()
@@ -68,7 +69,7 @@ fn check_points<const K: usize>(o: &Obj<K>, points: &[[u32; K]]) -> Result<(), T
     let many: Vec<[u32; K]> = inside
         .iter()
         .cycle()
-        .take(40_000)
+        .take(70_000)
         .chain(points)
         .copied()
         .collect();
@@ -371,6 +372,12 @@ fn check_mapped<const K: usize>(
         mapped.contains_many(points).unwrap(),
         tree.contains_many(points)
     );
+    // Enough points for the table of the top levels, read through the map.
+    let many: Vec<[u32; K]> = points.iter().cycle().take(70_000).copied().collect();
+    prop_assert_eq!(
+        mapped.contains_many(&many).unwrap(),
+        tree.contains_many(&many)
+    );
     prop_assert_eq!(mapped.bounding_box().unwrap(), tree.bounding_box());
     let (lo, hi) = (points[0], *points.last().unwrap());
     prop_assert_eq!(mapped.count(lo, hi).unwrap(), tree.count(lo, hi));
@@ -635,7 +642,12 @@ fn check_max_level<const K: usize>(b: &Boxes<K>, p: [u64; K]) -> Result<(), Test
     let probes: Vec<[u64; K]> = b.probe_points().into_iter().chain([p]).collect();
     let points: Vec<[u32; K]> = probes.iter().map(|&q| to_u32(q)).collect();
     let expect: Vec<bool> = probes.iter().map(|&q| b.contains(q)).collect();
-    prop_assert_eq!(tree.contains_many(&points), expect);
+    prop_assert_eq!(tree.contains_many(&points), expect.clone());
+    // Enough points for the table of the top levels, at the largest level.
+    let n = 70_000;
+    let many: Vec<[u32; K]> = points.iter().cycle().take(n).copied().collect();
+    let expect_many: Vec<bool> = expect.iter().cycle().take(n).copied().collect();
+    prop_assert_eq!(tree.contains_many(&many), expect_many);
     // Counts and crops of the box around each box and of a box from p to the top corner.
     let mut windows: Vec<Cuboid<K>> = b
         .boxes
