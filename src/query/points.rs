@@ -154,30 +154,10 @@ impl TopStates {
             states: vec![NodeState::Empty as u8; 1 << (K as u32 * depth)],
         };
         try_walk(tree, &mut fill)?;
-        return Ok(Self {
+        Ok(Self {
             shift,
             states: fill.states,
-        });
-
-        /// Writes each node of depth ≤ `depth` that is a leaf or at `depth` over its cells.
-        struct Fill {
-            depth: u32,
-            shift: u32,
-            states: Vec<u8>,
-        }
-        impl<const K: usize> Visitor<K> for Fill {
-            const LEAVES: bool = false;
-            fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-                if node.state == NodeState::Partial && node.cell.level < self.depth {
-                    return Walk::Descend;
-                }
-                // A node's cells are a contiguous range in Morton order.
-                let first = (morton_encode(node.cell.origin) >> self.shift) as usize;
-                let count = 1usize << (K as u32 * (self.depth - node.cell.level));
-                self.states[first..first + count].fill(node.state as u8);
-                Walk::Skip
-            }
-        }
+        })
     }
 
     /// The state of the cell holding the point of Morton key `key`: [`NodeState::Partial`] where the
@@ -185,6 +165,27 @@ impl TopStates {
     #[inline]
     fn state(&self, key: u64) -> NodeState {
         NodeState::from_bits(u32::from(self.states[(key >> self.shift) as usize]))
+    }
+}
+
+/// Writes each node of a [`TopStates`] walk that is a leaf above its depth, or at its depth, over its cells.
+struct Fill {
+    depth: u32,
+    shift: u32,
+    states: Vec<u8>,
+}
+
+impl<const K: usize> Visitor<K> for Fill {
+    const LEAVES: bool = false;
+    fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+        if node.state == NodeState::Partial && node.cell.level < self.depth {
+            return Walk::Descend;
+        }
+        // A node's cells are a contiguous range in Morton order.
+        let first = (morton_encode(node.cell.origin) >> self.shift) as usize;
+        let count = 1usize << (K as u32 * (self.depth - node.cell.level));
+        self.states[first..first + count].fill(node.state as u8);
+        Walk::Skip
     }
 }
 
@@ -217,19 +218,6 @@ where
     } else {
         None
     };
-    contains_many_with(tree, points, top.as_ref())
-}
-
-/// [`contains_many`] with the table `top` or none.
-fn contains_many_with<const K: usize, T>(
-    tree: &T,
-    points: &[[u32; K]],
-    top: Option<&TopStates>,
-) -> Result<Vec<bool>, T::Error>
-where
-    T: TreeStorage<K> + Sync,
-    T::Error: Send,
-{
     let side = 1u64 << tree.level();
     let mut out = vec![false; points.len()];
     let answer = |(points, out): (&[[u32; K]], &mut [bool])| -> Result<(), T::Error> {
@@ -239,7 +227,7 @@ where
                 continue;
             }
             let key = morton_encode(*p);
-            match top.map_or(NodeState::Partial, |t| t.state(key)) {
+            match top.as_ref().map_or(NodeState::Partial, |t| t.state(key)) {
                 NodeState::Partial => order.push((key, i as u32)),
                 state => out[i] = state == NodeState::Full,
             }

@@ -43,9 +43,8 @@
 use rayon::prelude::*;
 
 use super::ShapeError;
-use crate::radix;
-use crate::rays::RaySet;
 use crate::tree::cursor::{walk, Visitor, Walk};
+use crate::tree::to_rays::SlabRuns;
 use crate::tree::{NodeRef, NodeState};
 use crate::KTree;
 
@@ -457,8 +456,7 @@ fn runs_of<const K: usize>(tree: &KTree<K>, b: &Bx<K>, keep: &[bool]) -> Vec<(u6
 /// The tree of the runs that `runs_in` gives for each block (a block's runs `(column key, z1, z2)` in row
 /// order), the blocks in [`blocks`]' order. The blocks are taken slab by slab along the first axis, each
 /// slab's on all threads; a column's pieces then come in order along it (its blocks are consecutive, in
-/// order along the last axis), so one stable radix sort by the column puts a slab's runs in order, and they
-/// are appended, touching pieces joined. Memory holds the result's runs and one slab's pieces, never every
+/// order along the last axis), as [`SlabRuns`] needs. Memory holds the result's runs and one slab's pieces, never every
 /// block's at once.
 fn tree_of_blocks<const K: usize>(
     tree: &KTree<K>,
@@ -466,43 +464,12 @@ fn tree_of_blocks<const K: usize>(
     side: i64,
     runs_in: impl Fn(&Bx<K>) -> Vec<(u64, u32, u32)> + Sync,
 ) -> KTree<K> {
-    let level = tree.level();
-    let inner_bits = level * (K.max(2) as u32 - 2);
-    let key_bits = if K == 1 {
-        0
-    } else {
-        side.trailing_zeros() + inner_bits
-    };
-    let (mut columns, mut merged): (Vec<u64>, Vec<(u32, u32)>) = (Vec::new(), Vec::new());
-    let mut scratch = Vec::new();
+    let mut out = SlabRuns::<K>::new(tree.level(), side as u64);
     for slab in blocks.chunk_by(|a, b| a.lo[0] == b.lo[0]) {
         let mut pieces: Vec<(u64, u32, u32)> = slab.par_iter().flat_map_iter(&runs_in).collect();
-        let base = if K == 1 {
-            0
-        } else {
-            (slab[0].lo[0] as u64) << inner_bits
-        };
-        radix::sort_by_key(&mut pieces, key_bits, &mut scratch, |p| p.0 - base);
-        for (key, z1, z2) in pieces {
-            if let (Some(&c), Some(last)) = (columns.last(), merged.last_mut()) {
-                if c == key {
-                    debug_assert!(z1 >= last.1, "a column's pieces in order");
-                    if z1 == last.1 {
-                        last.1 = z2;
-                        continue;
-                    }
-                }
-            }
-            columns.push(key);
-            merged.push((z1, z2));
-        }
+        out.append(slab[0].lo[0] as u64, &mut pieces);
     }
-    KTree::from_rays(&RaySet::from_sorted_parts(
-        tree.universe(),
-        columns,
-        merged,
-        None,
-    ))
+    KTree::from_rays(&out.finish(tree.universe()))
 }
 
 impl<const K: usize> KTree<K> {

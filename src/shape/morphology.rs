@@ -22,9 +22,9 @@ use super::{Element, ShapeError};
 use crate::KTree;
 
 /// Up to this many column offsets, a slice's dilation (erosion) merges (intersects) all its moved copies
-/// in one pass; beyond, it takes them one at a time (each output column would look at too many copies). Measured on the L = 10
-/// ball and armadillo, one thread: the unit cross (5 offsets) and the ball of r = 2 (13) 1.25–1.6× faster
-/// in one pass; the ball of r = 4 (49 offsets) and r = 8 (197) 1.4–1.6× slower.
+/// in one pass; beyond, it takes them one at a time (each output column would look at too many copies).
+/// Measured on the L = 10 ball and armadillo, one thread: the unit cross (5 offsets) and the ball of r = 2
+/// (13) 1.25–1.6× faster in one pass; the ball of r = 4 (49 offsets) and r = 8 (197) 1.4–1.6× slower.
 const MERGED_AT_ONCE: usize = 16;
 
 /// Sets `out` to the dilation of `runs` by one slice of an element; `spare` is a second buffer.

@@ -22,7 +22,7 @@ mod operators;
 pub mod sink;
 mod states;
 pub mod storage;
-mod to_rays;
+pub(crate) mod to_rays;
 pub(crate) mod words;
 
 pub(crate) use any::from_typed;

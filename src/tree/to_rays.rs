@@ -9,6 +9,7 @@
 
 use crate::radix;
 use crate::rays::RaySet;
+use crate::space::Universe;
 use crate::tree::cursor::{walk, Visitor, Walk};
 use crate::tree::{KTree, NodeRef, NodeState};
 
@@ -29,17 +30,8 @@ impl<const K: usize> KTree<K> {
         let side = universe.side();
         // K = 1 has one column, the last axis itself: one slab.
         let width = if K == 1 { side } else { (side / SLABS).max(1) };
-        let mut columns = Vec::new();
-        let mut runs: Vec<(u32, u32)> = Vec::new();
+        let mut out = SlabRuns::<K>::new(level, width);
         let mut pieces = Vec::new();
-        let mut scratch = Vec::new();
-        // Within a slab, a column key less the slab's first key is below 2^key_bits.
-        let inner_bits = level * (K.max(2) as u32 - 2);
-        let key_bits = if K == 1 {
-            0
-        } else {
-            width.next_power_of_two().trailing_zeros() + inner_bits
-        };
         let mut start = 0;
         while start < side {
             let end = (start + width).min(side);
@@ -50,24 +42,66 @@ impl<const K: usize> KTree<K> {
                 pieces: &mut pieces,
             };
             walk(self, &mut slab);
-            let base = if K == 1 { 0 } else { start << inner_bits };
-            radix::sort_by_key(&mut pieces, key_bits, &mut scratch, |p| p.0 - base);
-            for &(column, z1, z2) in pieces.iter() {
-                let last = runs.len();
-                if last > 0 && columns[last - 1] == column {
-                    debug_assert!(z1 >= runs[last - 1].1, "pieces of a column in order");
-                    if z1 == runs[last - 1].1 {
-                        // Touching the previous piece of the same column: extend it.
-                        runs[last - 1].1 = z2;
+            out.append(start, &mut pieces);
+            start = end;
+        }
+        out.finish(universe)
+    }
+}
+
+/// Runs gathered slab by slab along the first axis (slabs of a power-of-two width, in order): each slab's
+/// pieces `(column key, z1, z2)` come with every column's pieces in order along it, so one stable radix
+/// sort by the column alone orders them, and touching pieces of a column are joined.
+pub(crate) struct SlabRuns<const K: usize> {
+    /// A column key less its slab's first key is below `2^key_bits`.
+    key_bits: u32,
+    /// Bits of the column key below the first axis.
+    inner_bits: u32,
+    columns: Vec<u64>,
+    runs: Vec<(u32, u32)>,
+    scratch: Vec<(u64, u32, u32)>,
+}
+
+impl<const K: usize> SlabRuns<K> {
+    /// For a universe of level `level`, slabs `width` (a power of two) wide.
+    pub(crate) fn new(level: u32, width: u64) -> Self {
+        let inner_bits = level * (K.max(2) as u32 - 2);
+        let key_bits = if K == 1 {
+            0
+        } else {
+            width.trailing_zeros() + inner_bits
+        };
+        Self {
+            key_bits,
+            inner_bits,
+            columns: Vec::new(),
+            runs: Vec::new(),
+            scratch: Vec::new(),
+        }
+    }
+
+    /// Appends the pieces of the slab starting at `start` on the first axis (after every earlier slab's).
+    pub(crate) fn append(&mut self, start: u64, pieces: &mut Vec<(u64, u32, u32)>) {
+        let base = if K == 1 { 0 } else { start << self.inner_bits };
+        radix::sort_by_key(pieces, self.key_bits, &mut self.scratch, |p| p.0 - base);
+        for &(column, z1, z2) in pieces.iter() {
+            if let (Some(&last_column), Some(last)) = (self.columns.last(), self.runs.last_mut()) {
+                if last_column == column {
+                    debug_assert!(z1 >= last.1, "pieces of a column in order");
+                    if z1 == last.1 {
+                        last.1 = z2;
                         continue;
                     }
                 }
-                columns.push(column);
-                runs.push((z1, z2));
             }
-            start = end;
+            self.columns.push(column);
+            self.runs.push((z1, z2));
         }
-        RaySet::from_sorted_parts(universe, columns, runs, None)
+    }
+
+    /// The runs gathered, as a ray set of `universe`.
+    pub(crate) fn finish(self, universe: Universe<K>) -> RaySet<K> {
+        RaySet::from_sorted_parts(universe, self.columns, self.runs, None)
     }
 }
 
