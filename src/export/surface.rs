@@ -34,9 +34,10 @@
 //! once by their Morton key into distinct lattice points, and everything the mesh needs of a corner is then
 //! worked out point by point in that order and written at the corner's place, so the final pass over the
 //! rectangles reads memory in order. Each point's eight voxels are read with one descent from the deepest
-//! ancestor shared with the previous point's; a vertex is a point and a link part, numbered point by point;
-//! and the corners inside a rectangle's edge are the points between its two ends in the points' order
-//! along that edge's lines (one radix sort per axis). Time and peak memory against OpenVDB's
+//! ancestor shared with the previous point's, the children of the nodes read lately kept at hand; a
+//! vertex is a point and a link part, numbered point by point; and the corners inside a rectangle's edge
+//! are the points between its two ends along that edge's line: each axis's lines are sorted once with all
+//! the edge needs of their points, so that an edge reads a run of memory. Time and peak memory against OpenVDB's
 //! `volumeToMesh` in `results/performance/export.md`.
 //!
 //! ```
@@ -55,6 +56,7 @@ use std::sync::OnceLock;
 
 use crate::space::Cell;
 use crate::tree::cursor::Locator;
+use crate::tree::words::partial_mask;
 use crate::tree::{KTree, NodeState};
 
 use super::{ExportError, Frame};
@@ -215,7 +217,12 @@ fn link_parts() -> &'static [[u8; 12]; 256] {
 /// universe are empty). The eight lie in the smallest aligned cell holding both `p − 1` and `p` on every
 /// axis, found with `locator` (from a deep ancestor shared with the previous point's, when points come in
 /// Morton order); each voxel's state is then read from that cell down, a few levels for most points.
-fn occupancy(tree: &KTree<3>, locator: &mut Locator<3>, p: [u32; 3]) -> u8 {
+fn occupancy(
+    tree: &KTree<3>,
+    locator: &mut Locator<3>,
+    recent: &mut RecentChildren,
+    p: [u32; 3],
+) -> u8 {
     let side = tree.universe().side();
     let level = tree.level();
     // The cell's log side: one more than the most trailing zeros of a coordinate (a coordinate of 0 or the
@@ -236,16 +243,24 @@ fn occupancy(tree: &KTree<3>, locator: &mut Locator<3>, p: [u32; 3]) -> u8 {
         log_side,
     };
     let node = locator.locate(tree, &cell);
-    // The octants whose voxels are inside the universe.
-    let octants = (0..8u8)
-        .filter(|&o| {
-            (0..3).all(|a| (1..=side).contains(&(u64::from(p[a]) + u64::from(o >> a & 1))))
-        })
-        .fold(0u8, |set, o| set | 1 << o);
+    // The octants whose voxels are inside the universe: those below `p` along an axis are out where `p` is
+    // at 0 on it, those above where it is at the universe's side.
+    let octants = (0..3).fold(0xffu8, |set, a| {
+        let x = u64::from(p[a]);
+        let below_out = if x == 0 { !UPPER_ON[a] } else { 0 };
+        let above_out = if x >= side { UPPER_ON[a] } else { 0 };
+        set & !below_out & !above_out
+    });
+    let depth = node.cell().level() as usize;
+    let first = match node.state() {
+        NodeState::Partial => tree.first_child(depth, node.index()),
+        _ => 0,
+    };
     let mut m = 0u8;
     fill(
         tree,
-        (node.cell().level() as usize, node.index(), node.state()),
+        recent,
+        (depth, first, node.state()),
         log_side,
         p,
         octants,
@@ -259,7 +274,8 @@ fn occupancy(tree: &KTree<3>, locator: &mut Locator<3>, p: [u32; 3]) -> u8 {
 /// each node on the way is stepped into once.
 fn fill(
     tree: &KTree<3>,
-    (depth, index, state): (usize, usize, NodeState),
+    recent: &mut RecentChildren,
+    (depth, first, state): (usize, usize, NodeState),
     log_side: u32,
     p: [u32; 3],
     octants: u8,
@@ -269,7 +285,6 @@ fn fill(
         NodeState::Full => *m |= octants,
         NodeState::Empty => {}
         NodeState::Partial => {
-            let first = tree.first_child(depth, index);
             let bit = log_side - 1;
             // The child code of the voxels below `p` on every axis (octant 0) and above (octant 7); octant
             // `o` takes each axis's bit from the one or the other.
@@ -277,23 +292,23 @@ fn fill(
                 |x: [u32; 3]| (0..3).fold(0u8, |code, a| code | ((x[a] >> bit & 1) as u8) << a);
             let below = child_code(p.map(|x| x.wrapping_sub(1)));
             let above = child_code(p);
-            let code = |o: u8| below ^ ((below ^ above) & o);
-            // The eight children's states, read at once.
-            let states = tree.level_states(depth + 1).block_codes(first, 3);
+            let split = below ^ above;
+            let children = recent.of(tree, depth, first);
             let mut left = octants;
             while left != 0 {
-                let c = code(left.trailing_zeros() as u8);
-                let same = (0..8u8)
-                    .filter(|&o| left >> o & 1 == 1 && code(o) == c)
-                    .fold(0u8, |set, o| set | 1 << o);
+                let o = left.trailing_zeros() as u8;
+                let c = below ^ (split & o);
+                // The octants that go into the same child: those agreeing with `o` on the axes that split.
+                let same = left & AGREEING[usize::from(split)][usize::from(o)];
                 left &= !same;
                 let c = usize::from(c);
-                match NodeState::from_bits(states >> (2 * c)) {
+                match children.state(c) {
                     NodeState::Full => *m |= same,
                     NodeState::Empty => {}
                     NodeState::Partial => fill(
                         tree,
-                        (depth + 1, first + c, NodeState::Partial),
+                        recent,
+                        (depth + 1, children.first_child(c), NodeState::Partial),
                         bit,
                         p,
                         same,
@@ -304,6 +319,30 @@ fn fill(
         }
     }
 }
+
+/// The octants on the upper side of each axis (bit `o` set: octant `o`).
+const UPPER_ON: [u8; 3] = [0b1010_1010, 0b1100_1100, 0b1111_0000];
+
+/// For a set of axes `s` (bit `a`: axis `a`) and an octant `o`, the octants agreeing with `o` on those axes.
+const AGREEING: [[u8; 8]; 8] = {
+    let mut table = [[0u8; 8]; 8];
+    let mut s = 0;
+    while s < 8 {
+        let mut o = 0;
+        while o < 8 {
+            let mut q = 0;
+            while q < 8 {
+                if (q ^ o) & s == 0 {
+                    table[s][o] |= 1 << q;
+                }
+                q += 1;
+            }
+            o += 1;
+        }
+        s += 1;
+    }
+    table
+};
 
 /// The Morton key of a lattice point (coordinates up to 2^22 − 1; bits interleaved, axis 0 lowest).
 fn morton(p: [u32; 3]) -> u128 {
@@ -350,6 +389,82 @@ fn packed_plane_key(plane: u64, level: u32) -> u64 {
     (plane >> 33) << (level + 2) | (plane & 0x1_ffff_ffff)
 }
 
+/// The eight children of a partial node: their states, read at once, and where the children of the
+/// partial ones start, from one rank of the first (the partial children's children are consecutive).
+#[derive(Debug, Clone, Copy)]
+struct Children {
+    /// Child `c`'s state at bits `2c`.
+    states: u32,
+    /// The index of the first child's first child, were it partial.
+    grandchildren: usize,
+}
+
+impl Children {
+    /// The children of the partial node at `depth` whose first child is `first`.
+    #[inline]
+    fn of(tree: &KTree<3>, depth: usize, first: usize) -> Children {
+        let level = tree.level_states(depth + 1);
+        let states = level.block_codes(first, 3);
+        let grandchildren = if partial_mask(u64::from(states)) == 0 {
+            0
+        } else {
+            level.partial_rank(first) << 3
+        };
+        Children {
+            states,
+            grandchildren,
+        }
+    }
+
+    /// Child `code`'s state.
+    #[inline]
+    fn state(&self, code: usize) -> NodeState {
+        NodeState::from_bits(self.states >> (2 * code))
+    }
+
+    /// The index of partial child `code`'s first child.
+    #[inline]
+    fn first_child(&self, code: usize) -> usize {
+        let before = partial_mask(u64::from(self.states) & ((1 << (2 * code)) - 1));
+        self.grandchildren + ((before.count_ones() as usize) << 3)
+    }
+}
+
+/// The children of the partial nodes read lately, a few at each depth (points in Morton order read
+/// the same nodes again and again).
+struct RecentChildren {
+    /// By depth, then by the first child's index divided by 8, modulo [`RecentChildren::WAYS`]:
+    /// `(first, children)`.
+    slots: Vec<[(usize, Children); RecentChildren::WAYS]>,
+}
+
+impl RecentChildren {
+    const WAYS: usize = 8;
+
+    fn new(tree: &KTree<3>) -> Self {
+        let none = (
+            usize::MAX,
+            Children {
+                states: 0,
+                grandchildren: 0,
+            },
+        );
+        RecentChildren {
+            slots: vec![[none; Self::WAYS]; tree.level() as usize + 1],
+        }
+    }
+
+    /// As [`Children::of`].
+    #[inline]
+    fn of(&mut self, tree: &KTree<3>, depth: usize, first: usize) -> Children {
+        let slot = &mut self.slots[depth][(first >> 3) % Self::WAYS];
+        if slot.0 != first {
+            *slot = (first, Children::of(tree, depth, first));
+        }
+        slot.1
+    }
+}
+
 /// A node met by the walk of [`boundary_squares`]: where it is in the tree, its cell and state.
 #[derive(Debug, Clone, Copy)]
 struct Node {
@@ -379,24 +494,18 @@ impl Node {
 
     /// The eight children of a partial node, by child code.
     fn children(&self, tree: &KTree<3>) -> [Node; 8] {
-        let states = self.child_states(tree);
-        std::array::from_fn(|code| self.child(tree, states, code))
+        let children = Children::of(tree, self.depth, self.first);
+        std::array::from_fn(|code| self.child(&children, code))
     }
 
-    /// The states of a partial node's children, child `c` at bits `2c`.
-    fn child_states(&self, tree: &KTree<3>) -> u32 {
-        tree.level_states(self.depth + 1).block_codes(self.first, 3)
-    }
-
-    /// The child `code` of a partial node whose children's states are `states`.
-    fn child(&self, tree: &KTree<3>, states: u32, code: usize) -> Node {
+    /// The child `code` of a partial node whose children are `children`.
+    fn child(&self, children: &Children, code: usize) -> Node {
         let half = 1u32 << (self.log_side - 1);
-        let (depth, index) = (self.depth + 1, self.first + code);
-        let state = NodeState::from_bits(states >> (2 * code));
+        let state = children.state(code);
         Node {
-            depth,
+            depth: self.depth + 1,
             first: match state {
-                NodeState::Partial => tree.first_child(depth, index),
+                NodeState::Partial => children.first_child(code),
                 _ => 0,
             },
             state,
@@ -470,9 +579,9 @@ fn across(
             match n {
                 Some(node) if node.state == NodeState::Partial => {
                     let (b, c) = others(a);
-                    let states = node.child_states(tree);
+                    let children = Children::of(tree, node.depth, node.first);
                     std::array::from_fn(|q| {
-                        Some(node.child(tree, states, upper << a | (q & 1) << b | (q >> 1) << c))
+                        Some(node.child(&children, upper << a | (q & 1) << b | (q >> 1) << c))
                     })
                 }
                 other => [other; 4],
@@ -644,37 +753,34 @@ impl Rect {
 /// [`Rect::corners`]).
 const CORNER_QUADRANTS: [usize; 4] = [0b11, 0b10, 0b00, 0b01];
 
-/// A lattice point at rectangles' corners, and what is known of it.
-#[derive(Debug, Clone, Copy)]
-struct Point {
-    at: [u32; 3],
-    /// The occupancy of the eight voxels around the point.
-    mask: u8,
-    /// For each direction `d`, the link parts (bit set) of the corners here whose rectangle has an edge
-    /// along `d`.
-    on_lines: [u8; 3],
+/// A lattice point at rectangles' corners, as a line along one direction `d` holds it.
+#[derive(Debug, Clone, Copy, Default)]
+struct LinePoint {
+    /// The point's coordinate along `d`.
+    along: u32,
     /// The vertex of the point's first link part at a corner; the others follow in order of part.
     first_vertex: u32,
-    /// The point's place in each of [`Corners::order`].
-    position: [u32; 3],
+    /// The occupancy of the eight voxels around the point.
+    mask: u8,
+    /// The link parts (bit set) of the corners here whose rectangle has an edge along `d`.
+    on_line: u8,
+    /// The link parts of all corners here.
+    parts: u8,
 }
 
-impl Point {
+impl LinePoint {
     /// The vertex of link part `part` (a part of some corner at the point).
     fn vertex(&self, part: u8) -> u32 {
-        let parts = self.on_lines[0] | self.on_lines[1] | self.on_lines[2];
-        debug_assert!(parts >> part & 1 == 1);
-        self.first_vertex + (parts & ((1u8 << part) - 1)).count_ones()
+        debug_assert!(self.parts >> part & 1 == 1);
+        self.first_vertex + (self.parts & ((1u8 << part) - 1)).count_ones()
     }
 }
 
 /// The lattice points at the rectangles' corners, and the vertices made at them.
 struct Corners {
-    /// The points, in Morton order.
-    points: Vec<Point>,
-    /// For each lattice direction `d`, the points ordered line by line along `d` (sorted by their other two
+    /// For each lattice direction `d`, the points line by line along `d` (sorted by their other two
     /// coordinates, then along `d`).
-    order: [Vec<u32>; 3],
+    lines: [Vec<LinePoint>; 3],
     /// What the mesh needs of corner `k` of rectangle `r`, at `4r + k`.
     corners: Vec<Corner>,
     /// The vertex of each point and corner link part: the points' in Morton order, each point's by part.
@@ -682,7 +788,7 @@ struct Corners {
 }
 
 /// A rectangle's corner: its point's vertex (of the corner's link part) and occupancy, and the point's
-/// places in the orders along the rectangle's axes `b` and `c`.
+/// places in [`Corners::lines`] along the rectangle's axes `b` and `c`.
 #[derive(Debug, Clone, Copy, Default)]
 struct Corner {
     vertex: u32,
@@ -719,15 +825,29 @@ impl Corners {
         let part = |mask: u8, &(_, slot, _, a): &(u64, u32, u8, u8)| {
             part_of(mask, usize::from(a), CORNER_QUADRANTS[slot as usize % 4])
         };
-        let mut locator = Locator::new(tree);
-        let mut points: Vec<Point> = Vec::new();
+        let (mut locator, mut recent) = (Locator::new(tree), RecentChildren::new(tree));
         let mut corners = vec![Corner::default(); keyed.len()];
         let mut vertices = Vec::new();
+        // The points, in Morton order: where each is, what is around it, the lines through it by link
+        // part (see `LinePoint::on_line`) and its first vertex. The occupancies first, in a pass that
+        // reads nothing but the tree.
+        let mut points: Vec<([u32; 3], u8, [u8; 3], u32)> = Vec::new();
         for group in keyed.chunk_by(same_point) {
             let (low, _, high, _) = group[0];
             let at = point_of(u128::from(high) << 64 | u128::from(low));
-            let mask = occupancy(tree, &mut locator, at);
-            // The lines along the corners' rectangles' edges through the point, by link part.
+            points.push((
+                at,
+                occupancy(tree, &mut locator, &mut recent, at),
+                [0; 3],
+                0,
+            ));
+        }
+        for (point_index, (point, group)) in points
+            .iter_mut()
+            .zip(keyed.chunk_by(same_point))
+            .enumerate()
+        {
+            let (at, mask) = (point.0, point.1);
             let mut on_lines = [0u8; 3];
             for corner in group {
                 let (b, c) = others(usize::from(corner.3));
@@ -735,65 +855,69 @@ impl Corners {
                 on_lines[b] |= bit;
                 on_lines[c] |= bit;
             }
-            let point = Point {
-                at,
-                mask,
-                on_lines,
-                first_vertex: u32::try_from(vertices.len())
-                    .expect("fewer than 2^32 vertices (indices are 32-bit)"),
-                position: [0; 3],
-            };
+            let first_vertex = u32::try_from(vertices.len())
+                .expect("fewer than 2^32 vertices (indices are 32-bit)");
             let parts = on_lines[0] | on_lines[1] | on_lines[2];
             vertices.extend(std::iter::repeat_n(
                 at.map(f64::from),
                 parts.count_ones() as usize,
             ));
             for corner in group {
+                let part = part(mask, corner);
                 corners[corner.1 as usize] = Corner {
-                    vertex: point.vertex(part(mask, corner)),
-                    // The point, until its places are known.
-                    positions: [points.len() as u32, 0],
+                    vertex: first_vertex + (parts & ((1u8 << part) - 1)).count_ones(),
+                    // The point, until its places in the lines are known.
+                    positions: [point_index as u32, 0],
                     mask,
                 };
             }
-            points.push(point);
+            *point = (at, mask, on_lines, first_vertex);
         }
         drop(keyed);
-        let (mut lines, mut scratch) = (Vec::with_capacity(points.len()), Vec::new());
-        let order: [Vec<u32>; 3] = std::array::from_fn(|d| {
+        // The lines along each direction, sorted with what they hold of each point (no point is looked up
+        // afterwards), and each point's place in them.
+        let mut places = vec![[0u32; 3]; points.len()];
+        let (mut sorted, mut scratch) = (Vec::with_capacity(points.len()), Vec::new());
+        let width = bits / 3;
+        let lines: [Vec<LinePoint>; 3] = std::array::from_fn(|d| {
             let (x, y) = match d {
                 0 => (1, 2),
                 1 => (0, 2),
                 _ => (0, 1),
             };
-            lines.clear();
-            lines.extend(
-                points
-                    .iter()
-                    .enumerate()
-                    .map(|(i, p)| ([p.at[x], p.at[y], p.at[d]], i as u32)),
-            );
-            let width = bits / 3;
-            radix::sort_by_wide_key(&mut lines, bits, &mut scratch, |&(at, _)| {
-                u128::from(at[0]) << (2 * width) | u128::from(at[1]) << width | u128::from(at[2])
+            sorted.clear();
+            sorted.extend(points.iter().enumerate().map(
+                |(i, &(at, mask, on_lines, first_vertex))| {
+                    let point = LinePoint {
+                        along: at[d],
+                        first_vertex,
+                        mask,
+                        on_line: on_lines[d],
+                        parts: on_lines[0] | on_lines[1] | on_lines[2],
+                    };
+                    ([at[x], at[y]], point, i as u32)
+                },
+            ));
+            radix::sort_by_wide_key(&mut sorted, bits, &mut scratch, |&(line, point, _)| {
+                u128::from(line[0]) << (2 * width)
+                    | u128::from(line[1]) << width
+                    | u128::from(point.along)
             });
-            lines.iter().map(|&(_, i)| i).collect()
-        });
-        for (d, order) in order.iter().enumerate() {
-            for (j, &i) in order.iter().enumerate() {
-                points[i as usize].position[d] = j as u32;
+            for (j, &(_, _, i)) in sorted.iter().enumerate() {
+                places[i as usize][d] = j as u32;
             }
-        }
+            sorted.iter().map(|&(_, point, _)| point).collect()
+        });
+        drop(points);
         for (rect, corners) in rects.iter().zip(corners.chunks_exact_mut(4)) {
             let (b, c) = others(rect.a);
             for corner in corners {
-                let point = &points[corner.positions[0] as usize];
-                corner.positions = [point.position[b], point.position[c]];
+                let place = places[corner.positions[0] as usize];
+                corner.positions = [place[b], place[c]];
             }
         }
         Self {
-            points,
-            order,
+            lines,
             corners,
             vertices,
         }
@@ -896,8 +1020,7 @@ pub const SMOOTH_FACE_LIMIT: u64 = 1 << 26;
 /// The mesh of boundary rectangles `rects` (see [`boundary_mesh`]).
 fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {
     let Corners {
-        points,
-        order,
+        lines,
         corners,
         vertices,
     } = Corners::new(tree, rects);
@@ -909,7 +1032,7 @@ fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {
     // Midpoints of segments where two solids touch, by doubled position and the full octant bounded.
     let mut midpoints: HashMap<([u64; 3], u8), u32> = HashMap::new();
     let mut ring: Vec<u32> = Vec::new();
-    let mut stops: Vec<(usize, u8)> = Vec::new();
+    let mut stops: Vec<(u32, u8, Option<u32>)> = Vec::new();
     for (rect, corner) in rects.iter().zip(corners.chunks_exact(4)) {
         let (b, c) = others(rect.a);
         let rect_corners = rect.corners();
@@ -937,12 +1060,11 @@ fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {
             // The corners strictly inside the edge, on the same sheet as the rectangle there.
             stops.clear();
             let (j0, j1) = (corner[k].positions[k % 2], corner[next].positions[k % 2]);
-            for &i in &order[d][(j0.min(j1) + 1) as usize..j0.max(j1) as usize] {
-                let point = &points[i as usize];
+            for point in &lines[d][(j0.min(j1) + 1) as usize..j0.max(j1) as usize] {
                 let part = link_parts()[point.mask as usize][face];
                 debug_assert!(part < 4, "a rectangle's edge past a non-boundary face");
-                if part < 8 && point.on_lines[d] >> part & 1 == 1 {
-                    stops.push((i as usize, part));
+                if part < 8 && point.on_line >> part & 1 == 1 {
+                    stops.push((point.along, point.mask, Some(point.vertex(part))));
                 }
             }
             if j1 < j0 {
@@ -952,17 +1074,11 @@ fn mesh_of(tree: &KTree<3>, rects: &[Rect]) -> SurfaceMesh {
             let full_side = usize::from(!rect.upper);
             let octant = (full_side << rect.a | e_side << e) as u8;
             // Along the edge: each stop, then the next corner, as (coordinate along d, occupancy, vertex).
-            let ends = stops
-                .iter()
-                .map(|&(i, part)| {
-                    let point = &points[i];
-                    (point.at[d], point.mask, Some(point.vertex(part)))
-                })
-                .chain(std::iter::once((
-                    rect_corners[next].0[d],
-                    corner[next].mask,
-                    None,
-                )));
+            let ends = stops.iter().copied().chain(std::iter::once((
+                rect_corners[next].0[d],
+                corner[next].mask,
+                None,
+            )));
             let mut prev = (p[d], corner[k].mask);
             for (at, mask, vertex) in ends {
                 let lower = if prev.0 < at { prev.1 } else { mask };
