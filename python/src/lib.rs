@@ -553,7 +553,8 @@ impl Tree {
     }
 
     /// Whether voxels are inside: one point (K integers) gives a bool, an `(N, K)` integer array an
-    /// `(N,)` bool array (answered on all threads, ordered by Morton key, without the interpreter lock).
+    /// `(N,)` bool array (answered on all threads without the interpreter lock: a large batch first
+    /// through a table of the tree's top levels, the points it leaves open in Morton order).
     /// Points outside the universe (negative ones too) are outside.
     fn contains<'py>(
         &self,

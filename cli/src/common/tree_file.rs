@@ -18,8 +18,9 @@ static VERSION: OnceLock<u16> = OnceLock::new();
 /// The option, shared by every subcommand.
 #[derive(Debug, clap::Args)]
 pub struct FormatArgs {
-    /// The `.ktree` format version written: 2 (a checksummed section per level; `stats` reads it through
-    /// a memory map) or 1 (one body, for older readers).
+    /// The `.ktree` format version of the trees written, by the commands that write trees (the others
+    /// ignore it): 2 (a checksummed section per level; `stats` reads it through a memory map) or 1 (one
+    /// body, for older readers).
     #[arg(long, global = true, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=2))]
     format_version: u16,
 }
