@@ -874,10 +874,10 @@ impl Corners {
             *point = (at, mask, on_lines, first_vertex);
         }
         drop(keyed);
-        // The lines along each direction, sorted with what they hold of each point (no point is looked up
-        // afterwards), and each point's place in them.
+        // The lines along each direction, holding what an edge needs of each point (so that an edge reads
+        // a run of memory), and each point's place in them.
         let mut places = vec![[0u32; 3]; points.len()];
-        let (mut sorted, mut scratch) = (Vec::with_capacity(points.len()), Vec::new());
+        let mut sorted = Vec::with_capacity(points.len());
         let width = bits / 3;
         let lines: [Vec<LinePoint>; 3] = std::array::from_fn(|d| {
             let (x, y) = match d {
@@ -885,29 +885,36 @@ impl Corners {
                 1 => (0, 2),
                 _ => (0, 1),
             };
+            // The point's coordinates across the line, along it, and the point.
             sorted.clear();
-            sorted.extend(points.iter().enumerate().map(
-                |(i, &(at, mask, on_lines, first_vertex))| {
-                    let point = LinePoint {
-                        along: at[d],
+            sorted.extend(
+                points
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &(at, ..))| [at[x], at[y], at[d], i as u32]),
+            );
+            // (A fresh scratch buffer for each sort: it is gone before the line is made, and the peak of
+            // memory is here.)
+            radix::sort_by_wide_key(&mut sorted, bits, &mut Vec::new(), |p| {
+                u128::from(p[0]) << (2 * width) | u128::from(p[1]) << width | u128::from(p[2])
+            });
+            sorted
+                .iter()
+                .enumerate()
+                .map(|(j, &[.., along, i])| {
+                    places[i as usize][d] = j as u32;
+                    let (_, mask, on_lines, first_vertex) = points[i as usize];
+                    LinePoint {
+                        along,
                         first_vertex,
                         mask,
                         on_line: on_lines[d],
                         parts: on_lines[0] | on_lines[1] | on_lines[2],
-                    };
-                    ([at[x], at[y]], point, i as u32)
-                },
-            ));
-            radix::sort_by_wide_key(&mut sorted, bits, &mut scratch, |&(line, point, _)| {
-                u128::from(line[0]) << (2 * width)
-                    | u128::from(line[1]) << width
-                    | u128::from(point.along)
-            });
-            for (j, &(_, _, i)) in sorted.iter().enumerate() {
-                places[i as usize][d] = j as u32;
-            }
-            sorted.iter().map(|&(_, point, _)| point).collect()
+                    }
+                })
+                .collect()
         });
+        drop(sorted);
         drop(points);
         for (rect, corners) in rects.iter().zip(corners.chunks_exact_mut(4)) {
             let (b, c) = others(rect.a);
