@@ -433,13 +433,14 @@ impl Children {
 /// The children of the partial nodes read lately, a few at each depth (points in Morton order read
 /// the same nodes again and again).
 struct RecentChildren {
-    /// By depth, then by the first child's index divided by 8, modulo [`RecentChildren::WAYS`]:
+    /// By depth, then by the first child's index divided by 8, modulo [`RecentChildren::SLOTS`]:
     /// `(first, children)`.
-    slots: Vec<[(usize, Children); RecentChildren::WAYS]>,
+    slots: Vec<[(usize, Children); RecentChildren::SLOTS]>,
 }
 
 impl RecentChildren {
-    const WAYS: usize = 8;
+    /// Nodes kept at each depth.
+    const SLOTS: usize = 8;
 
     fn new(tree: &KTree<3>) -> Self {
         let none = (
@@ -450,14 +451,14 @@ impl RecentChildren {
             },
         );
         RecentChildren {
-            slots: vec![[none; Self::WAYS]; tree.level() as usize + 1],
+            slots: vec![[none; Self::SLOTS]; tree.level() as usize + 1],
         }
     }
 
     /// As [`Children::of`].
     #[inline]
     fn of(&mut self, tree: &KTree<3>, depth: usize, first: usize) -> Children {
-        let slot = &mut self.slots[depth][(first >> 3) % Self::WAYS];
+        let slot = &mut self.slots[depth][(first >> 3) % Self::SLOTS];
         if slot.0 != first {
             *slot = (first, Children::of(tree, depth, first));
         }
@@ -771,9 +772,27 @@ struct LinePoint {
 impl LinePoint {
     /// The vertex of link part `part` (a part of some corner at the point).
     fn vertex(&self, part: u8) -> u32 {
-        debug_assert!(self.parts >> part & 1 == 1);
-        self.first_vertex + (self.parts & ((1u8 << part) - 1)).count_ones()
+        vertex_of(self.first_vertex, self.parts, part)
     }
+}
+
+/// The vertex of link part `part` at a point whose corners have link parts `parts` (bit set) and whose
+/// first part's vertex is `first_vertex`: the parts' vertices follow in order of part.
+fn vertex_of(first_vertex: u32, parts: u8, part: u8) -> u32 {
+    debug_assert!(parts >> part & 1 == 1);
+    first_vertex + (parts & ((1u8 << part) - 1)).count_ones()
+}
+
+/// A lattice point at rectangles' corners, while the lines are made.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    at: [u32; 3],
+    /// The occupancy of the eight voxels around the point.
+    mask: u8,
+    /// For each direction `d`, the link parts (bit set) of the corners here whose rectangle has an edge
+    /// along `d`.
+    on_lines: [u8; 3],
+    first_vertex: u32,
 }
 
 /// The lattice points at the rectangles' corners, and the vertices made at them.
@@ -828,26 +847,19 @@ impl Corners {
         let (mut locator, mut recent) = (Locator::new(tree), RecentChildren::new(tree));
         let mut corners = vec![Corner::default(); keyed.len()];
         let mut vertices = Vec::new();
-        // The points, in Morton order: where each is, what is around it, the lines through it by link
-        // part (see `LinePoint::on_line`) and its first vertex. The occupancies first, in a pass that
-        // reads nothing but the tree.
-        let mut points: Vec<([u32; 3], u8, [u8; 3], u32)> = Vec::new();
-        for group in keyed.chunk_by(same_point) {
+        // The points, in Morton order. The occupancies first, in a pass that reads nothing but the tree.
+        let masks: Vec<u8> = keyed
+            .chunk_by(same_point)
+            .map(|group| {
+                let (low, _, high, _) = group[0];
+                let at = point_of(u128::from(high) << 64 | u128::from(low));
+                occupancy(tree, &mut locator, &mut recent, at)
+            })
+            .collect();
+        let mut points: Vec<Point> = Vec::with_capacity(masks.len());
+        for (group, &mask) in keyed.chunk_by(same_point).zip(&masks) {
             let (low, _, high, _) = group[0];
             let at = point_of(u128::from(high) << 64 | u128::from(low));
-            points.push((
-                at,
-                occupancy(tree, &mut locator, &mut recent, at),
-                [0; 3],
-                0,
-            ));
-        }
-        for (point_index, (point, group)) in points
-            .iter_mut()
-            .zip(keyed.chunk_by(same_point))
-            .enumerate()
-        {
-            let (at, mask) = (point.0, point.1);
             let mut on_lines = [0u8; 3];
             for corner in group {
                 let (b, c) = others(usize::from(corner.3));
@@ -863,16 +875,21 @@ impl Corners {
                 parts.count_ones() as usize,
             ));
             for corner in group {
-                let part = part(mask, corner);
                 corners[corner.1 as usize] = Corner {
-                    vertex: first_vertex + (parts & ((1u8 << part) - 1)).count_ones(),
+                    vertex: vertex_of(first_vertex, parts, part(mask, corner)),
                     // The point, until its places in the lines are known.
-                    positions: [point_index as u32, 0],
+                    positions: [points.len() as u32, 0],
                     mask,
                 };
             }
-            *point = (at, mask, on_lines, first_vertex);
+            points.push(Point {
+                at,
+                mask,
+                on_lines,
+                first_vertex,
+            });
         }
+        drop(masks);
         drop(keyed);
         // The lines along each direction, holding what an edge needs of each point (so that an edge reads
         // a run of memory), and each point's place in them.
@@ -891,7 +908,7 @@ impl Corners {
                 points
                     .iter()
                     .enumerate()
-                    .map(|(i, &(at, ..))| [at[x], at[y], at[d], i as u32]),
+                    .map(|(i, p)| [p.at[x], p.at[y], p.at[d], i as u32]),
             );
             // (A fresh scratch buffer for each sort: it is gone before the line is made, and the peak of
             // memory is here.)
@@ -903,13 +920,13 @@ impl Corners {
                 .enumerate()
                 .map(|(j, &[.., along, i])| {
                     places[i as usize][d] = j as u32;
-                    let (_, mask, on_lines, first_vertex) = points[i as usize];
+                    let p = &points[i as usize];
                     LinePoint {
                         along,
-                        first_vertex,
-                        mask,
-                        on_line: on_lines[d],
-                        parts: on_lines[0] | on_lines[1] | on_lines[2],
+                        first_vertex: p.first_vertex,
+                        mask: p.mask,
+                        on_line: p.on_lines[d],
+                        parts: p.on_lines[0] | p.on_lines[1] | p.on_lines[2],
                     }
                 })
                 .collect()
