@@ -119,6 +119,140 @@ impl LevelFile {
     }
 }
 
+/// Gives the disk of a spill file back while its pieces are read, in any order: reading piece `s` punches a
+/// hole over it (`fallocate` with `FALLOC_FL_PUNCH_HOLE`), widened to the whole blocks at its ends when
+/// every other piece in them was read before, so each block is freed when the last piece in it is read and
+/// the file holds no block once all are. A build that spills as much as it writes then needs about the
+/// output's size of disk, not twice it. Where holes cannot be punched (a system other than Linux, or a file
+/// system without them) the file keeps its blocks until it is removed; nothing read is ever punched twice,
+/// and nothing not yet read at all.
+pub(crate) struct PieceRelease<'a> {
+    /// The word offset of each piece in the file, in file order (pieces may be empty).
+    offsets: &'a [u64],
+    /// The file's length in words (the end of the last piece).
+    end: u64,
+    /// One bit per piece: read.
+    read: Vec<u64>,
+    /// The file system's block size in bytes.
+    block: u64,
+    /// False once a hole could not be punched.
+    punching: bool,
+}
+
+impl<'a> PieceRelease<'a> {
+    /// The pieces at word offsets `offsets` of `file`, which is `end` words long.
+    pub(crate) fn new(file: &File, offsets: &'a [u64], end: u64) -> Self {
+        Self::with_block(offsets, end, block_size(file))
+    }
+
+    fn with_block(offsets: &'a [u64], end: u64, block: u64) -> Self {
+        Self {
+            offsets,
+            end,
+            read: vec![0; offsets.len().div_ceil(64)],
+            block: block.max(1),
+            punching: true,
+        }
+    }
+
+    fn bytes(&self, piece: usize) -> std::ops::Range<u64> {
+        let start = self.offsets[piece];
+        let end = self.offsets.get(piece + 1).copied().unwrap_or(self.end);
+        8 * start..8 * end
+    }
+
+    fn is_read(&self, piece: usize) -> bool {
+        self.read[piece / 64] >> (piece % 64) & 1 == 1 || self.bytes(piece).is_empty()
+    }
+
+    /// Whether every one of `pieces` was read; false if there are more than [`NEIGHBOURS_LOOKED_AT`] (a
+    /// block shared by that many pieces stays until its file is removed, so each piece read costs a bounded
+    /// time whatever the order).
+    fn all_read(&self, mut pieces: impl Iterator<Item = usize>) -> bool {
+        pieces
+            .by_ref()
+            .take(NEIGHBOURS_LOOKED_AT)
+            .all(|p| self.is_read(p))
+            && pieces.next().is_none()
+    }
+
+    /// Marks `piece` read; returns the bytes that may now be freed: the piece, widened at each end to the
+    /// block boundary when every other piece in that block is read (empty when none is whole).
+    fn mark_read(&mut self, piece: usize) -> std::ops::Range<u64> {
+        self.read[piece / 64] |= 1 << (piece % 64);
+        let bytes = self.bytes(piece);
+        if bytes.is_empty() {
+            return 0..0;
+        }
+        let b = self.block;
+        let first_block = bytes.start / b * b;
+        let before_read = self.all_read(
+            (0..piece)
+                .rev()
+                .take_while(|&p| self.bytes(p).end > first_block),
+        );
+        let start = if before_read {
+            first_block
+        } else {
+            bytes.start.next_multiple_of(b)
+        };
+        let last_block = bytes.end.next_multiple_of(b);
+        let after_read = self.all_read(
+            (piece + 1..self.offsets.len()).take_while(|&p| self.bytes(p).start < last_block),
+        );
+        let end = if after_read {
+            last_block
+        } else {
+            bytes.end / b * b
+        };
+        if start < end {
+            start..end
+        } else {
+            0..0
+        }
+    }
+
+    /// Marks `piece` of `file` read and frees what it can of it. Punching is an economy, not a part of the
+    /// result: a hole that cannot be punched stops the punching of this file, with no error.
+    pub(crate) fn release(&mut self, file: &File, piece: usize) {
+        let range = self.mark_read(piece);
+        if self.punching && !range.is_empty() {
+            self.punching = punch_hole(file, range).is_ok();
+        }
+    }
+}
+
+/// The most pieces [`PieceRelease`] looks at on each side of a piece read.
+const NEIGHBOURS_LOOKED_AT: usize = 64;
+
+/// The block size of `file`'s file system (4096 where it cannot be read).
+fn block_size(file: &File) -> u64 {
+    #[cfg(unix)]
+    if let Ok(meta) = file.metadata() {
+        return std::os::unix::fs::MetadataExt::blksize(&meta);
+    }
+    let _ = file;
+    4096
+}
+
+/// Frees the bytes `range` of `file` (they read as zeros after), keeping its size.
+#[cfg(target_os = "linux")]
+fn punch_hole(file: &File, range: std::ops::Range<u64>) -> std::io::Result<()> {
+    use rustix::fs::{fallocate, FallocateFlags};
+    fallocate(
+        file,
+        FallocateFlags::PUNCH_HOLE | FallocateFlags::KEEP_SIZE,
+        range.start,
+        range.end - range.start,
+    )
+    .map_err(std::io::Error::from)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn punch_hole(_file: &File, _range: std::ops::Range<u64>) -> std::io::Result<()> {
+    Err(std::io::ErrorKind::Unsupported.into())
+}
+
 /// What [`SpillLevels`] wrote.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct SpilledTree {
@@ -184,13 +318,18 @@ impl SpillLevels {
             writer.end_level()?;
             let mut words = vec![0u64; BUFFER_BYTES / 8];
             let mut bytes = vec![0u8; BUFFER_BYTES];
+            let per_word = NODES_PER_WORD as u64;
             for (path, file, nodes) in readers {
                 let with_path = |e: std::io::Error| {
                     std::io::Error::new(e.kind(), format!("spill file {}: {e}", path.display()))
                 };
-                let mut reader = BufReader::new(file);
+                // Read in chunks of `words.len()` words, each given back once read.
+                let file_words = nodes.div_ceil(per_word);
+                let chunks: Vec<u64> = (0..file_words).step_by(words.len()).collect();
+                let mut release = PieceRelease::new(&file, &chunks, file_words);
+                let mut reader = BufReader::new(&file);
                 let mut left = nodes;
-                let per_word = NODES_PER_WORD as u64;
+                let mut chunk = 0;
                 while left > 0 {
                     let n = left.min(per_word * words.len() as u64);
                     let w = n.div_ceil(per_word) as usize;
@@ -199,6 +338,8 @@ impl SpillLevels {
                         *word = u64::from_le_bytes(b.try_into().expect("8 bytes"));
                     }
                     writer.append_words(&words[..w], n)?;
+                    release.release(&file, chunk);
+                    chunk += 1;
                     left -= n;
                 }
                 writer.end_level()?;
@@ -228,5 +369,127 @@ impl LevelSink for SpillLevels {
 
     fn finish(self, root: NodeState) -> Result<SpilledTree, SpillError> {
         self.write(root)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Word offsets of pieces of `sizes` words, and the file's end.
+    fn offsets(sizes: &[u64]) -> (Vec<u64>, u64) {
+        let mut at = 0;
+        let offsets = sizes
+            .iter()
+            .map(|&n| {
+                at += n;
+                at - n
+            })
+            .collect();
+        (offsets, at)
+    }
+
+    /// The pieces with bytes in block `b` (of `block` bytes).
+    fn pieces_in(sizes: &[u64], block: u64, b: u64) -> Vec<usize> {
+        let (offsets, _) = offsets(sizes);
+        (0..sizes.len())
+            .filter(|&p| {
+                let (start, end) = (8 * offsets[p], 8 * (offsets[p] + sizes[p]));
+                start < end && start < (b + 1) * block && end > b * block
+            })
+            .collect()
+    }
+
+    proptest! {
+        /// Read in any order, a block is given back exactly when every piece in it was read (a block of
+        /// more pieces than are looked at may stay), never before.
+        #[test]
+        fn blocks_are_given_back_once_all_their_pieces_are_read(
+            sizes in prop::collection::vec(prop_oneof![Just(0u64), 1u64..4, 1u64..40], 1..120),
+            block in prop::sample::select(vec![8u64, 16, 64, 512]),
+            order in any::<prop::sample::Index>(),
+            seed: u64,
+        ) {
+            let (offsets, end) = offsets(&sizes);
+            let n = sizes.len();
+            // A permutation of the pieces, from `seed`.
+            let mut perm: Vec<usize> = (0..n).collect();
+            let mut state = seed | 1;
+            for i in (1..n).rev() {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                perm.swap(i, (state % (i as u64 + 1)) as usize);
+            }
+            perm.rotate_left(order.index(n));
+            let blocks = (8 * end).div_ceil(block);
+            let mut release = PieceRelease::with_block(&offsets, end, block);
+            let mut released = vec![false; blocks as usize];
+            let mut read = vec![false; n];
+            for &p in &perm {
+                read[p] = true;
+                let range = release.mark_read(p);
+                prop_assert!(range.start.is_multiple_of(block) && range.end.is_multiple_of(block));
+                for b in range.start / block..range.end / block {
+                    prop_assert!(b < blocks, "a block past the end");
+                    prop_assert!(!released[b as usize], "block {b} given back twice");
+                    released[b as usize] = true;
+                }
+                for b in 0..blocks {
+                    let inside = pieces_in(&sizes, block, b);
+                    let all_read = inside.iter().all(|&q| read[q]);
+                    if released[b as usize] {
+                        prop_assert!(all_read, "block {b} given back with a piece unread");
+                    } else if inside.len() <= NEIGHBOURS_LOOKED_AT / 2 {
+                        prop_assert!(!all_read, "block {b} kept though all its pieces were read");
+                    }
+                }
+            }
+        }
+    }
+
+    /// On a real file: once every piece is read back (in an order far from the file's), the file holds no
+    /// block, and a piece not yet read keeps its bytes while those around it are punched.
+    #[test]
+    fn a_spill_file_read_back_holds_no_disk() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("level");
+        let sizes: Vec<u64> = (0..400u64).map(|i| (i * 37) % 300).collect();
+        let (offsets, end) = offsets(&sizes);
+        let data: Vec<u8> = (0..8 * end).map(|i| (i % 251) as u8 + 1).collect();
+        std::fs::write(&path, &data).unwrap();
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&path)
+            .unwrap();
+        file.sync_all().unwrap();
+        let held = |file: &File| std::os::unix::fs::MetadataExt::blocks(&file.metadata().unwrap());
+        assert!(held(&file) > 0);
+        let mut release = PieceRelease::new(&file, &offsets, end);
+        // Every piece but piece 200, in a scattered order.
+        for p in (0..400).map(|i| (i * 173) % 400).filter(|&p| p != 200) {
+            release.release(&file, p);
+        }
+        let kept = 8 * offsets[200] as usize..8 * (offsets[200] + sizes[200]) as usize;
+        let now = std::fs::read(&path).unwrap();
+        assert_eq!(now.len(), data.len(), "the file keeps its size");
+        assert_eq!(
+            now[kept.clone()],
+            data[kept],
+            "an unread piece keeps its bytes"
+        );
+        release.release(&file, 200);
+        if !release.punching {
+            eprintln!("holes cannot be punched in this file system: only the bytes were checked");
+        } else {
+            assert_eq!(
+                held(&file),
+                0,
+                "blocks still held after every piece was read"
+            );
+            assert!(std::fs::read(&path).unwrap().iter().all(|&b| b == 0));
+        }
     }
 }

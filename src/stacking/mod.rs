@@ -21,7 +21,8 @@
 //! ## How it runs
 //! The cells of depth `m` are stacked slab by slab exactly as in [`Builder::build`],
 //! but no finished subtree is kept: the levels `1, 2, …` of each partial cell's subtree are appended to
-//! one temporary *spill file* per level (word-aligned, in the order the slabs finish), and only a small
+//! one temporary *spill file* per level (word-aligned; slab after slab in the order they finish, each slab's cells
+//! in Morton order), and only a small
 //! index (the cell's Morton index and its node count per level) and the states of the cells of depth `m`
 //! (see *Memory*) stay in memory. At the end the file is written level by level through a [`KtreeWriter`](crate::io::KtreeWriter): the
 //! top levels `0 … m` (from the cells' states; a uniform top collapses), then each level `m + j` as the
@@ -62,6 +63,15 @@
 //! default the output's folder), removed when the build ends, whether it succeeds or fails; a process
 //! killed mid-build leaves it behind, and the next build of the same output removes the folders of
 //! processes that no longer run.
+//!
+//! **Disk.** The spill files hold what the levels below `m` will take in the output, so a build holds about
+//! twice the output's size if the files are kept to the end. They are not: each piece read back into the
+//! output is punched out of its spill file (`fallocate` with `FALLOC_FL_PUNCH_HOLE`, on Linux), a block
+//! as soon as every piece in it is read, and each spill file is emptied once its level is written. As
+//! each slab's part of a file is in Morton order, the order it is read in, its blocks go back nearly as
+//! fast as the output grows: the build needs about the output's size of disk (the column *disk peak* of
+//! `results/performance/scale-large.md`). On other
+//! systems or file systems without holes the spill files keep their blocks until their level is written.
 //!
 //! ```
 //! use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};

@@ -3,7 +3,7 @@
 //! L = 10 … 13; the whole-set build (all rays, then one stacking) beside it up to L = 12; and the
 //! out-of-core build (subtrees spilled to temporary files, the `.ktree` written level by level in a memory
 //! budget) at L = 13 and 14. Apart (`perf -- scale-large`, minutes and gigabytes of disk): the out-of-core
-//! build at L = 15 and 16 in a budget of 1 GiB.
+//! build at L = 15 and 16 in a budget of 1 GiB, and at L = 17 in 3 GiB.
 
 use std::fmt::Write as _;
 
@@ -23,10 +23,10 @@ const OUT_OF_CORE_LEVELS: [u32; 2] = [13, 14];
 const OUT_OF_CORE_BUDGET: u64 = 1536 << 20;
 /// Threads of the out-of-core builds.
 const OUT_OF_CORE_THREADS: usize = 2;
-/// Levels of the large out-of-core builds (`perf -- scale-large`).
-const LARGE_LEVELS: [u32; 2] = [15, 16];
-/// Their memory budget: 1 GiB.
-const LARGE_BUDGET: u64 = 1 << 30;
+/// Levels of the large out-of-core builds (`perf -- scale-large`), each with its memory budget: 1 GiB up to
+/// L = 16; 3 GiB at L = 17, where the index of the ~1.7 × 10^7 stacked cells of depth 11 alone takes
+/// about 1.3 GiB.
+const LARGE_LEVELS: [(u32, u64); 3] = [(15, 1 << 30), (16, 1 << 30), (17, 3 << 30)];
 
 fn sphere(level: u32) -> Solid<3> {
     let u = 1i64 << level;
@@ -145,11 +145,13 @@ fn out_of_core_case(
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let out = dir.path().join("sphere.ktree");
     let source = SolidSource::new(solid, level, Sample::Centre).map_err(|e| e.to_string())?;
+    let disk = DiskSampler::start(dir.path());
     let start = std::time::Instant::now();
     let report = pool
         .install(|| Builder::new(&source).to_file(&out, budget))
         .map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
+    let disk_peak = disk.stop();
     let build_peak = ktree_repro::peak_rss_bytes().unwrap_or(0);
     let view = KtreeView::open(&out).map_err(|e| e.to_string())?;
     if view.counts_per_level() != report.counts_per_level {
@@ -185,6 +187,7 @@ fn out_of_core_case(
     facts.push(("nodes".into(), total.nodes().to_string()));
     facts.push(("file_bytes".into(), report.file_bytes.to_string()));
     facts.push(("spilled_bytes".into(), report.spilled_bytes.to_string()));
+    facts.push(("disk_peak_bytes".into(), disk_peak.to_string()));
     facts.push(("build_peak_bytes".into(), build_peak.to_string()));
     facts.push((
         "accounted_peak_bytes".into(),
@@ -193,28 +196,45 @@ fn out_of_core_case(
     Ok(seconds)
 }
 
-/// Runs the out-of-core case at each of `levels` (in `budget_mib`, or the default budget) and appends its
-/// table to `md`.
+/// Runs the out-of-core case at each of `levels` (each in its budget, or the default budget) and appends
+/// its table to `md`; `disk` adds the disk the build held at most.
 fn out_of_core_table(
     md: &mut String,
-    levels: &[u32],
-    budget_mib: Option<u64>,
+    levels: &[(u32, Option<u64>)],
+    disk: bool,
 ) -> Result<(), String> {
+    let (budget_head, disk_head) = if disk {
+        (" budget MiB |", " disk peak MiB |")
+    } else {
+        ("", "")
+    };
+    let columns = 10 + 2 * usize::from(disk);
     let _ = writeln!(
         md,
-        "| L | rays | voxels | nodes | seconds | ns/node | peak MiB | accounted MiB | spilled MiB | file MiB |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "| L |{budget_head} rays | voxels | nodes | seconds | ns/node | peak MiB | accounted MiB | spilled MiB |{disk_head} file MiB |\n|{}",
+        "---:|".repeat(columns)
     );
-    for &level in levels {
-        let case = match budget_mib {
-            Some(mib) => format!("ooc-{level}-{mib}"),
+    for &(level, budget) in levels {
+        let case = match budget {
+            Some(bytes) => format!("ooc-{level}-{}", bytes >> 20),
             None => format!("ooc-{level}"),
         };
         let m: Measured = run_child("scale", &case)?;
         let nodes: f64 = m.fact("nodes").parse().unwrap_or(f64::NAN);
         let bytes = |key: &str| mib(m.fact(key).parse().unwrap_or(0));
+        let budget_cell = match (disk, budget) {
+            (true, Some(b)) => format!(" {} |", b >> 20),
+            (true, None) => format!(" {} |", OUT_OF_CORE_BUDGET >> 20),
+            (false, _) => String::new(),
+        };
+        let disk_cell = if disk {
+            format!(" {} |", bytes("disk_peak_bytes"))
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             md,
-            "| {level} | {} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {} |",
+            "| {level} |{budget_cell} {} | {} | {} | {:.1} | {:.1} | {} | {} | {} |{disk_cell} {} |",
             m.fact("rays"),
             m.fact("voxels"),
             m.fact("nodes"),
@@ -233,24 +253,80 @@ fn out_of_core_table(
 /// `results/performance/scale-large.md`.
 pub fn report_large() -> Result<String, String> {
     let mut md = String::new();
-    let budget_mib = LARGE_BUDGET >> 20;
     let _ = writeln!(
         md,
-        "# Scale, out of core: the sphere at L = 15 and 16 in 1 GiB\n\n\
-         Regenerate with `cargo run --release --example perf -- scale-large` (about 12 minutes here and \
-         8 GB free in the temporary folder for L = 16). Object: the sphere of `scale.md`. Build: \
+        "# Scale, out of core: the sphere at L = 15 and 16 in 1 GiB, and at L = 17\n\n\
+         Regenerate with `cargo run --release --example perf -- scale-large` (about 50 minutes here, and \
+         35 GB free in the temporary folder for L = 17). Object: the sphere of `scale.md`. Build: \
          `ktree::stacking::Builder::to_file`, what `ktree rays --solid ball --radius (U−1)/2 --level L \
-         --max-memory 1G --out FILE.ktree` runs, on {OUT_OF_CORE_THREADS} threads in a budget of \
-         {budget_mib} MiB. Seconds, peak and checks as in the out-of-core table of `scale.md`: the peak is \
-         the process's high-water resident set when the file is written, the checks (not timed) open the \
-         file, verify every section and compare its counts and voxels with the build's and the runs'. The \
-         goal: L = 16 in at most 1 GiB and 10 minutes.\n\nMachine: {}.\n",
+         --max-memory BUDGET --out FILE.ktree` runs, on {OUT_OF_CORE_THREADS} threads in the budget shown. \
+         Seconds, peak and checks as in the out-of-core table of `scale.md`: the peak is the process's \
+         high-water resident set when the file is written, the checks (not timed) open the file, verify \
+         every section and compare its counts and voxels with the build's and the runs'. Disk peak: the \
+         most disk the build's folder held (spill files and the output being written, sampled every \
+         {DISK_SAMPLE_MS} ms): the spill files give their disk back as they are read into the output, so it \
+         stays near the file's size instead of the spill's and the file's sum. The goal: L = 16 in at most \
+         1 GiB and 10 minutes, and L = 17 given the disk.\n\nMachine: {}.\n",
         machine_line().replace("; one thread used", "")
     );
-    out_of_core_table(&mut md, &LARGE_LEVELS, Some(budget_mib))?;
+    let levels: Vec<(u32, Option<u64>)> = LARGE_LEVELS
+        .iter()
+        .map(|&(level, budget)| (level, Some(budget)))
+        .collect();
+    out_of_core_table(&mut md, &levels, true)?;
     let path = results_path("scale-large");
     ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())
+}
+
+/// How often [`DiskSampler`] looks.
+const DISK_SAMPLE_MS: u64 = 200;
+
+/// Samples, on its own thread, the disk held by the files under a folder (their allocated blocks, so
+/// holes punched count as freed) and keeps the most seen.
+struct DiskSampler {
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    thread: std::thread::JoinHandle<u64>,
+}
+
+impl DiskSampler {
+    fn start(folder: &std::path::Path) -> Self {
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let (flag, folder) = (stop.clone(), folder.to_path_buf());
+        let thread = std::thread::spawn(move || {
+            let mut most = 0;
+            loop {
+                most = most.max(held_bytes(&folder));
+                if flag.load(std::sync::atomic::Ordering::Relaxed) {
+                    return most;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(DISK_SAMPLE_MS));
+            }
+        });
+        Self { stop, thread }
+    }
+
+    /// Stops sampling; the most bytes held.
+    fn stop(self) -> u64 {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        self.thread.join().unwrap_or(0)
+    }
+}
+
+/// Bytes allocated to the files under `folder` (512-byte blocks, as `du` counts).
+fn held_bytes(folder: &std::path::Path) -> u64 {
+    use std::os::unix::fs::MetadataExt;
+    let Ok(entries) = std::fs::read_dir(folder) else {
+        return 0;
+    };
+    entries
+        .flatten()
+        .map(|e| match e.metadata() {
+            Ok(meta) if meta.is_dir() => held_bytes(&e.path()),
+            Ok(meta) => 512 * meta.blocks(),
+            Err(_) => 0,
+        })
+        .sum()
 }
 
 fn mib(bytes: u64) -> String {
@@ -331,7 +407,8 @@ pub fn report() -> Result<String, String> {
          lengths.\n",
         OUT_OF_CORE_BUDGET >> 20
     );
-    out_of_core_table(&mut md, &OUT_OF_CORE_LEVELS, None)?;
+    let levels: Vec<(u32, Option<u64>)> = OUT_OF_CORE_LEVELS.iter().map(|&l| (l, None)).collect();
+    out_of_core_table(&mut md, &levels, false)?;
     let path = results_path("scale");
     ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok(path.display().to_string())

@@ -169,10 +169,13 @@ where
         let (mut set_aside, mut too_big, mut round_cost) = (Vec::new(), false, 0u64);
         for (&b0, outcome) in round.iter().zip(outcomes) {
             match outcome? {
-                SlabOutcome::Stacked { cost, pieces } => {
+                SlabOutcome::Stacked { cost, mut pieces } => {
                     largest = largest.max(cost);
                     round_cost += cost;
                     done += 1;
+                    // Spilled in Morton order, the order they are read back in: each slab's part of a
+                    // spill file is then read front to back, and its disk given back as it goes.
+                    pieces.sort_unstable_by_key(|&(morton, _)| morton);
                     for (morton, piece) in pieces {
                         spill_piece(&mut spill, &mut cells, &mut index, morton, piece)?;
                     }
@@ -408,7 +411,7 @@ impl SpilledPart {
         for j in 0..t {
             let at = level_offsets(&self.own, t, j, &mut offsets);
             let (path, file) = &mut self.readers[j];
-            let mut reader = SpillReader::new(path, file, at);
+            let mut reader = SpillReader::new(path, file, &offsets, at);
             for &s in &order {
                 let count = self.own.counts[s * t + j].div_ceil(32);
                 let mut left = count;
@@ -423,7 +426,9 @@ impl SpilledPart {
                         chunk.clear();
                     }
                 }
+                reader.release(s);
             }
+            reader.finish();
         }
         if !chunk.is_empty() {
             send(&chunk)?;
@@ -527,7 +532,7 @@ impl SpilledPart {
             let mut words: Vec<u64> = Vec::new();
             for (j, (path, file)) in readers.iter_mut().enumerate().take(deepest) {
                 let at = level_offsets(&own, t, j, &mut offsets);
-                let mut reader = SpillReader::new(path, file, at);
+                let mut reader = SpillReader::new(path, file, &offsets, at);
                 for &o in &order {
                     let (owner, s) = unpack(o);
                     let nodes = parts[owner].counts[s * t + j];
@@ -539,12 +544,14 @@ impl SpilledPart {
                     if owner == 0 {
                         reader.seek(offsets[s])?;
                         reader.read_into(count, &mut words)?;
+                        reader.release(s);
                     } else {
                         words.resize(count, 0);
                         receive(owner, &mut words)?;
                     }
                     writer.append_words(&words, nodes)?;
                 }
+                reader.finish();
                 writer.end_level()?;
                 done += 1;
                 progress(Progress {

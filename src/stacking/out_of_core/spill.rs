@@ -2,7 +2,7 @@
 //! written as the cells are stacked and read back, piece by piece, when the tree is written.
 
 use crate::fs::SpillError;
-use crate::io::spill::LevelFile;
+use crate::io::spill::{LevelFile, PieceRelease};
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
@@ -45,7 +45,8 @@ pub(super) fn level_offsets(index: &SubtreeIndex, t: usize, j: usize, offsets: &
 }
 
 /// Reads pieces of one spill file back, one read per piece (pieces are taken out of the order they were
-/// spilled in, so a buffer ahead would mostly be wasted); errors name the file.
+/// spilled in, so a buffer ahead would mostly be wasted), and gives the disk of each piece back once it is
+/// read ([`PieceRelease`]); errors name the file.
 pub(super) struct SpillReader<'a> {
     path: &'a Path,
     file: &'a mut File,
@@ -53,16 +54,21 @@ pub(super) struct SpillReader<'a> {
     at: u64,
     /// The file's length in words.
     len: u64,
+    /// The pieces of the file (their word offsets), and which were read.
+    pieces: PieceRelease<'a>,
     bytes: Vec<u8>,
 }
 
 impl<'a> SpillReader<'a> {
-    pub(super) fn new(path: &'a Path, file: &'a mut File, len: u64) -> Self {
+    /// The reader of `file`, `len` words long, of pieces at word offsets `offsets` (in file order).
+    pub(super) fn new(path: &'a Path, file: &'a mut File, offsets: &'a [u64], len: u64) -> Self {
+        let pieces = PieceRelease::new(file, offsets, len);
         Self {
             path,
             file,
             at: u64::MAX,
             len,
+            pieces,
             bytes: Vec::new(),
         }
     }
@@ -103,6 +109,17 @@ impl<'a> SpillReader<'a> {
         );
         self.at += count as u64;
         Ok(())
+    }
+
+    /// Marks piece `s` read (all its words): its disk is given back.
+    pub(super) fn release(&mut self, s: usize) {
+        self.pieces.release(self.file, s);
+    }
+
+    /// Ends reading the file: what is left of it is given back (it is not read again).
+    pub(super) fn finish(self) {
+        // An economy, like the holes: the spill folder is removed at the end in any case.
+        let _ = self.file.set_len(0);
     }
 }
 
