@@ -479,7 +479,7 @@ fn read_text(bytes: &[u8], header: bool) -> Result<Vec<[f64; 3]>, String> {
 
 /// A scalar field of a binary record.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Scalar {
+pub(super) enum Scalar {
     I8,
     U8,
     I16,
@@ -603,70 +603,159 @@ fn records(bytes: &[u8], at: usize, count: u64, record: usize, what: &str) -> Re
 
 /// A PLY property: a scalar, or a list with its count and item types.
 #[derive(Debug, Clone)]
-enum PlyProperty {
+pub(super) enum PlyProperty {
     Scalar(String, Scalar),
     List(Scalar, Scalar),
 }
 
-fn read_ply(bytes: &[u8]) -> Result<Vec<[f64; 3]>, String> {
-    let (lines, body) = header_lines(bytes, |l| l == "end_header", "PLY")?;
-    if lines.first().map(|l| l.1) != Some("ply") {
-        return Err("line 1: a PLY file starts with 'ply'".into());
-    }
-    let mut format = None;
-    let mut elements: Vec<(String, u64, Vec<PlyProperty>)> = Vec::new();
-    for &(n, line) in &lines[1..] {
-        let words: Vec<&str> = line.split_ascii_whitespace().collect();
-        match words.as_slice() {
-            ["format", f, _] => format = Some(f.to_string()),
-            ["element", name, count] => {
-                let count = count
-                    .parse::<u64>()
-                    .map_err(|_| format!("line {n}: bad element count '{count}'"))?;
-                elements.push((name.to_string(), count, Vec::new()));
+/// An element a PLY header declares: its name, how many entries the body holds, and their properties.
+#[derive(Debug, Clone)]
+pub(super) struct PlyElement {
+    pub(super) name: String,
+    pub(super) count: u64,
+    pub(super) properties: Vec<PlyProperty>,
+}
+
+/// The header of a PLY file, read the same way for point clouds (here) and meshes (whose body `ply-rs`
+/// then parses, [`TriangleMesh`](super::mesh::TriangleMesh)).
+#[derive(Debug, Clone)]
+pub(super) struct PlyHeader {
+    /// `None`: ASCII; `Some(big)`: binary, big-endian or not.
+    pub(super) big: Option<bool>,
+    pub(super) elements: Vec<PlyElement>,
+    /// The byte offset of the body.
+    pub(super) body: usize,
+    /// The header's lines (the body starts on the next).
+    pub(super) lines: usize,
+}
+
+impl PlyHeader {
+    /// Reads the header at the start of `bytes`, a line at a time, the first bad line ending it: a number
+    /// on a `format` or `element` line that does not fit a `u64`, an unknown line, format or type, a
+    /// property before any element, an element of entries with no property. Errors name the line.
+    pub(super) fn parse(bytes: &[u8]) -> Result<Self, String> {
+        let mut big = None;
+        let mut elements: Vec<PlyElement> = Vec::new();
+        let mut at = 0;
+        for (i, line) in bytes.split_inclusive(|&b| b == b'\n').enumerate() {
+            let n = i + 1;
+            at += line.len();
+            if !line.ends_with(b"\n") && line.trim_ascii() != b"end_header" {
+                // The file ends inside its header.
+                break;
             }
-            ["property", "list", c, t, _] => {
-                let (Some(c), Some(t)) = (Scalar::ply(c), Scalar::ply(t)) else {
-                    return Err(format!("line {n}: unknown property type in '{line}'"));
-                };
-                let e = elements
-                    .last_mut()
-                    .ok_or_else(|| format!("line {n}: property before any element"))?;
-                e.2.push(PlyProperty::List(c, t));
+            let line = std::str::from_utf8(line)
+                .map_err(|_| format!("line {n}: the PLY header is not text"))?
+                .trim();
+            if n == 1 {
+                if line != "ply" {
+                    return Err("line 1: a PLY file starts with 'ply'".into());
+                }
+                continue;
             }
-            ["property", t, name] => {
-                let t = Scalar::ply(t)
-                    .ok_or_else(|| format!("line {n}: unknown property type '{t}'"))?;
-                let e = elements
-                    .last_mut()
-                    .ok_or_else(|| format!("line {n}: property before any element"))?;
-                e.2.push(PlyProperty::Scalar(name.to_string(), t));
+            let words: Vec<&str> = line.split_ascii_whitespace().collect();
+            let numbered = matches!(words.first(), Some(&("format" | "element")));
+            if numbered
+                && line
+                    .split(|c: char| !c.is_ascii_digit())
+                    .any(|run| !run.is_empty() && run.parse::<u64>().is_err())
+            {
+                return Err(format!(
+                    "line {n}: PLY: number too large in header line '{line}'"
+                ));
             }
-            ["comment", ..] | ["obj_info", ..] | ["end_header"] | [] => {}
-            _ => return Err(format!("line {n}: unexpected header line '{line}'")),
+            match words.as_slice() {
+                ["format", f, _] => {
+                    big = Some(match *f {
+                        "ascii" => None,
+                        "binary_little_endian" => Some(false),
+                        "binary_big_endian" => Some(true),
+                        f => return Err(format!("line {n}: PLY: unknown format '{f}'")),
+                    });
+                }
+                ["element", name, count] => {
+                    let count = count
+                        .parse::<u64>()
+                        .map_err(|_| format!("line {n}: bad element count '{count}'"))?;
+                    elements.push(PlyElement {
+                        name: name.to_string(),
+                        count,
+                        properties: Vec::new(),
+                    });
+                }
+                ["property", "list", c, t, _] => {
+                    let (Some(c), Some(t)) = (Scalar::ply(c), Scalar::ply(t)) else {
+                        return Err(format!("line {n}: unknown property type in '{line}'"));
+                    };
+                    let e = elements
+                        .last_mut()
+                        .ok_or_else(|| format!("line {n}: property before any element"))?;
+                    e.properties.push(PlyProperty::List(c, t));
+                }
+                ["property", t, name] => {
+                    let t = Scalar::ply(t)
+                        .ok_or_else(|| format!("line {n}: unknown property type '{t}'"))?;
+                    let e = elements
+                        .last_mut()
+                        .ok_or_else(|| format!("line {n}: property before any element"))?;
+                    e.properties.push(PlyProperty::Scalar(name.to_string(), t));
+                }
+                ["end_header"] => {
+                    let big = big.ok_or("PLY: no format line")?;
+                    if let Some(e) = elements
+                        .iter()
+                        .find(|e| e.count > 0 && e.properties.is_empty())
+                    {
+                        return Err(format!(
+                            "PLY: element '{}' has {} entries but no property",
+                            e.name, e.count
+                        ));
+                    }
+                    return Ok(Self {
+                        big,
+                        elements,
+                        body: at,
+                        lines: n,
+                    });
+                }
+                ["comment", ..] | ["obj_info", ..] | [] => {}
+                _ => return Err(format!("line {n}: unexpected header line '{line}'")),
+            }
         }
+        Err("PLY: the header has no end line (no end_header)".into())
     }
-    let format = format.ok_or("PLY: no format line")?;
-    let big = match format.as_str() {
-        "ascii" => None,
-        "binary_little_endian" => Some(false),
-        "binary_big_endian" => Some(true),
-        f => return Err(format!("PLY: unknown format '{f}'")),
-    };
-    if let Some((_, count, _)) = elements.iter().find(|e| e.0 == "face" && e.1 > 0) {
+
+    /// Checks that the body can hold the entries declared: each takes at least a byte, so a header
+    /// declaring more entries than bytes follow it is refused before anything is allocated for them.
+    pub(super) fn check_counts(&self, bytes: &[u8]) -> Result<(), String> {
+        let body = (bytes.len() - self.body) as u64;
+        let declared = self
+            .elements
+            .iter()
+            .fold(0u64, |sum, e| sum.saturating_add(e.count));
+        if declared > body {
+            return Err(format!(
+                "byte {}: PLY: the header declares {declared} elements but only {body} bytes follow it",
+                self.body
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn read_ply(bytes: &[u8]) -> Result<Vec<[f64; 3]>, String> {
+    let header = PlyHeader::parse(bytes)?;
+    let (big, body, elements) = (header.big, header.body, &header.elements);
+    if let Some(e) = elements.iter().find(|e| e.name == "face" && e.count > 0) {
         return Err(format!(
-            "PLY: the file has {count} faces: it is a mesh, not a point cloud"
+            "PLY: the file has {} faces: it is a mesh, not a point cloud",
+            e.count
         ));
     }
-    if let Some((name, count, _)) = elements.iter().find(|e| e.1 > 0 && e.2.is_empty()) {
-        return Err(format!(
-            "PLY: element '{name}' has {count} entries but no property"
-        ));
-    }
-    let Some(vertex) = elements.iter().position(|e| e.0 == "vertex") else {
+    let Some(vertex) = elements.iter().position(|e| e.name == "vertex") else {
         return Err("PLY: no 'vertex' element".into());
     };
-    let props = &elements[vertex].2;
+    let props = &elements[vertex].properties;
     let axis = |name: &str| {
         props
             .iter()
@@ -674,15 +763,20 @@ fn read_ply(bytes: &[u8]) -> Result<Vec<[f64; 3]>, String> {
             .ok_or_else(|| format!("PLY: the vertex element has no scalar property '{name}'"))
     };
     let xyz = [axis("x")?, axis("y")?, axis("z")?];
-    let count = elements[vertex].1;
+    let count = elements[vertex].count;
     match big {
-        None => read_ply_ascii(bytes, body, lines.len(), &elements[..=vertex], xyz),
+        None => read_ply_ascii(bytes, body, header.lines, &elements[..=vertex], xyz),
         Some(big) => {
             // Elements before the vertices are skipped record by record.
             let mut at = body;
-            for (name, count, props) in &elements[..vertex] {
+            for PlyElement {
+                name,
+                count,
+                properties,
+            } in &elements[..vertex]
+            {
                 for _ in 0..*count {
-                    for p in props {
+                    for p in properties {
                         at = skip_ply_property(bytes, at, p, big)
                             .ok_or_else(|| format!("byte {at}: PLY: element '{name}' cut short"))?;
                     }
@@ -747,7 +841,7 @@ fn read_ply_ascii(
     bytes: &[u8],
     body: usize,
     header_lines: usize,
-    elements: &[(String, u64, Vec<PlyProperty>)],
+    elements: &[PlyElement],
     xyz: [usize; 3],
 ) -> Result<Vec<[f64; 3]>, String> {
     let mut lines = bytes[body..]
@@ -756,14 +850,14 @@ fn read_ply_ascii(
         .map(|(i, l)| (header_lines + 1 + i, l))
         .filter(|(_, l)| !l.iter().all(u8::is_ascii_whitespace));
     let (vertex, before) = elements.split_last().expect("the vertex element");
-    for (name, count, _) in before {
+    for PlyElement { name, count, .. } in before {
         for _ in 0..*count {
             lines
                 .next()
                 .ok_or_else(|| format!("PLY: the file ends inside element '{name}'"))?;
         }
     }
-    let count = vertex.1;
+    let count = vertex.count;
     // Each vertex takes a line of at least one byte: a larger count cannot fit.
     if count > (bytes.len() - body) as u64 {
         return Err(format!(
@@ -780,7 +874,7 @@ fn read_ply_ascii(
         let words: Vec<&str> = text.split_ascii_whitespace().collect();
         let mut p = [0.0; 3];
         let mut w = 0; // the word where property j starts
-        for (j, prop) in vertex.2.iter().enumerate() {
+        for (j, prop) in vertex.properties.iter().enumerate() {
             let word = |w: usize| {
                 words
                     .get(w)

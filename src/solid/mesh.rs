@@ -799,67 +799,13 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-/// Checks a PLY header before the `ply-rs` parser sees it: every number on a `format` or `element` line fits
-/// in a `u64` (the parser panics otherwise), every declared element has a property, and the elements declared
-/// are no more than the bytes after the header (each takes at least one), so the parser never loops or
-/// allocates beyond the input.
-fn check_ply_header(bytes: &[u8]) -> Result<(), String> {
-    let mut elements: Vec<(String, u64, usize)> = Vec::new();
-    let mut at = 0;
-    for line in bytes.split_inclusive(|&b| b == b'\n') {
-        at += line.len();
-        let text = String::from_utf8_lossy(line);
-        let mut words = text.split_ascii_whitespace();
-        let first = words.next().unwrap_or("");
-        if first == "format" || first == "element" {
-            let too_big = text
-                .split(|c: char| !c.is_ascii_digit())
-                .any(|run| !run.is_empty() && run.parse::<u64>().is_err());
-            if too_big {
-                return Err(format!(
-                    "PLY: number too large in header line '{}'",
-                    text.trim()
-                ));
-            }
-        }
-        match first {
-            "element" => {
-                let name = words.next().unwrap_or("").to_string();
-                let count = words.next().and_then(|c| c.parse().ok()).unwrap_or(0);
-                elements.push((name, count, 0));
-            }
-            "property" => {
-                if let Some(e) = elements.last_mut() {
-                    e.2 += 1;
-                }
-            }
-            "end_header" => {
-                let body = (bytes.len() - at) as u64;
-                let mut declared = 0u64;
-                for (name, count, properties) in &elements {
-                    if *count > 0 && *properties == 0 {
-                        return Err(format!(
-                            "PLY: element '{name}' has {count} entries but no property"
-                        ));
-                    }
-                    declared = declared.saturating_add(*count);
-                }
-                if declared > body {
-                    return Err(format!(
-                        "PLY: the header declares {declared} elements but only {body} bytes follow it"
-                    ));
-                }
-                return Ok(());
-            }
-            _ => {}
-        }
-    }
-    Err("PLY: no end_header line".into())
-}
-
 fn read_ply(mut bytes: &[u8]) -> Result<TriangleMesh, String> {
     use ply_rs::ply::Property;
-    check_ply_header(bytes)?;
+    // The header is read and checked before `ply-rs` sees it: a number on a `format` or `element` line
+    // beyond `u64` makes it panic, an element without properties or more entries than bytes makes it loop
+    // and allocate beyond the input.
+    let header = super::cloud::PlyHeader::parse(bytes)?;
+    header.check_counts(bytes)?;
     let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
     let ply = parser
         .read_ply(&mut bytes)

@@ -65,12 +65,12 @@
 //! processes that no longer run.
 //!
 //! **Disk.** The spill files hold what the levels below `m` will take in the output, so a build holds about
-//! twice the output's size if the files are kept to the end. They are not: each piece read back into the
-//! output is punched out of its spill file (`fallocate` with `FALLOC_FL_PUNCH_HOLE`, on Linux), a block
-//! as soon as every piece in it is read, and each spill file is emptied once its level is written. As
-//! each slab's part of a file is in Morton order, the order it is read in, its blocks go back nearly as
-//! fast as the output grows: the build needs about the output's size of disk (the column *disk peak* of
-//! `results/performance/scale-large.md`). On other
+//! twice the output's size if the files are kept to the end. They are not: the pieces read back into the
+//! output are punched out of their spill file (`fallocate` with `FALLOC_FL_PUNCH_HOLE`, on Linux), a block
+//! once every piece in it is read, in holes of at least 256 KiB, and each spill file is emptied once its
+//! level is written. As each slab's part of a file is in Morton order, the order it is read in, its blocks
+//! go back nearly as fast as the output grows: the build needs about the output's size of disk, plus up
+//! to 256 KiB per slab (the column *disk peak* of `results/performance/scale-large.md`). On other
 //! systems or file systems without holes the spill files keep their blocks until their level is written.
 //!
 //! ```

@@ -204,11 +204,11 @@ fn out_of_core_table(
     disk: bool,
 ) -> Result<(), String> {
     let (budget_head, disk_head) = if disk {
-        (" budget MiB |", " disk peak MiB |")
+        (" budget MiB |", " disk peak MiB | load at end |")
     } else {
         ("", "")
     };
-    let columns = 10 + 2 * usize::from(disk);
+    let columns = 10 + 3 * usize::from(disk);
     let _ = writeln!(
         md,
         "| L |{budget_head} rays | voxels | nodes | seconds | ns/node | peak MiB | accounted MiB | spilled MiB |{disk_head} file MiB |\n|{}",
@@ -227,8 +227,11 @@ fn out_of_core_table(
             (true, None) => format!(" {} |", OUT_OF_CORE_BUDGET >> 20),
             (false, _) => String::new(),
         };
+        // The machine is shared: how busy it was by the end of each build (1-minute load average).
         let disk_cell = if disk {
-            format!(" {} |", bytes("disk_peak_bytes"))
+            let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+            let load = load.split_whitespace().next().unwrap_or("?").to_string();
+            format!(" {} | {load} |", bytes("disk_peak_bytes"))
         } else {
             String::new()
         };
@@ -264,8 +267,9 @@ pub fn report_large() -> Result<String, String> {
          high-water resident set when the file is written, the checks (not timed) open the file, verify \
          every section and compare its counts and voxels with the build's and the runs'. Disk peak: the \
          most disk the build's folder held (spill files and the output being written, sampled every \
-         {DISK_SAMPLE_MS} ms): the spill files give their disk back as they are read into the output, so it \
-         stays near the file's size instead of the spill's and the file's sum. The goal: L = 16 in at most \
+         {DISK_SAMPLE_MS} ms; the folder holds nothing else): the spill files give their disk back as they are read into the output, so it \
+         stays near the file's size instead of the spill's and the file's sum. Load at end: the 1-minute load \
+         average when the build ended, the build's own threads included. The goal: L = 16 in at most \
          1 GiB and 10 minutes, and L = 17 given the disk.\n\nMachine: {}.\n",
         machine_line().replace("; one thread used", "")
     );

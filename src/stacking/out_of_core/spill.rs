@@ -118,8 +118,7 @@ impl<'a> SpillReader<'a> {
 
     /// Ends reading the file: what is left of it is given back (it is not read again).
     pub(super) fn finish(self) {
-        // An economy, like the holes: the spill folder is removed at the end in any case.
-        let _ = self.file.set_len(0);
+        self.pieces.finish(self.file);
     }
 }
 
