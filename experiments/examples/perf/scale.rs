@@ -24,8 +24,8 @@ const OUT_OF_CORE_BUDGET: u64 = 1536 << 20;
 /// Threads of the out-of-core builds.
 const OUT_OF_CORE_THREADS: usize = 2;
 /// Levels of the large out-of-core builds (`perf -- scale-large`), each with its memory budget: 1 GiB up to
-/// L = 16; 3 GiB at L = 17, where the index of the ~1.7 × 10^7 stacked cells of depth 11 alone takes
-/// about 1.3 GiB.
+/// L = 16; 3 GiB at L = 17, where the index of the stacked cells of depth 11 grows past 1 GiB (the
+/// accounted peak there is in the report).
 const LARGE_LEVELS: [(u32, u64); 3] = [(15, 1 << 30), (16, 1 << 30), (17, 3 << 30)];
 
 fn sphere(level: u32) -> Solid<3> {
