@@ -125,11 +125,11 @@ impl LevelFile {
 /// freed by punching a hole over them (`fallocate` with `FALLOC_FL_PUNCH_HOLE`), so each block is freed
 /// once the last piece in it is read. A build that spills as much as it writes then needs about the
 /// output's size of disk, not twice it. Freed ranges that touch are joined and punched once they reach
-/// [`PUNCH_BYTES`], so at most that much per run of pieces read in file order waits; [`finish`](Self::finish)
-/// gives back the rest. (A hole for each piece made the file system the bottleneck: punches cost about
-/// 100 µs each here, and the L = 15 sphere's ~5 × 10^5 of them took its writing from 10 to 58 s.) Where holes cannot be punched (a system
-/// other than Linux, or a file system without them) the file keeps its blocks until it is finished;
-/// nothing not yet read is ever punched.
+/// [`PUNCH_BYTES`], so at most that much per run of pieces read in file order waits;
+/// [`finish`](Self::finish) gives back the rest. (A hole for each piece made the file system the
+/// bottleneck: punches cost about 100 µs each here, and the L = 15 sphere's ~5 × 10^5 of them took its
+/// writing from 10 to 58 s.) Where holes cannot be punched (a system other than Linux, or a file system
+/// without them) the file keeps its blocks until it is finished; nothing not yet read is ever punched.
 pub(crate) struct PieceRelease<'a> {
     /// The word offset of each piece in the file, in file order (pieces may be empty).
     offsets: &'a [u64],
