@@ -59,20 +59,6 @@ pub(crate) fn sort_by_key<T: Copy>(
     }
 }
 
-/// Sorts `items` stably by `key`, whose values are below `2^bits` for `bits` up to 128: by the low 64 bits,
-/// then (where `bits` > 64) stably by the high ones. Costs as [`radix_sort`].
-pub(crate) fn sort_by_wide_key<T: Copy>(
-    items: &mut Vec<T>,
-    bits: u32,
-    scratch: &mut Vec<T>,
-    key: impl Fn(&T) -> u128,
-) {
-    sort_by_key(items, bits.min(64), scratch, |t| key(t) as u64);
-    if bits > 64 {
-        sort_by_key(items, bits - 64, scratch, |t| (key(t) >> 64) as u64);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -137,38 +123,6 @@ mod tests {
             let mut got = order;
             sort_by_key(&mut got, bits, &mut Vec::new(), |p| p.0);
             assert_eq!(got, expect, "{len} pairs of {bits}-bit keys");
-        }
-    }
-
-    #[test]
-    fn wide_keys_sort_stably() {
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
-        for (len, bits) in [
-            (0, 70),
-            (100, 66),
-            (5000, 66),
-            (5000, 100),
-            (3000, 128),
-            (4000, 40),
-        ] {
-            let items: Vec<(u128, u32)> = (0..len)
-                .map(|i| {
-                    // Sixteen distinct keys, so that stability is tested, with bits in both halves.
-                    let v = u128::from(next() % 16);
-                    ((v & 3) << (bits - 2) | v >> 2, i)
-                })
-                .collect();
-            let mut expect = items.clone();
-            expect.sort_by_key(|p| p.0);
-            let mut got = items;
-            sort_by_wide_key(&mut got, bits, &mut Vec::new(), |p| p.0);
-            assert_eq!(got, expect, "{len} items of {bits}-bit keys");
         }
     }
 }

@@ -481,6 +481,32 @@ proptest! {
     }
 
     #[test]
+    fn unions_and_differences_of_boxes_give_closed_exact_meshes(
+        level in 3u32..=5,
+        boxes in prop::collection::vec(
+            (any::<bool>(), prop::array::uniform3(0usize..32), prop::array::uniform3(1usize..24)),
+            1..8,
+        ),
+    ) {
+        // Boxes of every size, added and cut out in turn: leaves of many sizes side by side, with
+        // T-junctions, holes and edge and corner contacts.
+        let u = 1usize << level;
+        let mut dense = vec![false; u * u * u];
+        for (add, corner, size) in boxes {
+            let lo = corner.map(|c| c % u);
+            let hi: [usize; 3] = std::array::from_fn(|a| (lo[a] + size[a]).min(u));
+            for z in lo[2]..hi[2] {
+                for y in lo[1]..hi[1] {
+                    for x in lo[0]..hi[0] {
+                        dense[x + u * (y + u * z)] = add;
+                    }
+                }
+            }
+        }
+        check_dense(level, &dense);
+    }
+
+    #[test]
     fn random_quadtrees_give_closed_outlines(
         level in 1u32..=4,
         cells in proptest::collection::vec(any::<bool>(), 256),
