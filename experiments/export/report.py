@@ -77,7 +77,8 @@ def main() -> None:
         "centred in the universe, and the armadillo (`data/meshes/`) fitted into the universe and voxelized.",
         "",
         "**ktree**: `export::surface::boundary_mesh`, the closed, 2-manifold boundary of the voxels with merged "
-        "rectangles — the exact surface of the voxels (its volume is the voxel count). Timed: extracting the mesh, "
+        "rectangles — the exact surface of the voxels (its volume is the voxel count), made by one sweep across "
+        "the first axis over the tree's cross-sections. Timed: extracting the mesh, "
         "from the built tree, one thread; writing it as binary PLY into memory is shown apart (one run); peak "
         "memory is the child process's high-water mark of resident memory (building the tree included). "
         f"**OpenVDB** (libopenvdb-dev {dpkg_version('libopenvdb-dev')}, `experiments/export/peers.cpp`): the voxels written by "
