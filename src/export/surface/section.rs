@@ -281,29 +281,10 @@ mod tests {
 
     #[test]
     fn sections_hold_the_voxels_of_their_plane_until_the_next() {
-        let level = 4;
-        let side = 1u32 << level;
+        let side = 16;
         let mut state = 0x2545_F491_4F6C_DD1Du64;
         for _ in 0..40 {
-            // Aligned cells of every size at random places, as a dense array (axis 0 fastest).
-            let mut dense = vec![false; (side * side * side) as usize];
-            for _ in 0..6 {
-                state = state
-                    .wrapping_mul(6_364_136_223_846_793_005)
-                    .wrapping_add(1_442_695_040_888_963_407);
-                let log_side = (state >> 60) as u32 % level;
-                let at = [state >> 8, state >> 20, state >> 32]
-                    .map(|c| ((c as u32 % side) >> log_side) << log_side);
-                let s = 1 << log_side;
-                for z in at[2]..at[2] + s {
-                    for y in at[1]..at[1] + s {
-                        for x in at[0]..at[0] + s {
-                            dense[(x + side * (y + side * z)) as usize] = true;
-                        }
-                    }
-                }
-            }
-            let tree = KTree::<3>::from_dense(level, &dense).unwrap();
+            let tree = super::super::random_blocks(4, &mut state, 6, false);
             let mut slab = Slab::default();
             let mut x = 0;
             while x < side {

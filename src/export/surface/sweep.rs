@@ -25,27 +25,12 @@ use super::{
 
 /// The boundary of `tree` as a closed, outward-oriented triangle mesh, its planes merged as `merge` says.
 pub(super) fn sweep(tree: &KTree<3>, merge: Merge) -> SurfaceMesh {
-    let level = tree.level();
-    let side = 1u32 << level;
-    let mut sweep = Sweep::new(level, merge);
-    let (mut below, mut slab) = (Slab::default(), Slab::default());
-    let mut x = 0;
-    loop {
-        let next = if x < side {
-            section(tree, x, &mut slab)
-        } else {
-            slab.clear();
-            side
-        };
+    let mut sweep = Sweep::new(tree.level(), merge);
+    for_each_section(tree, |x, _, below, slab| {
         if !(below.bands.is_empty() && slab.bands.is_empty()) {
-            sweep.step(x, &below, &slab);
+            sweep.step(x, below, slab);
         }
-        if x >= side {
-            break;
-        }
-        std::mem::swap(&mut below, &mut slab);
-        x = next.min(side);
-    }
+    });
     debug_assert!(sweep.open[0].is_empty() && sweep.open[1].is_empty());
     assert!(
         u32::try_from(sweep.mesh.vertices.len()).is_ok(),
@@ -57,27 +42,15 @@ pub(super) fn sweep(tree: &KTree<3>, merge: Merge) -> SurfaceMesh {
 /// The number of unit faces on the boundary of `tree`, counted on its cross-sections as [`sweep`] meets
 /// them (nothing is made).
 pub(super) fn unit_faces(tree: &KTree<3>) -> u128 {
-    let side = 1u32 << tree.level();
-    let (mut below, mut slab) = (Slab::default(), Slab::default());
     let mut xor = Vec::new();
     let mut faces = 0u128;
     let length = |runs: &[(u32, u32)]| runs.iter().map(|r| u128::from(r.1 - r.0)).sum::<u128>();
-    let mut x = 0;
-    loop {
-        let next = if x < side {
-            section(tree, x, &mut slab)
-        } else {
-            slab.clear();
-            side
-        };
+    for_each_section(tree, |x, next, below, slab| {
         // The plane x = X.
-        for (y, end, lower, upper) in Pieces::new(&below, &slab) {
+        for (y, end, lower, upper) in Pieces::new(below, slab) {
             xor_runs(lower, upper, &mut xor);
             let stretch: u128 = xor.iter().map(|s| u128::from(s.1 - s.0)).sum();
             faces += u128::from(end - y) * stretch;
-        }
-        if x >= side {
-            break;
         }
         // The planes y = Y and z = Z through the slab, for each voxel of its thickness.
         let mut across = 0u128;
@@ -94,12 +67,32 @@ pub(super) fn unit_faces(tree: &KTree<3>) -> u128 {
                 across += length(runs);
             }
         }
-        let next = next.min(side);
         faces += across * u128::from(next - x);
+    });
+    faces
+}
+
+/// Calls `step(x, next, below, slab)` at each `x` where the cross-section of `tree` changes, in order, and
+/// at the universe's side (`slab` empty there): `slab` is the section from `x` up to `next`, `below` the
+/// one before `x`.
+fn for_each_section(tree: &KTree<3>, mut step: impl FnMut(u32, u32, &Slab, &Slab)) {
+    let side = 1u32 << tree.level();
+    let (mut below, mut slab) = (Slab::default(), Slab::default());
+    let mut x = 0;
+    loop {
+        let next = if x < side {
+            section(tree, x, &mut slab).min(side)
+        } else {
+            slab.clear();
+            side
+        };
+        step(x, next, &below, &slab);
+        if x >= side {
+            return;
+        }
         std::mem::swap(&mut below, &mut slab);
         x = next;
     }
-    faces
 }
 
 /// A rectangle of a plane `y = Y` or `z = Z` while the sweep carries it: its plane (`2 · coordinate +
@@ -986,28 +979,10 @@ mod tests {
 
     #[test]
     fn unit_faces_are_the_surface_area() {
-        let level = 4;
-        let side = 1usize << level;
         let mut state = 0x9E37_79B9_7F4A_7C15u64;
         for round in 0..30 {
             // Aligned blocks of every size, added and cut out.
-            let mut dense = vec![false; side * side * side];
-            for block in 0..8 {
-                state = state
-                    .wrapping_mul(6_364_136_223_846_793_005)
-                    .wrapping_add(1_442_695_040_888_963_407);
-                let log_side = (state >> 60) as usize % level as usize;
-                let at = [state >> 8, state >> 20, state >> 32]
-                    .map(|c| ((c as usize % side) >> log_side) << log_side);
-                for z in at[2]..at[2] + (1 << log_side) {
-                    for y in at[1]..at[1] + (1 << log_side) {
-                        for x in at[0]..at[0] + (1 << log_side) {
-                            dense[x + side * (y + side * z)] = block % 3 != 2;
-                        }
-                    }
-                }
-            }
-            let tree = KTree::<3>::from_dense(level, &dense).unwrap();
+            let tree = super::super::random_blocks(4, &mut state, 8, true);
             assert_eq!(unit_faces(&tree), tree.surface_area(), "round {round}");
         }
         // The full universe at the largest level, counted without a run per column.
