@@ -72,6 +72,8 @@
 // The one exception, a read-only memory map, is `io::mmap` (allowed there, with its soundness argument).
 #![deny(unsafe_code)]
 
+#[macro_use]
+mod dim;
 pub mod display;
 pub mod export;
 pub mod fs;

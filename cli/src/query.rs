@@ -7,10 +7,11 @@ use crate::common::error::CliResult;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use ktree::io::{ktree_file_version, KtreeView, MappedTree, VERSION};
-use ktree::query::{self, RayCast, RayHit};
-use ktree::tree::cursor::LevelOrder;
-use ktree::AnyTree;
+use ktree::io::FileTree;
+use ktree::query::{self, Query, RayCast, RayHit};
+use ktree::with_tree;
+
+use crate::common::error::read_error;
 
 use crate::table;
 
@@ -51,23 +52,9 @@ pub struct RaycastArgs {
     json: bool,
 }
 
-/// The tree of a file: mapped (version 2) or loaded, and the queries run on either.
-fn with_tree<R>(
-    path: &Path,
-    mut mapped: impl FnMut(&KtreeView) -> CliResult<R>,
-    mut loaded: impl FnMut(&AnyTree) -> CliResult<R>,
-) -> CliResult<R> {
-    if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION {
-        let view = KtreeView::open(path).map_err(|e| e.to_string())?;
-        mapped(&view)
-    } else {
-        loaded(&crate::common::tree_file::read(path)?)
-    }
-}
-
-/// The mapped tree of `view`, of dimension `K`.
-fn mapped_tree<const K: usize>(view: &KtreeView) -> Result<MappedTree<'_, K>, String> {
-    MappedTree::<K>::new(view).map_err(|e| e.to_string())
+/// The tree of a file: mapped (version 2) or loaded; the queries run on either.
+fn open(path: &Path) -> CliResult<FileTree> {
+    FileTree::open(path, &ktree::io::ReadOptions::default()).map_err(|e| e.to_string().into())
 }
 
 /// Standard output, buffered; writes end the command quietly on a closed pipe.
@@ -84,11 +71,7 @@ fn points<const K: usize>(t: &table::Table<i64>) -> Vec<[i64; K]> {
 }
 
 /// Answers the point queries on `tree` and prints them.
-fn answer_points<const K: usize, T: LevelOrder<K> + Sync>(
-    tree: &T,
-    args: &QueryArgs,
-    check: impl Fn() -> CliResult,
-) -> CliResult {
+fn answer_points<const K: usize, T: Query<K>>(tree: &T, args: &QueryArgs) -> CliResult {
     let table = table::read::<i64>(&args.points, K)?;
     let pts = points::<K>(&table);
     // Points beyond the u32 range are outside every universe.
@@ -96,13 +79,12 @@ fn answer_points<const K: usize, T: LevelOrder<K> + Sync>(
         .iter()
         .map(|p| p.map(|v| u32::try_from(v).unwrap_or(u32::MAX)))
         .collect();
-    let inside = query::contains_many(tree, &voxels).unwrap_or_else(|e| match e {});
+    let inside = tree.contains_many(&voxels).map_err(read_error)?;
     let near = if args.distance || args.nearest {
-        query::nearest_many_signed(tree, &pts).unwrap_or_else(|e| match e {})
+        query::nearest_many_signed(tree, &pts).map_err(read_error)?
     } else {
         Vec::new()
     };
-    check()?;
     let mut w = out();
     let io = crate::common::error::CliError::from_output;
     if args.json {
@@ -166,28 +148,7 @@ fn answer_points<const K: usize, T: LevelOrder<K> + Sync>(
 
 /// Runs `ktree query`.
 pub fn run_query(args: QueryArgs) -> CliResult {
-    with_tree(
-        &args.tree,
-        |view| match view.k() {
-            1 => {
-                let t = mapped_tree::<1>(view)?;
-                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
-            }
-            2 => {
-                let t = mapped_tree::<2>(view)?;
-                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
-            }
-            3 => {
-                let t = mapped_tree::<3>(view)?;
-                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
-            }
-            _ => {
-                let t = mapped_tree::<4>(view)?;
-                answer_points(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
-            }
-        },
-        |tree| ktree::with_dim!(tree, AnyTree, t => answer_points(t, &args, || Ok(()))),
-    )
+    with_tree!(&open(&args.tree)?, t => answer_points(t, &args))
 }
 
 /// The rays of a table, each of `2K` numbers, checked.
@@ -207,11 +168,7 @@ fn rays<const K: usize>(t: &table::Table<f64>, max_t: f64) -> Result<Vec<RayCast
 }
 
 /// Casts the rays on `tree` and prints the hits.
-fn answer_rays<const K: usize, T: LevelOrder<K> + Sync>(
-    tree: &T,
-    args: &RaycastArgs,
-    check: impl Fn() -> CliResult,
-) -> CliResult {
+fn answer_rays<const K: usize, T: Query<K>>(tree: &T, args: &RaycastArgs) -> CliResult {
     if args.max_t.is_nan() || args.max_t < 0.0 {
         return Err(format!(
             "--max-t must be a number >= 0 (inf for no limit), got {}",
@@ -221,9 +178,7 @@ fn answer_rays<const K: usize, T: LevelOrder<K> + Sync>(
     }
     let table = table::read::<f64>(&args.rays, 2 * K)?;
     let casts = rays::<K>(&table, args.max_t)?;
-    let hits: Vec<Option<RayHit<K>>> =
-        query::cast_rays(tree, &casts).unwrap_or_else(|e| match e {});
-    check()?;
+    let hits: Vec<Option<RayHit<K>>> = tree.cast_rays(&casts).map_err(read_error)?;
     let mut w = out();
     let io = crate::common::error::CliError::from_output;
     if args.json {
@@ -262,26 +217,5 @@ fn answer_rays<const K: usize, T: LevelOrder<K> + Sync>(
 
 /// Runs `ktree raycast`.
 pub fn run_raycast(args: RaycastArgs) -> CliResult {
-    with_tree(
-        &args.tree,
-        |view| match view.k() {
-            1 => {
-                let t = mapped_tree::<1>(view)?;
-                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
-            }
-            2 => {
-                let t = mapped_tree::<2>(view)?;
-                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
-            }
-            3 => {
-                let t = mapped_tree::<3>(view)?;
-                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
-            }
-            _ => {
-                let t = mapped_tree::<4>(view)?;
-                answer_rays(&t, &args, || t.failure().map_err(|e| e.to_string().into()))
-            }
-        },
-        |tree| ktree::with_dim!(tree, AnyTree, t => answer_rays(t, &args, || Ok(()))),
-    )
+    with_tree!(&open(&args.tree)?, t => answer_rays(t, &args))
 }

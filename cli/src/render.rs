@@ -15,8 +15,8 @@ use ktree::display::{
     default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
     RenderOptions,
 };
-use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, KtreeView, MappedTree};
-use ktree::tree::cursor::LevelOrder;
+use ktree::io::{read_rays_file, AnyMappedTree, FileTree};
+use ktree::tree::storage::TreeStorage;
 use ktree::{AnyRaySet, AnyTree};
 
 /// Arguments of `ktree render`.
@@ -82,17 +82,15 @@ pub fn run(args: Args) -> CliResult {
         }
     };
     // An octree in a version 2 file is rendered from its memory map, whatever its size.
-    if ktree_file_version(&args.file).is_ok_and(|v| v == 2) {
-        let view = KtreeView::open(&args.file).map_err(|e| e.to_string())?;
-        if view.k() == 3 {
-            let tree = MappedTree::<3>::new(&view).map_err(|e| e.to_string())?;
-            let rendered = render_octree(&tree, &args, &out, w, h, bar.as_ref(), &mut tick);
-            // A file changed while it was read: its error, not a picture of what was read.
-            tree.failure().map_err(|e| e.to_string())?;
-            return rendered;
+    let file = FileTree::open(&args.file, &ktree::io::ReadOptions::default())
+        .map_err(|e| e.to_string())?;
+    let tree = match file {
+        FileTree::Mapped(AnyMappedTree::K3(tree)) => {
+            return render_octree(&tree, &args, &out, w, h, bar.as_ref(), &mut tick)
         }
-    }
-    let tree = read_ktree_file(&args.file).map_err(|e| e.to_string())?;
+        FileTree::Mapped(mapped) => mapped.view().to_any_tree().map_err(|e| e.to_string())?,
+        FileTree::Memory(tree) => tree,
+    };
     match tree {
         AnyTree::K3(tree) => render_octree(&tree, &args, &out, w, h, bar.as_ref(), &mut tick)?,
         AnyTree::K2(tree) => {
@@ -132,7 +130,7 @@ pub fn run(args: Args) -> CliResult {
 }
 
 /// Renders an octree, in memory or memory-mapped, to the PNG `out` (and the depth image if asked).
-fn render_octree<T: LevelOrder<3>>(
+fn render_octree<T: TreeStorage<3>>(
     tree: &T,
     args: &Args,
     out: &Path,
@@ -147,7 +145,9 @@ fn render_octree<T: LevelOrder<3>>(
     if let Some(eye) = &args.eye {
         camera.eye = parse_vec3(eye, "eye")?;
         let side = tree.universe().side() as f64;
-        let (lo, hi) = object_bounds(tree).unwrap_or(([0.0; 3], [side; 3]));
+        let (lo, hi) = object_bounds(tree)
+            .map_err(crate::common::error::read_error)?
+            .unwrap_or(([0.0; 3], [side; 3]));
         camera.target = match &args.target {
             Some(t) => parse_vec3(t, "target")?,
             None => [0, 1, 2].map(|i| (lo[i] + hi[i]) / 2.0),

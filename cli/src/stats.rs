@@ -1,17 +1,20 @@
-//! `ktree stats FILE | --rays FILE [--json]`: node counts of a tree or of the tree a ray file stacks to.
-//! A version 2 tree file is checked and counted through a memory map; a file of another format `ktree`
-//! reads (`.vdb`, `.bt`, binvox, …) is read into memory; the surface area and the Euler number
-//! (`surface_area`, `euler_number`) are measured on the tree read into memory, when the file is small next
-//! to the memory budget.
+//! `ktree stats FILE | --rays FILE [--json] [--measures]`: node counts, voxels and bounding box of a tree
+//! or of the tree a ray file stacks to. A version 2 tree file is checked and counted through a memory map
+//! (the counts come from its directory; the bounding box from one walk that descends only where a face of
+//! the box may lie); a file of another format `ktree` reads (`.vdb`, `.bt`, binvox, …) is read into memory.
+//! With `--measures`, the surface area and the Euler number (`surface_area`, `euler_number`) too, measured
+//! on the tree read into memory when the file is small next to the memory budget.
 
 use crate::common::error::CliResult;
 use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::{ktree_file_version, read_ktree_file, read_rays_file, Format, KtreeView, VERSION};
-use ktree::tree::heap_bytes_for_levels;
-use ktree::tree::TreeStats;
+use ktree::io::{read_rays_file, FileTree};
+use ktree::query::{stats, TreeStats};
+use ktree::with_tree;
+
+use crate::common::error::read_error;
 
 /// Arguments of `ktree stats`.
 #[derive(Debug, clap::Args)]
@@ -25,50 +28,32 @@ pub struct Args {
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
-}
-
-/// The statistics of a version 2 file, read through its memory map (the tree is not loaded; its memory is
-/// what the navigable tree would take).
-fn view_stats(view: &KtreeView) -> TreeStats {
-    let c = view.counts();
-    let per_level = view.counts_per_level();
-    TreeStats {
-        k: view.k(),
-        level: view.level(),
-        rays: None,
-        full: c.full,
-        empty: c.empty,
-        partial: c.partial,
-        nodes: c.nodes(),
-        bytes_at_2_bits: view.bytes_at_two_bits(),
-        memory_bytes: heap_bytes_for_levels(&per_level) as u64,
-        per_level,
-    }
+    /// Also measure the surface area (faces between full and empty voxels) and the Euler number (JSON
+    /// keys `surface_area`, `euler_number`): a pass over the tree's runs, longer than the counts.
+    #[arg(long)]
+    measures: bool,
 }
 
 /// Prints the statistics.
 pub fn run(args: Args) -> CliResult {
     // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
     let (stats, measures) = match (&args.tree, &args.rays) {
-        (Some(path), None) if Format::of(path).is_some_and(|f| f != Format::Ktree) => {
-            let tree = crate::common::tree_file::read_any(path)?;
-            (tree.stats(None), Some(crate::shape::measures(&tree)))
-        }
-        (Some(path), None) if ktree_file_version(path).map_err(|e| e.to_string())? == VERSION => (
-            view_stats(&KtreeView::open(path).map_err(|e| e.to_string())?),
-            crate::shape::measures_of_file(path)?,
-        ),
         (Some(path), None) => {
-            let tree = read_ktree_file(path).map_err(|e| e.to_string())?;
-            (tree.stats(None), Some(crate::shape::measures(&tree)))
+            let file = FileTree::open(path, &ktree::io::ReadOptions::default())
+                .map_err(|e| e.to_string())?;
+            let stats = with_tree!(&file, t => stats(t, None).map_err(read_error))?;
+            let measures = match (&file, args.measures) {
+                (_, false) => None,
+                (FileTree::Memory(tree), true) => Some(crate::shape::measures(tree)),
+                (FileTree::Mapped(_), true) => crate::shape::measures_of_file(path)?,
+            };
+            (stats, measures)
         }
         (None, Some(path)) => {
             let rays = read_rays_file(path).map_err(|e| e.to_string())?;
             let tree = rays.build();
-            (
-                tree.stats(Some(rays.len() as u64)),
-                Some(crate::shape::measures(&tree)),
-            )
+            let measures = args.measures.then(|| crate::shape::measures(&tree));
+            (tree.stats(Some(rays.len() as u64)), measures)
         }
         _ => return Err("give either a .ktree file or --rays FILE".into()),
     };
@@ -101,6 +86,11 @@ pub fn run(args: Args) -> CliResult {
     outln!("empty    {}", stats.empty);
     outln!("partial  {}", stats.partial);
     outln!("nodes    {}", stats.nodes);
+    outln!("voxels   {}", stats.voxels);
+    match &stats.bounding_box {
+        Some([lo, hi]) => outln!("box      {lo:?} to {hi:?} (upper bound excluded)"),
+        None => outln!("box      - (the object is empty)"),
+    }
     outln!("bytes    {} (at 2 bits/node)", stats.bytes_at_2_bits);
     outln!(
         "memory   {} bytes navigable in memory ({:.3} bits/node)",
@@ -114,7 +104,10 @@ pub fn run(args: Args) -> CliResult {
                 outln!("euler    {e} (connectivity {})", stats.k);
             }
         }
-        None => outln!("surface  - (not measured: the file is large next to the memory budget)"),
+        None if args.measures => {
+            outln!("surface  - (not measured: the file is large next to the memory budget)")
+        }
+        None => {}
     }
     outln!("level        full       empty     partial");
     for l in &stats.per_level {

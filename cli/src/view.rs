@@ -8,11 +8,9 @@ use std::path::{Path, PathBuf};
 
 use ktree::display::View;
 use ktree::export::view::{write_view, Page, ViewOptions, DEFAULT_BUDGET};
-use ktree::io::{ktree_file_version, KtreeView, MappedTree};
+use ktree::io::FileTree;
 use ktree::tree::cursor::TreeStorage;
-use ktree::AnyTree;
-
-use crate::common::tree_file;
+use ktree::with_tree;
 
 /// Arguments of `ktree view`.
 #[derive(Debug, clap::Args)]
@@ -59,17 +57,9 @@ pub fn run(args: Args) -> CliResult {
             .map_or_else(|| "ktree".into(), |n| n.to_string_lossy().into_owned()),
     };
     // A version 2 file is read through its memory map, whatever its size.
-    let page = if ktree_file_version(&args.file).is_ok_and(|v| v == 2) {
-        let view = KtreeView::open(&args.file).map_err(|e| e.to_string())?;
-        match view.k() {
-            2 => mapped::<2>(&view, &out, &options)?,
-            3 => mapped::<3>(&view, &out, &options)?,
-            4 => mapped::<4>(&view, &out, &options)?,
-            _ => write(&tree_file::read_any(&args.file)?, &out, &options)?,
-        }
-    } else {
-        write(&tree_file::read_any(&args.file)?, &out, &options)?
-    };
+    let file = FileTree::open(&args.file, &ktree::io::ReadOptions::default())
+        .map_err(|e| e.to_string())?;
+    let page = with_tree!(&file, t => page_of(t, &out, &options))?;
     outln!(
         "wrote {} ({} boxes{}, {} bytes)",
         out.display(),
@@ -90,32 +80,12 @@ pub fn run(args: Args) -> CliResult {
     Ok(())
 }
 
-/// The page of a memory-mapped tree of dimension `K`.
-fn mapped<const K: usize>(
-    view: &KtreeView,
-    out: &Path,
-    options: &ViewOptions,
-) -> Result<Page, String> {
-    let tree = MappedTree::<K>::new(view).map_err(|e| e.to_string())?;
-    let page = page_of(&tree, out, options);
-    // A file changed while it was read: its error, not a page of what was read.
-    tree.failure().map_err(|e| e.to_string())?;
-    page
-}
-
 fn page_of<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     out: &Path,
     options: &ViewOptions,
-) -> Result<Page, String>
-where
-    T::Error: std::error::Error + Send + Sync + 'static,
-{
+) -> Result<Page, String> {
     write_view(out, tree, options).map_err(|e| e.to_string())
-}
-
-fn write(tree: &AnyTree, out: &Path, options: &ViewOptions) -> Result<Page, String> {
-    ktree::with_dim!(tree, AnyTree, t => page_of(t, out, options))
 }
 
 /// A new page's path in the temporary folder, named after the input.

@@ -39,6 +39,16 @@ fn build_then_stats_json_has_the_promised_keys() {
     assert_eq!(v["level"], 7);
     assert!(v["rays"].is_null(), "rays is null for a tree file");
     assert_eq!(v["full"], 76);
+    // The ray (1, 1, 17, 93): 76 voxels in the box [1, 1, 17] .. [2, 2, 93).
+    assert_eq!(v["voxels"], 76);
+    assert_eq!(
+        v["bounding_box"],
+        serde_json::json!([[1, 1, 17], [2, 2, 93]])
+    );
+    assert!(
+        v.get("surface_area").is_none() && v.get("euler_number").is_none(),
+        "the measures only when asked for"
+    );
     let per_level = v["per_level"].as_array().unwrap();
     for key in ["level", "full", "empty", "partial"] {
         assert!(per_level[0].get(key).is_some(), "per_level misses {key}");
@@ -56,6 +66,13 @@ fn build_then_stats_json_has_the_promised_keys() {
     assert!(ok);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["rays"], 1);
+    // An empty tree: no voxel, no box.
+    let empty = write(dir.path(), "empty.rays", "# ktree rays v1\n2 3\n");
+    let (ok, out, err) = ktree(&["stats", "--rays", &empty, "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["voxels"], 0);
+    assert!(v["bounding_box"].is_null());
 }
 
 #[test]

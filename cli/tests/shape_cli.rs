@@ -150,7 +150,12 @@ fn components_and_measures() {
         ]);
         assert!(ok, "{err}");
         let complement = ktree::ops::complement(&tree);
-        let (ok, out, err) = ktree(&[command, s(&pf), "--json"]);
+        // `stats` measures when asked; `mass` always does.
+        let mut args = vec![command, s(&pf)];
+        if command == "stats" {
+            args.push("--measures");
+        }
+        let (ok, out, err) = ktree(&[&args[..], &["--json"]].concat());
         assert!(ok, "{command}: {err}");
         let v: serde_json::Value = serde_json::from_str(&out).unwrap();
         assert_eq!(
@@ -163,7 +168,7 @@ fn components_and_measures() {
             complement.euler_number(2).unwrap(),
             "{command}"
         );
-        let (ok, out, _) = ktree(&[command, s(&pf)]);
+        let (ok, out, _) = ktree(&args);
         assert!(
             ok && out.contains(&format!("{} faces", complement.surface_area())),
             "{out}"
@@ -172,7 +177,7 @@ fn components_and_measures() {
     // A 4-D tree has a surface area and no Euler number key.
     let p4 = dir.path().join("t4.ktree");
     write_ktree_file(&p4, &KTree::<4>::full(1).unwrap()).unwrap();
-    let (ok, out, err) = ktree(&["stats", s(&p4), "--json"]);
+    let (ok, out, err) = ktree(&["stats", s(&p4), "--json", "--measures"]);
     assert!(ok, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["surface_area"], 2 * 4 * 8);

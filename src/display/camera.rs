@@ -17,8 +17,8 @@
 //! ```
 
 use super::error::{CameraProblem, DisplayError};
-use crate::space::Cell;
-use crate::tree::cursor::LevelOrder;
+use crate::tree::cursor::TryLeaves;
+use crate::tree::storage::TreeStorage;
 use crate::tree::NodeState;
 
 /// 3-D vector helpers (private to the display module).
@@ -327,32 +327,26 @@ impl Camera {
     }
 }
 
+/// A box `[lo, hi]` in continuous voxel coordinates.
+pub type Bounds<const K: usize> = ([f64; K], [f64; K]);
+
 /// The bounding box `[lo, hi]` (in voxel coordinates) of the full cells of a tree, `None` for an empty
-/// object.
-pub fn object_bounds<const K: usize, T: LevelOrder<K>>(tree: &T) -> Option<([f64; K], [f64; K])> {
-    let mut lo = [f64::INFINITY; K];
-    let mut hi = [f64::NEG_INFINITY; K];
-    let mut any = false;
-    tree.for_each_leaf(|cell: Cell<K>, state| {
-        if state == NodeState::Full {
-            any = true;
-            let s = cell.side() as f64;
-            for i in 0..K {
-                let o = f64::from(cell.origin[i]);
-                lo[i] = lo[i].min(o);
-                hi[i] = hi[i].max(o + s);
-            }
-        }
-    });
-    any.then_some((lo, hi))
+/// object: [`query::bounding_box`](crate::query::bounding_box) in continuous coordinates.
+///
+/// # Errors
+/// The storage's read error.
+pub fn object_bounds<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+) -> Result<Option<Bounds<K>>, T::Error> {
+    Ok(crate::query::bounding_box(tree)?.map(|(lo, hi)| (lo.map(f64::from), hi.map(f64::from))))
 }
 
 /// The default camera for a tree: [`ISO_TOWARD_EYE`] framing the object (the whole universe if it is
 /// empty), orthographic unless a field of view is given.
 ///
 /// # Errors
-/// As [`Camera::framing`].
-pub fn default_camera<T: LevelOrder<3>>(
+/// As [`Camera::framing`]; [`DisplayError::Storage`] if a read of the tree fails.
+pub fn default_camera<T: TreeStorage<3>>(
     tree: &T,
     toward_eye: [f64; 3],
     fov_y_degrees: Option<f64>,
@@ -360,7 +354,9 @@ pub fn default_camera<T: LevelOrder<3>>(
     height: u32,
 ) -> Result<Camera, DisplayError> {
     let side = tree.universe().side() as f64;
-    let (lo, hi) = object_bounds(tree).unwrap_or(([0.0; 3], [side; 3]));
+    let (lo, hi) = object_bounds(tree)
+        .map_err(|e| DisplayError::Storage(e.into()))?
+        .unwrap_or(([0.0; 3], [side; 3]));
     let mut camera = Camera::framing(lo, hi, toward_eye, fov_y_degrees, width, height)?;
     // Tighter: fit the projected corners of the full leaves rather than the bounding box (or sphere).
     let Frame { f, r, u } = camera.frame();
@@ -374,9 +370,10 @@ pub fn default_camera<T: LevelOrder<3>>(
         }
         Projection::Orthographic { .. } => (1.0, 1.0),
     };
-    tree.for_each_leaf(|cell, state| {
+    for leaf in TryLeaves::new(tree) {
+        let (cell, state) = leaf.map_err(|e| DisplayError::Storage(e.into()))?;
         if state != NodeState::Full {
-            return;
+            continue;
         }
         let s = cell.side() as f64;
         let o = cell.origin.map(f64::from);
@@ -393,7 +390,7 @@ pub fn default_camera<T: LevelOrder<3>>(
             let along = v3::dot(v, toward);
             distance = distance.max(along + x / tan_h).max(along + y / tan_v);
         }
-    });
+    }
     match camera.projection {
         Projection::Orthographic { height: box_height } => {
             let fitted = (2.0 * ey).max(2.0 * ex / aspect).max(1.0) * 1.05;

@@ -43,6 +43,9 @@ pub enum DisplayError {
         /// What went wrong.
         source: std::io::Error,
     },
+    /// Reading the tree failed (a file read in place was changed after it was opened).
+    #[error(transparent)]
+    Storage(#[from] crate::tree::StorageError),
     /// Encoding an image failed.
     #[cfg(feature = "png")]
     #[error("cannot encode the image: {0}")]

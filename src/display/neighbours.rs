@@ -4,7 +4,7 @@
 //! part of it that touches the face (or an edge) is read by descending only into the children that touch
 //! it. Both are [`cursor`] walks that choose which children to visit. A [`Neighbours`] asks many such
 //! questions about nearby cells, each descent starting from the deepest ancestor it shares with the last
-//! one ([`cursor::Locator`]).
+//! one ([`PointCursor`]).
 //!
 //! ```
 //! use ktree::display::neighbours::is_surrounded;
@@ -17,13 +17,15 @@
 //! ```
 
 use crate::space::Cell;
-use crate::tree::cursor::{self, ChildOrder, Locator, Visitor, Walk};
+use crate::tree::cursor::{self, ChildOrder, Visitor, Walk};
+use crate::tree::locate::PointCursor;
+use crate::tree::storage::infallible;
 use crate::tree::{KTree, NodeRef, NodeState};
 
 /// The node whose cell contains the aligned cell `region` and is either a leaf or `region` itself.
 /// `region` must lie inside the tree's universe.
 pub fn locate<const K: usize>(tree: &KTree<K>, region: &Cell<K>) -> NodeRef<K> {
-    cursor::locate(tree, tree.root(), region)
+    infallible(crate::tree::locate::locate(tree, tree.root(), region))
 }
 
 /// The cell of the same size as `cell` across its face on `axis` (`upper`: the face at `origin + side`),
@@ -95,7 +97,7 @@ pub fn is_surrounded<const K: usize>(tree: &KTree<K>, cell: &Cell<K>) -> bool {
 #[derive(Debug, Clone)]
 pub struct Neighbours<'t, const K: usize> {
     tree: &'t KTree<K>,
-    locator: Locator<K>,
+    locator: PointCursor<'t, K, KTree<K>>,
 }
 
 impl<'t, const K: usize> Neighbours<'t, K> {
@@ -103,13 +105,13 @@ impl<'t, const K: usize> Neighbours<'t, K> {
     pub fn new(tree: &'t KTree<K>) -> Self {
         Self {
             tree,
-            locator: Locator::new(tree),
+            locator: infallible(PointCursor::new(tree)),
         }
     }
 
     /// As [`locate`].
     pub fn locate(&mut self, region: &Cell<K>) -> NodeRef<K> {
-        self.locator.locate(self.tree, region)
+        infallible(self.locator.locate(region))
     }
 
     /// As [`face_all_full`].

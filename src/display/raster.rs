@@ -32,7 +32,8 @@ use super::error::{check_size, DisplayError};
 use super::order::{walk_ordered, Order, ViewOrder, Viewer, Walk};
 use crate::rays::RaySet;
 use crate::space::Cell;
-use crate::tree::cursor::{self, LevelOrder};
+use crate::tree::cursor;
+use crate::tree::storage::TreeStorage;
 use crate::tree::{NodeRef, NodeState, Octree};
 
 /// Everything a rendering can be asked for besides the tree and the camera, with defaults: a 512×512
@@ -431,8 +432,9 @@ fn ray_normal(rays: &RaySet<3>, v: [u32; 3], axis: usize, dir: [f64; 3]) -> Opti
 /// ```
 ///
 /// # Errors
-/// [`DisplayError::BadSize`] or [`DisplayError::BadCamera`].
-pub fn render<T: LevelOrder<3>>(
+/// [`DisplayError::BadSize`] or [`DisplayError::BadCamera`]; [`DisplayError::Storage`] if a read of the
+/// tree fails.
+pub fn render<T: TreeStorage<3>>(
     tree: &T,
     camera: &Camera,
     options: &RenderOptions,
@@ -444,7 +446,7 @@ pub fn render<T: LevelOrder<3>>(
 ///
 /// # Errors
 /// As [`render`].
-pub fn render_with_progress<T: LevelOrder<3>>(
+pub fn render_with_progress<T: TreeStorage<3>>(
     tree: &T,
     camera: &Camera,
     options: &RenderOptions,
@@ -469,7 +471,7 @@ pub fn render_with_progress<T: LevelOrder<3>>(
 /// # Errors
 /// [`DisplayError::BadSize`], [`DisplayError::BadCamera`], or the PNG's encoding and writing errors.
 #[cfg(feature = "png")]
-pub fn render_png<T: LevelOrder<3>>(
+pub fn render_png<T: TreeStorage<3>>(
     tree: &T,
     view: super::View,
     width: u32,
@@ -487,7 +489,7 @@ pub fn render_png<T: LevelOrder<3>>(
     Ok(image.stats)
 }
 
-fn front_to_back<T: LevelOrder<3>>(
+fn front_to_back<T: TreeStorage<3>>(
     tree: &T,
     camera: &Camera,
     options: &RenderOptions,
@@ -583,10 +585,11 @@ fn front_to_back<T: LevelOrder<3>>(
             Walk::Skip
         }
     };
-    cursor::walk(
+    cursor::try_walk(
         tree,
         &mut ViewOrder::new(viewer(camera), Order::FrontToBack, visit),
-    );
+    )
+    .map_err(|e| DisplayError::Storage(e.into()))?;
     if let Some(p) = progress.as_mut() {
         p(total - cov.uncovered(), total);
     }

@@ -173,7 +173,8 @@ pub fn time_strip(
         })?;
     let mut canvas = Canvas::new(strip_width, frame_size, [255, 255, 255])?;
     let side = tree.universe().side();
-    let (lo, hi) = super::camera::object_bounds(tree).unwrap_or(([0.0; 4], [side as f64; 4]));
+    let (lo, hi) = crate::tree::storage::infallible(super::camera::object_bounds(tree))
+        .unwrap_or(([0.0; 4], [side as f64; 4]));
     let keep = |v: [f64; 4]| -> [f64; 3] {
         let mut out = [0.0; 3];
         let mut j = 0;

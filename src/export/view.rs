@@ -394,10 +394,7 @@ fn pack<const K: usize>(lod: &Lod<K>, level: u32) -> (String, Vec<u8>) {
 pub fn view_page<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     options: &ViewOptions,
-) -> Result<Page, ViewError>
-where
-    T::Error: std::error::Error + Send + Sync + 'static,
-{
+) -> Result<Page, ViewError> {
     if K == 1 {
         return Err(ViewError::Bintree);
     }
@@ -464,10 +461,7 @@ pub fn write_view<const K: usize, T: TreeStorage<K>>(
     path: &Path,
     tree: &T,
     options: &ViewOptions,
-) -> Result<Page, ViewError>
-where
-    T::Error: std::error::Error + Send + Sync + 'static,
-{
+) -> Result<Page, ViewError> {
     let page = view_page(tree, options)?;
     write_atomic(path, page.html.as_bytes()).map_err(ViewError::Write)?;
     Ok(page)

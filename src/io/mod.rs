@@ -24,6 +24,7 @@
 //! ```
 
 mod dispatch;
+mod file_tree;
 pub mod interop;
 pub mod ktree;
 mod location;
@@ -38,6 +39,7 @@ pub use dispatch::{
 };
 #[cfg(any(feature = "mesh", feature = "volume"))]
 pub use dispatch::{voxel_source, VoxelSource, VoxelizedSource};
+pub use file_tree::FileTree;
 pub use interop::{
     read_binvox, read_bt, read_vdb, write_binvox, write_bt, write_vdb, write_vdb_level_set,
     GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree, BINVOX_MAX_DIM,
@@ -46,7 +48,8 @@ pub use interop::{
 pub use ktree::v1::{write_ktree_v1, write_ktree_v1_view};
 pub use ktree::{
     ktree_file_version, read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file,
-    KtreeFileError, KtreeFileErrorKind, KtreeView, KtreeWriter, MappedTree, MAGIC, VERSION,
+    AnyMappedTree, KtreeFileError, KtreeFileErrorKind, KtreeView, KtreeWriter, MappedTree, MAGIC,
+    VERSION,
 };
 pub use location::{FileError, Location, Place, ProblemKind};
 pub use rays::{

@@ -39,14 +39,8 @@ use std::path::Path;
 use super::boolean::{boolean_into, complement_into};
 use super::BoolOp;
 use crate::io::spill::{SpillLevels, SpilledTree};
-use crate::io::{KtreeFileError, KtreeFileErrorKind, KtreeView};
-use crate::space::Universe;
-use crate::tree::storage::TreeStorage;
-use crate::tree::words;
-use crate::tree::{LevelCounts, NodeState};
-
-/// Nodes in a word, counted as the file's node counts are.
-const NODES_PER_WORD: u64 = words::NODES_PER_WORD as u64;
+use crate::io::{KtreeFileError, KtreeView, MappedTree};
+use crate::tree::LevelCounts;
 
 /// Why a streamed Boolean failed. The target file is untouched and the spill files are removed.
 #[derive(Debug, thiserror::Error)]
@@ -168,7 +162,7 @@ pub fn boolean_views(
         1 => boolean_views_k::<1>(a, operation, out, temp_dir),
         2 => boolean_views_k::<2>(a, operation, out, temp_dir),
         3 => boolean_views_k::<3>(a, operation, out, temp_dir),
-        // Any other `K` is refused by `ViewStorage::new`.
+        // Any other `K` is refused by `MappedTree::new`.
         _ => boolean_views_k::<4>(a, operation, out, temp_dir),
     }
 }
@@ -180,12 +174,14 @@ fn boolean_views_k<const K: usize>(
     out: &Path,
     temp_dir: Option<&Path>,
 ) -> Result<BooleanFileReport, BooleanFileError> {
-    let sa = ViewStorage::<K>::new(a)?;
+    let sa = MappedTree::<K>::new(a)?;
     let sb = match operation {
-        ViewOperation::Binary(_, b) => Some(ViewStorage::<K>::new(b)?),
+        ViewOperation::Binary(_, b) => Some(MappedTree::<K>::new(b)?),
         ViewOperation::Complement => None,
     };
-    let depths = a.depth_count().max(sb.map_or(0, |b| b.view.depth_count()));
+    let depths = a
+        .depth_count()
+        .max(sb.as_ref().map_or(0, |b| b.view().depth_count()));
     let folder = crate::fs::spill_folder(out, temp_dir)
         .map_err(|(path, source)| BooleanFileError::Files(SpillError::TempDir { path, source }))?;
     let sink = SpillLevels::create(folder.path(), depths, K, a.level(), out)?;
@@ -201,93 +197,4 @@ fn boolean_views_k<const K: usize>(
         counts_per_level: written.counts_per_level,
         spilled_bytes: written.spilled_bytes,
     })
-}
-
-/// A version 2 file read through its view as a [`TreeStorage`], every read checked against the shape
-/// found when the file was opened: a file changed since gives an error naming the file and a byte offset
-/// within the level read, never a read past the map.
-#[derive(Debug, Clone, Copy)]
-struct ViewStorage<'a, const K: usize> {
-    view: &'a KtreeView,
-    universe: Universe<K>,
-}
-
-impl<'a, const K: usize> ViewStorage<'a, K> {
-    fn new(view: &'a KtreeView) -> Result<Self, KtreeFileError> {
-        Ok(Self {
-            view,
-            universe: view.universe::<K>()?,
-        })
-    }
-
-    /// The error for nodes `index …` of level `depth` that the shape says exist but the file does not
-    /// hold as it did: the offset is that of the level's last word read, within the file.
-    fn changed(&self, depth: usize, index: u64) -> KtreeFileError {
-        let depth = depth.min(self.view.depth_count().saturating_sub(1));
-        let last = index.min(self.view.level_nodes(depth).saturating_sub(1));
-        let mut error = self.view.changed(depth, last);
-        error.kind = KtreeFileErrorKind::Tree(format!(
-            "node {index} of level {depth} is missing or has the code 11: the file was changed after it was opened"
-        ));
-        error
-    }
-
-    /// The `n ≤ 32` states of level `depth` from `first`, checked to be in the level.
-    fn read(&self, depth: usize, first: u64, n: u64) -> Result<u64, KtreeFileError> {
-        if depth >= self.view.depth_count()
-            || first.saturating_add(n) > self.view.level_nodes(depth)
-        {
-            return Err(self.changed(depth, first));
-        }
-        let words = self.view.level_nodes(depth).div_ceil(NODES_PER_WORD);
-        let (j, off) = (first / NODES_PER_WORD, first % NODES_PER_WORD);
-        let mut word = self.view.level_word(depth, j)? >> (2 * off);
-        if off > 0 && j + 1 < words {
-            word |= self.view.level_word(depth, j + 1)? << (2 * (NODES_PER_WORD - off));
-        }
-        let word = word & words::slots_mask(n as usize);
-        // A code 11 is not a state: the bytes are not the file's any more.
-        if words::unused_mask(word) != 0 {
-            return Err(self.changed(depth, first));
-        }
-        Ok(word)
-    }
-}
-
-impl<const K: usize> TreeStorage<K> for ViewStorage<'_, K> {
-    type Error = KtreeFileError;
-
-    fn universe(&self) -> Universe<K> {
-        self.universe
-    }
-
-    fn depth_count(&self) -> usize {
-        self.view.depth_count()
-    }
-
-    fn root_state(&self) -> Result<NodeState, KtreeFileError> {
-        self.view.checked_state(0, 0)
-    }
-
-    fn first_child(&self, depth: usize, index: usize) -> Result<usize, KtreeFileError> {
-        let index = index as u64;
-        if depth + 1 >= self.view.depth_count()
-            || self.view.checked_state(depth, index)? != NodeState::Partial
-        {
-            return Err(self.changed(depth, index));
-        }
-        let first = self.view.partial_rank(depth, index)?.saturating_mul(1 << K);
-        if first.saturating_add(1 << K) > self.view.level_nodes(depth + 1) {
-            return Err(self.changed(depth + 1, first));
-        }
-        Ok(first as usize)
-    }
-
-    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, KtreeFileError> {
-        Ok(self.read(depth, first as u64, 1 << K)? as u32)
-    }
-
-    fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, KtreeFileError> {
-        self.read(depth, first as u64, n as u64)
-    }
 }

@@ -33,7 +33,8 @@
 
 use super::emit::{collapse, leaf, LevelWriter};
 use crate::space::Cell;
-use crate::tree::cursor::voxel_state;
+use crate::tree::locate::PointCursor;
+use crate::tree::storage::infallible;
 use crate::tree::{KTree, NodeState};
 
 /// How target voxels map back into the source universe.
@@ -155,7 +156,7 @@ impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
             return self.src.contains(p);
         };
         let start = self.src.node_at(e.index, e.cell);
-        voxel_state(self.src, &start, p) == NodeState::Full
+        infallible(PointCursor::at(self.src, start).and_then(|mut c| c.state(p))) == NodeState::Full
     }
 
     /// Decides target cell `cell` given its parent's overlay `parent` (a range of `self.overlay`).

@@ -5,7 +5,8 @@ use super::emit::LevelWriter;
 use super::overlay::{resample, Preimage};
 use super::OpsError;
 use crate::space::{max_level, Universe};
-use crate::tree::cursor::locate;
+use crate::tree::locate::locate;
+use crate::tree::storage::infallible;
 use crate::tree::{KTree, NodeState};
 
 fn check_path<const K: usize>(path: &[usize], level: u32) -> Result<(), OpsError> {
@@ -99,7 +100,7 @@ pub fn zoom<const K: usize>(tree: &KTree<K>, path: &[usize]) -> Result<KTree<K>,
     let target = path
         .iter()
         .fold(tree.universe().root(), |c, &code| c.child(code));
-    let node = locate(tree, tree.root(), &target);
+    let node = infallible(locate(tree, tree.root(), &target));
     if node.state != NodeState::Partial {
         return Ok(uniform(level, node.state));
     }

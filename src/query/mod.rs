@@ -7,8 +7,11 @@
 //! Boxes are `(lo, hi)` with `hi` exclusive. Distances are Euclidean, in voxel units, between voxel
 //! centres (as scipy's `distance_transform_edt` measures them).
 //!
-//! Every query is generic over [`TreeStorage`](crate::tree::storage::TreeStorage) and runs as one walk
-//! of [`cursor`](crate::tree::cursor); the batch forms run on the threads of the current rayon pool.
+//! Every query is a provided method of [`Query`], implemented for every
+//! [`TreeStorage`](crate::tree::storage::TreeStorage): a tree in memory and a `.ktree` file mapped in
+//! place (`io::MappedTree`) answer the same calls, each a walk of [`cursor`](crate::tree::cursor) or the
+//! one point descent of [`locate`](crate::tree::locate); the batch forms run on the threads of the
+//! current rayon pool. [`KTree`] also has each as a method that cannot fail.
 //!
 //! ```
 //! use ktree::KTree;
@@ -25,14 +28,127 @@ pub mod boxes;
 pub mod nearest;
 pub mod points;
 pub mod ray;
+pub mod stats;
 
 pub use boxes::{bounding_box, count, crop, VoxelBox};
 pub use nearest::{distance, nearest, nearest_many, nearest_many_signed, nearest_signed, Nearest};
 pub use points::{contains, contains_many, PointCursor};
 pub use ray::{cast_ray, cast_rays, Face, RayCast, RayError, RayHit};
+pub use stats::{stats, TreeStats};
 
-use crate::tree::storage::infallible;
+use crate::tree::storage::{infallible, TreeStorage};
 use crate::KTree;
+
+/// The questions asked of a map, provided for every storage of a tree: [`KTree`] in memory (whose
+/// reads cannot fail: its own methods of the same names drop the `Result`) and a `.ktree` file read in
+/// place (`io::MappedTree`), whose reads fail with an error naming the file and byte when the file
+/// changed after it was opened. One primitive is required (the storage's reads); every query is
+/// provided on it, as parry's `PointQuery` provides its queries on one projection.
+///
+/// ```
+/// use ktree::query::Query;
+/// use ktree::KTree;
+/// fn inside_share<T: Query<2>>(tree: &T) -> Result<f64, T::Error> {
+///     let inside = tree.contains_many(&[[0, 0], [1, 1], [2, 2], [3, 3]])?;
+///     Ok(inside.iter().filter(|&&b| b).count() as f64 / 4.0)
+/// }
+/// let tree = KTree::<2>::from_dense(2, &(0..16).map(|i| i < 8).collect::<Vec<_>>()).unwrap();
+/// assert_eq!(inside_share(&tree), Ok(0.5));
+/// ```
+pub trait Query<const K: usize>: TreeStorage<K> + Sync + Sized {
+    /// Whether voxel `point` is inside the object ([`contains()`]).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn contains(&self, point: [u32; K]) -> Result<bool, Self::Error> {
+        contains(self, point)
+    }
+
+    /// Whether each voxel of `points` is inside the object, in the order given, on all threads
+    /// ([`contains_many()`]).
+    ///
+    /// # Errors
+    /// The storage's first read error.
+    fn contains_many(&self, points: &[[u32; K]]) -> Result<Vec<bool>, Self::Error> {
+        contains_many(self, points)
+    }
+
+    /// A cursor for coherent point queries ([`PointCursor`]).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn cursor(&self) -> Result<PointCursor<'_, K, Self>, Self::Error> {
+        PointCursor::new(self)
+    }
+
+    /// The bounding box of the full voxels, `(lo, hi)` with `hi` exclusive; `None` when empty
+    /// ([`bounding_box()`]).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn bounding_box(&self) -> Result<Option<VoxelBox<K>>, Self::Error> {
+        bounding_box(self)
+    }
+
+    /// The number of full voxels in the box `[lo, hi)` ([`count()`]).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn count(&self, lo: [u32; K], hi: [u32; K]) -> Result<u128, Self::Error> {
+        count(self, lo, hi)
+    }
+
+    /// The object cut to the box `[lo, hi)`, in memory ([`crop()`]).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn crop(&self, lo: [u32; K], hi: [u32; K]) -> Result<KTree<K>, Self::Error> {
+        crop(self, lo, hi)
+    }
+
+    /// The first full voxel `ray` enters ([`cast_ray()`]; ties as [`ray`] says).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn cast_ray(&self, ray: &RayCast<K>) -> Result<Option<RayHit<K>>, Self::Error> {
+        cast_ray(self, ray)
+    }
+
+    /// [`Query::cast_ray`] for each ray, on all threads ([`cast_rays()`]).
+    ///
+    /// # Errors
+    /// The storage's first read error.
+    fn cast_rays(&self, rays: &[RayCast<K>]) -> Result<Vec<Option<RayHit<K>>>, Self::Error> {
+        cast_rays(self, rays)
+    }
+
+    /// A nearest full voxel to voxel `point` and its squared distance; `None` when empty ([`nearest()`]).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn nearest(&self, point: [u32; K]) -> Result<Option<Nearest<K>>, Self::Error> {
+        nearest(self, point)
+    }
+
+    /// [`Query::nearest`] for each point, on all threads ([`nearest_many()`]).
+    ///
+    /// # Errors
+    /// The storage's first read error.
+    fn nearest_many(&self, points: &[[u32; K]]) -> Result<Vec<Option<Nearest<K>>>, Self::Error> {
+        nearest_many(self, points)
+    }
+
+    /// The distance from voxel `point` to the nearest full voxel: `0` inside, infinite when empty
+    /// ([`distance()`]).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn distance(&self, point: [u32; K]) -> Result<f64, Self::Error> {
+        distance(self, point)
+    }
+}
+
+impl<const K: usize, T: TreeStorage<K> + Sync> Query<K> for T {}
 
 /// The queries of this module as methods of a tree in memory.
 impl<const K: usize> KTree<K> {

@@ -183,7 +183,6 @@ fn search_many<const K: usize, T>(
 ) -> Result<Vec<Option<Nearest<K>>>, T::Error>
 where
     T: TreeStorage<K> + Sync,
-    T::Error: Send,
 {
     let top = tree.universe().side() as i64 - 1;
     let mut order: Vec<(u64, u32)> = points
@@ -248,7 +247,6 @@ pub fn nearest_many_signed<const K: usize, T>(
 ) -> Result<Vec<Option<Nearest<K>>>, T::Error>
 where
     T: TreeStorage<K> + Sync,
-    T::Error: Send,
 {
     search_many(tree, points)
 }
@@ -263,7 +261,6 @@ pub fn nearest_many<const K: usize, T>(
 ) -> Result<Vec<Option<Nearest<K>>>, T::Error>
 where
     T: TreeStorage<K> + Sync,
-    T::Error: Send,
 {
     let points: Vec<[i64; K]> = points.iter().map(|p| p.map(i64::from)).collect();
     search_many(tree, &points)

@@ -396,7 +396,6 @@ pub fn cast_rays<const K: usize, T>(
 ) -> Result<Vec<Option<RayHit<K>>>, T::Error>
 where
     T: TreeStorage<K> + Sync,
-    T::Error: Send,
 {
     rays.par_iter()
         .with_min_len(256)

@@ -1,7 +1,6 @@
 //! Ray sets whose dimension is known only at run time (read from a ray file): [`AnyRaySet`].
 
 use super::RaySet;
-use crate::with_dim;
 
 /// A [`RaySet`] of any supported dimension, as read from a ray file whose header names `K`.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,4 +42,4 @@ impl AnyRaySet {
     }
 }
 
-crate::tree::from_typed!(RaySet, AnyRaySet);
+crate::dim::from_typed!(RaySet, AnyRaySet);

@@ -3,9 +3,9 @@
 //! the whole walk, and that chooses which children to visit and in what order (code order, a view order,
 //! the one child towards a point).
 //!
-//! Queries are small visitors, not new descents: point location ([`locate`]) takes the walk's one step
-//! ([`child`]) towards a point; the Booleans and interference tests are [`walk_pair`] visitors; display orders are
-//! [`ChildOrder::xor`] orders. The nodes under a node are contiguous at every level, so a whole subtree is
+//! Queries are small visitors, not new descents: the Booleans and interference tests are [`walk_pair`]
+//! visitors; display orders are [`ChildOrder::xor`] orders; point location is the one descent of
+//! [`locate`](super::locate). The nodes under a node are contiguous at every level, so a whole subtree is
 //! also a list of index ranges ([`subtree_ranges`]), which the level writer copies in bulk.
 //!
 //! ```
@@ -31,10 +31,12 @@
 
 use smallvec::SmallVec;
 
-use super::ktree::{KTree, NodeRef, TreeId};
+use super::ktree::{KTree, NodeRef};
 use super::states::NodeState;
+use std::convert::Infallible;
+
 use super::storage::infallible;
-pub use super::storage::{LevelOrder, TreeStorage};
+pub use super::storage::TreeStorage;
 use crate::space::Cell;
 
 /// What a visitor wants after seeing a node.
@@ -201,7 +203,10 @@ fn child_ref<const K: usize>(
 
 /// Walks `tree` depth first from the root with `visitor`. Returns `true` if the visitor stopped the walk.
 /// For a storage whose reads can fail, [`try_walk`].
-pub fn walk<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(tree: &T, visitor: &mut V) -> bool {
+pub fn walk<const K: usize, T: TreeStorage<K, Error = Infallible>, V: Visitor<K>>(
+    tree: &T,
+    visitor: &mut V,
+) -> bool {
     infallible(try_walk(tree, visitor))
 }
 
@@ -211,7 +216,7 @@ pub fn walk<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(tree: &T, visitor: 
 /// # Panics
 /// If `node` is a node of another tree (see [`NodeRef`]).
 #[track_caller]
-pub fn walk_from<const K: usize, T: LevelOrder<K>, V: Visitor<K>>(
+pub fn walk_from<const K: usize, T: TreeStorage<K, Error = Infallible>, V: Visitor<K>>(
     tree: &T,
     node: NodeRef<K>,
     v: &mut V,
@@ -355,14 +360,14 @@ impl<const K: usize, T: TreeStorage<K>> Iterator for TryLeaves<'_, K, T> {
 #[derive(Debug, Clone)]
 pub struct Leaves<'a, const K: usize, T = KTree<K>>(TryLeaves<'a, K, T>);
 
-impl<'a, const K: usize, T: LevelOrder<K>> Leaves<'a, K, T> {
+impl<'a, const K: usize, T: TreeStorage<K, Error = Infallible>> Leaves<'a, K, T> {
     /// The leaves of `tree`.
     pub fn new(tree: &'a T) -> Self {
         Self(TryLeaves::new(tree))
     }
 }
 
-impl<const K: usize, T: LevelOrder<K>> Iterator for Leaves<'_, K, T> {
+impl<const K: usize, T: TreeStorage<K, Error = Infallible>> Iterator for Leaves<'_, K, T> {
     type Item = (Cell<K>, NodeState);
 
     #[inline]
@@ -439,7 +444,12 @@ pub trait PairVisitor<const K: usize> {
 /// walk_pair(&a, &b, &mut m);
 /// assert!(m.0);
 /// ```
-pub fn walk_pair<const K: usize, A: LevelOrder<K>, B: LevelOrder<K>, V: PairVisitor<K>>(
+pub fn walk_pair<
+    const K: usize,
+    A: TreeStorage<K, Error = Infallible>,
+    B: TreeStorage<K, Error = Infallible>,
+    V: PairVisitor<K>,
+>(
     a: &A,
     b: &B,
     visitor: &mut V,
@@ -588,168 +598,6 @@ pub fn child<const K: usize>(tree: &KTree<K>, node: &NodeRef<K>, code: usize) ->
     );
     let first = tree.first_child(node.cell.level as usize, node.index);
     child_ref(tree, node, first, code, true)
-}
-
-/// The node of `tree` whose cell contains the aligned cell `target` and is either a leaf or `target`
-/// itself, found by descending from `start` (a node whose cell contains `target`; usually
-/// [`KTree::root`]) one child at a time, towards `target`. `O(levels descended)` rank lookups.
-///
-/// ```
-/// use ktree::tree::cursor::locate;
-/// use ktree::{KTree, NodeState};
-/// let tree = KTree::<1>::from_dense(2, &[false, true, true, true]).unwrap();
-/// let voxel = tree.universe().cell([3], 2).unwrap();
-/// let node = locate(&tree, tree.root(), &voxel);
-/// assert_eq!((node.state(), node.cell().side()), (NodeState::Full, 2));
-/// ```
-///
-/// # Panics
-/// If `start` is a node of another tree (see [`NodeRef`]).
-#[inline]
-#[track_caller]
-pub fn locate<const K: usize>(tree: &KTree<K>, start: NodeRef<K>, target: &Cell<K>) -> NodeRef<K> {
-    start.assert_of(tree.id());
-    descend(tree, start, target, |_| {})
-}
-
-/// [`locate`], calling `on_step` with each node stepped to.
-#[inline(always)]
-fn descend<const K: usize>(
-    tree: &KTree<K>,
-    start: NodeRef<K>,
-    target: &Cell<K>,
-    mut on_step: impl FnMut(&NodeRef<K>),
-) -> NodeRef<K> {
-    debug_assert!(start.cell.level <= target.level);
-    let bit_top = tree.level().saturating_sub(1);
-    let mut node = start;
-    while node.state == NodeState::Partial && node.cell.level < target.level {
-        let bit = bit_top - node.cell.level;
-        let mut code = 0usize;
-        for (axis, &c) in target.origin.iter().enumerate() {
-            code |= ((c >> bit & 1) as usize) << axis;
-        }
-        let first = tree.first_child(node.cell.level as usize, node.index);
-        node = child_ref(tree, &node, first, code, false);
-        on_step(&node);
-    }
-    // The steps did not track origins: the node's cell is the target's ancestor at its level.
-    let low = ((1u64 << node.cell.log_side) - 1) as u32;
-    node.cell.origin = target.origin.map(|o| o & !low);
-    node
-}
-
-/// Point location that remembers its last path from the root: a target near the previous one (a
-/// neighbour of the same leaf, the next leaf in Morton order) is found from their deepest common ancestor
-/// instead of from the root. Gives what [`locate`] from the root gives.
-///
-/// ```
-/// use ktree::tree::cursor::{locate, Locator};
-/// use ktree::KTree;
-/// let tree = KTree::<2>::from_dense(3, &(0..64).map(|i| i % 5 == 0).collect::<Vec<_>>()).unwrap();
-/// let mut locator = Locator::new(&tree);
-/// for (x, y) in [(3, 4), (3, 5), (7, 0), (0, 0)] {
-///     let voxel = tree.universe().cell([x, y], 3).unwrap();
-///     assert_eq!(locator.locate(&tree, &voxel), locate(&tree, tree.root(), &voxel));
-/// }
-/// ```
-#[derive(Debug, Clone)]
-pub struct Locator<const K: usize> {
-    /// `(index, state)` of the node at each depth of the last path.
-    path: [(usize, NodeState); 33],
-    /// Nodes on the last path.
-    len: usize,
-    /// The origin of the last target.
-    last: [u32; K],
-    /// The tree the path is in.
-    tree: TreeId,
-}
-
-impl<const K: usize> Locator<K> {
-    /// A locator for `tree`, its path at the root.
-    pub fn new(tree: &KTree<K>) -> Self {
-        let mut path = [(0, NodeState::Empty); 33];
-        path[0] = (0, tree.root_state());
-        Self {
-            path,
-            len: 1,
-            last: [0; K],
-            tree: tree.id(),
-        }
-    }
-
-    /// As [`locate`] from the root of `tree` (the tree the locator was made for).
-    ///
-    /// # Panics
-    /// If `tree` is not the tree (or a clone of the tree) the locator was made for.
-    #[track_caller]
-    pub fn locate(&mut self, tree: &KTree<K>, target: &Cell<K>) -> NodeRef<K> {
-        assert!(
-            self.tree == tree.id(),
-            "a Locator is used only with the tree (or a clone of the tree) it was made for"
-        );
-        let top = tree.level();
-        // The depth down to which the last target's ancestors are the target's.
-        let differ = (0..K)
-            .map(|a| 32 - (self.last[a] ^ target.origin[a]).leading_zeros())
-            .max()
-            .unwrap_or(0);
-        let common = top.saturating_sub(differ) as usize;
-        let depth = common.min(self.len - 1).min(target.level as usize);
-        let (index, state) = self.path[depth];
-        let start = NodeRef {
-            index,
-            cell: Cell {
-                origin: target.origin,
-                level: depth as u32,
-                log_side: top - depth as u32,
-            },
-            state,
-            tree: self.tree,
-        };
-        let path = &mut self.path;
-        let node = descend(tree, start, target, |n| {
-            path[n.cell.level as usize] = (n.index, n.state)
-        });
-        self.len = node.cell.level as usize + 1;
-        self.last = target.origin;
-        node
-    }
-}
-
-/// The state of the voxel `point` (inside `start`'s cell): [`locate`] for one voxel when only its state is
-/// wanted, descending from `start` without tracking cells.
-///
-/// ```
-/// use ktree::tree::cursor::voxel_state;
-/// use ktree::{KTree, NodeState};
-/// let tree = KTree::<1>::from_dense(2, &[false, true, true, true]).unwrap();
-/// assert_eq!(voxel_state(&tree, &tree.root(), [0]), NodeState::Empty);
-/// assert_eq!(voxel_state(&tree, &tree.root(), [3]), NodeState::Full);
-/// ```
-///
-/// # Panics
-/// If `start` is a node of another tree (see [`NodeRef`]).
-#[inline(always)]
-#[track_caller]
-pub fn voxel_state<const K: usize>(
-    tree: &KTree<K>,
-    start: &NodeRef<K>,
-    point: [u32; K],
-) -> NodeState {
-    start.assert_of(tree.id());
-    let (mut depth, mut index) = (start.cell.level as usize, start.index);
-    let (mut state, mut log_side) = (start.state, start.cell.log_side);
-    while state == NodeState::Partial {
-        log_side -= 1;
-        let code = (0..K).fold(0, |code, a| {
-            code | ((point[a] >> log_side & 1) as usize) << a
-        });
-        index = tree.first_child(depth, index) + code;
-        depth += 1;
-        state = tree.state(depth, index);
-    }
-    state
 }
 
 /// The ranges of node indices, level by level from `depth + 1` down, that hold the descendants of the

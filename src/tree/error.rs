@@ -91,3 +91,50 @@ pub enum TreeError {
         index: usize,
     },
 }
+
+/// Why a read of a stored tree failed: a tree read in place from a file found the file changed since it
+/// was opened (the error names the file and a byte offset inside it). A tree in memory never fails; its
+/// read error is [`Infallible`](std::convert::Infallible), which converts into this one.
+///
+/// Every operation that reads a tree through [`TreeStorage`](super::TreeStorage) and has errors of its
+/// own keeps a storage error as a variant whose source is this one.
+///
+/// ```
+/// use ktree::tree::StorageError;
+/// let e = StorageError::new(std::io::Error::other("map.ktree: byte 64: the file changed"));
+/// assert_eq!(e.to_string(), "map.ktree: byte 64: the file changed");
+/// assert!(e.downcast_ref::<std::io::Error>().is_some());
+/// ```
+#[derive(Debug)]
+pub struct StorageError(Box<dyn std::error::Error + Send + Sync + 'static>);
+
+/// The storage's own error, shown as it is (its source is the storage error's source).
+impl std::fmt::Display for StorageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for StorageError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.0.source()
+    }
+}
+
+impl StorageError {
+    /// A storage's read error.
+    pub fn new(error: impl std::error::Error + Send + Sync + 'static) -> Self {
+        Self(Box::new(error))
+    }
+
+    /// The storage's own error, if it is an `E`.
+    pub fn downcast_ref<E: std::error::Error + 'static>(&self) -> Option<&E> {
+        self.0.downcast_ref::<E>()
+    }
+}
+
+impl From<std::convert::Infallible> for StorageError {
+    fn from(never: std::convert::Infallible) -> Self {
+        match never {}
+    }
+}

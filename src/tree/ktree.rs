@@ -419,7 +419,8 @@ impl<const K: usize> KTree<K> {
         if self.universe.check_point(point).is_err() {
             return false;
         }
-        super::cursor::voxel_state(self, &self.root(), point) == NodeState::Full
+        let state = super::locate::PointCursor::new(self).and_then(|mut c| c.state(point));
+        super::storage::infallible(state) == NodeState::Full
     }
 
     /// Visits every leaf (empty and full) in Morton (depth-first) order: [`KTree::leaves`] as a callback.
@@ -605,7 +606,8 @@ pub fn heap_bytes_for_levels(per_level: &[LevelCounts]) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tree::cursor::{child, locate, walk_from, Locator, Visitor, Walk};
+    use crate::tree::cursor::{child, walk_from, Visitor, Walk};
+    use crate::tree::locate::{locate, PointCursor};
 
     /// Two bintrees of level 2 with the same shape at the top (a partial root whose first child is
     /// partial) and other voxels: a node of one is a valid position in the other.
@@ -676,11 +678,10 @@ mod tests {
     }
 
     #[test]
-    #[should_panic(expected = "made for")]
-    fn a_locator_refuses_another_tree() {
+    #[should_panic(expected = "belongs to another tree")]
+    fn a_cursor_refuses_a_start_of_another_tree() {
         let (a, b) = two_trees();
-        let mut locator = Locator::new(&a);
-        let _ = locator.locate(&b, &b.universe().cell([1], 2).unwrap());
+        let _ = PointCursor::at(&b, first_child_of(&a));
     }
 
     #[test]

@@ -18,6 +18,7 @@ mod assemble;
 pub mod cursor;
 mod error;
 mod ktree;
+pub mod locate;
 mod operators;
 pub mod sink;
 mod states;
@@ -25,11 +26,10 @@ pub mod storage;
 pub(crate) mod to_rays;
 pub(crate) mod words;
 
-pub(crate) use any::from_typed;
-pub use any::{AnyTree, DimensionMismatch, TreeStats};
+pub use any::{AnyTree, DimensionMismatch};
 pub(crate) use assemble::{LevelWriter, TreeAssembler};
 pub use cursor::Leaves;
-pub use error::TreeError;
+pub use error::{StorageError, TreeError};
 pub use ktree::{
     heap_bytes_for_levels, voxels_of_levels, Bintree, KTree, LevelCounts, NodeRef, Octree,
     Quadtree, Tree4,

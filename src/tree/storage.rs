@@ -1,13 +1,11 @@
-//! Where a tree's levels are read from: the one storage trait every walk runs over.
+//! Where a tree's levels are read from: the one storage trait every walk, query and operation runs over.
 //!
 //! A tree is stored in level order, two bits a node, and the walks of [`cursor`](super::cursor) only ever
 //! ask a storage for the state codes of a block of siblings and for the first child of a partial node.
 //! [`TreeStorage`] is that question with a fallible answer, so that the same walks run on a tree in memory
-//! ([`KTree`], whose reads cannot fail: its error is [`Infallible`]) and on a file read in place, whose
-//! reads fail with an error naming the file and the byte offset when the file no longer is what it was.
-//!
-//! [`LevelOrder`] is the storage whose reads cannot fail; every `LevelOrder` is a `TreeStorage` with the
-//! error [`Infallible`], and the walks over it return their result without a `Result`.
+//! ([`KTree`], whose reads cannot fail: its error is [`Infallible`], and the compiler removes the checks)
+//! and on a file read in place (`io::MappedTree`), whose every read is checked and fails with an error
+//! naming the file and the byte offset when the file no longer is what it was.
 //!
 //! ```
 //! use ktree::tree::storage::TreeStorage;
@@ -21,14 +19,15 @@
 
 use std::convert::Infallible;
 
+use super::error::StorageError;
 use super::ktree::TreeId;
-use super::ktree::{KTree, NodeRef};
+use super::ktree::{KTree, LevelCounts, NodeRef};
 use super::states::NodeState;
 use super::words::slots_mask;
 use crate::space::Universe;
 
 /// The `n ≤ 32` states from node `first`, gathered from the blocks of `2^K` siblings that cover them
-/// (`block(at)` reads the block starting at node `at`): the default of both storages' `slots`.
+/// (`block(at)` reads the block starting at node `at`): the default of [`TreeStorage::slots`].
 fn slots_from_blocks<const K: usize, E>(
     first: usize,
     n: usize,
@@ -50,14 +49,18 @@ fn slots_from_blocks<const K: usize, E>(
     Ok(word & slots_mask(n))
 }
 
-/// A `K`-dimensional tree stored in level order, read one block of siblings at a time. Reads may fail
-/// (a file changed underneath): every read returns `Result<_, Self::Error>`.
+/// A `K`-dimensional tree stored in level order, read one block of siblings at a time: the one
+/// primitive every walk, query, operation, picture and export of the crate reads trees through.
+/// Reads may fail (a file changed underneath): every read returns `Result<_, Self::Error>`.
 ///
-/// Implementors give the five reads; the rest is provided. Implemented by every [`LevelOrder`] (with
-/// [`Infallible`] errors) and by stored files read in place.
+/// Implementors give the reads below; the rest is provided. Implemented by [`KTree`] (with
+/// [`Infallible`] errors, at no cost) and by `io::MappedTree`, a `.ktree` file read in place. The
+/// questions asked of a tree (points, boxes, rays, nearest voxels) are provided on top of it by
+/// `query::Query`.
 pub trait TreeStorage<const K: usize> {
-    /// Why a read failed ([`Infallible`] for a tree in memory).
-    type Error;
+    /// Why a read failed ([`Infallible`] for a tree in memory); it converts into a [`StorageError`],
+    /// which the operations with errors of their own keep as a variant.
+    type Error: std::error::Error + Into<StorageError> + Send + Sync + 'static;
 
     /// The universe.
     fn universe(&self) -> Universe<K>;
@@ -65,17 +68,23 @@ pub trait TreeStorage<const K: usize> {
     /// The number of stored levels.
     fn depth_count(&self) -> usize;
 
+    /// The number of nodes of level `depth` (0 below the last stored level).
+    fn level_len(&self, depth: usize) -> usize;
+
+    /// Node counts per level, from the root down (the tree's shape, known without a walk).
+    fn counts_per_level(&self) -> Vec<LevelCounts>;
+
     /// The root's state.
     ///
     /// # Errors
     /// The storage's read error.
     fn root_state(&self) -> Result<NodeState, Self::Error>;
 
-    /// The index (in level `depth + 1`) of the first child of the partial node `index` of level `depth`.
+    /// The number of partial nodes of level `depth` before node `index` (`index ≤` the level's length).
     ///
     /// # Errors
-    /// The storage's read error, for instance when `index` is not a partial node of the level.
-    fn first_child(&self, depth: usize, index: usize) -> Result<usize, Self::Error>;
+    /// The storage's read error, for instance when `index` is past the level.
+    fn partial_rank(&self, depth: usize, index: usize) -> Result<usize, Self::Error>;
 
     /// The states of the `2^K` siblings of level `depth` from `first` (a multiple of `2^K`), two bits each,
     /// the first in the low bits.
@@ -83,6 +92,16 @@ pub trait TreeStorage<const K: usize> {
     /// # Errors
     /// The storage's read error, for instance when the block is not in the level.
     fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Self::Error>;
+
+    /// The index (in level `depth + 1`) of the first child of the partial node `index` of level `depth`:
+    /// `2^K` times its rank among the level's partial nodes.
+    ///
+    /// # Errors
+    /// The storage's read error, for instance when `index` is not a partial node of the level.
+    #[inline(always)]
+    fn first_child(&self, depth: usize, index: usize) -> Result<usize, Self::Error> {
+        Ok(self.partial_rank(depth, index)? << K)
+    }
 
     /// The states of the `n ≤ 32` nodes of level `depth ≥ 1` from `first`, two bits each, the first in the
     /// low bits (higher bits clear): what bulk copies of a subtree read. The default reads the blocks of
@@ -95,14 +114,31 @@ pub trait TreeStorage<const K: usize> {
     }
 
     /// The universe level `L`.
+    #[inline]
     fn level(&self) -> u32 {
         self.universe().level()
+    }
+
+    /// The total node counts (`level` holds the universe level), as [`KTree::counts`].
+    fn counts(&self) -> LevelCounts {
+        LevelCounts::total(self.level(), &self.counts_per_level())
+    }
+
+    /// The total number of nodes.
+    fn node_count(&self) -> u64 {
+        self.counts().nodes()
+    }
+
+    /// The number of voxels inside the object, from the counts per level (no walk).
+    fn voxel_count(&self) -> u128 {
+        super::voxels_of_levels(K, self.level(), &self.counts_per_level())
     }
 
     /// The root node.
     ///
     /// # Errors
     /// The storage's read error.
+    #[inline]
     fn root(&self) -> Result<NodeRef<K>, Self::Error> {
         Ok(NodeRef {
             index: 0,
@@ -124,99 +160,9 @@ pub trait TreeStorage<const K: usize> {
     }
 }
 
-/// A tree stored in level order whose reads cannot fail: a tree in memory ([`KTree`]). Every
-/// `LevelOrder` is a [`TreeStorage`] with the error [`Infallible`], so the walks over it return plain
-/// results.
-pub trait LevelOrder<const K: usize> {
-    /// The universe.
-    fn universe(&self) -> Universe<K>;
-
-    /// The number of stored levels.
-    fn depth_count(&self) -> usize;
-
-    /// The root's state.
-    fn root_state(&self) -> NodeState;
-
-    /// The index (in level `depth + 1`) of the first child of the partial node `index` of level `depth`.
-    fn first_child(&self, depth: usize, index: usize) -> usize;
-
-    /// The states of the `2^K` siblings of level `depth` from `first` (a multiple of `2^K`), two bits each,
-    /// the first in the low bits.
-    fn block_codes(&self, depth: usize, first: usize) -> u32;
-
-    /// As [`TreeStorage::slots`] (`depth ≥ 1`); the default reads the blocks of siblings the range covers.
-    fn slots(&self, depth: usize, first: usize, n: usize) -> u64 {
-        infallible(slots_from_blocks::<K, _>(first, n, |at| {
-            Ok(self.block_codes(depth, at))
-        }))
-    }
-
-    /// The universe level `L`.
-    fn level(&self) -> u32 {
-        self.universe().level()
-    }
-
-    /// The root node.
-    fn root(&self) -> NodeRef<K> {
-        NodeRef {
-            index: 0,
-            cell: self.universe().root(),
-            state: self.root_state(),
-            tree: TreeId::NONE,
-        }
-    }
-
-    /// Visits every leaf (empty and full) in Morton order.
-    fn for_each_leaf(&self, mut visit: impl FnMut(crate::space::Cell<K>, NodeState))
-    where
-        Self: Sized,
-    {
-        for (cell, state) in super::cursor::Leaves::new(self) {
-            visit(cell, state);
-        }
-    }
-}
-
-impl<const K: usize, T: LevelOrder<K>> TreeStorage<K> for T {
+impl<const K: usize> TreeStorage<K> for KTree<K> {
     type Error = Infallible;
 
-    #[inline(always)]
-    fn universe(&self) -> Universe<K> {
-        LevelOrder::universe(self)
-    }
-
-    #[inline(always)]
-    fn depth_count(&self) -> usize {
-        LevelOrder::depth_count(self)
-    }
-
-    #[inline(always)]
-    fn root_state(&self) -> Result<NodeState, Infallible> {
-        Ok(LevelOrder::root_state(self))
-    }
-
-    #[inline(always)]
-    fn first_child(&self, depth: usize, index: usize) -> Result<usize, Infallible> {
-        Ok(LevelOrder::first_child(self, depth, index))
-    }
-
-    #[inline(always)]
-    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Infallible> {
-        Ok(LevelOrder::block_codes(self, depth, first))
-    }
-
-    #[inline(always)]
-    fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, Infallible> {
-        Ok(LevelOrder::slots(self, depth, first, n))
-    }
-
-    #[inline(always)]
-    fn root(&self) -> Result<NodeRef<K>, Infallible> {
-        Ok(LevelOrder::root(self))
-    }
-}
-
-impl<const K: usize> LevelOrder<K> for KTree<K> {
     #[inline]
     fn universe(&self) -> Universe<K> {
         KTree::universe(self)
@@ -228,44 +174,74 @@ impl<const K: usize> LevelOrder<K> for KTree<K> {
     }
 
     #[inline]
-    fn root_state(&self) -> NodeState {
-        KTree::root_state(self)
+    fn level_len(&self, depth: usize) -> usize {
+        if depth < self.depth_count() {
+            self.level_states(depth).len()
+        } else {
+            0
+        }
+    }
+
+    fn counts_per_level(&self) -> Vec<LevelCounts> {
+        KTree::counts_per_level(self)
+    }
+
+    fn counts(&self) -> LevelCounts {
+        KTree::counts(self)
+    }
+
+    fn voxel_count(&self) -> u128 {
+        KTree::voxel_count(self)
     }
 
     #[inline]
-    fn root(&self) -> NodeRef<K> {
-        KTree::root(self)
+    fn root_state(&self) -> Result<NodeState, Infallible> {
+        Ok(KTree::root_state(self))
+    }
+
+    #[inline]
+    fn root(&self) -> Result<NodeRef<K>, Infallible> {
+        Ok(KTree::root(self))
     }
 
     #[inline(always)]
-    fn first_child(&self, depth: usize, index: usize) -> usize {
-        KTree::first_child(self, depth, index)
+    fn partial_rank(&self, depth: usize, index: usize) -> Result<usize, Infallible> {
+        Ok(self.level_states(depth).partial_rank(index))
     }
 
     #[inline(always)]
-    fn block_codes(&self, depth: usize, first: usize) -> u32 {
-        self.level_states(depth).block_codes(first, K)
+    fn first_child(&self, depth: usize, index: usize) -> Result<usize, Infallible> {
+        Ok(KTree::first_child(self, depth, index))
     }
 
     #[inline(always)]
-    fn slots(&self, depth: usize, first: usize, n: usize) -> u64 {
+    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Infallible> {
+        Ok(self.level_states(depth).block_codes(first, K))
+    }
+
+    #[inline(always)]
+    fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, Infallible> {
         let words = self.level_states(depth).words();
         let (w, s) = (first / 32, 2 * (first % 32));
         let mut chunk = words[w] >> s;
         if s > 0 && w + 1 < words.len() {
             chunk |= words[w + 1] << (64 - s);
         }
-        chunk & slots_mask(n)
-    }
-
-    fn for_each_leaf(&self, visit: impl FnMut(crate::space::Cell<K>, NodeState)) {
-        KTree::for_each_leaf(self, visit)
+        Ok(chunk & slots_mask(n))
     }
 }
 
-/// The value of a read that cannot fail.
+/// The value of a read that cannot fail: what the infallible conveniences of [`KTree`] return from the
+/// generic walks and queries.
+///
+/// ```
+/// use ktree::tree::storage::{infallible, TreeStorage};
+/// use ktree::{KTree, NodeState};
+/// let tree = KTree::<1>::full(2).unwrap();
+/// assert_eq!(infallible(TreeStorage::root_state(&tree)), NodeState::Full);
+/// ```
 #[inline(always)]
-pub(crate) fn infallible<T>(result: Result<T, Infallible>) -> T {
+pub fn infallible<T>(result: Result<T, Infallible>) -> T {
     match result {
         Ok(value) => value,
         Err(never) => match never {},
@@ -277,24 +253,32 @@ mod tests {
     use super::*;
     use crate::tree::sink::{copy_subtree, LevelSink, MemorySink};
 
-    /// A tree in memory read only through the required reads: the provided `slots` is under test.
+    /// A tree in memory read only through the required reads: the provided `slots` and `first_child`
+    /// are under test.
     struct BlocksOnly<'a, const K: usize>(&'a KTree<K>);
 
-    impl<const K: usize> LevelOrder<K> for BlocksOnly<'_, K> {
+    impl<const K: usize> TreeStorage<K> for BlocksOnly<'_, K> {
+        type Error = Infallible;
         fn universe(&self) -> Universe<K> {
             self.0.universe()
         }
         fn depth_count(&self) -> usize {
             self.0.depth_count()
         }
-        fn root_state(&self) -> NodeState {
-            self.0.root_state()
+        fn level_len(&self, depth: usize) -> usize {
+            TreeStorage::level_len(self.0, depth)
         }
-        fn first_child(&self, depth: usize, index: usize) -> usize {
-            self.0.first_child(depth, index)
+        fn counts_per_level(&self) -> Vec<LevelCounts> {
+            self.0.counts_per_level()
         }
-        fn block_codes(&self, depth: usize, first: usize) -> u32 {
-            LevelOrder::block_codes(self.0, depth, first)
+        fn root_state(&self) -> Result<NodeState, Infallible> {
+            Ok(self.0.root_state())
+        }
+        fn partial_rank(&self, depth: usize, index: usize) -> Result<usize, Infallible> {
+            TreeStorage::partial_rank(self.0, depth, index)
+        }
+        fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Infallible> {
+            TreeStorage::block_codes(self.0, depth, first)
         }
     }
 
@@ -316,8 +300,8 @@ mod tests {
                 for first in 0..len {
                     for n in 1..=32.min(len - first) {
                         assert_eq!(
-                            LevelOrder::slots(&b, depth, first, n),
-                            LevelOrder::slots(&t, depth, first, n),
+                            TreeStorage::slots(&b, depth, first, n),
+                            TreeStorage::slots(&t, depth, first, n),
                             "K = {K}, depth {depth}, {first} + {n}"
                         );
                     }

@@ -5,7 +5,8 @@ use ktree::display::{default_camera, render, RenderOptions, ISO_TOWARD_EYE};
 use ktree::io::{write_ktree, KtreeView, MappedTree};
 use ktree::rays::ball_rays;
 use ktree::stacking::paper::stack;
-use ktree::tree::cursor::LevelOrder;
+use ktree::tree::cursor::TryLeaves;
+use ktree::tree::storage::TreeStorage;
 use ktree::KTree;
 use ktree_verify::objects::object;
 use proptest::prelude::*;
@@ -19,10 +20,22 @@ fn view_of<const K: usize>(tree: &KTree<K>) -> KtreeView {
 fn check_leaves<const K: usize>(tree: &KTree<K>) -> Result<(), TestCaseError> {
     let view = view_of(tree);
     let mapped = MappedTree::<K>::new(&view).unwrap();
-    let mut leaves = Vec::new();
-    mapped.for_each_leaf(|cell, state| leaves.push((cell, state)));
+    let leaves: Vec<_> = TryLeaves::new(&mapped).collect::<Result<_, _>>().unwrap();
     prop_assert_eq!(leaves, tree.leaves().collect::<Vec<_>>());
-    prop_assert_eq!(LevelOrder::depth_count(&mapped), tree.depth_count());
+    prop_assert_eq!(mapped.depth_count(), tree.depth_count());
+    prop_assert_eq!(mapped.counts_per_level(), tree.counts_per_level());
+    prop_assert_eq!(TreeStorage::voxel_count(&mapped), tree.voxel_count());
+    // The rank of every node, the level's end included, as the tree in memory counts it.
+    for depth in 0..tree.depth_count() {
+        let len = tree.level_states(depth).len();
+        prop_assert_eq!(mapped.level_len(depth), len);
+        for index in 0..=len {
+            prop_assert_eq!(
+                mapped.partial_rank(depth, index).unwrap(),
+                tree.level_states(depth).partial_rank(index)
+            );
+        }
+    }
     Ok(())
 }
 

@@ -8,8 +8,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use ktree::io::{write_ktree, KtreeView, MappedTree};
-use ktree::query::{self, Face, RayCast, RayHit};
+use ktree::query::{self, Face, Query, RayCast, RayHit};
 use ktree::space::morton_encode;
+use ktree::tree::storage::TreeStorage;
 use ktree::{KTree, NodeState, Universe};
 use ktree_verify::objects::{object, Obj};
 use ktree_verify::sparse::{boxes, point, union_volume, Boxes, Cuboid};
@@ -391,8 +392,10 @@ fn check_mapped<const K: usize>(
     let mut cursor = query::PointCursor::new(&mapped).unwrap();
     for &p in points {
         prop_assert_eq!(cursor.contains(p).unwrap(), tree.contains(p));
+        prop_assert_eq!(Query::contains(&mapped, p).unwrap(), tree.contains(p));
+        prop_assert_eq!(Query::nearest(&mapped, p).unwrap(), tree.nearest(p));
+        prop_assert_eq!(Query::distance(&mapped, p).unwrap(), tree.distance(p));
     }
-    prop_assert!(mapped.failure().is_ok());
     Ok(())
 }
 

@@ -1,12 +1,12 @@
 //! The cursor against brute force on the dense array, K = 1 … 4: one-tree and two-tree walks visit exactly
 //! the nodes (cells and states) a recursive enumeration of the dense array finds, in the same order, with
-//! skipping and early exit; point location (from the root, or from a [`Locator`]'s last path) and subtree
-//! ranges agree with the dense array.
+//! skipping and early exit; point location (from the root, or from a [`PointCursor`]'s last path) and
+//! subtree ranges agree with the dense array.
 
 use ktree::tree::cursor::{
-    locate, subtree_ranges, walk, walk_pair, ChildOrder, Locator, PairNode, PairVisitor, Visitor,
-    Walk,
+    subtree_ranges, walk, walk_pair, ChildOrder, PairNode, PairVisitor, Visitor, Walk,
 };
+use ktree::tree::locate::{locate, PointCursor};
 use ktree::tree::NodeRef;
 use ktree::{Cell, KTree, NodeState, Universe};
 use ktree_verify::objects::{object, pair, Obj};
@@ -129,7 +129,7 @@ fn check_one<const K: usize>(
     // Point location: the located leaf holds the voxel's dense value.
     for (i, &full) in dense.iter().enumerate().step_by(7) {
         let voxel = u.cell(u.dense_point(i), u.level()).unwrap();
-        let node = locate(&tree, tree.root(), &voxel);
+        let node = locate(&tree, tree.root(), &voxel).unwrap();
         prop_assert!(node.cell().contains(voxel.origin()));
         prop_assert_eq!(
             node.state(),
@@ -276,11 +276,13 @@ fn a_single_leaf_tree_is_one_visit() {
     assert_eq!(v.seen, [(tree.universe().root(), NodeState::Full)]);
 }
 
-/// A locator that keeps its path finds, for any sequence of cells, what a descent from the root finds.
+/// A cursor that keeps its path finds, for any sequence of cells, the node the dense array says holds
+/// each: a leaf of the cell's dense state containing it, or the cell itself when it is mixed.
 fn check_locator<const K: usize>(o: &Obj<K>, picks: &[(u64, u32)]) -> Result<(), TestCaseError> {
     let tree = o.tree();
     let u = tree.universe();
-    let mut locator = Locator::new(&tree);
+    let dense = tree.to_dense().unwrap();
+    let mut locator = PointCursor::new(&tree).unwrap();
     for &(seed, level) in picks {
         let level = level % (u.level() + 1);
         let side = 1u64 << level;
@@ -289,10 +291,16 @@ fn check_locator<const K: usize>(o: &Obj<K>, picks: &[(u64, u32)]) -> Result<(),
             (x << (u.level() - level)) as u32
         });
         let target = u.cell(origin, level).unwrap();
-        prop_assert_eq!(
-            locator.locate(&tree, &target),
-            locate(&tree, tree.root(), &target)
+        let node = locator.locate(&target).unwrap();
+        prop_assert!(
+            node.cell().contains(target.origin()) && node.depth() <= target.level() as usize
         );
+        let expect = dense_state(&u, &dense, &node.cell());
+        prop_assert_eq!(node.state(), expect);
+        if expect == NodeState::Partial {
+            prop_assert_eq!(node.cell(), target);
+        }
+        prop_assert_eq!(node, locate(&tree, tree.root(), &target).unwrap());
     }
     Ok(())
 }

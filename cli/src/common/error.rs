@@ -37,6 +37,12 @@ impl fmt::Display for CliError {
 
 impl std::error::Error for CliError {}
 
+/// A failed read of a tree (a file read in place that changed after it was opened), as a command's
+/// error: what the generic code over any storage maps its reads' errors with.
+pub fn read_error(e: impl Into<ktree::tree::StorageError>) -> CliError {
+    CliError::Failed(e.into().to_string())
+}
+
 impl From<String> for CliError {
     fn from(message: String) -> Self {
         Self::Failed(message)

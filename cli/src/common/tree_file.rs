@@ -78,11 +78,6 @@ pub fn read(path: &Path) -> Result<AnyTree, String> {
     read_ktree_file(path).map_err(|e| e.to_string())
 }
 
-/// Reads a tree from a file of any format `ktree` reads (by extension), with the path in any error.
-pub fn read_any(path: &Path) -> Result<AnyTree, String> {
-    ktree::io::read_tree(path, &ktree::io::ReadOptions::default()).map_err(|e| e.to_string())
-}
-
 /// Writes a tree file and prints a one-line summary.
 pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> CliResult {
     write_tree(path, tree).map_err(|e| format!("cannot write {}: {e}", path.display()))?;

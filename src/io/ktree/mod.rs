@@ -28,7 +28,7 @@ use crate::tree::{AnyTree, KTree};
 pub mod v1;
 pub mod v2;
 
-pub use v2::{KtreeView, KtreeWriter, MappedTree};
+pub use v2::{AnyMappedTree, KtreeView, KtreeWriter, MappedTree};
 
 /// The format version [`write_ktree`] writes.
 pub const VERSION: u16 = v2::VERSION;

@@ -1,143 +1,111 @@
-//! A `.ktree` version 2 file read as a tree in place: the walks of [`cursor`](crate::tree::cursor) (and so
-//! rendering) run on its memory map, for trees larger than memory.
+//! A `.ktree` version 2 file read as a tree in place: a [`TreeStorage`] whose every read is checked, so
+//! every walk, query, operation, picture and export of the crate runs on its memory map as on a tree in
+//! memory, for trees larger than memory.
 
+use super::layout::NODES_PER_WORD;
 use super::KtreeView;
-use crate::io::KtreeFileError;
-use crate::query;
+use crate::io::{KtreeFileError, KtreeFileErrorKind};
 use crate::space::Universe;
-use crate::tree::cursor::LevelOrder;
-use crate::tree::storage::infallible;
-use crate::tree::NodeState;
-use crate::KTree;
-use std::convert::Infallible;
-use std::sync::OnceLock;
+use crate::tree::storage::TreeStorage;
+use crate::tree::{words, LevelCounts, NodeState, StorageError};
 
-/// A `K`-dimensional tree read through a [`KtreeView`]: what the walks need, with each first child found
-/// from the file's rank samples (at most 64 word pop-counts) instead of an index in memory.
+/// A `K`-dimensional tree read in place through a [`KtreeView`] (a clone of it, sharing its map): a
+/// [`TreeStorage`] whose every read is checked against the shape found when the file was opened, each
+/// first child found from the file's rank samples (at most 64 word pop-counts) instead of an index in
+/// memory. A file changed since it was opened gives an error naming the file and a byte offset within
+/// the level read, never a read past the map, a panic or a wrong answer from the walk that noticed.
+///
+/// The questions of [`query::Query`](crate::query::Query) are asked of it as of a tree in memory:
 ///
 /// ```
-/// use ktree::tree::cursor::LevelOrder;
+/// use ktree::query::Query;
+/// use ktree::tree::cursor::TryLeaves;
 /// use ktree::{io, KTree};
 /// let tree = KTree::<2>::from_dense(2, &(0..16).map(|i| i % 3 == 0).collect::<Vec<_>>()).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("t.ktree");
 /// io::write_ktree_file(&path, &tree).unwrap();
-/// let view = io::KtreeView::open(&path).unwrap();
-/// let mapped = io::MappedTree::<2>::new(&view).unwrap();
-/// let mut leaves = Vec::new();
-/// mapped.for_each_leaf(|cell, state| leaves.push((cell, state)));
+/// let mapped = io::MappedTree::<2>::open(&path).unwrap();
+/// let leaves: Vec<_> = TryLeaves::new(&mapped).collect::<Result<_, _>>().unwrap();
 /// assert_eq!(leaves, tree.leaves().collect::<Vec<_>>());
+/// assert_eq!(mapped.contains_many(&[[0, 0], [1, 0]]).unwrap(), [true, false]);
+/// assert_eq!(mapped.bounding_box().unwrap(), tree.bounding_box());
 /// ```
-#[derive(Debug)]
-pub struct MappedTree<'a, const K: usize> {
-    view: &'a KtreeView,
+#[derive(Debug, Clone)]
+pub struct MappedTree<const K: usize> {
+    view: KtreeView,
     universe: Universe<K>,
-    /// The first read that found the file changed since it was opened.
-    failure: OnceLock<KtreeFileError>,
 }
 
-impl<'a, const K: usize> MappedTree<'a, K> {
-    /// The tree of `view`.
+impl<const K: usize> MappedTree<K> {
+    /// The tree of `view` (which it clones: the two share the map).
     ///
     /// # Errors
-    /// [`KtreeFileErrorKind::Dimension`](crate::io::KtreeFileErrorKind::Dimension) if the file's `K` is not `K`.
-    pub fn new(view: &'a KtreeView) -> Result<Self, KtreeFileError> {
+    /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`.
+    pub fn new(view: &KtreeView) -> Result<Self, KtreeFileError> {
         Ok(Self {
-            view,
+            view: view.clone(),
             universe: view.universe::<K>()?,
-            failure: OnceLock::new(),
         })
     }
 
-    /// `Ok` if every read so far found the file as it was checked when opened; otherwise the first
-    /// failed read's error (naming the file and a byte offset inside it). Walks over a file changed
-    /// underneath read the nodes they cannot find as empty and go on: call this after a walk.
+    /// Opens, checks and maps the version 2 file `path` ([`KtreeView::open`]).
     ///
     /// # Errors
-    /// The first failed read's error.
-    pub fn failure(&self) -> Result<(), KtreeFileError> {
-        self.failure.get().map_or(Ok(()), |e| Err(e.clone()))
+    /// As [`KtreeView::open`]; [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`.
+    pub fn open(path: &std::path::Path) -> Result<Self, KtreeFileError> {
+        Self::new(&KtreeView::open(path)?)
     }
 
-    /// `value` of a read, or `fallback` after recording its error.
-    fn checked<T>(&self, read: Result<T, KtreeFileError>, fallback: T) -> T {
-        read.unwrap_or_else(|e| {
-            let _ = self.failure.set(e);
-            fallback
-        })
+    /// The view the tree is read through.
+    pub fn view(&self) -> &KtreeView {
+        &self.view
+    }
+
+    /// The error for nodes `index …` of level `depth` that the shape says exist but the file does not
+    /// hold as it did: the offset is that of the level's last word read, within the file.
+    fn changed(&self, depth: usize, index: u64) -> KtreeFileError {
+        let depth = depth.min(self.view.depth_count().saturating_sub(1));
+        let last = index.min(self.view.level_nodes(depth).saturating_sub(1));
+        let mut error = self.view.changed(depth, last);
+        error.kind = KtreeFileErrorKind::Tree(format!(
+            "node {index} of level {depth} is missing or has the code 11: the file was changed after it was opened"
+        ));
+        error
+    }
+
+    /// The `n ≤ 32` states of level `depth` from `first`, checked to be in the level and to hold no
+    /// unused code.
+    #[inline]
+    fn read(&self, depth: usize, first: u64, n: u64) -> Result<u64, KtreeFileError> {
+        let nodes = self.view.level_nodes(depth);
+        if first.saturating_add(n) > nodes {
+            return Err(self.changed(depth, first));
+        }
+        let words = nodes.div_ceil(NODES_PER_WORD);
+        let (j, off) = (first / NODES_PER_WORD, first % NODES_PER_WORD);
+        let mut word = self.view.level_word(depth, j)? >> (2 * off);
+        if off > 0 && j + 1 < words {
+            word |= self.view.level_word(depth, j + 1)? << (2 * (NODES_PER_WORD - off));
+        }
+        let word = word & words::slots_mask(n as usize);
+        // A code 11 is not a state: the bytes are not the file's any more.
+        if words::unused_mask(word) != 0 {
+            return Err(self.changed(depth, first));
+        }
+        Ok(word)
     }
 }
 
-/// The queries of [`crate::query`] read through the map; each checks [`MappedTree::failure`] after its
-/// walk, so a file changed underneath gives an error naming the file and an offset, not a wrong answer.
-impl<const K: usize> MappedTree<'_, K> {
-    /// The query's answer, or the first failed read's error.
-    fn answer<T>(&self, value: Result<T, Infallible>) -> Result<T, KtreeFileError> {
-        let value = infallible(value);
-        self.failure().map(|()| value)
-    }
-
-    /// The number of voxels inside the object, from the file's per-level counts (no walk).
-    pub fn voxel_count(&self) -> u128 {
-        self.view.voxel_count()
-    }
-
-    /// As [`KTree::contains_many`](crate::KTree::contains_many).
-    ///
-    /// # Errors
-    /// The first failed read's error.
-    pub fn contains_many(&self, points: &[[u32; K]]) -> Result<Vec<bool>, KtreeFileError> {
-        self.answer(query::contains_many(self, points))
-    }
-
-    /// As [`KTree::bounding_box`](crate::KTree::bounding_box).
-    ///
-    /// # Errors
-    /// The first failed read's error.
-    pub fn bounding_box(&self) -> Result<Option<query::VoxelBox<K>>, KtreeFileError> {
-        self.answer(query::bounding_box(self))
-    }
-
-    /// As [`KTree::count`](crate::KTree::count).
-    ///
-    /// # Errors
-    /// The first failed read's error.
-    pub fn count(&self, lo: [u32; K], hi: [u32; K]) -> Result<u128, KtreeFileError> {
-        self.answer(query::count(self, lo, hi))
-    }
-
-    /// As [`KTree::crop`](crate::KTree::crop): the cropped tree, in memory.
-    ///
-    /// # Errors
-    /// The first failed read's error.
-    pub fn crop(&self, lo: [u32; K], hi: [u32; K]) -> Result<KTree<K>, KtreeFileError> {
-        self.answer(query::crop(self, lo, hi))
-    }
-
-    /// As [`query::cast_rays`] (ties as [`query::ray`] says).
-    ///
-    /// # Errors
-    /// The first failed read's error.
-    pub fn cast_rays(
-        &self,
-        rays: &[query::RayCast<K>],
-    ) -> Result<Vec<Option<query::RayHit<K>>>, KtreeFileError> {
-        self.answer(query::cast_rays(self, rays))
-    }
-
-    /// As [`KTree::nearest_many`](crate::KTree::nearest_many).
-    ///
-    /// # Errors
-    /// The first failed read's error.
-    pub fn nearest_many(
-        &self,
-        points: &[[u32; K]],
-    ) -> Result<Vec<Option<query::Nearest<K>>>, KtreeFileError> {
-        self.answer(query::nearest_many(self, points))
+impl From<KtreeFileError> for StorageError {
+    fn from(e: KtreeFileError) -> Self {
+        StorageError::new(e)
     }
 }
 
-impl<const K: usize> LevelOrder<K> for MappedTree<'_, K> {
+impl<const K: usize> TreeStorage<K> for MappedTree<K> {
+    type Error = KtreeFileError;
+
     fn universe(&self) -> Universe<K> {
         self.universe
     }
@@ -146,50 +114,131 @@ impl<const K: usize> LevelOrder<K> for MappedTree<'_, K> {
         self.view.depth_count()
     }
 
-    fn root_state(&self) -> NodeState {
-        self.checked(self.view.checked_state(0, 0), NodeState::Empty)
+    fn level_len(&self, depth: usize) -> usize {
+        self.view.level_nodes(depth) as usize
     }
 
-    fn first_child(&self, depth: usize, index: usize) -> usize {
-        let first = self
-            .view
-            .partial_rank(depth, index as u64)
-            .map(|rank| rank.saturating_mul(1 << K))
-            .and_then(|first| {
-                // The whole block of children must be in the level below.
-                if first.saturating_add(1 << K) <= self.view.level_nodes(depth + 1) {
-                    Ok(first as usize)
-                } else {
-                    Err(self.view.changed(depth + 1, first))
-                }
-            });
-        self.checked(first, 0)
+    fn counts_per_level(&self) -> Vec<LevelCounts> {
+        self.view.counts_per_level()
     }
 
-    fn block_codes(&self, depth: usize, first: usize) -> u32 {
-        // `2^K` divides 32: the block lies in one word.
-        let first = first as u64;
-        let block = if first.saturating_add(1 << K) <= self.view.level_nodes(depth) {
-            self.view.level_word(depth, first / 32)
-        } else {
-            Err(self.view.changed(depth, first))
-        };
-        let word = self.checked(block, 0) >> (2 * (first % 32));
-        let codes = (word & ((1u64 << (2 << K)) - 1)) as u32;
-        // A code 11 is no state: the bytes are not the file's any more.
-        if crate::tree::words::unused_mask(u64::from(codes)) != 0 {
-            let _ = self.failure.set(self.view.changed(depth, first));
-            return 0;
+    fn root_state(&self) -> Result<NodeState, KtreeFileError> {
+        self.view.checked_state(0, 0)
+    }
+
+    fn partial_rank(&self, depth: usize, index: usize) -> Result<usize, KtreeFileError> {
+        let index = index as u64;
+        let nodes = self.view.level_nodes(depth);
+        if index > nodes || depth >= self.view.depth_count() {
+            return Err(self.changed(depth, index));
         }
-        codes
+        if index == nodes {
+            // The rank of the level's end: that of its last node plus the last node's own.
+            let last = index.checked_sub(1).map_or(Ok(0), |i| {
+                let own = u64::from(self.view.checked_state(depth, i)? == NodeState::Partial);
+                Ok::<_, KtreeFileError>(self.view.partial_rank(depth, i)? + own)
+            })?;
+            return Ok(last as usize);
+        }
+        Ok(self.view.partial_rank(depth, index)? as usize)
+    }
+
+    fn first_child(&self, depth: usize, index: usize) -> Result<usize, KtreeFileError> {
+        // The node was read as partial from its parent's block: its children must be a whole block of
+        // the level below.
+        let index = index as u64;
+        if depth + 1 >= self.view.depth_count() {
+            return Err(self.changed(depth, index));
+        }
+        let first = self.view.partial_rank(depth, index)?.saturating_mul(1 << K);
+        if first.saturating_add(1 << K) > self.view.level_nodes(depth + 1) {
+            return Err(self.changed(depth + 1, first));
+        }
+        Ok(first as usize)
+    }
+
+    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, KtreeFileError> {
+        Ok(self.read(depth, first as u64, 1 << K)? as u32)
+    }
+
+    fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, KtreeFileError> {
+        self.read(depth, first as u64, n as u64)
     }
 }
+
+/// A [`MappedTree`] of the dimension its file names: the mapped twin of [`AnyTree`](crate::AnyTree). Run
+/// generic code on it with [`with_dim!`](crate::with_dim) (`with_dim!(&m, AnyMappedTree, t => …)`), or on
+/// either twin with [`with_tree!`](crate::with_tree).
+///
+/// ```
+/// use ktree::tree::storage::TreeStorage;
+/// use ktree::{io, with_dim, KTree};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("t.ktree");
+/// io::write_ktree_file(&path, &KTree::<3>::full(2).unwrap()).unwrap();
+/// let mapped = io::AnyMappedTree::open(&path).unwrap();
+/// assert_eq!(mapped.k(), 3);
+/// assert_eq!(with_dim!(&mapped, AnyMappedTree, t => t.voxel_count()), 64);
+/// ```
+#[derive(Debug, Clone)]
+pub enum AnyMappedTree {
+    /// A bintree.
+    K1(MappedTree<1>),
+    /// A quadtree.
+    K2(MappedTree<2>),
+    /// An octree.
+    K3(MappedTree<3>),
+    /// A 4-D tree.
+    K4(MappedTree<4>),
+}
+
+impl AnyMappedTree {
+    /// The tree of `view`, of the dimension its header names.
+    ///
+    /// # Errors
+    /// None in practice (the view's `K` was checked when it was opened); the signature matches
+    /// [`MappedTree::new`].
+    pub fn new(view: &KtreeView) -> Result<Self, KtreeFileError> {
+        Ok(match view.k() {
+            1 => Self::K1(MappedTree::new(view)?),
+            2 => Self::K2(MappedTree::new(view)?),
+            3 => Self::K3(MappedTree::new(view)?),
+            _ => Self::K4(MappedTree::new(view)?),
+        })
+    }
+
+    /// Opens, checks and maps the version 2 file `path` ([`KtreeView::open`]).
+    ///
+    /// # Errors
+    /// As [`KtreeView::open`].
+    pub fn open(path: &std::path::Path) -> Result<Self, KtreeFileError> {
+        Self::new(&KtreeView::open(path)?)
+    }
+
+    /// The view the tree is read through.
+    pub fn view(&self) -> &KtreeView {
+        crate::with_dim!(self, AnyMappedTree, t => t.view())
+    }
+
+    /// The dimension `K`.
+    pub fn k(&self) -> usize {
+        self.view().k()
+    }
+
+    /// The universe level `L`.
+    pub fn level(&self) -> u32 {
+        self.view().level()
+    }
+}
+
+crate::dim::from_typed!(MappedTree, AnyMappedTree);
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::rays::ball_rays;
     use crate::stacking::paper::stack;
+    use crate::tree::cursor::TryLeaves;
 
     /// A file rewritten in place (same inode) with a smaller, different tree after it was opened: walks
     /// and queries give errors naming offsets inside the file, never a panic.
@@ -212,16 +261,13 @@ mod tests {
         small.resize(len as usize, 0xFF);
         std::fs::write(&path, &small).unwrap();
         let mapped = MappedTree::<3>::new(&view).unwrap();
-        mapped.for_each_leaf(|_, _| {});
-        if let Err(e) = mapped.failure() {
+        let leaves = |m: &MappedTree<3>| TryLeaves::new(m).collect::<Result<Vec<_>, _>>();
+        if let Err(e) = leaves(&mapped) {
             assert!(e.offset().is_some_and(|o| o < len), "{e}");
         }
         std::fs::write(&path, vec![0xFF; len as usize]).unwrap();
         let mapped = MappedTree::<3>::new(&view).unwrap();
-        mapped.for_each_leaf(|_, _| {});
-        let e = mapped
-            .failure()
-            .expect_err("a changed file read without an error");
+        let e = leaves(&mapped).expect_err("a changed file read without an error");
         assert!(e.offset().is_some_and(|o| o < len), "{e}");
         assert!(e.to_string().contains("changed after it was opened"), "{e}");
         for p in [[0u32, 0, 0], [30, 33, 35], [63, 63, 63], [31, 40, 20]] {

@@ -10,7 +10,7 @@ mod writer;
 
 pub(crate) use check::read_v2_any;
 pub use layout::VERSION;
-pub use mapped::MappedTree;
+pub use mapped::{AnyMappedTree, MappedTree};
 pub(crate) use view::read_at;
 pub use view::KtreeView;
 pub(crate) use writer::write_levels;

@@ -2,6 +2,7 @@
 
 use std::fs::File;
 use std::path::Path;
+use std::sync::Arc;
 
 use super::super::{KtreeFileError, KtreeFileErrorKind};
 use super::check::check_bytes;
@@ -11,13 +12,13 @@ use crate::io::mmap::FileMap;
 use crate::space::{Cell, Universe};
 use crate::tree::{KTree, LevelCounts, NodeState, PackedStates};
 
-/// Where a view's bytes are.
-#[derive(Debug)]
+/// Where a view's bytes are (shared by the view's clones).
+#[derive(Debug, Clone)]
 enum Backing {
     /// A file, mapped whole.
-    Map(FileMap),
+    Map(Arc<FileMap>),
     /// Bytes in memory.
-    Bytes(Vec<u8>),
+    Bytes(Arc<[u8]>),
 }
 
 /// A read-only view of a `.ktree` version 2 file through a memory map: statistics, point queries and leaf
@@ -37,7 +38,7 @@ enum Backing {
 /// assert_eq!(view.counts(), tree.counts());
 /// assert!(view.contains([0u32, 0]).unwrap() && !view.contains([1u32, 0]).unwrap());
 /// ```
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct KtreeView {
     name: String,
     backing: Backing,
@@ -76,7 +77,7 @@ impl KtreeView {
         let map = FileMap::map(&file, 0, len_usize).map_err(|e| io_error(0, e))?;
         Ok(Self {
             name,
-            backing: Backing::Map(map),
+            backing: Backing::Map(Arc::new(map)),
             layout,
         })
     }
@@ -90,7 +91,7 @@ impl KtreeView {
         check_bytes(&layout, &bytes, name)?;
         Ok(Self {
             name: name.to_string(),
-            backing: Backing::Bytes(bytes),
+            backing: Backing::Bytes(bytes.into()),
             layout,
         })
     }
@@ -248,13 +249,11 @@ impl KtreeView {
     /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`; the failed read's error if the file
     /// was changed after it was opened.
     pub fn contains<const K: usize>(&self, point: [u32; K]) -> Result<bool, KtreeFileError> {
-        let tree = MappedTree::<K>::new(self)?;
-        let inside = crate::tree::storage::infallible(crate::query::contains(&tree, point));
-        tree.failure().map(|()| inside)
+        crate::query::contains(&MappedTree::<K>::new(self)?, point)
     }
 
     /// Visits every leaf (empty and full) in Morton (depth-first) order, as [`KTree::for_each_leaf`],
-    /// through the one walk over any storage ([`Leaves`](crate::tree::cursor::Leaves) over the map).
+    /// through the one walk over any storage ([`TryLeaves`](crate::tree::cursor::TryLeaves) over the map).
     ///
     /// # Errors
     /// [`KtreeFileErrorKind::Dimension`] if the file's `K` is not `K`; the first failed read's error if the
@@ -264,11 +263,11 @@ impl KtreeView {
         mut visit: impl FnMut(Cell<K>, NodeState),
     ) -> Result<(), KtreeFileError> {
         let tree = MappedTree::<K>::new(self)?;
-        for (cell, state) in crate::tree::cursor::Leaves::new(&tree) {
-            tree.failure()?;
+        for leaf in crate::tree::cursor::TryLeaves::new(&tree) {
+            let (cell, state) = leaf?;
             visit(cell, state);
         }
-        tree.failure()
+        Ok(())
     }
 
     /// Visits the full leaves in Morton order: the object's linear tree.
@@ -283,6 +282,19 @@ impl KtreeView {
             if state == NodeState::Full {
                 visit(cell)
             }
+        })
+    }
+
+    /// Loads the tree, of the dimension the file names, into memory.
+    ///
+    /// # Errors
+    /// A read error if the file was changed after it was opened.
+    pub fn to_any_tree(&self) -> Result<crate::AnyTree, KtreeFileError> {
+        Ok(match self.k() {
+            1 => self.to_tree::<1>()?.into(),
+            2 => self.to_tree::<2>()?.into(),
+            3 => self.to_tree::<3>()?.into(),
+            _ => self.to_tree::<4>()?.into(),
         })
     }
 
