@@ -89,6 +89,17 @@ pub mod space;
 pub mod stacking;
 pub mod tree;
 
+/// The traits every tree storage answers through, to `use ktree::prelude::*` at once: [`TreeStorage`]
+/// (the reads) and [`Query`] (the questions of [`query`]), so that a `.ktree` file read in place
+/// (`io::MappedTree`) answers the same calls as a tree in memory.
+///
+/// [`TreeStorage`]: crate::tree::storage::TreeStorage
+/// [`Query`]: crate::query::Query
+pub mod prelude {
+    pub use crate::query::Query;
+    pub use crate::tree::storage::TreeStorage;
+}
+
 pub use rays::{AnyRaySet, Ray, RaySet};
 pub use space::{max_level, Cell, Universe, MAX_K};
 pub use tree::{AnyTree, KTree, LevelCounts, NodeState, Octree, Quadtree};

@@ -113,6 +113,18 @@ pub trait TreeStorage<const K: usize> {
         slots_from_blocks::<K, _>(first, n, |at| self.block_codes(depth, at))
     }
 
+    /// The state of node `index` of level `depth`.
+    ///
+    /// # Errors
+    /// The storage's read error, for instance when the node is not in the level.
+    #[inline]
+    fn state(&self, depth: usize, index: usize) -> Result<NodeState, Self::Error> {
+        if depth == 0 {
+            return self.root_state();
+        }
+        Ok(NodeState::from_bits(self.slots(depth, index, 1)? as u32))
+    }
+
     /// The universe level `L`.
     #[inline]
     fn level(&self) -> u32 {
@@ -202,6 +214,11 @@ impl<const K: usize> TreeStorage<K> for KTree<K> {
     #[inline]
     fn root(&self) -> Result<NodeRef<K>, Infallible> {
         Ok(KTree::root(self))
+    }
+
+    #[inline(always)]
+    fn state(&self, depth: usize, index: usize) -> Result<NodeState, Infallible> {
+        Ok(KTree::state(self, depth, index))
     }
 
     #[inline(always)]
@@ -298,6 +315,10 @@ mod tests {
             for depth in 1..t.depth_count() {
                 let len = t.level_states(depth).len();
                 for first in 0..len {
+                    assert_eq!(
+                        TreeStorage::state(&b, depth, first),
+                        Ok(t.state(depth, first))
+                    );
                     for n in 1..=32.min(len - first) {
                         assert_eq!(
                             TreeStorage::slots(&b, depth, first, n),
