@@ -6,7 +6,7 @@ use crate::common::error::CliResult;
 use std::path::PathBuf;
 
 use ktree::io::{open_rays_file, RaysFile, RaysFileSource};
-use ktree::stacking::RaySource;
+use ktree::rays::RaySource;
 use ktree::{LevelCounts, RaySet};
 
 /// Arguments of `ktree build`.

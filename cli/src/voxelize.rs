@@ -13,9 +13,9 @@ use std::path::{Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
 use ktree::io::{voxel_source, voxelize, Format, ReadOptions, VoxelSource};
+use ktree::rays::{RaySource, SlabRuns};
 use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
-use ktree::stacking::{RaySource, SlabRuns};
 use ktree::{LevelCounts, Universe};
 
 use crate::common::output::{is_tree_file, write_output};

@@ -345,7 +345,7 @@ impl VoxelSource {
 }
 
 #[cfg(any(feature = "mesh", feature = "volume"))]
-impl crate::stacking::RaySource<3> for VoxelSource {
+impl crate::rays::RaySource<3> for VoxelSource {
     type Error = std::convert::Infallible;
 
     fn universe(&self) -> crate::Universe<3> {
@@ -360,7 +360,7 @@ impl crate::stacking::RaySource<3> for VoxelSource {
     fn slab(
         &self,
         x: std::ops::Range<u32>,
-    ) -> Result<crate::stacking::SlabRuns<'_>, std::convert::Infallible> {
+    ) -> Result<crate::rays::SlabRuns<'_>, std::convert::Infallible> {
         match self {
             #[cfg(feature = "mesh")]
             Self::Mesh(m) => m.slab(x),

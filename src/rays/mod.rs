@@ -17,6 +17,7 @@ mod ball;
 mod csg;
 mod rayset;
 mod rows;
+pub mod source;
 mod split;
 
 pub use any::AnyRaySet;
@@ -24,3 +25,4 @@ pub use ball::ball_rays;
 pub use csg::CsgError;
 pub use rayset::{ColumnGroups, Normal, Ray, RayError, RaySet};
 pub use rows::{maximal_rows, MaximalRows, Row};
+pub use source::{RaySource, SlabRuns};

@@ -46,9 +46,10 @@ use std::path::Path;
 
 use super::SolidError;
 use crate::radix::radix_sort;
+use crate::rays::source::default_split_depth;
 use crate::rays::RaySet;
+use crate::rays::{RaySource, SlabRuns};
 use crate::space::Universe;
-use crate::stacking::{default_split_depth, RaySource, SlabRuns};
 
 /// Bits of sub-voxel precision of placed vertices.
 const FRAC: u32 = 16;

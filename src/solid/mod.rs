@@ -40,8 +40,8 @@ use std::borrow::Cow;
 use std::ops::Range;
 
 use crate::rays::RaySet;
+use crate::rays::{RaySource, SlabRuns};
 use crate::space::Universe;
-use crate::stacking::{RaySource, SlabRuns};
 
 /// The most runs a quadric or a box generates (about 1.5 GiB of rays); beyond it the generator stops with
 /// [`SolidError::TooManyRays`] instead of exhausting memory.

@@ -28,8 +28,8 @@ use serde::Deserialize;
 
 use super::SolidError;
 use crate::rays::RaySet;
+use crate::rays::{RaySource, SlabRuns};
 use crate::space::Universe;
-use crate::stacking::{RaySource, SlabRuns};
 
 /// Which samples are inside.
 #[derive(Debug, Clone, Copy, PartialEq)]

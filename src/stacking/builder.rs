@@ -20,8 +20,9 @@ use super::out_of_core::{
     build_slabs, slab_cost, stack_part, stack_to_file, BuildError, OutOfCore, OutOfCoreReport,
     Progress, SpilledPart,
 };
-use super::partition::{default_split_depth, stack_source, RaySource};
+use super::partition::{default_split_depth, stack_source};
 use crate::rays::RaySet;
+use crate::rays::RaySource;
 use crate::tree::KTree;
 
 /// How each cell the object's boundary passes through is stacked (the tree is the same either way).

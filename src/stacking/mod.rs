@@ -102,4 +102,4 @@ pub use builder::{Builder, CellStacking};
 pub use out_of_core::{
     balanced_parts, BuildError, OutOfCoreReport, Progress, SpilledPart, Stage, MAX_PARTS,
 };
-pub use partition::{default_split_depth, RaySource, SlabRuns};
+pub use partition::default_split_depth;

@@ -11,8 +11,9 @@ use ktree::fs::SpillError;
 use std::path::Path;
 
 use ktree::io::write_ktree;
+use ktree::rays::RaySource;
 use ktree::reference::{Dim, Fanout, NaiveTree};
-use ktree::stacking::{balanced_parts, paper::stack, BuildError, Builder, RaySource};
+use ktree::stacking::{balanced_parts, paper::stack, BuildError, Builder};
 use ktree::RaySet;
 use ktree_verify::cases::{ray_sets, Case};
 use proptest::prelude::*;

@@ -7,9 +7,10 @@ use ktree::io::{
     open_rays_file, read_rays_file, write_ktree, write_rays, write_rays_file, AnyRaysFileSource,
     RaysFile, RaysFileSource,
 };
+use ktree::rays::RaySource;
 use ktree::solid::mesh::{MeshSource, MeshTransform, TriangleMesh};
 use ktree::solid::volume::{Select, Volume, VolumeSource};
-use ktree::stacking::{paper::stack, Builder, RaySource};
+use ktree::stacking::{paper::stack, Builder};
 use ktree::AnyRaySet;
 use ktree::{Ray, RaySet};
 use ktree_verify::cases::{self, ray_sets, Case};

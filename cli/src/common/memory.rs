@@ -16,7 +16,8 @@ use ktree::fs::SpillError;
 use std::path::{Path, PathBuf};
 
 use crate::common::progress::report_progress;
-use ktree::stacking::{BuildError, Builder, OutOfCoreReport, RaySource};
+use ktree::rays::RaySource;
+use ktree::stacking::{BuildError, Builder, OutOfCoreReport};
 use ktree::{LevelCounts, RaySet};
 
 /// The share of the machine's memory used when no `--max-memory` is given: a half.

@@ -29,7 +29,8 @@
 
 use std::path::Path;
 
-use ktree::stacking::{OutOfCoreReport, RaySource};
+use ktree::rays::RaySource;
+use ktree::stacking::OutOfCoreReport;
 
 use crate::common::memory::BuildArgs;
 

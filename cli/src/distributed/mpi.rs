@@ -10,7 +10,8 @@ use rayon::prelude::*;
 
 use super::{Ranks, STOPPED};
 use crate::common::memory::BuildArgs;
-use ktree::stacking::{balanced_parts, OutOfCoreReport, RaySource};
+use ktree::rays::RaySource;
+use ktree::stacking::{balanced_parts, OutOfCoreReport};
 
 /// Keeps MPI initialised; finalises it when dropped.
 pub struct Guard {

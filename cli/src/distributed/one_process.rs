@@ -2,7 +2,8 @@
 
 use super::Ranks;
 use crate::common::memory::BuildArgs;
-use ktree::stacking::{OutOfCoreReport, RaySource};
+use ktree::rays::RaySource;
+use ktree::stacking::OutOfCoreReport;
 use std::path::Path;
 
 /// Nothing to hold without MPI.

@@ -8,8 +8,9 @@
 use std::fmt::Write as _;
 
 use ktree::io::KtreeView;
+use ktree::rays::RaySource;
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{default_split_depth, paper::stack, Builder, RaySource};
+use ktree::stacking::{default_split_depth, paper::stack, Builder};
 use ktree::LevelCounts;
 
 use crate::measure::{best_of, machine_line, results_path, run_child, Measured};

@@ -14,9 +14,10 @@ use ktree::io::{
     open_rays_file, read_rays_file, voxel_source, voxelize, write_rays_source, AnyRaysFileSource,
     RaysFile, ReadOptions,
 };
+use ktree::rays::RaySource;
 use ktree::solid::volume::Select;
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
-use ktree::stacking::{default_split_depth, Builder, RaySource};
+use ktree::stacking::{default_split_depth, Builder};
 use ktree::AnyRaySet;
 
 use crate::measure::{machine_line, results_path, run_child};

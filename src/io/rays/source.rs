@@ -31,8 +31,8 @@ use std::path::{Path, PathBuf};
 use super::text::{read_header, read_rays_file, NumberedLines, RaysTextError, RaysTextErrorKind};
 use crate::rays::AnyRaySet;
 use crate::rays::Ray;
+use crate::rays::{RaySource, SlabRuns};
 use crate::space::Universe;
-use crate::stacking::{RaySource, SlabRuns};
 
 /// A ray file opened by [`open_rays_file`].
 #[derive(Debug, Clone)]

@@ -17,9 +17,9 @@ use std::path::Path;
 use thiserror::Error;
 
 use crate::rays::AnyRaySet;
+use crate::rays::RaySource;
 use crate::rays::{Normal, Ray, RayError, RaySet};
 use crate::space::{max_level, MAX_K};
-use crate::stacking::RaySource;
 
 /// What was wrong with a ray file.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]

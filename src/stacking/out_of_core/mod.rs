@@ -16,8 +16,8 @@ pub use progress::{Progress, Stage};
 use std::fmt::Display;
 use std::path::{Path, PathBuf};
 
-use super::partition::RaySource;
 use super::CellStacking;
+use crate::rays::RaySource;
 use crate::tree::LevelCounts;
 
 /// How an out-of-core build runs (set through [`Builder`](super::Builder)).

@@ -19,8 +19,9 @@ use super::{OutOfCore, OutOfCoreReport};
 use crate::fs::write_atomic_with;
 use crate::io::spill::LevelFile;
 use crate::io::KtreeWriter;
+use crate::rays::RaySource;
 use crate::stacking::cells::{CellBlock, CellStates};
-use crate::stacking::partition::{slab_pieces, Piece, RaySource};
+use crate::stacking::partition::{slab_pieces, Piece};
 use crate::tree::NodeState;
 
 /// What came of one slab in a round of slabs run at once.

@@ -30,9 +30,9 @@ use std::path::{Path, PathBuf};
 use super::lists::{combine_or_split, half_offsets, pack_key, unpack_key, Cells};
 use super::StackingStats;
 use crate::radix::radix_sort;
+use crate::rays::RaySource;
 use crate::rays::{maximal_rows, RaySet};
 use crate::space::morton_encode;
-use crate::stacking::partition::RaySource;
 use crate::tree::KTree;
 
 /// What the file lists did.
