@@ -2,8 +2,9 @@
 //! Debian's `pyopenvdb` reads it as a `FloatGrid` of class level set with the band's values, and OpenVDB's
 //! `tools::sdfInteriorMask` (C++, `vdb_level_set_check.cpp` here built against `libopenvdb-dev`) gives back
 //! the tree's voxels — and level sets read back: ktree's own, and OpenVDB's (written by `pyopenvdb` and
-//! rewritten by the C++ check with each compression) as their interior. A test whose tool is missing prints
-//! a visible `SKIPPED:` line and passes.
+//! rewritten by the C++ check with each compression) as their interior. A test whose tool is missing (Debian's
+//! `python3-openvdb`, or `g++` and `libopenvdb-dev`) prints a visible `SKIPPED:` line and passes, or fails
+//! under `KTREE_REQUIRE_TOOLS=1`, as `.ci/run` sets it (`common::tools`).
 
 mod common;
 
@@ -11,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use common::ktree;
+use common::{ktree, run_openvdb, tools};
 use ktree::io::{write_tree, WriteOptions};
 use ktree::rays::ball_rays;
 use ktree::{AnyTree, KTree, Ray, RaySet};
@@ -35,29 +36,11 @@ fn write(dir: &Path, name: &str, tree: &KTree<3>) -> String {
     path.display().to_string()
 }
 
-/// Runs `/usr/bin/python3` with OpenVDB's module on `script`; `None` (after a visible line) without it.
-fn pyopenvdb(script: &str) -> Option<String> {
-    let probe = Command::new("/usr/bin/python3")
-        .args(["-c", "import pyopenvdb"])
-        .output();
-    if !matches!(probe, Ok(ref o) if o.status.success()) {
-        println!("SKIPPED: python3-openvdb not installed (module pyopenvdb for /usr/bin/python3)");
-        return None;
-    }
-    let out = Command::new("/usr/bin/python3")
-        .args(["-c", script])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    Some(String::from_utf8(out.stdout).unwrap())
-}
-
 #[test]
 fn pyopenvdb_reads_the_level_set_with_the_band_values() {
+    let Some(python) = tools::require_python_openvdb() else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     for (name, tree) in objects() {
         let (band, size) = (2.5, 0.25);
@@ -91,15 +74,13 @@ fn pyopenvdb_reads_the_level_set_with_the_band_values() {
             .map(|p| format!("({},{},{})", p[0], p[1], p[2]))
             .collect();
         let script = format!(
-            "import pyopenvdb as vdb\ng = vdb.read({:?}, 'ktree')\na = g.getConstAccessor()\n\
+            "g = vdb.read({:?}, 'ktree')\na = g.getConstAccessor()\n\
              print(type(g).__name__, g.gridClass, g.background, g.activeVoxelCount(), g.transform.voxelSize()[0])\n\
              for p in [{}]:\n    print(repr(a.getValue(p)), int(a.isValueOn(p)))",
             out.display().to_string(),
             list.join(",")
         );
-        let Some(text) = pyopenvdb(&script) else {
-            return;
-        };
+        let text = run_openvdb(&python, &script);
         let mut lines = text.lines();
         let head: Vec<&str> = lines.next().unwrap().split_whitespace().collect();
         assert_eq!(head[0], "FloatGrid");
@@ -123,39 +104,40 @@ fn pyopenvdb_reads_the_level_set_with_the_band_values() {
     }
 }
 
-/// Builds `vdb_level_set_check` against the installed OpenVDB into `dir`, or says why it cannot. Built once
-/// a test run: the tests running side by side share the program.
+/// Builds `vdb_level_set_check` against the installed OpenVDB into `dir`; `None` after [`tools::missing`]
+/// without `g++` or OpenVDB's headers. Built once a test run: the tests running side by side share the
+/// program.
+///
+/// # Panics
+/// If it does not build with both there.
 fn level_set_check(dir: &Path) -> Option<PathBuf> {
-    static BUILT: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    let compiler = tools::require(&["g++"], "install g++")?;
+    if !tools::require_file(
+        Path::new("/usr/include/openvdb/openvdb.h"),
+        "install Debian's libopenvdb-dev (OpenVDB's headers and library)",
+    ) {
+        return None;
+    }
+    static BUILT: OnceLock<PathBuf> = OnceLock::new();
     let built = BUILT.get_or_init(|| {
-        if !Path::new("/usr/include/openvdb/openvdb.h").exists() {
-            return Err("libopenvdb-dev not installed (OpenVDB's headers)".into());
-        }
         let exe = dir.join("vdb_level_set_check");
         let src =
             PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/interop/vdb_level_set_check.cpp");
-        let built = Command::new("g++")
+        let built = Command::new(compiler)
             .args(["-std=c++17", "-O1", "-o"])
             .arg(&exe)
             .arg(&src)
             .args(["-lopenvdb", "-ltbb", "-lImath"])
-            .output();
-        match built {
-            Ok(o) if o.status.success() => Ok(exe),
-            Ok(o) => panic!(
-                "vdb_level_set_check does not build: {}",
-                String::from_utf8_lossy(&o.stderr)
-            ),
-            Err(e) => Err(format!("g++ not found ({e})")),
-        }
+            .output()
+            .unwrap();
+        assert!(
+            built.status.success(),
+            "vdb_level_set_check does not build: {}",
+            String::from_utf8_lossy(&built.stderr)
+        );
+        exe
     });
-    match built {
-        Ok(exe) => Some(exe.clone()),
-        Err(why) => {
-            println!("SKIPPED: {why}");
-            None
-        }
-    }
+    Some(built.clone())
 }
 
 #[test]
@@ -325,6 +307,9 @@ fn check_voxels(report: &str) -> Vec<[i64; 3]> {
 
 #[test]
 fn level_sets_written_by_openvdb_read_as_their_interior() {
+    let Some(python) = tools::require_python_openvdb() else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     // Two boxes of known voxels (faces halfway between voxel centres, far enough apart for their bands not
     // to meet: OpenVDB then signs a few voxels between them as inside) and a sphere, as pyopenvdb makes
@@ -348,7 +333,7 @@ fn level_sets_written_by_openvdb_read_as_their_interior() {
     let d = |n: &str| dir.path().join(n);
     let script = format!(
         r#"
-import numpy as np, pyopenvdb as vdb
+import numpy as np
 points, quads = [], []
 for lo, hi in [{boxes}]:
     b = len(points)
@@ -375,9 +360,7 @@ for name, g in grids.items():
         boxes = box_list.join(", "),
         dir = dir.path().display().to_string(),
     );
-    let Some(text) = pyopenvdb(&script) else {
-        return;
-    };
+    let text = run_openvdb(&python, &script);
     let mut files = Vec::new();
     for line in text.lines() {
         let w: Vec<&str> = line.split_whitespace().collect();

@@ -1,44 +1,49 @@
 //! Interoperability checked against the real tools, not against our own reading of their formats: OctoMap
-//! (Debian `octomap-tools`, `liboctomap-dev`, and `octomap_check.cpp` here built against it) for `.bt` and
-//! binvox. A test whose tool is missing prints a visible `SKIPPED:` line and passes; `.ci/run` installs them.
+//! (Debian `octomap-tools`, `liboctomap-dev`, and `octomap_check.cpp` here built against it with `g++`) for
+//! `.bt` and binvox, OpenVDB's Python module (Debian `python3-openvdb`) for `.vdb`. A test whose tool is
+//! missing prints a visible `SKIPPED:` line and passes, or fails under `KTREE_REQUIRE_TOOLS=1`, which
+//! `.ci/run` sets after installing them (`common::tools`).
 
 mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use common::{data_dir, ktree};
+use common::{data_dir, ktree, run_openvdb, tools};
 use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
 use ktree::stacking::paper::stack;
 use ktree::AnyTree;
 use ktree::{KTree, NodeState};
 
-/// Builds `octomap_check` against the installed OctoMap into `dir`, or says why it cannot.
+/// Builds `octomap_check` against the installed OctoMap into `dir`; `None` after [`tools::missing`] without
+/// `g++` or OctoMap's headers.
+///
+/// # Panics
+/// If it does not build with both there.
 fn octomap_check(dir: &Path) -> Option<PathBuf> {
+    let compiler = tools::require(&["g++"], "install g++")?;
+    if !tools::require_file(
+        Path::new("/usr/include/octomap/octomap.h"),
+        "install Debian's liboctomap-dev (OctoMap's headers and library)",
+    ) {
+        return None;
+    }
     let exe = dir.join("octomap_check");
     let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/interop/octomap_check.cpp");
-    let built = Command::new("g++")
+    let built = Command::new(compiler)
         .args(["-O1", "-o"])
         .arg(&exe)
         .arg(&src)
         .args(["-loctomap", "-loctomath"])
-        .output();
-    match built {
-        Ok(o) if o.status.success() => Some(exe),
-        _ => {
-            println!("SKIPPED: octomap-tools not installed (g++ and liboctomap-dev are needed)");
-            None
-        }
-    }
-}
-
-fn has_binvox2bt() -> bool {
-    let found = Command::new("binvox2bt").output().is_ok();
-    if !found {
-        println!("SKIPPED: octomap-tools not installed (binvox2bt)");
-    }
-    found
+        .output()
+        .unwrap();
+    assert!(
+        built.status.success(),
+        "octomap_check does not build: {}",
+        String::from_utf8_lossy(&built.stderr)
+    );
+    Some(exe)
 }
 
 /// The occupied (`"leaf"`) or free leaves OctoMap reads from a file: (grid index of the corner, side).
@@ -191,9 +196,9 @@ fn a_bt_written_by_octomap_reads_into_ktree_with_the_same_voxels() {
 #[test]
 fn a_binvox_written_by_ktree_reads_in_binvox2bt_and_comes_back() {
     let dir = tempfile::tempdir().unwrap();
-    if !has_binvox2bt() {
+    let Some(binvox2bt) = tools::require(&["binvox2bt"], "install Debian's octomap-tools") else {
         return;
-    }
+    };
     for (name, tree) in objects() {
         if tree.root_state() == NodeState::Empty {
             continue; // binvox2bt writes no file for an empty grid
@@ -201,7 +206,7 @@ fn a_binvox_written_by_ktree_reads_in_binvox2bt_and_comes_back() {
         let vox = dir.path().join(format!("{name}.binvox"));
         let bt = dir.path().join(format!("{name}_binvox2bt.bt"));
         write_tree(&vox, &AnyTree::K3(tree.clone()), &WriteOptions::default()).unwrap();
-        let out = Command::new("binvox2bt")
+        let out = Command::new(&binvox2bt)
             .arg("-o")
             .arg(&bt)
             .arg(&vox)
@@ -260,29 +265,11 @@ fn convert_goes_through_every_format_and_back() {
     assert!(!ok && err.contains("bad.binvox: byte"), "{err}");
 }
 
-/// Runs `/usr/bin/python3` with OpenVDB's module on `script`; `None` (after a visible line) without it.
-fn pyopenvdb(script: &str) -> Option<String> {
-    let probe = Command::new("/usr/bin/python3")
-        .args(["-c", "import pyopenvdb"])
-        .output();
-    if !matches!(probe, Ok(ref o) if o.status.success()) {
-        println!("SKIPPED: python3-openvdb not installed (module pyopenvdb for /usr/bin/python3)");
-        return None;
-    }
-    let out = Command::new("/usr/bin/python3")
-        .args(["-c", script])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    Some(String::from_utf8(out.stdout).unwrap())
-}
-
 #[test]
 fn a_vdb_written_by_ktree_opens_in_openvdb_with_the_same_voxels_and_box() {
+    let Some(python) = tools::require_python_openvdb() else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     for (name, tree) in objects() {
         for offset in [[0, 0, 0], [20, -7, 3]] {
@@ -293,13 +280,11 @@ fn a_vdb_written_by_ktree_opens_in_openvdb_with_the_same_voxels_and_box() {
             };
             write_tree(&path, &AnyTree::K3(tree.clone()), &options).unwrap();
             let script = format!(
-                "import pyopenvdb as vdb\ng = vdb.read({:?}, 'ktree')\nprint(type(g).__name__, g.activeVoxelCount(), \
+                "g = vdb.read({:?}, 'ktree')\nprint(type(g).__name__, g.activeVoxelCount(), \
                  *g.evalActiveVoxelBoundingBox()[0], *g.evalActiveVoxelBoundingBox()[1])",
                 path.display().to_string()
             );
-            let Some(out) = pyopenvdb(&script) else {
-                return;
-            };
+            let out = run_openvdb(&python, &script);
             let w: Vec<&str> = out.split_whitespace().collect();
             assert_eq!(w[0], "BoolGrid");
             assert_eq!(w[1], tree.voxel_count().to_string(), "{name}");
@@ -329,6 +314,9 @@ fn a_vdb_written_by_ktree_opens_in_openvdb_with_the_same_voxels_and_box() {
 
 #[test]
 fn a_vdb_written_by_openvdb_reads_into_ktree_with_the_same_voxels() {
+    let Some(python) = tools::require_python_openvdb() else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     for (name, tree) in objects() {
         // The full voxels at OpenVDB index = voxel − 9 (negative indices included), written by pyopenvdb
@@ -346,13 +334,11 @@ fn a_vdb_written_by_openvdb_reads_into_ktree_with_the_same_voxels() {
         }
         let path = dir.path().join(format!("{name}_openvdb.vdb"));
         let script = format!(
-            "import pyopenvdb as vdb\ng = vdb.BoolGrid()\ng.name = 'g'\na = g.getAccessor()\nfor p in [{voxels}]:\n    \
+            "g = vdb.BoolGrid()\ng.name = 'g'\na = g.getAccessor()\nfor p in [{voxels}]:\n    \
              a.setValueOn(p, True)\ng.prune()\nvdb.write({:?}, grids=[g])\nprint(g.activeVoxelCount())",
             path.display().to_string()
         );
-        let Some(out) = pyopenvdb(&script) else {
-            return;
-        };
+        let out = run_openvdb(&python, &script);
         assert_eq!(out.trim(), tree.voxel_count().to_string());
         let options = ReadOptions {
             level: Some(tree.level()),

@@ -1,11 +1,14 @@
 """The Python module checked against numpy references: dense arrays, Booleans, node counts by pooling, mass
-by sums, transforms by array shifts and rotations, files by round trips, and the CLI's JSON keys."""
+by sums, transforms by array shifts and rotations, files by round trips, and the CLI's JSON keys. A test whose
+tool is missing (the `ktree` binary, `setpriv` as root) is skipped, or fails when the environment variable
+KTREE_REQUIRE_TOOLS is set to anything but empty or 0, as `.ci/run` sets it (see `missing`)."""
 
 import json
 import os
 import shutil
 import struct
 import subprocess
+import sys
 import zlib
 from fractions import Fraction
 from pathlib import Path
@@ -28,6 +31,15 @@ def random_object(rng, k, level, density=0.5):
         start = rng.integers(0, side // block, size=k) * block
         a[tuple(slice(s, s + block) for s in start)] = rng.random() < 0.7
     return a
+
+
+def missing(needed, install):
+    """A test without something it needs: fails, saying what to install, when KTREE_REQUIRE_TOOLS is set to
+    anything but empty or 0 (as `.ci/run` sets it); otherwise skips."""
+    message = f"needs {needed}: {install}"
+    if os.environ.get("KTREE_REQUIRE_TOOLS", "") not in ("", "0"):
+        pytest.fail(f"{message} (KTREE_REQUIRE_TOOLS is set: a missing tool is an error; unset it to skip)")
+    pytest.skip(message)
 
 
 def whole(t):
@@ -440,8 +452,7 @@ def test_mesh_file_equals_mesh_arrays(tmp_path):
 
 def test_real_mesh_from_data_folder():
     meshes = sorted((ROOT / "data" / "meshes").glob("*.obj")) + sorted((ROOT / "data" / "meshes").glob("*.stl"))
-    if not meshes:
-        pytest.skip("no mesh in data/meshes")
+    assert meshes, f"no mesh in {ROOT / 'data' / 'meshes'} (the meshes are part of the repository)"
     t = ktree.Tree.from_mesh(str(meshes[0]), 6)
     assert t.k == 3 and t.voxel_count > 0
     assert t.render(width=32, height=32).shape == (32, 32, 3)
@@ -523,20 +534,22 @@ def test_every_format_saves_and_loads_the_same_tree(tmp_path):
 
 
 def cli():
-    """The `ktree` binary: $KTREE_BIN, else one built in the workspace's target folder, else None."""
+    """The `ktree` binary: $KTREE_BIN, else one built in the workspace's target folder, else one on the PATH;
+    without one, `missing`."""
     if os.environ.get("KTREE_BIN"):
         return os.environ["KTREE_BIN"]
     for profile in ("release", "debug"):
         path = ROOT / "target" / profile / "ktree"
         if path.exists():
             return str(path)
-    return shutil.which("ktree")
+    found = shutil.which("ktree")
+    if found is None:
+        missing("the ktree binary", "build it (cargo build -p ktree-cli) or set KTREE_BIN to it")
+    return found
 
 
 def run_json(*args):
     binary = cli()
-    if binary is None:
-        pytest.skip("no ktree binary (set KTREE_BIN)")
     out = subprocess.run([binary, *map(str, args), "--json"], check=True, capture_output=True, text=True)
     return json.loads(out.stdout)
 
@@ -583,8 +596,6 @@ def read_png_rgb(path):
 
 def test_render_equals_the_cli_image(tmp_path):
     binary = cli()
-    if binary is None:
-        pytest.skip("no ktree binary (set KTREE_BIN)")
     t = ktree.Tree.from_dense(ball(5, 9)) - ktree.Tree.from_dense(ball(5, 6)).translate([6, 0, 4])
     t.save(tmp_path / "t.ktree")
     for view in ("iso", "front"):
@@ -671,15 +682,45 @@ def test_a_missing_file_raises_file_not_found_with_its_name(tmp_path, name):
     assert name in str(caught.value)
 
 
-@pytest.mark.skipif(os.geteuid() == 0, reason="root reads files whatever their mode")
+LOAD_ERROR = """
+import json, sys, ktree
+try:
+    ktree.Tree.load(sys.argv[1])
+    print(json.dumps(["loaded", None]))
+except Exception as e:
+    print(json.dumps([type(e).__name__, getattr(e, "filename", None)]))
+"""
+
+
+def load_error(path):
+    """What `Tree.load(path)` raises: (the exception's type name, its filename). Root reads files whatever
+    their mode, so as root the load runs in a child process still root but without the capabilities that
+    let it (CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH, dropped by util-linux's `setpriv`)."""
+    if os.geteuid() != 0:
+        try:
+            ktree.Tree.load(path)
+        except Exception as e:
+            return type(e).__name__, getattr(e, "filename", None)
+        return "loaded", None
+    setpriv = shutil.which("setpriv")
+    if setpriv is None:
+        missing("setpriv to drop root's file capabilities", "install util-linux")
+    caps = "-dac_override,-dac_read_search"
+    out = subprocess.run(
+        [setpriv, f"--inh-caps={caps}", f"--bounding-set={caps}", "--", sys.executable, "-c", LOAD_ERROR, path],
+        capture_output=True,
+        text=True,
+    )
+    assert out.returncode == 0, out.stderr
+    return tuple(json.loads(out.stdout))
+
+
 @pytest.mark.parametrize("name", ["locked.ktree", "locked.vdb", "locked.bt"])
 def test_an_unreadable_file_raises_permission_error(tmp_path, name):
     path = tmp_path / name
     ktree.Tree.from_dense(np.ones((2, 2, 2), dtype=bool)).save(str(path))
     path.chmod(0)
-    with pytest.raises(PermissionError) as caught:
-        ktree.Tree.load(str(path))
-    assert caught.value.filename == str(path)
+    assert load_error(str(path)) == ("PermissionError", str(path))
 
 
 def test_saving_into_a_file_in_place_of_a_folder_raises_an_os_error(tmp_path):

@@ -1,8 +1,9 @@
 //! Interop: a sphere, two real meshes and the CT skull written as `.ktree`, OctoMap `.bt`, OpenVDB `.vdb` and
 //! binvox; file sizes side by side, each file read back by ktree, and each checked by the real tool where it
 //! is installed: OctoMap's `convert_octree` reads ktree's `.bt` and writes it again, and ktree reads that back;
-//! `binvox2bt` turns ktree's binvox into a `.bt` that ktree reads back; OpenVDB's Python module counts the
-//! active voxels of ktree's `.vdb`. Writes `results/interop.md`.
+//! `binvox2bt` turns ktree's binvox into a `.bt` that ktree reads back; OpenVDB's Python module (in the
+//! interpreter `ktree_verify::tools::PythonOpenVdb::find` finds: `KTREE_PYTHON_OPENVDB`, else `python3` or
+//! `/usr/bin/python3`) counts the active voxels of ktree's `.vdb`. Writes `results/interop.md`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -13,6 +14,7 @@ use ktree::rays::ball_rays;
 use ktree::solid::volume::Select;
 use ktree::stacking::paper::stack;
 use ktree::AnyTree;
+use ktree_verify::tools::{find_program, PythonOpenVdb};
 
 const LEVEL: u32 = 8;
 
@@ -48,10 +50,7 @@ fn objects() -> Result<Vec<(String, AnyTree)>, String> {
 }
 
 fn have(command: &str) -> bool {
-    Command::new("sh")
-        .args(["-c", &format!("command -v {command}")])
-        .output()
-        .is_ok_and(|o| o.status.success())
+    find_program(&[command]).is_some()
 }
 
 /// Runs a command; whether it succeeded.
@@ -66,22 +65,21 @@ fn same(path: &Path, tree: &AnyTree) -> bool {
     read_tree(path, &ReadOptions::default()).is_ok_and(|t| &t == tree)
 }
 
-fn vdb_active_voxels(path: &Path) -> Option<u128> {
-    let script = "import sys, pyopenvdb as v; print(v.read(sys.argv[1], v.readAllGridMetadata(sys.argv[1])[0].name).activeVoxelCount())";
-    let out = Command::new("/usr/bin/python3")
-        .args(["-c", script])
-        .arg(path)
-        .output()
-        .ok()?;
-    String::from_utf8_lossy(&out.stdout).trim().parse().ok()
+fn vdb_active_voxels(python: &PythonOpenVdb, path: &Path) -> Option<u128> {
+    let script = "import sys\nprint(vdb.read(sys.argv[1], vdb.readAllGridMetadata(sys.argv[1])[0].name).activeVoxelCount())";
+    let out = python.run(script, &[path.as_os_str()]).ok()?;
+    out.trim().parse().ok()
 }
 
 /// Writes the report; returns its path.
 pub fn report() -> Result<String, String> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
-    let (octomap, binvox2bt, openvdb) =
-        (have("convert_octree"), have("binvox2bt"), have_pyopenvdb());
+    let (octomap, binvox2bt, openvdb) = (
+        have("convert_octree"),
+        have("binvox2bt"),
+        PythonOpenVdb::find().ok(),
+    );
     let mut md = String::from(
         "# Interop: the same objects in four formats\n\nRegenerate with `cargo run --release --example perf -- interop`. \
          Each object is written by `ktree::io` in every format and read back by ktree (\"read back\" = the same tree, \
@@ -123,8 +121,8 @@ pub fn report() -> Result<String, String> {
                 if ok { "same" } else { "DIFFERS" }
             ));
         }
-        if openvdb {
-            let ok = vdb_active_voxels(&paths[2]) == Some(t.voxel_count());
+        if let Some(python) = &openvdb {
+            let ok = vdb_active_voxels(python, &paths[2]) == Some(t.voxel_count());
             tools.push(format!(
                 "pyopenvdb active voxels: {}",
                 if ok { "same" } else { "DIFFER" }
@@ -149,11 +147,4 @@ pub fn report() -> Result<String, String> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/interop.md");
     ktree::fs::write_atomic(&path, md.as_bytes()).map_err(|e| e.to_string())?;
     Ok("results/interop.md".into())
-}
-
-fn have_pyopenvdb() -> bool {
-    Command::new("/usr/bin/python3")
-        .args(["-c", "import pyopenvdb"])
-        .output()
-        .is_ok_and(|o| o.status.success())
 }
