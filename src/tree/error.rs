@@ -74,6 +74,29 @@ pub enum TreeError {
         /// The children's common state.
         state: NodeState,
     },
+    /// A valued tree's node with children whose children could be one leaf (all empty, or all full of one
+    /// value), or whose code does not fit its children (a partial node all of whose voxels hold values, a
+    /// mixed node with an empty voxel).
+    #[error("not minimal: node {index} of level {depth} does not fit its children")]
+    NotMinimal {
+        /// The node's level.
+        depth: usize,
+        /// Its index in the level.
+        index: usize,
+    },
+    /// A level of a valued tree holds another number of values than of full nodes.
+    #[error("level {depth} has {full} full nodes but {values} values")]
+    ValueCount {
+        /// The level.
+        depth: usize,
+        /// Its full nodes.
+        full: usize,
+        /// Its values.
+        values: usize,
+    },
+    /// A value no voxel may hold.
+    #[error(transparent)]
+    Value(super::value::ValueError),
     /// A cell belongs to a universe of another level.
     #[error("cell {index} belongs to a level-{found} universe, not level {expected}")]
     CellUniverse {

@@ -4,6 +4,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::cursor::Leaves;
 use super::states::{node_out_of_range, NodeState, PackedStates};
+use super::valued::LevelValues;
+use super::value::Value;
 use super::TreeError;
 
 use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
@@ -83,26 +85,37 @@ impl LevelCounts {
 /// assert!((&a | &KTree::<1>::full(3)?).is_err()); // another universe
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
+///
+/// # Values
+/// `KTree<K, V>` with a [`Value`] type `V` other than `()` is a *valued* tree: every voxel is empty or
+/// holds a value of type `V` (a label, a density, a colour), full nodes hold one value each and nodes whose
+/// voxels all hold values, not all equal, have the code `11` (see [`crate::tree::valued`]). `KTree<K>` is
+/// `KTree<K, ()>`: no value column, the same bits and speed.
 #[derive(Debug, Clone)]
-pub struct KTree<const K: usize> {
-    universe: Universe<K>,
-    levels: Vec<PackedStates>,
+pub struct KTree<const K: usize, V: Value = ()> {
+    pub(crate) universe: Universe<K>,
+    pub(crate) levels: Vec<PackedStates>,
+    /// The values of each level's full nodes, with their rank index; empty when `V` is `()`.
+    pub(crate) values: Vec<LevelValues<V>>,
     /// Which tree this is, for its [`NodeRef`]s: not part of the object (`==` ignores it); a clone keeps it.
-    id: TreeId,
+    pub(crate) id: TreeId,
 }
 
-impl<const K: usize> PartialEq for KTree<K> {
+impl<const K: usize, V: Value> PartialEq for KTree<K, V> {
     fn eq(&self, other: &Self) -> bool {
-        self.universe == other.universe && self.levels == other.levels
+        self.universe == other.universe && self.levels == other.levels && self.values == other.values
     }
 }
 
-impl<const K: usize> Eq for KTree<K> {}
+impl<const K: usize, V: Value> Eq for KTree<K, V> {}
 
-impl<const K: usize> std::hash::Hash for KTree<K> {
+impl<const K: usize, V: Value> std::hash::Hash for KTree<K, V> {
     fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
         self.universe.hash(state);
         self.levels.hash(state);
+        for level in &self.values {
+            level.hash(state);
+        }
     }
 }
 
@@ -116,7 +129,7 @@ impl TreeId {
     pub(crate) const NONE: TreeId = TreeId(0);
 
     /// A new identity, distinct from every other one handed out in this process.
-    fn fresh() -> Self {
+    pub(crate) fn fresh() -> Self {
         static NEXT: AtomicU64 = AtomicU64::new(1);
         TreeId(NEXT.fetch_add(1, Ordering::Relaxed))
     }
@@ -205,10 +218,131 @@ fn node_of_another_tree(depth: u32, index: usize) -> ! {
     )
 }
 
-impl<const K: usize> KTree<K> {
-    /// The number of children of a partial node, `2^K`.
+impl<const K: usize, V: Value> KTree<K, V> {
+    /// The number of children of a node that has children, `2^K`.
     pub const FANOUT: usize = 1 << K;
 
+    /// The tree's identity, carried by its [`NodeRef`]s.
+    #[inline]
+    pub(crate) fn id(&self) -> TreeId {
+        self.id
+    }
+
+    /// The universe.
+    pub fn universe(&self) -> Universe<K> {
+        self.universe
+    }
+
+    /// The universe level `L`.
+    pub fn level(&self) -> u32 {
+        self.universe.level()
+    }
+
+    /// The number of stored levels (the depth of the deepest node plus one).
+    pub fn depth_count(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// The packed states of level `depth`.
+    pub fn level_states(&self, depth: usize) -> &PackedStates {
+        &self.levels[depth]
+    }
+
+    /// The total number of nodes.
+    pub fn node_count(&self) -> u64 {
+        self.levels.iter().map(|l| l.len() as u64).sum()
+    }
+
+    /// Bytes needed at Meagher's 2 bits a node.
+    pub fn bytes_at_two_bits(&self) -> u64 {
+        self.node_count().div_ceil(4)
+    }
+
+
+    /// Checks the tree's invariants: level 0 holds the root, level sizes match the partial counts above, no
+    /// partial node at the universe level, the last level has no partial node, and the tree is reduced (no
+    /// partial node whose children are all full or all empty); for a valued tree, also the rules of
+    /// [`crate::tree::valued`] (mixed nodes, one value a full node, minimality). Cost: `O(nodes)`.
+    ///
+    /// # Errors
+    /// The first broken invariant.
+    pub fn check(&self) -> Result<(), TreeError> {
+        if V::STORED {
+            self.check_values()
+        } else {
+            check_levels::<K>(self.level(), &self.levels)
+        }
+    }
+
+    /// Panics with a readable message unless [`KTree::check`] passes. Property tests call it after every
+    /// operation.
+    pub fn assert_well_formed(&self) {
+        if let Err(e) = self.check() {
+            panic!("malformed KTree<{K}, {}> (level {}): {e}", std::any::type_name::<V>(), self.level());
+        }
+    }
+
+    /// Node counts per level, from the root (level 0) down to the deepest stored level (a valued tree's
+    /// mixed nodes count as partial: they have children).
+    pub fn counts_per_level(&self) -> Vec<LevelCounts> {
+        self.levels
+            .iter()
+            .enumerate()
+            .map(|(depth, l)| {
+                let partial = l.partial_count() as u64;
+                let full = l.full_count() as u64;
+                LevelCounts {
+                    level: depth as u32,
+                    full,
+                    partial,
+                    empty: l.len() as u64 - full - partial,
+                }
+            })
+            .collect()
+    }
+
+    /// Total node counts over all levels (`level` holds the universe level).
+    pub fn counts(&self) -> LevelCounts {
+        LevelCounts::total(self.level(), &self.counts_per_level())
+    }
+
+    /// Bytes of memory held by the navigable tree: packed states and rank indexes (about 2.07 bits a node on
+    /// large trees), plus the per-level bookkeeping; for a valued tree also the full nodes' rank index and
+    /// values.
+    pub fn heap_bytes(&self) -> usize {
+        self.levels
+            .iter()
+            .map(PackedStates::heap_bytes)
+            .sum::<usize>()
+            + self.levels.capacity() * std::mem::size_of::<PackedStates>()
+            + self
+                .values
+                .iter()
+                .map(|l| l.rank.heap_bytes() + l.values.capacity() * std::mem::size_of::<V>())
+                .sum::<usize>()
+            + self.values.capacity() * std::mem::size_of::<LevelValues<V>>()
+    }
+
+    /// The number of voxels inside the object, from the full-node counts of each level (no walk: a
+    /// pop-count of each level's words).
+    ///
+    /// ```
+    /// use ktree::KTree;
+    /// let tree = KTree::<2>::from_dense(2, &(0..16).map(|i| i < 9).collect::<Vec<_>>()).unwrap();
+    /// assert_eq!(tree.voxel_count(), 9);
+    /// assert_eq!(KTree::<3>::full(21).unwrap().voxel_count(), 1 << 63);
+    /// ```
+    pub fn voxel_count(&self) -> u128 {
+        let level = self.level();
+        self.levels
+            .iter()
+            .enumerate()
+            .map(|(depth, l)| (l.full_count() as u128) << (K * (level as usize - depth)))
+            .sum()
+    }
+}
+
+impl<const K: usize> KTree<K> {
     /// The tree of the empty object (one empty root).
     ///
     /// # Errors
@@ -261,6 +395,7 @@ impl<const K: usize> KTree<K> {
         Self {
             universe,
             levels,
+            values: Vec::new(),
             id: TreeId::fresh(),
         }
     }
@@ -274,32 +409,6 @@ impl<const K: usize> KTree<K> {
             state: self.state(cell.level as usize, index),
             tree: self.id,
         }
-    }
-
-    /// The tree's identity, carried by its [`NodeRef`]s.
-    #[inline]
-    pub(crate) fn id(&self) -> TreeId {
-        self.id
-    }
-
-    /// The universe.
-    pub fn universe(&self) -> Universe<K> {
-        self.universe
-    }
-
-    /// The universe level `L`.
-    pub fn level(&self) -> u32 {
-        self.universe.level()
-    }
-
-    /// The number of stored levels (the depth of the deepest node plus one).
-    pub fn depth_count(&self) -> usize {
-        self.levels.len()
-    }
-
-    /// The packed states of level `depth`.
-    pub fn level_states(&self, depth: usize) -> &PackedStates {
-        &self.levels[depth]
     }
 
     /// The root's state.
@@ -332,49 +441,6 @@ impl<const K: usize> KTree<K> {
             node_out_of_range(index, level.len());
         }
         level.partial_rank(index) << K
-    }
-
-    /// The total number of nodes.
-    pub fn node_count(&self) -> u64 {
-        self.levels.iter().map(|l| l.len() as u64).sum()
-    }
-
-    /// Node counts per level, from the root (level 0) down to the deepest stored level.
-    pub fn counts_per_level(&self) -> Vec<LevelCounts> {
-        self.levels
-            .iter()
-            .enumerate()
-            .map(|(depth, l)| {
-                let partial = l.partial_count() as u64;
-                let full = l.full_count() as u64;
-                LevelCounts {
-                    level: depth as u32,
-                    full,
-                    partial,
-                    empty: l.len() as u64 - full - partial,
-                }
-            })
-            .collect()
-    }
-
-    /// Total node counts over all levels (`level` holds the universe level).
-    pub fn counts(&self) -> LevelCounts {
-        LevelCounts::total(self.level(), &self.counts_per_level())
-    }
-
-    /// Bytes needed at Meagher's 2 bits a node.
-    pub fn bytes_at_two_bits(&self) -> u64 {
-        self.node_count().div_ceil(4)
-    }
-
-    /// Bytes of memory held by the navigable tree: packed states and rank indexes (about 2.07 bits a node on
-    /// large trees), plus the per-level bookkeeping.
-    pub fn heap_bytes(&self) -> usize {
-        self.levels
-            .iter()
-            .map(PackedStates::heap_bytes)
-            .sum::<usize>()
-            + self.levels.capacity() * std::mem::size_of::<PackedStates>()
     }
 
     /// The root node.
@@ -448,24 +514,6 @@ impl<const K: usize> KTree<K> {
             .filter_map(|(cell, state)| (state == NodeState::Full).then_some(cell))
     }
 
-    /// The number of voxels inside the object, from the full-node counts of each level (no walk: a
-    /// pop-count of each level's words).
-    ///
-    /// ```
-    /// use ktree::KTree;
-    /// let tree = KTree::<2>::from_dense(2, &(0..16).map(|i| i < 9).collect::<Vec<_>>()).unwrap();
-    /// assert_eq!(tree.voxel_count(), 9);
-    /// assert_eq!(KTree::<3>::full(21).unwrap().voxel_count(), 1 << 63);
-    /// ```
-    pub fn voxel_count(&self) -> u128 {
-        let level = self.level();
-        self.levels
-            .iter()
-            .enumerate()
-            .map(|(depth, l)| (l.full_count() as u128) << (K * (level as usize - depth)))
-            .sum()
-    }
-
     /// The object as a dense boolean array (axis 0 fastest).
     ///
     /// # Errors
@@ -479,24 +527,6 @@ impl<const K: usize> KTree<K> {
             }
         });
         Ok(dense)
-    }
-
-    /// Checks the tree's invariants: level 0 holds the root, level sizes match the partial counts above, no
-    /// partial node at the universe level, the last level has no partial node, and the tree is reduced (no
-    /// partial node whose children are all full or all empty). Cost: `O(nodes)`.
-    ///
-    /// # Errors
-    /// The first broken invariant.
-    pub fn check(&self) -> Result<(), TreeError> {
-        check_levels::<K>(self.level(), &self.levels)
-    }
-
-    /// Panics with a readable message unless [`KTree::check`] passes. Property tests call it after every
-    /// operation.
-    pub fn assert_well_formed(&self) {
-        if let Err(e) = self.check() {
-            panic!("malformed KTree<{K}> (level {}): {e}", self.level());
-        }
     }
 }
 

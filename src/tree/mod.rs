@@ -23,6 +23,8 @@ mod operators;
 pub mod sink;
 mod states;
 pub mod storage;
+pub mod value;
+pub mod valued;
 pub(crate) mod to_rays;
 pub(crate) mod words;
 
@@ -36,3 +38,5 @@ pub use ktree::{
 };
 pub use states::{NodeState, PackedStates};
 pub use storage::TreeStorage;
+pub use value::{Dtype, Rgb, Value};
+pub use valued::{ValueState, ValueStorage};

@@ -42,7 +42,7 @@ impl NodeState {
     }
 }
 
-use super::words::{full_count, partial_count, partial_mask, unused_mask, NODES_PER_WORD};
+use super::words::{children_mask, full_count, full_mask, partial_mask, unused_mask, NODES_PER_WORD};
 use super::TreeError;
 
 /// Words per rank block: 256 nodes share one 16-bit block rank.
@@ -74,12 +74,12 @@ pub struct PackedStates {
     partial: usize,
 }
 
-/// Adds the partial slots of `word` into 4-bit fields of `acc` (at most 2 a word per field): up to seven
-/// words can be summed before [`nibble_total`] reads the sum.
+/// Adds the slots of `word` that have children (partial, or mixed in a valued tree) into 4-bit fields of
+/// `acc` (at most 2 a word per field): up to seven words can be summed before [`nibble_total`] reads the sum.
 #[inline(always)]
 fn nibble_add(acc: u64, word: u64) -> u64 {
     const NIBBLE_PAIRS: u64 = 0x3333_3333_3333_3333;
-    let m = partial_mask(word);
+    let m = children_mask(word);
     acc + (m & NIBBLE_PAIRS) + ((m >> 2) & NIBBLE_PAIRS)
 }
 
@@ -92,16 +92,16 @@ fn nibble_total(acc: u64) -> u64 {
     bytes.wrapping_mul(0x0101_0101_0101_0101) >> 56
 }
 
-/// Partial nodes in `words`, two words per population count.
+/// Nodes with children in `words` (partial, or mixed in a valued tree), two words per population count.
 #[inline]
 fn partials_in(words: &[u64]) -> u64 {
     let mut pairs = words.chunks_exact(2);
     let mut n = 0u64;
     for p in &mut pairs {
-        n += u64::from((partial_mask(p[0]) | partial_mask(p[1]) << 1).count_ones());
+        n += u64::from((children_mask(p[0]) | children_mask(p[1]) << 1).count_ones());
     }
     if let [w] = pairs.remainder() {
-        n += u64::from(partial_count(*w));
+        n += u64::from(children_mask(*w).count_ones());
     }
     n
 }
@@ -136,6 +136,19 @@ impl PackedStates {
         }
         let last = self.words.len() - 1;
         self.words[last] |= (state as u64) << (2 * slot);
+        self.len += 1;
+    }
+
+    /// Appends a node by its 2-bit code (`11` only in a valued tree). Call [`PackedStates::finish`] after the
+    /// last push.
+    #[inline]
+    pub(crate) fn push_code(&mut self, code: u64) {
+        let slot = self.len % NODES_PER_WORD;
+        if slot == 0 {
+            self.words.push(0);
+        }
+        let last = self.words.len() - 1;
+        self.words[last] |= (code & 3) << (2 * slot);
         self.len += 1;
     }
 
@@ -346,6 +359,68 @@ impl PackedStates {
     }
 }
 
+/// A rank index over the full nodes (`01`) of a level, for a valued tree: the number of full nodes before a
+/// node is the position of its value in the level's value column. Built only for trees that carry values:
+/// a 64-bit count every 65 536 nodes and a 16-bit count every 256 nodes, as [`PackedStates`]' own index
+/// (about 0.064 bits a node).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
+pub(crate) struct FullRank {
+    /// `super_rank[s]` = full nodes in words `0 .. 8·256·s`.
+    super_rank: Vec<u64>,
+    /// `block_rank[b]` = full nodes from the start of block `b`'s superblock to the block's.
+    block_rank: Vec<u16>,
+}
+
+impl FullRank {
+    /// The index of the full nodes of `level`.
+    pub(crate) fn new(level: &PackedStates) -> Self {
+        let words = level.words();
+        let blocks = words.len() / WORDS_PER_BLOCK + 1;
+        let mut super_rank = Vec::with_capacity(blocks.div_ceil(BLOCKS_PER_SUPER));
+        let mut block_rank = Vec::with_capacity(blocks);
+        let (mut total, mut base) = (0u64, 0u64);
+        for b in 0..blocks {
+            if b % BLOCKS_PER_SUPER == 0 {
+                super_rank.push(total);
+                base = total;
+            }
+            block_rank.push((total - base) as u16);
+            let from = b * WORDS_PER_BLOCK;
+            let to = (from + WORDS_PER_BLOCK).min(words.len());
+            total += words[from..to]
+                .iter()
+                .map(|&w| u64::from(full_count(w)))
+                .sum::<u64>();
+        }
+        Self {
+            super_rank,
+            block_rank,
+        }
+    }
+
+    /// The number of full nodes of `level` (the level this index was built for) before node `i ≤ len`.
+    #[inline]
+    pub(crate) fn rank(&self, level: &PackedStates, i: usize) -> usize {
+        let words = level.words();
+        let word = i / NODES_PER_WORD;
+        let block = word / WORDS_PER_BLOCK;
+        let mut rank = self.super_rank[block / BLOCKS_PER_SUPER] + u64::from(self.block_rank[block]);
+        for &w in &words[block * WORDS_PER_BLOCK..word] {
+            rank += u64::from(full_count(w));
+        }
+        let below = (1u64 << (2 * (i % NODES_PER_WORD))) - 1;
+        if below != 0 {
+            rank += u64::from((full_mask(words[word]) & below).count_ones());
+        }
+        rank as usize
+    }
+
+    /// Bytes of memory held.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.super_rank.capacity() * 8 + self.block_rank.capacity() * 2
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -373,6 +448,41 @@ mod tests {
         assert_eq!(packed.partial_count(), rank);
         let full = plain.iter().filter(|&&s| s == NodeState::Full).count();
         assert_eq!(packed.full_count(), full);
+    }
+
+    #[test]
+    fn ranks_of_nodes_with_children_and_of_full_nodes_count_a_valued_level_as_a_plain_vector_does() {
+        // Codes 00, 01, 10 and 11 (a mixed node of a valued tree: it has children, it is not full).
+        let mut words = Vec::new();
+        let mut codes = Vec::new();
+        let mut x = 99u64;
+        let n = 2 * 65_536 + 4_321;
+        for i in 0..n {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let code = (x >> 61) & 3;
+            if i % 32 == 0 {
+                words.push(0u64);
+            }
+            *words.last_mut().unwrap() |= code << (2 * (i % 32));
+            codes.push(code);
+        }
+        let mut level = PackedStates {
+            words,
+            len: n,
+            ..PackedStates::default()
+        };
+        level.finish();
+        let full = FullRank::new(&level);
+        let (mut with_children, mut fulls) = (0, 0);
+        for (i, &code) in codes.iter().enumerate() {
+            assert_eq!(level.partial_rank(i), with_children, "node {i}");
+            assert_eq!(full.rank(&level, i), fulls, "node {i}");
+            with_children += usize::from(code >= 2);
+            fulls += usize::from(code == 1);
+        }
+        assert_eq!(level.partial_rank(n), with_children);
+        assert_eq!(full.rank(&level, n), fulls);
+        assert_eq!(level.partial_count(), with_children);
     }
 
     #[test]

@@ -30,22 +30,24 @@ pub(crate) fn partial_mask(word: u64) -> u64 {
     (word >> 1) & !word & LOW_BITS
 }
 
+/// The low bit of each slot set where the node has children: `Partial` (`10`), or in a valued tree a
+/// mixed node (`11`, every voxel holding a value, not all equal). In a binary tree, [`partial_mask`].
+#[inline(always)]
+pub(crate) fn children_mask(word: u64) -> u64 {
+    (word >> 1) & LOW_BITS
+}
+
 /// The low bit of each slot set where the slot holds `Full` (`01`).
 #[inline(always)]
 pub(crate) fn full_mask(word: u64) -> u64 {
     word & !(word >> 1) & LOW_BITS
 }
 
-/// The low bit of each slot set where the slot holds the unused code `11`.
+/// The low bit of each slot set where the slot holds the code `11`: unused in a binary tree, a mixed node
+/// in a valued one.
 #[inline(always)]
 pub(crate) fn unused_mask(word: u64) -> u64 {
     (word >> 1) & word & LOW_BITS
-}
-
-/// The partial nodes of a word.
-#[inline(always)]
-pub(crate) fn partial_count(word: u64) -> u32 {
-    partial_mask(word).count_ones()
 }
 
 /// The full nodes of a word.
@@ -273,7 +275,7 @@ mod tests {
                 assert_eq!(partial_mask(word), partial);
                 assert_eq!(unused_mask(word), unused);
                 assert_eq!(full_count(word), full.count_ones());
-                assert_eq!(partial_count(word), partial.count_ones());
+                assert_eq!(partial_mask(word).count_ones(), partial.count_ones());
             }
         }
     }

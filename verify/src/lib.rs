@@ -7,6 +7,7 @@
 
 pub mod cases;
 mod config;
+pub mod labels;
 pub mod objects;
 pub mod sparse;
 pub mod tools;

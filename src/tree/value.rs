@@ -1,0 +1,281 @@
+//! What a voxel holds: nothing (a binary tree's `()`), or a value of one type — labels (`u8`, `u16`,
+//! `u32`), quantized log-odds (`i8`), densities, log-odds or distances (`f32`), colours ([`Rgb`]).
+//!
+//! A valued tree keeps, beside its 2-bit node codes, the value of each full node (a node all of whose
+//! voxels hold one equal value), in level order; a node whose voxels all hold values, not all equal, has
+//! the code `11` (*mixed*) and children. Two values are the same when their bits are: `0.0` and `-0.0` are
+//! two values, and NaN is refused ([`Value::check`]).
+//!
+//! ```
+//! use ktree::tree::value::{Dtype, Value};
+//! assert_eq!(<u16 as Value>::DTYPE, Some(Dtype::U16));
+//! assert_eq!(<() as Value>::DTYPE, None);
+//! assert!(1.5f32.check().is_ok() && f32::NAN.check().is_err());
+//! assert!(!0.0f32.same(-0.0)); // bit-equal, not IEEE-equal
+//! assert_eq!(Dtype::parse("rgb8"), Some(Dtype::Rgb));
+//! ```
+
+use std::fmt::Debug;
+use std::hash::Hash;
+
+/// A colour: red, green, blue.
+pub type Rgb = [u8; 3];
+
+/// The run-time name of a value type, where the dimension is run-time too (files, the command line,
+/// Python).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Dtype {
+    /// `u8` labels.
+    U8,
+    /// `u16` labels.
+    U16,
+    /// `u32` labels.
+    U32,
+    /// `i8`, quantized log-odds.
+    I8,
+    /// `f32`: densities, log-odds, distances.
+    F32,
+    /// [`Rgb`] colours.
+    Rgb,
+}
+
+impl Dtype {
+    /// Every value type.
+    pub const ALL: [Dtype; 6] = [
+        Dtype::U8,
+        Dtype::U16,
+        Dtype::U32,
+        Dtype::I8,
+        Dtype::F32,
+        Dtype::Rgb,
+    ];
+
+    /// The name numpy gives it (`uint8`, `uint16`, `uint32`, `int8`, `float32`), `rgb8` for colours.
+    pub fn name(self) -> &'static str {
+        match self {
+            Dtype::U8 => "uint8",
+            Dtype::U16 => "uint16",
+            Dtype::U32 => "uint32",
+            Dtype::I8 => "int8",
+            Dtype::F32 => "float32",
+            Dtype::Rgb => "rgb8",
+        }
+    }
+
+    /// The type of a name of [`Dtype::name`] (also `u8`, `u16`, `u32`, `i8`, `f32`, `rgb`).
+    pub fn parse(name: &str) -> Option<Dtype> {
+        Some(match name {
+            "uint8" | "u8" => Dtype::U8,
+            "uint16" | "u16" => Dtype::U16,
+            "uint32" | "u32" => Dtype::U32,
+            "int8" | "i8" => Dtype::I8,
+            "float32" | "f32" => Dtype::F32,
+            "rgb8" | "rgb" => Dtype::Rgb,
+            _ => return None,
+        })
+    }
+
+    /// The code stored in files (1 … 6; 0 is a tree without values).
+    pub fn code(self) -> u8 {
+        match self {
+            Dtype::U8 => 1,
+            Dtype::U16 => 2,
+            Dtype::U32 => 3,
+            Dtype::I8 => 4,
+            Dtype::F32 => 5,
+            Dtype::Rgb => 6,
+        }
+    }
+
+    /// The type of a file's code ([`Dtype::code`]).
+    pub fn from_code(code: u8) -> Option<Dtype> {
+        Dtype::ALL.into_iter().find(|d| d.code() == code)
+    }
+
+    /// Bytes a value.
+    pub fn bytes(self) -> usize {
+        match self {
+            Dtype::U8 | Dtype::I8 => 1,
+            Dtype::U16 => 2,
+            Dtype::U32 | Dtype::F32 => 4,
+            Dtype::Rgb => 3,
+        }
+    }
+}
+
+impl std::fmt::Display for Dtype {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A value that is not allowed in a tree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ValueError {
+    /// A NaN: it equals no value, not even itself, so no node could be full of it.
+    #[error("NaN is not a value a voxel can hold (use the background, or another value, for missing data)")]
+    NaN,
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for () {}
+    impl Sealed for u8 {}
+    impl Sealed for u16 {}
+    impl Sealed for u32 {}
+    impl Sealed for i8 {}
+    impl Sealed for f32 {}
+    impl Sealed for super::Rgb {}
+}
+
+/// A type a voxel can hold: `()` (a binary tree: no value column at all, the same bits and speed as a tree
+/// without values), `u8`, `u16`, `u32`, `i8`, `f32` or [`Rgb`]. Sealed: the file formats and the run-time
+/// [`Dtype`] know exactly these.
+pub trait Value: Copy + PartialEq + Debug + Send + Sync + 'static + sealed::Sealed {
+    /// Whether the type carries anything (`false` for `()` alone): when not, no value column exists.
+    const STORED: bool;
+
+    /// The run-time name (`None` for `()`).
+    const DTYPE: Option<Dtype>;
+
+    /// The value's identity: two values are the same when their keys are (bit-equality for `f32`).
+    type Key: Copy + Eq + Ord + Hash + Debug + Send + Sync;
+
+    /// The key of the value.
+    fn key(self) -> Self::Key;
+
+    /// Whether `self` and `other` are the same value (bit-equal).
+    #[inline]
+    fn same(self, other: Self) -> bool {
+        self.key() == other.key()
+    }
+
+    /// Refuses a value no voxel may hold (a NaN).
+    ///
+    /// # Errors
+    /// [`ValueError::NaN`].
+    #[inline]
+    fn check(self) -> Result<(), ValueError> {
+        Ok(())
+    }
+
+    /// Appends the value's bytes, little-endian.
+    fn write_le(self, out: &mut Vec<u8>);
+
+    /// The value of [`Dtype::bytes`] little-endian bytes (the slice is exactly that long).
+    fn read_le(bytes: &[u8]) -> Self;
+}
+
+impl Value for () {
+    const STORED: bool = false;
+    const DTYPE: Option<Dtype> = None;
+    type Key = ();
+    #[inline(always)]
+    fn key(self) {}
+    #[inline(always)]
+    fn write_le(self, _: &mut Vec<u8>) {}
+    #[inline(always)]
+    fn read_le(_: &[u8]) -> Self {}
+}
+
+macro_rules! integer_value {
+    ($t:ty, $d:expr) => {
+        impl Value for $t {
+            const STORED: bool = true;
+            const DTYPE: Option<Dtype> = Some($d);
+            type Key = $t;
+            #[inline(always)]
+            fn key(self) -> $t {
+                self
+            }
+            #[inline]
+            fn write_le(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_le_bytes());
+            }
+            #[inline]
+            fn read_le(bytes: &[u8]) -> Self {
+                <$t>::from_le_bytes(bytes.try_into().expect("the value's width"))
+            }
+        }
+    };
+}
+
+integer_value!(u8, Dtype::U8);
+integer_value!(u16, Dtype::U16);
+integer_value!(u32, Dtype::U32);
+integer_value!(i8, Dtype::I8);
+
+impl Value for f32 {
+    const STORED: bool = true;
+    const DTYPE: Option<Dtype> = Some(Dtype::F32);
+    type Key = u32;
+    #[inline(always)]
+    fn key(self) -> u32 {
+        self.to_bits()
+    }
+    #[inline]
+    fn check(self) -> Result<(), ValueError> {
+        if self.is_nan() {
+            Err(ValueError::NaN)
+        } else {
+            Ok(())
+        }
+    }
+    #[inline]
+    fn write_le(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+    #[inline]
+    fn read_le(bytes: &[u8]) -> Self {
+        f32::from_le_bytes(bytes.try_into().expect("four bytes"))
+    }
+}
+
+impl Value for Rgb {
+    const STORED: bool = true;
+    const DTYPE: Option<Dtype> = Some(Dtype::Rgb);
+    type Key = [u8; 3];
+    #[inline(always)]
+    fn key(self) -> [u8; 3] {
+        self
+    }
+    #[inline]
+    fn write_le(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self);
+    }
+    #[inline]
+    fn read_le(bytes: &[u8]) -> Self {
+        bytes.try_into().expect("three bytes")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn round_trip<V: Value>(values: &[V]) {
+        for &v in values {
+            let mut bytes = Vec::new();
+            v.write_le(&mut bytes);
+            assert_eq!(bytes.len(), V::DTYPE.map_or(0, Dtype::bytes));
+            assert!(V::read_le(&bytes).same(v), "{v:?}");
+        }
+    }
+
+    #[test]
+    fn values_go_through_their_bytes_and_dtypes_through_their_names_and_codes() {
+        round_trip(&[0u8, 7, 255]);
+        round_trip(&[0u16, 65535]);
+        round_trip(&[0u32, u32::MAX]);
+        round_trip(&[-128i8, 0, 127]);
+        round_trip(&[0.0f32, -0.0, 1.5, f32::INFINITY, f32::MIN_POSITIVE]);
+        round_trip(&[[1u8, 2, 3]]);
+        for d in Dtype::ALL {
+            assert_eq!(Dtype::parse(d.name()), Some(d));
+            assert_eq!(Dtype::from_code(d.code()), Some(d));
+        }
+        assert_eq!(Dtype::from_code(0), None);
+        assert_eq!(Dtype::parse("float64"), None);
+    }
+}

@@ -1,0 +1,720 @@
+//! Valued trees: every voxel empty or holding a value of one type `V` ([`Value`]), in one minimal tree.
+//!
+//! # Layout
+//! The levels are those of a binary tree, two bits a node, in level order, with one more code:
+//! * `00` empty: no voxel holds a value;
+//! * `01` full: every voxel holds the same value, stored in the level's value column;
+//! * `10` partial: some voxels are empty, some hold values — `2^K` children;
+//! * `11` mixed: every voxel holds a value, not all the same one — `2^K` children.
+//!
+//! The children of the `i`-th node with children (`10` or `11`) of a level are nodes `2^K·i …` of the level
+//! below, found by the same rank as a binary tree's; the value of the `j`-th full node of a level is the
+//! `j`-th of its value column, found by a rank over its full nodes. A binary tree is the case without values
+//! (`V = ()`): no `11` code, no value column, the same bits and speed. About 2.13 bits a node plus the
+//! value's bits a full node ([`KTree::heap_bytes`]).
+//!
+//! The tree is *minimal*: a node is a leaf exactly when all its voxels are empty, or all hold one equal
+//! value, so two trees of the same voxels and values are equal node for node.
+//!
+//! # The shape
+//! [`KTree::shape`] is the binary tree of the voxels that hold a value (a mixed node is a full leaf of it):
+//! every Boolean, query, shape operation, picture and export of the crate applies to it as to any tree.
+//!
+//! ```
+//! use ktree::KTree;
+//! // Four voxels of a bintree: label 3, 3, empty, 7.
+//! let tree = KTree::<1, u8>::from_dense_values(2, &[Some(3), Some(3), None, Some(7)]).unwrap();
+//! tree.assert_well_formed();
+//! assert_eq!(tree.value_at([1]), Some(3));
+//! assert_eq!(tree.value_at([2]), None);
+//! assert_eq!(tree.node_count(), 5); // the root, [3 3] as one full node, the partial [_ 7] and its two voxels
+//! assert_eq!(tree.to_dense_values().unwrap(), [Some(3), Some(3), None, Some(7)]);
+//! assert_eq!(tree.shape(), KTree::<1>::from_dense(2, &[true, true, false, true]).unwrap());
+//! ```
+
+use std::convert::Infallible;
+
+use smallvec::SmallVec;
+
+use super::cursor::Walk;
+use super::error::StorageError;
+use super::ktree::{KTree, TreeId};
+use super::sink::{LevelSink, MemorySink};
+use super::states::{FullRank, NodeState, PackedStates};
+use super::storage::infallible;
+use super::value::{Value, ValueError};
+use super::words::{children_mask, full_mask, unused_mask, LOW_BITS};
+use super::TreeError;
+use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
+
+/// The values of a level's full nodes, in level order, and the rank over the level's full nodes that finds
+/// a node's value.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct LevelValues<V> {
+    pub(crate) values: Vec<V>,
+    pub(crate) rank: FullRank,
+}
+
+impl<V: Value> PartialEq for LevelValues<V> {
+    fn eq(&self, other: &Self) -> bool {
+        self.values.len() == other.values.len()
+            && self.values.iter().zip(&other.values).all(|(a, b)| a.same(*b))
+    }
+}
+
+impl<V: Value> std::hash::Hash for LevelValues<V> {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        for v in &self.values {
+            v.key().hash(state);
+        }
+    }
+}
+
+/// A node of a valued tree as it is stored.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ValueState<V> {
+    /// No voxel holds a value (code `00`).
+    Empty,
+    /// Every voxel holds this value (code `01`).
+    Full(V),
+    /// Some voxels are empty, some hold values (code `10`): the node has children.
+    Partial,
+    /// Every voxel holds a value, not all the same one (code `11`): the node has children.
+    Mixed,
+}
+
+impl<V> ValueState<V> {
+    /// Whether the node has children.
+    #[inline]
+    pub fn has_children(&self) -> bool {
+        matches!(self, ValueState::Partial | ValueState::Mixed)
+    }
+
+    /// The node as a node of the tree's shape ([`KTree::shape`]): a mixed node is full.
+    #[inline]
+    pub fn shape(&self) -> NodeState {
+        match self {
+            ValueState::Empty => NodeState::Empty,
+            ValueState::Full(_) | ValueState::Mixed => NodeState::Full,
+            ValueState::Partial => NodeState::Partial,
+        }
+    }
+}
+
+/// A node met by a walk of a valued tree: its index in its level, its cell and its state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ValueNode<const K: usize, V> {
+    /// The node's index within its level.
+    pub index: usize,
+    /// The node's cell (its level is the node's depth).
+    pub cell: Cell<K>,
+    /// The node's state, with the value of a full node.
+    pub state: ValueState<V>,
+}
+
+/// A valued tree stored in level order, read one block of siblings at a time, reads failing like those of
+/// [`TreeStorage`](super::storage::TreeStorage): a valued tree in memory ([`KTree`] with a value type,
+/// [`Infallible`] reads) or a valued `.ktree` file read in place. A binary tree is one with `Value = ()`.
+pub trait ValueStorage<const K: usize> {
+    /// What a voxel holds.
+    type Value: Value;
+    /// Why a read failed ([`Infallible`] in memory).
+    type Error: std::error::Error + Into<StorageError> + Send + Sync + 'static;
+
+    /// The universe.
+    fn universe(&self) -> Universe<K>;
+
+    /// The number of stored levels.
+    fn depth_count(&self) -> usize;
+
+    /// The root's 2-bit code (`00`, `01`, `10` or `11`).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn root_code(&self) -> Result<u32, Self::Error>;
+
+    /// The 2-bit codes of the `2^K` siblings of level `depth` from `first` (a multiple of `2^K`), the first in
+    /// the low bits.
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn codes(&self, depth: usize, first: usize) -> Result<u32, Self::Error>;
+
+    /// The index in level `depth + 1` of the first child of node `index` of level `depth`, a node with
+    /// children (partial or mixed).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn children(&self, depth: usize, index: usize) -> Result<usize, Self::Error>;
+
+    /// The value of the full node `index` of level `depth`.
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn value(&self, depth: usize, index: usize) -> Result<Self::Value, Self::Error>;
+
+    /// The universe level `L`.
+    fn level(&self) -> u32 {
+        self.universe().level()
+    }
+
+    /// The state of a node of level `depth`, index `index`, whose code is `code`.
+    ///
+    /// # Errors
+    /// The storage's read error.
+    #[inline]
+    fn decode(
+        &self,
+        depth: usize,
+        index: usize,
+        code: u32,
+    ) -> Result<ValueState<Self::Value>, Self::Error> {
+        Ok(match code & 3 {
+            0 => ValueState::Empty,
+            1 => ValueState::Full(self.value(depth, index)?),
+            2 => ValueState::Partial,
+            _ => ValueState::Mixed,
+        })
+    }
+
+    /// The root node.
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn root(&self) -> Result<ValueNode<K, Self::Value>, Self::Error> {
+        Ok(ValueNode {
+            index: 0,
+            cell: self.universe().root(),
+            state: self.decode(0, 0, self.root_code()?)?,
+        })
+    }
+}
+
+impl<const K: usize, V: Value> ValueStorage<K> for KTree<K, V> {
+    type Value = V;
+    type Error = Infallible;
+
+    #[inline]
+    fn universe(&self) -> Universe<K> {
+        self.universe
+    }
+
+    #[inline]
+    fn depth_count(&self) -> usize {
+        self.levels.len()
+    }
+
+    #[inline]
+    fn root_code(&self) -> Result<u32, Infallible> {
+        Ok((self.levels[0].words()[0] & 3) as u32)
+    }
+
+    #[inline(always)]
+    fn codes(&self, depth: usize, first: usize) -> Result<u32, Infallible> {
+        Ok(self.levels[depth].block_codes(first, K))
+    }
+
+    #[inline(always)]
+    fn children(&self, depth: usize, index: usize) -> Result<usize, Infallible> {
+        Ok(self.levels[depth].partial_rank(index) << K)
+    }
+
+    #[inline]
+    fn value(&self, depth: usize, index: usize) -> Result<V, Infallible> {
+        if !V::STORED {
+            return Ok(V::read_le(&[]));
+        }
+        let level = &self.values[depth];
+        Ok(level.values[level.rank.rank(&self.levels[depth], index)])
+    }
+}
+
+/// A walk of a valued tree: sees each node before its children.
+pub trait ValueVisitor<const K: usize, V> {
+    /// Sees a node; says whether to visit its children, skip them, or stop.
+    fn visit(&mut self, node: &ValueNode<K, V>) -> Walk;
+
+    /// Called after the children of a node have all been visited (not when they were skipped).
+    #[inline]
+    fn leave(&mut self, _node: &ValueNode<K, V>) {}
+}
+
+/// Walks a valued tree depth first from the root, children in code (Morton) order. `Ok(true)` if the
+/// visitor stopped the walk.
+///
+/// # Errors
+/// The storage's first read error.
+pub fn try_walk_values<const K: usize, T: ValueStorage<K>, W: ValueVisitor<K, T::Value>>(
+    tree: &T,
+    visitor: &mut W,
+) -> Result<bool, T::Error> {
+    let mut stack: SmallVec<[(ValueNode<K, T::Value>, bool); 64]> = SmallVec::new();
+    stack.push((tree.root()?, false));
+    while let Some((node, leaving)) = stack.pop() {
+        if leaving {
+            visitor.leave(&node);
+            continue;
+        }
+        match visitor.visit(&node) {
+            Walk::Stop => return Ok(true),
+            Walk::Skip => continue,
+            Walk::Descend if !node.state.has_children() => continue,
+            Walk::Descend => {}
+        }
+        let depth = node.cell.level as usize;
+        let first = tree.children(depth, node.index)?;
+        let codes = tree.codes(depth + 1, first)?;
+        stack.push((node, true));
+        for code in (0..1usize << K).rev() {
+            let index = first + code;
+            stack.push((
+                ValueNode {
+                    index,
+                    cell: node.cell.child(code),
+                    state: tree.decode(depth + 1, index, codes >> (2 * code))?,
+                },
+                false,
+            ));
+        }
+    }
+    Ok(false)
+}
+
+/// The leaves of a valued tree, in Morton order: each leaf's cell and value (`None` for an empty leaf),
+/// or the storage's read error (after which the iterator ends).
+#[derive(Debug, Clone)]
+pub struct ValueLeaves<'a, const K: usize, T: ValueStorage<K>> {
+    tree: &'a T,
+    stack: Vec<ValueNode<K, T::Value>>,
+    fresh: bool,
+}
+
+impl<'a, const K: usize, T: ValueStorage<K>> ValueLeaves<'a, K, T> {
+    /// The leaves of `tree`.
+    pub fn new(tree: &'a T) -> Self {
+        Self {
+            tree,
+            stack: Vec::new(),
+            fresh: true,
+        }
+    }
+}
+
+impl<const K: usize, T: ValueStorage<K>> Iterator for ValueLeaves<'_, K, T> {
+    type Item = Result<(Cell<K>, Option<T::Value>), T::Error>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if std::mem::take(&mut self.fresh) {
+            match self.tree.root() {
+                Ok(root) => self.stack.push(root),
+                Err(e) => return Some(Err(e)),
+            }
+        }
+        while let Some(node) = self.stack.pop() {
+            match node.state {
+                ValueState::Empty => return Some(Ok((node.cell, None))),
+                ValueState::Full(v) => return Some(Ok((node.cell, Some(v)))),
+                ValueState::Partial | ValueState::Mixed => {}
+            }
+            let depth = node.cell.level as usize;
+            let read = self.tree.children(depth, node.index).and_then(|first| {
+                let codes = self.tree.codes(depth + 1, first)?;
+                for code in (0..1usize << K).rev() {
+                    let index = first + code;
+                    self.stack.push(ValueNode {
+                        index,
+                        cell: node.cell.child(code),
+                        state: self.tree.decode(depth + 1, index, codes >> (2 * code))?,
+                    });
+                }
+                Ok(())
+            });
+            if let Err(e) = read {
+                self.stack.clear();
+                return Some(Err(e));
+            }
+        }
+        None
+    }
+}
+
+/// Collects a valued tree from its nodes in depth-first order (children in code order): each node is
+/// appended to its level, each full node's value to its level's column. The caller guarantees a complete
+/// traversal of a minimal tree.
+#[derive(Debug, Clone)]
+pub struct ValueAssembler<const K: usize, V> {
+    universe: Universe<K>,
+    levels: Vec<PackedStates>,
+    values: Vec<Vec<V>>,
+}
+
+impl<const K: usize, V: Value> ValueAssembler<K, V> {
+    /// An assembler for a universe of level `level`.
+    ///
+    /// # Errors
+    /// [`SpaceError::LevelTooLarge`] for a level beyond [`crate::max_level`].
+    pub fn new(level: u32) -> Result<Self, SpaceError> {
+        let () = DimCheck::<K>::OK;
+        Ok(Self {
+            universe: Universe::new(level)?,
+            levels: Vec::new(),
+            values: Vec::new(),
+        })
+    }
+
+    /// Appends the next node of the traversal, at `depth`.
+    pub fn push(&mut self, depth: usize, state: ValueState<V>) {
+        while self.levels.len() <= depth {
+            self.levels.push(PackedStates::new());
+            self.values.push(Vec::new());
+        }
+        let code = match state {
+            ValueState::Empty => 0,
+            ValueState::Full(v) => {
+                self.values[depth].push(v);
+                1
+            }
+            ValueState::Partial => 2,
+            ValueState::Mixed => 3,
+        };
+        self.levels[depth].push_code(code);
+    }
+
+    /// The tree (the caller guarantees the traversal was complete and minimal).
+    pub fn finish(self) -> KTree<K, V> {
+        let mut levels = self.levels;
+        for level in &mut levels {
+            level.finish();
+        }
+        KTree::from_valued_levels(self.universe, levels, self.values)
+    }
+}
+
+impl<const K: usize, V: Value> KTree<K, V> {
+    /// Assembles a tree from its levels and their full nodes' values. The caller guarantees the structure
+    /// (see [`KTree::check`]).
+    pub(crate) fn from_valued_levels(
+        universe: Universe<K>,
+        levels: Vec<PackedStates>,
+        values: Vec<Vec<V>>,
+    ) -> Self {
+        let values = if V::STORED {
+            levels
+                .iter()
+                .zip(values)
+                .map(|(level, values)| LevelValues {
+                    rank: FullRank::new(level),
+                    values,
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Self {
+            universe,
+            levels,
+            values,
+            id: TreeId::fresh(),
+        }
+    }
+
+    /// The tree of a dense array of voxels (axis 0 fastest, see [`Universe::dense_index`]), each empty
+    /// (`None`) or holding a value; minimal.
+    ///
+    /// # Errors
+    /// [`TreeError::Space`] for a level beyond [`crate::max_level`], a universe beyond
+    /// [`DENSE_LIMIT`](crate::space::DENSE_LIMIT) or an array of another length than `U^K`;
+    /// [`TreeError::Value`] for a value no voxel may hold (a NaN).
+    pub fn from_dense_values(level: u32, dense: &[Option<V>]) -> Result<Self, TreeError> {
+        crate::tree::valued::reference_pyramid::<K, V>(level, dense)
+    }
+
+    /// The value of voxel `point`: `None` where it is empty or outside the universe.
+    pub fn value_at(&self, point: [u32; K]) -> Option<V> {
+        if self.universe.check_point(point).is_err() {
+            return None;
+        }
+        let (mut depth, mut index) = (0usize, 0usize);
+        let mut code = infallible(self.root_code());
+        let mut log_side = self.level();
+        while code >= 2 {
+            log_side -= 1;
+            let child = (0..K).fold(0, |c, a| c | ((point[a] >> log_side & 1) as usize) << a);
+            index = infallible(self.children(depth, index)) + child;
+            depth += 1;
+            code = (self.levels[depth].block_codes(index - child, K) >> (2 * child)) & 3;
+        }
+        (code == 1).then(|| infallible(self.value(depth, index)))
+    }
+
+    /// The leaves with their values (`None`: empty), in Morton order.
+    pub fn value_leaves(&self) -> impl Iterator<Item = (Cell<K>, Option<V>)> + '_ {
+        ValueLeaves::new(self).map(infallible)
+    }
+
+    /// The dense array of the voxels' values (axis 0 fastest, see [`Universe::dense_index`]).
+    ///
+    /// # Errors
+    /// [`SpaceError::TooLargeForDense`] if the universe exceeds [`DENSE_LIMIT`].
+    pub fn to_dense_values(&self) -> Result<Vec<Option<V>>, SpaceError> {
+        let len = self.universe.dense_len(DENSE_LIMIT)?;
+        let mut dense = vec![None; len];
+        for (cell, value) in self.value_leaves() {
+            if value.is_some() {
+                for_each_voxel(&self.universe, &cell, |i| dense[i] = value);
+            }
+        }
+        Ok(dense)
+    }
+
+    /// The binary tree of the voxels that hold a value: a mixed node is a full leaf of it. Every operation
+    /// of the crate on binary trees applies to it. `O(nodes)`.
+    pub fn shape(&self) -> KTree<K> {
+        let mut sink = MemorySink::<K>::new(self.universe);
+        // Depth first, children in code order: the partial nodes of each depth come in level order, and
+        // so do the blocks of their children appended to the level below.
+        let mut stack: Vec<(usize, usize)> = Vec::new();
+        let root = infallible(self.root_code());
+        if root == 2 {
+            stack.push((0, 0));
+        }
+        while let Some((depth, index)) = stack.pop() {
+            let first = infallible(self.children(depth, index));
+            let codes = u64::from(self.levels[depth + 1].block_codes(first, K));
+            // A mixed child is a full leaf of the shape: `11` becomes `01`.
+            let shape = codes & !(unused_mask(codes) << 1);
+            infallible(sink.append(depth + 1, shape, 1 << K));
+            for code in (0..1usize << K).rev() {
+                if codes >> (2 * code) & 3 == 2 {
+                    stack.push((depth + 1, first + code));
+                }
+            }
+        }
+        let root = match root {
+            0 => NodeState::Empty,
+            2 => NodeState::Partial,
+            _ => NodeState::Full,
+        };
+        infallible(sink.finish(root))
+    }
+
+    /// The invariants of a valued tree ([`KTree::check`]): level sizes, the codes (a mixed node only where `V` carries values,
+    /// under a mixed node neither empty nor partial nodes), minimality (no node with children whose
+    /// children are all empty, or all full of one value; a partial node's children not all holding values),
+    /// one value per full node and no NaN.
+    ///
+    pub(crate) fn check_values(&self) -> Result<(), TreeError> {
+        let level = self.level();
+        if self.levels.is_empty() || self.levels[0].len() != 1 {
+            return Err(TreeError::Root {
+                nodes: self.levels.first().map_or(0, PackedStates::len),
+            });
+        }
+        if self.levels.len() > level as usize + 1 {
+            return Err(TreeError::TooDeep {
+                levels: self.levels.len(),
+                level,
+            });
+        }
+        if V::STORED && self.values.len() != self.levels.len() {
+            return Err(TreeError::ValueCount {
+                depth: self.values.len().min(self.levels.len()),
+                full: 0,
+                values: 0,
+            });
+        }
+        for (depth, states) in self.levels.iter().enumerate() {
+            let words = states.words();
+            if !V::STORED && words.iter().any(|&w| unused_mask(w) != 0) {
+                let w = words.iter().position(|&w| unused_mask(w) != 0).unwrap_or(0);
+                return Err(TreeError::UnusedCode {
+                    node: w * 32 + unused_mask(words[w]).trailing_zeros() as usize / 2,
+                });
+            }
+            let with_children: usize = words
+                .iter()
+                .map(|&w| children_mask(w).count_ones() as usize)
+                .sum();
+            let next = self.levels.get(depth + 1).map_or(0, PackedStates::len);
+            if next != with_children << K {
+                return Err(TreeError::LevelSize {
+                    depth,
+                    partial: with_children,
+                    next,
+                });
+            }
+            if with_children > 0 && depth as u32 == level {
+                return Err(TreeError::PartialVoxel { depth });
+            }
+            if V::STORED {
+                let full: usize = words.iter().map(|&w| full_mask(w).count_ones() as usize).sum();
+                let values = &self.values[depth].values;
+                if values.len() != full {
+                    return Err(TreeError::ValueCount {
+                        depth,
+                        full,
+                        values: values.len(),
+                    });
+                }
+                if let Some(e) = values.iter().find_map(|v| v.check().err()) {
+                    return Err(TreeError::Value(e));
+                }
+            }
+        }
+        // Each node with children against its children.
+        for depth in 0..self.levels.len().saturating_sub(1) {
+            let states = &self.levels[depth];
+            for index in 0..states.len() {
+                let code = (states.words()[index / 32] >> (2 * (index % 32))) & 3;
+                if code < 2 {
+                    continue;
+                }
+                let first = infallible(self.children(depth, index));
+                let codes = u64::from(self.levels[depth + 1].block_codes(first, K));
+                let n = 1usize << K;
+                let mask = if n == 32 { u64::MAX } else { (1u64 << (2 * n)) - 1 };
+                let low = LOW_BITS & mask;
+                let empty_or_partial = !codes & low; // the low bit clear: 00 or 10
+                let all_empty = codes & mask == 0;
+                let all_full = full_mask(codes) & low == low;
+                let valued = empty_or_partial == 0; // every child 01 or 11
+                let bad = if all_empty {
+                    true
+                } else if all_full {
+                    // All full: minimal only if the values differ (a mixed node).
+                    !V::STORED || {
+                        let v0 = infallible(self.value(depth + 1, first));
+                        (1..n).all(|c| infallible(self.value(depth + 1, first + c)).same(v0))
+                    }
+                } else {
+                    // A partial node must have an empty or partial child; a mixed one must not.
+                    (code == 2) == valued
+                };
+                if bad || (code == 3 && !valued) {
+                    return Err(TreeError::NotMinimal { depth, index });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Calls `f` with the dense index of every voxel of `cell`.
+pub(crate) fn for_each_voxel<const K: usize>(
+    universe: &Universe<K>,
+    cell: &Cell<K>,
+    mut f: impl FnMut(usize),
+) {
+    let side = cell.side() as u32;
+    let mut offset = [0u32; K];
+    loop {
+        let p: [u32; K] = std::array::from_fn(|a| cell.origin[a] + offset[a]);
+        f(universe.dense_index(p));
+        let mut axis = 0;
+        loop {
+            if axis == K {
+                return;
+            }
+            offset[axis] += 1;
+            if offset[axis] < side {
+                break;
+            }
+            offset[axis] = 0;
+            axis += 1;
+        }
+    }
+}
+
+/// The reference builder of a valued tree: a dense bottom-up pyramid of node states, then a depth-first
+/// walk from the root. Simple enough to trust; `O(U^K)`.
+pub(crate) fn reference_pyramid<const K: usize, V: Value>(
+    level: u32,
+    dense: &[Option<V>],
+) -> Result<KTree<K, V>, TreeError> {
+    let universe = Universe::<K>::new(level)?;
+    let len = universe.dense_len(DENSE_LIMIT)?;
+    if dense.len() != len {
+        return Err(TreeError::Space(SpaceError::TooLargeForDense {
+            voxels: dense.len() as u128,
+            limit: len as u128,
+        }));
+    }
+    if let Some(e) = dense.iter().flatten().find_map(|v| v.check().err()) {
+        return Err(TreeError::Value(e));
+    }
+    let bottom: Vec<ValueState<V>> = dense
+        .iter()
+        .map(|v| v.map_or(ValueState::Empty, ValueState::Full))
+        .collect();
+    let mut pyramid = vec![bottom];
+    for depth in (0..level).rev() {
+        let fine = pyramid.last().expect("the voxel level");
+        let (fine_u, coarse_u) = (Universe::<K>::new(depth + 1)?, Universe::<K>::new(depth)?);
+        let coarse = (0..fine.len() >> K)
+            .map(|i| {
+                let p = coarse_u.dense_point(i);
+                let kids: Vec<ValueState<V>> = (0..1usize << K)
+                    .map(|code| {
+                        let q = std::array::from_fn(|a| 2 * p[a] + (code >> a & 1) as u32);
+                        fine[fine_u.dense_index(q)]
+                    })
+                    .collect();
+                combine(&kids)
+            })
+            .collect();
+        pyramid.push(coarse);
+    }
+    pyramid.reverse();
+    let mut out = ValueAssembler::<K, V>::new(level)?;
+    let mut stack = vec![(0u32, [0u32; K])];
+    while let Some((depth, p)) = stack.pop() {
+        let u = Universe::<K>::new(depth)?;
+        let state = pyramid[depth as usize][u.dense_index(p)];
+        out.push(depth as usize, state);
+        if state.has_children() {
+            for code in (0..1usize << K).rev() {
+                stack.push((depth + 1, std::array::from_fn(|a| 2 * p[a] + (code >> a & 1) as u32)));
+            }
+        }
+    }
+    Ok(out.finish())
+}
+
+/// The state of a node from its children's: the one rule of minimality.
+///
+/// ```
+/// use ktree::tree::valued::{combine, ValueState};
+/// use ValueState::*;
+/// assert_eq!(combine(&[Full(2u8), Full(2)]), Full(2));
+/// assert_eq!(combine(&[Full(2u8), Full(3)]), Mixed);
+/// assert_eq!(combine(&[Full(2u8), Mixed]), Mixed);
+/// assert_eq!(combine(&[Empty, Full(3u8)]), Partial);
+/// assert_eq!(combine::<u8>(&[Empty, Empty]), Empty);
+/// ```
+pub fn combine<V: Value>(kids: &[ValueState<V>]) -> ValueState<V> {
+    let first = kids[0];
+    match first {
+        ValueState::Empty if kids.iter().all(|k| matches!(k, ValueState::Empty)) => ValueState::Empty,
+        ValueState::Full(v)
+            if kids
+                .iter()
+                .all(|k| matches!(k, ValueState::Full(w) if w.same(v))) =>
+        {
+            ValueState::Full(v)
+        }
+        _ if kids
+            .iter()
+            .all(|k| matches!(k, ValueState::Full(_) | ValueState::Mixed)) =>
+        {
+            ValueState::Mixed
+        }
+        _ => ValueState::Partial,
+    }
+}
+
+/// A value no voxel may hold, as the trees' error.
+impl From<ValueError> for TreeError {
+    fn from(e: ValueError) -> Self {
+        TreeError::Value(e)
+    }
+}

@@ -1,0 +1,73 @@
+//! Valued trees against the dense array of values they were made from, K = 1 … 4 and every value type: the
+//! tree is well formed and minimal, gives back every voxel's value (point by point and densely), its leaves
+//! cover the universe, and its shape is the binary tree of the voxels that hold a value.
+
+use ktree::tree::valued::ValueLeaves;
+use ktree::tree::{Rgb, Value};
+use ktree::KTree;
+use ktree_verify::labels::{painted, Painted, Palette};
+use proptest::prelude::*;
+
+fn check<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseError> {
+    let dense = o.dense::<V>();
+    let tree = KTree::<K, V>::from_dense_values(o.level, &dense).unwrap();
+    tree.assert_well_formed();
+    let back = tree.to_dense_values().unwrap();
+    prop_assert!(back.len() == dense.len());
+    for (i, (a, b)) in back.iter().zip(&dense).enumerate() {
+        prop_assert!(
+            a.map(Value::key) == b.map(Value::key),
+            "voxel {i}: {a:?} != {b:?}"
+        );
+        let p = o.universe().dense_point(i);
+        prop_assert_eq!(tree.value_at(p).map(Value::key), b.map(Value::key));
+    }
+    // The leaves tile the universe.
+    let volume: u128 = ValueLeaves::new(&tree)
+        .map(|l| l.unwrap().0.volume())
+        .sum();
+    prop_assert_eq!(volume, o.universe().voxels());
+    // The shape: the voxels that hold a value.
+    let support: Vec<bool> = dense.iter().map(Option::is_some).collect();
+    let shape = tree.shape();
+    shape.assert_well_formed();
+    prop_assert_eq!(&shape, &KTree::<K>::from_dense(o.level, &support).unwrap());
+    prop_assert_eq!(tree.voxel_count(), shape.voxel_count());
+    // A tree of one value everywhere it is not empty is its shape with that value.
+    let one: Vec<Option<V>> = support.iter().map(|&b| b.then_some(V::PALETTE[0])).collect();
+    let uniform = KTree::<K, V>::from_dense_values(o.level, &one).unwrap();
+    prop_assert_eq!(uniform.counts_per_level(), shape.counts_per_level());
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(64))]
+    #[test]
+    fn dense_values_k1(o in painted::<1>()) { check::<1, u8>(&o)?; check::<1, f32>(&o)?; }
+    #[test]
+    fn dense_values_k2(o in painted::<2>()) { check::<2, u16>(&o)?; check::<2, Rgb>(&o)?; }
+    #[test]
+    fn dense_values_k3(o in painted::<3>()) { check::<3, u32>(&o)?; check::<3, i8>(&o)?; check::<3, f32>(&o)?; }
+    #[test]
+    fn dense_values_k4(o in painted::<4>()) { check::<4, u8>(&o)?; check::<4, Rgb>(&o)?; }
+}
+
+#[test]
+fn two_zeros_are_two_values_and_nan_is_refused() {
+    let tree = KTree::<1, f32>::from_dense_values(1, &[Some(0.0), Some(-0.0)]).unwrap();
+    assert_eq!(tree.node_count(), 3, "0.0 and -0.0 do not merge");
+    let e = KTree::<1, f32>::from_dense_values(1, &[Some(f32::NAN), None]).unwrap_err();
+    assert!(e.to_string().contains("NaN"), "{e}");
+}
+
+#[test]
+fn a_binary_tree_has_no_value_column_and_its_memory_is_unchanged() {
+    let tree = KTree::<3>::from_dense(3, &(0..512).map(|i| i % 7 < 3).collect::<Vec<_>>()).unwrap();
+    let unit = KTree::<3, ()>::from_dense_values(
+        3,
+        &(0..512).map(|i| (i % 7 < 3).then_some(())).collect::<Vec<_>>(),
+    )
+    .unwrap();
+    assert_eq!(tree, unit);
+    assert_eq!(tree.heap_bytes(), unit.heap_bytes());
+}
