@@ -8,7 +8,7 @@
 //! centres (as scipy's `distance_transform_edt` measures them).
 //!
 //! Every query is a provided method of [`Query`], implemented for every
-//! [`TreeStorage`](crate::tree::storage::TreeStorage): a tree in memory and a `.ktree` file mapped in
+//! [`TreeStorage`]: a tree in memory and a `.ktree` file mapped in
 //! place (`io::MappedTree`) answer the same calls, each a walk of [`cursor`](crate::tree::cursor) or the
 //! one point descent of [`locate`](crate::tree::locate); the batch forms run on the threads of the
 //! current rayon pool. [`KTree`] also has each as a method that cannot fail.
