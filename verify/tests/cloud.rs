@@ -420,8 +420,11 @@ fn malformed_files_name_the_line_or_byte() {
         ": byte {}: PCD: LZF: a reference 10 bytes back, but only 1 bytes are decompressed",
         body + 10
     );
+    let mut short_header = las(&p, false);
+    short_header[94..96].copy_from_slice(&100u16.to_le_bytes());
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
         ("las", huge_evlr, &huge_evlr_error),
+        ("las", short_header, ": byte 94: LAS: a header of 100 bytes, but LAS 1.2's takes 227"),
         ("xyz", b"1 2 3\n4 five 6\n".to_vec(), ":2: 'five' is not a number"),
         ("xyz", b"x y z\n1 2 3\n".to_vec(), ":1: 'x' is not a number"),
         ("xyz", b"1 2 3\n\n1 2\n".to_vec(), ":3: expected 3 numbers x y z, found 2"),

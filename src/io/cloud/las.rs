@@ -29,6 +29,7 @@ const LEGACY_POINT_COUNT: usize = 107;
 const POINT_COUNT: usize = 247;
 const POINT_FORMAT: usize = 104;
 const RECORD_LENGTH: usize = 105;
+const HEADER_SIZE: usize = 94;
 const OFFSET_TO_POINT_DATA: usize = 96;
 const START_OF_FIRST_EVLR: usize = 235;
 /// A variable-length record's header (54 bytes) and an extended one's (60).
@@ -70,6 +71,21 @@ pub(super) fn read(bytes: &[u8]) -> Result<Vec<[f64; 3]>, Fault> {
                 "LAS: records of {record} bytes are shorter than point format {}'s {} bytes",
                 header.point_data_record_format & 0x3f,
                 format.len()
+            ),
+        ));
+    }
+    // The header's size at least as its version's fields take (ASPRS: 227 bytes, 235 in 1.3, 375 in 1.4).
+    let least = match header.version.minor {
+        0..=2 => 227,
+        3 => 235,
+        _ => 375,
+    };
+    if header.header_size < least {
+        return Err(Fault::byte(
+            HEADER_SIZE,
+            format!(
+                "LAS: a header of {} bytes, but LAS 1.{}'s takes {least}",
+                header.header_size, header.version.minor
             ),
         ));
     }

@@ -122,7 +122,7 @@ pub fn is_cloud_file(path: &Path) -> Result<bool, GeometryFileError> {
         .map_err(|fault| fault.in_file(path))
 }
 
-/// `Err` naming `place` when a point has a coordinate that is not finite.
+/// The point, or `fault`'s error when it has a coordinate that is not finite.
 fn finite(p: [f64; 3], fault: impl FnOnce(String) -> Fault) -> Result<[f64; 3], Fault> {
     if p.iter().all(|c| c.is_finite()) {
         Ok(p)
