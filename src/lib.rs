@@ -21,8 +21,9 @@
 //! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
 //! * [`io`]: files, one module per format — `.ktree` (version 2 written, streamed and memory-mapped; version 1
-//!   read), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb` — and the spill files of trees larger than
-//!   memory (one level a file), which the out-of-core builder and the streamed Booleans both write.
+//!   read), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb`, point clouds and meshes in — and the spill
+//!   files of trees larger than memory (one level a file), which the out-of-core builder and the streamed
+//!   Booleans both write.
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
@@ -38,7 +39,8 @@
 //! # Layers
 //! Each layer imports only those below it, with the exceptions listed after the picture:
 //! ```text
-//!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text;
+//!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text,
+//!                     point clouds and meshes in (into solid/'s PointCloud and TriangleMesh);
 //!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in,
 //!                     meshes written through export/); spill files, one level a file, and the level
 //!                     sink over them

@@ -68,7 +68,8 @@ pub struct Args {
 
 /// Voxelizes the input and writes it.
 pub fn run(a: Args) -> CliResult {
-    if ktree::solid::cloud::is_cloud_file(&a.input).unwrap_or(false) {
+    // A `.ply` is a cloud or a mesh by its header: a broken one is said as such.
+    if ktree::io::is_cloud_file(&a.input).map_err(|e| e.to_string())? {
         return run_cloud(&a);
     }
     if a.voxel_size.is_some() || a.origin.is_some() || a.crop {
@@ -131,7 +132,8 @@ pub fn run(a: Args) -> CliResult {
 
 /// Voxelizes a point cloud and writes it.
 fn run_cloud(a: &Args) -> CliResult {
-    use ktree::solid::cloud::{CloudVoxelizer, PointCloud};
+    use ktree::solid::cloud::CloudVoxelizer;
+    use ktree::solid::SolidError;
     let size = a
         .voxel_size
         .ok_or_else(|| format!("{}: a point cloud needs --voxel-size S", a.input.display()))?;
@@ -156,10 +158,19 @@ fn run_cloud(a: &Args) -> CliResult {
     if let Some(l) = a.level {
         v = v.level(l);
     }
-    let cloud = PointCloud::read(&a.input).map_err(|e| e.to_string())?;
-    let voxels = v
-        .voxelize(cloud.points())
-        .map_err(|e| format!("{}: {e}", a.input.display()))?;
+    let cloud = ktree::io::read_cloud(&a.input).map_err(|e| e.to_string())?;
+    let voxels = v.voxelize(cloud.points()).map_err(|e| {
+        let hint = match e {
+            SolidError::PointsOutside { .. } => {
+                ": use a larger --level or --voxel-size, another --origin, or --crop to drop them"
+            }
+            SolidError::PointBelowOrigin { .. } => {
+                ": give --level and --crop to drop such points, or another --origin"
+            }
+            _ => "",
+        };
+        format!("{}: {e}{hint}", a.input.display())
+    })?;
     let root = crate::distributed::ranks().is_root();
     if root {
         let o = voxels.origin;

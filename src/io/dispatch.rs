@@ -137,8 +137,12 @@ pub enum IoError {
     /// A bad binvox, `.bt` or `.vdb` file.
     #[error(transparent)]
     Grid(#[from] GridFileError),
+    /// A point cloud or mesh file that could not be read.
+    #[cfg(any(feature = "cloud", feature = "mesh"))]
+    #[error(transparent)]
+    Geometry(#[from] super::GeometryFileError),
     /// A mesh or volume that could not be read or voxelized.
-    #[error("{file}: {source}")]
+    #[error("{}", with_file(.file, .source))]
     Solid {
         /// The file.
         file: String,
@@ -165,6 +169,14 @@ pub enum IoError {
         /// The dimensions.
         source: DimensionMismatch,
     },
+}
+
+/// A solid's error naming its file once (a file that cannot be read or parsed names itself).
+fn with_file(file: &str, e: &SolidError) -> String {
+    match e {
+        SolidError::Io { .. } | SolidError::Parse { .. } => e.to_string(),
+        _ => format!("{file}: {e}"),
+    }
 }
 
 fn usage(path: &Path, message: impl Into<String>) -> IoError {
@@ -299,7 +311,7 @@ pub fn voxelize(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError
 }
 
 /// A missing or unreadable input is said as such (an I/O error) before any option is asked for.
-#[cfg(any(feature = "mesh", feature = "volume"))]
+#[cfg(feature = "volume")]
 fn readable(path: &Path) -> Result<(), SolidError> {
     std::fs::File::open(path)
         .map(drop)
@@ -456,13 +468,13 @@ fn mesh_input(
     ),
     IoError,
 > {
-    use crate::solid::mesh::{MeshTransform, TriangleMesh};
+    use crate::solid::mesh::MeshTransform;
     let solid = solid_error(path);
-    readable(path).map_err(&solid)?;
+    std::fs::File::open(path).map_err(|e| super::geometry_file::io_error(path, e))?;
     let level = options
         .level
         .ok_or_else(|| usage(path, "a mesh needs a universe level"))?;
-    let mesh = TriangleMesh::read(path).map_err(&solid)?;
+    let mesh = super::read_mesh(path)?;
     let (placement, fitted) = match options.mesh_placement {
         Some(p) => (p, None),
         None => {
