@@ -30,6 +30,7 @@ pub mod ktree;
 mod location;
 #[allow(unsafe_code)]
 mod mmap;
+mod out_of_core;
 pub mod rays;
 pub(crate) mod spill;
 
@@ -52,6 +53,7 @@ pub use ktree::{
     VERSION,
 };
 pub use location::{FileError, Location, Place, ProblemKind};
+pub use out_of_core::{SpilledFiles, SpilledLevel};
 pub use rays::{
     open_rays_file, read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source,
     AnyRaysFileSource, RaysFile, RaysFileSource, RaysTextError, RaysTextErrorKind,
