@@ -95,11 +95,11 @@ impl SpilledPart<SpilledFiles> {
         let file = AtomicFile::create(out).map_err(|e| output_error(out, e))?;
         let writer =
             KtreeWriter::new(file, self.k(), self.level()).map_err(|e| output_error(out, e))?;
-        let mut receive = |owner: usize, words: &mut [u64]| {
+        let receive = |owner: usize, words: &mut [u64]| {
             receive(owner, words).map_err(|e| output_error(out, e))
         };
         let output = KtreeFile { writer, path: out };
-        let (file_bytes, report) = self.write_into(output, &mut receive, progress)?;
+        let (file_bytes, report) = self.write_into(output, receive, progress)?;
         Ok(OutOfCoreReport {
             file_bytes,
             ..report
@@ -190,7 +190,7 @@ impl StoredPieces for SpilledFiles {
 
 /// One spill file read back piece by piece, one read per piece (pieces are taken out of the order they
 /// were spilled in, so a buffer ahead would mostly be wasted), the disk of each piece given back once it
-/// is read ([`PieceRelease`]); errors name the file.
+/// is read (holes punched, see [`stacking`](crate::stacking)'s notes on disk); errors name the file.
 pub struct SpilledLevel<'a> {
     path: &'a Path,
     file: &'a mut File,

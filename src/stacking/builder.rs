@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 
 use super::out_of_core::{
     build_slabs, slab_cost, stack_part, BuildError, LevelOrderSink, OutOfCore, OutOfCoreReport,
-    PieceStore, Progress, SpilledPart,
+    PieceStore, Progress, SpilledPart, StoreBuildError,
 };
 use super::partition::{default_split_depth, stack_source};
 use crate::rays::RaySet;
@@ -152,17 +152,17 @@ impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
         store: P,
         output: O,
         max_memory: u64,
-    ) -> Result<(O::Output, OutOfCoreReport), BuildError<S::Error, P::Error>>
+    ) -> Result<(O::Output, OutOfCoreReport), StoreBuildError<S::Error, P>>
     where
         P: PieceStore,
         O: LevelOrderSink<Error = P::Error>,
     {
         let part = self.stack_part_into(&self.slabs(), store, max_memory)?;
         // One part of every slab: no other part sends anything.
-        let mut nothing = |_: usize, _: &mut [u64]| -> Result<(), P::Error> {
+        let nothing = |_: usize, _: &mut [u64]| -> Result<(), P::Error> {
             unreachable!("a build of one part receives no levels")
         };
-        part.write_into(output, &mut nothing, self.progress_callback())
+        part.write_into(output, nothing, self.progress_callback())
     }
 
     /// The slabs (numbered along axis 0, increasing) the build stacks: the slabs of cells of the split
@@ -194,7 +194,7 @@ impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
         slabs: &[u32],
         store: P,
         max_memory: u64,
-    ) -> Result<SpilledPart<P::Stored>, BuildError<S::Error, P::Error>> {
+    ) -> Result<SpilledPart<P::Stored>, StoreBuildError<S::Error, P>> {
         let options = OutOfCore {
             depth: self.depth(),
             max_memory,

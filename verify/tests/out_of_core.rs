@@ -501,9 +501,9 @@ fn in_memory_storage_agrees<const K: usize>(
             streams.push(stream.into_iter());
         }
         let (tree, _) = writer
-            .write_into::<String, _>(
+            .write_into::<String, _, _>(
                 MemoryLevels::<K>::new(level),
-                &mut |owner, words| {
+                |owner: usize, words: &mut [u64]| {
                     for w in words.iter_mut() {
                         *w = streams[owner - 1]
                             .next()

@@ -16,12 +16,16 @@ pub(crate) use budget::BUFFER_BYTES;
 pub use error::BuildError;
 pub use parts::{balanced_parts, SpilledPart, MAX_PARTS};
 pub(crate) use parts::{build_slabs, slab_cost, stack_part};
+
 pub use pieces::{LevelPieces, PieceStore, StoredPieces};
 pub use progress::{Progress, Stage};
 pub use sink::LevelOrderSink;
 
 use super::CellStacking;
 use crate::tree::LevelCounts;
+
+/// The error of a build out of core (the source's error `E`) into the store `P`.
+pub(crate) type StoreBuildError<E, P> = BuildError<E, <P as PieceStore>::Error>;
 
 /// How an out-of-core build runs (set through [`Builder`](super::Builder)).
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -13,7 +13,7 @@ use super::pieces::{LevelPieces, PieceStore, StoredPieces};
 use super::progress::{Progress, Stage};
 use super::sink::LevelOrderSink;
 use super::spill::{level_offsets, spill_piece, SubtreeIndex};
-use super::{OutOfCore, OutOfCoreReport};
+use super::{OutOfCore, OutOfCoreReport, StoreBuildError};
 use crate::rays::RaySource;
 use crate::stacking::cells::{CellBlock, CellStates};
 use crate::stacking::partition::{slab_pieces, Piece};
@@ -102,7 +102,7 @@ pub(crate) fn stack_part<const K: usize, S, P>(
     mut store: P,
     options: &OutOfCore,
     progress: &(dyn Fn(Progress) + Sync),
-) -> Result<SpilledPart<P::Stored>, BuildError<S::Error, P::Error>>
+) -> Result<SpilledPart<P::Stored>, StoreBuildError<S::Error, P>>
 where
     S: RaySource<K>,
     P: PieceStore,
@@ -456,14 +456,15 @@ impl<P: StoredPieces> SpilledPart<P> {
     /// [`BuildError::BudgetTooSmall`] if the index of all parts does not fit in the budget;
     /// [`BuildError::PartsOverlap`]; the error of a piece read back, of `output` or of `receive`. The
     /// pieces are dropped in any case.
-    pub fn write_into<E, O>(
+    pub fn write_into<E, O, R>(
         self,
         mut output: O,
-        receive: &mut dyn FnMut(usize, &mut [u64]) -> Result<(), P::Error>,
+        mut receive: R,
         progress: &(dyn Fn(Progress) + Sync),
     ) -> Result<(O::Output, OutOfCoreReport), BuildError<E, P::Error>>
     where
         O: LevelOrderSink<Error = P::Error>,
+        R: FnMut(usize, &mut [u64]) -> Result<(), P::Error>,
     {
         let SpilledPart {
             k: _,
