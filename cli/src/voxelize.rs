@@ -16,9 +16,9 @@ use ktree::io::{voxel_source, voxelize, Format, ReadOptions, VoxelSource};
 use ktree::rays::{RaySource, SlabRuns};
 use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
-use ktree::{LevelCounts, Universe};
+use ktree::Universe;
 
-use crate::common::output::{is_tree_file, write_output};
+use crate::common::output::{is_tree_file, write_output, TreeOutput};
 
 /// Arguments of `ktree voxelize`.
 #[derive(Debug, clap::Args)]
@@ -229,25 +229,12 @@ fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
         VoxelSource::Mesh(_) => format!("the placed triangles of {}", a.input.display()),
         VoxelSource::Volume(_) => format!("the samples of {}", a.input.display()),
     };
-    let budget = a.build.budget.left_after(&what, source.heap_bytes())?;
     let counted = CountedRuns::new(source);
-    let Some(report) =
-        crate::distributed::build_to_file(&counted, &a.out, a.threads, &a.build, budget)?
-    else {
-        return Ok(String::new());
-    };
-    let level = source.universe().level();
-    let c = LevelCounts::total(level, &report.counts_per_level);
-    Ok(format!(
-        "{}: K = 3, L = {level}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
-        a.out.display(),
-        counted.runs(),
-        crate::common::memory::voxels(3, level, &report.counts_per_level),
-        c.nodes(),
-        c.full,
-        c.empty,
-        c.partial
-    ))
+    let held = (what.as_str(), source.heap_bytes());
+    let built = TreeOutput::new(&a.out, a.threads, &a.build).write(&counted, Some(held))?;
+    Ok(built
+        .map(|b| b.summary(Some(counted.runs())))
+        .unwrap_or_default())
 }
 
 /// A source that counts the runs of its slabs as they are made (a slab made twice is counted once).

@@ -40,6 +40,7 @@ pub mod mesh;
 mod mmap;
 #[cfg(any(feature = "cloud", feature = "mesh"))]
 mod ply;
+mod out_of_core;
 pub mod rays;
 #[cfg(any(feature = "cloud", feature = "mesh"))]
 mod scalar;
@@ -71,6 +72,7 @@ pub use ktree::{
     VERSION,
 };
 pub use location::{FileError, Location, Place, ProblemKind};
+pub use out_of_core::{SpilledFiles, SpilledLevel};
 pub use rays::{
     open_rays_file, read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source,
     AnyRaysFileSource, RaysFile, RaysFileSource, RaysTextError, RaysTextErrorKind,
