@@ -23,7 +23,7 @@ mod operators;
 pub mod sink;
 mod states;
 pub mod storage;
-pub(crate) mod to_rays;
+mod to_rays;
 pub(crate) mod words;
 
 pub use any::{AnyTree, DimensionMismatch};
@@ -36,3 +36,4 @@ pub use ktree::{
 };
 pub use states::{NodeState, PackedStates};
 pub use storage::TreeStorage;
+pub use to_rays::rays_of;
