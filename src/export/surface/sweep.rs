@@ -15,7 +15,7 @@
 use std::collections::HashMap;
 
 use crate::radix;
-use crate::tree::KTree;
+use crate::tree::storage::TreeStorage;
 
 use super::section::{section, Pieces, Slab};
 
@@ -24,24 +24,24 @@ use super::{
 };
 
 /// The boundary of `tree` as a closed, outward-oriented triangle mesh, its planes merged as `merge` says.
-pub(super) fn sweep(tree: &KTree<3>, merge: Merge) -> SurfaceMesh {
+pub(super) fn sweep<T: TreeStorage<3>>(tree: &T, merge: Merge) -> Result<SurfaceMesh, T::Error> {
     let mut sweep = Sweep::new(tree.level(), merge);
     for_each_section(tree, |x, _, below, slab| {
         if !(below.bands.is_empty() && slab.bands.is_empty()) {
             sweep.step(x, below, slab);
         }
-    });
+    })?;
     debug_assert!(sweep.open[0].is_empty() && sweep.open[1].is_empty());
     assert!(
         u32::try_from(sweep.mesh.vertices.len()).is_ok(),
         "fewer than 2^32 vertices (indices are 32-bit)"
     );
-    sweep.mesh
+    Ok(sweep.mesh)
 }
 
 /// The number of unit faces on the boundary of `tree`, counted on its cross-sections as [`sweep`] meets
 /// them (nothing is made).
-pub(super) fn unit_faces(tree: &KTree<3>) -> u128 {
+pub(super) fn unit_faces<T: TreeStorage<3>>(tree: &T) -> Result<u128, T::Error> {
     let mut xor = Vec::new();
     let mut faces = 0u128;
     let length = |runs: &[(u32, u32)]| runs.iter().map(|r| u128::from(r.1 - r.0)).sum::<u128>();
@@ -68,27 +68,30 @@ pub(super) fn unit_faces(tree: &KTree<3>) -> u128 {
             }
         }
         faces += across * u128::from(next - x);
-    });
-    faces
+    })?;
+    Ok(faces)
 }
 
 /// Calls `step(x, next, below, slab)` at each `x` where the cross-section of `tree` changes, in order, and
 /// at the universe's side (`slab` empty there): `slab` is the section from `x` up to `next`, `below` the
 /// one before `x`.
-fn for_each_section(tree: &KTree<3>, mut step: impl FnMut(u32, u32, &Slab, &Slab)) {
+fn for_each_section<T: TreeStorage<3>>(
+    tree: &T,
+    mut step: impl FnMut(u32, u32, &Slab, &Slab),
+) -> Result<(), T::Error> {
     let side = 1u32 << tree.level();
     let (mut below, mut slab) = (Slab::default(), Slab::default());
     let mut x = 0;
     loop {
         let next = if x < side {
-            section(tree, x, &mut slab).min(side)
+            section(tree, x, &mut slab)?.min(side)
         } else {
             slab.clear();
             side
         };
         step(x, next, &below, &slab);
         if x >= side {
-            return;
+            return Ok(());
         }
         std::mem::swap(&mut below, &mut slab);
         x = next;
@@ -983,11 +986,11 @@ mod tests {
         for round in 0..30 {
             // Aligned blocks of every size, added and cut out.
             let tree = super::super::random_blocks(4, &mut state, 8, true);
-            assert_eq!(unit_faces(&tree), tree.surface_area(), "round {round}");
+            assert_eq!(unit_faces(&tree), Ok(tree.surface_area()), "round {round}");
         }
         // The full universe at the largest level, counted without a run per column.
-        let full = KTree::<3>::full(21).unwrap();
-        assert_eq!(unit_faces(&full), 6 << 42);
+        let full = crate::KTree::<3>::full(21).unwrap();
+        assert_eq!(unit_faces(&full), Ok(6 << 42));
     }
 
     #[test]
