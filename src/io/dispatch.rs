@@ -613,42 +613,27 @@ fn write_typed<const K: usize>(
             let t = octree()?;
             write(&|w| write_vdb(w, t, options.offset, &meta))
         }
-        Format::Vtu | Format::Htg => {
-            if K != 2 && K != 3 {
-                return Err(usage(
-                    path,
-                    format!(
-                        "VTK files are written for quadtrees and octrees (K = 2, 3); this tree has K = {K}"
-                    ),
-                ));
-            }
-            let htg = format == Format::Htg;
-            write(&|w| {
-                if htg {
-                    crate::export::vtk::write_htg(w, tree, &frame)
-                } else {
-                    crate::export::vtk::write_vtu(w, tree, &frame)
-                }
-            })
-        }
+        Format::Vtu | Format::Htg => crate::export::vtk::write_vtk_file(path, tree, &frame)
+            .map_err(|e| export_error(path, e)),
         Format::Mesh | Format::Glb | Format::Svg => {
             crate::export::write_mesh_of(path, tree, &frame)
                 .map(drop)
-                .map_err(|e| match e {
-                    crate::export::ExportError::Write(e) => IoError::Write(e),
-                    crate::export::ExportError::Usage { file, message } => {
-                        IoError::Usage { file, message }
-                    }
-                    e @ crate::export::ExportError::TooLarge { .. } => IoError::Usage {
-                        file: path.display().to_string(),
-                        message: e.to_string(),
-                    },
-                })
+                .map_err(|e| export_error(path, e))
         }
         Format::Volume => Err(usage(
             path,
             "volumes are inputs only: write .ktree, .rays, .binvox, .bt, .vdb or a mesh",
         )),
+    }
+}
+
+/// An export's error as a file error of `path`.
+fn export_error(path: &Path, e: crate::export::ExportError) -> IoError {
+    use crate::export::ExportError;
+    match e {
+        ExportError::Write(e) => IoError::Write(e),
+        ExportError::Usage { file, message } => IoError::Usage { file, message },
+        e => usage(path, e.to_string()),
     }
 }
 
