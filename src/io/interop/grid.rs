@@ -744,7 +744,7 @@ mod tests {
             let got = place_boxes(&boxes, &placement, u64::MAX).unwrap();
             prop_assert_eq!(&got, &want);
             got.assert_well_formed();
-            let nodes = want.node_count() as u64;
+            let nodes = want.node_count();
             prop_assert_eq!(count_work(&boxes, &placement, u64::MAX).0, Some(nodes));
             // The bound is the tree's size: refused one node below it.
             prop_assert!(place_boxes(&boxes, &placement, nodes).is_ok());
