@@ -5,7 +5,7 @@ Their inputs are decoded by the `arbitrary` crate (1.x), so each seed is the enc
 and floats little-endian, a bool or an Option's tag one byte, an enum's variant a u32 (variant
 `(v · count) >> 32`), a Vec each element after a byte 1 and ended by a byte 0. Files that the round-trip
 targets read are taken from the plain targets' seeds. The point cloud targets' seeds are small files of each
-format (PLY ASCII and binary, PCD ASCII and binary, XYZ, CSV, LAS 1.2 with point format 0).
+format (PLY ASCII and binary, PCD ASCII, binary and binary_compressed, XYZ, CSV, LAS 1.2 with point format 0).
 
     fuzz/make_seeds.py        # from anywhere; rewrites the seeds it owns
 """
@@ -188,6 +188,31 @@ def pcd_cloud(binary):
     return (head + "".join("%g %g %g 7\n" % p for p in CLOUD)).encode()
 
 
+def lzf_literals(data, repeat_at=None):
+    """LZF (liblzf's format) of `data`: literal runs of at most 32 bytes; where `repeat_at` is given, the
+    bytes from there on (a repeat of the 2 bytes just before) as one back reference instead."""
+    out = b""
+    head = data if repeat_at is None else data[:repeat_at]
+    for i in range(0, len(head), 32):
+        run = head[i:i + 32]
+        out += u8(len(run) - 1) + run
+    if repeat_at is not None:
+        n = len(data) - repeat_at  # a reference of n bytes, 2 back
+        assert 3 <= n <= 8 and data[repeat_at:] == (data[repeat_at - 2:repeat_at] * 4)[:n]
+        out += u8((n - 2) << 5) + u8(1)
+    return out
+
+
+def pcd_compressed_cloud():
+    """PCD `DATA binary_compressed`: the sizes, then LZF of the fields column by column (x, y, z, intensity),
+    the last bytes a back reference."""
+    head = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 2\nTYPE F F F U\nCOUNT 1 1 1 1\n" \
+        "WIDTH %d\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA binary_compressed\n" % (len(CLOUD), len(CLOUD))
+    columns = b"".join(struct.pack("<f", p[a]) for a in range(3) for p in CLOUD) + u16(7) * len(CLOUD)
+    data = lzf_literals(columns, len(columns) - 6)
+    return head.encode() + u32(len(data)) + u32(len(columns)) + data
+
+
 def las_cloud():
     """LAS 1.2, point format 0 (20-byte records), scale 0.01, no VLR."""
     scale = 0.01
@@ -205,7 +230,8 @@ def las_cloud():
 
 SEEDS.update({
     "cloud_ply": {"ascii.ply": ply_cloud(False), "binary.ply": ply_cloud(True)},
-    "cloud_pcd": {"ascii.pcd": pcd_cloud(False), "binary.pcd": pcd_cloud(True)},
+    "cloud_pcd": {"ascii.pcd": pcd_cloud(False), "binary.pcd": pcd_cloud(True),
+                  "compressed.pcd": pcd_compressed_cloud()},
     "cloud_xyz": {
         "points.xyz": ("# x y z\n" + "".join("%g %g %g 1\n" % p for p in CLOUD)).encode(),
         "points.csv": ("x,y,z\n" + "".join("%g,%g,%g\n" % p for p in CLOUD)).encode(),

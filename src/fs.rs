@@ -30,7 +30,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     write_atomic_with(path, |w| w.write_all(bytes))
 }
 
-/// Like [`write_atomic`], with the content produced by `fill` into a buffered writer.
+/// Like [`write_atomic`], with the content produced by `fill` into a buffered writer (through an
+/// [`AtomicFile`]).
 ///
 /// # Errors
 /// Any I/O error from `fill` or the file system, with the path in the message; the target is untouched.
@@ -40,40 +41,97 @@ pub fn write_atomic_with(
 ) -> std::io::Result<()> {
     let with_path =
         |e: std::io::Error| std::io::Error::new(e.kind(), format!("{}: {e}", path.display()));
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    std::fs::create_dir_all(dir).map_err(with_path)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    remove_stale(dir, &name, TEMP_SUFFIX);
-    let (prefix, suffix) = (
-        format!(".{name}."),
-        format!(".{}{TEMP_SUFFIX}", std::process::id()),
-    );
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(&suffix);
-    // The mode a plain `File::create` gives (0666 less the umask), not the temporary file's 0600.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut tmp = builder.tempfile_in(dir).map_err(with_path)?;
-    // A file replaced keeps its mode.
-    if let Ok(old) = std::fs::metadata(path) {
-        tmp.as_file()
-            .set_permissions(old.permissions())
-            .map_err(with_path)?;
-    }
+    let mut file = AtomicFile::create(path).map_err(with_path)?;
     {
-        let mut w = std::io::BufWriter::new(tmp.as_file_mut());
+        let mut w = std::io::BufWriter::new(&mut file);
         fill(&mut w).map_err(with_path)?;
         w.flush().map_err(with_path)?;
     }
-    tmp.as_file().sync_all().map_err(with_path)?;
-    tmp.persist(path).map_err(|e| with_path(e.error))?;
-    Ok(())
+    file.commit().map_err(with_path)
+}
+
+/// A file written atomically: written as a temporary file beside its target, which
+/// [`commit`](Self::commit) renames over the target; dropped without a commit, it is removed and the
+/// target is untouched. Unbuffered: wrap it in a [`std::io::BufWriter`] for small writes.
+///
+/// ```
+/// use std::io::Write;
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("out.txt");
+/// let mut file = ktree::fs::AtomicFile::create(&path).unwrap();
+/// file.write_all(b"hello").unwrap();
+/// assert!(!path.exists());
+/// file.commit().unwrap();
+/// assert_eq!(std::fs::read(&path).unwrap(), b"hello");
+/// ```
+#[derive(Debug)]
+pub struct AtomicFile {
+    tmp: tempfile::NamedTempFile,
+    path: PathBuf,
+}
+
+impl AtomicFile {
+    /// Starts writing `path`: creates its folder if needed, removes the temporary files of killed writes
+    /// to it, and creates its temporary file `.NAME.XXXXXX.PID.ktree-tmp`, with the mode `File::create`
+    /// would give a new file (0666 less the umask) or the mode of the file it replaces.
+    ///
+    /// # Errors
+    /// The folder or the temporary file cannot be created (the error as the system gave it).
+    pub fn create(path: &Path) -> std::io::Result<Self> {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        std::fs::create_dir_all(dir)?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        remove_stale(dir, &name, TEMP_SUFFIX);
+        let (prefix, suffix) = (
+            format!(".{name}."),
+            format!(".{}{TEMP_SUFFIX}", std::process::id()),
+        );
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(&suffix);
+        // The mode a plain `File::create` gives (0666 less the umask), not the temporary file's 0600.
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let tmp = builder.tempfile_in(dir)?;
+        // A file replaced keeps its mode.
+        if let Ok(old) = std::fs::metadata(path) {
+            tmp.as_file().set_permissions(old.permissions())?;
+        }
+        Ok(Self {
+            tmp,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Ends the write: the bytes written are synced to the disk, then the file is renamed over its target.
+    ///
+    /// # Errors
+    /// The sync or the rename failed (the error as the system gave it); the temporary file is removed and
+    /// the target untouched.
+    pub fn commit(self) -> std::io::Result<()> {
+        self.tmp.as_file().sync_all()?;
+        self.tmp.persist(&self.path).map_err(|e| e.error)?;
+        Ok(())
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        self.tmp.as_file_mut().write(bytes)
+    }
+
+    fn write_all(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.tmp.as_file_mut().write_all(bytes)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.tmp.as_file_mut().flush()
+    }
 }
 
 /// The suffix of spill folders: `.NAME.XXXXXX.PID.ktree-spill`.
@@ -175,6 +233,24 @@ pub enum SpillError {
         /// The error.
         source: std::io::Error,
     },
+}
+
+impl SpillError {
+    /// The kind of the I/O error behind it.
+    pub fn kind(&self) -> std::io::ErrorKind {
+        match self {
+            Self::TempDir { source, .. }
+            | Self::Spill { source, .. }
+            | Self::Output { source, .. } => source.kind(),
+        }
+    }
+}
+
+impl From<SpillError> for std::io::Error {
+    /// The error as an I/O error of the same kind, its message naming the file.
+    fn from(e: SpillError) -> Self {
+        std::io::Error::new(e.kind(), e)
+    }
 }
 
 /// An I/O failure kept whole inside a file error, so that its [`source`](std::error::Error::source) is the

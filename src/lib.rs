@@ -21,8 +21,9 @@
 //! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
 //! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
 //! * [`io`]: files, one module per format — `.ktree` (version 2 written, streamed and memory-mapped; version 1
-//!   read), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb` — and the spill files of trees larger than
-//!   memory (one level a file), which the out-of-core builder and the streamed Booleans both write.
+//!   read), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb`, point clouds and meshes in — and the spill
+//!   files of trees larger than memory (one level a file), which the out-of-core builder and the streamed
+//!   Booleans both write.
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity.
@@ -38,24 +39,27 @@
 //! # Layers
 //! Each layer imports only those below it, with the exceptions listed after the picture:
 //! ```text
-//!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text;
+//!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text,
+//!                     point clouds and meshes in (into solid/'s PointCloud and TriangleMesh);
 //!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in,
 //!                     meshes written through export/); spill files, one level a file, and the level
-//!                     sink over them
+//!                     sink over them; the out-of-core builder's files (Builder::to_file)
 //!  export/            boundaries as meshes and outlines, and their files (over display's neighbours);
 //!                     the 3-D view page (over the storage trait and display's named views)
 //!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink
 //!  query/  shape/     questions asked of a map (points, boxes, rays, nearest), over the storage trait;
 //!                     morphology, components, surface area, Euler number, on the runs
-//!  stacking/          Builder (cells on all threads, in memory or out of core; KTree::from_rays), paper/
+//!  stacking/          Builder (cells on all threads, in memory or out of core through a piece store and
+//!                     a level-order sink; KTree::from_rays), paper/
 //!  solid/             quadrics, meshes, volumes → rays, slab by slab
 //!  tree/              KTree, AnyTree, the storage trait, the walks, the level sink, packed 2-bit words
 //!  rays/   space   fs (atomic writes, spill folders)
 //! ```
 //! Not yet so: the ray sources of `solid/` implement `stacking::RaySource` (solid → stacking); the
-//! out-of-core builder and the streamed Booleans spill through `io`'s level files and write their output
-//! through `io::KtreeWriter`, and the streamed Booleans read their inputs through `io::KtreeView`
-//! (stacking, ops → io). (`KTree::from_rays` and `KTree::from_dense` are
+//! streamed Booleans spill through `io`'s level files, write their output through `io::KtreeWriter` and
+//! read their inputs through `io::KtreeView` (ops → io). (The out-of-core builder writes through its own
+//! traits, `stacking::PieceStore` and `stacking::LevelOrderSink`, which `io` implements with spill files
+//! and the `.ktree` writer: `Builder::to_file` is defined in `io`.) (`KTree::from_rays` and `KTree::from_dense` are
 //! defined beside their builders, in `stacking/` and `reference/`: the tree knows no builder.)
 //!
 //! # Example

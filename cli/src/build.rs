@@ -6,8 +6,9 @@ use crate::common::error::CliResult;
 use std::path::PathBuf;
 
 use ktree::io::{open_rays_file, RaysFile, RaysFileSource};
-use ktree::rays::RaySource;
-use ktree::{LevelCounts, RaySet};
+use ktree::RaySet;
+
+use crate::common::output::TreeOutput;
 
 /// Arguments of `ktree build`.
 #[derive(Debug, clap::Args)]
@@ -33,74 +34,28 @@ pub fn run(args: Args) -> CliResult {
         RaysFile::Sorted(source) => {
             ktree::with_dim!(&source, AnyRaysFileSource, s => build_source(s, &args))?
         }
-        RaysFile::Whole(rays) => {
-            ktree::with_dim!(&rays, AnyRaySet, r => build_out_of_core(r, &args))?
-        }
+        RaysFile::Whole(rays) => ktree::with_dim!(&rays, AnyRaySet, r => build_rays(r, &args))?,
     };
     crate::common::output::print_summary(&summary)
 }
 
-/// Stacks the rays straight into the output, out of core (across the MPI ranks of the run, if several);
-/// returns the summary (empty on ranks other than 0).
-fn build_out_of_core<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<String, String> {
+/// Stacks rays read whole straight into the output; returns the summary (empty on ranks other than 0).
+fn build_rays<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<String, String> {
     let what = format!("the rays of {}", args.rays.display());
-    let budget = args
-        .build
-        .budget
-        .left_after(&what, crate::common::memory::ray_bytes(rays))?;
-    let Some(report) =
-        crate::distributed::build_to_file(rays, &args.out, args.threads, &args.build, budget)?
-    else {
-        return Ok(String::new());
-    };
-    let c = LevelCounts::total(rays.level(), &report.counts_per_level);
-    Ok(summary(
-        &args.out,
-        K,
-        rays.level(),
-        rays.len(),
-        c,
-        c.nodes().div_ceil(4),
-    ))
+    let held = (what.as_str(), crate::common::memory::ray_bytes(rays));
+    let built = TreeOutput::new(&args.out, args.threads, &args.build).write(rays, Some(held))?;
+    Ok(built
+        .map(|b| b.summary_with_size(rays.len() as u64))
+        .unwrap_or_default())
 }
 
-/// Stacks a ray file read slab by slab straight into the output, out of core (across the MPI ranks of
-/// the run, if several, each reading its slabs' lines); returns the summary (empty on ranks other than 0).
+/// Stacks a ray file read slab by slab straight into the output (across the MPI ranks of the run, if
+/// several, each reading its slabs' lines); returns the summary (empty on ranks other than 0).
 fn build_source<const K: usize>(source: &RaysFileSource<K>, args: &Args) -> Result<String, String> {
     let what = format!("the index of {}", args.rays.display());
-    let budget = args.build.budget.left_after(&what, source.heap_bytes())?;
-    let Some(report) =
-        crate::distributed::build_to_file(source, &args.out, args.threads, &args.build, budget)?
-    else {
-        return Ok(String::new());
-    };
-    let level = source.universe().level();
-    let c = LevelCounts::total(level, &report.counts_per_level);
-    Ok(summary(
-        &args.out,
-        K,
-        level,
-        source.runs() as usize,
-        c,
-        c.nodes().div_ceil(4),
-    ))
-}
-
-/// The one-line summary of a build.
-fn summary(
-    out: &std::path::Path,
-    k: usize,
-    level: u32,
-    rays: usize,
-    c: LevelCounts,
-    bytes: u64,
-) -> String {
-    format!(
-        "{}: K = {k}, L = {level}, {rays} rays -> {} nodes ({} full, {} empty, {} partial), {bytes} bytes at 2 bits/node",
-        out.display(),
-        c.nodes(),
-        c.full,
-        c.empty,
-        c.partial,
-    )
+    let held = (what.as_str(), source.heap_bytes());
+    let built = TreeOutput::new(&args.out, args.threads, &args.build).write(source, Some(held))?;
+    Ok(built
+        .map(|b| b.summary_with_size(source.runs()))
+        .unwrap_or_default())
 }

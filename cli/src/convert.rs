@@ -5,11 +5,19 @@
 use crate::common::error::CliResult;
 use crate::outln;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use ktree::io::{read_tree_placed, write_tree, Format, ReadOptions, WriteOptions};
+use ktree::export::surface::smooth_mesh;
+use ktree::export::vtk::{write_time_slices, write_vtk_file};
+use ktree::export::{write_mesh_of, write_surface, ExportError, Frame};
+use ktree::io::{
+    ktree_file_version, read_tree_placed, write_tree, AnyMappedTree, FileTree, Format, ReadOptions,
+    WriteOptions, VERSION,
+};
 use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
+use ktree::tree::storage::TreeStorage;
+use ktree::{with_tree, AnyTree};
 
 /// Arguments of `ktree convert`.
 #[derive(Debug, clap::Args)]
@@ -108,11 +116,27 @@ pub fn run(a: Args) -> CliResult {
             (None, None) => None,
         },
     };
-    let read = read_tree_placed(&a.input, &options).map_err(|e| e.to_string())?;
-    for r in &read.remarks {
-        eprintln!("note: {}: {r}", a.input.display());
-    }
-    let out_offset = match (&a.out_offset, Format::of(&a.output), read.placement) {
+    let format = Format::of(&a.output);
+    let exported = matches!(
+        format,
+        Some(Format::Mesh | Format::Glb | Format::Svg | Format::Vtu | Format::Htg)
+    );
+    // Meshes and VTK files of a version 2 .ktree are made from its memory map, whatever its size; every
+    // other input is read into memory, with the placement and metadata of its format.
+    let (file, placement, read_meta) = if (exported || a.time_axis.is_some() || a.smooth)
+        && Format::of(&a.input) == Some(Format::Ktree)
+        && ktree_file_version(&a.input).is_ok_and(|v| v == VERSION)
+    {
+        let mapped = AnyMappedTree::open(&a.input).map_err(|e| e.to_string())?;
+        (FileTree::Mapped(mapped), None, None)
+    } else {
+        let read = read_tree_placed(&a.input, &options).map_err(|e| e.to_string())?;
+        for r in &read.remarks {
+            eprintln!("note: {}: {r}", a.input.display());
+        }
+        (FileTree::Memory(read.tree), read.placement, read.meta)
+    };
+    let out_offset = match (&a.out_offset, format, placement) {
         (Some(t), _, _) => parse_xyz("out-offset", t)?,
         (
             None,
@@ -123,7 +147,7 @@ pub fn run(a: Args) -> CliResult {
         ) => p.offset,
         _ => [0; 3],
     };
-    let mut meta = read.meta.unwrap_or_default();
+    let mut meta = read_meta.unwrap_or_default();
     if let Some(v) = a.voxel_size {
         if !(v.is_finite() && v > 0.0) {
             return Err(format!("--voxel-size {v}: expected a positive number").into());
@@ -135,54 +159,54 @@ pub fn run(a: Args) -> CliResult {
         // The grid's index 0 is ktree voxel `out_offset`.
         meta.origin = std::array::from_fn(|i| origin[i] + out_offset[i] as f64 * meta.voxel_size);
     }
-    let write_options = WriteOptions {
-        offset: out_offset,
-        meta: Some(meta),
-    };
     if let Some(axis) = a.time_axis {
-        let ktree::AnyTree::K4(t) = &read.tree else {
-            return Err(format!(
-                "{}: --time-axis slices 4-D trees; this tree has K = {}",
-                a.input.display(),
-                read.tree.k()
-            )
-            .into());
-        };
-        let frame = ktree::export::Frame {
+        let frame = Frame {
             voxel_size: meta.voxel_size,
             origin: meta.origin,
         };
-        let files = ktree::export::vtk::write_time_slices(&a.output, t, axis, &frame)
-            .map_err(|e| e.to_string())?;
+        let files = match &file {
+            FileTree::Memory(AnyTree::K4(t)) => write_time_slices(&a.output, t, axis, &frame),
+            FileTree::Mapped(AnyMappedTree::K4(t)) => write_time_slices(&a.output, t, axis, &frame),
+            other => {
+                return Err(format!(
+                    "{}: --time-axis slices 4-D trees; this tree has K = {}",
+                    a.input.display(),
+                    other.k()
+                )
+                .into())
+            }
+        }
+        .map_err(|e| e.to_string())?;
         outln!(
             "{}: K = 4, L = {}, {} slices along axis {axis} ({} files)",
             a.output.display(),
-            t.level(),
-            t.universe().side(),
+            file.level(),
+            1u64 << file.level(),
             files.len()
         );
         return Ok(());
     }
+    // Meshes and VTK files: ktree voxel v is at meta.origin + (v − out_offset) · voxel_size.
+    let frame = Frame {
+        voxel_size: meta.voxel_size,
+        origin: std::array::from_fn(|i| meta.origin[i] - out_offset[i] as f64 * meta.voxel_size),
+    };
     if a.smooth {
-        let ktree::AnyTree::K3(t) = &read.tree else {
-            return Err(format!(
-                "{}: --smooth makes surfaces of octrees (K = 3); this tree has K = {}",
-                a.input.display(),
-                read.tree.k()
-            )
-            .into());
-        };
-        // ktree voxel v is at meta.origin + (v − out_offset) · voxel_size, as for the exact boundary.
-        let frame = ktree::export::Frame {
-            voxel_size: meta.voxel_size,
-            origin: std::array::from_fn(|i| {
-                meta.origin[i] - out_offset[i] as f64 * meta.voxel_size
-            }),
-        };
-        let mesh = ktree::export::surface::smooth_mesh(t, SMOOTH_ITERATIONS)
-            .map_err(|e| format!("{}: {e}", a.input.display()))?
-            .placed(&frame);
-        let written = ktree::export::write_surface(&a.output, &mesh).map_err(|e| e.to_string())?;
+        let mesh = match &file {
+            FileTree::Memory(AnyTree::K3(t)) => smooth_mesh(t, SMOOTH_ITERATIONS),
+            FileTree::Mapped(AnyMappedTree::K3(t)) => smooth_mesh(t, SMOOTH_ITERATIONS),
+            other => {
+                return Err(format!(
+                    "{}: --smooth makes surfaces of octrees (K = 3); this tree has K = {}",
+                    a.input.display(),
+                    other.k()
+                )
+                .into())
+            }
+        }
+        .map_err(|e| format!("{}: {e}", a.input.display()))?
+        .placed(&frame);
+        let written = write_surface(&a.output, &mesh).map_err(|e| e.to_string())?;
         outln!(
             "{}: smooth surface of {} vertices, {} triangles",
             a.output.display(),
@@ -191,24 +215,46 @@ pub fn run(a: Args) -> CliResult {
         );
         return Ok(());
     }
-    if Format::of(&a.output) == Some(Format::Ktree) {
-        // The version --format-version asks for, as every command that writes trees.
-        ktree::with_dim!(&read.tree, AnyTree, t => crate::common::tree_file::write_tree(&a.output, t))
-            .map_err(|e| format!("cannot write {}: {e}", a.output.display()))?;
+    if exported {
+        with_tree!(&file, t => export(&a.output, t, &frame)).map_err(|e| e.to_string())?;
     } else {
-        write_tree(&a.output, &read.tree, &write_options).map_err(|e| e.to_string())?;
+        let FileTree::Memory(tree) = &file else {
+            unreachable!("only meshes and VTK files are made from a file read in place")
+        };
+        if format == Some(Format::Ktree) {
+            // The version --format-version asks for, as every command that writes trees.
+            ktree::with_dim!(tree, AnyTree, t => crate::common::tree_file::write_tree(&a.output, t))
+                .map_err(|e| format!("cannot write {}: {e}", a.output.display()))?;
+        } else {
+            let write_options = WriteOptions {
+                offset: out_offset,
+                meta: Some(meta),
+            };
+            write_tree(&a.output, tree, &write_options).map_err(|e| e.to_string())?;
+        }
     }
-    let c = read.tree.counts();
-    let placed = read.placement.map_or(String::new(), |p| {
+    let (c, voxels) = with_tree!(&file, t => (TreeStorage::counts(t), TreeStorage::voxel_count(t)));
+    let placed = placement.map_or(String::new(), |p| {
         format!(" (grid index + {:?} = ktree voxel)", p.offset)
     });
     outln!(
-        "{}: K = {}, L = {}, {} nodes, {} voxels{placed}",
+        "{}: K = {}, L = {}, {} nodes, {voxels} voxels{placed}",
         a.output.display(),
-        read.tree.k(),
-        read.tree.level(),
+        file.k(),
+        file.level(),
         c.nodes(),
-        ktree::with_dim!(&read.tree, AnyTree, t => t.voxel_count()),
     );
     Ok(())
+}
+
+/// Writes the tree's boundary (a mesh or an outline) or a VTK file, by the output's extension.
+fn export<const K: usize, T: TreeStorage<K>>(
+    path: &Path,
+    tree: &T,
+    frame: &Frame,
+) -> Result<(), ExportError> {
+    match Format::of(path) {
+        Some(Format::Vtu | Format::Htg) => write_vtk_file(path, tree, frame),
+        _ => write_mesh_of(path, tree, frame).map(drop),
+    }
 }

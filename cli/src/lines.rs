@@ -6,8 +6,9 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::display::{line_drawing_with_progress, png, svg, HiddenLineMethod};
-use ktree::io::read_ktree_file;
+use ktree::display::{line_drawing_with_progress, png, svg, HiddenLineMethod, LineDrawing};
+use ktree::io::{AnyMappedTree, FileTree};
+use ktree::tree::storage::TreeStorage;
 use ktree::AnyTree;
 
 use crate::common::picture::{parse_size, parse_view};
@@ -16,7 +17,8 @@ use crate::common::progress::progress_bar;
 /// Arguments of `ktree lines`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// A `.ktree` file of an octree (K = 3).
+    /// An octree (K = 3): a `.ktree` file (version 2 is read in place) or any format `ktree convert`
+    /// reads.
     file: PathBuf,
     /// Where the viewer looks from (parallel projection): iso, top, bottom, front, back, left, right, or a
     /// direction X,Y,Z from the object towards the viewer.
@@ -51,17 +53,9 @@ pub fn run(args: Args) -> CliResult {
     if !(args.stroke.is_finite() && args.stroke > 0.0) {
         return Err("--stroke must be a positive number".into());
     }
-    let tree = match read_ktree_file(&args.file).map_err(|e| e.to_string())? {
-        AnyTree::K3(t) => t,
-        other => {
-            return Err(format!(
-                "line drawings need an octree (K = 3); {} is a K = {} tree (try ktree render)",
-                args.file.display(),
-                other.k()
-            )
-            .into())
-        }
-    };
+    // A version 2 file is drawn from its memory map, whatever its size.
+    let file = FileTree::open(&args.file, &ktree::io::ReadOptions::default())
+        .map_err(|e| e.to_string())?;
     let out = args
         .out
         .clone()
@@ -73,8 +67,18 @@ pub fn run(args: Args) -> CliResult {
             b.set_position(done);
         }
     };
-    let drawing =
-        line_drawing_with_progress(&tree, toward, method, &mut tick).map_err(|e| e.to_string())?;
+    let drawing = match &file {
+        FileTree::Memory(AnyTree::K3(t)) => draw(t, toward, method, &mut tick)?,
+        FileTree::Mapped(AnyMappedTree::K3(t)) => draw(t, toward, method, &mut tick)?,
+        other => {
+            return Err(format!(
+                "line drawings need an octree (K = 3); {} is a K = {} tree (try ktree render)",
+                args.file.display(),
+                other.k()
+            )
+            .into())
+        }
+    };
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -101,4 +105,14 @@ pub fn run(args: Args) -> CliResult {
         s.segments
     );
     Ok(())
+}
+
+/// The line drawing of an octree, in memory or memory-mapped.
+fn draw<T: TreeStorage<3>>(
+    tree: &T,
+    toward: [f64; 3],
+    method: HiddenLineMethod,
+    tick: &mut dyn FnMut(u64, u64),
+) -> Result<LineDrawing, String> {
+    line_drawing_with_progress(tree, toward, method, tick).map_err(|e| e.to_string())
 }

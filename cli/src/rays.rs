@@ -3,15 +3,14 @@
 use crate::common::error::CliResult;
 use crate::outln;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use ktree::fs::write_atomic_with;
 use ktree::io::write_rays_source;
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSource};
 use ktree::stacking::default_split_depth;
-use ktree::LevelCounts;
 
-use crate::common::output::is_tree_file;
+use crate::common::output::{is_tree_file, TreeOutput};
 
 /// Arguments of `ktree rays`.
 #[derive(Debug, clap::Args)]
@@ -147,20 +146,6 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
     Ok(Solid::Quadric(q))
 }
 
-/// The summary of a tree written to `out`, from its counts per level.
-fn tree_summary<const K: usize>(out: &Path, level: u32, counts: &[LevelCounts]) -> String {
-    let c = LevelCounts::total(level, counts);
-    format!(
-        "{}: K = {K}, L = {level}, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
-        out.display(),
-        crate::common::memory::voxels(K, level, counts),
-        c.nodes(),
-        c.full,
-        c.empty,
-        c.partial
-    )
-}
-
 fn go<const K: usize>(a: &Args) -> CliResult {
     let s = solid::<K>(a)?;
     let sample = if a.corner {
@@ -172,14 +157,10 @@ fn go<const K: usize>(a: &Args) -> CliResult {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole
         // (across MPI ranks, each rank makes the rays of its own slabs only).
         let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
-        let budget = a.build.budget.budget();
-        let counts = match crate::distributed::build_to_file(
-            &source, &a.out, a.threads, &a.build, budget,
-        )? {
-            Some(report) => report.counts_per_level,
-            None => return Ok(()),
-        };
-        outln!("{}", tree_summary::<K>(&a.out, a.level, &counts));
+        let built = TreeOutput::new(&a.out, a.threads, &a.build).write(&source, None)?;
+        if let Some(built) = built {
+            outln!("{}", built.summary(None));
+        }
         return Ok(());
     }
     if !crate::distributed::ranks().is_root() {

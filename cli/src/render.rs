@@ -2,7 +2,7 @@
 //! hidden-surface image of an octree; a quadtree is drawn as a picture of its cells, a 4-D tree as a strip
 //! of time slices.
 
-use crate::common::error::CliResult;
+use crate::common::error::{read_error, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -22,7 +22,8 @@ use ktree::{AnyRaySet, AnyTree};
 /// Arguments of `ktree render`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// A `.ktree` file (K = 3: hidden-surface image; K = 2: picture of the cells; K = 4: strip of slices).
+    /// A `.ktree` file, version 2 read in place, or any format `ktree convert` reads (K = 3:
+    /// hidden-surface image; K = 2: picture of the cells; K = 4: strip of slices).
     file: PathBuf,
     /// Where the camera looks from: iso, top, bottom, front, back, left, right, or a direction X,Y,Z from
     /// the object towards the eye. The camera frames the object.
@@ -81,51 +82,61 @@ pub fn run(args: Args) -> CliResult {
             b.set_position(done);
         }
     };
-    // An octree in a version 2 file is rendered from its memory map, whatever its size.
+    // A version 2 file is drawn from its memory map, whatever its size.
     let file = FileTree::open(&args.file, &ktree::io::ReadOptions::default())
         .map_err(|e| e.to_string())?;
-    let tree = match file {
-        FileTree::Mapped(AnyMappedTree::K3(tree)) => {
-            return render_octree(&tree, &args, &out, w, h, bar.as_ref(), &mut tick)
+    match &file {
+        FileTree::Memory(AnyTree::K3(t)) => {
+            render_octree(t, &args, &out, w, h, bar.as_ref(), &mut tick)
         }
-        FileTree::Mapped(mapped) => mapped.view().to_any_tree().map_err(|e| e.to_string())?,
-        FileTree::Memory(tree) => tree,
-    };
-    match tree {
-        AnyTree::K3(tree) => render_octree(&tree, &args, &out, w, h, bar.as_ref(), &mut tick)?,
-        AnyTree::K2(tree) => {
-            let canvas = plane::quadtree_canvas(&tree, w.min(h)).map_err(|e| e.to_string())?;
-            canvas.write_png(&out).map_err(|e| e.to_string())?;
-            outln!(
-                "wrote {} (quadtree, {} leaves)",
-                out.display(),
-                tree.leaves().count()
-            );
+        FileTree::Mapped(AnyMappedTree::K3(t)) => {
+            render_octree(t, &args, &out, w, h, bar.as_ref(), &mut tick)
         }
-        AnyTree::K4(tree) => {
-            let (strip, frames) = slices::time_strip(&tree, args.time_axis, args.frames, h)
-                .map_err(|e| e.to_string())?;
-            strip.write_png(&out).map_err(|e| e.to_string())?;
-            if let Some(dir) = &args.frames_dir {
-                for (i, (_, frame)) in frames.iter().enumerate() {
-                    let path = dir.join(format!("frame_{i:03}.png"));
-                    png::write_rgb_png(&path, frame.width, frame.height, &frame.rgb)
-                        .map_err(|e| e.to_string())?;
-                }
-            }
-            let positions: Vec<String> = frames.iter().map(|(p, _)| p.to_string()).collect();
-            outln!(
-                "wrote {} ({} frames of the slices at {} on axis {})",
-                out.display(),
-                frames.len(),
-                positions.join(", "),
-                args.time_axis
-            );
-        }
-        AnyTree::K1(_) => {
-            return Err("a bintree (K = 1) has no picture; render needs K = 2, 3 or 4".into())
+        FileTree::Memory(AnyTree::K2(t)) => render_quadtree(t, &out, w.min(h)),
+        FileTree::Mapped(AnyMappedTree::K2(t)) => render_quadtree(t, &out, w.min(h)),
+        FileTree::Memory(AnyTree::K4(t)) => render_strip(t, &args, &out, h),
+        FileTree::Mapped(AnyMappedTree::K4(t)) => render_strip(t, &args, &out, h),
+        FileTree::Memory(AnyTree::K1(_)) | FileTree::Mapped(AnyMappedTree::K1(_)) => {
+            Err("a bintree (K = 1) has no picture; render needs K = 2, 3 or 4".into())
         }
     }
+}
+
+/// Draws a quadtree's cells, `size` pixels square, to the PNG `out`.
+fn render_quadtree<T: TreeStorage<2>>(tree: &T, out: &Path, size: u32) -> CliResult {
+    let canvas = plane::quadtree_canvas(tree, size).map_err(|e| e.to_string())?;
+    canvas.write_png(out).map_err(|e| e.to_string())?;
+    // Every leaf is full or empty: the counts say how many there are, without a walk.
+    let counts = tree.counts();
+    outln!(
+        "wrote {} (quadtree, {} leaves)",
+        out.display(),
+        counts.full + counts.empty
+    );
+    Ok(())
+}
+
+/// Draws a strip of a 4-D tree's slices, frames `size` pixels square, to the PNG `out` (and each frame
+/// to the frames' folder if asked).
+fn render_strip<T: TreeStorage<4>>(tree: &T, args: &Args, out: &Path, size: u32) -> CliResult {
+    let (strip, frames) =
+        slices::time_strip(tree, args.time_axis, args.frames, size).map_err(|e| e.to_string())?;
+    strip.write_png(out).map_err(|e| e.to_string())?;
+    if let Some(dir) = &args.frames_dir {
+        for (i, (_, frame)) in frames.iter().enumerate() {
+            let path = dir.join(format!("frame_{i:03}.png"));
+            png::write_rgb_png(&path, frame.width, frame.height, &frame.rgb)
+                .map_err(|e| e.to_string())?;
+        }
+    }
+    let positions: Vec<String> = frames.iter().map(|(p, _)| p.to_string()).collect();
+    outln!(
+        "wrote {} ({} frames of the slices at {} on axis {})",
+        out.display(),
+        frames.len(),
+        positions.join(", "),
+        args.time_axis
+    );
     Ok(())
 }
 
@@ -146,7 +157,7 @@ fn render_octree<T: TreeStorage<3>>(
         camera.eye = parse_vec3(eye, "eye")?;
         let side = tree.universe().side() as f64;
         let (lo, hi) = object_bounds(tree)
-            .map_err(crate::common::error::read_error)?
+            .map_err(read_error)?
             .unwrap_or(([0.0; 3], [side; 3]));
         camera.target = match &args.target {
             Some(t) => parse_vec3(t, "target")?,

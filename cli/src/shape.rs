@@ -1,17 +1,25 @@
 //! `ktree morph FILE dilate|erode|open|close --radius R [--shape ball|box|cross] --out OUT` and
 //! `ktree components FILE [--connectivity C] [--out-dir D] [--json]`: morphology and connected components
-//! of a `.ktree` file; and the measures (`surface_area`, `euler_number`) that `stats` and `mass` report.
+//! of a tree file (a version 2 `.ktree` read in place through its memory map, any other format read into
+//! memory); and the measures (`surface_area`, `euler_number`) that `stats` and `mass` report.
 
-use crate::common::error::CliResult;
+use crate::common::error::{read_error, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
 
-use ktree::shape::Element;
-use ktree::{AnyTree, KTree};
+use ktree::io::{FileTree, ReadOptions};
+use ktree::shape::{self, Element};
+use ktree::tree::TreeStorage;
+use ktree::{with_tree, AnyTree};
 use serde::Serialize;
 
-use crate::common::tree_file::{read, write};
+use crate::common::tree_file::write;
+
+/// Opens a tree file: a version 2 `.ktree` through its memory map, any other format read into memory.
+fn open(path: &Path) -> Result<FileTree, String> {
+    FileTree::open(path, &ReadOptions::default()).map_err(|e| e.to_string())
+}
 
 /// Arguments of `ktree morph`.
 #[derive(Debug, clap::Args)]
@@ -32,13 +40,13 @@ pub struct MorphArgs {
     out: PathBuf,
 }
 
-fn morph<const K: usize>(t: &KTree<K>, args: &MorphArgs) -> CliResult {
+fn morph<const K: usize, T: TreeStorage<K> + Sync>(t: &T, args: &MorphArgs) -> CliResult {
     let (r, e) = (args.radius, args.shape);
     let out = match args.operation.as_str() {
-        "dilate" => t.dilate(r, e),
-        "erode" => t.erode(r, e),
-        "open" => t.opening(r, e),
-        _ => t.closing(r, e),
+        "dilate" => shape::dilate(t, r, e),
+        "erode" => shape::erode(t, r, e),
+        "open" => shape::opening(t, r, e),
+        _ => shape::closing(t, r, e),
     }
     .map_err(|err| format!("{}: {err}", args.tree.display()))?;
     write(&args.out, &out)
@@ -49,8 +57,8 @@ pub fn run_morph(args: MorphArgs) -> CliResult {
     if !(args.radius.is_finite() && args.radius >= 0.0) {
         return Err(format!("--radius must be a number ≥ 0, got {}", args.radius).into());
     }
-    let tree = read(&args.tree)?;
-    ktree::with_dim!(&tree, AnyTree, t => morph(t, &args))
+    let tree = open(&args.tree)?;
+    with_tree!(&tree, t => morph(t, &args))
 }
 
 /// Arguments of `ktree components`.
@@ -77,13 +85,13 @@ struct ComponentsReport {
     files: Option<Vec<PathBuf>>,
 }
 
-fn components<const K: usize>(
-    t: &KTree<K>,
+fn components<const K: usize, T: TreeStorage<K>>(
+    t: &T,
     args: &ComponentsArgs,
 ) -> Result<ComponentsReport, String> {
     let name = |err: ktree::shape::ShapeError| format!("{}: {err}", args.tree.display());
     let Some(dir) = &args.out_dir else {
-        let sizes = t.component_sizes(args.connectivity).map_err(name)?;
+        let sizes = shape::component_sizes(t, args.connectivity).map_err(name)?;
         return Ok(ComponentsReport {
             connectivity: args.connectivity,
             count: sizes.len(),
@@ -91,7 +99,7 @@ fn components<const K: usize>(
             files: None,
         });
     };
-    let parts = t.components(args.connectivity).map_err(name)?;
+    let parts = shape::components(t, args.connectivity).map_err(name)?;
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let mut files = Vec::new();
     for (i, part) in parts.iter().enumerate() {
@@ -110,8 +118,8 @@ fn components<const K: usize>(
 
 /// Runs `ktree components`.
 pub fn run_components(args: ComponentsArgs) -> CliResult {
-    let tree = read(&args.tree)?;
-    let report = ktree::with_dim!(&tree, AnyTree, t => components(t, &args))?;
+    let tree = open(&args.tree)?;
+    let report = with_tree!(&tree, t => components(t, &args))?;
     if args.json {
         outln!(
             "{}",
@@ -139,26 +147,53 @@ pub fn run_components(args: ComponentsArgs) -> CliResult {
 pub struct Measures {
     /// The count of (K − 1)-faces between full and empty voxels.
     pub surface_area: u128,
-    /// The Euler number, K = 2 and 3 only.
+    /// The Euler number, K = 2 and 3 only, when the tree's runs fit the memory budget.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub euler_number: Option<i64>,
+    /// Whether the Euler number was left out because the tree's runs are large next to the memory budget.
+    #[serde(skip)]
+    pub euler_skipped: bool,
 }
 
-fn measures_of<const K: usize>(t: &KTree<K>) -> Measures {
-    Measures {
-        surface_area: t.surface_area(),
-        euler_number: matches!(K, 2 | 3).then(|| t.euler_number(K).expect("connectivity K")),
-    }
+/// Bytes a run of the tree takes while the Euler number walks the runs (its column key and ends, and its
+/// share of the pieces gathered), with room to spare.
+const BYTES_PER_RUN: u128 = 48;
+
+fn measures_of<const K: usize, T: TreeStorage<K>>(t: &T, budget: u64) -> Result<Measures, String> {
+    // The surface area walks the nodes alone; the Euler number holds the runs, counted first.
+    let surface_area = shape::surface_area(t).map_err(|e| read_error(e).to_string())?;
+    let fits = || -> Result<bool, String> {
+        let runs = shape::run_count(t).map_err(|e| read_error(e).to_string())?;
+        Ok(runs.saturating_mul(BYTES_PER_RUN) <= u128::from(budget))
+    };
+    let (euler_number, euler_skipped) = if matches!(K, 2 | 3) && fits()? {
+        let e = shape::euler_number(t, K).map_err(|e| e.to_string())?;
+        (Some(e), false)
+    } else {
+        (None, matches!(K, 2 | 3))
+    };
+    Ok(Measures {
+        surface_area,
+        euler_number,
+        euler_skipped,
+    })
 }
 
-/// The measures of a loaded tree.
-pub fn measures(tree: &AnyTree) -> Measures {
-    ktree::with_dim!(tree, AnyTree, t => measures_of(t))
+/// The measures of a tree file (read in place or in memory): the surface area, and the Euler number
+/// when the tree's runs fit the memory budget.
+pub fn measures(tree: &FileTree) -> Result<Measures, String> {
+    let budget = crate::common::memory::default_budget();
+    with_tree!(tree, t => measures_of(t, budget))
 }
 
-/// The measures of a tree file, read into memory if it is small next to the memory budget (at most 1/16 of
-/// it: the runs the measures walk take more than the tree); `None` for a larger file, which `stats` and
-/// `mass` then read through its memory map alone.
+/// [`measures`] of a tree in memory.
+pub fn measures_in_memory(tree: &AnyTree) -> Result<Measures, String> {
+    let budget = crate::common::memory::default_budget();
+    ktree::with_dim!(tree, AnyTree, t => measures_of(t, budget))
+}
+
+/// The measures of a tree file if it is small next to the memory budget (at most 1/16 of it), `None` for
+/// a larger file, which `mass` then reports without them (they take a pass over the whole tree).
 pub fn measures_of_file(path: &Path) -> Result<Option<Measures>, String> {
     let size = std::fs::metadata(path)
         .map_err(|e| format!("{}: {e}", path.display()))?
@@ -166,5 +201,5 @@ pub fn measures_of_file(path: &Path) -> Result<Option<Measures>, String> {
     if size > crate::common::memory::default_budget() / 16 {
         return Ok(None);
     }
-    Ok(Some(measures(&read(path)?)))
+    Ok(Some(measures(&open(path)?)?))
 }

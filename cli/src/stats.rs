@@ -3,7 +3,8 @@
 //! (the counts come from its directory; the bounding box from one walk that descends only where a face of
 //! the box may lie); a file of another format `ktree` reads (`.vdb`, `.bt`, binvox, …) is read into memory.
 //! With `--measures`, the surface area and the Euler number (`surface_area`, `euler_number`) too, measured
-//! on the tree read into memory when the file is small next to the memory budget.
+//! on the file as it is read (in place for a version 2 file): the surface area on the nodes alone, the
+//! Euler number on the tree's runs when they fit the memory budget.
 
 use crate::common::error::CliResult;
 use crate::outln;
@@ -29,7 +30,8 @@ pub struct Args {
     #[arg(long)]
     json: bool,
     /// Also measure the surface area (faces between full and empty voxels) and the Euler number (JSON
-    /// keys `surface_area`, `euler_number`): a pass over the tree's runs, longer than the counts.
+    /// keys `surface_area`, `euler_number`): a pass over the tree's nodes, and for the Euler number over its
+    /// runs, longer than the counts.
     #[arg(long)]
     measures: bool,
 }
@@ -42,17 +44,21 @@ pub fn run(args: Args) -> CliResult {
             let file = FileTree::open(path, &ktree::io::ReadOptions::default())
                 .map_err(|e| e.to_string())?;
             let stats = with_tree!(&file, t => stats(t, None).map_err(read_error))?;
-            let measures = match (&file, args.measures) {
-                (_, false) => None,
-                (FileTree::Memory(tree), true) => Some(crate::shape::measures(tree)),
-                (FileTree::Mapped(_), true) => crate::shape::measures_of_file(path)?,
+            let measures = if args.measures {
+                Some(crate::shape::measures(&file)?)
+            } else {
+                None
             };
             (stats, measures)
         }
         (None, Some(path)) => {
             let rays = read_rays_file(path).map_err(|e| e.to_string())?;
             let tree = rays.build();
-            let measures = args.measures.then(|| crate::shape::measures(&tree));
+            let measures = if args.measures {
+                Some(crate::shape::measures_in_memory(&tree)?)
+            } else {
+                None
+            };
             (tree.stats(Some(rays.len() as u64)), measures)
         }
         _ => return Err("give either a .ktree file or --rays FILE".into()),
@@ -97,17 +103,16 @@ pub fn run(args: Args) -> CliResult {
         stats.memory_bytes,
         stats.memory_bytes as f64 * 8.0 / stats.nodes as f64
     );
-    match measures {
-        Some(m) => {
-            outln!("surface  {} faces", m.surface_area);
-            if let Some(e) = m.euler_number {
-                outln!("euler    {e} (connectivity {})", stats.k);
-            }
+    if let Some(m) = measures {
+        outln!("surface  {} faces", m.surface_area);
+        if let Some(e) = m.euler_number {
+            outln!("euler    {e} (connectivity {})", stats.k);
         }
-        None if args.measures => {
-            outln!("surface  - (not measured: the file is large next to the memory budget)")
+        if m.euler_skipped {
+            outln!(
+                "euler    - (not measured: the tree's runs are large next to the memory budget)"
+            );
         }
-        None => {}
     }
     outln!("level        full       empty     partial");
     for l in &stats.per_level {

@@ -16,9 +16,9 @@ use ktree::io::{voxel_source, voxelize, Format, ReadOptions, VoxelSource};
 use ktree::rays::{RaySource, SlabRuns};
 use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
-use ktree::{LevelCounts, Universe};
+use ktree::Universe;
 
-use crate::common::output::{is_tree_file, write_output};
+use crate::common::output::{is_tree_file, write_output, TreeOutput};
 
 /// Arguments of `ktree voxelize`.
 #[derive(Debug, clap::Args)]
@@ -68,7 +68,8 @@ pub struct Args {
 
 /// Voxelizes the input and writes it.
 pub fn run(a: Args) -> CliResult {
-    if ktree::solid::cloud::is_cloud_file(&a.input).unwrap_or(false) {
+    // A `.ply` is a cloud or a mesh by its header: a broken one is said as such.
+    if ktree::io::is_cloud_file(&a.input).map_err(|e| e.to_string())? {
         return run_cloud(&a);
     }
     if a.voxel_size.is_some() || a.origin.is_some() || a.crop {
@@ -131,7 +132,8 @@ pub fn run(a: Args) -> CliResult {
 
 /// Voxelizes a point cloud and writes it.
 fn run_cloud(a: &Args) -> CliResult {
-    use ktree::solid::cloud::{CloudVoxelizer, PointCloud};
+    use ktree::solid::cloud::CloudVoxelizer;
+    use ktree::solid::SolidError;
     let size = a
         .voxel_size
         .ok_or_else(|| format!("{}: a point cloud needs --voxel-size S", a.input.display()))?;
@@ -156,10 +158,19 @@ fn run_cloud(a: &Args) -> CliResult {
     if let Some(l) = a.level {
         v = v.level(l);
     }
-    let cloud = PointCloud::read(&a.input).map_err(|e| e.to_string())?;
-    let voxels = v
-        .voxelize(cloud.points())
-        .map_err(|e| format!("{}: {e}", a.input.display()))?;
+    let cloud = ktree::io::read_cloud(&a.input).map_err(|e| e.to_string())?;
+    let voxels = v.voxelize(cloud.points()).map_err(|e| {
+        let hint = match e {
+            SolidError::PointsOutside { .. } => {
+                ": use a larger --level or --voxel-size, another --origin, or --crop to drop them"
+            }
+            SolidError::PointBelowOrigin { .. } => {
+                ": give --level and --crop to drop such points, or another --origin"
+            }
+            _ => "",
+        };
+        format!("{}: {e}{hint}", a.input.display())
+    })?;
     let root = crate::distributed::ranks().is_root();
     if root {
         let o = voxels.origin;
@@ -218,25 +229,12 @@ fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
         VoxelSource::Mesh(_) => format!("the placed triangles of {}", a.input.display()),
         VoxelSource::Volume(_) => format!("the samples of {}", a.input.display()),
     };
-    let budget = a.build.budget.left_after(&what, source.heap_bytes())?;
     let counted = CountedRuns::new(source);
-    let Some(report) =
-        crate::distributed::build_to_file(&counted, &a.out, a.threads, &a.build, budget)?
-    else {
-        return Ok(String::new());
-    };
-    let level = source.universe().level();
-    let c = LevelCounts::total(level, &report.counts_per_level);
-    Ok(format!(
-        "{}: K = 3, L = {level}, {} rays, {} voxels -> {} nodes ({} full, {} empty, {} partial)",
-        a.out.display(),
-        counted.runs(),
-        crate::common::memory::voxels(3, level, &report.counts_per_level),
-        c.nodes(),
-        c.full,
-        c.empty,
-        c.partial
-    ))
+    let held = (what.as_str(), source.heap_bytes());
+    let built = TreeOutput::new(&a.out, a.threads, &a.build).write(&counted, Some(held))?;
+    Ok(built
+        .map(|b| b.summary(Some(counted.runs())))
+        .unwrap_or_default())
 }
 
 /// A source that counts the runs of its slabs as they are made (a slab made twice is counted once).

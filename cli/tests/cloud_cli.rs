@@ -162,7 +162,7 @@ fn bad_clouds_are_one_line_errors() {
     for (args, want) in [
         (
             vec!["voxelize", &bad, "--voxel-size", "1", "--out", o],
-            "bad.xyz: line 2: expected 3 numbers",
+            "bad.xyz:2: expected 3 numbers",
         ),
         (vec!["voxelize", &good, "--out", o], "needs --voxel-size"),
         (
@@ -202,4 +202,144 @@ fn bad_clouds_are_one_line_errors() {
     assert!(!ok && err.contains("are for point clouds"), "{err}");
     let (ok, _, err) = ktree(&["voxelize", &mesh, "--level", "3", "--fit", "--out", o]);
     assert!(ok, "{err}");
+}
+
+/// A `.ply` whose header is broken is neither a cloud nor a mesh: the header's fault is said, naming the
+/// file once and the line (it was reported as a cloud needing --voxel-size); a mesh's error names the file
+/// once; points outside the universe get the command's hint.
+#[test]
+fn broken_files_are_said_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.ktree");
+    let o = out.to_str().unwrap();
+    let broken = write(
+        dir.path(),
+        "broken.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n",
+    );
+    let bad_index = write(
+        dir.path(),
+        "bad.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5.5\n",
+    );
+    let good = write(dir.path(), "good.xyz", "1 2 3\n9 2 3\n");
+    for (args, want) in [
+        (
+            vec!["voxelize", &broken, "--level", "3", "--fit", "--out", o],
+            format!("ktree: {broken}:5: unexpected PLY header line 'property float'"),
+        ),
+        (
+            vec!["voxelize", &broken, "--voxel-size", "1", "--out", o],
+            format!("ktree: {broken}:5: unexpected PLY header line 'property float'"),
+        ),
+        (
+            vec!["voxelize", &bad_index, "--level", "3", "--fit", "--out", o],
+            format!("ktree: {bad_index}:13: PLY face 0: '5.5' is not a vertex index"),
+        ),
+        (
+            vec!["voxelize", &good, "--voxel-size", "1", "--origin", "0,0,0", "--level", "2", "--out", o],
+            format!("ktree: {good}: 1 points lie outside the universe of level 2 (side 4 voxels); the first is point 1 [9.0, 2.0, 3.0] in voxel [9.0, 2.0, 3.0]: use a larger --level or --voxel-size, another --origin, or --crop to drop them"),
+        ),
+        (
+            vec!["voxelize", &good, "--voxel-size", "1", "--origin", "2,0,0", "--out", o],
+            format!("ktree: {good}: point 0 [1.0, 2.0, 3.0] lies below the origin [2.0, 0.0, 0.0] along axis 0: give --level and --crop to drop such points, or another --origin"),
+        ),
+    ] {
+        let (ok, _, err) = ktree(&args);
+        assert!(!ok, "{args:?}");
+        assert_eq!(err.trim(), want);
+    }
+}
+
+/// LAZ whose point count was raised by one: refused in one line naming the file and the byte, within a
+/// small address space (it once asked for 3.7 GB and aborted); PCL's `binary_compressed` PCD voxelizes as
+/// PCL's own conversion of it to `binary`.
+#[test]
+fn real_clouds_read_or_are_refused_with_bounded_memory() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/clouds");
+    let dir = tempfile::tempdir().unwrap();
+    let mut copc = std::fs::read(data.join("simple.copc.laz")).unwrap();
+    copc[107..111].copy_from_slice(&1066u32.to_le_bytes());
+    copc[247..255].copy_from_slice(&1066u64.to_le_bytes());
+    let bad = dir.path().join("bad.laz");
+    std::fs::write(&bad, &copc).unwrap();
+    let out = dir.path().join("o.ktree");
+    let command = format!(
+        "ulimit -v 1000000; exec {} voxelize {} --voxel-size 0.5 --out {}",
+        env!("CARGO_BIN_EXE_ktree"),
+        bad.display(),
+        out.display()
+    );
+    let run = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(&command)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{err}");
+    assert!(
+        err.trim().starts_with(&format!(
+            "ktree: {}: byte 107: LAZ: the header declares 1066 points, but the chunk table",
+            bad.display()
+        )),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    let mut trees = Vec::new();
+    for name in [
+        "pcl_brisk_keypoints_gt.pcd",
+        "pcl_brisk_keypoints_gt_binary.pcd",
+    ] {
+        let input = data.join(name);
+        let (ok, stdout, err) = ktree(&[
+            "voxelize",
+            input.to_str().unwrap(),
+            "--voxel-size",
+            "0.01",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        assert!(stdout.contains(": 1860 points, "), "{stdout}");
+        trees.push(tree(&out));
+    }
+    assert_eq!(trees[0], trees[1]);
+}
+
+/// A closed mesh whose every face has its own vertices is not warned about.
+#[test]
+fn closed_meshes_with_repeated_vertices_give_no_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    // A cube [0, 1]³ with four vertices a face, as PLY exporters write it for per-face attributes.
+    let faces = [
+        [[0, 0, 0], [0, 1, 0], [1, 1, 0], [1, 0, 0]],
+        [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
+        [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]],
+        [[0, 1, 0], [0, 1, 1], [1, 1, 1], [1, 1, 0]],
+        [[0, 0, 0], [0, 0, 1], [0, 1, 1], [0, 1, 0]],
+        [[1, 0, 0], [1, 1, 0], [1, 1, 1], [1, 0, 1]],
+    ];
+    let mut ply = String::from("ply\nformat ascii 1.0\nelement vertex 24\nproperty float x\nproperty float y\nproperty float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n");
+    for f in &faces {
+        for v in f {
+            ply += &format!("{} {} {}\n", v[0], v[1], v[2]);
+        }
+    }
+    for i in 0..6 {
+        ply += &format!("4 {} {} {} {}\n", 4 * i, 4 * i + 1, 4 * i + 2, 4 * i + 3);
+    }
+    let cube = write(dir.path(), "cube.ply", &ply);
+    let out = dir.path().join("o.ktree");
+    let (ok, _, err) = ktree(&[
+        "voxelize",
+        &cube,
+        "--level",
+        "4",
+        "--fit",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(!err.contains("not closed"), "{err}");
+    assert_eq!(tree(&out).voxel_count(), 14 * 14 * 14);
 }

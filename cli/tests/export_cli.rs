@@ -8,7 +8,7 @@ use std::path::Path;
 use common::ktree;
 use ktree::io::{read_tree_placed, write_tree, GridMeta, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
-use ktree::solid::mesh::{MeshTransform, TriangleMesh};
+use ktree::solid::mesh::MeshTransform;
 use ktree::{AnyTree, KTree};
 
 fn ball() -> KTree<3> {
@@ -21,7 +21,7 @@ fn save(path: &Path, tree: AnyTree) {
 
 /// The tree a mesh file voxelizes to at `level`, the world mapped back by `size` and `origin`.
 fn voxelized(path: &Path, level: u32, size: f64, origin: [f64; 3]) -> KTree<3> {
-    let mesh = TriangleMesh::read(path).unwrap();
+    let mesh = ktree::io::read_mesh(path).unwrap();
     assert_eq!(mesh.open_edges(), 0, "{}", path.display());
     let placement = MeshTransform {
         scale: 1.0 / size,
@@ -54,7 +54,7 @@ fn convert_writes_each_mesh_format_in_world_units() {
             assert_eq!(&bytes[..4], b"glTF");
             continue;
         }
-        let mesh = TriangleMesh::read(&out).unwrap();
+        let mesh = ktree::io::read_mesh(&out).unwrap();
         // In world units the sum of the tetrahedra rounds (voxel units are exact: verify/tests/mesh_out.rs).
         let volume = tree.voxel_count() as f64 * 0.125;
         assert!(
@@ -103,7 +103,7 @@ fn a_grid_keeps_its_voxel_size_and_origin() {
         voxelized(&out, read_tree.level(), m.voxel_size, origin),
         read_tree
     );
-    let mesh = TriangleMesh::read(&out).unwrap();
+    let mesh = ktree::io::read_mesh(&out).unwrap();
     let (lo, _) = mesh.bounds().unwrap();
     assert!(lo[0] >= 5.0, "{lo:?}");
 }
@@ -125,7 +125,7 @@ fn smooth_writes_a_closed_surface_near_the_voxels_volume() {
     ]);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("smooth"), "{stdout}");
-    let mesh = TriangleMesh::read(&out).unwrap();
+    let mesh = ktree::io::read_mesh(&out).unwrap();
     assert_eq!(mesh.open_edges(), 0);
     let volume = tree.voxel_count() as f64 * 0.125;
     assert!(

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use common::ktree;
 use ktree::io::{read_rays_file, voxelize, write_ktree, ReadOptions};
-use ktree::solid::mesh::{MeshTransform, TriangleMesh};
+use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
 use ktree::stacking::paper::stack;
 use ktree::AnyRaySet;
@@ -50,7 +50,7 @@ fn voxelize_builds_meshes_and_volumes_slab_by_slab() {
         brain.to_str().unwrap(),
     );
     // The bunny smaller, shifted along x and partly below the universe (crossings clamped to its face).
-    let fit = MeshTransform::fit(&TriangleMesh::read(Path::new(bunny)).unwrap(), 6).unwrap();
+    let fit = MeshTransform::fit(&ktree::io::read_mesh(Path::new(bunny)).unwrap(), 6).unwrap();
     let bunny_transform = MeshTransform {
         scale: fit.scale * 0.75,
         translate: [

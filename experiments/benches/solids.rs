@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use ktree::rays::ball_rays;
-use ktree::solid::mesh::{MeshTransform, TriangleMesh};
+use ktree::solid::mesh::MeshTransform;
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample};
 
 fn quadrics(c: &mut Criterion) {
@@ -34,7 +34,7 @@ fn meshes(c: &mut Criterion) {
     let mut group = c.benchmark_group("mesh");
     group.sample_size(10);
     for name in ["bunny_npm.obj", "armadillo.obj"] {
-        let mesh = TriangleMesh::read(&dir.join(name)).unwrap_or_else(|e| panic!("{e}"));
+        let mesh = ktree::io::read_mesh(&dir.join(name)).expect("mesh");
         let level = 10;
         let p = MeshTransform::fit(&mesh, level).expect("fit");
         group.bench_with_input(BenchmarkId::new(name, level), &mesh, |b, m| {

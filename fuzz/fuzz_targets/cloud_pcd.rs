@@ -1,4 +1,4 @@
-//! The PCD reader (ASCII and binary) on arbitrary bytes; accepted clouds are voxelized in a small universe.
+//! The PCD reader (ASCII, binary and binary_compressed) on arbitrary bytes; accepted clouds are voxelized in a small universe.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 

@@ -5,8 +5,8 @@ use std::path::Path;
 use arbitrary::Arbitrary;
 use ktree::io::{read_ktree_any, read_rays, write_ktree, write_ktree_v1, write_rays, KtreeFileError, KtreeView};
 use ktree::{AnyRaySet, AnyTree};
-use ktree::solid::cloud::{bounds as cloud_bounds, CloudVoxelizer, PointCloud};
-use ktree::solid::mesh::{MeshTransform, TriangleMesh};
+use ktree::solid::cloud::{bounds as cloud_bounds, CloudVoxelizer};
+use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::{Select, Volume};
 use ktree::{max_level, KTree, Universe};
 
@@ -152,7 +152,7 @@ pub fn check_accepted_rays(rays: &AnyRaySet) {
 /// Parses a mesh and, when accepted, voxelizes it fitted into a small universe: errors are fine, panics
 /// are not.
 pub fn check_mesh(bytes: &[u8], format: &str) {
-    let Ok(mesh) = TriangleMesh::from_bytes(bytes, format, Path::new("fuzz")) else {
+    let Ok(mesh) = ktree::io::read_mesh_bytes(bytes, format, Path::new("fuzz")) else {
         return;
     };
     if let Ok(placement) = MeshTransform::fit(&mesh, CHECK_LEVEL) {
@@ -167,7 +167,7 @@ pub fn check_mesh(bytes: &[u8], format: &str) {
 /// level ≤ [`CHECK_LEVEL`], and cropped to a level-3 universe
 /// at the origin 0; errors are fine, panics are not.
 pub fn check_cloud(bytes: &[u8], format: &str) {
-    let Ok(cloud) = PointCloud::from_bytes(bytes, format, Path::new("fuzz")) else {
+    let Ok(cloud) = ktree::io::read_cloud_bytes(bytes, format, Path::new("fuzz")) else {
         return;
     };
     let points = cloud.points();

@@ -307,7 +307,8 @@ impl Tree {
         level: u32,
         transform: Option<[f64; 4]>,
     ) -> PyResult<Self> {
-        let mesh = py.detach(|| TriangleMesh::read(&path).map_err(Failure::from))?;
+        let mesh =
+            py.detach(|| ktree::io::read_mesh(&path).map_err(|e| Failure::of_error(&e, &path)))?;
         mesh_tree(py, mesh, level, transform, &path.display().to_string())
     }
 
@@ -377,7 +378,18 @@ impl Tree {
         }
         let points: Vec<[f64; 3]> = p.outer_iter().map(|r| [r[0], r[1], r[2]]).collect();
         let tree = py.detach(|| KTree::from_points(&points, voxel_size, origin, level));
-        Ok(Tree::wrap(tree.map_err(Failure::value)?))
+        let hint = match &tree {
+            Err(ktree::solid::SolidError::PointsOutside { .. }) => {
+                ": use a larger level or voxel_size, or another origin"
+            }
+            Err(ktree::solid::SolidError::PointBelowOrigin { .. }) => {
+                ": give another origin (or none: the points' minimum corner)"
+            }
+            _ => "",
+        };
+        Ok(Tree::wrap(
+            tree.map_err(|e| Failure::Value(format!("{e}{hint}")))?,
+        ))
     }
 
     /// The octree of a volume file (a .json sidecar or its .raw, .nii, .nii.gz): samples with value

@@ -2,7 +2,7 @@
 //! cells, ray casts and nearest voxels. Arrays are read into plain vectors first, so that the work runs
 //! without the interpreter lock.
 
-use ktree::query::{self, RayCast};
+use ktree::query::{self, DenseError, DenseOrder, RayCast};
 use ktree::space::DENSE_LIMIT;
 use ktree::KTree;
 use numpy::ndarray::{Array1, Array2, ArrayD, ArrayViewD, IxDyn, ShapeBuilder};
@@ -72,59 +72,29 @@ pub(crate) fn nearest<const K: usize>(tree: &KTree<K>, flat: &[i64]) -> (Vec<f64
 }
 
 /// The voxels of the window of `shape` from `origin` as an array indexed `[x, y, z, …]` (memory in
-/// Fortran order); voxels outside the universe are `False`.
+/// Fortran order: the library's dense window, axis 0 fastest); voxels outside the universe are `False`.
 pub(crate) fn window<const K: usize>(
     tree: &KTree<K>,
     origin: [i64; K],
     shape: [usize; K],
 ) -> Result<ArrayD<bool>, Failure> {
-    let len = shape
+    let too_large = || {
+        Failure::Value(format!(
+            "a window of shape {shape:?} is more than {DENSE_LIMIT} voxels: ask for a smaller one"
+        ))
+    };
+    shape
         .iter()
         .try_fold(1u128, |n, &s| n.checked_mul(s as u128))
         .filter(|&n| n <= DENSE_LIMIT)
-        .ok_or_else(|| {
-            Failure::Value(format!(
-                "a window of shape {shape:?} is more than {DENSE_LIMIT} voxels: ask for a smaller one"
-            ))
-        })? as usize;
-    let side = tree.universe().side() as i64;
+        .ok_or_else(too_large)?;
     let end: [i64; K] = std::array::from_fn(|a| origin[a].saturating_add(shape[a] as i64));
-    let lo: [u32; K] = std::array::from_fn(|a| origin[a].clamp(0, side) as u32);
-    let hi: [u32; K] = std::array::from_fn(|a| end[a].clamp(0, side) as u32);
-    let mut data = vec![false; len];
-    if len > 0 {
-        let cut = tree.crop(lo, hi);
-        let mut stride = [1usize; K];
-        for a in 1..K {
-            stride[a] = stride[a - 1] * shape[a - 1];
-        }
-        for cell in cut.full_cells() {
-            let o = cell.origin();
-            let s = cell.side() as i64;
-            // The cell's part of the window, relative to the window's origin.
-            let from: [usize; K] =
-                std::array::from_fn(|a| (i64::from(o[a]).max(origin[a]) - origin[a]) as usize);
-            let to: [usize; K] =
-                std::array::from_fn(|a| ((i64::from(o[a]) + s).min(end[a]) - origin[a]) as usize);
-            let mut at = from;
-            'fill: loop {
-                let base: usize = (1..K).map(|a| at[a] * stride[a]).sum();
-                data[base + from[0]..base + to[0]].fill(true);
-                let mut a = 1;
-                loop {
-                    if a >= K {
-                        break 'fill;
-                    }
-                    at[a] += 1;
-                    if at[a] < to[a] {
-                        break;
-                    }
-                    at[a] = from[a];
-                    a += 1;
-                }
-            }
-        }
-    }
+    let data = query::dense_window(tree, origin, end, DenseOrder::FirstAxisFastest).map_err(
+        |e| match e {
+            DenseError::TooLarge { .. } => too_large(),
+            e => Failure::value(e),
+        },
+    )?;
     ArrayD::from_shape_vec(IxDyn(&shape).f(), data).map_err(Failure::value)
 }
 

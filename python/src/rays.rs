@@ -1,12 +1,15 @@
 //! Rays as integer arrays: one row per run, the column's `K − 1` coordinates, then `z1` and `z2` (the run
 //! covers `z1 ≤ z < z2` along the last axis), as in the ray text format.
 
-use ktree::{KTree, NodeState, Ray, RaySet};
+use ktree::shape::run_count;
+use ktree::tree::rays_of;
+use ktree::tree::storage::infallible;
+use ktree::{KTree, Ray, RaySet};
 use numpy::ndarray::{Array2, ArrayView2};
 
 use crate::failure::Failure;
 
-/// Most runs a tree is turned into before merging (checked before allocating).
+/// Most runs a tree is turned into (counted before anything is allocated).
 const MAX_RUNS: u128 = 1 << 27;
 
 /// The ray set of an `(n, K + 1)` array's rows in a universe of level `level`.
@@ -46,53 +49,17 @@ pub(crate) fn array_of_rays<const K: usize>(rays: &RaySet<K>) -> Array2<i64> {
     out
 }
 
-/// The runs of a tree's voxels along the last axis (each full leaf gives one run per column it covers;
-/// runs that touch are merged).
+/// The runs of a tree's voxels along the last axis (the library's [`rays_of`]), counted first
+/// ([`run_count`]): at most [`MAX_RUNS`] of them.
 ///
 /// # Errors
-/// A `ValueError` when the leaves would give more than [`MAX_RUNS`] runs before merging.
+/// A `ValueError` when the tree has more than [`MAX_RUNS`] runs.
 pub(crate) fn tree_rays<const K: usize>(tree: &KTree<K>) -> Result<RaySet<K>, Failure> {
-    let leaves: Vec<_> = tree
-        .leaves()
-        .filter(|(_, s)| *s == NodeState::Full)
-        .map(|(c, _)| c)
-        .collect();
-    let runs: u128 = leaves
-        .iter()
-        .map(|c| u128::from(c.side()).pow(K as u32 - 1))
-        .sum();
+    let runs = infallible(run_count(tree));
     if runs > MAX_RUNS {
         return Err(Failure::Value(format!(
-            "the tree's {} full leaves make {runs} runs, more than the {MAX_RUNS} this conversion allows",
-            leaves.len()
+            "the tree has {runs} runs, more than the {MAX_RUNS} this conversion allows"
         )));
     }
-    let mut rays = Vec::with_capacity(runs as usize);
-    for cell in &leaves {
-        let side = cell.side();
-        let z1 = cell.origin()[K - 1];
-        let z2 = u32::try_from(u64::from(z1) + side).map_err(Failure::value)?;
-        // Every column of the cell: an odometer over the first K − 1 axes.
-        let mut offset = [0u64; K];
-        loop {
-            let mut start = cell.origin();
-            for a in 0..K - 1 {
-                start[a] += offset[a] as u32;
-            }
-            rays.push(Ray::new(start, z2));
-            let mut axis = 0;
-            while axis < K - 1 {
-                offset[axis] += 1;
-                if offset[axis] < side {
-                    break;
-                }
-                offset[axis] = 0;
-                axis += 1;
-            }
-            if axis == K - 1 {
-                break;
-            }
-        }
-    }
-    Ok(RaySet::from_rays(tree.level(), rays)?)
+    Ok(infallible(rays_of(tree)))
 }

@@ -448,6 +448,12 @@ def test_mesh_file_equals_mesh_arrays(tmp_path):
     assert from_file.voxel_count == 8**3
     with pytest.raises(OSError):
         ktree.Tree.from_mesh(tmp_path / "missing.obj", 4)
+    # A malformed file: one line naming the file once, and the line.
+    bad = tmp_path / "bad.ply"
+    bad.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float\nend_header\n")
+    with pytest.raises(ValueError) as e:
+        ktree.Tree.from_mesh(bad, 4)
+    assert str(e.value) == f"{bad}:5: unexpected PLY header line 'property float'"
 
 
 def test_real_mesh_from_data_folder():

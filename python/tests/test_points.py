@@ -42,8 +42,14 @@ def test_from_points_equals_numpy_floor(seed, s):
 
 def test_from_points_errors():
     p = np.array([[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]])
-    with pytest.raises(ValueError, match="outside the universe"):
+    with pytest.raises(ValueError, match="outside the universe") as e:
         ktree.Tree.from_points(p, 1.0, origin=(0.0, 0.0, 0.0), level=2)
+    # The advice names what a Python caller can change, not the command line's flags.
+    assert str(e.value).endswith(": use a larger level or voxel_size, or another origin")
+    assert "--" not in str(e.value)
+    with pytest.raises(ValueError, match="below the origin") as e:
+        ktree.Tree.from_points(p, 1.0, origin=(1.0, 0.0, 0.0))
+    assert "another origin" in str(e.value) and "--" not in str(e.value)
     with pytest.raises(ValueError, match="not finite"):
         ktree.Tree.from_points(np.array([[0.0, np.nan, 0.0]]), 1.0)
     with pytest.raises(ValueError, match="voxel size"):

@@ -54,10 +54,10 @@ use super::camera::v3;
 use super::error::DisplayError;
 use super::hidden::{remove_hidden, HiddenLineMethod, ScreenBoxes};
 use super::neighbours::{shifted, Neighbours};
-use super::order::{ordered_full_cells, Order, Viewer};
+use super::order::{try_ordered_full_cells, Order, Viewer};
 use super::sightline::ExactView;
 use crate::space::Cell;
-use crate::tree::Octree;
+use crate::tree::storage::TreeStorage;
 
 /// A piece of a lattice line: along `axis`, at coordinates `fixed` on the two other axes (in increasing
 /// axis order), from `u0` to `u1` along `axis` (voxel units).
@@ -193,19 +193,19 @@ pub(crate) struct Piece {
 }
 
 /// The graphics nodes (non-surrounded full leaves in front-to-back order) and their edge pieces.
-pub(crate) fn extract(
-    tree: &Octree,
+pub(crate) fn extract<T: TreeStorage<3>>(
+    tree: &T,
     view: &ExactView,
     stats: &mut LineStats,
-) -> (Vec<Cell<3>>, Vec<Piece>) {
+) -> Result<(Vec<Cell<3>>, Vec<Piece>), T::Error> {
     let side_u = tree.universe().side();
     let mut cubes = Vec::new();
     let mut pieces = Vec::new();
-    let mut near = Neighbours::new(tree);
+    let mut near = Neighbours::new(tree)?;
     let order = Viewer::Direction(view.signs());
-    for cell in ordered_full_cells(tree, order, Order::FrontToBack) {
+    for cell in try_ordered_full_cells(tree, order, Order::FrontToBack)? {
         stats.full_leaves += 1;
-        if near.is_surrounded(&cell) {
+        if near.is_surrounded(&cell)? {
             stats.surrounded += 1;
             continue;
         }
@@ -231,9 +231,9 @@ pub(crate) fn extract(
                     };
                     // Query the viewer's quadrant first: if it is all full, nothing here shows.
                     let (viewer_q, which) = match (vb, vc) {
-                        (true, false) => (occ(&n1, !sb, sc), 1),
-                        (false, true) => (occ(&n2, sb, !sc), 2),
-                        _ => (occ(&dg, !sb, !sc), 3),
+                        (true, false) => (occ(&n1, !sb, sc)?, 1),
+                        (false, true) => (occ(&n2, sb, !sc)?, 2),
+                        _ => (occ(&dg, !sb, !sc)?, 3),
                     };
                     if viewer_q.iter().all(|r| r.2) {
                         continue;
@@ -241,17 +241,17 @@ pub(crate) fn extract(
                     let o1 = if which == 1 {
                         viewer_q.clone()
                     } else {
-                        occ(&n1, !sb, sc)
+                        occ(&n1, !sb, sc)?
                     };
                     let o2 = if which == 2 {
                         viewer_q.clone()
                     } else {
-                        occ(&n2, sb, !sc)
+                        occ(&n2, sb, !sc)?
                     };
                     let od = if which == 3 {
                         viewer_q
                     } else {
-                        occ(&dg, !sb, !sc)
+                        occ(&dg, !sb, !sc)?
                     };
                     let fixed = [
                         cell.origin[b] + if sb { s } else { 0 },
@@ -310,7 +310,7 @@ pub(crate) fn extract(
     }
     stats.graphics_nodes = cubes.len() as u64;
     stats.edge_pieces = pieces.len() as u64;
-    (cubes, pieces)
+    Ok((cubes, pieces))
 }
 
 /// Merges pieces of the same lattice line: overlapping parts are kept once, owned by the earliest
@@ -398,9 +398,10 @@ pub(crate) fn join_lines(mut pieces: Vec<Edge3>) -> Vec<Edge3> {
 /// ```
 ///
 /// # Errors
-/// [`DisplayError::BadDirection`] for a zero or non-finite direction.
-pub fn line_drawing(
-    tree: &Octree,
+/// [`DisplayError::BadDirection`] for a zero or non-finite direction; [`DisplayError::Storage`] if a read
+/// of the tree fails.
+pub fn line_drawing<T: TreeStorage<3>>(
+    tree: &T,
     toward_eye: [f64; 3],
     method: HiddenLineMethod,
 ) -> Result<LineDrawing, DisplayError> {
@@ -411,8 +412,8 @@ pub fn line_drawing(
 ///
 /// # Errors
 /// As [`line_drawing`].
-pub fn line_drawing_with_progress(
-    tree: &Octree,
+pub fn line_drawing_with_progress<T: TreeStorage<3>>(
+    tree: &T,
     toward_eye: [f64; 3],
     method: HiddenLineMethod,
     progress: &mut dyn FnMut(u64, u64),
@@ -420,8 +421,8 @@ pub fn line_drawing_with_progress(
     draw(tree, toward_eye, method, Some(progress))
 }
 
-fn draw(
-    tree: &Octree,
+fn draw<T: TreeStorage<3>>(
+    tree: &T,
     toward_eye: [f64; 3],
     method: HiddenLineMethod,
     progress: Option<&mut dyn FnMut(u64, u64)>,
@@ -441,7 +442,8 @@ fn draw(
         nodes: tree.node_count(),
         ..Default::default()
     };
-    let (cubes, pieces) = extract(tree, &view, &mut stats);
+    let (cubes, pieces) =
+        extract(tree, &view, &mut stats).map_err(|e| DisplayError::Storage(e.into()))?;
     let segments = merge_pieces(pieces);
     stats.segments = segments.len() as u64;
     let screen = ScreenBoxes::new(right, up, tree.universe().side() as f64);

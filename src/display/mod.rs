@@ -3,8 +3,9 @@
 //!
 //! * [`order`]: front-to-back / back-to-front traversal for any view.
 //! * [`camera`]: orthographic and perspective cameras, default framing.
-//! * [`raster`] + [`coverage`]: the front-to-back renderer with a screen coverage mask (and the painter's
-//!   back-to-front order, and a brute-force z-buffer reference).
+//! * [`raster`] + [`coverage`]: the front-to-back renderer with a screen coverage mask; the painter's
+//!   back-to-front order ([`render_back_to_front`]) and the brute-force z-buffer reference
+//!   ([`render_zbuffer`]) beside it, over the same screen geometry and shading.
 //! * [`neighbours`]: face neighbours in the compact tree, without pointers.
 //! * [`lines`]: line drawings — visible edges with cracks, hidden lines and dots removed ([`hidden`] holds
 //!   the paper's pairwise hidden-line step and a faster bucketed one).
@@ -27,24 +28,30 @@ pub mod hidden;
 pub mod lines;
 pub mod neighbours;
 pub mod order;
+mod painter;
 pub mod plane;
 pub mod png;
 pub mod raster;
+mod screen;
+mod shading;
 mod sightline;
 pub mod slices;
 pub mod svg;
 mod view;
+mod zbuffer;
 
 pub use camera::{default_camera, object_bounds, Camera, Projection, ISO_TOWARD_EYE};
 pub use coverage::Coverage;
 pub use error::{check_size, CameraProblem, DisplayError, MAX_IMAGE_SIDE, MAX_PIXELS};
 pub use hidden::HiddenLineMethod;
 pub use lines::{line_drawing, line_drawing_with_progress, Edge3, LineDrawing, LineStats};
-pub use order::{near_child, ordered_full_cells, walk_ordered, Order, Viewer, Walk};
+pub use order::{
+    near_child, ordered_full_cells, try_ordered_full_cells, try_walk_ordered, walk_ordered, Order,
+    Viewer, Walk,
+};
+pub use painter::render_back_to_front;
 #[cfg(feature = "png")]
 pub use raster::render_png;
-pub use raster::{
-    render, render_back_to_front, render_with_progress, render_zbuffer, RenderOptions, RenderStats,
-    Rendered,
-};
+pub use raster::{render, render_with_progress, RenderOptions, RenderStats, Rendered};
 pub use view::{View, ViewError, NAMED_VIEWS};
+pub use zbuffer::render_zbuffer;

@@ -16,16 +16,25 @@
 //! assert!(!is_surrounded(&full, &u.cell([0, 0, 0], 2).unwrap()));
 //! ```
 
+use std::convert::Infallible;
+
 use crate::space::Cell;
 use crate::tree::cursor::{self, ChildOrder, Visitor, Walk};
 use crate::tree::locate::PointCursor;
-use crate::tree::storage::infallible;
+use crate::tree::storage::{infallible, TreeStorage};
 use crate::tree::{KTree, NodeRef, NodeState};
 
 /// The node whose cell contains the aligned cell `region` and is either a leaf or `region` itself.
-/// `region` must lie inside the tree's universe.
-pub fn locate<const K: usize>(tree: &KTree<K>, region: &Cell<K>) -> NodeRef<K> {
-    infallible(crate::tree::locate::locate(tree, tree.root(), region))
+/// `region` must lie inside the tree's universe. (Any storage: [`Neighbours::locate`].)
+pub fn locate<const K: usize, T: TreeStorage<K, Error = Infallible>>(
+    tree: &T,
+    region: &Cell<K>,
+) -> NodeRef<K> {
+    infallible(crate::tree::locate::locate(
+        tree,
+        infallible(tree.root()),
+        region,
+    ))
 }
 
 /// The cell of the same size as `cell` across its face on `axis` (`upper`: the face at `origin + side`),
@@ -66,56 +75,74 @@ pub fn shifted<const K: usize>(
 }
 
 /// Whether every voxel of `region` that touches its face on `axis` (`upper` side) is full: the face of the
-/// region is wholly covered by the object.
-pub fn face_all_full<const K: usize>(
-    tree: &KTree<K>,
+/// region is wholly covered by the object. (Any storage: [`Neighbours::face_all_full`].)
+pub fn face_all_full<const K: usize, T: TreeStorage<K, Error = Infallible>>(
+    tree: &T,
     region: &Cell<K>,
     axis: usize,
     upper: bool,
 ) -> bool {
-    Neighbours::new(tree).face_all_full(region, axis, upper)
+    infallible(Neighbours::new(tree).and_then(|mut n| n.face_all_full(region, axis, upper)))
 }
 
 /// Whether a full leaf is surrounded: each of its `2K` faces touches only full voxels across it (V5).
-/// Faces on the universe's boundary are open.
-pub fn is_surrounded<const K: usize>(tree: &KTree<K>, cell: &Cell<K>) -> bool {
-    Neighbours::new(tree).is_surrounded(cell)
+/// Faces on the universe's boundary are open. (Any storage: [`Neighbours::is_surrounded`].)
+pub fn is_surrounded<const K: usize, T: TreeStorage<K, Error = Infallible>>(
+    tree: &T,
+    cell: &Cell<K>,
+) -> bool {
+    infallible(Neighbours::new(tree).and_then(|mut n| n.is_surrounded(cell)))
 }
 
-/// Questions about the cells near one another in a tree, each descent starting from the deepest ancestor
-/// shared with the previous question's cell.
+/// Questions about the cells near one another in a tree, on any storage, each descent starting from the
+/// deepest ancestor shared with the previous question's cell. Every answer is the storage's read or its
+/// error.
 ///
 /// ```
 /// use ktree::display::neighbours::Neighbours;
 /// use ktree::KTree;
 /// let full = KTree::<3>::full(2).unwrap();
 /// let u = full.universe();
-/// let mut n = Neighbours::new(&full);
-/// assert!(n.is_surrounded(&u.cell([1, 1, 1], 2).unwrap()));
-/// assert!(!n.is_surrounded(&u.cell([0, 0, 0], 2).unwrap()));
+/// let mut n = Neighbours::new(&full).unwrap();
+/// assert_eq!(n.is_surrounded(&u.cell([1, 1, 1], 2).unwrap()), Ok(true));
+/// assert_eq!(n.is_surrounded(&u.cell([0, 0, 0], 2).unwrap()), Ok(false));
 /// ```
 #[derive(Debug, Clone)]
-pub struct Neighbours<'t, const K: usize> {
-    tree: &'t KTree<K>,
-    locator: PointCursor<'t, K, KTree<K>>,
+pub struct Neighbours<'t, const K: usize, T = KTree<K>> {
+    tree: &'t T,
+    locator: PointCursor<'t, K, T>,
 }
 
-impl<'t, const K: usize> Neighbours<'t, K> {
+impl<'t, const K: usize, T: TreeStorage<K>> Neighbours<'t, K, T> {
     /// Questions about `tree`.
-    pub fn new(tree: &'t KTree<K>) -> Self {
-        Self {
+    ///
+    /// # Errors
+    /// The storage's read error.
+    pub fn new(tree: &'t T) -> Result<Self, T::Error> {
+        Ok(Self {
             tree,
-            locator: infallible(PointCursor::new(tree)),
-        }
+            locator: PointCursor::new(tree)?,
+        })
     }
 
     /// As [`locate`].
-    pub fn locate(&mut self, region: &Cell<K>) -> NodeRef<K> {
-        infallible(self.locator.locate(region))
+    ///
+    /// # Errors
+    /// The storage's read error.
+    pub fn locate(&mut self, region: &Cell<K>) -> Result<NodeRef<K>, T::Error> {
+        self.locator.locate(region)
     }
 
     /// As [`face_all_full`].
-    pub fn face_all_full(&mut self, region: &Cell<K>, axis: usize, upper: bool) -> bool {
+    ///
+    /// # Errors
+    /// The storage's read error.
+    pub fn face_all_full(
+        &mut self,
+        region: &Cell<K>,
+        axis: usize,
+        upper: bool,
+    ) -> Result<bool, T::Error> {
         struct AllFull {
             face: ChildOrder,
             all_full: bool,
@@ -137,9 +164,9 @@ impl<'t, const K: usize> Neighbours<'t, K> {
             face: ChildOrder::half::<K>(axis, upper),
             all_full: true,
         };
-        let node = self.locate(region);
-        cursor::walk_from(self.tree, node, &mut query);
-        query.all_full
+        let node = self.locate(region)?;
+        cursor::try_walk_from(self.tree, node, &mut query)?;
+        Ok(query.all_full)
     }
 
     /// Calls `f` with each leaf (cell and state) of `region` that touches the region's face on `axis`
@@ -151,16 +178,20 @@ impl<'t, const K: usize> Neighbours<'t, K> {
     /// // Voxels 0 and 3 of a 2 × 2 square: its upper face on axis 0 touches voxels 1 (empty) and 3 (full).
     /// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
     /// let mut seen = Vec::new();
-    /// Neighbours::new(&tree).face_leaves(&tree.universe().root(), 0, true, |c, s| seen.push((c.origin(), s)));
+    /// let mut near = Neighbours::new(&tree).unwrap();
+    /// near.face_leaves(&tree.universe().root(), 0, true, |c, s| seen.push((c.origin(), s))).unwrap();
     /// assert_eq!(seen, [([1, 0], NodeState::Empty), ([1, 1], NodeState::Full)]);
     /// ```
+    ///
+    /// # Errors
+    /// The storage's read error.
     pub fn face_leaves(
         &mut self,
         region: &Cell<K>,
         axis: usize,
         upper: bool,
         f: impl FnMut(&Cell<K>, NodeState),
-    ) {
+    ) -> Result<(), T::Error> {
         struct FaceLeaves<F> {
             face: ChildOrder,
             f: F,
@@ -177,28 +208,37 @@ impl<'t, const K: usize> Neighbours<'t, K> {
                 self.face
             }
         }
-        let node = self.locate(region);
+        let node = self.locate(region)?;
         if node.state != NodeState::Partial {
             let mut f = f;
             f(region, node.state);
-            return;
+            return Ok(());
         }
         let mut query = FaceLeaves {
             face: ChildOrder::half::<K>(axis, upper),
             f,
         };
-        cursor::walk_from(self.tree, node, &mut query);
+        cursor::try_walk_from(self.tree, node, &mut query)?;
+        Ok(())
     }
 
     /// As [`is_surrounded`].
-    pub fn is_surrounded(&mut self, cell: &Cell<K>) -> bool {
+    ///
+    /// # Errors
+    /// The storage's read error.
+    pub fn is_surrounded(&mut self, cell: &Cell<K>) -> Result<bool, T::Error> {
         let side = self.tree.universe().side();
-        (0..K).all(|axis| {
-            [false, true].iter().all(|&upper| {
-                face_neighbour_cell(cell, axis, upper, side)
-                    .is_some_and(|n| self.face_all_full(&n, axis, !upper))
-            })
-        })
+        for axis in 0..K {
+            for upper in [false, true] {
+                let Some(n) = face_neighbour_cell(cell, axis, upper, side) else {
+                    return Ok(false);
+                };
+                if !self.face_all_full(&n, axis, !upper)? {
+                    return Ok(false);
+                }
+            }
+        }
+        Ok(true)
     }
 }
 
@@ -206,19 +246,23 @@ impl<'t, const K: usize> Neighbours<'t, K> {
 /// at the region's `side_b` face on axis `b` and `side_c` face on axis `c` (`true` = upper). Returns
 /// `(start, end, full)` runs covering `[0, region side)` as offsets from the region's origin along `axis`,
 /// in order, adjacent runs of equal state merged. A missing region (outside the universe) is empty.
-pub fn edge_occupancy(
-    tree: &KTree<3>,
+/// (Any storage: [`Neighbours::edge_occupancy`].)
+pub fn edge_occupancy<T: TreeStorage<3, Error = Infallible>>(
+    tree: &T,
     region: Option<&Cell<3>>,
     side: u32,
     axis: usize,
     b: (usize, bool),
     c: (usize, bool),
 ) -> Vec<(u32, u32, bool)> {
-    Neighbours::new(tree).edge_occupancy(region, side, axis, b, c)
+    infallible(Neighbours::new(tree).and_then(|mut n| n.edge_occupancy(region, side, axis, b, c)))
 }
 
-impl Neighbours<'_, 3> {
+impl<T: TreeStorage<3>> Neighbours<'_, 3, T> {
     /// As [`edge_occupancy`].
+    ///
+    /// # Errors
+    /// The storage's read error.
     pub fn edge_occupancy(
         &mut self,
         region: Option<&Cell<3>>,
@@ -226,13 +270,13 @@ impl Neighbours<'_, 3> {
         axis: usize,
         (b, side_b): (usize, bool),
         (c, side_c): (usize, bool),
-    ) -> Vec<(u32, u32, bool)> {
+    ) -> Result<Vec<(u32, u32, bool)>, T::Error> {
         let mut out: Vec<(u32, u32, bool)> = Vec::new();
         let Some(region) = region else {
-            return vec![(0, side, false)];
+            return Ok(vec![(0, side, false)]);
         };
         let tree = self.tree;
-        let node = self.locate(region);
+        let node = self.locate(region)?;
         let base = region.origin[axis];
         let mut push = |start: u32, end: u32, full: bool| match out.last_mut() {
             Some(last) if last.2 == full && last.1 == start => last.1 = end,
@@ -240,7 +284,7 @@ impl Neighbours<'_, 3> {
         };
         if node.state != NodeState::Partial {
             push(0, side, node.state == NodeState::Full);
-            return out;
+            return Ok(out);
         }
         // Depth-first along the edge, lower half first.
         struct Edge<F> {
@@ -273,7 +317,7 @@ impl Neighbours<'_, 3> {
             base,
             push,
         };
-        cursor::walk_from(tree, node, &mut query);
-        out
+        cursor::try_walk_from(tree, node, &mut query)?;
+        Ok(out)
     }
 }

@@ -27,9 +27,12 @@
 //! assert_eq!(seen, [1, 0]);
 //! ```
 
+use std::convert::Infallible;
+
 use crate::space::Cell;
 use crate::tree::cursor::{self, ChildOrder, Visitor};
-use crate::tree::{KTree, NodeRef, NodeState};
+use crate::tree::storage::{infallible, TreeStorage};
+use crate::tree::{NodeRef, NodeState};
 
 /// Which way a traversal goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,7 +91,8 @@ pub fn child_at<const K: usize>(near: usize, j: usize, order: Order) -> usize {
 }
 
 /// Visits the nodes of `tree` in pre-order with children in view order; `visit` sees every node (partial
-/// nodes before their children) and may skip a subtree or stop. A [`cursor`] walk with a view order.
+/// nodes before their children) and may skip a subtree or stop. A [`cursor`] walk with a view order, for a
+/// storage whose reads cannot fail; any storage: [`try_walk_ordered`].
 ///
 /// ```
 /// use ktree::display::{walk_ordered, Order, Viewer, Walk};
@@ -101,13 +105,27 @@ pub fn child_at<const K: usize>(near: usize, j: usize, order: Order) -> usize {
 /// });
 /// assert_eq!(full, tree.full_cells().count());
 /// ```
-pub fn walk_ordered<const K: usize>(
-    tree: &KTree<K>,
+pub fn walk_ordered<const K: usize, T: TreeStorage<K, Error = Infallible>>(
+    tree: &T,
     viewer: Viewer<K>,
     order: Order,
     visit: impl FnMut(&NodeRef<K>) -> Walk,
 ) {
-    cursor::walk(tree, &mut ViewOrder::new(viewer, order, visit));
+    infallible(try_walk_ordered(tree, viewer, order, visit));
+}
+
+/// [`walk_ordered`] over any storage: the walk ends at the first read that fails.
+///
+/// # Errors
+/// The storage's read error.
+pub fn try_walk_ordered<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    viewer: Viewer<K>,
+    order: Order,
+    visit: impl FnMut(&NodeRef<K>) -> Walk,
+) -> Result<(), T::Error> {
+    cursor::try_walk(tree, &mut ViewOrder::new(viewer, order, visit))?;
+    Ok(())
 }
 
 /// A visitor in view order: wraps a per-node function and visits children front to back or back to front.
@@ -157,18 +175,31 @@ impl<const K: usize, F: FnMut(&NodeRef<K>) -> Walk> Visitor<K> for ViewOrder<K, 
     }
 }
 
-/// The full leaves of `tree` in view order.
-pub fn ordered_full_cells<const K: usize>(
-    tree: &KTree<K>,
+/// The full leaves of `tree` in view order (a storage whose reads cannot fail; any storage:
+/// [`try_ordered_full_cells`]).
+pub fn ordered_full_cells<const K: usize, T: TreeStorage<K, Error = Infallible>>(
+    tree: &T,
     viewer: Viewer<K>,
     order: Order,
 ) -> Vec<Cell<K>> {
+    infallible(try_ordered_full_cells(tree, viewer, order))
+}
+
+/// [`ordered_full_cells`] over any storage.
+///
+/// # Errors
+/// The storage's read error.
+pub fn try_ordered_full_cells<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    viewer: Viewer<K>,
+    order: Order,
+) -> Result<Vec<Cell<K>>, T::Error> {
     let mut out = Vec::new();
-    walk_ordered(tree, viewer, order, |n| {
+    try_walk_ordered(tree, viewer, order, |n| {
         if n.state == NodeState::Full {
             out.push(n.cell);
         }
         Walk::Descend
-    });
-    out
+    })?;
+    Ok(out)
 }

@@ -7,11 +7,14 @@
 //! assert!(svg.starts_with("<svg") && svg.contains("<rect"));
 //! ```
 
+use std::convert::Infallible;
 use std::fmt::Write as _;
 
 use super::error::DisplayError;
 use super::png::Canvas;
-use crate::tree::{NodeState, Quadtree};
+use crate::tree::cursor::TryLeaves;
+use crate::tree::storage::{infallible, TreeStorage};
+use crate::tree::NodeState;
 
 /// Colours of a quadtree picture.
 const FILL: [u8; 3] = [70, 110, 170];
@@ -30,14 +33,16 @@ const GRID: [u8; 3] = [150, 150, 150];
 /// ```
 ///
 /// # Errors
-/// [`DisplayError::BadSize`] for a zero or too large size.
-pub fn quadtree_canvas(tree: &Quadtree, size: u32) -> Result<Canvas, DisplayError> {
+/// [`DisplayError::BadSize`] for a zero or too large size; [`DisplayError::Storage`] if a read of the tree
+/// fails.
+pub fn quadtree_canvas<T: TreeStorage<2>>(tree: &T, size: u32) -> Result<Canvas, DisplayError> {
     let mut canvas = Canvas::new(size, size, EMPTY)?;
     let scale = f64::from(size) / tree.universe().side() as f64;
     let px = |v: f64| (v * scale).round() as i64;
     let h = i64::from(size);
     let mut outlines = Vec::new();
-    tree.for_each_leaf(|cell, state| {
+    for leaf in TryLeaves::new(tree) {
+        let (cell, state) = leaf.map_err(|e| DisplayError::Storage(e.into()))?;
         let (x0, y0) = (f64::from(cell.origin[0]), f64::from(cell.origin[1]));
         let s = cell.side() as f64;
         let (a, b, c, d) = (px(x0), h - px(y0 + s), px(x0 + s), h - px(y0));
@@ -47,7 +52,7 @@ pub fn quadtree_canvas(tree: &Quadtree, size: u32) -> Result<Canvas, DisplayErro
         if s * scale >= 3.0 {
             outlines.push((a, b, c, d));
         }
-    });
+    }
     for (a, b, c, d) in outlines {
         for x in a..c.min(h) {
             canvas.blend(x, b, GRID, 1.0);
@@ -61,12 +66,22 @@ pub fn quadtree_canvas(tree: &Quadtree, size: u32) -> Result<Canvas, DisplayErro
     Ok(canvas)
 }
 
-/// The same picture as SVG: one rectangle per leaf (full filled), `size` pixels square.
-pub fn quadtree_svg(tree: &Quadtree, size: u32) -> String {
+/// The same picture as SVG: one rectangle per leaf (full filled), `size` pixels square. (Any storage:
+/// [`try_quadtree_svg`].)
+pub fn quadtree_svg<T: TreeStorage<2, Error = Infallible>>(tree: &T, size: u32) -> String {
+    infallible(try_quadtree_svg(tree, size))
+}
+
+/// [`quadtree_svg`] over any storage.
+///
+/// # Errors
+/// The storage's read error.
+pub fn try_quadtree_svg<T: TreeStorage<2>>(tree: &T, size: u32) -> Result<String, T::Error> {
     let mut s = super::svg::header(size, size);
     let scale = f64::from(size) / tree.universe().side() as f64;
     let h = f64::from(size);
-    tree.for_each_leaf(|cell, state| {
+    for leaf in TryLeaves::new(tree) {
+        let (cell, state) = leaf?;
         let side = cell.side() as f64 * scale;
         let x = f64::from(cell.origin[0]) * scale;
         let y = h - f64::from(cell.origin[1]) * scale - side;
@@ -80,7 +95,7 @@ pub fn quadtree_svg(tree: &Quadtree, size: u32) -> String {
             "<rect x=\"{x:.3}\" y=\"{y:.3}\" width=\"{side:.3}\" height=\"{side:.3}\" fill=\"{fill}\" \
              stroke=\"rgb(150,150,150)\" stroke-width=\"0.5\"/>"
         );
-    });
+    }
     s.push_str("</svg>\n");
-    s
+    Ok(s)
 }

@@ -16,8 +16,9 @@ use super::error::DisplayError;
 use super::png::Canvas;
 use super::raster::{render, RenderOptions, Rendered};
 use crate::space::{Cell, Universe};
-use crate::tree::cursor::{walk, Visitor, Walk};
-use crate::tree::{KTree, NodeRef, NodeState, Octree, Tree4};
+use crate::tree::cursor::{try_walk, Visitor, Walk};
+use crate::tree::storage::TreeStorage;
+use crate::tree::{KTree, NodeRef, NodeState, Octree};
 
 /// The octree of the 4-D tree's slice at `position` along `axis` (the remaining axes keep their order).
 ///
@@ -30,8 +31,13 @@ use crate::tree::{KTree, NodeRef, NodeState, Octree, Tree4};
 /// ```
 ///
 /// # Errors
-/// [`DisplayError::SliceOutside`] if `axis > 3` or the position is outside the universe.
-pub fn slice_4d(tree: &Tree4, axis: usize, position: u32) -> Result<Octree, DisplayError> {
+/// [`DisplayError::SliceOutside`] if `axis > 3` or the position is outside the universe;
+/// [`DisplayError::Storage`] if a read of the tree fails.
+pub fn slice_4d<T: TreeStorage<4>>(
+    tree: &T,
+    axis: usize,
+    position: u32,
+) -> Result<Octree, DisplayError> {
     let side = tree.universe().side();
     if axis > 3 || u64::from(position) >= side {
         return Err(DisplayError::SliceOutside {
@@ -73,7 +79,7 @@ pub fn slice_4d(tree: &Tree4, axis: usize, position: u32) -> Result<Octree, Disp
         }
     }
     let mut cells: Vec<Cell<3>> = Vec::new();
-    walk(
+    try_walk(
         tree,
         &mut Slab {
             axis,
@@ -86,7 +92,8 @@ pub fn slice_4d(tree: &Tree4, axis: usize, position: u32) -> Result<Octree, Disp
                 })
             },
         },
-    );
+    )
+    .map_err(|e| DisplayError::Storage(e.into()))?;
     cells.sort_unstable_by_key(|c| c.morton());
     Ok(KTree::from_sorted_cells(universe, &merge_siblings(cells)))
 }
@@ -147,9 +154,10 @@ fn first_child_origin(first: &Cell<3>, code: usize) -> [u32; 3] {
 /// their slice positions (to write as an animated sequence of PNGs).
 ///
 /// # Errors
-/// [`DisplayError::NoFrames`], [`DisplayError::SliceOutside`], [`DisplayError::BadSize`].
-pub fn time_strip(
-    tree: &Tree4,
+/// [`DisplayError::NoFrames`], [`DisplayError::SliceOutside`], [`DisplayError::BadSize`];
+/// [`DisplayError::Storage`] if a read of the tree fails.
+pub fn time_strip<T: TreeStorage<4>>(
+    tree: &T,
     axis: usize,
     frames: usize,
     frame_size: u32,
@@ -173,7 +181,8 @@ pub fn time_strip(
         })?;
     let mut canvas = Canvas::new(strip_width, frame_size, [255, 255, 255])?;
     let side = tree.universe().side();
-    let (lo, hi) = crate::tree::storage::infallible(super::camera::object_bounds(tree))
+    let (lo, hi) = super::camera::object_bounds(tree)
+        .map_err(|e| DisplayError::Storage(e.into()))?
         .unwrap_or(([0.0; 4], [side as f64; 4]));
     let keep = |v: [f64; 4]| -> [f64; 3] {
         let mut out = [0.0; 3];

@@ -24,7 +24,9 @@ use std::path::Path;
 use thiserror::Error;
 
 use crate::fs::write_atomic_with;
-use crate::tree::{AnyTree, KTree};
+use crate::space::Universe;
+use crate::tree::storage::TreeStorage;
+use crate::tree::{AnyTree, LevelCounts, NodeState, StorageError};
 
 /// Where voxels are in the world: voxel coordinate `v` is at `origin + voxel_size · v` (the universe's
 /// corner at `origin`; quadtrees use the first two coordinates).
@@ -115,6 +117,9 @@ pub enum ExportError {
         /// [`surface::SMOOTH_FACE_LIMIT`].
         limit: u64,
     },
+    /// Reading the tree failed (a file read in place was changed after it was opened).
+    #[error(transparent)]
+    Storage(#[from] StorageError),
 }
 
 /// Writes the boundary of `tree` to `path` in the format its extension names, atomically: an octree as a
@@ -128,13 +133,14 @@ pub fn write_mesh(path: &Path, tree: &AnyTree, frame: &Frame) -> Result<Written,
     crate::with_dim!(tree, AnyTree, t => write_mesh_of(path, t, frame))
 }
 
-/// [`write_mesh`] of a tree whose dimension is known.
+/// [`write_mesh`] of a tree whose dimension is known, on any storage (a mapped `.ktree` file is read in
+/// place).
 ///
 /// # Errors
-/// As [`write_mesh`].
-pub fn write_mesh_of<const K: usize>(
+/// As [`write_mesh`]; [`ExportError::Storage`] if a read of the tree fails.
+pub fn write_mesh_of<const K: usize, T: TreeStorage<K>>(
     path: &Path,
-    tree: &KTree<K>,
+    tree: &T,
     frame: &Frame,
 ) -> Result<Written, ExportError> {
     let usage = |message: &str| ExportError::Usage {
@@ -146,37 +152,98 @@ pub fn write_mesh_of<const K: usize>(
     let write = |fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
         write_atomic_with(path, |w| fill(w)).map_err(ExportError::Write)
     };
-    let any = tree as &dyn std::any::Any;
-    if let Some(t) = any.downcast_ref::<KTree<3>>() {
+    if let Some(t) = Dimension::<_, K>::of::<3>(tree) {
         if format == MeshFormat::Svg {
             return Err(usage(
                 "SVG holds the outlines of quadtrees (K = 2); this tree has K = 3",
             ));
         }
-        write_surface(path, &surface::boundary_mesh(t).placed(frame))
-    } else if let Some(t) = any.downcast_ref::<KTree<2>>() {
-        {
-            let loops = place_loops(&outline::boundary_loops(t), frame);
-            match format {
-                MeshFormat::Ply => write(&|w| files::write_ply_edges(w, &loops))?,
-                MeshFormat::Obj => write(&|w| files::write_obj_lines(w, &loops))?,
-                MeshFormat::Svg => write(&|w| files::write_svg(w, &loops))?,
-                MeshFormat::Stl | MeshFormat::Glb => {
-                    return Err(usage(
-                        "a quadtree's boundary is polylines: write .ply, .obj or .svg",
-                    ))
-                }
+        let mesh = surface::try_boundary_mesh(&t).map_err(|e| ExportError::Storage(e.into()))?;
+        write_surface(path, &mesh.placed(frame))
+    } else if let Some(t) = Dimension::<_, K>::of::<2>(tree) {
+        let loops = outline::try_boundary_loops(&t).map_err(|e| ExportError::Storage(e.into()))?;
+        let loops = place_loops(&loops, frame);
+        match format {
+            MeshFormat::Ply => write(&|w| files::write_ply_edges(w, &loops))?,
+            MeshFormat::Obj => write(&|w| files::write_obj_lines(w, &loops))?,
+            MeshFormat::Svg => write(&|w| files::write_svg(w, &loops))?,
+            MeshFormat::Stl | MeshFormat::Glb => {
+                return Err(usage(
+                    "a quadtree's boundary is polylines: write .ply, .obj or .svg",
+                ))
             }
-            let n = loops.iter().map(Vec::len).sum();
-            Ok(Written {
-                vertices: n,
-                elements: n,
-            })
         }
+        let n = loops.iter().map(Vec::len).sum();
+        Ok(Written {
+            vertices: n,
+            elements: n,
+        })
     } else {
         Err(usage(&format!(
             "meshes are written for octrees (K = 3) and outlines for quadtrees (K = 2); this tree has K = {K}"
         )))
+    }
+}
+
+/// A tree of dimension `K` read as one of dimension `J`, made only when `J == K` ([`Dimension::of`]): how
+/// code generic over `K` calls the code of one dimension (an octree's mesh, a quadtree's outline) on any
+/// storage. Every read is the tree's own.
+struct Dimension<'a, T, const K: usize>(&'a T);
+
+impl<'a, T: TreeStorage<K>, const K: usize> Dimension<'a, T, K> {
+    /// `tree` as a tree of dimension `J`, if that is its dimension.
+    fn of<const J: usize>(tree: &'a T) -> Option<Self> {
+        (J == K).then_some(Self(tree))
+    }
+}
+
+impl<T: TreeStorage<K>, const K: usize, const J: usize> TreeStorage<J> for Dimension<'_, T, K> {
+    type Error = T::Error;
+
+    fn universe(&self) -> Universe<J> {
+        Universe::new(self.0.level()).expect("a tree's level is in range for its own dimension")
+    }
+
+    fn depth_count(&self) -> usize {
+        self.0.depth_count()
+    }
+
+    fn level_len(&self, depth: usize) -> usize {
+        self.0.level_len(depth)
+    }
+
+    fn counts_per_level(&self) -> Vec<LevelCounts> {
+        self.0.counts_per_level()
+    }
+
+    #[inline]
+    fn root_state(&self) -> Result<NodeState, Self::Error> {
+        self.0.root_state()
+    }
+
+    #[inline(always)]
+    fn partial_rank(&self, depth: usize, index: usize) -> Result<usize, Self::Error> {
+        self.0.partial_rank(depth, index)
+    }
+
+    #[inline(always)]
+    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Self::Error> {
+        self.0.block_codes(depth, first)
+    }
+
+    #[inline(always)]
+    fn first_child(&self, depth: usize, index: usize) -> Result<usize, Self::Error> {
+        self.0.first_child(depth, index)
+    }
+
+    #[inline(always)]
+    fn slots(&self, depth: usize, first: usize, n: usize) -> Result<u64, Self::Error> {
+        self.0.slots(depth, first, n)
+    }
+
+    #[inline(always)]
+    fn state(&self, depth: usize, index: usize) -> Result<NodeState, Self::Error> {
+        self.0.state(depth, index)
     }
 }
 

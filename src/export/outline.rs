@@ -17,10 +17,13 @@
 //! ```
 
 use std::collections::{BTreeMap, HashMap};
+use std::convert::Infallible;
 
 use crate::display::neighbours::{face_neighbour_cell, Neighbours};
 use crate::space::Cell;
-use crate::tree::{KTree, NodeState};
+use crate::tree::cursor::TryLeaves;
+use crate::tree::storage::{infallible, TreeStorage};
+use crate::tree::NodeState;
 
 /// A closed polyline: its vertices in order (the last joins the first), in pixel coordinates.
 pub type Loop = Vec<[f64; 2]>;
@@ -42,14 +45,27 @@ pub fn signed_area(l: &[[f64; 2]]) -> f64 {
 }
 
 /// The boundary of `tree` as closed loops: counter-clockwise around the object, clockwise around holes,
-/// each vertex a corner of the outline (collinear pieces merged). Empty for an empty tree.
-pub fn boundary_loops(tree: &KTree<2>) -> Vec<Loop> {
+/// each vertex a corner of the outline (collinear pieces merged). Empty for an empty tree. (Any storage:
+/// [`try_boundary_loops`].)
+pub fn boundary_loops<T: TreeStorage<2, Error = Infallible>>(tree: &T) -> Vec<Loop> {
+    infallible(try_boundary_loops(tree))
+}
+
+/// [`boundary_loops`] over any storage.
+///
+/// # Errors
+/// The storage's read error.
+pub fn try_boundary_loops<T: TreeStorage<2>>(tree: &T) -> Result<Vec<Loop>, T::Error> {
     let side = tree.universe().side();
-    let mut near = Neighbours::new(tree);
+    let mut near = Neighbours::new(tree)?;
     // Boundary pieces by line: (axis of the normal, coordinate, normal up the axis) → (start, length) along
     // the other axis.
     let mut lines: BTreeMap<(usize, u32, bool), Vec<(u32, u32)>> = BTreeMap::new();
-    for cell in tree.full_cells() {
+    for leaf in TryLeaves::new(tree) {
+        let (cell, state) = leaf?;
+        if state != NodeState::Full {
+            continue;
+        }
         let s = cell.side() as u32;
         for a in 0..2 {
             let b = 1 - a;
@@ -63,39 +79,40 @@ pub fn boundary_loops(tree: &KTree<2>) -> Vec<Loop> {
                         if state == NodeState::Empty {
                             pieces.push((leaf.origin[b], leaf.side() as u32));
                         }
-                    }),
+                    })?,
                 }
             }
         }
     }
     let level = tree.level();
-    let mut full = |v: [i64; 2]| {
+    let mut full = |v: [i64; 2]| -> Result<bool, T::Error> {
         if v.iter().any(|&x| x < 0 || x as u64 >= side) {
-            return false;
+            return Ok(false);
         }
         let cell = Cell {
             origin: v.map(|x| x as u32),
             level,
             log_side: 0,
         };
-        near.locate(&cell).state() == NodeState::Full
+        Ok(near.locate(&cell)?.state() == NodeState::Full)
     };
     // A vertex is a lattice point and, where two full pixels touch only there, the quadrant of the full
     // pixel its segments bound (bit i: on the upper side along axis i).
-    let mut tag = |p: [u32; 2], quadrant: u8| -> u8 {
-        let f: Vec<bool> = (0..4)
-            .map(|q| {
-                full([
-                    i64::from(p[0]) - 1 + (q & 1) as i64,
-                    i64::from(p[1]) - 1 + (q >> 1) as i64,
-                ])
-            })
-            .collect();
-        if f == [true, false, false, true] || f == [false, true, true, false] {
-            quadrant
-        } else {
-            u8::MAX
+    let mut tag = |p: [u32; 2], quadrant: u8| -> Result<u8, T::Error> {
+        let mut f = [false; 4];
+        for (q, fq) in f.iter_mut().enumerate() {
+            *fq = full([
+                i64::from(p[0]) - 1 + (q & 1) as i64,
+                i64::from(p[1]) - 1 + (q >> 1) as i64,
+            ])?;
         }
+        Ok(
+            if f == [true, false, false, true] || f == [false, true, true, false] {
+                quadrant
+            } else {
+                u8::MAX
+            },
+        )
     };
     // Directed segments from vertex to vertex.
     let mut next: HashMap<([u32; 2], u8), ([u32; 2], u8)> = HashMap::new();
@@ -119,8 +136,8 @@ pub fn boundary_loops(tree: &KTree<2>) -> Vec<Loop> {
                 p
             };
             let (p0, p1) = (at(t0), at(t1));
-            let v0 = (p0, tag(p0, full_a | 1 << b));
-            let v1 = (p1, tag(p1, full_a));
+            let v0 = (p0, tag(p0, full_a | 1 << b)?);
+            let v1 = (p1, tag(p1, full_a)?);
             // Counter-clockwise: the object on the left. Normal +x runs +y, +y runs −x, −x runs −y, −y runs +x.
             let forward = (a == 0) == upper;
             let (from, to) = if forward { (v0, v1) } else { (v1, v0) };
@@ -142,5 +159,5 @@ pub fn boundary_loops(tree: &KTree<2>) -> Vec<Loop> {
         debug_assert_eq!(v, start, "an open boundary chain");
         loops.push(l);
     }
-    loops
+    Ok(loops)
 }

@@ -22,9 +22,11 @@ use std::path::{Path, PathBuf};
 
 use super::{ExportError, Frame};
 use crate::display::slices::slice_4d;
+use crate::display::DisplayError;
 use crate::fs::write_atomic_with;
-use crate::tree::cursor::{walk, Visitor, Walk};
-use crate::tree::{KTree, NodeRef, NodeState};
+use crate::tree::cursor::{try_walk, TryLeaves, Visitor, Walk};
+use crate::tree::storage::TreeStorage;
+use crate::tree::{NodeRef, NodeState, StorageError};
 
 /// One array of the appended section.
 struct Array {
@@ -81,92 +83,150 @@ fn offsets(arrays: &[&Array]) -> Vec<u64> {
 }
 
 /// The full leaves of `tree` as an unstructured grid: `VTK_VOXEL` cells (K = 3) or `VTK_PIXEL` cells
-/// (K = 2, in the plane z = `frame.origin[2]`), corners shared between cells, placed by `frame`.
+/// (K = 2, in the plane z = `frame.origin[2]`), corners shared between cells, placed by `frame`. The tree
+/// is read (any storage) before anything is written.
 ///
 /// # Errors
-/// The writer's; [`io::ErrorKind::InvalidInput`] for K other than 2 and 3.
-pub fn write_vtu<const K: usize>(
+/// The writer's; [`io::ErrorKind::InvalidInput`] for K other than 2 and 3; a read of the tree that fails,
+/// as an [`io::ErrorKind::Other`] error carrying the [`StorageError`] ([`write_vtk_file`] keeps it apart).
+pub fn write_vtu<const K: usize, T: TreeStorage<K>>(
     w: &mut dyn Write,
-    tree: &KTree<K>,
+    tree: &T,
     frame: &Frame,
 ) -> io::Result<()> {
+    check_dimension::<K>(".vtu")?;
+    Grid::of(tree, frame).map_err(read_error)?.write(w)
+}
+
+/// The arrays of a `.vtu` file, read from the tree.
+struct Grid {
+    points: Array,
+    point_count: usize,
+    connectivity: Array,
+    offsets: Array,
+    types: Array,
+    level: Array,
+    side: Array,
+    cells: u64,
+}
+
+impl Grid {
+    /// The full leaves of `tree` as cells (see [`write_vtu`]).
+    fn of<const K: usize, T: TreeStorage<K>>(tree: &T, frame: &Frame) -> Result<Self, T::Error> {
+        let corners = 1usize << K;
+        let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut grid = Grid {
+            points: Array::new("Points", "Float64", 3),
+            point_count: 0,
+            connectivity: Array::new("connectivity", "Int64", 1),
+            offsets: Array::new("offsets", "Int64", 1),
+            types: Array::new("types", "UInt8", 1),
+            level: Array::new("level", "Int32", 1),
+            side: Array::new("side", "Float64", 1),
+            cells: 0,
+        };
+        for leaf in TryLeaves::new(tree) {
+            let (cell, state) = leaf?;
+            if state != NodeState::Full {
+                continue;
+            }
+            let s = cell.side() as u32;
+            for o in 0..corners {
+                let p: [u32; 3] = std::array::from_fn(|a| {
+                    if a < K {
+                        cell.origin[a] + if o >> a & 1 == 1 { s } else { 0 }
+                    } else {
+                        0
+                    }
+                });
+                let next = ids.len() as u32;
+                let points = &mut grid.points;
+                let id = *ids.entry(p).or_insert_with(|| {
+                    for (a, &pa) in p.iter().enumerate() {
+                        let x = if a < K {
+                            frame.origin[a] + frame.voxel_size * f64::from(pa)
+                        } else {
+                            frame.origin[a]
+                        };
+                        points.bytes.extend_from_slice(&x.to_le_bytes());
+                    }
+                    next
+                });
+                grid.connectivity
+                    .bytes
+                    .extend_from_slice(&i64::from(id).to_le_bytes());
+            }
+            grid.cells += 1;
+            grid.offsets
+                .bytes
+                .extend_from_slice(&((grid.cells * corners as u64) as i64).to_le_bytes());
+            grid.types.bytes.push(if K == 3 { 11 } else { 8 });
+            grid.level
+                .bytes
+                .extend_from_slice(&(cell.level as i32).to_le_bytes());
+            grid.side
+                .bytes
+                .extend_from_slice(&(frame.voxel_size * f64::from(s)).to_le_bytes());
+        }
+        grid.point_count = ids.len();
+        Ok(grid)
+    }
+
+    /// The `.vtu` file.
+    fn write(&self, w: &mut dyn Write) -> io::Result<()> {
+        let order = [
+            &self.level,
+            &self.side,
+            &self.points,
+            &self.connectivity,
+            &self.offsets,
+            &self.types,
+        ];
+        let at = offsets(&order);
+        writeln!(
+            w,
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" \
+             byte_order=\"LittleEndian\" header_type=\"UInt64\">\n <UnstructuredGrid>\n  \
+             <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
+            self.point_count, self.cells
+        )?;
+        writeln!(
+            w,
+            "   <CellData Scalars=\"level\">\n    {}\n    {}\n   </CellData>",
+            self.level.tag(at[0]),
+            self.side.tag(at[1])
+        )?;
+        writeln!(
+            w,
+            "   <Points>\n    {}\n   </Points>",
+            self.points.tag(at[2])
+        )?;
+        writeln!(
+            w,
+            "   <Cells>\n    {}\n    {}\n    {}\n   </Cells>",
+            self.connectivity.tag(at[3]),
+            self.offsets.tag(at[4]),
+            self.types.tag(at[5])
+        )?;
+        writeln!(w, "  </Piece>\n </UnstructuredGrid>")?;
+        appended(w, &order)
+    }
+}
+
+/// [`io::ErrorKind::InvalidInput`] unless `K` is 2 or 3, the dimensions VTK's files of `ext` hold.
+fn check_dimension<const K: usize>(ext: &str) -> io::Result<()> {
     if K != 2 && K != 3 {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
-            format!(".vtu holds quadtrees and octrees; this tree has K = {K}"),
+            format!("{ext} holds quadtrees and octrees; this tree has K = {K}"),
         ));
     }
-    let corners = 1usize << K;
-    let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
-    let mut points = Array::new("Points", "Float64", 3);
-    let mut connectivity = Array::new("connectivity", "Int64", 1);
-    let mut offsets_a = Array::new("offsets", "Int64", 1);
-    let mut types = Array::new("types", "UInt8", 1);
-    let mut level = Array::new("level", "Int32", 1);
-    let mut side = Array::new("side", "Float64", 1);
-    let mut cells = 0u64;
-    for cell in tree.full_cells() {
-        let s = cell.side() as u32;
-        for o in 0..corners {
-            let p: [u32; 3] = std::array::from_fn(|a| {
-                if a < K {
-                    cell.origin[a] + if o >> a & 1 == 1 { s } else { 0 }
-                } else {
-                    0
-                }
-            });
-            let next = ids.len() as u32;
-            let id = *ids.entry(p).or_insert_with(|| {
-                for (a, &pa) in p.iter().enumerate() {
-                    let x = if a < K {
-                        frame.origin[a] + frame.voxel_size * f64::from(pa)
-                    } else {
-                        frame.origin[a]
-                    };
-                    points.bytes.extend_from_slice(&x.to_le_bytes());
-                }
-                next
-            });
-            connectivity
-                .bytes
-                .extend_from_slice(&i64::from(id).to_le_bytes());
-        }
-        cells += 1;
-        offsets_a
-            .bytes
-            .extend_from_slice(&((cells * corners as u64) as i64).to_le_bytes());
-        types.bytes.push(if K == 3 { 11 } else { 8 });
-        level
-            .bytes
-            .extend_from_slice(&(cell.level as i32).to_le_bytes());
-        side.bytes
-            .extend_from_slice(&(frame.voxel_size * f64::from(s)).to_le_bytes());
-    }
-    let order = [&level, &side, &points, &connectivity, &offsets_a, &types];
-    let at = offsets(&order);
-    writeln!(
-        w,
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" \
-         byte_order=\"LittleEndian\" header_type=\"UInt64\">\n <UnstructuredGrid>\n  \
-         <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{cells}\">",
-        ids.len()
-    )?;
-    writeln!(
-        w,
-        "   <CellData Scalars=\"level\">\n    {}\n    {}\n   </CellData>",
-        level.tag(at[0]),
-        side.tag(at[1])
-    )?;
-    writeln!(w, "   <Points>\n    {}\n   </Points>", points.tag(at[2]))?;
-    writeln!(
-        w,
-        "   <Cells>\n    {}\n    {}\n    {}\n   </Cells>",
-        connectivity.tag(at[3]),
-        offsets_a.tag(at[4]),
-        types.tag(at[5])
-    )?;
-    writeln!(w, "  </Piece>\n </UnstructuredGrid>")?;
-    appended(w, &order)
+    Ok(())
+}
+
+/// A storage's read error as an I/O error that carries it.
+fn read_error(e: impl Into<StorageError>) -> io::Error {
+    io::Error::other(e.into())
 }
 
 /// The nodes of a tree breadth first, as VTK's hyper tree descriptor wants them: per depth, each node's
@@ -209,119 +269,174 @@ fn pack_bits(bits: impl Iterator<Item = bool>) -> Vec<u8> {
 /// tree's level order and child code.
 ///
 /// # Errors
-/// The writer's; [`io::ErrorKind::InvalidInput`] for K other than 2 and 3.
-pub fn write_htg<const K: usize>(
+/// As [`write_vtu`].
+pub fn write_htg<const K: usize, T: TreeStorage<K>>(
     w: &mut dyn Write,
-    tree: &KTree<K>,
+    tree: &T,
     frame: &Frame,
 ) -> io::Result<()> {
-    if K != 2 && K != 3 {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            format!(".htg holds quadtrees and octrees; this tree has K = {K}"),
-        ));
+    check_dimension::<K>(".htg")?;
+    Depths::of(tree)
+        .map_err(read_error)?
+        .write(w, tree.level(), frame)
+}
+
+impl<const K: usize> Depths<K> {
+    /// The nodes of `tree`, read before anything is written. Level order is breadth first: each depth's
+    /// nodes in index order, which a depth-first walk meets in the same order.
+    fn of<T: TreeStorage<K>>(tree: &T) -> Result<Self, T::Error> {
+        let mut depths = Depths::<K> { nodes: Vec::new() };
+        try_walk(tree, &mut depths)?;
+        Ok(depths)
     }
-    // Level order is breadth first: each depth's nodes in index order, which a depth-first walk meets in
-    // the same order.
-    let mut depths = Depths::<K> { nodes: Vec::new() };
-    walk(tree, &mut depths);
-    let all: Vec<(NodeState, u32)> = depths.nodes.iter().flatten().copied().collect();
-    let u = tree.universe().side() as f64 * frame.voxel_size;
-    // The descriptor: one bit per node of every depth but the last, refined or not.
-    let inner = depths.nodes.len().saturating_sub(1);
-    let descriptor = pack_bits(
-        depths.nodes[..inner]
-            .iter()
-            .flatten()
-            .map(|(s, _)| *s == NodeState::Partial),
-    );
-    let described: usize = depths.nodes[..inner].iter().map(Vec::len).sum();
-    let mask = pack_bits(all.iter().map(|(s, _)| *s == NodeState::Empty));
-    let per_depth: Vec<String> = depths.nodes.iter().map(|d| d.len().to_string()).collect();
-    let top = tree.level();
-    let dims = (0..3)
-        .map(|a| if a < K { "2" } else { "1" })
-        .collect::<Vec<_>>()
-        .join(" ");
-    writeln!(
-        w,
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"HyperTreeGrid\" version=\"2.0\" \
+
+    /// The `.htg` file of a tree of universe level `top` whose nodes these are.
+    fn write(&self, w: &mut dyn Write, top: u32, frame: &Frame) -> io::Result<()> {
+        let depths = self;
+        let all: Vec<(NodeState, u32)> = depths.nodes.iter().flatten().copied().collect();
+        let u = (1u64 << top) as f64 * frame.voxel_size;
+        // The descriptor: one bit per node of every depth but the last, refined or not.
+        let inner = depths.nodes.len().saturating_sub(1);
+        let descriptor = pack_bits(
+            depths.nodes[..inner]
+                .iter()
+                .flatten()
+                .map(|(s, _)| *s == NodeState::Partial),
+        );
+        let described: usize = depths.nodes[..inner].iter().map(Vec::len).sum();
+        let mask = pack_bits(all.iter().map(|(s, _)| *s == NodeState::Empty));
+        let per_depth: Vec<String> = depths.nodes.iter().map(|d| d.len().to_string()).collect();
+        let dims = (0..3)
+            .map(|a| if a < K { "2" } else { "1" })
+            .collect::<Vec<_>>()
+            .join(" ");
+        writeln!(
+            w,
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"HyperTreeGrid\" version=\"2.0\" \
          byte_order=\"LittleEndian\" header_type=\"UInt32\">\n \
          <HyperTreeGrid BranchFactor=\"2\" TransposedRootIndexing=\"0\" Dimensions=\"{dims}\">"
-    )?;
-    writeln!(w, "  <Grid>")?;
-    for (a, name) in ["XCoordinates", "YCoordinates", "ZCoordinates"]
-        .iter()
-        .enumerate()
-    {
-        let o = frame.origin[a];
-        if a < K {
-            writeln!(
+        )?;
+        writeln!(w, "  <Grid>")?;
+        for (a, name) in ["XCoordinates", "YCoordinates", "ZCoordinates"]
+            .iter()
+            .enumerate()
+        {
+            let o = frame.origin[a];
+            if a < K {
+                writeln!(
                 w,
                 "   <DataArray type=\"Float64\" Name=\"{name}\" NumberOfTuples=\"2\" format=\"ascii\" \
                  RangeMin=\"{o}\" RangeMax=\"{}\">{o} {}</DataArray>",
                 o + u,
                 o + u
             )?;
-        } else {
-            writeln!(
+            } else {
+                writeln!(
                 w,
                 "   <DataArray type=\"Float64\" Name=\"{name}\" NumberOfTuples=\"1\" format=\"ascii\" \
                  RangeMin=\"{o}\" RangeMax=\"{o}\">{o}</DataArray>"
             )?;
+            }
         }
-    }
-    writeln!(w, "  </Grid>\n  <Trees>")?;
-    let bits = |packed: &[u8], n: usize| -> String {
-        (0..n)
-            .map(|i| {
-                if packed[i / 8] >> (7 - i % 8) & 1 == 1 {
-                    "1"
-                } else {
-                    "0"
-                }
-            })
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
-    let array = |w: &mut dyn Write, kind: &str, name: &str, n: usize, text: &str| {
-        writeln!(
+        writeln!(w, "  </Grid>\n  <Trees>")?;
+        let bits = |packed: &[u8], n: usize| -> String {
+            (0..n)
+                .map(|i| {
+                    if packed[i / 8] >> (7 - i % 8) & 1 == 1 {
+                        "1"
+                    } else {
+                        "0"
+                    }
+                })
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        let array = |w: &mut dyn Write, kind: &str, name: &str, n: usize, text: &str| {
+            writeln!(
             w,
             "   <DataArray type=\"{kind}\" Name=\"{name}\" NumberOfTuples=\"{n}\" format=\"ascii\">{text}</DataArray>"
         )
+        };
+        array(
+            w,
+            "Bit",
+            "Descriptors",
+            described,
+            &bits(&descriptor, described),
+        )?;
+        array(
+            w,
+            "Int64",
+            "NumberOfVerticesPerDepth",
+            per_depth.len(),
+            &per_depth.join(" "),
+        )?;
+        array(w, "Int64", "TreeIds", 1, "0")?;
+        array(
+            w,
+            "UInt32",
+            "DepthPerTree",
+            1,
+            &depths.nodes.len().to_string(),
+        )?;
+        array(w, "Bit", "Mask", all.len(), &bits(&mask, all.len()))?;
+        writeln!(w, "  </Trees>\n  <CellData>")?;
+        let levels: Vec<String> = all.iter().map(|(_, d)| d.to_string()).collect();
+        let sides: Vec<String> = all
+            .iter()
+            .map(|(_, d)| (frame.voxel_size * (1u64 << (top - d)) as f64).to_string())
+            .collect();
+        array(w, "Int32", "level", all.len(), &levels.join(" "))?;
+        array(w, "Float64", "side", all.len(), &sides.join(" "))?;
+        writeln!(w, "  </CellData>\n </HyperTreeGrid>\n</VTKFile>")
+    }
+}
+
+/// Writes `tree` to `path` as the VTK file its extension names, atomically: `.vtu` ([`write_vtu`]) or
+/// `.htg` ([`write_htg`]), placed by `frame`. The tree (any storage) is read before the file is opened.
+///
+/// ```
+/// use ktree::export::{vtk::write_vtk_file, Frame};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("square.htg");
+/// write_vtk_file(&path, &ktree::KTree::<2>::full(2).unwrap(), &Frame::default()).unwrap();
+/// assert!(std::fs::read_to_string(&path).unwrap().contains("HyperTreeGrid"));
+/// ```
+///
+/// # Errors
+/// [`ExportError::Usage`] for another extension or a tree that is not a quadtree or an octree;
+/// [`ExportError::Storage`] if a read of the tree fails; [`ExportError::Write`] from the file system.
+pub fn write_vtk_file<const K: usize, T: TreeStorage<K>>(
+    path: &Path,
+    tree: &T,
+    frame: &Frame,
+) -> Result<(), ExportError> {
+    let usage = |message: String| ExportError::Usage {
+        file: path.display().to_string(),
+        message,
     };
-    array(
-        w,
-        "Bit",
-        "Descriptors",
-        described,
-        &bits(&descriptor, described),
-    )?;
-    array(
-        w,
-        "Int64",
-        "NumberOfVerticesPerDepth",
-        per_depth.len(),
-        &per_depth.join(" "),
-    )?;
-    array(w, "Int64", "TreeIds", 1, "0")?;
-    array(
-        w,
-        "UInt32",
-        "DepthPerTree",
-        1,
-        &depths.nodes.len().to_string(),
-    )?;
-    array(w, "Bit", "Mask", all.len(), &bits(&mask, all.len()))?;
-    writeln!(w, "  </Trees>\n  <CellData>")?;
-    let levels: Vec<String> = all.iter().map(|(_, d)| d.to_string()).collect();
-    let sides: Vec<String> = all
-        .iter()
-        .map(|(_, d)| (frame.voxel_size * (1u64 << (top - d)) as f64).to_string())
-        .collect();
-    array(w, "Int32", "level", all.len(), &levels.join(" "))?;
-    array(w, "Float64", "side", all.len(), &sides.join(" "))?;
-    writeln!(w, "  </CellData>\n </HyperTreeGrid>\n</VTKFile>")
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    if ext != "vtu" && ext != "htg" {
+        return Err(usage("a VTK file is written as .vtu or .htg".into()));
+    }
+    if K != 2 && K != 3 {
+        return Err(usage(format!(
+            "VTK files are written for quadtrees and octrees (K = 2, 3); this tree has K = {K}"
+        )));
+    }
+    let storage = |e: T::Error| ExportError::Storage(e.into());
+    if ext == "htg" {
+        let depths = Depths::of(tree).map_err(storage)?;
+        write_atomic_with(path, |w| depths.write(w, tree.level(), frame))
+    } else {
+        let grid = Grid::of(tree, frame).map_err(storage)?;
+        write_atomic_with(path, |w| grid.write(w))
+    }
+    .map_err(ExportError::Write)
 }
 
 /// A 4-D tree as a time series for ParaView: the octree of each slice along `time_axis` (the other axes
@@ -340,11 +455,11 @@ pub fn write_htg<const K: usize>(
 /// ```
 ///
 /// # Errors
-/// [`ExportError::Usage`] for another extension or an axis past 3; [`ExportError::Write`] from the file
-/// system.
-pub fn write_time_slices(
+/// [`ExportError::Usage`] for another extension or an axis past 3; [`ExportError::Storage`] if a read of
+/// the tree fails; [`ExportError::Write`] from the file system.
+pub fn write_time_slices<T: TreeStorage<4>>(
     path: &Path,
-    tree: &KTree<4>,
+    tree: &T,
     time_axis: usize,
     frame: &Frame,
 ) -> Result<Vec<PathBuf>, ExportError> {
@@ -381,7 +496,10 @@ pub fn write_time_slices(
     let mut written = Vec::new();
     let mut entries = String::new();
     for t in 0..side as u32 {
-        let slice = slice_4d(tree, time_axis, t).map_err(|e| usage(e.to_string()))?;
+        let slice = slice_4d(tree, time_axis, t).map_err(|e| match e {
+            DisplayError::Storage(e) => ExportError::Storage(e),
+            e => usage(e.to_string()),
+        })?;
         let name = format!("{stem}_{t:0digits$}.{slice_ext}");
         let file = dir.join(&name);
         write_atomic_with(&file, |w| {

@@ -137,8 +137,12 @@ pub enum IoError {
     /// A bad binvox, `.bt` or `.vdb` file.
     #[error(transparent)]
     Grid(#[from] GridFileError),
+    /// A point cloud or mesh file that could not be read.
+    #[cfg(any(feature = "cloud", feature = "mesh"))]
+    #[error(transparent)]
+    Geometry(#[from] super::GeometryFileError),
     /// A mesh or volume that could not be read or voxelized.
-    #[error("{file}: {source}")]
+    #[error("{}", with_file(.file, .source))]
     Solid {
         /// The file.
         file: String,
@@ -165,6 +169,14 @@ pub enum IoError {
         /// The dimensions.
         source: DimensionMismatch,
     },
+}
+
+/// A solid's error naming its file once (a file that cannot be read or parsed names itself).
+fn with_file(file: &str, e: &SolidError) -> String {
+    match e {
+        SolidError::Io { .. } | SolidError::Parse { .. } => e.to_string(),
+        _ => format!("{file}: {e}"),
+    }
 }
 
 fn usage(path: &Path, message: impl Into<String>) -> IoError {
@@ -299,7 +311,7 @@ pub fn voxelize(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError
 }
 
 /// A missing or unreadable input is said as such (an I/O error) before any option is asked for.
-#[cfg(any(feature = "mesh", feature = "volume"))]
+#[cfg(feature = "volume")]
 fn readable(path: &Path) -> Result<(), SolidError> {
     std::fs::File::open(path)
         .map(drop)
@@ -456,13 +468,13 @@ fn mesh_input(
     ),
     IoError,
 > {
-    use crate::solid::mesh::{MeshTransform, TriangleMesh};
+    use crate::solid::mesh::MeshTransform;
     let solid = solid_error(path);
-    readable(path).map_err(&solid)?;
+    std::fs::File::open(path).map_err(|e| super::geometry_file::io_error(path, e))?;
     let level = options
         .level
         .ok_or_else(|| usage(path, "a mesh needs a universe level"))?;
-    let mesh = TriangleMesh::read(path).map_err(&solid)?;
+    let mesh = super::read_mesh(path)?;
     let (placement, fitted) = match options.mesh_placement {
         Some(p) => (p, None),
         None => {
@@ -601,42 +613,27 @@ fn write_typed<const K: usize>(
             let t = octree()?;
             write(&|w| write_vdb(w, t, options.offset, &meta))
         }
-        Format::Vtu | Format::Htg => {
-            if K != 2 && K != 3 {
-                return Err(usage(
-                    path,
-                    format!(
-                        "VTK files are written for quadtrees and octrees (K = 2, 3); this tree has K = {K}"
-                    ),
-                ));
-            }
-            let htg = format == Format::Htg;
-            write(&|w| {
-                if htg {
-                    crate::export::vtk::write_htg(w, tree, &frame)
-                } else {
-                    crate::export::vtk::write_vtu(w, tree, &frame)
-                }
-            })
-        }
+        Format::Vtu | Format::Htg => crate::export::vtk::write_vtk_file(path, tree, &frame)
+            .map_err(|e| export_error(path, e)),
         Format::Mesh | Format::Glb | Format::Svg => {
             crate::export::write_mesh_of(path, tree, &frame)
                 .map(drop)
-                .map_err(|e| match e {
-                    crate::export::ExportError::Write(e) => IoError::Write(e),
-                    crate::export::ExportError::Usage { file, message } => {
-                        IoError::Usage { file, message }
-                    }
-                    e @ crate::export::ExportError::TooLarge { .. } => IoError::Usage {
-                        file: path.display().to_string(),
-                        message: e.to_string(),
-                    },
-                })
+                .map_err(|e| export_error(path, e))
         }
         Format::Volume => Err(usage(
             path,
             "volumes are inputs only: write .ktree, .rays, .binvox, .bt, .vdb or a mesh",
         )),
+    }
+}
+
+/// An export's error as a file error of `path`.
+fn export_error(path: &Path, e: crate::export::ExportError) -> IoError {
+    use crate::export::ExportError;
+    match e {
+        ExportError::Write(e) => IoError::Write(e),
+        ExportError::Usage { file, message } => IoError::Usage { file, message },
+        e => usage(path, e.to_string()),
     }
 }
 

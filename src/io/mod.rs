@@ -5,6 +5,8 @@
 //!   version 1 (read);
 //! * [`rays`](mod@rays): the ray text format;
 //! * [`interop`]: other tools' grids — binvox, OctoMap `.bt`, OpenVDB `.vdb`;
+//! * [`cloud`](mod@cloud) and [`mesh`](mod@mesh): point clouds (PLY, PCD, XYZ/CSV, LAS/LAZ) and triangle
+//!   meshes (OBJ, STL, PLY) in ([`read_cloud`], [`read_mesh`]), one PLY reader for both;
 //! * [`read_tree`] and [`write_tree`] choose among all of them (and meshes and volumes as inputs) by the
 //!   file's extension.
 //!
@@ -23,15 +25,33 @@
 //! assert_eq!(read_ktree::<3>(&bytes, "mem").unwrap(), tree);
 //! ```
 
+#[cfg(feature = "cloud")]
+pub mod cloud;
 mod dispatch;
 mod file_tree;
+#[cfg(any(feature = "cloud", feature = "mesh"))]
+mod geometry_file;
 pub mod interop;
 pub mod ktree;
 mod location;
+#[cfg(feature = "mesh")]
+pub mod mesh;
 #[allow(unsafe_code)]
 mod mmap;
+#[cfg(any(feature = "cloud", feature = "mesh"))]
+mod ply;
+mod out_of_core;
 pub mod rays;
+#[cfg(any(feature = "cloud", feature = "mesh"))]
+mod scalar;
 pub(crate) mod spill;
+
+#[cfg(feature = "cloud")]
+pub use cloud::{is_cloud_file, read_cloud, read_cloud_bytes, CLOUD_FORMATS};
+#[cfg(any(feature = "cloud", feature = "mesh"))]
+pub use geometry_file::{GeometryFileError, GeometryFileErrorKind};
+#[cfg(feature = "mesh")]
+pub use mesh::{read_mesh, read_mesh_bytes, MESH_FORMATS};
 
 pub use dispatch::{
     read_tree, read_tree_placed, voxelize, write_tree, Format, IoError, ReadOptions, ReadTree,
@@ -52,6 +72,7 @@ pub use ktree::{
     VERSION,
 };
 pub use location::{FileError, Location, Place, ProblemKind};
+pub use out_of_core::{SpilledFiles, SpilledLevel};
 pub use rays::{
     open_rays_file, read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source,
     AnyRaysFileSource, RaysFile, RaysFileSource, RaysTextError, RaysTextErrorKind,

@@ -5,8 +5,9 @@
 //! a [`BUFFER_BYTES`] buffer), or whole words at a word boundary, and read back once writing is over. Two
 //! jobs spill through it:
 //!
-//! * the out-of-core builder appends each stacked cell's subtree, level by level, as whole words (a piece
-//!   per cell), and reads the pieces back in Morton order when it writes the tree;
+//! * the out-of-core builder's store of pieces ([`crate::io::SpilledFiles`]) appends each stacked cell's
+//!   subtree, level by level, as whole words (a piece per cell), and reads the pieces back in Morton order
+//!   when it writes the tree;
 //! * [`SpillLevels`], the [`LevelSink`] of the streamed Booleans, appends nodes in depth-first order, so
 //!   each file holds its level in level order, and streams the files into a `.ktree` when finished.
 //!
@@ -32,7 +33,6 @@ pub(crate) struct LevelFile {
     file: BufWriter<File>,
     packer: WordPacker,
     nodes: u64,
-    words: u64,
 }
 
 impl LevelFile {
@@ -49,7 +49,6 @@ impl LevelFile {
                 file: BufWriter::with_capacity(BUFFER_BYTES, file),
                 packer: WordPacker::default(),
                 nodes: 0,
-                words: 0,
             }),
             Err(source) => Err(SpillError::Spill { path, source }),
         }
@@ -63,7 +62,6 @@ impl LevelFile {
     }
 
     fn write_word(&mut self, word: u64) -> Result<(), SpillError> {
-        self.words += 1;
         self.file
             .write_all(&word.to_le_bytes())
             .map_err(|e| self.error(e))
@@ -96,11 +94,6 @@ impl LevelFile {
     /// The states appended so far.
     pub(crate) fn nodes(&self) -> u64 {
         self.nodes
-    }
-
-    /// The words written so far (the states still waiting for their word not counted).
-    pub(crate) fn words(&self) -> u64 {
-        self.words
     }
 
     /// Ends writing: the last word padded and written, everything flushed. Returns the file's path and

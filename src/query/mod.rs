@@ -1,6 +1,6 @@
 //! Questions asked of a map, for every `K` and on every storage (a tree in memory, a `.ktree` file read
 //! through its map): batch point queries and a cached cursor ([`points`]), bounding boxes, counts and
-//! crops of boxes ([`boxes`]), ray casting ([`ray`]) and the nearest full voxel ([`nearest`](mod@nearest)).
+//! crops of boxes ([`boxes`]), dense windows ([`dense`]), ray casting ([`ray`]) and the nearest full voxel ([`nearest`](mod@nearest)).
 //!
 //! Conventions: voxel `v` is the box `[v, v + 1)` in continuous coordinates and the universe is
 //! `[0, U)^K`; points outside the universe are outside the object (a query answers, it does not fail).
@@ -8,7 +8,7 @@
 //! centres (as scipy's `distance_transform_edt` measures them).
 //!
 //! Every query is a provided method of [`Query`], implemented for every
-//! [`TreeStorage`](crate::tree::storage::TreeStorage): a tree in memory and a `.ktree` file mapped in
+//! [`TreeStorage`]: a tree in memory and a `.ktree` file mapped in
 //! place (`io::MappedTree`) answer the same calls, each a walk of [`cursor`](crate::tree::cursor) or the
 //! one point descent of [`locate`](crate::tree::locate); the batch forms run on the threads of the
 //! current rayon pool. [`KTree`] also has each as a method that cannot fail.
@@ -25,12 +25,14 @@
 //! ```
 
 pub mod boxes;
+pub mod dense;
 pub mod nearest;
 pub mod points;
 pub mod ray;
 pub mod stats;
 
 pub use boxes::{bounding_box, count, crop, VoxelBox};
+pub use dense::{dense_window, dense_window_into, window_voxels, DenseError, DenseOrder};
 pub use nearest::{distance, nearest, nearest_many, nearest_many_signed, nearest_signed, Nearest};
 pub use points::{contains, contains_many, PointCursor};
 pub use ray::{cast_ray, cast_rays, Face, RayCast, RayError, RayHit};
@@ -104,6 +106,20 @@ pub trait Query<const K: usize>: TreeStorage<K> + Sync + Sized {
     /// The storage's read error.
     fn crop(&self, lo: [u32; K], hi: [u32; K]) -> Result<KTree<K>, Self::Error> {
         crop(self, lo, hi)
+    }
+
+    /// The voxels of the box `[lo, hi)` (anywhere: outside the universe is empty) as a dense array in
+    /// `order` ([`dense_window()`]).
+    ///
+    /// # Errors
+    /// [`DenseError::TooLarge`] past the dense limit, [`DenseError::Storage`] for a read error.
+    fn dense_window(
+        &self,
+        lo: [i64; K],
+        hi: [i64; K],
+        order: DenseOrder,
+    ) -> Result<Vec<bool>, DenseError> {
+        dense_window(self, lo, hi, order)
     }
 
     /// The first full voxel `ray` enters ([`cast_ray()`]; ties as [`ray`] says).

@@ -1,11 +1,15 @@
 //! Boolean operations and translation on ray sets (Akman & Franklin's AF11: "on rays, Boolean operations are
-//! 1-D"): each works column by column in one merge pass over both sorted sets.
+//! 1-D"): each works column by column, the columns of both sets side by side ([`join_columns`]), each
+//! column's runs through the one merge of runs ([`merge_runs`]) with the operation's truth table.
 //!
 //! Normals: a result carries normals when every operand does; each end keeps the normal of the operand's run
 //! end it comes from, negated where it comes from the subtracted set or a complement. Ends cut by the universe
 //! (complement, translation) get `−z` at `z1` and `+z` at `z2`.
 
-use super::{Normal, RaySet};
+use std::ops::Range;
+
+use super::merge::{merge_runs, Cause, TruthTable};
+use super::{join_columns, Normal, RaySet};
 use thiserror::Error;
 
 /// Errors of Boolean operations on ray sets.
@@ -20,24 +24,6 @@ pub enum CsgError {
     /// The complement would have more than 2^32 columns.
     #[error("the complement of a level-{0} universe has too many columns")]
     TooManyColumns(u32),
-}
-
-/// The Boolean operation applied to the memberships `(in a, in b)`; `(false, false)` must give `false`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Op {
-    Union,
-    Intersection,
-    Difference,
-}
-
-impl Op {
-    fn apply(self, a: bool, b: bool) -> bool {
-        match self {
-            Op::Union => a || b,
-            Op::Intersection => a && b,
-            Op::Difference => a && !b,
-        }
-    }
 }
 
 fn z_axis<const K: usize>(dir: f32) -> Normal<K> {
@@ -83,7 +69,54 @@ impl<const K: usize> Out<K> {
             ns.push(n);
         }
     }
+
+    /// Appends the runs of column `key` where `table` holds of the runs `ra` of `a` and `rb` of `b` (none
+    /// when `b` is `None`), in a line of `side` voxels. Each end carries the normal of the input run end
+    /// it comes from, negated where that input's membership changes the other way (a run of the
+    /// subtracted set, a complement); the universe's ends carry `∓z`.
+    fn merge(
+        &mut self,
+        key: u64,
+        a: &RaySet<K>,
+        ra: Range<usize>,
+        b: Option<(&RaySet<K>, Range<usize>)>,
+        table: TruthTable,
+        side: u32,
+    ) {
+        let (b, rb) = match b {
+            Some((b, rb)) => (b, rb),
+            None => (a, 0..0),
+        };
+        let normal = |cause: Cause, at_exit: bool| {
+            let n = match cause {
+                Cause::First { run, exit } => {
+                    a.normals(ra.start + run).map(|n| n[usize::from(exit)])
+                }
+                Cause::Second { run, exit } => {
+                    b.normals(rb.start + run).map(|n| n[usize::from(exit)])
+                }
+                Cause::Span => Some(z_axis::<K>(if at_exit { 1.0 } else { -1.0 })),
+            };
+            let n = n.unwrap_or([0.0; K]);
+            if cause.reversed(at_exit) {
+                neg(n)
+            } else {
+                n
+            }
+        };
+        let (runs_a, runs_b) = (&a.runs()[ra.clone()], &b.runs()[rb.clone()]);
+        merge_runs(
+            runs_a.iter().copied(),
+            runs_b.iter().copied(),
+            table,
+            0..side,
+            |z1, z2, start, end| self.push(key, z1, z2, [normal(start, false), normal(end, true)]),
+        );
+    }
 }
+
+/// The complement's table: inside where the one input is not.
+const NOT_FIRST: TruthTable = TruthTable::new(0b0101);
 
 impl<const K: usize> RaySet<K> {
     /// The voxels in `self` or in `other`.
@@ -100,7 +133,7 @@ impl<const K: usize> RaySet<K> {
     /// # Errors
     /// [`CsgError::LevelMismatch`] if the two sets live in universes of different levels.
     pub fn union(&self, other: &Self) -> Result<Self, CsgError> {
-        self.merge(other, Op::Union)
+        self.merge(other, TruthTable::UNION)
     }
 
     /// The voxels in both `self` and `other`.
@@ -108,7 +141,7 @@ impl<const K: usize> RaySet<K> {
     /// # Errors
     /// As [`RaySet::union`].
     pub fn intersection(&self, other: &Self) -> Result<Self, CsgError> {
-        self.merge(other, Op::Intersection)
+        self.merge(other, TruthTable::INTERSECTION)
     }
 
     /// The voxels in `self` but not in `other`.
@@ -116,7 +149,7 @@ impl<const K: usize> RaySet<K> {
     /// # Errors
     /// As [`RaySet::union`].
     pub fn difference(&self, other: &Self) -> Result<Self, CsgError> {
-        self.merge(other, Op::Difference)
+        self.merge(other, TruthTable::DIFFERENCE)
     }
 
     /// The voxels of the universe not in `self`.
@@ -132,24 +165,11 @@ impl<const K: usize> RaySet<K> {
         let side = self.universe().side() as u32;
         let mut out = Out::<K>::new(self.has_normals());
         let keys = self.column_keys();
-        let runs = self.runs();
         let mut i = 0;
         for key in 0..columns {
-            let mut z = 0u32;
-            let mut n1 = z_axis::<K>(-1.0);
-            while i < keys.len() && keys[i] == key {
-                let (z1, z2) = runs[i];
-                let ns = self.normals(i).unwrap_or([[0.0; K]; 2]);
-                if z1 > z {
-                    out.push(key, z, z1, [n1, neg(ns[0])]);
-                }
-                z = z2;
-                n1 = neg(ns[1]);
-                i += 1;
-            }
-            if z < side {
-                out.push(key, z, side, [n1, z_axis::<K>(1.0)]);
-            }
+            let end = i + keys[i..].iter().take_while(|&&k| k == key).count();
+            out.merge(key, self, i..end, None, NOT_FIRST, side);
+            i = end;
         }
         Ok(RaySet::from_sorted_parts(
             self.universe(),
@@ -169,20 +189,12 @@ impl<const K: usize> RaySet<K> {
     /// ```
     pub fn translated(&self, offset: [i64; K]) -> Self {
         let side = self.universe().side() as i64;
-        let level = self.level();
+        let keys = self.keys();
         let mut out = Out::<K>::new(self.has_normals());
         for (key, range) in self.column_groups() {
-            let col = self.column_of_key(key);
-            let mut new_key = 0u64;
-            let mut inside = true;
-            for a in 0..K - 1 {
-                let c = i64::from(col[a]).saturating_add(offset[a]);
-                inside &= (0..side).contains(&c);
-                new_key = (new_key << level) | (c.max(0) as u64);
-            }
-            if !inside {
+            let Some(new_key) = keys.moved(key, offset) else {
                 continue;
-            }
+            };
             for i in range {
                 let (z1, z2) = self.runs()[i];
                 let (a, b) = (
@@ -206,37 +218,22 @@ impl<const K: usize> RaySet<K> {
         RaySet::from_sorted_parts(self.universe(), out.columns, out.runs, out.normals)
     }
 
-    fn merge(&self, other: &Self, op: Op) -> Result<Self, CsgError> {
+    fn merge(&self, other: &Self, table: TruthTable) -> Result<Self, CsgError> {
         if self.level() != other.level() {
             return Err(CsgError::LevelMismatch(self.level(), other.level()));
         }
         let normals = self.has_normals() && other.has_normals();
         let mut out = Out::<K>::new(normals);
-        let (ka, kb) = (self.column_keys(), other.column_keys());
-        let (mut i, mut j) = (0, 0);
-        while i < ka.len() || j < kb.len() {
-            let key = match (ka.get(i), kb.get(j)) {
-                (Some(&a), Some(&b)) => a.min(b),
-                (Some(&a), None) => a,
-                (None, Some(&b)) => b,
-                (None, None) => unreachable!(),
-            };
-            let i_end = i + ka[i..].iter().take_while(|&&k| k == key).count();
-            let j_end = j + kb[j..].iter().take_while(|&&k| k == key).count();
-            if j == j_end {
-                // A column of `self` only: its runs are kept whole or dropped whole.
-                if op.apply(true, false) {
-                    out.copy(self, i..i_end);
-                }
-            } else if i == i_end {
-                if op.apply(false, true) {
-                    out.copy(other, j..j_end);
-                }
-            } else {
-                merge_column(self, i..i_end, other, j..j_end, key, op, &mut out);
+        let side = self.universe().side() as u32;
+        for (key, ra, rb) in join_columns(self.column_keys(), other.column_keys(), 0) {
+            if rb.is_empty() && table.apply(true, false) {
+                // A column of `self` only: its runs are kept whole (or dropped whole).
+                out.copy(self, ra);
+            } else if ra.is_empty() && table.apply(false, true) {
+                out.copy(other, rb);
+            } else if !ra.is_empty() && !rb.is_empty() {
+                out.merge(key, self, ra, Some((other, rb)), table, side);
             }
-            i = i_end;
-            j = j_end;
         }
         Ok(RaySet::from_sorted_parts(
             self.universe(),
@@ -244,71 +241,6 @@ impl<const K: usize> RaySet<K> {
             out.runs,
             out.normals,
         ))
-    }
-}
-
-/// Sweeps the run ends of one column of `a` and `b` in order and emits the runs where `op` holds.
-fn merge_column<const K: usize>(
-    a: &RaySet<K>,
-    ra: std::ops::Range<usize>,
-    b: &RaySet<K>,
-    rb: std::ops::Range<usize>,
-    key: u64,
-    op: Op,
-    out: &mut Out<K>,
-) {
-    let (runs_a, runs_b) = (&a.runs()[ra.clone()], &b.runs()[rb.clone()]);
-    // Each operand's state changes at its run ends; walk both lists of ends together.
-    let (mut ia, mut ib) = (0usize, 0usize); // index of the next end: run = idx / 2, end = idx % 2
-    let (mut in_a, mut in_b) = (false, false);
-    let mut open: Option<(u32, Normal<K>)> = None;
-    let end_of = |runs: &[(u32, u32)], idx: usize| {
-        let r = runs[idx / 2];
-        if idx.is_multiple_of(2) {
-            r.0
-        } else {
-            r.1
-        }
-    };
-    loop {
-        let za = (ia < 2 * runs_a.len()).then(|| end_of(runs_a, ia));
-        let zb = (ib < 2 * runs_b.len()).then(|| end_of(runs_b, ib));
-        let z = match (za, zb) {
-            (None, None) => break,
-            (Some(x), None) => x,
-            (None, Some(y)) => y,
-            (Some(x), Some(y)) => x.min(y),
-        };
-        // Apply every change at z, remembering the normal of the last end applied from each side.
-        let mut normal_a = None;
-        let mut normal_b = None;
-        while ia < 2 * runs_a.len() && end_of(runs_a, ia) == z {
-            in_a = ia % 2 == 0;
-            normal_a = a.normals(ra.start + ia / 2).map(|n| n[ia % 2]);
-            ia += 1;
-        }
-        while ib < 2 * runs_b.len() && end_of(runs_b, ib) == z {
-            in_b = ib % 2 == 0;
-            normal_b = b.normals(rb.start + ib / 2).map(|n| n[ib % 2]);
-            ib += 1;
-        }
-        let now = op.apply(in_a, in_b);
-        let from_b = |n: Normal<K>| {
-            if op == Op::Difference {
-                neg(n)
-            } else {
-                n
-            }
-        };
-        let normal = normal_a.or(normal_b.map(from_b)).unwrap_or([0.0; K]);
-        match (open, now) {
-            (None, true) => open = Some((z, normal)),
-            (Some((z1, n1)), false) => {
-                out.push(key, z1, z, [n1, normal]);
-                open = None;
-            }
-            _ => {}
-        }
     }
 }
 
@@ -339,10 +271,15 @@ mod tests {
             ],
         )
         .unwrap();
-        for op in [Op::Union, Op::Intersection, Op::Difference] {
+        for op in [
+            TruthTable::UNION,
+            TruthTable::INTERSECTION,
+            TruthTable::DIFFERENCE,
+        ] {
             for (x, y) in [(&a, &b), (&b, &a)] {
                 let merged = x.merge(y, op).unwrap();
                 let mut swept = Out::<2>::new(true);
+                let side = x.universe().side() as u32;
                 let (kx, ky) = (x.column_keys(), y.column_keys());
                 let mut keys: Vec<u64> = kx.iter().chain(ky).copied().collect();
                 keys.sort_unstable();
@@ -350,7 +287,7 @@ mod tests {
                 for key in keys {
                     let rx = kx.partition_point(|&k| k < key)..kx.partition_point(|&k| k <= key);
                     let ry = ky.partition_point(|&k| k < key)..ky.partition_point(|&k| k <= key);
-                    merge_column(x, rx, y, ry, key, op, &mut swept);
+                    swept.merge(key, x, rx, Some((y, ry)), op, side);
                 }
                 assert_eq!(merged.column_keys(), swept.columns, "{op:?}");
                 assert_eq!(merged.runs(), swept.runs, "{op:?}");

@@ -1,5 +1,8 @@
-//! Objects as rays: `RaySet<K>` (sorted, disjoint runs along the last axis per column) and the maximal rows
-//! of a run.
+//! Objects as rays: `RaySet<K>` (sorted, disjoint runs along the last axis per column), the maximal rows
+//! of a run, and the one toolkit every list of runs of the crate is handled with: the column keys
+//! ([`ColumnKeys`], and [`SignedColumnKeys`] for columns past the universe), the columns of two lists side
+//! by side ([`join_columns`]) and the one merge of two lists of runs by a truth table ([`merge_runs`],
+//! [`TruthTable`], its [`stretches`]).
 //!
 //! ```
 //! use ktree::{rays::maximal_rows, Ray, RaySet};
@@ -14,7 +17,10 @@
 
 mod any;
 mod ball;
+pub mod column;
 mod csg;
+mod gather;
+pub mod merge;
 mod rayset;
 mod rows;
 pub mod source;
@@ -22,7 +28,10 @@ mod split;
 
 pub use any::AnyRaySet;
 pub use ball::ball_rays;
+pub use column::{join_columns, ColumnJoin, ColumnKeys, SignedColumnKeys};
 pub use csg::CsgError;
+pub(crate) use gather::RunGatherer;
+pub use merge::{joined, merge_runs, stretches, Cause, Joined, Stretch, Stretches, TruthTable};
 pub use rayset::{ColumnGroups, Normal, Ray, RayError, RaySet};
 pub use rows::{maximal_rows, MaximalRows, Row};
 pub use source::{RaySource, SlabRuns};

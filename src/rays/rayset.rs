@@ -1,5 +1,6 @@
 //! `RaySet<K>`: an object as sorted, disjoint runs along the last axis, one list per column.
 
+use super::ColumnKeys;
 use crate::space::{DimCheck, SpaceError, Universe};
 use thiserror::Error;
 
@@ -309,12 +310,15 @@ impl<const K: usize> RaySet<K> {
     }
 
     /// The key of a column: its `K − 1` coordinates packed with axis 0 most significant, `L` bits each
-    /// (the last coordinate of `point` is ignored). Keys sort columns lexicographically.
+    /// (the last coordinate of `point` is ignored; [`ColumnKeys::pack`]). Keys sort columns
+    /// lexicographically.
     pub fn column_key(&self, point: [u32; K]) -> u64 {
-        let level = self.level();
-        point[..K - 1]
-            .iter()
-            .fold(0u64, |key, &c| (key << level) | u64::from(c))
+        self.keys().pack(point)
+    }
+
+    /// How this set's column keys pack a column ([`ColumnKeys`] of its level).
+    pub fn keys(&self) -> ColumnKeys<K> {
+        ColumnKeys::new(self.level())
     }
 
     /// The column of a key (last coordinate 0): the inverse of [`RaySet::column_key`].
@@ -323,14 +327,8 @@ impl<const K: usize> RaySet<K> {
     }
 
     /// [`RaySet::column_of_key`] in a universe of level `level`.
-    pub fn column_of_key_at(level: u32, mut key: u64) -> [u32; K] {
-        let mask = (1u64 << level) - 1;
-        let mut point = [0u32; K];
-        for c in point[..K - 1].iter_mut().rev() {
-            *c = (key & mask) as u32;
-            key >>= level;
-        }
-        point
+    pub fn column_of_key_at(level: u32, key: u64) -> [u32; K] {
+        ColumnKeys::<K>::new(level).unpack(key)
     }
 
     /// The runs of one column, as a slice of `(z1, z2)`, found by binary search.

@@ -3,7 +3,7 @@
 
 use std::ops::Range;
 
-use super::RaySet;
+use super::{ColumnKeys, RaySet};
 use crate::space::{Cell, Universe};
 
 impl<const K: usize> RaySet<K> {
@@ -20,7 +20,6 @@ impl<const K: usize> RaySet<K> {
     /// assert_eq!(inner.iter().collect::<Vec<_>>(), [Ray::new([1, 0], 3)]);
     /// ```
     pub fn cell_rays(&self, cell: Cell<K>) -> RaySet<K> {
-        let level = self.level();
         let local = Universe::<K>::new(cell.log_side).expect("a cell's level is a valid level");
         let side = cell.side() as u32;
         let (z_lo, z_hi) = (cell.origin[K - 1], cell.origin[K - 1] + side);
@@ -29,7 +28,7 @@ impl<const K: usize> RaySet<K> {
         } else {
             self.slab_range(cell.origin[0]..cell.origin[0] + side)
         };
-        let mask = (1u64 << level) - 1;
+        let (keys, local_keys) = (self.keys(), ColumnKeys::<K>::new(cell.log_side));
         let mut columns = Vec::new();
         let mut runs = Vec::new();
         for i in slab {
@@ -38,16 +37,10 @@ impl<const K: usize> RaySet<K> {
             if z2 <= z_lo || z1 >= z_hi {
                 continue;
             }
-            let mut local_key = 0u64;
-            let mut inside = true;
-            for a in 0..K.saturating_sub(1) {
-                let c = (key >> ((K - 2 - a) as u32 * level) & mask) as u32;
-                let o = cell.origin[a];
-                inside &= c >= o && c - o < side;
-                local_key = local_key << cell.log_side | u64::from(c.wrapping_sub(o));
-            }
-            if inside {
-                columns.push(local_key);
+            let column = keys.unpack(key);
+            if (0..K - 1).all(|a| column[a].wrapping_sub(cell.origin[a]) < side) {
+                let local = std::array::from_fn(|a| column[a].wrapping_sub(cell.origin[a]));
+                columns.push(local_keys.pack(local));
                 runs.push((z1.max(z_lo) - z_lo, z2.min(z_hi) - z_lo));
             }
         }
@@ -60,11 +53,9 @@ impl<const K: usize> RaySet<K> {
         if K == 1 {
             return 0..self.len();
         }
-        let shift = (K - 2) as u32 * self.level();
+        let range = self.keys().slab(x);
         let keys = self.column_keys();
-        let lo = keys.partition_point(|&k| k >> shift < u64::from(x.start));
-        let hi = keys.partition_point(|&k| k >> shift < u64::from(x.end));
-        lo..hi
+        keys.partition_point(|&k| k < range.start)..keys.partition_point(|&k| k < range.end)
     }
 }
 

@@ -42,9 +42,12 @@
 
 use rayon::prelude::*;
 
+use super::input::{read_error, Complement};
 use super::ShapeError;
-use crate::tree::cursor::{walk, Visitor, Walk};
-use crate::tree::to_rays::SlabRuns;
+use crate::query::{self, dense_window_into, DenseOrder};
+use crate::rays::{ColumnKeys, RunGatherer};
+use crate::tree::cursor::{try_walk, Visitor, Walk};
+use crate::tree::storage::TreeStorage;
 use crate::tree::{NodeRef, NodeState};
 use crate::KTree;
 
@@ -104,7 +107,7 @@ impl<const K: usize> Bx<K> {
 }
 
 /// The universe as a box.
-fn universe_box<const K: usize>(tree: &KTree<K>) -> Bx<K> {
+fn universe_box<const K: usize, T: TreeStorage<K>>(tree: &T) -> Bx<K> {
     Bx {
         lo: [0; K],
         dims: [tree.universe().side() as i64; K],
@@ -112,59 +115,33 @@ fn universe_box<const K: usize>(tree: &KTree<K>) -> Bx<K> {
 }
 
 /// Full voxels of `tree` in box `b` (clipped to the universe).
-fn count_in<const K: usize>(tree: &KTree<K>, b: &Bx<K>) -> u128 {
+fn count_in<const K: usize, T: TreeStorage<K>>(tree: &T, b: &Bx<K>) -> Result<u128, ShapeError> {
     let m = b.meet(&universe_box(tree));
     if m.is_empty() {
-        return 0;
+        return Ok(0);
     }
     let (lo, hi) = m.corners();
-    tree.count(lo, hi)
+    query::count(tree, lo, hi).map_err(read_error)
 }
 
-/// A dense mask of box `b` (row-major, last axis fastest): `true` on the full voxels when `full`, on the
-/// empty ones otherwise; a voxel outside the universe counts as empty when `outside_empty`, else as
-/// neither (never `true`).
-fn mask<const K: usize>(tree: &KTree<K>, b: &Bx<K>, full: bool, outside_empty: bool) -> Vec<bool> {
-    struct Fill<'a, const K: usize> {
-        b: Bx<K>,
-        strides: [usize; K],
-        data: &'a mut [bool],
-        value: bool,
-    }
-    impl<const K: usize> Visitor<K> for Fill<'_, K> {
-        const LEAVES: bool = false;
-        fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-            let cell = node.cell();
-            let c = Bx {
-                lo: cell.origin.map(i64::from),
-                dims: [cell.side() as i64; K],
-            }
-            .meet(&self.b);
-            if c.is_empty() || node.state() == NodeState::Empty {
-                return Walk::Skip;
-            }
-            if node.state() == NodeState::Partial {
-                return Walk::Descend;
-            }
-            fill_box(&self.b, &self.strides, self.data, &c, self.value);
-            Walk::Skip
-        }
-    }
-    let strides = strides(&b.dims);
-    let inside = b.meet(&universe_box(tree));
-    // Start from what the empty voxels hold, then write the full cells' value.
-    let mut data = vec![!full && outside_empty; b.len() as usize];
-    if !inside.is_empty() {
-        fill_box(b, &strides, &mut data, &inside, !full);
-        let mut v = Fill {
-            b: *b,
-            strides,
-            data: &mut data,
-            value: full,
-        };
-        walk(tree, &mut v);
-    }
-    data
+/// A dense mask of box `b` (row-major, last axis fastest): `true` on the full voxels when `full`, else on
+/// the others (the empty voxels and those outside the universe): the one dense window of the crate.
+fn mask<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    b: &Bx<K>,
+    full: bool,
+) -> Result<Vec<bool>, ShapeError> {
+    let mut data = vec![false; b.len() as usize];
+    dense_window_into(
+        tree,
+        b.lo,
+        b.hi(),
+        DenseOrder::LastAxisFastest,
+        &mut data,
+        full,
+    )
+    .map_err(read_error)?;
+    Ok(data)
 }
 
 /// Row-major strides of a box's dims.
@@ -174,27 +151,6 @@ fn strides<const K: usize>(dims: &[i64; K]) -> [usize; K] {
         s[a] = s[a + 1] * dims[a + 1] as usize;
     }
     s
-}
-
-/// Sets the voxels of `part` (inside `b`) to `value` in `b`'s dense array.
-fn fill_box<const K: usize>(
-    b: &Bx<K>,
-    strides: &[usize; K],
-    data: &mut [bool],
-    part: &Bx<K>,
-    value: bool,
-) {
-    let mut at = [0i64; K];
-    loop {
-        let start: usize = (0..K - 1)
-            .map(|a| (part.lo[a] + at[a] - b.lo[a]) as usize * strides[a])
-            .sum::<usize>()
-            + (part.lo[K - 1] - b.lo[K - 1]) as usize;
-        data[start..start + part.dims[K - 1] as usize].fill(value);
-        if !odometer(&mut at, &part.dims, K - 1) {
-            return;
-        }
-    }
 }
 
 /// Steps `at` over the first `axes` axes of `dims`, the last of them fastest; `false` when done.
@@ -337,7 +293,7 @@ impl<const K: usize> NarrowBand<K> {
 
 /// The side of a block: a power of two of about 2^15 voxels, at least twice the margin, at most the
 /// universe's side.
-fn block_side<const K: usize>(tree: &KTree<K>, margin: i64) -> i64 {
+fn block_side<const K: usize, T: TreeStorage<K>>(tree: &T, margin: i64) -> i64 {
     let mut side = 1i64 << (15 / K);
     while side < 2 * margin {
         side *= 2;
@@ -348,7 +304,11 @@ fn block_side<const K: usize>(tree: &KTree<K>, margin: i64) -> i64 {
 /// The blocks (cells of side `side`, a power of two) that hold a full voxel, with their neighbours within
 /// `reach` blocks when `reach > 0`, clipped to the universe: the only blocks where a margin of at most
 /// `reach · side` voxels can see a full voxel.
-fn blocks<const K: usize>(tree: &KTree<K>, side: i64, reach: i64) -> Vec<Bx<K>> {
+fn blocks<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    side: i64,
+    reach: i64,
+) -> Result<Vec<Bx<K>>, ShapeError> {
     struct Occupied<const K: usize> {
         side: u64,
         out: Vec<[i64; K]>,
@@ -378,7 +338,7 @@ fn blocks<const K: usize>(tree: &KTree<K>, side: i64, reach: i64) -> Vec<Bx<K>> 
         side: side as u64,
         out: Vec::new(),
     };
-    walk(tree, &mut v);
+    try_walk(tree, &mut v).map_err(read_error)?;
     let count = tree.universe().side() as i64 / side;
     let mut all = if reach > 0 {
         let n = [2 * reach + 1; K];
@@ -401,18 +361,20 @@ fn blocks<const K: usize>(tree: &KTree<K>, side: i64, reach: i64) -> Vec<Bx<K>> 
     };
     all.par_sort_unstable();
     all.dedup();
-    all.into_iter()
+    Ok(all
+        .into_iter()
         .map(|b| Bx {
             lo: b.map(|x| x * side),
             dims: [side; K],
         })
-        .collect()
+        .collect())
 }
 
 /// The bounding box of the full voxels as a box.
-fn object_box<const K: usize>(tree: &KTree<K>) -> Option<Bx<K>> {
-    tree.bounding_box()
-        .map(|(lo, hi)| Bx::from_lo_hi(lo.map(i64::from), hi.map(i64::from)))
+fn object_box<const K: usize, T: TreeStorage<K>>(tree: &T) -> Result<Option<Bx<K>>, ShapeError> {
+    Ok(query::bounding_box(tree)
+        .map_err(read_error)?
+        .map(|(lo, hi)| Bx::from_lo_hi(lo.map(i64::from), hi.map(i64::from))))
 }
 
 /// The voxel at row-major index `i` of box `b`.
@@ -427,15 +389,11 @@ fn voxel_of<const K: usize>(b: &Bx<K>, mut i: usize) -> [u32; K] {
 }
 
 /// Runs along the last axis of a row-major mask of box `b`, as `(column key, z1, z2)`.
-fn runs_of<const K: usize>(tree: &KTree<K>, b: &Bx<K>, keep: &[bool]) -> Vec<(u64, u32, u32)> {
-    let level = tree.level();
+fn runs_of<const K: usize>(keys: ColumnKeys<K>, b: &Bx<K>, keep: &[bool]) -> Vec<(u64, u32, u32)> {
     let n = b.dims[K - 1] as usize;
     let mut out = Vec::new();
     for (row, line) in keep.chunks(n).enumerate() {
-        let first = voxel_of(b, row * n);
-        let key = first[..K - 1]
-            .iter()
-            .fold(0u64, |key, &x| (key << level) | u64::from(x));
+        let key = keys.pack(voxel_of(b, row * n));
         let mut z = 0;
         while z < n {
             if !line[z] {
@@ -456,25 +414,297 @@ fn runs_of<const K: usize>(tree: &KTree<K>, b: &Bx<K>, keep: &[bool]) -> Vec<(u6
 /// The tree of the runs that `runs_in` gives for each block (a block's runs `(column key, z1, z2)` in row
 /// order), the blocks in [`blocks`]' order. The blocks are taken slab by slab along the first axis, each
 /// slab's on all threads; a column's pieces then come in order along it (its blocks are consecutive, in
-/// order along the last axis), as [`SlabRuns`] needs. Memory holds the result's runs and one slab's pieces, never every
-/// block's at once.
-fn tree_of_blocks<const K: usize>(
-    tree: &KTree<K>,
+/// order along the last axis), as [`RunGatherer`] needs. Memory holds the result's runs and one slab's
+/// pieces, never every block's at once.
+fn tree_of_blocks<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
     blocks: &[Bx<K>],
     side: i64,
-    runs_in: impl Fn(&Bx<K>) -> Vec<(u64, u32, u32)> + Sync,
-) -> KTree<K> {
-    let mut out = SlabRuns::<K>::new(tree.level(), side as u64);
+    runs_in: impl Fn(&Bx<K>) -> Result<Vec<(u64, u32, u32)>, ShapeError> + Sync,
+) -> Result<KTree<K>, ShapeError> {
+    let mut out = RunGatherer::<K>::new(tree.level(), side as u64);
+    let mut pieces = Vec::new();
     for slab in blocks.chunk_by(|a, b| a.lo[0] == b.lo[0]) {
-        let mut pieces: Vec<(u64, u32, u32)> = slab.par_iter().flat_map_iter(&runs_in).collect();
+        let parts: Vec<Vec<(u64, u32, u32)>> =
+            slab.par_iter().map(&runs_in).collect::<Result<_, _>>()?;
+        pieces.clear();
+        parts.into_iter().for_each(|p| pieces.extend(p));
         out.append(slab[0].lo[0] as u64, &mut pieces);
     }
-    KTree::from_rays(&out.finish(tree.universe()))
+    Ok(KTree::from_rays(&out.finish(tree.universe())))
+}
+
+/// The signed distance of each voxel of `points` (see [`crate::shape::distance`]'s conventions) in `tree`
+/// (in memory or a file read in place), exact: one nearest-voxel search each, on all threads, in the
+/// tree (empty voxels) or its complement (full voxels; read through the tree, not made).
+///
+/// ```
+/// use ktree::{shape::signed_distance_at, KTree};
+/// let tree = KTree::<1>::from_dense(3, &[false, true, true, true, false, false, false, false]).unwrap();
+/// assert_eq!(signed_distance_at(&tree, &[[0], [2], [7]]).unwrap(), [1.0, -2.0, 4.0]);
+/// ```
+///
+/// # Errors
+/// [`ShapeError::PointOutside`] for a point outside the universe; [`ShapeError::Storage`] for a read
+/// error.
+pub fn signed_distance_at<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
+    points: &[[u32; K]],
+) -> Result<Vec<f64>, ShapeError> {
+    let side = tree.universe().side();
+    if let Some(p) = points
+        .iter()
+        .find(|p| p.iter().any(|&x| u64::from(x) >= side))
+    {
+        return Err(ShapeError::PointOutside {
+            point: p.to_vec(),
+            side,
+        });
+    }
+    let inside = query::contains_many(tree, points).map_err(read_error)?;
+    let (mut full, mut empty) = (Vec::new(), Vec::new());
+    for (p, &i) in points.iter().zip(&inside) {
+        if i {
+            full.push(*p);
+        } else {
+            empty.push(*p);
+        }
+    }
+    let to_full = query::nearest_many(tree, &empty).map_err(read_error)?;
+    let to_empty = query::nearest_many(&Complement(tree), &full).map_err(read_error)?;
+    let (mut f, mut e) = (to_empty.into_iter(), to_full.into_iter());
+    Ok(inside
+        .iter()
+        .map(|&i| {
+            if i {
+                -f.next().flatten().map_or(f64::INFINITY, |n| n.distance())
+            } else {
+                e.next().flatten().map_or(f64::INFINITY, |n| n.distance())
+            }
+        })
+        .collect())
+}
+
+/// The signed distances of the window `[origin, origin + shape)` of `tree`, row-major with the last axis
+/// fastest (numpy's C order of an array indexed `[x0, …, x(K−1)]`), exact as `f32` rounds them; the
+/// window sees the whole tree, not only what lies inside it.
+///
+/// ```
+/// use ktree::{shape::signed_distance_window, KTree};
+/// let tree = KTree::<2>::from_dense(2, &(0..16).map(|i| i == 5).collect::<Vec<_>>()).unwrap();
+/// let f = signed_distance_window(&tree, [0, 0], [4, 4]).unwrap(); // dense voxel (1, 1)
+/// assert_eq!(f[1 * 4 + 1], -1.0);
+/// assert_eq!(f[3 * 4 + 3], 8f32.sqrt());
+/// ```
+///
+/// # Performance
+/// `O(K · voxels)` of the window grown by a margin that doubles until every value is exact (at most to
+/// the full voxels' bounding box); memory the same.
+///
+/// # Errors
+/// [`ShapeError::Window`] if the window leaves the universe or holds more than 2^31 voxels;
+/// [`ShapeError::Storage`] for a read error.
+pub fn signed_distance_window<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
+    origin: [u32; K],
+    shape: [usize; K],
+) -> Result<Vec<f32>, ShapeError> {
+    let side = tree.universe().side();
+    let voxels = shape.iter().map(|&s| s as u128).product::<u128>();
+    if (0..K).any(|a| u64::from(origin[a]) + shape[a] as u64 > side) || voxels > MAX_WINDOW {
+        return Err(ShapeError::Window {
+            origin: origin.to_vec(),
+            shape: shape.to_vec(),
+            side,
+        });
+    }
+    let w = Bx {
+        lo: origin.map(i64::from),
+        dims: shape.map(|s| s as i64),
+    };
+    if w.is_empty() {
+        return Ok(Vec::new());
+    }
+    let Some(object) = object_box(tree)? else {
+        return Ok(vec![f32::INFINITY; voxels as usize]);
+    };
+    let full = count_in(tree, &w)?;
+    let outside = if full < voxels {
+        Some(exact_window(tree, &w, &object, true)?)
+    } else {
+        None
+    };
+    let inside = if full > 0 {
+        let grown = object.grown(1).meet(&universe_box(tree));
+        Some(exact_window(tree, &w, &grown, false)?)
+    } else {
+        None
+    };
+    let sqrt = |d: u64| {
+        if d == FAR {
+            f32::INFINITY
+        } else {
+            (d as f64).sqrt() as f32
+        }
+    };
+    Ok((0..voxels as usize)
+        .map(|i| match (&outside, &inside) {
+            (Some(o), Some(n)) if o[i] == 0 => -sqrt(n[i]),
+            (Some(o), _) => sqrt(o[i]),
+            (None, Some(n)) => -sqrt(n[i]),
+            (None, None) => unreachable!("a window holds full or empty voxels"),
+        })
+        .collect())
+}
+
+/// The narrow band of half-width `width` (voxels) of `tree`: every voxel with `|sd| ≤ width` and its
+/// signed distance, exact, computed block by block on all threads.
+///
+/// ```
+/// use ktree::{shape::narrow_band, KTree};
+/// let tree = KTree::<1>::from_dense(3, &[false, true, true, true, true, false, false, false]).unwrap();
+/// let band = narrow_band(&tree, 1.0).unwrap();
+/// assert_eq!(band.voxels, [[0], [1], [4], [5]]);
+/// assert_eq!(band.values, [1.0, -1.0, -1.0, 1.0]);
+/// ```
+///
+/// # Performance
+/// `O(K · (b + 2w)^K)` per block of side `b` the surface passes through; memory one block per thread.
+///
+/// # Errors
+/// [`ShapeError::BadWidth`] for a negative or non-finite width; [`ShapeError::Storage`] for a read error.
+pub fn narrow_band<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
+    width: f64,
+) -> Result<NarrowBand<K>, ShapeError> {
+    check_width(width)?;
+    let limit = squared_limit(width);
+    let universe = universe_box(tree);
+    let pad = (width.floor() as i64).min(universe.dims[0]);
+    let side = block_side(tree, pad);
+    let band_of = |b: &Bx<K>| -> Result<(Vec<[u32; K]>, Vec<f64>), ShapeError> {
+        let src = b.grown(pad).meet(&universe);
+        let n = count_in(tree, &src)?;
+        if n == 0 || n == src.len() {
+            return Ok((Vec::new(), Vec::new()));
+        }
+        let full = mask(tree, &src, true)?;
+        let empty: Vec<bool> = full.iter().map(|&f| !f).collect();
+        let out = edt(&src, &full, b);
+        let inn = edt(&src, &empty, b);
+        let (mut voxels, mut values) = (Vec::new(), Vec::new());
+        for i in 0..out.len() {
+            let (d, sign) = if out[i] == 0 {
+                (inn[i], -1.0)
+            } else {
+                (out[i], 1.0)
+            };
+            if d <= limit {
+                voxels.push(voxel_of(b, i));
+                values.push(sign * (d as f64).sqrt());
+            }
+        }
+        Ok((voxels, values))
+    };
+    let mut band = NarrowBand {
+        width,
+        ..NarrowBand::default()
+    };
+    // A few blocks a thread at a time, appended at once: memory is the band and those blocks' parts.
+    let chunk = 16 * rayon::current_num_threads();
+    for blocks in blocks(tree, side, 1)?.chunks(chunk) {
+        let parts: Vec<(Vec<[u32; K]>, Vec<f64>)> =
+            blocks.par_iter().map(band_of).collect::<Result<_, _>>()?;
+        for (v, d) in parts {
+            band.voxels.extend(v);
+            band.values.extend(d);
+        }
+    }
+    Ok(band)
+}
+
+/// [`dilate`](super::dilate) by a ball through the distance transform, block by block: the voxels within
+/// `r` of a full voxel of `tree`. [`dilate`](super::dilate) takes this path where it is the faster one
+/// (see [`crate::shape`]); the result is the same.
+///
+/// ```
+/// use ktree::{rays::ball_rays, shape::{dilate, dilate_ball_by_distance, Element}, KTree};
+/// let tree = KTree::from_rays(&ball_rays::<3>(5, [16, 16, 16], 6).unwrap());
+/// assert_eq!(dilate_ball_by_distance(&tree, 4.5).unwrap(), dilate(&tree, 4.5, Element::Ball).unwrap());
+/// ```
+///
+/// # Errors
+/// [`ShapeError::BadRadius`] for a negative or non-finite `r`; [`ShapeError::Storage`] for a read error.
+pub fn dilate_ball_by_distance<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
+    r: f64,
+) -> Result<KTree<K>, ShapeError> {
+    super::element::check_radius(r)?;
+    let limit = squared_limit(r);
+    let universe = universe_box(tree);
+    let pad = (r.floor() as i64).min(universe.dims[0]);
+    let side = block_side(tree, pad);
+    let keys = ColumnKeys::new(tree.level());
+    tree_of_blocks(tree, &blocks(tree, side, 1)?, side, |b| {
+        let src = b.grown(pad).meet(&universe);
+        if count_in(tree, &src)? == 0 {
+            return Ok(Vec::new());
+        }
+        if count_in(tree, b)? == b.len() {
+            return Ok(runs_of(keys, b, &vec![true; b.len() as usize]));
+        }
+        let d = edt(&src, &mask(tree, &src, true)?, b);
+        let keep: Vec<bool> = d.iter().map(|&d| d <= limit).collect();
+        Ok(runs_of(keys, b, &keep))
+    })
+}
+
+/// [`erode`](super::erode) by a ball through the distance transform, the outside of the universe empty
+/// (scipy's `border_value=0`): the full voxels of `tree` farther than `r` from every empty voxel.
+///
+/// ```
+/// use ktree::{rays::ball_rays, shape::{erode, erode_ball_by_distance, Element}, KTree};
+/// let tree = KTree::from_rays(&ball_rays::<3>(5, [16, 16, 16], 20).unwrap());
+/// assert_eq!(erode_ball_by_distance(&tree, 4.5).unwrap(), erode(&tree, 4.5, Element::Ball).unwrap());
+/// ```
+///
+/// # Errors
+/// [`ShapeError::BadRadius`] for a negative or non-finite `r`; [`ShapeError::Storage`] for a read error.
+pub fn erode_ball_by_distance<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
+    r: f64,
+) -> Result<KTree<K>, ShapeError> {
+    super::element::check_radius(r)?;
+    let limit = squared_limit(r);
+    let universe = universe_box(tree);
+    let pad = (r.floor() as i64).min(universe.dims[0]);
+    let side = block_side(tree, pad);
+    let keys = ColumnKeys::new(tree.level());
+    tree_of_blocks(tree, &blocks(tree, side, 0)?, side, |b| {
+        let src = b.grown(pad);
+        let inside = src.meet(&universe) == src;
+        if count_in(tree, b)? == 0 {
+            return Ok(Vec::new());
+        }
+        if inside && count_in(tree, &src)? == src.len() {
+            return Ok(runs_of(keys, b, &vec![true; b.len() as usize]));
+        }
+        let d = edt(&src, &mask(tree, &src, false)?, b);
+        let keep: Vec<bool> = d.iter().map(|&d| d > limit).collect();
+        Ok(runs_of(keys, b, &keep))
+    })
+}
+
+/// Whether a block of the ball morphology by distance of `tree`, grown by `r`, stays within
+/// [`MAX_BLOCK_SOURCE`] voxels (else the run extension is taken, whatever its cost).
+pub(crate) fn ball_by_distance_fits<const K: usize, T: TreeStorage<K>>(tree: &T, r: f64) -> bool {
+    let pad = (r.floor().min(1e12) as i64).min(universe_box(tree).dims[0]);
+    let side = block_side(tree, pad);
+    ((side + 2 * pad) as u128).saturating_pow(K as u32) <= MAX_BLOCK_SOURCE
 }
 
 impl<const K: usize> KTree<K> {
-    /// The signed distance of each voxel of `points` (see [`crate::shape::distance`]'s conventions), exact:
-    /// one nearest-voxel search each, on all threads, in the tree (empty voxels) or its complement (full).
+    /// The signed distance of each voxel of `points` ([`signed_distance_at()`]).
     ///
     /// ```
     /// use ktree::KTree;
@@ -483,255 +713,57 @@ impl<const K: usize> KTree<K> {
     /// ```
     ///
     /// # Errors
-    /// [`ShapeError::PointOutside`] for a point outside the universe.
+    /// As [`signed_distance_at()`].
     pub fn signed_distance_at(&self, points: &[[u32; K]]) -> Result<Vec<f64>, ShapeError> {
-        let side = self.universe().side();
-        if let Some(p) = points
-            .iter()
-            .find(|p| p.iter().any(|&x| u64::from(x) >= side))
-        {
-            return Err(ShapeError::PointOutside {
-                point: p.to_vec(),
-                side,
-            });
-        }
-        let inside = self.contains_many(points);
-        let (mut full, mut empty) = (Vec::new(), Vec::new());
-        for (p, &i) in points.iter().zip(&inside) {
-            if i {
-                full.push(*p);
-            } else {
-                empty.push(*p);
-            }
-        }
-        let complement = !self;
-        let to_full = self.nearest_many(&empty);
-        let to_empty = complement.nearest_many(&full);
-        let (mut f, mut e) = (to_empty.into_iter(), to_full.into_iter());
-        Ok(inside
-            .iter()
-            .map(|&i| {
-                if i {
-                    -f.next().flatten().map_or(f64::INFINITY, |n| n.distance())
-                } else {
-                    e.next().flatten().map_or(f64::INFINITY, |n| n.distance())
-                }
-            })
-            .collect())
+        signed_distance_at(self, points)
     }
 
-    /// The signed distances of the window `[origin, origin + shape)`, row-major with the last axis fastest
-    /// (numpy's C order of an array indexed `[x0, …, x(K−1)]`), exact as `f32` rounds them; the window sees
-    /// the whole tree, not only what lies inside it.
+    /// The signed distances of the window `[origin, origin + shape)`, C order ([`signed_distance_window()`]).
     ///
     /// ```
     /// use ktree::KTree;
     /// let tree = KTree::<2>::from_dense(2, &(0..16).map(|i| i == 5).collect::<Vec<_>>()).unwrap();
-    /// let f = tree.signed_distance_window([0, 0], [4, 4]).unwrap(); // dense voxel (1, 1)
-    /// assert_eq!(f[1 * 4 + 1], -1.0);
-    /// assert_eq!(f[3 * 4 + 3], 8f32.sqrt());
+    /// assert_eq!(tree.signed_distance_window([1, 1], [1, 1]).unwrap(), [-1.0]);
     /// ```
     ///
-    /// # Performance
-    /// `O(K · voxels)` of the window grown by a margin that doubles until every value is exact (at most to
-    /// the full voxels' bounding box); memory the same.
-    ///
     /// # Errors
-    /// [`ShapeError::Window`] if the window leaves the universe or holds more than 2^31 voxels.
+    /// As [`signed_distance_window()`].
     pub fn signed_distance_window(
         &self,
         origin: [u32; K],
         shape: [usize; K],
     ) -> Result<Vec<f32>, ShapeError> {
-        let side = self.universe().side();
-        let voxels = shape.iter().map(|&s| s as u128).product::<u128>();
-        if (0..K).any(|a| u64::from(origin[a]) + shape[a] as u64 > side) || voxels > MAX_WINDOW {
-            return Err(ShapeError::Window {
-                origin: origin.to_vec(),
-                shape: shape.to_vec(),
-                side,
-            });
-        }
-        let w = Bx {
-            lo: origin.map(i64::from),
-            dims: shape.map(|s| s as i64),
-        };
-        if w.is_empty() {
-            return Ok(Vec::new());
-        }
-        let Some(object) = object_box(self) else {
-            return Ok(vec![f32::INFINITY; voxels as usize]);
-        };
-        let full = count_in(self, &w);
-        let outside = if full < voxels {
-            Some(exact_window(self, &w, &object, true))
-        } else {
-            None
-        };
-        let inside = if full > 0 {
-            let grown = object.grown(1).meet(&universe_box(self));
-            Some(exact_window(self, &w, &grown, false))
-        } else {
-            None
-        };
-        let sqrt = |d: u64| {
-            if d == FAR {
-                f32::INFINITY
-            } else {
-                (d as f64).sqrt() as f32
-            }
-        };
-        Ok((0..voxels as usize)
-            .map(|i| match (&outside, &inside) {
-                (Some(o), Some(n)) if o[i] == 0 => -sqrt(n[i]),
-                (Some(o), _) => sqrt(o[i]),
-                (None, Some(n)) => -sqrt(n[i]),
-                (None, None) => unreachable!("a window holds full or empty voxels"),
-            })
-            .collect())
+        signed_distance_window(self, origin, shape)
     }
 
-    /// The narrow band of half-width `width` (voxels): every voxel with `|sd| ≤ width` and its signed
-    /// distance, exact, computed block by block on all threads.
+    /// The narrow band of half-width `width` ([`narrow_band()`]).
     ///
     /// ```
     /// use ktree::KTree;
     /// let tree = KTree::<1>::from_dense(3, &[false, true, true, true, true, false, false, false]).unwrap();
-    /// let band = tree.narrow_band(1.0).unwrap();
-    /// assert_eq!(band.voxels, [[0], [1], [4], [5]]);
-    /// assert_eq!(band.values, [1.0, -1.0, -1.0, 1.0]);
+    /// assert_eq!(tree.narrow_band(1.0).unwrap().len(), 4);
     /// ```
     ///
-    /// # Performance
-    /// `O(K · (b + 2w)^K)` per block of side `b` the surface passes through; memory one block per thread.
-    ///
     /// # Errors
-    /// [`ShapeError::BadWidth`] for a negative or non-finite width.
+    /// As [`narrow_band()`].
     pub fn narrow_band(&self, width: f64) -> Result<NarrowBand<K>, ShapeError> {
-        check_width(width)?;
-        let limit = squared_limit(width);
-        let universe = universe_box(self);
-        let pad = (width.floor() as i64).min(universe.dims[0]);
-        let side = block_side(self, pad);
-        let band_of = |b: &Bx<K>| {
-            let src = b.grown(pad).meet(&universe);
-            let n = count_in(self, &src);
-            if n == 0 || n == src.len() {
-                return (Vec::new(), Vec::new());
-            }
-            let full = mask(self, &src, true, false);
-            let empty: Vec<bool> = full.iter().map(|&f| !f).collect();
-            let out = edt(&src, &full, b);
-            let inn = edt(&src, &empty, b);
-            let (mut voxels, mut values) = (Vec::new(), Vec::new());
-            for i in 0..out.len() {
-                let (d, sign) = if out[i] == 0 {
-                    (inn[i], -1.0)
-                } else {
-                    (out[i], 1.0)
-                };
-                if d <= limit {
-                    voxels.push(voxel_of(b, i));
-                    values.push(sign * (d as f64).sqrt());
-                }
-            }
-            (voxels, values)
-        };
-        let mut band = NarrowBand {
-            width,
-            ..NarrowBand::default()
-        };
-        // A few blocks a thread at a time, appended at once: memory is the band and those blocks' parts.
-        let chunk = 16 * rayon::current_num_threads();
-        for blocks in blocks(self, side, 1).chunks(chunk) {
-            let parts: Vec<(Vec<[u32; K]>, Vec<f64>)> = blocks.par_iter().map(band_of).collect();
-            for (v, d) in parts {
-                band.voxels.extend(v);
-                band.values.extend(d);
-            }
-        }
-        Ok(band)
+        narrow_band(self, width)
     }
 
-    /// [`KTree::dilate`] by a ball through the distance transform, block by block: the voxels within `r`
-    /// of a full voxel. [`KTree::dilate`] takes this path where it is the faster one (see
-    /// [`crate::shape`]); the result is the same.
-    ///
-    /// ```
-    /// use ktree::{rays::ball_rays, shape::Element, KTree};
-    /// let tree = KTree::from_rays(&ball_rays::<3>(5, [16, 16, 16], 6).unwrap());
-    /// assert_eq!(tree.dilate_ball_by_distance(4.5).unwrap(), tree.dilate(4.5, Element::Ball).unwrap());
-    /// ```
+    /// [`KTree::dilate`] by a ball through the distance transform ([`dilate_ball_by_distance()`]).
     ///
     /// # Errors
-    /// [`ShapeError::BadRadius`] for a negative or non-finite `r`.
+    /// As [`dilate_ball_by_distance()`].
     pub fn dilate_ball_by_distance(&self, r: f64) -> Result<KTree<K>, ShapeError> {
-        super::element::check_radius(r)?;
-        Ok(self.dilate_ball_edt(r))
+        dilate_ball_by_distance(self, r)
     }
 
-    /// [`KTree::erode`] by a ball through the distance transform (the outside of the universe empty).
-    ///
-    /// ```
-    /// use ktree::{rays::ball_rays, shape::Element, KTree};
-    /// let tree = KTree::from_rays(&ball_rays::<3>(5, [16, 16, 16], 20).unwrap());
-    /// assert_eq!(tree.erode_ball_by_distance(4.5).unwrap(), tree.erode(4.5, Element::Ball).unwrap());
-    /// ```
+    /// [`KTree::erode`] by a ball through the distance transform ([`erode_ball_by_distance()`]).
     ///
     /// # Errors
-    /// [`ShapeError::BadRadius`] for a negative or non-finite `r`.
+    /// As [`erode_ball_by_distance()`].
     pub fn erode_ball_by_distance(&self, r: f64) -> Result<KTree<K>, ShapeError> {
-        super::element::check_radius(r)?;
-        Ok(self.erode_ball_edt(r))
-    }
-
-    /// Whether a block of the ball morphology by distance, grown by `r`, stays within
-    /// [`MAX_BLOCK_SOURCE`] voxels (else the run extension is taken, whatever its cost).
-    pub(crate) fn ball_by_distance_fits(&self, r: f64) -> bool {
-        let pad = (r.floor().min(1e12) as i64).min(universe_box(self).dims[0]);
-        let side = block_side(self, pad);
-        ((side + 2 * pad) as u128).saturating_pow(K as u32) <= MAX_BLOCK_SOURCE
-    }
-
-    pub(crate) fn dilate_ball_edt(&self, r: f64) -> KTree<K> {
-        let limit = squared_limit(r);
-        let universe = universe_box(self);
-        let pad = (r.floor() as i64).min(universe.dims[0]);
-        let side = block_side(self, pad);
-        tree_of_blocks(self, &blocks(self, side, 1), side, |b| {
-            let src = b.grown(pad).meet(&universe);
-            if count_in(self, &src) == 0 {
-                return Vec::new();
-            }
-            if count_in(self, b) == b.len() {
-                return runs_of(self, b, &vec![true; b.len() as usize]);
-            }
-            let d = edt(&src, &mask(self, &src, true, false), b);
-            let keep: Vec<bool> = d.iter().map(|&d| d <= limit).collect();
-            runs_of(self, b, &keep)
-        })
-    }
-
-    /// Erosion by a ball through the distance transform, the outside of the universe empty (scipy's
-    /// `border_value=0`): the full voxels farther than `r` from every empty voxel.
-    pub(crate) fn erode_ball_edt(&self, r: f64) -> KTree<K> {
-        let limit = squared_limit(r);
-        let universe = universe_box(self);
-        let pad = (r.floor() as i64).min(universe.dims[0]);
-        let side = block_side(self, pad);
-        tree_of_blocks(self, &blocks(self, side, 0), side, |b| {
-            let src = b.grown(pad);
-            let inside = src.meet(&universe) == src;
-            if count_in(self, b) == 0 {
-                return Vec::new();
-            }
-            if inside && count_in(self, &src) == src.len() {
-                return runs_of(self, b, &vec![true; b.len() as usize]);
-            }
-            let d = edt(&src, &mask(self, &src, false, true), b);
-            let keep: Vec<bool> = d.iter().map(|&d| d > limit).collect();
-            runs_of(self, b, &keep)
-        })
+        erode_ball_by_distance(self, r)
     }
 }
 
@@ -742,37 +774,38 @@ const SOURCE_GROWTH: u128 = 8;
 /// The exact squared distances from each voxel of `w` to the nearest full (`full`) or empty voxel of the
 /// tree, which all lie in `feature` (the full voxels' bounding box, or it grown by one for the empty
 /// ones): the source box grows until every value is exact, or until it would outgrow
-/// [`SOURCE_GROWTH`] windows, when the values still unsure come from [`KTree::nearest`] searches (in the
+/// [`SOURCE_GROWTH`] windows, when the values still unsure come from nearest-voxel searches (in the
 /// tree or its complement).
-fn exact_window<const K: usize>(
-    tree: &KTree<K>,
+fn exact_window<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
     w: &Bx<K>,
     feature: &Bx<K>,
     full: bool,
-) -> Vec<u64> {
+) -> Result<Vec<u64>, ShapeError> {
     let widest = w.dims.iter().copied().max().unwrap_or(1);
     let cap = (w.len() * SOURCE_GROWTH).max(1 << 20);
     let mut m = (widest / 2).max(8);
     loop {
         let src = w.grown(m).meet(feature);
-        let mut d = edt(&src, &mask(tree, &src, full, false), w);
+        let mut d = edt(&src, &mask(tree, &src, full)?, w);
         let bound = (m as u128 * m as u128).min(u128::from(FAR - 1)) as u64;
         if src == *feature || d.iter().all(|&v| v <= bound) {
-            return d;
+            return Ok(d);
         }
         let next = m.saturating_mul(4);
         if w.grown(next).meet(feature).len() > cap {
             let unsure: Vec<usize> = (0..d.len()).filter(|&i| d[i] > bound).collect();
             let points: Vec<[u32; K]> = unsure.iter().map(|&i| voxel_of(w, i)).collect();
             let found = if full {
-                tree.nearest_many(&points)
+                query::nearest_many(tree, &points)
             } else {
-                (!tree).nearest_many(&points)
-            };
+                query::nearest_many(&Complement(tree), &points)
+            }
+            .map_err(read_error)?;
             for (i, n) in unsure.into_iter().zip(found) {
                 d[i] = n.map_or(FAR, |n| n.squared.min(u128::from(FAR - 1)) as u64);
             }
-            return d;
+            return Ok(d);
         }
         m = next;
     }

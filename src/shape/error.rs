@@ -2,7 +2,7 @@
 use thiserror::Error;
 
 /// Errors of the shape operations.
-#[derive(Debug, Clone, PartialEq, Error)]
+#[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum ShapeError {
     /// The radius is negative, NaN or infinite: give a finite number ≥ 0.
@@ -58,6 +58,9 @@ pub enum ShapeError {
         /// The dimension.
         k: usize,
     },
+    /// Reading the input tree failed (a file read in place was changed after it was opened).
+    #[error(transparent)]
+    Storage(#[from] crate::tree::StorageError),
     /// The Euler number is defined for connectivity 1 and `K` only (scikit-image: 4 or 8 in 2-D, 6 or 26 in 3-D).
     #[error("the Euler number in {k}-D is defined for connectivity 1 or {k}, not {connectivity}")]
     EulerConnectivity {

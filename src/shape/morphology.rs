@@ -16,9 +16,12 @@
 //! The closing is the erosion of the dilation computed in an unbounded space (signed coordinates, no
 //! universe), so the universe's faces cut neither; the result is then clipped to the universe. It equals
 //! scipy's `binary_closing` on an array padded by more than the radius on every side, then cropped.
+use super::distance::{ball_by_distance_fits, dilate_ball_by_distance, erode_ball_by_distance};
 use super::element::{check_radius, plan, Slice};
+use super::input::runs;
 use super::runs::Runs;
 use super::{Element, ShapeError};
+use crate::tree::storage::TreeStorage;
 use crate::KTree;
 
 /// Up to this many column offsets, a slice's dilation (erosion) merges (intersects) all its moved copies
@@ -93,8 +96,8 @@ fn erode_all<const K: usize>(runs: Runs<K>, steps: &[Slice<K>]) -> Runs<K> {
     all_steps(runs, steps, erode_runs)
 }
 
-/// The number of column offsets of a ball's slice, `(2⌊r⌋ + 1)^(K−1)`, from which [`KTree::dilate`] and
-/// [`KTree::erode`] take the distance transform ([`KTree::dilate_ball_by_distance`]) instead of the run
+/// The number of column offsets of a ball's slice, `(2⌊r⌋ + 1)^(K−1)`, from which [`dilate`] and
+/// [`erode`] take the distance transform ([`dilate_ball_by_distance`]) instead of the run
 /// extension, whose cost grows with that number while the transform's grows only with the blocks' margin.
 /// Measured on the L = 9 ball (radius 256) and armadillo, dilation, one thread, one run each, load 1.4–1.7:
 ///
@@ -115,111 +118,178 @@ fn by_distance<const K: usize>(r: f64, element: Element) -> bool {
     K >= 2 && element == Element::Ball && offsets >= BALL_BY_DISTANCE_FROM
 }
 
-impl<const K: usize> KTree<K> {
-    fn morph(
-        &self,
-        r: f64,
-        element: Element,
-        f: impl FnOnce(Runs<K>, &[Slice<K>]) -> Runs<K>,
-        bound: i64,
-    ) -> Result<KTree<K>, ShapeError> {
-        check_radius(r)?;
-        let steps = plan::<K>(element, r, bound)?;
-        let runs = Runs::from_rays(&self.to_rays());
-        Ok(KTree::from_rays(&f(runs, &steps).to_rays(self.universe())))
-    }
+/// Reads the runs of `tree`, applies `f` with the element's slices, and stacks the result.
+fn morph<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    r: f64,
+    element: Element,
+    f: impl FnOnce(Runs<K>, &[Slice<K>]) -> Runs<K>,
+    bound: i64,
+) -> Result<KTree<K>, ShapeError> {
+    check_radius(r)?;
+    let steps = plan::<K>(element, r, bound)?;
+    let runs = Runs::from_rays(&runs(tree)?);
+    Ok(KTree::from_rays(&f(runs, &steps).to_rays(tree.universe())))
+}
 
+/// The voxels within the element of radius `r` of a full voxel of `tree` (in memory or a file read in
+/// place), clipped to the universe (scipy's `binary_dilation` with that structure).
+///
+/// ```
+/// use ktree::{shape::{dilate, Element}, KTree, Ray, RaySet};
+/// let dot = KTree::from_rays(&RaySet::<2>::from_rays(3, [Ray::new([4, 4], 5)]).unwrap());
+/// assert_eq!(dilate(&dot, 1.0, Element::Ball).unwrap().voxel_count(), 5);
+/// assert_eq!(dilate(&dot, 1.0, Element::Box).unwrap().voxel_count(), 9);
+/// assert_eq!(dilate(&dot, 2.0, Element::Cross).unwrap().voxel_count(), 13);
+/// ```
+///
+/// # Performance
+/// One merge pass over the runs per column offset of the element (see [`crate::shape`]'s morphology
+/// notes); a ball of many offsets through the distance transform instead ([`BALL_BY_DISTANCE_FROM`]).
+///
+/// # Errors
+/// [`ShapeError::BadRadius`] for a negative or non-finite `r`; [`ShapeError::RadiusTooLarge`] if the
+/// element has more than 2^24 column offsets inside the universe's reach; [`ShapeError::Storage`] for a
+/// read error.
+pub fn dilate<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
+    r: f64,
+    element: Element,
+) -> Result<KTree<K>, ShapeError> {
+    if by_distance::<K>(r, element) && ball_by_distance_fits(tree, r) {
+        return dilate_ball_by_distance(tree, r);
+    }
+    let bound = tree.universe().side() as i64;
+    morph(tree, r, element, dilate_all, bound)
+}
+
+/// The voxels of `tree` whose whole element of radius `r` lies in the object, outside the universe
+/// counting as empty (scipy's `binary_erosion(..., border_value=0)`).
+///
+/// ```
+/// use ktree::{shape::{erode, Element}, KTree};
+/// let full = KTree::<2>::full(3).unwrap();
+/// assert_eq!(erode(&full, 1.0, Element::Box).unwrap().voxel_count(), 36); // the 6 × 6 inside
+/// ```
+///
+/// # Errors
+/// As [`dilate`].
+pub fn erode<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
+    r: f64,
+    element: Element,
+) -> Result<KTree<K>, ShapeError> {
+    check_radius(r)?;
+    let side = tree.universe().side();
+    // The element reaches ⌊r⌋ along every axis: wider than the universe, nothing survives.
+    if 2.0 * r.floor() + 1.0 > side as f64 {
+        return Ok(KTree::empty(tree.level()).expect("the tree's level"));
+    }
+    if by_distance::<K>(r, element) && ball_by_distance_fits(tree, r) {
+        return erode_ball_by_distance(tree, r);
+    }
+    morph(tree, r, element, erode_all, side as i64)
+}
+
+/// The dilation of the erosion of `tree` (scipy's `binary_opening` with `border_value=0` semantics).
+///
+/// ```
+/// use ktree::{shape::{opening, Element}, KTree, Ray, RaySet};
+/// // A 4 × 4 square with a one-voxel spur: the opening by a 3 × 3 box removes the spur.
+/// let mut rays: Vec<_> = (2..6).map(|x| Ray::new([x, 2], 6)).collect();
+/// rays.push(Ray::new([6, 3], 4));
+/// let tree = KTree::from_rays(&RaySet::<2>::from_rays(3, rays).unwrap());
+/// assert_eq!(opening(&tree, 1.0, Element::Box).unwrap().voxel_count(), 16);
+/// ```
+///
+/// # Errors
+/// As [`dilate`].
+pub fn opening<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
+    r: f64,
+    element: Element,
+) -> Result<KTree<K>, ShapeError> {
+    dilate(&erode(tree, r, element)?, r, element)
+}
+
+/// The erosion of the dilation of `tree`, both in an unbounded space so the universe's faces cut
+/// neither, then clipped to the universe (scipy's `binary_closing` on an array padded by more than `r`,
+/// cropped).
+///
+/// ```
+/// use ktree::{shape::{closing, Element}, KTree, Ray, RaySet};
+/// // Two runs with a one-voxel gap: the closing fills it.
+/// let rays = RaySet::<1>::from_rays(3, [Ray::new([0], 3), Ray::new([4], 8)]).unwrap();
+/// let closed = closing(&KTree::from_rays(&rays), 1.0, Element::Ball).unwrap();
+/// assert_eq!(closed.voxel_count(), 8);
+/// ```
+///
+/// # Errors
+/// As [`dilate`] (with the element's full reach counted, not cut at the universe), and
+/// [`ShapeError::ClosingTooWide`] for a radius over four times the universe's side.
+pub fn closing<const K: usize, T: TreeStorage<K> + Sync>(
+    tree: &T,
+    r: f64,
+    element: Element,
+) -> Result<KTree<K>, ShapeError> {
+    check_radius(r)?;
+    let side = tree.universe().side();
+    if r.floor() > 4.0 * side as f64 {
+        return Err(ShapeError::ClosingTooWide { radius: r, side });
+    }
+    morph(
+        tree,
+        r,
+        element,
+        |runs, steps| erode_all(dilate_all(runs, steps), steps),
+        i64::MAX / 4,
+    )
+}
+
+impl<const K: usize> KTree<K> {
     /// The voxels within the element of radius `r` of a full voxel, clipped to the universe (scipy's
-    /// `binary_dilation` with that structure).
+    /// `binary_dilation` with that structure; [`dilate()`]).
     ///
     /// ```
     /// use ktree::{shape::Element, KTree, Ray, RaySet};
     /// let dot = KTree::from_rays(&RaySet::<2>::from_rays(3, [Ray::new([4, 4], 5)]).unwrap());
     /// assert_eq!(dot.dilate(1.0, Element::Ball).unwrap().voxel_count(), 5);
-    /// assert_eq!(dot.dilate(1.0, Element::Box).unwrap().voxel_count(), 9);
-    /// assert_eq!(dot.dilate(2.0, Element::Cross).unwrap().voxel_count(), 13);
     /// ```
     ///
-    /// # Performance
-    /// One merge pass over the runs per column offset of the element (see [`crate::shape`]'s morphology notes).
-    ///
     /// # Errors
-    /// [`ShapeError::BadRadius`] for a negative or non-finite `r`; [`ShapeError::RadiusTooLarge`] if the
-    /// element has more than 2^24 column offsets inside the universe's reach.
+    /// As [`dilate()`].
     pub fn dilate(&self, r: f64, element: Element) -> Result<KTree<K>, ShapeError> {
-        if by_distance::<K>(r, element) && self.ball_by_distance_fits(r) {
-            return self.dilate_ball_by_distance(r);
-        }
-        let bound = self.universe().side() as i64;
-        self.morph(r, element, dilate_all, bound)
+        dilate(self, r, element)
     }
 
     /// The voxels whose whole element of radius `r` lies in the object, outside the universe counting as
-    /// empty (scipy's `binary_erosion(..., border_value=0)`).
+    /// empty (scipy's `binary_erosion(..., border_value=0)`; [`erode()`]).
     ///
     /// ```
     /// use ktree::{shape::Element, KTree};
     /// let full = KTree::<2>::full(3).unwrap();
-    /// assert_eq!(full.erode(1.0, Element::Box).unwrap().voxel_count(), 36); // the 6 × 6 inside
+    /// assert_eq!(full.erode(1.0, Element::Box).unwrap().voxel_count(), 36);
     /// ```
     ///
     /// # Errors
-    /// As [`KTree::dilate`].
+    /// As [`dilate()`].
     pub fn erode(&self, r: f64, element: Element) -> Result<KTree<K>, ShapeError> {
-        check_radius(r)?;
-        let side = self.universe().side();
-        // The element reaches ⌊r⌋ along every axis: wider than the universe, nothing survives.
-        if 2.0 * r.floor() + 1.0 > side as f64 {
-            return Ok(KTree::empty(self.level()).expect("the tree's level"));
-        }
-        if by_distance::<K>(r, element) && self.ball_by_distance_fits(r) {
-            return self.erode_ball_by_distance(r);
-        }
-        self.morph(r, element, erode_all, side as i64)
+        erode(self, r, element)
     }
 
-    /// The dilation of the erosion (scipy's `binary_opening` with `border_value=0` semantics).
-    ///
-    /// ```
-    /// use ktree::{shape::Element, KTree, Ray, RaySet};
-    /// // A 4 × 4 square with a one-voxel spur: the opening by a 3 × 3 box removes the spur.
-    /// let mut rays: Vec<_> = (2..6).map(|x| Ray::new([x, 2], 6)).collect();
-    /// rays.push(Ray::new([6, 3], 4));
-    /// let tree = KTree::from_rays(&RaySet::<2>::from_rays(3, rays).unwrap());
-    /// assert_eq!(tree.opening(1.0, Element::Box).unwrap().voxel_count(), 16);
-    /// ```
+    /// The dilation of the erosion ([`opening()`]).
     ///
     /// # Errors
-    /// As [`KTree::dilate`].
+    /// As [`dilate()`].
     pub fn opening(&self, r: f64, element: Element) -> Result<KTree<K>, ShapeError> {
-        self.erode(r, element)?.dilate(r, element)
+        opening(self, r, element)
     }
 
-    /// The erosion of the dilation, both in an unbounded space so the universe's faces cut neither, then
-    /// clipped to the universe (scipy's `binary_closing` on an array padded by more than `r`, cropped).
-    ///
-    /// ```
-    /// use ktree::{shape::Element, KTree, Ray, RaySet};
-    /// // Two runs with a one-voxel gap: the closing fills it.
-    /// let rays = RaySet::<1>::from_rays(3, [Ray::new([0], 3), Ray::new([4], 8)]).unwrap();
-    /// let closed = KTree::from_rays(&rays).closing(1.0, Element::Ball).unwrap();
-    /// assert_eq!(closed.voxel_count(), 8);
-    /// ```
+    /// The erosion of the dilation, in an unbounded space, clipped to the universe ([`closing()`]).
     ///
     /// # Errors
-    /// As [`KTree::dilate`] (with the element's full reach counted, not cut at the universe), and
-    /// [`ShapeError::ClosingTooWide`] for a radius over four times the universe's side.
+    /// As [`closing()`].
     pub fn closing(&self, r: f64, element: Element) -> Result<KTree<K>, ShapeError> {
-        check_radius(r)?;
-        let side = self.universe().side();
-        if r.floor() > 4.0 * side as f64 {
-            return Err(ShapeError::ClosingTooWide { radius: r, side });
-        }
-        self.morph(
-            r,
-            element,
-            |runs, steps| erode_all(dilate_all(runs, steps), steps),
-            i64::MAX / 4,
-        )
+        closing(self, r, element)
     }
 }

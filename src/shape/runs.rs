@@ -1,40 +1,19 @@
 //! Runs with signed coordinates, not clipped to a universe: the working form of the morphology, so that an
 //! intermediate result (a dilation before an erosion) may reach past the universe's faces.
 //!
-//! A column (the first `K − 1` coordinates) is kept as one packed key: each coordinate biased by half its
-//! field, in a field of `64 / (K − 1)` bits, the first coordinate highest, so that keys sort as the
-//! columns do lexicographically and a column offset moves every key by one constant. The fields hold
-//! every coordinate the morphology reaches: the universe's side plus twice the largest radius a closing
-//! accepts (four sides), that is below `2^(L + 4)` — at most 2^25 for K = 3 (fields of 32 bits) and 2^20
-//! for K = 4 (21 bits; `L ≤ 16`).
-use crate::rays::RaySet;
+//! A column (the first `K − 1` coordinates) is kept as one signed key ([`SignedColumnKeys`]), which sorts
+//! as the columns do and moves by one constant for a column offset. Its fields hold every coordinate the
+//! morphology reaches: the universe's side plus twice the largest radius a closing accepts (four sides),
+//! that is below `2^(L + 4)` — at most 2^25 for K = 3 (fields of 32 bits) and 2^20 for K = 4 (21 bits;
+//! `L ≤ 16`).
+use crate::rays::{join_columns, merge_runs, RaySet, SignedColumnKeys, TruthTable};
 use crate::space::Universe;
 
-/// Bits of each column coordinate's field in a packed key.
-const fn field_bits(k: usize) -> u32 {
-    if k <= 1 {
-        0
-    } else {
-        64 / (k as u32 - 1)
-    }
-}
+/// The signed column keys of the morphology.
+type Keys<const K: usize> = SignedColumnKeys<K>;
 
-/// Packs the first `K − 1` coordinates of `col` (see the module's docs).
-fn pack<const K: usize>(col: &[i64]) -> u64 {
-    let w = field_bits(K);
-    col[..K - 1].iter().fold(0u128, |key, &x| {
-        let field = (x as i128 + (1i128 << (w - 1))) as u128 & ((1u128 << w) - 1);
-        (key << w) | field
-    }) as u64
-}
-
-/// Coordinate `axis` (`< K − 1`) of a packed key.
-fn unpack_axis<const K: usize>(key: u64, axis: usize) -> i64 {
-    let w = field_bits(K);
-    let shift = w * (K as u32 - 2 - axis as u32);
-    let field = (u128::from(key) >> shift) & ((1u128 << w) - 1);
-    (field as i128 - (1i128 << (w - 1))) as i64
-}
+/// The line of the runs (they are never complemented, so its ends are never reached).
+const LINE: std::ops::Range<i64> = i64::MIN..i64::MAX;
 
 /// Sorted columns (packed keys, see the module's docs), each with sorted, disjoint, non-touching half-open
 /// runs `[z1, z2)`.
@@ -46,11 +25,11 @@ pub(crate) struct Runs<const K: usize> {
 
 impl<const K: usize> Runs<K> {
     pub(crate) fn from_rays(set: &RaySet<K>) -> Self {
-        let level = set.level();
+        let keys = set.keys();
         let cols = set
             .column_keys()
             .iter()
-            .map(|&k| pack::<K>(&RaySet::<K>::column_of_key_at(level, k).map(i64::from)))
+            .map(|&k| Keys::<K>::of_unsigned(keys, k))
             .collect();
         let runs = set
             .runs()
@@ -72,25 +51,19 @@ impl<const K: usize> Runs<K> {
 
     /// The runs clipped to the universe, as a ray set.
     pub(crate) fn to_rays(&self, universe: Universe<K>) -> RaySet<K> {
-        let level = universe.level();
+        let keys = crate::rays::ColumnKeys::<K>::new(universe.level());
         let side = universe.side() as i64;
         let mut columns = Vec::new();
         let mut runs = Vec::new();
-        'runs: for (&c, &(z1, z2)) in self.cols.iter().zip(&self.runs) {
+        for (&c, &(z1, z2)) in self.cols.iter().zip(&self.runs) {
             let (z1, z2) = (z1.max(0), z2.min(side));
             if z1 >= z2 {
                 continue;
             }
-            let mut key = 0u64;
-            for axis in 0..K - 1 {
-                let x = unpack_axis::<K>(c, axis);
-                if x < 0 || x >= side {
-                    continue 'runs;
-                }
-                key = (key << level) | x as u64;
+            if let Some(key) = Keys::<K>::to_unsigned(keys, c) {
+                columns.push(key);
+                runs.push((z1 as u32, z2 as u32));
             }
-            columns.push(key);
-            runs.push((z1 as u32, z2 as u32));
         }
         RaySet::from_sorted_parts(universe, columns, runs, None)
     }
@@ -98,10 +71,9 @@ impl<const K: usize> Runs<K> {
     /// The runs moved by the column offset `by` and grown by `grow` at both ends (shrunk if negative), read
     /// on the fly by [`Runs::combine_into`]; a column offset keeps the columns' order.
     pub(crate) fn moved(&self, by: [i64; K], grow: i64) -> Moved<'_, K> {
-        // Packing is linear while no field overflows: the offset's key less the origin's.
         Moved {
             runs: self,
-            by: pack::<K>(&by).wrapping_sub(pack::<K>(&[0; K])),
+            by: Keys::<K>::offset(by),
             grow,
         }
     }
@@ -183,21 +155,18 @@ impl<const K: usize> Runs<K> {
                 while *j < self.cols.len() && copy.column(self.cols[*j]) < col {
                     *j += 1;
                 }
-                let (mut p, mut q) = (0, *j);
-                next.clear();
-                while p < acc.len() && q < self.cols.len() && copy.column(self.cols[q]) == col {
-                    let (z1, z2) = self.runs[q];
-                    let b = (z1 - copy.grow, z2 + copy.grow);
-                    let (lo, hi) = (acc[p].0.max(b.0), acc[p].1.min(b.1));
-                    if lo < hi {
-                        next.push((lo, hi));
-                    }
-                    if acc[p].1 < b.1 {
-                        p += 1;
-                    } else {
-                        q += 1;
-                    }
+                let mut end = *j;
+                while end < self.cols.len() && copy.column(self.cols[end]) == col {
+                    end += 1;
                 }
+                next.clear();
+                merge_runs(
+                    acc.iter().copied(),
+                    copy.runs_of(*j..end),
+                    TruthTable::INTERSECTION,
+                    LINE,
+                    |z1, z2, _, _| next.push((z1, z2)),
+                );
                 std::mem::swap(&mut acc, &mut next);
                 if acc.is_empty() {
                     continue 'columns;
@@ -210,66 +179,32 @@ impl<const K: usize> Runs<K> {
         }
     }
 
-    /// Sets `out` to the union (`union = true`) or intersection of `self` and `other`, in one merge pass.
-    /// `out`'s buffers are reused, so a chain of combinations allocates only while the runs grow.
+    /// Sets `out` to the union (`union = true`) or intersection of `self` and `other`, in one merge pass
+    /// ([`merge_runs`] column by column). `out`'s buffers are reused, so a chain of combinations allocates
+    /// only while the runs grow.
     pub(crate) fn combine_into(&self, other: Moved<'_, K>, union: bool, out: &mut Self) {
         out.clear();
-        let (a_cols, b_cols) = (&self.cols, &other.runs.cols);
-        let (mut i, mut j) = (0, 0);
-        while i < a_cols.len() || j < b_cols.len() {
-            let ci = a_cols.get(i).copied();
-            let cj = b_cols.get(j).map(|&c| other.column(c));
-            let col = match (ci, cj) {
-                (Some(a), Some(b)) => a.min(b),
-                (Some(a), None) => a,
-                (None, Some(b)) => b,
-                (None, None) => unreachable!(),
-            };
-            let mut i_end = i;
-            while i_end < a_cols.len() && a_cols[i_end] == col {
-                i_end += 1;
+        let table = if union {
+            TruthTable::UNION
+        } else {
+            TruthTable::INTERSECTION
+        };
+        for (col, ra, rb) in join_columns(&self.cols, &other.runs.cols, other.by) {
+            if !union && (ra.is_empty() || rb.is_empty()) {
+                continue;
             }
-            let mut j_end = j;
-            while j_end < b_cols.len() && other.column(b_cols[j_end]) == col {
-                j_end += 1;
-            }
-            let a = &self.runs[i..i_end];
-            let b = &other.runs.runs[j..j_end];
-            let grown = |&(z1, z2): &(i64, i64)| (z1 - other.grow, z2 + other.grow);
-            if union {
-                // Merge by z1 (growing keeps the order); `push` joins overlaps.
-                let (mut p, mut q) = (0, 0);
-                while p < a.len() || q < b.len() {
-                    let take_a = q >= b.len() || (p < a.len() && a[p].0 <= grown(&b[q]).0);
-                    let r = if take_a { a[p] } else { grown(&b[q]) };
-                    if take_a {
-                        p += 1;
-                    } else {
-                        q += 1;
-                    }
-                    if r.0 < r.1 {
-                        out.push(col, r.0, r.1);
-                    }
-                }
-            } else {
-                // Shrinking keeps both ends' order; an emptied run meets nothing.
-                let (mut p, mut q) = (0, 0);
-                while p < a.len() && q < b.len() {
-                    let bq = grown(&b[q]);
-                    let (lo, hi) = (a[p].0.max(bq.0), a[p].1.min(bq.1));
-                    if lo < hi {
-                        out.cols.push(col);
-                        out.runs.push((lo, hi));
-                    }
-                    if a[p].1 < bq.1 {
-                        p += 1;
-                    } else {
-                        q += 1;
-                    }
-                }
-            }
-            i = i_end;
-            j = j_end;
+            // Growing may make a column's runs overlap, which a union takes; shrinking may empty some
+            // (dropped).
+            merge_runs(
+                self.runs[ra].iter().copied(),
+                other.runs_of(rb),
+                table,
+                LINE,
+                |z1, z2, _, _| {
+                    out.cols.push(col);
+                    out.runs.push((z1, z2));
+                },
+            );
         }
     }
 }
@@ -287,6 +222,17 @@ impl<const K: usize> Moved<'_, K> {
     /// Column `col` of the runs, moved.
     fn column(&self, col: u64) -> u64 {
         col.wrapping_add(self.by)
+    }
+
+    /// The runs `range` (of one column), grown (shrunk ones that vanish dropped).
+    fn runs_of(
+        &self,
+        range: std::ops::Range<usize>,
+    ) -> impl Iterator<Item = (i64, i64)> + Clone + '_ {
+        let grow = self.grow;
+        self.runs.runs[range]
+            .iter()
+            .map(move |&(z1, z2)| (z1 - grow, z2 + grow))
     }
 
     /// Sets `out` to the moved runs (emptied runs dropped).
@@ -320,20 +266,23 @@ mod tests {
                 col
             })
             .collect();
-        let origin = pack::<K>(&[0; K]);
         for a in &cols {
-            let key = pack::<K>(a);
+            let key = Keys::<K>::pack(*a);
             for (axis, &x) in a[..K - 1].iter().enumerate() {
-                assert_eq!(unpack_axis::<K>(key, axis), x);
+                assert_eq!(Keys::<K>::axis(key, axis), x);
             }
+            assert_eq!(Keys::<K>::unpack(key), *a);
             for b in &cols {
-                assert_eq!(key.cmp(&pack::<K>(b)), a.cmp(b), "{a:?} against {b:?}");
+                assert_eq!(
+                    key.cmp(&Keys::<K>::pack(*b)),
+                    a.cmp(b),
+                    "{a:?} against {b:?}"
+                );
                 let sum: [i64; K] = std::array::from_fn(|i| a[i] + b[i]);
                 if sum.iter().all(|x| x.abs() <= reach) {
-                    let by = pack::<K>(b).wrapping_sub(origin);
                     assert_eq!(
-                        key.wrapping_add(by),
-                        pack::<K>(&sum),
+                        key.wrapping_add(Keys::<K>::offset(*b)),
+                        Keys::<K>::pack(sum),
                         "{a:?} moved by {b:?}"
                     );
                 }

@@ -2,7 +2,7 @@
 
 use super::rational::common_denominator;
 use super::{Frame, Rational, Sample, SolidError};
-use crate::rays::RaySet;
+use crate::rays::{ColumnKeys, RaySet};
 use crate::space::Universe;
 
 /// The closed box `lo ≤ x ≤ hi` (each axis), tested at the voxel's sample point like a quadric.
@@ -136,9 +136,7 @@ impl<const K: usize> BoxSolid<K> {
         if r.iter().all(|&(l, h)| l <= h) {
             let mut col: [i64; K] = std::array::from_fn(|a| r[a].0);
             'outer: loop {
-                let key = col[..K - 1]
-                    .iter()
-                    .fold(0u64, |key, &c| (key << level) | c as u64);
+                let key = ColumnKeys::<K>::new(level).pack(col.map(|c| c as u32));
                 columns.push(key);
                 runs.push((r[K - 1].0 as u32, r[K - 1].1 as u32 + 1));
                 let mut axis = K - 1;

@@ -45,6 +45,34 @@ pub enum SolidError {
         /// The limit.
         limit: usize,
     },
+    /// Points of a cloud lie outside the universe of the level asked for (and were not to be cropped): how
+    /// many, and the first of them. A larger level or voxel size, another origin, or cropping fixes it.
+    #[error("{count} points lie outside the universe of level {level} (side {} voxels); the first is point {first} {point:?} in voxel {voxel:?}", side(.level))]
+    PointsOutside {
+        /// How many points.
+        count: u64,
+        /// The level of the universe.
+        level: u32,
+        /// The index of the first point outside.
+        first: usize,
+        /// That point.
+        point: [f64; 3],
+        /// Its voxel, `floor((point − origin) / voxel size)`.
+        voxel: [f64; 3],
+    },
+    /// A point of a cloud lies below the origin given, along an axis, and no level was given (whose
+    /// universe could crop it). Another origin, or a level and cropping, fixes it.
+    #[error("point {index} {point:?} lies below the origin {origin:?} along axis {axis}")]
+    PointBelowOrigin {
+        /// The index of the point.
+        index: usize,
+        /// The point.
+        point: [f64; 3],
+        /// The origin.
+        origin: [f64; 3],
+        /// The axis (0, 1, 2).
+        axis: usize,
+    },
     /// A file could not be read.
     #[error("{path}: {source}")]
     Io {
@@ -61,4 +89,9 @@ pub enum SolidError {
         /// What is wrong, with the line or byte where known.
         what: String,
     },
+}
+
+/// The side of a universe of level `level`, in voxels.
+fn side(level: &u32) -> u64 {
+    2u64.saturating_pow(*level)
 }

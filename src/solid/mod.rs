@@ -3,8 +3,10 @@
 //!
 //! * [`Quadric`]: `Vᵀ Ξ V ≤ 0` with named constructors (ball, ellipsoid, paraboloid, cylinder, cone,
 //!   half-space) and [`BoxSolid`]; exact integer inside tests at voxel centres (or corners).
-//! * [`mesh`]: OBJ, STL and PLY triangle meshes, inside by the winding number along each column.
-//! * [`cloud`]: point clouds (PLY, PCD, XYZ/CSV, LAS/LAZ), the voxels holding points.
+//! * [`mesh`]: triangle meshes, inside by the winding number along each column.
+//! * [`cloud`]: point clouds, the voxels holding points.
+//!
+//! Meshes and clouds are read from their files by [`crate::io`] (`read_mesh`, `read_cloud`).
 //! * [`volume`]: dense 3-D scalar volumes (raw + JSON sidecar, NIfTI) by threshold or label.
 //!
 //! Boolean operations and translation on the resulting rays are in [`crate::rays`] (`union`, …).

@@ -22,7 +22,7 @@
 //! generator [`crate::rays::ball_rays`], which gives the same rays for a ball.
 
 use super::{rational::gcd_i128, Rational, SolidError};
-use crate::rays::{Normal, RaySet};
+use crate::rays::{ColumnKeys, Normal, RaySet};
 use crate::space::Universe;
 
 /// Which coordinates a quadric's matrix is written in.
@@ -531,9 +531,7 @@ impl<const K: usize> Generator<K> {
         for a in 0..K - 1 {
             point[a] = col[a] as u32;
         }
-        let key = point[..K - 1]
-            .iter()
-            .fold(0u64, |key, &c| (key << self.level) | u64::from(c));
+        let key = ColumnKeys::<K>::new(self.level).pack(point);
         for &(z1, z2) in &found[..n] {
             self.columns.push(key);
             self.runs.push((z1 as u32, z2 as u32 + 1));

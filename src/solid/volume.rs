@@ -27,8 +27,7 @@ use std::path::Path;
 use serde::Deserialize;
 
 use super::SolidError;
-use crate::rays::RaySet;
-use crate::rays::{RaySource, SlabRuns};
+use crate::rays::{ColumnKeys, RaySet, RaySource, SlabRuns};
 use crate::space::Universe;
 
 /// Which samples are inside.
@@ -417,8 +416,11 @@ impl Volume {
         let mut runs = Vec::new();
         for x in first..last {
             for y in 0..ny {
-                let key =
-                    (u64::from(offset[0]) + x as u64) << level | (u64::from(offset[1]) + y as u64);
+                let key = ColumnKeys::<3>::new(level).pack([
+                    offset[0] + x as u32,
+                    offset[1] + y as u32,
+                    0,
+                ]);
                 let mut start = None;
                 for z in 0..=nz {
                     let inside = z < nz && select.test(self.values[x + nx * (y + ny * z)]);

@@ -1,6 +1,8 @@
-//! The one way to build a tree from rays: [`Builder`], in memory ([`Builder::build`]) or straight to a
-//! `.ktree` file in a memory budget ([`Builder::to_file`]), on all threads; and the constructors of
-//! [`KTree`] that build ([`KTree::from_rays`], `From<&RaySet>`).
+//! The one way to build a tree from rays: [`Builder`], in memory ([`Builder::build`]) or out of core in a
+//! memory budget, the subtrees spilled to any [`PieceStore`] and the tree written to any
+//! [`LevelOrderSink`] ([`Builder::build_into`]; `io` gives [`Builder::to_file`], to a `.ktree` file through
+//! spill files), on all threads; and the constructors of [`KTree`] that build ([`KTree::from_rays`],
+//! `From<&RaySet>`).
 //!
 //! # What runs
 //! The universe is cut into its cells of depth `m` (the *split depth*, by default
@@ -13,12 +15,11 @@
 //! ([`paper::stack`](super::paper::stack)). `results/performance/build.md` measures the two ways of
 //! stacking a cell side by side.
 
-use std::fmt::Display;
 use std::path::{Path, PathBuf};
 
 use super::out_of_core::{
-    build_slabs, slab_cost, stack_part, stack_to_file, BuildError, OutOfCore, OutOfCoreReport,
-    Progress, SpilledPart,
+    build_slabs, slab_cost, stack_part, BuildError, LevelOrderSink, OutOfCore, OutOfCoreReport,
+    PieceStore, Progress, SpilledPart, StoreBuildError,
 };
 use super::partition::{default_split_depth, stack_source};
 use crate::rays::RaySet;
@@ -99,13 +100,13 @@ impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
     }
 
     /// The folder of the spill files of [`to_file`](Self::to_file) and [`stack_part`](Self::stack_part)
-    /// (by default the output's folder).
+    /// (by default the output's folder; other stores ignore it).
     pub fn temp_dir(mut self, dir: impl Into<PathBuf>) -> Self {
         self.temp_dir = Some(dir.into());
         self
     }
 
-    /// Called on the calling thread as a build to a file stacks slabs and writes levels.
+    /// Called on the calling thread as a build out of core stacks slabs and writes levels.
     pub fn progress(mut self, progress: &'a (dyn Fn(Progress) + Sync)) -> Self {
         self.progress = Some(progress);
         self
@@ -136,27 +137,32 @@ impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
         stack_source(self.source, self.depth(), self.cells)
     }
 
-    /// Builds the tree straight into `out` as a `.ktree` version 2 file (atomically: a temporary file
-    /// renamed over it), holding at most about `max_memory` bytes: the subtrees of the cells are spilled
-    /// to temporary files as they are stacked (see [`stacking`](super)'s notes on memory). The file is
-    /// byte for byte what [`write_ktree_file`](crate::io::write_ktree_file) writes for the tree
-    /// [`build`](Self::build) makes.
+    /// Builds the tree out of core, holding at most about `max_memory` bytes: the subtrees of the cells
+    /// are spilled to `store` as they are stacked, then the tree is written to `output` level after level
+    /// (see [`stacking`](super)'s notes on memory). Returns the finished output and the report (its
+    /// `file_bytes` 0). [`to_file`](Self::to_file) is this build into spill files and a `.ktree` file;
+    /// the example of [`PieceStore`] builds in memory.
     ///
     /// # Errors
     /// [`BuildError`]: the source's first error, a budget too small (at once when what is known before
-    /// any slab is stacked does not fit), threads that cannot be started, a temporary folder or output
-    /// that cannot be written (a full disk included). The target is then untouched and no temporary file
-    /// remains.
-    pub fn to_file(
+    /// any slab is stacked does not fit), threads that cannot be started, the error of `store` or
+    /// `output`.
+    pub fn build_into<P, O>(
         &self,
-        out: &Path,
+        store: P,
+        output: O,
         max_memory: u64,
-    ) -> Result<OutOfCoreReport, BuildError<S::Error>>
+    ) -> Result<(O::Output, OutOfCoreReport), StoreBuildError<S::Error, P>>
     where
-        S::Error: Display,
+        P: PieceStore,
+        O: LevelOrderSink<Error = P::Error>,
     {
-        let options = self.options(max_memory);
-        self.on_threads(|| stack_to_file(self.source, out, &options, self.progress_or_none()))?
+        let part = self.stack_part_into(&self.slabs(), store, max_memory)?;
+        // One part of every slab: no other part sends anything.
+        let nothing = |_: usize, _: &mut [u64]| -> Result<(), P::Error> {
+            unreachable!("a build of one part receives no levels")
+        };
+        part.write_into(output, nothing, self.progress_callback())
     }
 
     /// The slabs (numbered along axis 0, increasing) the build stacks: the slabs of cells of the split
@@ -176,44 +182,55 @@ impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
     }
 
     /// Stacks the cells of some slabs (from [`slabs`](Self::slabs), increasing) and spills their subtrees
-    /// next to `out` (or in the [`temp_dir`](Self::temp_dir)), in a budget of `max_memory` bytes for this
-    /// part alone; nothing is written to `out`. One part gathers the others' indexes and writes the file
-    /// ([`SpilledPart::add_part`], [`SpilledPart::write`]): the file is that of
-    /// [`to_file`](Self::to_file) for any cut into parts.
+    /// to `store`, in a budget of `max_memory` bytes for this part alone. One part gathers the others'
+    /// indexes and writes the tree ([`SpilledPart::add_part`], [`SpilledPart::write_into`]): the tree is
+    /// that of [`build_into`](Self::build_into) for any cut into parts. [`stack_part`](Self::stack_part)
+    /// is this into spill files.
     ///
     /// # Errors
-    /// As [`to_file`](Self::to_file).
-    pub fn stack_part(
+    /// As [`build_into`](Self::build_into) (the budget covers this part alone).
+    pub fn stack_part_into<P: PieceStore>(
         &self,
         slabs: &[u32],
-        out: &Path,
+        store: P,
         max_memory: u64,
-    ) -> Result<SpilledPart, BuildError<S::Error>>
-    where
-        S::Error: Display,
-    {
-        let options = self.options(max_memory);
-        self.on_threads(|| stack_part(self.source, slabs, out, &options, self.progress_or_none()))?
-    }
-
-    fn options(&self, max_memory: u64) -> OutOfCore {
-        OutOfCore {
+    ) -> Result<SpilledPart<P::Stored>, StoreBuildError<S::Error, P>> {
+        let options = OutOfCore {
             depth: self.depth(),
             max_memory,
-            temp_dir: self.temp_dir.clone(),
             cells: self.cells,
-        }
+        };
+        self.on_threads(|| {
+            stack_part(
+                self.source,
+                slabs,
+                store,
+                &options,
+                self.progress_callback(),
+            )
+        })?
     }
 
-    fn progress_or_none(&self) -> &(dyn Fn(Progress) + Sync) {
+    /// The folder given for spill files ([`temp_dir`](Self::temp_dir)), if any.
+    pub(crate) fn spill_dir(&self) -> Option<&Path> {
+        self.temp_dir.as_deref()
+    }
+
+    /// The levels of the subtrees of the cells below their roots: `L` less the split depth.
+    pub(crate) fn subtree_levels(&self) -> usize {
+        (self.source.universe().level() - self.depth()) as usize
+    }
+
+    /// The progress callback given, or one that does nothing.
+    pub(crate) fn progress_callback(&self) -> &(dyn Fn(Progress) + Sync) {
         self.progress.unwrap_or(&|_| {})
     }
 
     /// Runs `work` on the pool asked for, or on the current one.
-    fn on_threads<T: Send>(
+    fn on_threads<T: Send, F>(
         &self,
         work: impl FnOnce() -> T + Send,
-    ) -> Result<T, BuildError<S::Error>> {
+    ) -> Result<T, BuildError<S::Error, F>> {
         match self.threads {
             None => Ok(work()),
             Some(threads) => rayon::ThreadPoolBuilder::new()
@@ -224,7 +241,6 @@ impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
         }
     }
 }
-
 impl<const K: usize> KTree<K> {
     /// The tree of a ray set, by the default build ([`Builder`]: cells of the default split depth on the
     /// threads of the current rayon pool); also `KTree::from(&rays)`.

@@ -1,8 +1,10 @@
 //! Building a tree from rays. [`Builder`] is the one entry point, and [`KTree::from_rays`] runs it: the
 //! universe is cut into cells stacked apart on all threads (by default each through a bitmap pyramid of
-//! its voxels) and joined level by level — in memory ([`Builder::build`]) or straight to a `.ktree` file in
-//! bounded memory, the subtrees spilled to temporary files ([`Builder::to_file`]), also in parts that run
-//! apart, as the ranks of a distributed run do ([`Builder::stack_part`], [`SpilledPart`]).
+//! its voxels) and joined level by level — in memory ([`Builder::build`]) or out of core in bounded memory,
+//! the subtrees spilled as they are stacked and the tree written level after level
+//! ([`Builder::build_into`] any [`PieceStore`] and [`LevelOrderSink`]; [`Builder::to_file`] a `.ktree`
+//! file through spill files, which `io` implements), also in parts that run apart, as the ranks of a
+//! distributed run do ([`Builder::stack_part`], [`SpilledPart`]).
 //!
 //! Akman & Franklin's stacking itself — rays to maximal rows, combined and split through the
 //! dimension-level lists — is in [`paper`], in memory, with the lists as files, and as a pipeline; the
@@ -21,15 +23,16 @@
 //! ## How it runs
 //! The cells of depth `m` are stacked slab by slab exactly as in [`Builder::build`],
 //! but no finished subtree is kept: the levels `1, 2, …` of each partial cell's subtree are appended to
-//! one temporary *spill file* per level (word-aligned; slab after slab in the order they finish, each slab's cells
-//! in Morton order), and only a small
-//! index (the cell's Morton index and its node count per level) and the states of the cells of depth `m`
-//! (see *Memory*) stay in memory. At the end the file is written level by level through a [`KtreeWriter`](crate::io::KtreeWriter): the
-//! top levels `0 … m` (from the cells' states; a uniform top collapses), then each level `m + j` as the
-//! concatenation, in Morton order of the cells, of the subtrees' levels `j` read back from spill file `j`
-//! (the writer shifts each piece into place). The file goes to a temporary file renamed over the target
-//! ([`write_atomic_with`](crate::fs::write_atomic_with)), so the bytes are exactly those of the tree built in memory and written by
-//! [`write_ktree`](crate::io::write_ktree), for any number of threads.
+//! a [`PieceStore`] as one *piece* per level (word-aligned; slab after slab in the order they finish,
+//! each slab's cells in Morton order), and only a small index (the cell's Morton index and its node count
+//! per level) and the states of the cells of depth `m` (see *Memory*) stay in memory. At the end the tree
+//! is written level by level to a [`LevelOrderSink`]: the top levels `0 … m` (from the cells' states; a
+//! uniform top collapses), then each level `m + j` as the concatenation, in Morton order of the cells, of
+//! the subtrees' levels `j` read back from the store (the sink shifts each piece into place). The builder
+//! knows nothing else of where the pieces wait and where the tree goes. [`Builder::to_file`] gives it
+//! `io`'s spill files (one per level, see *Temporary files*) and the `.ktree` writer over a temporary
+//! file renamed over the target, so the file's bytes are exactly those of the tree built in memory and
+//! written by [`write_ktree`](crate::io::write_ktree), for any number of threads.
 //!
 //! ## In parts
 //! The two phases also run apart, as the ranks of a distributed run do: [`Builder::stack_part`] stacks some of the
@@ -39,16 +42,17 @@
 //! ([`SpilledPart::write`]), walking the stacked cells of all parts in Morton order and taking each
 //! piece from its own spill files or from the stream of words the owning part sends in its own Morton
 //! order ([`SpilledPart::stream_levels`]). The bytes are those of [`Builder::to_file`], which is one part
-//! of every slab.
+//! of every slab. ([`Builder::stack_part_into`] and [`SpilledPart::write_into`] do the same with any store
+//! and sink.)
 //!
 //! ## Memory
 //! The budget (`max_memory` of [`Builder::to_file`]) is kept by accounting, not by measuring the process:
 //! 64 bytes per run of each slab being stacked (its copies and the subtrees made from it, until
 //! they are spilled), 48 bytes per block of the full cells of depth `m` — kept reduced, as the top of the
 //! tree is: `2^K` full siblings are one block of their parent, so a solid's interior costs a few blocks,
-//! not one entry per cell — 24 plus 8 per level for each stacked cell, and the I/O
-//! buffers (64 KiB per spill file and two more). A budget below the buffers fails before any
-//! slab is made. The first slab runs alone; then rounds of up to as many slabs as the rayon pool has
+//! not one entry per cell — 24 plus 8 per level for each stacked cell, and the I/O buffers (64 KiB per
+//! level of spilled pieces, one for the output, one for reading back). A budget below the buffers fails
+//! before any slab is made. The first slab runs alone; then rounds of up to as many slabs as the rayon pool has
 //! threads run at once, as many as the largest slab seen so far allows in what is left of the budget; a
 //! slab whose rays turn out not to fit beside those already admitted is set aside (its rays dropped) for
 //! the next round. Only these rays, made before their size is known, are held beyond the accounted
@@ -59,7 +63,7 @@
 //! names then (what the build holds at its end plus its largest slab) is enough for the whole build.
 //!
 //! ## Temporary files
-//! The spill files live in a hidden folder `.NAME.XXXXXX.PID.ktree-spill` in [`Builder::temp_dir`] (by
+//! (Of [`Builder::to_file`] and [`Builder::stack_part`].) The spill files live in a hidden folder `.NAME.XXXXXX.PID.ktree-spill` in [`Builder::temp_dir`] (by
 //! default the output's folder), removed when the build ends, whether it succeeds or fails; a process
 //! killed mid-build leaves it behind, and the next build of the same output removes the folders of
 //! processes that no longer run.
@@ -99,7 +103,9 @@ mod partition;
 mod solids;
 
 pub use builder::{Builder, CellStacking};
+pub(crate) use out_of_core::BUFFER_BYTES;
 pub use out_of_core::{
-    balanced_parts, BuildError, OutOfCoreReport, Progress, SpilledPart, Stage, MAX_PARTS,
+    balanced_parts, BuildError, LevelOrderSink, LevelPieces, OutOfCoreReport, PieceStore, Progress,
+    SpilledPart, Stage, StoredPieces, MAX_PARTS,
 };
 pub use partition::default_split_depth;

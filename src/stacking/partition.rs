@@ -28,7 +28,7 @@ use super::cells::{top_levels_of_blocks, CellBlock};
 use super::paper::stack;
 use super::CellStacking;
 pub use crate::rays::source::default_split_depth;
-use crate::rays::{RaySet, RaySource, SlabRuns};
+use crate::rays::{ColumnKeys, RaySet, RaySource, SlabRuns};
 use crate::space::{morton_encode, Universe};
 use crate::tree::words::LevelWords;
 use crate::tree::{KTree, NodeState, PackedStates};
@@ -109,7 +109,7 @@ pub(super) fn slab_pieces<const K: usize>(
     }
     // Bucket the slab's runs by block (the cell coordinates along axes 1 … K−2), keeping their order, with
     // column keys made local to the block.
-    let mask = (1u64 << level) - 1;
+    let columns = ColumnKeys::<K>::new(level);
     let local_mask = u64::from(side) - 1;
     let blocks_per_slab = 1usize << ((K - 2) as u32 * m);
     if blocks_per_slab > runs.len().max(64) {
@@ -120,8 +120,7 @@ pub(super) fn slab_pieces<const K: usize>(
     for &key in keys {
         let mut b = 0usize;
         for a in 1..K - 1 {
-            let c = key >> ((K - 2 - a) as u32 * level) & mask;
-            b = b << m | (c >> t) as usize;
+            b = b << m | (columns.axis(key, a) >> t) as usize;
         }
         block_of.push(b);
         counts[b + 1] += 1;
@@ -134,8 +133,7 @@ pub(super) fn slab_pieces<const K: usize>(
     for (i, (&key, &run)) in keys.iter().zip(runs).enumerate() {
         let mut lk = 0u64;
         for a in 0..K - 1 {
-            let c = key >> ((K - 2 - a) as u32 * level) & mask;
-            lk = lk << t | (c & local_mask);
+            lk = lk << t | (u64::from(columns.axis(key, a)) & local_mask);
         }
         let at = &mut counts[block_of[i]];
         local[*at] = (lk, run);
@@ -172,16 +170,14 @@ fn stack_sparse_slab<const K: usize>(
     cells: CellStacking,
 ) -> Vec<(u64, Piece<K>)> {
     let t = level - m;
-    let mask = (1u64 << level) - 1;
+    let columns = ColumnKeys::<K>::new(level);
     let local_mask = (1u64 << t) - 1;
     // (block coordinates on axes 1 … K−2, position) sorts by block, keeping the order within a block.
     let mut order: Vec<(u64, usize)> = keys
         .iter()
         .enumerate()
         .map(|(i, &key)| {
-            let b = (1..K - 1).fold(0u64, |b, a| {
-                b << m | (key >> ((K - 2 - a) as u32 * level) & mask) >> t
-            });
+            let b = (1..K - 1).fold(0u64, |b, a| b << m | u64::from(columns.axis(key, a)) >> t);
             (b, i)
         })
         .collect();
@@ -196,7 +192,7 @@ fn stack_sparse_slab<const K: usize>(
         while at < order.len() && order[at].0 == b {
             let i = order[at].1;
             let lk = (0..K - 1).fold(0u64, |lk, a| {
-                lk << t | (keys[i] >> ((K - 2 - a) as u32 * level) & mask & local_mask)
+                lk << t | (u64::from(columns.axis(keys[i], a)) & local_mask)
             });
             block.keys.push(lk);
             block.runs.push(runs[i]);

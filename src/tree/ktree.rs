@@ -8,7 +8,7 @@ use super::valued::LevelValues;
 use super::value::Value;
 use super::TreeError;
 
-use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
+use crate::space::{Cell, DimCheck, SpaceError, Universe};
 
 /// Node counts of one level (or of a whole tree): Meagher's complexity metric.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
@@ -512,47 +512,6 @@ impl<const K: usize> KTree<K> {
     pub fn full_cells(&self) -> impl Iterator<Item = Cell<K>> + '_ {
         self.leaves()
             .filter_map(|(cell, state)| (state == NodeState::Full).then_some(cell))
-    }
-
-    /// The object as a dense boolean array (axis 0 fastest).
-    ///
-    /// # Errors
-    /// [`SpaceError::TooLargeForDense`] if the universe exceeds [`DENSE_LIMIT`] voxels.
-    pub fn to_dense(&self) -> Result<Vec<bool>, SpaceError> {
-        let len = self.universe.dense_len(DENSE_LIMIT)?;
-        let mut dense = vec![false; len];
-        self.for_each_leaf(|cell, state| {
-            if state == NodeState::Full {
-                fill_cell(&self.universe, &mut dense, cell);
-            }
-        });
-        Ok(dense)
-    }
-}
-
-/// Sets every voxel of `cell` in a dense array of `universe`.
-pub(crate) fn fill_cell<const K: usize>(universe: &Universe<K>, dense: &mut [bool], cell: Cell<K>) {
-    let side = cell.side() as u32;
-    let mut offset = [0u32; K];
-    loop {
-        let mut p = cell.origin;
-        for (pi, oi) in p.iter_mut().zip(offset.iter()) {
-            *pi += oi;
-        }
-        dense[universe.dense_index(p)] = true;
-        // Odometer over the cell's voxels.
-        let mut axis = 0;
-        loop {
-            if axis == K {
-                return;
-            }
-            offset[axis] += 1;
-            if offset[axis] < side {
-                break;
-            }
-            offset[axis] = 0;
-            axis += 1;
-        }
     }
 }
 

@@ -23,9 +23,9 @@ mod operators;
 pub mod sink;
 mod states;
 pub mod storage;
+mod to_rays;
 pub mod value;
 pub mod valued;
-pub(crate) mod to_rays;
 pub(crate) mod words;
 
 pub use any::{AnyTree, DimensionMismatch};
@@ -38,5 +38,6 @@ pub use ktree::{
 };
 pub use states::{NodeState, PackedStates};
 pub use storage::TreeStorage;
+pub use to_rays::rays_of;
 pub use value::{Dtype, Rgb, Value};
 pub use valued::{ValueState, ValueStorage};

@@ -7,7 +7,8 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use ktree::solid::cloud::{CloudVoxelizer, PointCloud};
+use ktree::io::{read_cloud, read_cloud_bytes};
+use ktree::solid::cloud::CloudVoxelizer;
 use ktree::{KTree, Universe};
 use proptest::prelude::*;
 
@@ -110,6 +111,76 @@ fn pcd_binary(points: &[[f64; 3]]) -> Vec<u8> {
     b
 }
 
+/// PCD `DATA binary_compressed` as PCL writes it: the fields column by column (the padding field `_` not
+/// stored), compressed by [`lzf`].
+fn pcd_compressed(points: &[[f64; 3]]) -> Vec<u8> {
+    let n = points.len();
+    let mut b = format!(
+        "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z _ rgb\nSIZE 8 8 8 1 4\nTYPE F F F U U\nCOUNT 1 1 1 4 1\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA binary_compressed\n"
+    )
+    .into_bytes();
+    let mut columns = Vec::new();
+    for a in 0..3 {
+        for p in points {
+            columns.extend(p[a].to_le_bytes());
+        }
+    }
+    for i in 0..n {
+        columns.extend((i as u32 % 3).to_le_bytes());
+    }
+    let data = lzf(&columns);
+    b.extend((data.len() as u32).to_le_bytes());
+    b.extend((columns.len() as u32).to_le_bytes());
+    b.extend(data);
+    b
+}
+
+/// A plain LZF compressor (liblzf's format: literal runs of at most 32 bytes, back references of 3 to 264
+/// bytes at most 8192 back), greedy over the last position of each 3 bytes.
+fn lzf(data: &[u8]) -> Vec<u8> {
+    fn flush(out: &mut Vec<u8>, literal: &mut Vec<u8>) {
+        for run in literal.chunks(32) {
+            out.push((run.len() - 1) as u8);
+            out.extend(run);
+        }
+        literal.clear();
+    }
+    let mut out = Vec::new();
+    let mut literal = Vec::new();
+    let mut last: std::collections::HashMap<[u8; 3], usize> = std::collections::HashMap::new();
+    let mut i = 0;
+    while i < data.len() {
+        let key = (i + 3 <= data.len()).then(|| [data[i], data[i + 1], data[i + 2]]);
+        let found = key
+            .and_then(|k| last.get(&k).copied())
+            .filter(|&j| i - j <= 8192);
+        if let Some(k) = key {
+            last.insert(k, i);
+        }
+        let Some(j) = found else {
+            literal.push(data[i]);
+            i += 1;
+            continue;
+        };
+        let mut len = 3;
+        while i + len < data.len() && len < 264 && data[j + len] == data[i + len] {
+            len += 1;
+        }
+        flush(&mut out, &mut literal);
+        let (back, n) = (i - j - 1, len - 2);
+        if n < 7 {
+            out.push(((n as u8) << 5) | (back >> 8) as u8);
+        } else {
+            out.push((7 << 5) | (back >> 8) as u8);
+            out.push((n - 7) as u8);
+        }
+        out.push((back & 0xff) as u8);
+        i += len;
+    }
+    flush(&mut out, &mut literal);
+    out
+}
+
 fn xyz(points: &[[f64; 3]]) -> Vec<u8> {
     let mut s = String::from("# x y z intensity\n\n");
     for p in points {
@@ -156,6 +227,19 @@ fn las_1_4(points: &[[f64; 3]], extended: &[Vec<u8>]) -> Vec<u8> {
     write_las(b, points)
 }
 
+/// LAZ 1.4 of `points` (point format 6, compressed in layered chunks), with a scale of 1/1024.
+fn laz_1_4(points: &[[f64; 3]]) -> Vec<u8> {
+    let mut b = las::Builder::from((1, 4));
+    b.point_format = las::point::Format::new(6).unwrap();
+    b.point_format.is_compressed = true;
+    let t = las::Transform {
+        scale: 1.0 / 1024.0,
+        offset: 0.0,
+    };
+    b.transforms = las::Vector { x: t, y: t, z: t };
+    write_las(b, points)
+}
+
 /// The file `b` describes, holding `points`.
 fn write_las(b: las::Builder, points: &[[f64; 3]]) -> Vec<u8> {
     let gps_time = b.point_format.has_gps_time.then_some(0.0);
@@ -182,6 +266,7 @@ fn all_formats(points: &[[f64; 3]]) -> Vec<(&'static str, Vec<u8>)> {
         ("ply", ply_binary(points, true)),
         ("pcd", pcd_ascii(points)),
         ("pcd", pcd_binary(points)),
+        ("pcd", pcd_compressed(points)),
         ("xyz", xyz(points)),
         ("csv", csv(points)),
         ("las", las(points, false)),
@@ -203,7 +288,7 @@ proptest! {
     #[test]
     fn every_format_reads_back_the_points(points in cloud(60, 40)) {
         for (ext, bytes) in all_formats(&points) {
-            let read = PointCloud::from_bytes(&bytes, ext, Path::new("t")).unwrap();
+            let read = read_cloud_bytes(&bytes, ext, Path::new("t")).unwrap();
             prop_assert_eq!(read.points(), &points[..], "{}", ext);
         }
     }
@@ -273,8 +358,8 @@ fn files_of_every_format_voxelize_as_the_reference() {
     for (i, (ext, bytes)) in all_formats(&points).into_iter().enumerate() {
         let path = dir.path().join(format!("c{i}.{ext}"));
         std::fs::write(&path, bytes).unwrap();
-        assert!(ktree::solid::cloud::is_cloud_file(&path).unwrap());
-        let cloud = PointCloud::read(&path).unwrap();
+        assert!(ktree::io::is_cloud_file(&path).unwrap());
+        let cloud = read_cloud(&path).unwrap();
         let v = CloudVoxelizer::new(0.5)
             .unwrap()
             .min_points(2)
@@ -284,7 +369,7 @@ fn files_of_every_format_voxelize_as_the_reference() {
     }
 }
 
-/// A malformed file is an error naming the file and the line (text) or byte (binary).
+/// A malformed file is an error naming the file once and the line (text) or byte (binary), in one line.
 #[test]
 fn malformed_files_name_the_line_or_byte() {
     let p = [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]];
@@ -305,70 +390,217 @@ fn malformed_files_name_the_line_or_byte() {
     let mut record = vec![0u8; 60];
     record[20..28].copy_from_slice(&(1u64 << 54).to_le_bytes());
     huge_evlr.extend_from_slice(&record);
-    let huge_evlr_error = format!("byte {start}: LAS: the extended variable-length record there declares 18014398509481984 bytes");
+    let huge_evlr_error = format!(
+        ": byte {start}: LAS: the extended variable-length record there declares 18014398509481984 bytes"
+    );
+    // binary_compressed: the sizes after the header, then the LZF data.
+    let compressed = pcd_compressed(&p);
+    let end = b"DATA binary_compressed\n";
+    let body = compressed
+        .windows(end.len())
+        .position(|w| w == end)
+        .unwrap()
+        + end.len();
+    let mut cut_compressed = compressed.clone();
+    cut_compressed.truncate(cut_compressed.len() - 1);
+    let mut wrong_size = compressed.clone();
+    wrong_size[body + 4..body + 8].copy_from_slice(&61u32.to_le_bytes());
+    let mut far_back = compressed.clone();
+    far_back[body + 8..body + 12].copy_from_slice(&[0, 7, 0x20, 9]); // 1 literal byte, then 10 bytes back
+    let data = compressed.len() - body - 8;
+    let cut_error = format!(
+        ": byte {body}: PCD: {data} bytes of compressed data declared but the file has {} after the sizes",
+        data - 1
+    );
+    let wrong_size_error = format!(
+        ": byte {}: PCD: 2 points of 28 bytes need 56 bytes, but the uncompressed size is 61",
+        body + 4
+    );
+    let far_back_error = format!(
+        ": byte {}: PCD: LZF: a reference 10 bytes back, but only 1 bytes are decompressed",
+        body + 10
+    );
+    let mut short_header = las(&p, false);
+    short_header[94..96].copy_from_slice(&100u16.to_le_bytes());
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
         ("las", huge_evlr, &huge_evlr_error),
-        ("xyz", b"1 2 3\n4 five 6\n".to_vec(), "line 2: 'five' is not a number"),
-        ("xyz", b"x y z\n1 2 3\n".to_vec(), "line 1: 'x' is not a number"),
-        ("xyz", b"1 2 3\n\n1 2\n".to_vec(), "line 3: expected 3 numbers"),
-        ("xyz", b"1 2 3\n1 nan 2\n".to_vec(), "line 2: coordinate not finite"),
-        ("csv", b"x,y,z\n1,2,3\n4,5,inf\n".to_vec(), "line 3: coordinate not finite"),
-        ("csv", b"x,y,z\n1,2,3\nx,y,z\n".to_vec(), "line 3: 'x' is not a number"),
-        ("ply", ply_ascii(&p)[..150].to_vec(), "no end line"),
+        ("las", short_header, ": byte 94: LAS: a header of 100 bytes, but LAS 1.2's takes 227"),
+        ("xyz", b"1 2 3\n4 five 6\n".to_vec(), ":2: 'five' is not a number"),
+        ("xyz", b"x y z\n1 2 3\n".to_vec(), ":1: 'x' is not a number"),
+        ("xyz", b"1 2 3\n\n1 2\n".to_vec(), ":3: expected 3 numbers x y z, found 2"),
+        ("xyz", b"1 2 3\n1 nan 2\n".to_vec(), ":2: the point has a coordinate that is not finite"),
+        ("csv", b"x,y,z\n1,2,3\n4,5,inf\n".to_vec(), ":3: the point has a coordinate that is not finite"),
+        ("csv", b"x,y,z\n1,2,3\nx,y,z\n".to_vec(), ":3: 'x' is not a number"),
+        ("ply", ply_ascii(&p)[..150].to_vec(), ": the PLY header has no end line"),
         (
             "ply",
             String::from_utf8(ply_ascii(&p)).unwrap().replace("4 5 7 6", "4 5 7 nan").into_bytes(),
-            "line 13: vertex 1 has a coordinate that is not finite",
+            ":13: PLY vertex 1 has a coordinate that is not finite",
         ),
         (
             "ply",
             String::from_utf8(ply_ascii(&p)).unwrap().replace("4 5 7 6", "4 5").into_bytes(),
-            "line 13: vertex 1 has too few values",
+            ":13: vertex 1 has too few values",
         ),
-        ("ply", bad_ply_binary, "byte 151: PLY vertices: 2 points of 25 bytes need 50 bytes"),
-        ("ply", nan_ply_binary, "byte 180: PLY vertex 1 has a coordinate that is not finite"),
+        (
+            "ply",
+            bad_ply_binary,
+            ": byte 151: the PLY header declares 2 'vertex' entries, which take at least 50 bytes, but only 28 bytes follow it",
+        ),
+        ("ply", nan_ply_binary, ": byte 180: PLY vertex 1 has a coordinate that is not finite"),
         (
             "ply",
             b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec(),
-            "it is a mesh",
+            ": the PLY file has 1 faces: it is a mesh",
         ),
         (
             "ply",
             b"ply\nformat binary_little_endian 1.0\nelement junk 99999999999\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n".to_vec(),
-            "element 'junk' has 99999999999 entries but no property",
+            ":8: PLY element 'junk' has 99999999999 entries but no property",
         ),
-        ("pcd", bad_pcd_binary, "points of 28 bytes need 56 bytes but the file has 53"),
+        ("pcd", bad_pcd_binary, ": byte 174: PCD: 2 points of 28 bytes need 56 bytes but the file has 53"),
         (
             "pcd",
             String::from_utf8(pcd_ascii(&p)).unwrap().replace("4 5 6 ", "4 5 ").into_bytes(),
-            "line 13: expected 4 values, found 3",
+            ":13: expected 4 values, found 3",
         ),
         (
             "pcd",
             String::from_utf8(pcd_ascii(&p)).unwrap().replace("4 5 6 ", "4 -inf 6 ").into_bytes(),
-            "line 13: point 1 has a coordinate that is not finite",
+            ":13: point 1 has a coordinate that is not finite",
         ),
         (
             "pcd",
             String::from_utf8(pcd_ascii(&p)).unwrap().replace("POINTS 2", "POINTS 99999999999").into_bytes(),
-            "99999999999 points declared but only",
+            ": byte 183: PCD: 99999999999 points declared but only",
         ),
-        (
-            "pcd",
-            String::from_utf8(pcd_ascii(&p)).unwrap().replace("DATA ascii", "DATA binary_compressed").into_bytes(),
-            "line 11: PCD 'DATA binary_compressed' is not read",
-        ),
-        ("las", huge_las, "byte 0: LAS: the header declares 4294967295 points"),
-        ("las", b"LASF".to_vec(), "LAS header"),
+        ("pcd", cut_compressed, &cut_error),
+        ("pcd", wrong_size, &wrong_size_error),
+        ("pcd", far_back, &far_back_error),
+        ("las", huge_las, ": byte 107: LAS: the header declares 4294967295 points"),
+        ("las", b"LASF".to_vec(), ": byte 0: LAS header"),
     ];
     let dir = tempfile::tempdir().unwrap();
     for (i, (ext, bytes, want)) in cases.into_iter().enumerate() {
         let path = dir.path().join(format!("bad{i}.{ext}"));
         std::fs::write(&path, &bytes).unwrap();
-        let e = PointCloud::read(&path).unwrap_err().to_string();
-        assert!(e.contains(&format!("bad{i}.{ext}")), "{e}");
-        assert!(e.contains(want), "case {i}: {e} (wanted: {want})");
+        let e = read_cloud(&path).unwrap_err().to_string();
+        let name = path.display().to_string();
+        let rest = e
+            .strip_prefix(&name)
+            .unwrap_or_else(|| panic!("case {i}: {e}"));
+        assert!(rest.starts_with(want), "case {i}: {e} (wanted: {want})");
+        assert!(
+            !rest.contains(&format!("bad{i}.{ext}")),
+            "the file named twice: {e}"
+        );
         assert!(!e.contains('\n'), "{e}");
+    }
+}
+
+/// A LAS or LAZ file whose point count was raised is refused, naming the byte, before any point beyond
+/// the data is decoded: uncompressed, against the point data; compressed, against the chunk table and
+/// each chunk's own bytes (LAS 1.2 with chunks of points, LAS 1.4 with chunks of layers); in LAS 1.4 the
+/// two counts of the header must agree.
+#[test]
+fn a_point_count_the_data_cannot_hold_is_refused() {
+    let p: Vec<[f64; 3]> = (0..300)
+        .map(|i| [f64::from(i), 2.0, f64::from(i % 7)])
+        .collect();
+    let raised = |mut bytes: Vec<u8>, at: std::ops::Range<usize>, by: u64| {
+        let mut n = [0u8; 8];
+        n[..at.len()].copy_from_slice(&bytes[at.clone()]);
+        let count = u64::from_le_bytes(n) + by;
+        bytes[at.clone()].copy_from_slice(&count.to_le_bytes()[..at.len()]);
+        bytes
+    };
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("las", raised(las(&p, false), 107..111, 1), ": byte 107: LAS: the header declares 301 points of 20 bytes (6020 bytes), but the point data"),
+        ("laz", raised(las(&p, true), 107..111, 1), "LAZ chunk 0: its"),
+        ("laz", raised(las(&p, true), 107..111, 2), "bytes end after 300 of the 302 points the header and the chunk table give it"),
+        ("laz", raised(raised(laz_1_4(&p), 107..111, 1), 247..255, 1), "LAZ chunk 0: the chunk says it holds 300 points, the header and the chunk table give it 301"),
+        ("las", raised(las_1_4(&p, &[]), 107..111, 5), ": byte 107: LAS: the legacy point count 305 disagrees with the point count 300 at byte 247"),
+    ];
+    for (i, (ext, bytes, want)) in cases.into_iter().enumerate() {
+        let e = read_cloud_bytes(&bytes, ext, Path::new("raised"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("raised: byte "), "case {i}: {e}");
+        assert!(e.contains(want), "case {i}: {e} (wanted: {want})");
+    }
+    // As written, every one reads.
+    for bytes in [las(&p, false), las(&p, true), laz_1_4(&p), las_1_4(&p, &[])] {
+        assert_eq!(
+            read_cloud_bytes(&bytes, "las", Path::new("t"))
+                .unwrap()
+                .points(),
+            &p[..]
+        );
+    }
+}
+
+/// laspy's COPC file (LAS 1.4, LASzip layered chunks of variable size) reads; with its point counts
+/// raised (the legacy one alone, or both), it is refused naming the byte: once this made the LASzip
+/// decoder read past the last chunk and ask for 3.7 GB.
+#[test]
+fn a_copc_file_with_a_raised_count_is_refused() {
+    let file =
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/clouds/simple.copc.laz"))
+            .unwrap();
+    let cloud = read_cloud_bytes(&file, "laz", Path::new("simple.copc.laz")).unwrap();
+    assert_eq!(cloud.len(), 1065);
+    let mut legacy = file.clone();
+    legacy[107..111].copy_from_slice(&1066u32.to_le_bytes());
+    let e = read_cloud_bytes(&legacy, "laz", Path::new("c.laz"))
+        .unwrap_err()
+        .to_string();
+    assert_eq!(e, "c.laz: byte 107: LAS: the legacy point count 1066 disagrees with the point count 1065 at byte 247");
+    let mut both = legacy.clone();
+    both[247..255].copy_from_slice(&1066u64.to_le_bytes());
+    let e = read_cloud_bytes(&both, "laz", Path::new("c.laz"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with(
+            "c.laz: byte 107: LAZ: the header declares 1066 points, but the chunk table (byte "
+        ),
+        "{e}"
+    );
+    assert!(e.ends_with(") gives its chunks 1065"), "{e}");
+}
+
+/// PCL's own `binary_compressed` file reads the points PCL reads from it (PCL's conversion of it to
+/// `binary`, kept beside it).
+#[test]
+fn pcl_compressed_file_reads_as_pcl_reads_it() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/clouds");
+    let compressed = read_cloud(&dir.join("pcl_brisk_keypoints_gt.pcd")).unwrap();
+    let binary = read_cloud(&dir.join("pcl_brisk_keypoints_gt_binary.pcd")).unwrap();
+    assert_eq!(compressed.len(), 1860);
+    assert_eq!(compressed, binary);
+}
+
+/// PCD points whose x, y and z are all NaN (PCL's pixels without a measurement) are skipped, in each
+/// kind of data; a point with one NaN coordinate is an error.
+#[test]
+fn pcd_points_without_a_measurement_are_skipped() {
+    let p = [[1.0, 2.0, 3.0], [f64::NAN; 3], [4.0, 5.0, 6.0]];
+    for (i, bytes) in [pcd_ascii(&p), pcd_binary(&p), pcd_compressed(&p)]
+        .into_iter()
+        .enumerate()
+    {
+        let read = read_cloud_bytes(&bytes, "pcd", Path::new("t")).unwrap();
+        assert_eq!(read.points(), &[p[0], p[2]], "{i}");
+    }
+    let half = [[1.0, 2.0, 3.0], [f64::NAN, 0.0, 0.0]];
+    for bytes in [pcd_ascii(&half), pcd_binary(&half), pcd_compressed(&half)] {
+        let e = read_cloud_bytes(&bytes, "pcd", Path::new("t"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("point 1 has a coordinate that is not finite"),
+            "{e}"
+        );
     }
 }
 
@@ -381,7 +613,7 @@ fn las_1_4_with_extended_records_reads() {
         vec![vec![1u8; 3], vec![2u8; 70_000]],
     ] {
         let bytes = las_1_4(&p, &extended);
-        let cloud = PointCloud::from_bytes(&bytes, "las", Path::new("x.las")).unwrap();
+        let cloud = read_cloud_bytes(&bytes, "las", Path::new("x.las")).unwrap();
         assert_eq!(
             cloud.points(),
             &p[..],

@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use ktree::export::outline::{boundary_loops, signed_area};
 use ktree::export::surface::{boundary_mesh, SurfaceMesh};
 use ktree::export::{write_mesh, Frame};
-use ktree::solid::mesh::{MeshTransform, TriangleMesh};
+use ktree::solid::mesh::MeshTransform;
 use ktree::{AnyTree, KTree};
 use proptest::prelude::*;
 
@@ -173,7 +173,7 @@ fn round_trip(tree: &KTree<3>, name: &str, frame: &Frame) {
     if tree.voxel_count() == 0 {
         return; // no triangle: not a mesh the reader takes
     }
-    let mesh = TriangleMesh::read(&path).unwrap();
+    let mesh = ktree::io::read_mesh(&path).unwrap();
     assert_eq!(mesh.open_edges(), 0, "{name}");
     let s = 1.0 / frame.voxel_size;
     let placement = MeshTransform {

@@ -135,14 +135,14 @@ proptest! {
         let _ = read_ktree_any(&fixed, "crafted");
         let _ = read_ktree::<2>(&fixed, "crafted");
         for format in ["obj", "stl", "STL", "ply", "off", ""] {
-            if let Ok(mesh) = TriangleMesh::from_bytes(&data, format, Path::new("arbitrary")) {
+            if let Ok(mesh) = ktree::io::read_mesh_bytes(&data, format, Path::new("arbitrary")) {
                 mesh_checks(&mesh);
             }
         }
         let mut binary_stl = vec![0u8; 80];
         binary_stl.extend_from_slice(&((data.len() / 50) as u32).to_le_bytes());
         binary_stl.extend_from_slice(&data);
-        if let Ok(mesh) = TriangleMesh::from_bytes(&binary_stl, "stl", Path::new("arbitrary")) {
+        if let Ok(mesh) = ktree::io::read_mesh_bytes(&binary_stl, "stl", Path::new("arbitrary")) {
             mesh_checks(&mesh);
         }
         let (sidecar, raw) = data.split_at(data.len() / 2);

@@ -6,6 +6,9 @@
 //! distributed run build it: balanced shares of the slabs stacked apart, their indexes added to one part
 //! and their levels streamed to it in chunks), the file is the same, for 1 … 5 parts and any chunk size;
 //! a damaged index or a stream that breaks off is an error that leaves the target and no temporary file.
+//! The builder knows its storage only through its traits: with a store of pieces and an output in memory
+//! (written here, outside the library) it builds the tree of the in-memory build, whole or in parts,
+//! reads each piece it stored once and whole, and accounts for memory as with files.
 
 use ktree::fs::SpillError;
 use std::path::Path;
@@ -13,8 +16,12 @@ use std::path::Path;
 use ktree::io::write_ktree;
 use ktree::rays::RaySource;
 use ktree::reference::{Dim, Fanout, NaiveTree};
-use ktree::stacking::{balanced_parts, paper::stack, BuildError, Builder};
-use ktree::RaySet;
+use ktree::stacking::{
+    balanced_parts, paper::stack, BuildError, Builder, LevelOrderSink, LevelPieces, PieceStore,
+    StoredPieces,
+};
+use ktree::tree::PackedStates;
+use ktree::{KTree, LevelCounts, NodeState, RaySet};
 use ktree_verify::cases::{ray_sets, Case};
 use proptest::prelude::*;
 
@@ -35,7 +42,9 @@ fn entries(dir: &Path) -> Vec<String> {
     names
 }
 
-fn needed_of<E: std::fmt::Debug>(e: BuildError<E>) -> Result<u64, TestCaseError> {
+fn needed_of<E: std::fmt::Debug, F: std::fmt::Debug>(
+    e: BuildError<E, F>,
+) -> Result<u64, TestCaseError> {
     match e {
         BuildError::BudgetTooSmall { needed, .. } => Ok(needed),
         other => Err(TestCaseError::fail(format!(
@@ -242,6 +251,300 @@ proptest! {
         let source = SolidSource::new(&ball, 5, Sample::Centre).unwrap();
         let expected = in_memory_bytes(&ball.to_rays(5, Sample::Centre, false).unwrap());
         out_of_core_agrees::<3, _>(&source, &expected)?;
+    }
+}
+
+/// A store of pieces in memory: each level's pieces one after the other in a `Vec`, and the length of
+/// each piece, to check that the builder reads every piece once, whole and in order.
+#[derive(Default)]
+struct VecPieces {
+    levels: Vec<Vec<u64>>,
+    piece_words: Vec<Vec<u64>>,
+}
+
+impl PieceStore for VecPieces {
+    type Error = std::io::Error;
+    type Stored = VecPieces;
+
+    fn append(&mut self, depth: usize, words: &[u64], nodes: u64) -> std::io::Result<()> {
+        assert!(depth >= 1, "pieces go to the levels below the cells");
+        assert_eq!(
+            words.len() as u64,
+            nodes.div_ceil(32),
+            "a piece in whole words"
+        );
+        if self.levels.len() < depth {
+            self.levels.resize(depth, Vec::new());
+            self.piece_words.resize(depth, Vec::new());
+        }
+        self.levels[depth - 1].extend_from_slice(words);
+        self.piece_words[depth - 1].push(words.len() as u64);
+        Ok(())
+    }
+
+    fn finish(self) -> std::io::Result<VecPieces> {
+        Ok(self)
+    }
+}
+
+/// A level of a [`VecPieces`] being read: its words, the offsets the builder gave, and the words of
+/// each piece read so far.
+struct VecLevel<'a> {
+    words: Vec<u64>,
+    offsets: &'a [u64],
+    read: Vec<u64>,
+}
+
+impl StoredPieces for VecPieces {
+    type Error = std::io::Error;
+    type Level<'a> = VecLevel<'a>;
+
+    fn level<'a>(&'a mut self, depth: usize, offsets: &'a [u64], words: u64) -> VecLevel<'a> {
+        let level = self.levels.get_mut(depth - 1).map(std::mem::take);
+        let sizes = self.piece_words.get(depth - 1).cloned().unwrap_or_default();
+        // The builder's index places the pieces where they were stored: empty pieces (a subtree not
+        // that deep) were not stored at all.
+        let stored: Vec<u64> = offsets
+            .iter()
+            .enumerate()
+            .map(|(s, &at)| offsets.get(s + 1).copied().unwrap_or(words) - at)
+            .filter(|&n| n > 0)
+            .collect();
+        let nonempty: Vec<u64> = sizes.iter().copied().filter(|&n| n > 0).collect();
+        assert_eq!(
+            stored, nonempty,
+            "level {depth}: the pieces are not where they were stored"
+        );
+        VecLevel {
+            words: level.unwrap_or_default(),
+            offsets,
+            read: vec![0; offsets.len()],
+        }
+    }
+}
+
+impl VecLevel<'_> {
+    fn piece_len(&self, piece: usize) -> u64 {
+        let end = self
+            .offsets
+            .get(piece + 1)
+            .copied()
+            .unwrap_or(self.words.len() as u64);
+        end - self.offsets[piece]
+    }
+}
+
+impl LevelPieces for VecLevel<'_> {
+    type Error = std::io::Error;
+
+    fn read(&mut self, piece: usize, at: u64, out: &mut [u64]) -> std::io::Result<()> {
+        assert_eq!(
+            at, self.read[piece],
+            "piece {piece} not read in order, or read twice"
+        );
+        assert!(
+            at + out.len() as u64 <= self.piece_len(piece),
+            "piece {piece} read past its end"
+        );
+        let start = (self.offsets[piece] + at) as usize;
+        out.copy_from_slice(&self.words[start..start + out.len()]);
+        self.read[piece] += out.len() as u64;
+        Ok(())
+    }
+
+    fn finish(self) {
+        for piece in 0..self.offsets.len() {
+            assert_eq!(
+                self.read[piece],
+                self.piece_len(piece),
+                "piece {piece} not read whole"
+            );
+        }
+    }
+}
+
+/// An output in memory: the levels as node states, made a [`KTree`] when finished.
+struct MemoryLevels<const K: usize> {
+    level: u32,
+    levels: Vec<Vec<NodeState>>,
+    current: Vec<NodeState>,
+}
+
+impl<const K: usize> MemoryLevels<K> {
+    fn new(level: u32) -> Self {
+        Self {
+            level,
+            levels: Vec::new(),
+            current: Vec::new(),
+        }
+    }
+}
+
+impl<const K: usize> LevelOrderSink for MemoryLevels<K> {
+    type Error = std::io::Error;
+    type Output = KTree<K>;
+
+    fn append_words(&mut self, words: &[u64], nodes: u64) -> std::io::Result<()> {
+        for i in 0..nodes as usize {
+            self.current
+                .push(match words[i / 32] >> (2 * (i % 32)) & 3 {
+                    0 => NodeState::Empty,
+                    1 => NodeState::Full,
+                    2 => NodeState::Partial,
+                    _ => return Err(std::io::Error::other("the unused code 11")),
+                });
+        }
+        Ok(())
+    }
+
+    fn end_level(&mut self) -> std::io::Result<()> {
+        self.levels.push(std::mem::take(&mut self.current));
+        Ok(())
+    }
+
+    fn counts_per_level(&self) -> Vec<LevelCounts> {
+        (0..self.levels.len())
+            .map(|d| {
+                let count = |state| self.levels[d].iter().filter(|&&s| s == state).count() as u64;
+                LevelCounts {
+                    level: d as u32,
+                    empty: count(NodeState::Empty),
+                    full: count(NodeState::Full),
+                    partial: count(NodeState::Partial),
+                }
+            })
+            .collect()
+    }
+
+    fn finish(self) -> std::io::Result<KTree<K>> {
+        assert!(self.current.is_empty(), "a level left open");
+        let levels = self
+            .levels
+            .iter()
+            .map(|states| {
+                let mut words = vec![0u64; states.len().div_ceil(32)];
+                for (i, &s) in states.iter().enumerate() {
+                    words[i / 32] |= (s as u64) << (2 * (i % 32));
+                }
+                PackedStates::from_words(words, states.len()).map_err(std::io::Error::other)
+            })
+            .collect::<std::io::Result<Vec<_>>>()?;
+        KTree::from_level_states(self.level, levels).map_err(std::io::Error::other)
+    }
+}
+
+/// With a store of pieces and an output in memory, at every split depth: the tree of the in-memory
+/// build, whole and in `parts` parts streaming their levels in chunks of `chunk` words; the counts and
+/// the spilled bytes reported; and the budget needed is the one the build to a file names.
+fn in_memory_storage_agrees<const K: usize>(
+    rays: &RaySet<K>,
+    parts: usize,
+    chunk: usize,
+) -> Result<(), TestCaseError> {
+    let expected = stack(rays);
+    let level = rays.level();
+    let dir = tempfile::tempdir().unwrap();
+    for depth in 0..=level {
+        let builder = Builder::new(rays).split_depth(depth);
+        let store = VecPieces::default();
+        let (tree, report) = builder
+            .build_into(store, MemoryLevels::<K>::new(level), u64::MAX)
+            .map_err(|e| TestCaseError::fail(format!("depth {depth}: {e}")))?;
+        prop_assert!(tree == expected, "split depth {}: the tree differs", depth);
+        prop_assert_eq!(&report.counts_per_level, &expected.counts_per_level());
+        prop_assert_eq!(report.file_bytes, 0);
+        let file = builder
+            .to_file(&dir.path().join("tree.ktree"), u64::MAX)
+            .unwrap();
+        prop_assert_eq!(report.spilled_bytes, file.spilled_bytes);
+        prop_assert_eq!(report.subtrees, file.subtrees);
+        prop_assert_eq!(report.peak_accounted_bytes, file.peak_accounted_bytes);
+        // The memory accounted does not depend on the storage: a budget of nothing names the same need.
+        let needed_memory = needed_of(
+            builder
+                .build_into(VecPieces::default(), MemoryLevels::<K>::new(level), 0)
+                .unwrap_err(),
+        )?;
+        let needed_file = needed_of(
+            builder
+                .to_file(&dir.path().join("tree.ktree"), 0)
+                .unwrap_err(),
+        )?;
+        prop_assert_eq!(needed_memory, needed_file);
+
+        // In parts, every part's pieces in memory.
+        let slabs = builder.slabs();
+        let costs: Vec<u64> = slabs
+            .iter()
+            .map(|&b0| builder.slab_cost(b0).unwrap())
+            .collect();
+        let mut stacked: Vec<_> = balanced_parts(&costs, parts)
+            .into_iter()
+            .map(|r| {
+                builder
+                    .stack_part_into(&slabs[r], VecPieces::default(), u64::MAX)
+                    .unwrap()
+            })
+            .collect();
+        let mut writer = stacked.remove(0);
+        let mut streams = Vec::new();
+        for mut other in stacked {
+            let words = writer.add_part(&other.index_words()).unwrap();
+            let mut stream = Vec::new();
+            other
+                .stream_levels(chunk, &mut |c| {
+                    stream.extend_from_slice(c);
+                    Ok(())
+                })
+                .unwrap();
+            prop_assert_eq!(stream.len() as u64, words);
+            streams.push(stream.into_iter());
+        }
+        let (tree, _) = writer
+            .write_into::<String, _, _>(
+                MemoryLevels::<K>::new(level),
+                |owner: usize, words: &mut [u64]| {
+                    for w in words.iter_mut() {
+                        *w = streams[owner - 1]
+                            .next()
+                            .ok_or_else(|| std::io::Error::other("a stream ended early"))?;
+                    }
+                    Ok(())
+                },
+                &|_| {},
+            )
+            .map_err(|e| TestCaseError::fail(format!("depth {depth}, {parts} parts: {e}")))?;
+        prop_assert!(
+            tree == expected,
+            "split depth {}, {} parts: the tree differs",
+            depth,
+            parts
+        );
+        for (i, s) in streams.iter_mut().enumerate() {
+            prop_assert!(s.next().is_none(), "part {} sent words not written", i + 1);
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn in_memory_storage_k1(case in ray_sets::<1>(), parts in 1usize..=4, chunk in 1usize..40) {
+        in_memory_storage_agrees(&case.rays, parts, chunk)?;
+    }
+    #[test]
+    fn in_memory_storage_k2(case in ray_sets::<2>(), parts in 1usize..=4, chunk in 1usize..40) {
+        in_memory_storage_agrees(&case.rays, parts, chunk)?;
+    }
+    #[test]
+    fn in_memory_storage_k3(case in ray_sets::<3>(), parts in 1usize..=4, chunk in 1usize..40) {
+        in_memory_storage_agrees(&case.rays, parts, chunk)?;
+    }
+    #[test]
+    fn in_memory_storage_k4(case in ray_sets::<4>(), parts in 1usize..=4, chunk in 1usize..40) {
+        in_memory_storage_agrees(&case.rays, parts, chunk)?;
     }
 }
 

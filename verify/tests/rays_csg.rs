@@ -196,3 +196,98 @@ fn difference_negates_the_subtracted_normals() {
     assert_eq!(d.normals(1).unwrap()[0], [0.0, -1.0]);
     let _ = Universe::<2>::new(3).unwrap();
 }
+
+/// A normal naming its set, run and end (negated where an operation turns it around).
+fn label<const K: usize>(set: f32, run: usize, exit: bool) -> [f32; K] {
+    let mut n = [0.0; K];
+    n[0] = 10.0 + 10_000.0 * set + 2.0 * run as f32 + f32::from(u8::from(exit));
+    n
+}
+
+/// `set` with a normal of its own at each end of each run.
+fn labelled<const K: usize>(set: &RaySet<K>, id: f32) -> RaySet<K> {
+    RaySet::from_rays_with_normals(
+        set.level(),
+        set.iter()
+            .enumerate()
+            .map(|(i, r)| (r, [label(id, i, false), label(id, i, true)])),
+    )
+    .unwrap()
+}
+
+/// The normal a result's end at `z` of column `key` (its start, or its end if `exit`) carries: that of the
+/// first operand's run end there, else the second's, negated where the operand's membership changes the
+/// other way; `∓z` at the universe's ends.
+fn expected_normal<const K: usize>(
+    operands: &[&RaySet<K>],
+    key: u64,
+    z: u32,
+    exit: bool,
+) -> [f32; K] {
+    for set in operands {
+        for i in 0..set.len() {
+            if set.column_keys()[i] != key {
+                continue;
+            }
+            let (z1, z2) = set.runs()[i];
+            for (at, end_exit) in [(z1, false), (z2, true)] {
+                if at == z {
+                    let n = set.normals(i).unwrap()[usize::from(end_exit)];
+                    return if end_exit == exit { n } else { n.map(|x| -x) };
+                }
+            }
+        }
+    }
+    let mut n = [0.0; K];
+    n[K - 1] = if exit { 1.0 } else { -1.0 };
+    n
+}
+
+fn check_normals<const K: usize>(a: &RaySet<K>, b: &RaySet<K>) -> Result<(), TestCaseError> {
+    let (a, b) = (labelled(a, 1.0), labelled(b, 2.0));
+    let results = [
+        (a.union(&b).unwrap(), vec![&a, &b]),
+        (a.intersection(&b).unwrap(), vec![&a, &b]),
+        (a.difference(&b).unwrap(), vec![&a, &b]),
+        (a.complement().unwrap(), vec![&a]),
+    ];
+    for (what, (got, operands)) in ["union", "intersection", "difference", "complement"]
+        .iter()
+        .zip(&results)
+    {
+        // A set of no run carries no normals (nor does a result made with it).
+        if operands.iter().any(|o| o.is_empty()) {
+            continue;
+        }
+        prop_assert!(got.has_normals(), "{}", what);
+        for i in 0..got.len() {
+            let key = got.column_keys()[i];
+            let (z1, z2) = got.runs()[i];
+            let n = got.normals(i).unwrap();
+            prop_assert_eq!(
+                n[0],
+                expected_normal(operands, key, z1, false),
+                "{} start",
+                what
+            );
+            prop_assert_eq!(
+                n[1],
+                expected_normal(operands, key, z2, true),
+                "{} end",
+                what
+            );
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(64))]
+    /// Normals ride with the run ends they bound, turned around where the membership turns.
+    #[test]
+    fn normals_ride_with_their_ends_k1((a, b, _) in pair::<1>()) { check_normals(&a, &b)?; }
+    #[test]
+    fn normals_ride_with_their_ends_k2((a, b, _) in pair::<2>()) { check_normals(&a, &b)?; }
+    #[test]
+    fn normals_ride_with_their_ends_k3((a, b, _) in pair::<3>()) { check_normals(&a, &b)?; }
+}

@@ -1,10 +1,14 @@
 //! Shape operations against dense references in K = 1 … 4: morphology by brute force over all offsets of
 //! the element (the closing in a padded array), components by flood fill, the surface area by counting
 //! faces, the Euler number by counting the cells of the cubical complex; plus the laws (idempotence,
-//! duality under complement) and trees at the largest level of each K.
+//! duality under complement) and trees at the largest level of each K; every operation on a `.ktree` file
+//! read in place gives what it gives on the tree in memory; the surface area of the whole universe at the
+//! largest levels.
 
-use ktree::shape::{Element, ShapeError};
-use ktree::{ops, KTree, Ray, RaySet, Universe};
+use ktree::io::{write_ktree, KtreeView, MappedTree};
+use ktree::shape::{self, Element, ShapeError};
+use ktree::tree::sink::{LevelSink, MemorySink};
+use ktree::{ops, KTree, NodeState, Ray, RaySet, Universe};
 use ktree_verify::objects::{obj_at, Obj};
 use proptest::prelude::*;
 
@@ -469,13 +473,13 @@ fn named_cases() {
     assert_eq!(shell.euler_number(1).unwrap(), 2);
     assert_eq!(shell.euler_number(3).unwrap(), 2);
     assert_eq!(shell.surface_area(), 54 + 6);
-    assert_eq!(
-        shell.euler_number(2).unwrap_err(),
-        ShapeError::EulerConnectivity {
+    assert!(matches!(
+        shell.euler_number(2),
+        Err(ShapeError::EulerConnectivity {
             connectivity: 2,
             k: 3
-        }
-    );
+        })
+    ));
     // Bad input.
     assert!(matches!(
         shell.dilate(-1.0, Element::Ball),
@@ -513,4 +517,121 @@ fn named_cases() {
     assert_eq!(ops::intersection(&grown, &ball).unwrap(), ball);
     let closed = ball.closing(8.0, Element::Ball).unwrap();
     assert_eq!(ops::intersection(&closed, &ball).unwrap(), ball);
+}
+
+/// Every shape operation on a `.ktree` file read in place gives what it gives on the tree in memory.
+fn check_mapped<const K: usize>(o: &Obj<K>, e: Element, r: f64) -> Result<(), TestCaseError> {
+    let tree = o.tree();
+    let mut bytes = Vec::new();
+    write_ktree(&mut bytes, &tree).unwrap();
+    let view = KtreeView::from_bytes(bytes, "mem").unwrap();
+    let mapped = MappedTree::<K>::new(&view).unwrap();
+    prop_assert_eq!(
+        shape::dilate(&mapped, r, e).unwrap(),
+        tree.dilate(r, e).unwrap()
+    );
+    prop_assert_eq!(
+        shape::erode(&mapped, r, e).unwrap(),
+        tree.erode(r, e).unwrap()
+    );
+    prop_assert_eq!(
+        shape::opening(&mapped, r, e).unwrap(),
+        tree.opening(r, e).unwrap()
+    );
+    prop_assert_eq!(
+        shape::closing(&mapped, r, e).unwrap(),
+        tree.closing(r, e).unwrap()
+    );
+    prop_assert_eq!(
+        shape::dilate_ball_by_distance(&mapped, r).unwrap(),
+        tree.dilate_ball_by_distance(r).unwrap()
+    );
+    prop_assert_eq!(
+        shape::erode_ball_by_distance(&mapped, r).unwrap(),
+        tree.erode_ball_by_distance(r).unwrap()
+    );
+    prop_assert_eq!(shape::surface_area(&mapped).unwrap(), tree.surface_area());
+    for c in 1..=K {
+        let parts = shape::components(&mapped, c).unwrap();
+        prop_assert_eq!(&parts, &tree.components(c).unwrap());
+        prop_assert_eq!(
+            shape::component_sizes(&mapped, c).unwrap(),
+            tree.component_sizes(c).unwrap()
+        );
+        prop_assert_eq!(
+            shape::largest_component(&mapped, c).unwrap(),
+            tree.largest_component(c).unwrap()
+        );
+        if c == 1 || c == K {
+            prop_assert_eq!(
+                shape::euler_number(&mapped, c).unwrap(),
+                tree.euler_number(c).unwrap()
+            );
+        }
+    }
+    let side = o.universe().side() as u32;
+    let points: Vec<[u32; K]> = (0..side).map(|i| [i * 5 % side; K]).collect();
+    prop_assert_eq!(
+        shape::signed_distance_at(&mapped, &points).unwrap(),
+        tree.signed_distance_at(&points).unwrap()
+    );
+    let shape_of = [side as usize; K];
+    prop_assert_eq!(
+        shape::signed_distance_window(&mapped, [0; K], shape_of).unwrap(),
+        tree.signed_distance_window([0; K], shape_of).unwrap()
+    );
+    prop_assert_eq!(
+        shape::narrow_band(&mapped, r).unwrap(),
+        tree.narrow_band(r).unwrap()
+    );
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(32))]
+    #[test]
+    fn mapped_files_k1(o in obj::<1>(), e in element(), r in radius()) { check_mapped(&o, e, r)?; }
+    #[test]
+    fn mapped_files_k2(o in obj::<2>(), e in element(), r in radius()) { check_mapped(&o, e, r)?; }
+    #[test]
+    fn mapped_files_k3(o in obj::<3>(), e in element(), r in radius()) { check_mapped(&o, e, r)?; }
+    #[test]
+    fn mapped_files_k4(o in obj::<4>(), e in element(), r in radius()) { check_mapped(&o, e, r)?; }
+}
+
+/// The surface area of the whole universe at the largest level of each K, and of trees whose full leaves
+/// are huge, counted on the nodes (a run per column would be 2^42 runs for K = 3).
+#[test]
+fn surface_area_of_the_whole_universe() {
+    assert_eq!(KTree::<3>::full(21).unwrap().surface_area(), 6 << 42);
+    assert_eq!(KTree::<4>::full(16).unwrap().surface_area(), 8 << 48);
+    assert_eq!(KTree::<2>::full(31).unwrap().surface_area(), 4 << 31);
+    assert_eq!(KTree::<1>::full(31).unwrap().surface_area(), 2);
+    assert_eq!(
+        shape::run_count(&KTree::<3>::full(21).unwrap()),
+        Ok(1 << 42)
+    );
+    // Half the universe (x < U/2) at the largest level: 2·U² across x, U² across y and z.
+    let mut sink = MemorySink::<3>::new(Universe::new(21).unwrap());
+    let kids: Vec<NodeState> = (0..8)
+        .map(|c| {
+            if c & 1 == 0 {
+                NodeState::Full
+            } else {
+                NodeState::Empty
+            }
+        })
+        .collect();
+    sink.push_block(1, &kids).unwrap();
+    let half = sink.finish(NodeState::Partial).unwrap();
+    assert_eq!(half.voxel_count(), 1 << 62);
+    assert_eq!(
+        shape::faces_per_axis(&half),
+        Ok([2 << 42, 1 << 42, 1 << 42])
+    );
+    // A huge full leaf beside a small one: the small one's faces come off the big one's.
+    let mut dense = vec![false; 64];
+    dense[0] = true;
+    let corner = KTree::<3>::from_dense(2, &dense).unwrap();
+    assert_eq!(corner.surface_area(), 6);
 }

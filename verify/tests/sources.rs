@@ -187,7 +187,7 @@ proptest! {
 fn bundled_meshes_equal_their_whole_rays() {
     let dir = cases::data_dir("meshes");
     for name in ["bunny_npm.obj", "fandisk.obj", "armadillo.obj"] {
-        let mesh = TriangleMesh::read(&dir.join(name)).unwrap();
+        let mesh = ktree::io::read_mesh(&dir.join(name)).unwrap();
         for level in [5, 7] {
             let placement = MeshTransform::fit(&mesh, level).unwrap();
             let whole = mesh.to_rays(level, &placement).unwrap();

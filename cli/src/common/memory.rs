@@ -1,10 +1,10 @@
 //! `--max-memory SIZE`, `--temp-dir DIR` and `--progress`: trees written out of core, in a memory budget.
 //! (`ktree op` streams version 2 files in bounded memory, and checks that trees it must load fit.)
 //!
-//! A command that writes a `.ktree` from rays builds it with
-//! [`ktree::stacking::Builder::to_file`]: the subtrees of the cells are spilled to temporary files as they
-//! are stacked and streamed into the output, so only the top of the tree and the slabs being stacked are
-//! held. The file is byte for byte the one the in-memory build writes. The budget covers what the command
+//! A command that writes a `.ktree` from rays builds it with [`ktree::stacking::Builder::to_file`] (in
+//! [`crate::common::output::TreeOutput::write`]): the subtrees of the cells are spilled to temporary files
+//! as they are stacked and streamed into the output, so only the top of the tree and the slabs being
+//! stacked are held. The file is byte for byte the one the in-memory build writes. The budget covers what the command
 //! holds besides: a solid, a sorted ray file, a mesh or a volume makes its rays slab by slab, and only its
 //! own data (the ray file's index, the placed triangles, the samples) counts against it; rays read whole (an
 //! unsorted ray file) count whole. A file of format version 1 is built the same way, as a version 2 file that
@@ -12,12 +12,8 @@
 //! chooses how a tree is built.
 //! Across MPI ranks the budget applies to each rank (see [`crate::distributed`]).
 
-use ktree::fs::SpillError;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use crate::common::progress::report_progress;
-use ktree::rays::RaySource;
-use ktree::stacking::{BuildError, Builder, OutOfCoreReport};
 use ktree::{LevelCounts, RaySet};
 
 /// The share of the machine's memory used when no `--max-memory` is given: a half.
@@ -117,58 +113,6 @@ pub fn size_text(bytes: u64) -> String {
         format!("{bytes} bytes ({:.2} GiB)", b / (1024.0 * MIB))
     } else {
         format!("{bytes} bytes ({:.1} MiB)", b / MIB)
-    }
-}
-
-/// Stacks `source` straight into the `.ktree` file `out`, out of core, in `budget` bytes, on the threads
-/// of the current rayon pool.
-pub fn build_to_file<const K: usize, S>(
-    source: &S,
-    out: &Path,
-    args: &BuildArgs,
-    budget: u64,
-) -> Result<OutOfCoreReport, String>
-where
-    S: RaySource<K>,
-    S::Error: std::fmt::Display,
-{
-    let bar = crate::common::progress::progress_bar(args.progress, "stacking");
-    let progress = |p| report_progress(bar.as_ref(), p);
-    let report = builder(source, args)
-        .progress(&progress)
-        .to_file(out, budget);
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
-    report.map_err(|e| describe(out, e, 0))
-}
-
-/// The build of `source` out of core: cells of the default split depth, the spill folder of `args`.
-pub fn builder<'a, const K: usize, S: RaySource<K>>(
-    source: &'a S,
-    args: &BuildArgs,
-) -> Builder<'a, K, S> {
-    let builder = Builder::new(source);
-    match &args.temp_dir {
-        Some(dir) => builder.temp_dir(dir),
-        None => builder,
-    }
-}
-
-/// The message of a failed out-of-core build of `out`; `held` bytes were set apart from the budget before
-/// the build (message buffers) and are added back to the budgets it names.
-pub fn describe<E: std::fmt::Display>(out: &Path, e: BuildError<E>, held: u64) -> String {
-    match e {
-        BuildError::BudgetTooSmall { budget, needed } => format!(
-            "{}: {} (--max-memory)",
-            out.display(),
-            BuildError::<E>::BudgetTooSmall {
-                budget: budget.saturating_add(held),
-                needed: needed.saturating_add(held),
-            }
-        ),
-        BuildError::Files(output @ SpillError::Output { .. }) => output.to_string(),
-        other => format!("{}: {other}", out.display()),
     }
 }
 

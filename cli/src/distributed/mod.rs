@@ -1,7 +1,10 @@
-//! Building across MPI ranks (cargo feature `mpi`; without it, one process does everything).
+//! Building across MPI ranks (cargo feature `mpi`; without it, every run is one process, and a build never
+//! comes here).
 //!
-//! Started as `mpirun -n P ktree rays|build|voxelize … --out F.ktree`, every rank runs the out-of-core
-//! build of [`ktree::stacking`] on its share of the slabs of cells, in `--max-memory` bytes of its own:
+//! Started as `mpirun -n P ktree rays|build|voxelize … --out F.ktree`, every rank takes the one
+//! build-and-write step ([`crate::common::output::TreeOutput::write`]), which in a run of several ranks
+//! hands the build to [`build_across_ranks`]: every rank runs the out-of-core build of
+//! [`ktree::stacking`] on its share of the slabs of cells, in `--max-memory` bytes of its own:
 //!
 //! 1. **Partition.** The slabs of cells (one cell wide along axis 0, [`ktree::stacking::Builder::slabs`]) are
 //!    measured by their runs ([`ktree::stacking::Builder::slab_cost`]: rank `r` measures the slabs `r, r + P, …`, an
@@ -27,13 +30,6 @@
 //! a failure mark, and rank 0, whose write then fails, takes the rest of the other streams before agreeing.
 //! A failure outside the build (an input a rank cannot read) stops every rank with `MPI_Abort`.
 
-use std::path::Path;
-
-use ktree::rays::RaySource;
-use ktree::stacking::OutOfCoreReport;
-
-use crate::common::memory::BuildArgs;
-
 /// The partition of the run: this process's rank and the number of ranks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Ranks {
@@ -52,54 +48,6 @@ impl Ranks {
 
 /// The error of the ranks that did not fail when another did (they print nothing: the failed rank does).
 const STOPPED: &str = "stopped: another rank failed";
-
-/// Builds the tree of `source` into the `.ktree` (version 2) file `out` across the ranks of the run, out
-/// of core in `budget` bytes per rank, on `threads` worker threads per rank (all cores when `None`):
-/// `Some(report)` on rank 0 (and in a run of one process), `None` on the other ranks.
-///
-/// # Errors
-/// A message naming the output if the build fails on this rank; [`STOPPED`] if it failed on another.
-pub fn build_to_file<const K: usize, S>(
-    source: &S,
-    out: &Path,
-    threads: Option<usize>,
-    args: &BuildArgs,
-    budget: u64,
-) -> Result<Option<OutOfCoreReport>, String>
-where
-    S: RaySource<K>,
-    S::Error: std::fmt::Display,
-{
-    if crate::common::tree_file::version() == 1 {
-        return crate::common::tree_file::as_version_1(out, |v2| {
-            build_to_file_v2(source, v2, threads, args, budget)
-        });
-    }
-    build_to_file_v2(source, out, threads, args, budget)
-}
-
-/// [`build_to_file`] of a version 2 file.
-fn build_to_file_v2<const K: usize, S>(
-    source: &S,
-    out: &Path,
-    threads: Option<usize>,
-    args: &BuildArgs,
-    budget: u64,
-) -> Result<Option<OutOfCoreReport>, String>
-where
-    S: RaySource<K>,
-    S::Error: std::fmt::Display,
-{
-    if ranks().size == 1 {
-        return crate::common::threads::with_threads(threads, || {
-            crate::common::memory::build_to_file(source, out, args, budget)
-        })?
-        .map(Some);
-    }
-    // MPI is called from this thread only; the pool stacks.
-    let pool = crate::common::threads::thread_pool(threads)?;
-    imp::build_to_file(source, out, &pool, args, budget)
-}
 
 /// This process's rank and the number of ranks (`0` of `1` without MPI).
 pub fn ranks() -> Ranks {
@@ -135,3 +83,6 @@ mod imp;
 #[cfg(feature = "mpi")]
 #[path = "mpi.rs"]
 mod imp;
+
+#[cfg(feature = "mpi")]
+pub use imp::build_across_ranks;

@@ -9,7 +9,7 @@ use mpi::traits::*;
 use rayon::prelude::*;
 
 use super::{Ranks, STOPPED};
-use crate::common::memory::BuildArgs;
+use crate::common::output::{describe, TreeOutput};
 use ktree::rays::RaySource;
 use ktree::stacking::{balanced_parts, OutOfCoreReport};
 
@@ -75,19 +75,25 @@ fn agree<T>(w: &SimpleCommunicator, outcome: Result<T, String>) -> Result<T, Str
     }
 }
 
-pub fn build_to_file<const K: usize, S>(
+/// Builds the tree of `source` into the `.ktree` (version 2) file `out` across the ranks of the run,
+/// out of core in `budget` bytes per rank, on the worker threads of `tree` on each rank (MPI is called
+/// from this thread only; the pool stacks): `Some(report)` on rank 0, `None` on the other ranks.
+///
+/// # Errors
+/// A message naming the output if the build fails on this rank; [`STOPPED`] if it failed on another.
+pub fn build_across_ranks<const K: usize, S>(
+    tree: &TreeOutput<'_>,
     source: &S,
     out: &Path,
-    pool: &rayon::ThreadPool,
-    args: &BuildArgs,
     budget: u64,
 ) -> Result<Option<OutOfCoreReport>, String>
 where
     S: RaySource<K>,
     S::Error: std::fmt::Display,
 {
+    let pool = crate::common::threads::thread_pool(tree.threads)?;
     let w = world();
-    let outcome = run(&w, source, out, pool, args, budget);
+    let outcome = run(&w, tree, source, out, &pool, budget);
     if outcome.is_err() {
         // Every rank has dropped its spill folder: none is stopped before it could.
         w.barrier();
@@ -99,10 +105,10 @@ where
 /// The phases of the build, each ending with an agreement (the spill folder is dropped on return).
 fn run<const K: usize, S>(
     w: &SimpleCommunicator,
+    tree: &TreeOutput<'_>,
     source: &S,
     out: &Path,
     pool: &rayon::ThreadPool,
-    args: &BuildArgs,
     budget: u64,
 ) -> Result<Option<OutOfCoreReport>, String>
 where
@@ -114,9 +120,9 @@ where
     // The message buffers come out of the budget: rank 0 holds one per other rank.
     let held = 8 * chunk as u64 * if rank == 0 { size as u64 - 1 } else { 1 };
     let part_budget = budget.saturating_sub(held);
-    let bar = crate::common::progress::progress_bar(args.progress && rank == 0, "stacking");
+    let bar = crate::common::progress::progress_bar(tree.args.progress && rank == 0, "stacking");
     let progress = |p| crate::common::progress::report_progress(bar.as_ref(), p);
-    let builder = crate::common::memory::builder(source, args).progress(&progress);
+    let builder = tree.builder(source).progress(&progress);
 
     // 1. Partition: the slabs' costs, each rank measuring every P-th slab.
     let slabs = builder.slabs();
@@ -142,7 +148,7 @@ where
     // 2. Stacking: this rank's slabs, spilled.
     let part = pool
         .install(|| builder.stack_part(&slabs[mine], out, part_budget))
-        .map_err(|e| crate::common::memory::describe(out, e, held));
+        .map_err(|e| describe(out, e, held));
     let mut part = agree(w, part)?;
 
     // 3. Index, and 4. levels: the other ranks send, rank 0 writes.
@@ -196,10 +202,7 @@ where
         stream.drain();
         moved += stream.received;
     }
-    let report = agree(
-        w,
-        written.map_err(|e| crate::common::memory::describe(out, e, held)),
-    )?;
+    let report = agree(w, written.map_err(|e| describe(out, e, held)))?;
     let mut peaks = vec![0u64; size];
     let own = crate::common::memory::peak_rss_bytes().unwrap_or(0);
     root.gather_into_root(&own, &mut peaks[..]);

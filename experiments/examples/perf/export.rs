@@ -7,7 +7,7 @@ use std::path::Path;
 use ktree::export::files::write_ply;
 use ktree::export::surface::boundary_mesh;
 use ktree::rays::ball_rays;
-use ktree::solid::mesh::{MeshTransform, TriangleMesh};
+use ktree::solid::mesh::MeshTransform;
 use ktree::{KTree, Octree};
 
 use crate::measure::best_of;
@@ -24,7 +24,7 @@ pub fn tree_of(case: &str) -> Result<Octree, String> {
         }
         "armadillo" => {
             let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/meshes/armadillo.obj");
-            let mesh = TriangleMesh::read(&path).map_err(|e| e.to_string())?;
+            let mesh = ktree::io::read_mesh(&path).map_err(|e| e.to_string())?;
             let placement = MeshTransform::fit(&mesh, level).map_err(|e| e.to_string())?;
             let rays = mesh.to_rays(level, &placement).map_err(|e| e.to_string())?;
             Ok(KTree::from_rays(&rays.rays))

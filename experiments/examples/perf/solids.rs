@@ -32,7 +32,8 @@ fn ball(level: u32) -> Quadric<3> {
 }
 
 fn mesh_rays(name: &str) -> Result<(TriangleMesh, MeshTransform), String> {
-    let mesh = TriangleMesh::read(&data(&format!("meshes/{name}"))?).map_err(|e| e.to_string())?;
+    let mesh =
+        ktree::io::read_mesh(&data(&format!("meshes/{name}"))?).map_err(|e| e.to_string())?;
     let p = MeshTransform::fit(&mesh, LEVEL).map_err(|e| e.to_string())?;
     Ok((mesh, p))
 }

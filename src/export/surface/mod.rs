@@ -54,8 +54,11 @@
 mod section;
 mod sweep;
 
+use std::convert::Infallible;
 use std::sync::OnceLock;
 
+use crate::tree::storage::{infallible, TreeStorage};
+#[cfg(test)]
 use crate::tree::KTree;
 
 use super::{ExportError, Frame};
@@ -270,11 +273,34 @@ fn part_of(mask: u8, a: usize, q: usize) -> u8 {
 }
 
 /// The boundary of `tree` as a closed, outward-oriented triangle mesh in voxel coordinates (see the
-/// module's documentation for how it is made crack-free and 2-manifold). Empty for an empty tree.
+/// module's documentation for how it is made crack-free and 2-manifold). Empty for an empty tree. (Any
+/// storage, a mapped file among them: [`try_boundary_mesh`].)
 ///
 /// # Panics
 /// If the mesh would need 2^32 or more vertices or rectangle corners (its indices are 32-bit).
-pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
+pub fn boundary_mesh<T: TreeStorage<3, Error = Infallible>>(tree: &T) -> SurfaceMesh {
+    infallible(try_boundary_mesh(tree))
+}
+
+/// [`boundary_mesh`] over any storage: the tree's cross-sections are read as the sweep meets them.
+///
+/// ```
+/// use ktree::export::surface::{boundary_mesh, try_boundary_mesh};
+/// use ktree::io::{write_ktree, KtreeView, MappedTree};
+/// let block = ktree::KTree::<3>::full(1).unwrap();
+/// let mut bytes = Vec::new();
+/// write_ktree(&mut bytes, &block).unwrap();
+/// let view = KtreeView::from_bytes(bytes, "block.ktree").unwrap();
+/// let mapped = MappedTree::<3>::new(&view).unwrap();
+/// assert_eq!(try_boundary_mesh(&mapped).unwrap(), boundary_mesh(&block));
+/// ```
+///
+/// # Errors
+/// The storage's read error.
+///
+/// # Panics
+/// As [`boundary_mesh`].
+pub fn try_boundary_mesh<T: TreeStorage<3>>(tree: &T) -> Result<SurfaceMesh, T::Error> {
     sweep::sweep(tree, Merge::Rectangles)
 }
 
@@ -299,19 +325,23 @@ pub fn boundary_mesh(tree: &KTree<3>) -> SurfaceMesh {
 ///
 /// # Errors
 /// [`ExportError::TooLarge`] when the boundary has more than [`SMOOTH_FACE_LIMIT`] unit faces (counted
-/// before anything is made).
+/// before anything is made); [`ExportError::Storage`] if a read of the tree fails.
 ///
 /// # Panics
 /// As [`boundary_mesh`].
-pub fn smooth_mesh(tree: &KTree<3>, iterations: usize) -> Result<SurfaceMesh, ExportError> {
-    let faces = sweep::unit_faces(tree);
+pub fn smooth_mesh<T: TreeStorage<3>>(
+    tree: &T,
+    iterations: usize,
+) -> Result<SurfaceMesh, ExportError> {
+    let storage = |e: T::Error| ExportError::Storage(e.into());
+    let faces = sweep::unit_faces(tree).map_err(storage)?;
     if faces > u128::from(SMOOTH_FACE_LIMIT) {
         return Err(ExportError::TooLarge {
             faces,
             limit: SMOOTH_FACE_LIMIT,
         });
     }
-    let mut mesh = sweep::sweep(tree, Merge::None);
+    let mut mesh = sweep::sweep(tree, Merge::None).map_err(storage)?;
     let start = mesh.vertices.clone();
     let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); mesh.vertices.len()];
     for t in &mesh.triangles {

@@ -7,8 +7,9 @@
 //! nodes, not its area. The walk also finds where the section next changes: the nearest end along `x` of
 //! the leaves it met.
 
-use crate::tree::cursor::{walk, ChildOrder, Visitor, Walk};
-use crate::tree::{KTree, NodeRef, NodeState};
+use crate::tree::cursor::{try_walk, ChildOrder, Visitor, Walk};
+use crate::tree::storage::TreeStorage;
+use crate::tree::{NodeRef, NodeState};
 
 /// Stretches `[y0, y1)` of a slab, each with its runs along `z` (a range of [`Slab::runs`]), in order
 /// of `y` and disjoint (touching bands may have the same runs).
@@ -96,7 +97,11 @@ impl<'s> Iterator for Pieces<'s> {
 
 /// The cross-section of `tree` at `x` (below the universe's side) into `slab`; returns the next `x`
 /// at which the section may differ.
-pub(super) fn section(tree: &KTree<3>, x: u32, slab: &mut Slab) -> u32 {
+pub(super) fn section<T: TreeStorage<3>>(
+    tree: &T,
+    x: u32,
+    slab: &mut Slab,
+) -> Result<u32, T::Error> {
     slab.clear();
     let mut visitor = Section {
         x,
@@ -105,10 +110,11 @@ pub(super) fn section(tree: &KTree<3>, x: u32, slab: &mut Slab) -> u32 {
         results: Vec::new(),
         orders: [order(0), order(1)],
     };
-    walk(tree, &mut visitor);
+    let read = try_walk(tree, &mut visitor);
     *slab = visitor.slab;
+    read?;
     debug_assert!(visitor.results.len() <= 1);
-    visitor.next
+    Ok(visitor.next)
 }
 
 /// The walk's state: the results of the nodes done whose parent is not, each where its bands start in the
@@ -288,7 +294,7 @@ mod tests {
             let mut slab = Slab::default();
             let mut x = 0;
             while x < side {
-                let next = section(&tree, x, &mut slab);
+                let next = crate::tree::storage::infallible(section(&tree, x, &mut slab));
                 assert!(next > x);
                 let bands = &slab.bands;
                 assert!(bands.windows(2).all(|w| w[0].y1 <= w[1].y0));

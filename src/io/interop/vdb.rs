@@ -18,7 +18,7 @@
 //! voxel `(x, y, z)` minus the offset written with, and the transform's voxel size and translation (the
 //! world centre of index 0) become the [`GridMeta`].
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use std::io::Write;
 
 use super::grid::{
@@ -451,11 +451,21 @@ impl Reader<'_> {
             other => {
                 self.at = map_at;
                 return Err(self.fail(GridFileErrorKind::Unsupported(format!(
-                    "transform {other:?}"
+                    "transform {:?}",
+                    shortened(other)
                 ))));
             }
         };
         Ok(head)
+    }
+}
+
+/// A name from the file for a message: its first 64 characters (a damaged file's name may be its whole
+/// length).
+fn shortened(name: &str) -> String {
+    match name.char_indices().nth(64) {
+        Some((end, _)) => format!("{}…", &name[..end]),
+        None => name.to_string(),
     }
 }
 
@@ -477,34 +487,63 @@ pub(super) fn push_box(
     Ok(())
 }
 
-/// Adds the voxels `n` of the 8³ leaf at `lo` for which `inside(n)` holds, as runs along z (`n = x·64 +
-/// y·8 + z`, z the fastest index).
+/// Adds the voxels `n` of the 8³ leaf at `lo` whose bit is set in `mask` (8 words; `n = x·64 + y·8 + z`,
+/// so a word is a slice of constant x and a byte a row along z) as boxes: each run of set bits in a row,
+/// taken over the neighbouring rows (along y) and slices (along x) that are the same.
 pub(super) fn add_leaf(
     boxes: &mut GridBoxes,
     r: &Reader,
     lo: [i64; 3],
-    inside: impl Fn(usize) -> bool,
+    mask: &[u64],
 ) -> Result<(), GridFileError> {
-    for row in 0..64 {
-        let mut z = 0;
-        while z < 8 {
-            if !inside(row * 8 + z) {
-                z += 1;
-                continue;
+    let mut x = 0;
+    while x < 8 {
+        let slice = mask[x];
+        let x_end = x + mask[x..].iter().take_while(|&&w| w == slice).count();
+        let rows = slice.to_le_bytes();
+        let mut y = 0;
+        while y < 8 {
+            let row = rows[y];
+            let y_end = y + rows[y..].iter().take_while(|&&b| b == row).count();
+            let mut rest = row;
+            while rest != 0 {
+                let z0 = rest.trailing_zeros();
+                let z1 = z0 + (rest >> z0).trailing_ones();
+                let origin = [lo[0] + x as i64, lo[1] + y as i64, lo[2] + i64::from(z0)];
+                let size = [x_end - x, y_end - y, (z1 - z0) as usize].map(|s| s as u64);
+                push_box(boxes, r, origin, size)?;
+                rest &= !(((1u16 << z1) - 1) as u8);
             }
-            let z0 = z;
-            while z < 8 && inside(row * 8 + z) {
-                z += 1;
-            }
-            let origin = [
-                lo[0] + (row / 8) as i64,
-                lo[1] + (row % 8) as i64,
-                lo[2] + z0 as i64,
-            ];
-            push_box(boxes, r, origin, [1, 1, (z - z0) as u64])?;
+            y = y_end;
         }
+        x = x_end;
     }
     Ok(())
+}
+
+/// Reads a root entry's origin (a tile's or a child's): a multiple of 4096 on every axis, as OpenVDB keys
+/// its root table, and not met before. An entry off those keys or at a place already taken describes no
+/// tree OpenVDB writes, and its boxes could overlap others.
+pub(super) fn root_origin(
+    r: &mut Reader,
+    seen: &mut HashSet<[i64; 3]>,
+    what: &str,
+) -> Result<[i64; 3], GridFileError> {
+    let at = r.at;
+    let o = [r.i32(what)?, r.i32(what)?, r.i32(what)?].map(i64::from);
+    if o.iter().any(|c| c % 4096 != 0) {
+        return Err(r.fail_at(
+            at,
+            GridFileErrorKind::Data(format!("{what} {o:?} is not a multiple of 4096")),
+        ));
+    }
+    if !seen.insert(o) {
+        return Err(r.fail_at(
+            at,
+            GridFileErrorKind::Data(format!("a second root entry at {o:?}")),
+        ));
+    }
+    Ok(o)
 }
 
 /// Checks, before anything is allocated for them, that `tiles` root tiles of `tile_bytes` bytes and
@@ -541,8 +580,9 @@ fn read_active(
     let children = r.u32("root child count")? as usize;
     check_root_counts(r, tiles, 14, children)?;
     let mut boxes = GridBoxes::default();
+    let mut seen = HashSet::new();
     for _ in 0..tiles {
-        let o = [r.i32("tile")?, r.i32("tile")?, r.i32("tile")?].map(i64::from);
+        let o = root_origin(r, &mut seen, "root tile origin")?;
         r.take(1, "tile value")?;
         if r.take(1, "tile state")?[0] != 0 {
             push_box(&mut boxes, r, o, [4096; 3])?;
@@ -550,12 +590,7 @@ fn read_active(
     }
     let mut leaves = 0usize;
     for _ in 0..children {
-        let o = [
-            r.i32("node origin")?,
-            r.i32("node origin")?,
-            r.i32("node origin")?,
-        ]
-        .map(i64::from);
+        let o = root_origin(r, &mut seen, "root child origin")?;
         let child_mask = r.mask(UPPER_WORDS)?;
         let value_mask = r.mask(UPPER_WORDS)?;
         r.values(coding, UPPER_WORDS * 64, &value_mask, 0.0)?;
@@ -577,9 +612,7 @@ fn read_active(
             for m in ones(&lower_children) {
                 leaves += 1;
                 let leaf = r.mask(LEAF_WORDS)?;
-                add_leaf(&mut boxes, r, corner_of(lo, m, 4, 3), |i| {
-                    leaf[i / 64] >> (i % 64) & 1 == 1
-                })?;
+                add_leaf(&mut boxes, r, corner_of(lo, m, 4, 3), &leaf)?;
             }
         }
     }
@@ -683,7 +716,7 @@ pub fn read_vdb(
                             "a {} of class {:?}: of a FloatGrid or DoubleGrid only a level set's \
                              interior (values below 0) is read",
                             grid.name(),
-                            class.unwrap_or("unknown")
+                            shortened(class.unwrap_or("unknown"))
                         )),
                     )
                 });
@@ -878,5 +911,126 @@ mod tests {
             (e.offset(), e.to_string().contains("bad magic")),
             (Some(0), true)
         );
+    }
+
+    /// The position of the root child count in a file `write_vdb` wrote: after the buffer count (1), the
+    /// background (false) and the tile count (0); the first child's origin follows it.
+    fn root_counts_at(bytes: &[u8]) -> usize {
+        bytes
+            .windows(9)
+            .position(|w| w == [1, 0, 0, 0, 0, 0, 0, 0, 0])
+            .unwrap()
+            + 9
+    }
+
+    #[test]
+    fn root_entries_off_the_root_keys_or_met_twice_are_refused() {
+        let tree = stack(&ball_rays::<3>(4, [8, 8, 8], 5).unwrap());
+        let mut bytes = Vec::new();
+        write_vdb(&mut bytes, &tree, [0; 3], &GridMeta::default()).unwrap();
+        let origin_at = root_counts_at(&bytes) + 4;
+        // The child's origin moved one voxel along y: OpenVDB keys its root table by multiples of 4096.
+        let mut off = bytes.clone();
+        off[origin_at + 4] = 1;
+        let e = read_vdb(&off, "off", None, None).unwrap_err();
+        assert!(
+            matches!(&e.kind, GridFileErrorKind::Data(m) if m.contains("[0, 1, 0] is not a multiple of 4096")),
+            "{e}"
+        );
+        assert_eq!(e.offset(), Some(origin_at as u64), "{e}");
+        // An active tile at the child's origin, before it: the child meets a place already taken.
+        let tiles_at = origin_at - 8;
+        let mut twice = bytes[..tiles_at].to_vec();
+        twice.extend_from_slice(&1u32.to_le_bytes());
+        twice.extend_from_slice(&bytes[tiles_at + 4..origin_at]);
+        twice.extend_from_slice(&[0; 12]);
+        twice.extend_from_slice(&[1, 1]);
+        twice.extend_from_slice(&bytes[origin_at..]);
+        let e = read_vdb(&twice, "twice", None, None).unwrap_err();
+        assert!(
+            matches!(&e.kind, GridFileErrorKind::Data(m) if m.contains("a second root entry at [0, 0, 0]")),
+            "{e}"
+        );
+        assert_eq!(e.offset(), Some(origin_at as u64 + 14), "{e}");
+    }
+
+    #[test]
+    fn leaf_masks_become_boxes_of_exactly_their_voxels() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut random = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut masks = vec![[0u64; 8], [u64::MAX; 8], [0x5555_5555_5555_5555; 8]];
+        masks.push(std::array::from_fn(
+            |x| if x % 3 == 0 { u64::MAX } else { 0 },
+        ));
+        for _ in 0..200 {
+            let sparse = random() % 4;
+            masks.push(std::array::from_fn(|_| {
+                let w = random();
+                (0..sparse).fold(w, |w, _| w & random())
+            }));
+        }
+        let r = Reader {
+            bytes: &[],
+            at: 0,
+            file: "t",
+        };
+        for mask in &masks {
+            let mut boxes = GridBoxes::default();
+            add_leaf(&mut boxes, &r, [8, -16, 24], mask).unwrap();
+            let mut seen = [false; 512];
+            for b in &boxes.inside {
+                for x in 0..b.size[0] as i64 {
+                    for y in 0..b.size[1] as i64 {
+                        for z in 0..b.size[2] as i64 {
+                            let p = [
+                                b.origin[0] + x - 8,
+                                b.origin[1] + y + 16,
+                                b.origin[2] + z - 24,
+                            ];
+                            assert!(p.iter().all(|c| (0..8).contains(c)), "{b:?}");
+                            let n = (p[0] * 64 + p[1] * 8 + p[2]) as usize;
+                            assert!(!seen[n], "voxel {n} twice");
+                            seen[n] = true;
+                        }
+                    }
+                }
+            }
+            for (n, &s) in seen.iter().enumerate() {
+                assert_eq!(
+                    s,
+                    mask[n / 64] >> (n % 64) & 1 == 1,
+                    "voxel {n} of {mask:x?}"
+                );
+            }
+        }
+        // Equal rows and slices are one box: a full leaf is one.
+        let mut boxes = GridBoxes::default();
+        add_leaf(&mut boxes, &r, [0; 3], &[u64::MAX; 8]).unwrap();
+        assert_eq!(boxes.inside.len(), 1);
+    }
+
+    #[test]
+    fn a_long_transform_name_is_shortened_in_its_message() {
+        let tree = stack(&ball_rays::<3>(4, [8, 8, 8], 5).unwrap());
+        let mut bytes = Vec::new();
+        write_vdb(&mut bytes, &tree, [0; 3], &GridMeta::default()).unwrap();
+        let name = b"UniformScaleTranslateMap";
+        let at = bytes.windows(name.len()).position(|w| w == name).unwrap();
+        let long = "M".repeat(10_000);
+        let mut bad = bytes[..at - 4].to_vec();
+        put_str(&mut bad, &long);
+        bad.extend_from_slice(&bytes[at + name.len()..]);
+        let e = read_vdb(&bad, "long", None, None).unwrap_err();
+        assert!(
+            matches!(&e.kind, GridFileErrorKind::Unsupported(m) if m.contains(&format!("{}…", &long[..64]))),
+            "{e}"
+        );
+        assert!(e.to_string().len() < 200, "{e}");
+        assert_eq!(e.offset(), Some(at as u64 - 4));
     }
 }

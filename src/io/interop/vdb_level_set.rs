@@ -15,13 +15,13 @@
 //! the origin (or by root tiles from 4096³ on). Values are stored uncompressed (compression flags 0), which
 //! every OpenVDB reads.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use std::io::Write;
 
 use super::grid::{GridBoxes, GridFileError};
 use super::vdb::{
     add_leaf, check_root_counts, corner_of, origin_of, push_box, put_grid_head, put_str, put_u32,
-    slot, FILE_VERSION, FLOAT_TREE, LEAF_WORDS, LOWER_WORDS, MAGIC, UPPER_WORDS,
+    root_origin, slot, FILE_VERSION, FLOAT_TREE, LEAF_WORDS, LOWER_WORDS, MAGIC, UPPER_WORDS,
 };
 use super::vdb_values::{ones, Reader, ValueCoding, ValueKind};
 use crate::tree::{KTree, NodeState};
@@ -334,6 +334,11 @@ pub fn write_vdb_level_set(
     w.flush()
 }
 
+/// The bits of `a` that are not in `b`.
+fn and_not(a: &[u64], b: &[u64]) -> Vec<u64> {
+    a.iter().zip(b).map(|(x, y)| x & !y).collect()
+}
+
 /// The interior of a level set's tree (from its background on) as boxes of grid indices: every voxel of a
 /// leaf, tile of an internal node and tile of the root whose value is below `min(0, background − ε)` (ε =
 /// 10⁻⁸ for floats, 10⁻¹⁵ for doubles: `tools::sdfInteriorMask`'s threshold, 0 for a valid level set),
@@ -352,8 +357,9 @@ pub(super) fn read_interior(
     let children = r.u32("root child count")? as usize;
     check_root_counts(r, tiles, 12 + kind.size() + 1, children)?;
     let mut boxes = GridBoxes::default();
+    let mut seen = HashSet::new();
     for _ in 0..tiles {
-        let o = [r.i32("tile")?, r.i32("tile")?, r.i32("tile")?].map(i64::from);
+        let o = root_origin(r, &mut seen, "root tile origin")?;
         let value = r.value(kind, "tile value")?;
         r.take(1, "tile state")?;
         if value < iso {
@@ -363,30 +369,24 @@ pub(super) fn read_interior(
     // The leaves' origins and value masks, in the order of their buffers.
     let mut leaves: Vec<([i64; 3], Vec<u64>)> = Vec::new();
     for _ in 0..children {
-        let o = [
-            r.i32("node origin")?,
-            r.i32("node origin")?,
-            r.i32("node origin")?,
-        ]
-        .map(i64::from);
+        let o = root_origin(r, &mut seen, "root child origin")?;
         let child_mask = r.mask(UPPER_WORDS)?;
         let value_mask = r.mask(UPPER_WORDS)?;
-        let values = r.values(coding, UPPER_WORDS * 64, &value_mask, background)?;
-        let is_child = |mask: &[u64], n: usize| mask[n / 64] >> (n % 64) & 1 == 1;
-        for (n, &v) in values.iter().enumerate() {
-            if v < iso && !is_child(&child_mask, n) {
-                push_box(&mut boxes, r, corner_of(o, n, 5, 7), [128; 3])?;
-            }
+        let inside = r
+            .values(coding, UPPER_WORDS * 64, &value_mask, background)?
+            .below(&value_mask, iso);
+        for n in ones(&and_not(&inside, &child_mask)) {
+            push_box(&mut boxes, r, corner_of(o, n, 5, 7), [128; 3])?;
         }
         for n in ones(&child_mask) {
             let lo = corner_of(o, n, 5, 7);
             let lower_children = r.mask(LOWER_WORDS)?;
             let lower_values = r.mask(LOWER_WORDS)?;
-            let values = r.values(coding, LOWER_WORDS * 64, &lower_values, background)?;
-            for (m, &v) in values.iter().enumerate() {
-                if v < iso && !is_child(&lower_children, m) {
-                    push_box(&mut boxes, r, corner_of(lo, m, 4, 3), [8; 3])?;
-                }
+            let inside = r
+                .values(coding, LOWER_WORDS * 64, &lower_values, background)?
+                .below(&lower_values, iso);
+            for m in ones(&and_not(&inside, &lower_children)) {
+                push_box(&mut boxes, r, corner_of(lo, m, 4, 3), [8; 3])?;
             }
             for m in ones(&lower_children) {
                 leaves.push((corner_of(lo, m, 4, 3), r.mask(LEAF_WORDS)?));
@@ -397,8 +397,10 @@ pub(super) fn read_interior(
         // The buffer's copy of the value mask: OpenVDB reading a file seeks past it and keeps the
         // topology's.
         r.take(8 * LEAF_WORDS, "leaf value mask")?;
-        let values = r.values(coding, LEAF_WORDS * 64, mask, background)?;
-        add_leaf(&mut boxes, r, *lo, |n| values[n] < iso)?;
+        let inside = r
+            .values(coding, LEAF_WORDS * 64, mask, background)?
+            .below(mask, iso);
+        add_leaf(&mut boxes, r, *lo, &inside)?;
     }
     Ok(boxes)
 }

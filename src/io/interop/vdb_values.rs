@@ -129,15 +129,16 @@ impl<'a> Reader<'a> {
         Ok(Cow::Owned(decoded))
     }
 
-    /// A node's `count` values (`readCompressedValues`), inactive ones rebuilt as OpenVDB does: `active`
-    /// is the node's value mask, `background` the grid's.
+    /// A node's `count` values (`readCompressedValues`), as stored: `active` is the node's value mask
+    /// (its stored values are checked to be as many as it asks for), `background` the grid's. Nothing is
+    /// decoded until [`NodeValues::each`] asks.
     pub fn values(
         &mut self,
         coding: &ValueCoding,
         count: usize,
         active: &[u64],
         background: f64,
-    ) -> Result<Vec<f64>, GridFileError> {
+    ) -> Result<NodeValues<'a>, GridFileError> {
         let kind = coding.kind;
         let flag_at = self.at;
         let metadata = self.take(1, "value compression byte")?[0];
@@ -173,27 +174,68 @@ impl<'a> Reader<'a> {
             count
         };
         let size = if coding.half { 2 } else { kind.size() };
-        let raw = if coding.half && stored == 0 {
+        let stored = if coding.half && stored == 0 {
             Cow::Borrowed(&[][..])
         } else {
             self.chunk(coding.compression, stored * size)?
         };
-        let mut read = raw.chunks_exact(size).map(|b| kind.decode(b, coding.half));
-        if stored == count {
-            return Ok(read.collect());
+        Ok(NodeValues {
+            count,
+            kind,
+            half: coding.half,
+            size,
+            stored,
+            masked,
+            inactive,
+            selection,
+        })
+    }
+}
+
+/// A node's values as a file stores them: the stored ones (every value, or the active ones only) and how
+/// the inactive ones are rebuilt (OpenVDB's `readCompressedValues`).
+pub(super) struct NodeValues<'a> {
+    count: usize,
+    kind: ValueKind,
+    half: bool,
+    /// Bytes of one stored value.
+    size: usize,
+    stored: Cow<'a, [u8]>,
+    /// Whether only the active values are stored.
+    masked: bool,
+    /// The inactive values where the selection mask's bit is off and on.
+    inactive: [f64; 2],
+    selection: Option<&'a [u8]>,
+}
+
+impl NodeValues<'_> {
+    /// Calls `f(n, value)` for each value `n` of the node in order; `active` is the value mask the
+    /// values were read with.
+    pub fn each(&self, active: &[u64], mut f: impl FnMut(usize, f64)) {
+        let mut stored = self
+            .stored
+            .chunks_exact(self.size)
+            .map(|b| self.kind.decode(b, self.half));
+        for n in 0..self.count {
+            let value = if !self.masked || active[n / 64] >> (n % 64) & 1 == 1 {
+                stored.next().expect("one stored value an active bit")
+            } else {
+                let on = self.selection.is_some_and(|s| s[n / 8] >> (n % 8) & 1 == 1);
+                self.inactive[usize::from(on)]
+            };
+            f(n, value);
         }
-        let bit = |words: &[u64], n: usize| words[n / 64] >> (n % 64) & 1 == 1;
-        let byte_bit = |bytes: &[u8], n: usize| bytes[n / 8] >> (n % 8) & 1 == 1;
-        Ok((0..count)
-            .map(|n| {
-                if bit(active, n) {
-                    read.next().expect("one stored value an active bit")
-                } else {
-                    let on = selection.is_some_and(|s| byte_bit(s, n));
-                    inactive[usize::from(on)]
-                }
-            })
-            .collect())
+    }
+
+    /// The mask of the values below `threshold`.
+    pub fn below(&self, active: &[u64], threshold: f64) -> Vec<u64> {
+        let mut mask = vec![0u64; self.count.div_ceil(64)];
+        self.each(active, |n, v| {
+            if v < threshold {
+                mask[n / 64] |= 1 << (n % 64);
+            }
+        });
+        mask
     }
 }
 
@@ -265,9 +307,14 @@ pub(super) struct ValueCoding {
 /// The positions of the set bits of mask words, in order.
 pub(super) fn ones(words: &[u64]) -> impl Iterator<Item = usize> + '_ {
     words.iter().enumerate().flat_map(|(i, &w)| {
-        (0..64)
-            .filter(move |b| w >> b & 1 == 1)
-            .map(move |b| i * 64 + b)
+        let mut rest = w;
+        std::iter::from_fn(move || {
+            (rest != 0).then(|| {
+                let b = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                i * 64 + b
+            })
+        })
     })
 }
 
@@ -281,6 +328,23 @@ mod tests {
             at: 0,
             file: "t",
         }
+    }
+
+    /// A node's values, decoded.
+    fn decoded(
+        bytes: &[u8],
+        coding: &ValueCoding,
+        count: usize,
+        active: &[u64],
+        background: f64,
+    ) -> Result<Vec<f64>, GridFileError> {
+        let node = reader(bytes).values(coding, count, active, background)?;
+        let mut all = Vec::new();
+        node.each(active, |n, v| {
+            assert_eq!(n, all.len());
+            all.push(v);
+        });
+        Ok(all)
     }
 
     const F32: ValueCoding = ValueCoding {
@@ -303,7 +367,7 @@ mod tests {
             .collect();
         b.extend_from_slice(&(-(values.len() as i64)).to_le_bytes());
         b.extend_from_slice(&values);
-        let v = reader(&b).values(&F32, 64, &active, 3.0).unwrap();
+        let v = decoded(&b, &F32, 64, &active, 3.0).unwrap();
         assert_eq!(v[..5], [0.5, -3.0, 3.0, -0.25, -3.0]);
         assert!(v[5..].iter().all(|&x| x == -3.0));
         // The same values through a Blosc frame, and through zlib.
@@ -312,7 +376,7 @@ mod tests {
         let frame = blosc::tests::encode(&values, 4, 8, true, true, true);
         blosc.extend_from_slice(&(frame.len() as i64).to_le_bytes());
         blosc.extend_from_slice(&frame);
-        assert_eq!(reader(&blosc).values(&F32, 64, &active, 3.0).unwrap(), v);
+        assert_eq!(decoded(&blosc, &F32, 64, &active, 3.0).unwrap(), v);
         let mut zip = vec![3u8];
         zip.extend_from_slice(&selection);
         let packed = {
@@ -327,13 +391,11 @@ mod tests {
             compression: COMPRESS_ACTIVE_MASK | COMPRESS_ZIP,
             ..F32
         };
-        assert_eq!(reader(&zip).values(&coding, 64, &active, 3.0).unwrap(), v);
+        assert_eq!(decoded(&zip, &coding, 64, &active, 3.0).unwrap(), v);
         // Cut anywhere: an error naming a byte inside the buffer, never a panic.
         for (input, coding) in [(&b, &F32), (&blosc, &F32), (&zip, &coding)] {
             for cut in 0..input.len() {
-                let e = reader(&input[..cut])
-                    .values(coding, 64, &active, 3.0)
-                    .unwrap_err();
+                let e = decoded(&input[..cut], coding, 64, &active, 3.0).unwrap_err();
                 assert!(e.offset().unwrap() <= cut as u64, "{e}");
             }
         }
@@ -351,20 +413,20 @@ mod tests {
         for v in [1.0f32, -2.5, 0.0, -0.0, 3.0, -1.0, 65504.0, -0.125] {
             b.extend_from_slice(&half::f16::from_f32(v).to_le_bytes());
         }
-        let v = reader(&b).values(&coding, 8, &[0], 3.0).unwrap();
+        let v = decoded(&b, &coding, 8, &[0], 3.0).unwrap();
         assert_eq!(v, [1.0, -2.5, 0.0, -0.0, 3.0, -1.0, 65504.0, -0.125]);
         // No active value, mask compression, halves: no chunk at all.
         let coding = ValueCoding {
             compression: COMPRESS_ACTIVE_MASK | COMPRESS_BLOSC,
             ..coding
         };
-        let v = reader(&[1u8]).values(&coding, 8, &[0], 3.0).unwrap();
+        let v = decoded(&[1u8], &coding, 8, &[0], 3.0).unwrap();
         assert_eq!(v, [-3.0; 8]);
         // A raw chunk announcing another size than the buffer's.
         let mut b = vec![6u8];
         b.extend_from_slice(&(-3i64).to_le_bytes());
         b.extend_from_slice(&[0; 32]);
-        let e = reader(&b).values(&F32, 8, &[0], 3.0).unwrap_err();
+        let e = decoded(&b, &F32, 8, &[0], 3.0).unwrap_err();
         assert_eq!(e.offset(), Some(1), "{e}");
     }
 }

@@ -30,8 +30,7 @@ use std::path::{Path, PathBuf};
 
 use super::text::{read_header, read_rays_file, NumberedLines, RaysTextError, RaysTextErrorKind};
 use crate::rays::AnyRaySet;
-use crate::rays::Ray;
-use crate::rays::{RaySource, SlabRuns};
+use crate::rays::{ColumnKeys, Ray, RaySource, SlabRuns};
 use crate::space::Universe;
 
 /// A ray file opened by [`open_rays_file`].
@@ -166,16 +165,14 @@ fn checked<const K: usize>(
     ray: &Ray<K>,
 ) -> Result<(u64, u32, u32), String> {
     let side = universe.side();
-    let level = universe.level();
-    let mut key = 0u64;
     for (axis, &c) in ray.start[..K - 1].iter().enumerate() {
         if u64::from(c) >= side {
             return Err(format!(
                 "coordinate {c} on axis {axis} is outside the universe of side {side}"
             ));
         }
-        key = key << level | u64::from(c);
     }
+    let key = ColumnKeys::<K>::new(universe.level()).pack(ray.start);
     let (z1, z2) = (ray.z1(), ray.z2);
     if u64::from(z2) > side || z1 >= z2 {
         return Err(format!(

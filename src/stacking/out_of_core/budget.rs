@@ -6,8 +6,9 @@ pub(crate) const RUN_BYTES: u64 = 64;
 /// Bytes accounted for each stacked cell, besides 8 per level of its subtree (its place in the index and
 /// in the order the levels are written in).
 pub(crate) const SUBTREE_BYTES: u64 = 24;
-/// Bytes of each I/O buffer (one per spill file, one for the output, one for reading back).
-pub(crate) const BUFFER_BYTES: u64 = crate::io::spill::BUFFER_BYTES as u64;
+/// Bytes accounted for each I/O buffer: one per level of the [`PieceStore`](super::PieceStore), one for
+/// the output, one for reading back (the spill files and the `.ktree` writer of `io` buffer this much).
+pub(crate) const BUFFER_BYTES: u64 = 1 << 16;
 
 /// A byte count with its size in MiB or GiB, for messages.
 pub(crate) fn bytes_text(bytes: u64) -> String {

@@ -2,9 +2,12 @@
 
 use super::budget::bytes_text;
 
-/// Why a build failed. A build to a file leaves the target untouched and removes its spill files.
+/// Why a build failed: `E` is the source's error, `F` the error of the [`PieceStore`](super::PieceStore)
+/// and output of a build out of core (by default that of the spill files and `.ktree` file of
+/// [`Builder::to_file`](crate::stacking::Builder::to_file)). A build to a file leaves the target untouched
+/// and removes its spill files.
 #[derive(Debug, thiserror::Error)]
-pub enum BuildError<E> {
+pub enum BuildError<E, F = crate::fs::SpillError> {
     /// The source could not produce its rays.
     #[error("{0}")]
     Source(E),
@@ -27,7 +30,16 @@ pub enum BuildError<E> {
         /// what did not fit).
         needed: u64,
     },
-    /// A temporary file or the output could not be written.
+    /// The parts of a build written together overlap: a cell of depth `m` was stacked by two of them, or
+    /// stacked by one and full in another (an index added with
+    /// [`SpilledPart::add_part`](crate::stacking::SpilledPart::add_part) that is not of another part
+    /// of the same build).
+    #[error(
+        "the indexes of the parts overlap: a cell of depth m was stacked twice or is also full"
+    )]
+    PartsOverlap,
+    /// The subtrees could not be stored or read back, or the output could not be written (for a file: a
+    /// temporary folder or file, or the output, a full disk included).
     #[error(transparent)]
-    Files(#[from] crate::fs::SpillError),
+    Files(#[from] F),
 }

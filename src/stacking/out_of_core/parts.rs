@@ -1,24 +1,19 @@
 //! A build in parts: some slabs stacked and spilled by each part ([`stack_part`]), the parts' indexes
-//! gathered by one of them, which writes the file ([`SpilledPart::write`]) — as the ranks of a distributed
-//! run do, and as a build in one process does with one part of every slab.
+//! gathered by one of them, which writes the tree ([`SpilledPart::write_into`]) — as the ranks of a
+//! distributed run do, and as a build in one process does with one part of every slab.
 
-use crate::fs::SpillError;
 use std::collections::VecDeque;
-use std::fmt::Display;
-use std::fs::File;
-use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
 use super::budget::{Budget, RUN_BYTES};
 use super::error::BuildError;
+use super::pieces::{LevelPieces, PieceStore, StoredPieces};
 use super::progress::{Progress, Stage};
-use super::spill::{level_offsets, open_spill, spill_piece, Spill, SpillReader, SubtreeIndex};
-use super::{OutOfCore, OutOfCoreReport};
-use crate::fs::write_atomic_with;
-use crate::io::spill::LevelFile;
-use crate::io::KtreeWriter;
+use super::sink::LevelOrderSink;
+use super::spill::{level_offsets, spill_piece, SubtreeIndex};
+use super::{OutOfCore, OutOfCoreReport, StoreBuildError};
 use crate::rays::RaySource;
 use crate::stacking::cells::{CellBlock, CellStates};
 use crate::stacking::partition::{slab_pieces, Piece};
@@ -92,30 +87,30 @@ pub fn balanced_parts(costs: &[u64], parts: usize) -> Vec<std::ops::Range<usize>
 }
 
 /// The stacking phase of an out-of-core build run on some of its slabs (for a process that builds a
-/// share of the tree): the cells of `slabs` (numbers from [`build_slabs`], increasing) are stacked as
-/// [`stack_to_file`](super::stack_to_file) does and their subtrees spilled next to `out` (or in [`OutOfCore::temp_dir`]);
-/// nothing is written to `out`. The part's index travels to the process that writes
-/// ([`SpilledPart::index_words`], [`SpilledPart::add_part`]) and its levels follow
-/// ([`SpilledPart::stream_levels`]).
+/// share of the tree): the cells of `slabs` (numbers from [`build_slabs`], increasing) are stacked, on the
+/// threads of the current rayon pool, and their subtrees spilled to `store` (levels `1 … L − m`). The
+/// part's index travels to the part that writes ([`SpilledPart::index_words`], [`SpilledPart::add_part`])
+/// and its levels follow ([`SpilledPart::stream_levels`]); a build of one part writes at once
+/// ([`SpilledPart::write_into`]).
 ///
 /// # Errors
-/// As [`stack_to_file`](super::stack_to_file) (the budget covers this part alone).
-pub(crate) fn stack_part<const K: usize, S>(
+/// [`BuildError`]: the source's first error (in slab order), a budget too small for this part (at once
+/// when what is known before any slab is stacked does not fit), the store's error.
+pub(crate) fn stack_part<const K: usize, S, P>(
     source: &S,
     slabs: &[u32],
-    out: &Path,
+    mut store: P,
     options: &OutOfCore,
     progress: &(dyn Fn(Progress) + Sync),
-) -> Result<SpilledPart, BuildError<S::Error>>
+) -> Result<SpilledPart<P::Stored>, StoreBuildError<S::Error, P>>
 where
     S: RaySource<K>,
-    S::Error: Display,
+    P: PieceStore,
 {
     let universe = source.universe();
     let level = universe.level();
     let m = options.depth.min(level);
     let t = level - m;
-    let mut spill = open_spill(out, options.temp_dir.as_deref(), t as usize)?;
     let mut budget = Budget {
         max: options.max_memory,
         t: u64::from(t),
@@ -123,6 +118,7 @@ where
     };
     let mut cells = CellStates::new(K as u32, m);
     let mut index = SubtreeIndex::default();
+    let mut spilled_words = 0u64;
     // What is held before any slab is stacked (the buffers): a budget below it fails before any work.
     let before = budget.fixed(cells.bytes(), 0);
     if before > budget.max {
@@ -166,7 +162,7 @@ where
                 let pieces = slab_pieces::<K>(&slab, level, m, b0, options.cells);
                 Ok(SlabOutcome::Stacked { cost, pieces })
             })
-            .collect::<Vec<Result<SlabOutcome<K>, BuildError<S::Error>>>>();
+            .collect::<Vec<Result<SlabOutcome<K>, BuildError<S::Error, P::Error>>>>();
         let (mut set_aside, mut too_big, mut round_cost) = (Vec::new(), false, 0u64);
         for (&b0, outcome) in round.iter().zip(outcomes) {
             match outcome? {
@@ -178,7 +174,9 @@ where
                     // spill file is then read front to back, and its disk given back as it goes.
                     pieces.sort_unstable_by_key(|&(morton, _)| morton);
                     for (morton, piece) in pieces {
-                        spill_piece(&mut spill, &mut cells, &mut index, morton, piece)?;
+                        spilled_words += spill_piece(
+                            &mut store, t as usize, &mut cells, &mut index, morton, piece,
+                        )?;
                     }
                 }
                 SlabOutcome::SetAside => set_aside.push(b0),
@@ -218,12 +216,6 @@ where
         });
     }
     budget.peak = budget.peak.max(end);
-    let spilled_words = spill.words();
-    let Spill { dir, files } = spill;
-    let readers = files
-        .into_iter()
-        .map(LevelFile::finish)
-        .collect::<Result<Vec<_>, _>>()?;
     Ok(SpilledPart {
         k: K as u32,
         level,
@@ -231,19 +223,21 @@ where
         cells,
         own: index,
         others: Vec::new(),
-        dir,
-        readers,
+        pieces: store.finish()?,
         budget,
         largest,
         spilled_bytes: 8 * spilled_words,
     })
 }
 
-/// The cells of some slabs stacked and their subtrees spilled ([`Builder::stack_part`](crate::stacking::Builder::stack_part)), and the index of the
-/// parts other processes stacked ([`add_part`](Self::add_part)): all that is needed to write the tree
-/// ([`write`](Self::write)), with the levels of the other parts received as streams. The spill folder is
-/// removed when the part is dropped.
-pub struct SpilledPart {
+/// The cells of some slabs stacked and their subtrees spilled to the stored pieces `P`
+/// ([`Builder::stack_part`](crate::stacking::Builder::stack_part) to spill files,
+/// [`Builder::stack_part_into`](crate::stacking::Builder::stack_part_into) to any [`PieceStore`]), and the
+/// index of the parts other processes stacked ([`add_part`](Self::add_part)): all that is needed to write
+/// the tree ([`write`](Self::write) to a file, [`write_into`](Self::write_into) to any
+/// [`LevelOrderSink`]), with the levels of the other parts received as streams. The pieces (the spill
+/// folder) are dropped with the part.
+pub struct SpilledPart<P> {
     k: u32,
     level: u32,
     m: u32,
@@ -253,9 +247,8 @@ pub struct SpilledPart {
     own: SubtreeIndex,
     /// The cells stacked by the parts added, owner `1, 2, …` in the order added.
     others: Vec<SubtreeIndex>,
-    dir: tempfile::TempDir,
-    /// The spill files of levels `1 … t`, for reading back.
-    readers: Vec<(PathBuf, File)>,
+    /// The subtrees' levels `1 … t` of the cells stacked here, for reading back.
+    pieces: P,
     budget: Budget,
     largest: u64,
     /// Bytes written to spill files by this part and the parts added.
@@ -269,7 +262,17 @@ pub const MAX_PARTS: usize = 1 << 16;
 /// The first word of a part's index.
 const INDEX_MAGIC: u64 = u64::from_le_bytes(*b"ktpart02");
 
-impl SpilledPart {
+impl<P: StoredPieces> SpilledPart<P> {
+    /// The dimension `K` of the tree.
+    pub(crate) fn k(&self) -> usize {
+        self.k as usize
+    }
+
+    /// The level `L` of the tree's universe.
+    pub(crate) fn level(&self) -> u32 {
+        self.level
+    }
+
     /// Levels of a subtree below its root.
     fn t(&self) -> usize {
         (self.level - self.m) as usize
@@ -392,15 +395,18 @@ impl SpilledPart {
     /// Sends this part's subtree levels to the process that writes the tree: for each level `1 … t`, the
     /// pieces of the cells it stacked in Morton order (each piece `⌈nodes / 32⌉` words), concatenated and
     /// cut into chunks of at most `chunk_words` words handed to `send` in order; returns the words sent.
-    /// The writer takes them in the same order ([`write`](Self::write)).
+    /// The writer takes them in the same order ([`write_into`](Self::write_into)).
     ///
     /// # Errors
-    /// A spill file that cannot be read back (naming it), or the error of `send`.
+    /// A piece that cannot be read back (naming its spill file), or the error of `send`.
     pub fn stream_levels(
         &mut self,
         chunk_words: usize,
         send: &mut dyn FnMut(&[u64]) -> std::io::Result<()>,
-    ) -> std::io::Result<u64> {
+    ) -> std::io::Result<u64>
+    where
+        P::Error: Into<std::io::Error>,
+    {
         let chunk_words = chunk_words.max(1);
         let t = self.t();
         let n = self.own.mortons.len();
@@ -411,25 +417,26 @@ impl SpilledPart {
         let mut offsets = vec![0u64; n];
         for j in 0..t {
             let at = level_offsets(&self.own, t, j, &mut offsets);
-            let (path, file) = &mut self.readers[j];
-            let mut reader = SpillReader::new(path, file, &offsets, at);
+            let mut level = self.pieces.level(j + 1, &offsets, at);
             for &s in &order {
                 let count = self.own.counts[s * t + j].div_ceil(32);
-                let mut left = count;
-                reader.seek(offsets[s])?;
-                while left > 0 {
-                    let take = left.min((chunk_words - chunk.len()) as u64);
-                    reader.read_into(take as usize, &mut chunk)?;
-                    left -= take;
+                let mut read = 0;
+                while read < count {
+                    let take = (count - read).min((chunk_words - chunk.len()) as u64);
+                    let filled = chunk.len();
+                    chunk.resize(filled + take as usize, 0);
+                    level
+                        .read(s, read, &mut chunk[filled..])
+                        .map_err(Into::into)?;
+                    read += take;
                     if chunk.len() == chunk_words {
                         send(&chunk)?;
                         sent += chunk.len() as u64;
                         chunk.clear();
                     }
                 }
-                reader.release(s);
             }
-            reader.finish();
+            level.finish();
         }
         if !chunk.is_empty() {
             send(&chunk)?;
@@ -438,30 +445,35 @@ impl SpilledPart {
         Ok(sent)
     }
 
-    /// The writing phase: writes the tree to `out` as a `.ktree` version 2 file, atomically — the top levels
-    /// from the cells' states, then each level below as the pieces of the stacked cells in Morton order,
-    /// each from its owner: this part's spill files, or `receive(owner, words)`, which fills `words` with
-    /// the next words of that owner's [`stream_levels`](Self::stream_levels).
+    /// The writing phase: writes the tree to `output`, level after level — the top levels from the cells'
+    /// states, then each level below as the pieces of the stacked cells in Morton order, each from its
+    /// owner: this part's pieces, or `receive(owner, words)`, which fills `words` with the next words of
+    /// that owner's [`stream_levels`](Self::stream_levels). Returns the finished output and the report
+    /// (its `file_bytes` 0: the output's size is the output's own; [`write`](Self::write) gives the
+    /// file's).
     ///
     /// # Errors
-    /// [`BuildError::BudgetTooSmall`] if the index of all parts does not fit in the budget; the output
-    /// or a spill file that cannot be written or read (an error of `receive` included). The target is then
-    /// untouched; the spill folder is removed in any case.
-    pub fn write<E>(
+    /// [`BuildError::BudgetTooSmall`] if the index of all parts does not fit in the budget;
+    /// [`BuildError::PartsOverlap`]; the error of a piece read back, of `output` or of `receive`. The
+    /// pieces are dropped in any case.
+    pub fn write_into<E, O, R>(
         self,
-        out: &Path,
-        receive: &mut dyn FnMut(usize, &mut [u64]) -> std::io::Result<()>,
+        mut output: O,
+        mut receive: R,
         progress: &(dyn Fn(Progress) + Sync),
-    ) -> Result<OutOfCoreReport, BuildError<E>> {
+    ) -> Result<(O::Output, OutOfCoreReport), BuildError<E, P::Error>>
+    where
+        O: LevelOrderSink<Error = P::Error>,
+        R: FnMut(usize, &mut [u64]) -> Result<(), P::Error>,
+    {
         let SpilledPart {
-            k,
+            k: _,
             level,
             m,
             cells,
             own,
             others,
-            dir,
-            mut readers,
+            mut pieces,
             mut budget,
             largest,
             spilled_bytes,
@@ -497,13 +509,7 @@ impl SpilledPart {
             .collect();
         let top = cells
             .into_top_levels(&partial)
-            .map_err(|_| BuildError::Files(SpillError::Output {
-                path: out.to_path_buf(),
-                source: std::io::Error::new(
-                    std::io::ErrorKind::InvalidData,
-                    "the indexes of the parts overlap: a cell of depth m was stacked twice or is also full",
-                ),
-            }))?;
+            .map_err(|_| BuildError::PartsOverlap)?;
         drop(partial);
         let deepest = (1..=t)
             .rev()
@@ -514,78 +520,58 @@ impl SpilledPart {
             })
             .unwrap_or(0);
         let total = (top.len() + deepest) as u64;
-        let mut counts = Vec::new();
-        write_atomic_with(out, |w| {
-            let mut writer = KtreeWriter::new(w, k as usize, level)?;
-            let mut done = 0;
-            for states in &top {
-                writer.append_states(states)?;
-                writer.end_level()?;
-                done += 1;
-                progress(Progress {
-                    stage: Stage::Writing,
-                    done,
-                    total,
-                });
-            }
-            drop(top);
-            let mut offsets = vec![0u64; own.mortons.len()];
-            let mut words: Vec<u64> = Vec::new();
-            for (j, (path, file)) in readers.iter_mut().enumerate().take(deepest) {
-                let at = level_offsets(&own, t, j, &mut offsets);
-                let mut reader = SpillReader::new(path, file, &offsets, at);
-                for &o in &order {
-                    let (owner, s) = unpack(o);
-                    let nodes = parts[owner].counts[s * t + j];
-                    if nodes == 0 {
-                        continue;
-                    }
-                    let count = nodes.div_ceil(32) as usize;
-                    words.clear();
-                    if owner == 0 {
-                        reader.seek(offsets[s])?;
-                        reader.read_into(count, &mut words)?;
-                        reader.release(s);
-                    } else {
-                        words.resize(count, 0);
-                        receive(owner, &mut words)?;
-                    }
-                    writer.append_words(&words, nodes)?;
+        let mut done = 0;
+        for states in &top {
+            output.append_states(states)?;
+            output.end_level()?;
+            done += 1;
+            progress(Progress {
+                stage: Stage::Writing,
+                done,
+                total,
+            });
+        }
+        drop(top);
+        let mut offsets = vec![0u64; own.mortons.len()];
+        let mut words: Vec<u64> = Vec::new();
+        for j in 0..deepest {
+            let at = level_offsets(&own, t, j, &mut offsets);
+            let mut level = pieces.level(j + 1, &offsets, at);
+            for &o in &order {
+                let (owner, s) = unpack(o);
+                let nodes = parts[owner].counts[s * t + j];
+                if nodes == 0 {
+                    continue;
                 }
-                reader.finish();
-                writer.end_level()?;
-                done += 1;
-                progress(Progress {
-                    stage: Stage::Writing,
-                    done,
-                    total,
-                });
+                words.clear();
+                words.resize(nodes.div_ceil(32) as usize, 0);
+                if owner == 0 {
+                    level.read(s, 0, &mut words)?;
+                } else {
+                    receive(owner, &mut words)?;
+                }
+                output.append_words(&words, nodes)?;
             }
-            counts = writer.counts_per_level();
-            writer.finish().map(drop)
-        })
-        .map_err(|source| {
-            BuildError::Files(SpillError::Output {
-                path: out.to_path_buf(),
-                source,
-            })
-        })?;
-        drop(readers);
-        drop(dir);
-        let file_bytes = std::fs::metadata(out)
-            .map_err(|source| {
-                BuildError::Files(SpillError::Output {
-                    path: out.to_path_buf(),
-                    source,
-                })
-            })?
-            .len();
-        Ok(OutOfCoreReport {
-            counts_per_level: counts,
-            file_bytes,
-            subtrees: subtrees as u64,
-            spilled_bytes,
-            peak_accounted_bytes: budget.peak,
-        })
+            level.finish();
+            output.end_level()?;
+            done += 1;
+            progress(Progress {
+                stage: Stage::Writing,
+                done,
+                total,
+            });
+        }
+        let counts_per_level = output.counts_per_level();
+        let output = output.finish()?;
+        Ok((
+            output,
+            OutOfCoreReport {
+                counts_per_level,
+                file_bytes: 0,
+                subtrees: subtrees as u64,
+                spilled_bytes,
+                peak_accounted_bytes: budget.peak,
+            },
+        ))
     }
 }

@@ -1,0 +1,414 @@
+//! ASPRS LAS 1.0–1.4, and LAZ (LASzip-compressed LAS): every point's `X`, `Y`, `Z` (the first 12 bytes of
+//! every point format), scaled and offset as the header says.
+//!
+//! The header is read by the `las` crate; everything it declares is checked against the file before
+//! anything is allocated for it:
+//! * the point count (in LAS 1.4 the legacy count at byte 107 and the 64-bit one at byte 247 must agree
+//!   when both are given) against the point data: uncompressed, `count × record length` bytes between the
+//!   offset to the point data and the first extended record (or the end of the file); compressed, the
+//!   chunk table (its chunks' point counts must add up to the count, or, for chunks of a fixed size, their
+//!   number must be the count's);
+//! * the variable-length records and the extended ones against the bytes that follow them;
+//! * each LAZ chunk is decoded by the `laz` crate from its own bytes only, so a chunk that cannot hold the
+//!   points it should is an error, not points read from the bytes after it; the layers a LAS 1.4 chunk
+//!   declares for its coordinates are checked against the chunk before they are read.
+
+use std::io::Cursor;
+
+use laz::las::selective::DecompressionSelection;
+use laz::laszip::{ChunkTable, LazVlr};
+use laz::record::{
+    LayeredPointRecordDecompressor, RecordDecompressor, SequentialPointRecordDecompressor,
+};
+
+use super::finite;
+use crate::io::geometry_file::Fault;
+
+/// Byte offsets of header fields (ASPRS LAS 1.4 R15, table 3).
+const LEGACY_POINT_COUNT: usize = 107;
+const POINT_COUNT: usize = 247;
+const POINT_FORMAT: usize = 104;
+const RECORD_LENGTH: usize = 105;
+const HEADER_SIZE: usize = 94;
+const OFFSET_TO_POINT_DATA: usize = 96;
+const START_OF_FIRST_EVLR: usize = 235;
+/// A variable-length record's header (54 bytes) and an extended one's (60).
+const VLR_HEADER: usize = 54;
+const EVLR_HEADER: usize = 60;
+
+/// The points of a LAS or LAZ file.
+pub(super) fn read(bytes: &[u8]) -> Result<Vec<[f64; 3]>, Fault> {
+    let header = las::raw::Header::read_from(bytes)
+        .map_err(|e| Fault::byte(0, format!("LAS header: {e}")))?;
+    let legacy = u64::from(header.number_of_point_records);
+    let count = match header.large_file {
+        Some(large) if large.number_of_point_records != 0 => {
+            if legacy != 0 && legacy != large.number_of_point_records {
+                return Err(Fault::byte(
+                    LEGACY_POINT_COUNT,
+                    format!(
+                        "LAS: the legacy point count {legacy} disagrees with the point count {} at byte {POINT_COUNT}",
+                        large.number_of_point_records
+                    ),
+                ));
+            }
+            large.number_of_point_records
+        }
+        _ => legacy,
+    };
+    let count_at = if legacy == 0 && header.large_file.is_some() {
+        POINT_COUNT
+    } else {
+        LEGACY_POINT_COUNT
+    };
+    let format = las::point::Format::new(header.point_data_record_format)
+        .map_err(|e| Fault::byte(POINT_FORMAT, format!("LAS: {e}")))?;
+    let record = usize::from(header.point_data_record_length);
+    if record < usize::from(format.len()) || record < 12 {
+        return Err(Fault::byte(
+            RECORD_LENGTH,
+            format!(
+                "LAS: records of {record} bytes are shorter than point format {}'s {} bytes",
+                header.point_data_record_format & 0x3f,
+                format.len()
+            ),
+        ));
+    }
+    // The header's size at least as its version's fields take (ASPRS: 227 bytes, 235 in 1.3, 375 in 1.4).
+    let least = match header.version.minor {
+        0..=2 => 227,
+        3 => 235,
+        _ => 375,
+    };
+    if header.header_size < least {
+        return Err(Fault::byte(
+            HEADER_SIZE,
+            format!(
+                "LAS: a header of {} bytes, but LAS 1.{}'s takes {least}",
+                header.header_size, header.version.minor
+            ),
+        ));
+    }
+    let start = header.offset_to_point_data as usize;
+    if start > bytes.len() || start < usize::from(header.header_size) {
+        return Err(Fault::byte(
+            OFFSET_TO_POINT_DATA,
+            format!(
+                "LAS: the point data are said to start at byte {start}, outside the {} bytes after the {}-byte header",
+                bytes.len().saturating_sub(usize::from(header.header_size)),
+                header.header_size
+            ),
+        ));
+    }
+    let vlrs = variable_length_records(bytes, usize::from(header.header_size), start, &header)?;
+    let end = match header.evlr {
+        Some(evlr) => {
+            check_extended_records(bytes, evlr.start_of_first_evlr, evlr.number_of_evlrs, start)?
+        }
+        None => bytes.len(),
+    };
+    let scale = [
+        (header.x_scale_factor, header.x_offset),
+        (header.y_scale_factor, header.y_offset),
+        (header.z_scale_factor, header.z_offset),
+    ];
+    let point = |i: u64, raw: &[u8], at: usize| -> Result<[f64; 3], Fault> {
+        let p = std::array::from_fn(|a| {
+            let v =
+                i32::from_le_bytes([raw[4 * a], raw[4 * a + 1], raw[4 * a + 2], raw[4 * a + 3]]);
+            f64::from(v) * scale[a].0 + scale[a].1
+        });
+        finite(p, |why| Fault::byte(at, format!("LAS point {i} {why}")))
+    };
+    if !format.is_compressed {
+        let need = count.saturating_mul(record as u64);
+        let have = (end - start) as u64;
+        if need > have {
+            return Err(Fault::byte(
+                count_at,
+                format!(
+                    "LAS: the header declares {count} points of {record} bytes ({need} bytes), but the point data (bytes {start} to {end}) hold {have}"
+                ),
+            ));
+        }
+        let mut points = Vec::with_capacity(count as usize);
+        for i in 0..count {
+            let at = start + i as usize * record;
+            points.push(point(i, &bytes[at..at + 12], at)?);
+        }
+        return Ok(points);
+    }
+    let laszip = vlrs.laszip.ok_or_else(|| {
+        Fault::byte(
+            POINT_FORMAT,
+            "LAZ: the point format says compressed, but no LASzip record describes the compression",
+        )
+    })?;
+    let vlr = LazVlr::read_from(&bytes[laszip.clone()])
+        .map_err(|e| Fault::byte(laszip.start, format!("LAZ: the LASzip record: {e}")))?;
+    let items: usize = vlr
+        .items()
+        .iter()
+        .map(|item| usize::from(item.size()))
+        .sum();
+    if items != record {
+        return Err(Fault::byte(
+            laszip.start,
+            format!("LAZ: the LASzip record describes points of {items} bytes, the header says {record}"),
+        ));
+    }
+    // The record's first field (ASPRS's LASzip record): 1 a single stream, 2 and 3 chunks (of points, of
+    // layers).
+    let compressor = u16::from_le_bytes([bytes[laszip.start], bytes[laszip.start + 1]]);
+    let chunks = chunks(bytes, (start, end), count, (&vlr, compressor), count_at)?;
+    let mut points = Vec::with_capacity(count as usize);
+    let mut raw = vec![0u8; record];
+    for (k, chunk) in chunks.iter().enumerate() {
+        let data = &bytes[chunk.bytes.clone()];
+        let mut decoder = decoder(data, &vlr, record, chunk.points)
+            .map_err(|why| Fault::byte(chunk.bytes.start, format!("LAZ chunk {k}: {why}")))?;
+        for j in 0..chunk.points {
+            decoder.decompress_next(&mut raw).map_err(|e| {
+                let why = if e.kind() == std::io::ErrorKind::UnexpectedEof {
+                    format!(
+                        "its {} bytes end after {j} of the {} points the header and the chunk table give it",
+                        data.len(),
+                        chunk.points
+                    )
+                } else {
+                    e.to_string()
+                };
+                Fault::byte(chunk.bytes.start, format!("LAZ chunk {k}: {why}"))
+            })?;
+            let i = points.len() as u64;
+            points.push(point(i, &raw, chunk.bytes.start)?);
+        }
+    }
+    Ok(points)
+}
+
+/// What the variable-length records hold for this reader: where the LASzip record's data lie.
+struct Vlrs {
+    laszip: Option<std::ops::Range<usize>>,
+}
+
+/// Walks the variable-length records between the header and the point data.
+fn variable_length_records(
+    bytes: &[u8],
+    mut at: usize,
+    start: usize,
+    header: &las::raw::Header,
+) -> Result<Vlrs, Fault> {
+    let mut laszip = None;
+    for k in 0..header.number_of_variable_length_records {
+        if at + VLR_HEADER > start {
+            return Err(Fault::byte(
+                at,
+                format!(
+                    "LAS: variable-length record {k} of {} runs past the start of the point data (byte {start})",
+                    header.number_of_variable_length_records
+                ),
+            ));
+        }
+        let user = &bytes[at + 2..at + 18];
+        let id = u16::from_le_bytes([bytes[at + 18], bytes[at + 19]]);
+        let length = usize::from(u16::from_le_bytes([bytes[at + 20], bytes[at + 21]]));
+        let data = at + VLR_HEADER..at + VLR_HEADER + length;
+        if data.end > start {
+            return Err(Fault::byte(
+                at,
+                format!("LAS: variable-length record {k}'s {length} bytes run past the start of the point data (byte {start})"),
+            ));
+        }
+        let user = user.split(|&b| b == 0).next().unwrap_or_default();
+        if user == LazVlr::USER_ID.as_bytes() && id == LazVlr::RECORD_ID {
+            laszip = Some(data.clone());
+        }
+        at = data.end;
+    }
+    Ok(Vlrs { laszip })
+}
+
+/// Checks the extended variable-length records of LAS 1.4 (each declares a 64-bit length) against the
+/// file; returns where the point data end: at the first record, or the end of the file without one.
+fn check_extended_records(bytes: &[u8], first: u64, n: u32, start: usize) -> Result<usize, Fault> {
+    if first == 0 || n == 0 {
+        return Ok(bytes.len());
+    }
+    let first = usize::try_from(first).unwrap_or(usize::MAX);
+    if first < start || first > bytes.len() {
+        return Err(Fault::byte(
+            START_OF_FIRST_EVLR,
+            format!(
+                "LAS: the extended variable-length records are said to start at byte {first}, outside bytes {start} to {} after the point data's start",
+                bytes.len()
+            ),
+        ));
+    }
+    let mut at = first;
+    for _ in 0..n {
+        let room = bytes.len().saturating_sub(at.saturating_add(EVLR_HEADER)) as u64;
+        let Some(length) = bytes
+            .get(at + 20..at + 28)
+            .map(|b| u64::from_le_bytes(b.try_into().unwrap_or_default()))
+        else {
+            return Err(Fault::byte(
+                at,
+                "LAS: the file ends inside an extended variable-length record's header",
+            ));
+        };
+        if length > room {
+            return Err(Fault::byte(
+                at,
+                format!(
+                    "LAS: the extended variable-length record there declares {length} bytes of data, but the file has {room} bytes after its header"
+                ),
+            ));
+        }
+        at += EVLR_HEADER + length as usize;
+    }
+    Ok(first)
+}
+
+/// A LAZ chunk: its bytes and the points it holds.
+struct Chunk {
+    bytes: std::ops::Range<usize>,
+    points: u64,
+}
+
+/// The chunks of the compressed point data between `start` and `end`, checked against the point count.
+fn chunks(
+    bytes: &[u8],
+    (start, end): (usize, usize),
+    count: u64,
+    (vlr, compressor): (&LazVlr, u16),
+    count_at: usize,
+) -> Result<Vec<Chunk>, Fault> {
+    match compressor {
+        // One stream without a chunk table: its points read until the data end.
+        1 => {
+            return Ok(vec![Chunk {
+                bytes: start..end,
+                points: count,
+            }])
+        }
+        2 | 3 => {}
+        c => return Err(Fault::byte(start, format!("LAZ: unknown compressor {c}"))),
+    }
+    // The chunk table's offset is the first 8 bytes of the point data; a writer that could not go back
+    // to fill it in wrote it in the last 8 bytes of the file instead.
+    let i64_at = |at: usize| {
+        bytes
+            .get(at..at + 8)
+            .map(|b| i64::from_le_bytes(b.try_into().unwrap_or_default()))
+    };
+    let data = start + 8;
+    let valid = |t: Option<i64>| {
+        t.and_then(|t| usize::try_from(t).ok())
+            .filter(|&t| t >= data && t.saturating_add(8) <= end)
+    };
+    let table = valid(i64_at(start))
+        .or_else(|| valid(bytes.len().checked_sub(8).and_then(i64_at)))
+        .ok_or_else(|| {
+            Fault::byte(start, "LAZ: no chunk table (its offset, here or in the file's last 8 bytes, points nowhere in the point data)")
+        })?;
+    let n = u32::from_le_bytes(bytes[table + 4..table + 8].try_into().unwrap_or_default()) as u64;
+    let variable = vlr.uses_variable_size_chunks();
+    let size = u64::from(vlr.chunk_size());
+    // Each chunk takes a byte at least; chunks of a fixed size are as many as the count needs.
+    let fixed = count.div_ceil(size.max(1));
+    if (!variable && n != fixed) || n > (table - data) as u64 {
+        return Err(Fault::byte(
+            table,
+            if variable {
+                format!("LAZ: the chunk table declares {n} chunks, more than the {} bytes of compressed points can hold", table - data)
+            } else {
+                format!(
+                    "LAZ: the chunk table declares {n} chunks of {size} points, but the {count} points the header declares (byte {count_at}) take {fixed}"
+                )
+            },
+        ));
+    }
+    let entries = ChunkTable::read(&mut Cursor::new(&bytes[table..end]), variable)
+        .map_err(|e| Fault::byte(table, format!("LAZ: the chunk table: {e}")))?;
+    let mut chunks = Vec::with_capacity(entries.len());
+    let (mut at, mut held) = (data, 0u64);
+    for (k, e) in entries.as_ref().iter().enumerate() {
+        let points = if variable {
+            e.point_count
+        } else {
+            size.min(count - held)
+        };
+        let next = (at as u64).saturating_add(e.byte_count);
+        if next > table as u64 {
+            return Err(Fault::byte(
+                table,
+                format!("LAZ: the chunk table gives chunk {k} {} bytes from byte {at}, past the table's start", e.byte_count),
+            ));
+        }
+        chunks.push(Chunk {
+            bytes: at..next as usize,
+            points,
+        });
+        (at, held) = (next as usize, held.saturating_add(points));
+    }
+    if held != count {
+        return Err(Fault::byte(
+            count_at,
+            format!("LAZ: the header declares {count} points, but the chunk table (byte {table}) gives its chunks {held}"),
+        ));
+    }
+    Ok(chunks)
+}
+
+/// A decoder of one chunk's `points` points from its bytes `data`, only the coordinates asked for.
+fn decoder<'a>(
+    data: &'a [u8],
+    vlr: &LazVlr,
+    record: usize,
+    points: u64,
+) -> Result<Box<dyn RecordDecompressor<Cursor<&'a [u8]>> + 'a>, String> {
+    let version = vlr.items().first().map_or(0, |item| item.version());
+    let mut decoder: Box<dyn RecordDecompressor<Cursor<&'a [u8]>> + 'a> = match version {
+        1 | 2 => Box::new(SequentialPointRecordDecompressor::new(Cursor::new(data))),
+        3 | 4 => {
+            check_layers(data, record, points)?;
+            Box::new(LayeredPointRecordDecompressor::new(Cursor::new(data)))
+        }
+        v => return Err(format!("unknown LASzip item version {v}")),
+    };
+    decoder
+        .set_fields_from(vlr.items())
+        .map_err(|e| e.to_string())?;
+    decoder.set_selection(DecompressionSelection::xy_returns_channel().decompress_z());
+    Ok(decoder)
+}
+
+/// A layered chunk (LAS 1.4 point formats) starts with its first point whole, then its point count and
+/// the byte counts of its layers, the coordinates' first (`x`, `y` with the returns and channel; `z`).
+/// Those two layers are the ones read into memory: their sizes are checked against the chunk here, and
+/// the count against the chunk table.
+fn check_layers(data: &[u8], record: usize, points: u64) -> Result<(), String> {
+    if points == 0 {
+        return Ok(());
+    }
+    let u32_at = |at: usize| {
+        data.get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| format!("its {} bytes end inside its layers' sizes", data.len()))
+    };
+    let held = u64::from(u32_at(record)?);
+    if held != points {
+        return Err(format!(
+            "the chunk says it holds {held} points, the header and the chunk table give it {points}"
+        ));
+    }
+    let layers = u64::from(u32_at(record + 4)?) + u64::from(u32_at(record + 8)?);
+    if layers > data.len() as u64 {
+        return Err(format!(
+            "its coordinates' layers declare {layers} bytes, more than its {} bytes",
+            data.len()
+        ));
+    }
+    Ok(())
+}
