@@ -121,4 +121,7 @@ pub enum OpsError {
         /// The distance given.
         distance: f64,
     },
+    /// An operation made a value no voxel may hold (a sum of floats `inf + -inf` is a NaN).
+    #[error("the result would hold {0}")]
+    Value(#[from] crate::tree::value::ValueError),
 }

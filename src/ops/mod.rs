@@ -47,6 +47,7 @@ mod rotate;
 mod scale;
 mod separation;
 mod translate;
+pub mod values;
 
 pub use affine::{transform, Affine};
 pub use boolean::{

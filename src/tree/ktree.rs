@@ -4,8 +4,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::cursor::Leaves;
 use super::states::{node_out_of_range, NodeState, PackedStates};
-use super::valued::LevelValues;
 use super::value::Value;
+use super::valued::LevelValues;
 use super::TreeError;
 
 use crate::space::{Cell, DimCheck, SpaceError, Universe};
@@ -103,7 +103,9 @@ pub struct KTree<const K: usize, V: Value = ()> {
 
 impl<const K: usize, V: Value> PartialEq for KTree<K, V> {
     fn eq(&self, other: &Self) -> bool {
-        self.universe == other.universe && self.levels == other.levels && self.values == other.values
+        self.universe == other.universe
+            && self.levels == other.levels
+            && self.values == other.values
     }
 }
 
@@ -258,7 +260,6 @@ impl<const K: usize, V: Value> KTree<K, V> {
         self.node_count().div_ceil(4)
     }
 
-
     /// Checks the tree's invariants: level 0 holds the root, level sizes match the partial counts above, no
     /// partial node at the universe level, the last level has no partial node, and the tree is reduced (no
     /// partial node whose children are all full or all empty); for a valued tree, also the rules of
@@ -278,7 +279,11 @@ impl<const K: usize, V: Value> KTree<K, V> {
     /// operation.
     pub fn assert_well_formed(&self) {
         if let Err(e) = self.check() {
-            panic!("malformed KTree<{K}, {}> (level {}): {e}", std::any::type_name::<V>(), self.level());
+            panic!(
+                "malformed KTree<{K}, {}> (level {}): {e}",
+                std::any::type_name::<V>(),
+                self.level()
+            );
         }
     }
 

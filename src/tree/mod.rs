@@ -24,6 +24,7 @@ pub mod sink;
 mod states;
 pub mod storage;
 mod to_rays;
+pub mod top_down;
 pub mod value;
 pub mod valued;
 pub(crate) mod words;

@@ -42,7 +42,9 @@ impl NodeState {
     }
 }
 
-use super::words::{children_mask, full_count, full_mask, partial_mask, unused_mask, NODES_PER_WORD};
+use super::words::{
+    children_mask, full_count, full_mask, partial_mask, unused_mask, NODES_PER_WORD,
+};
 use super::TreeError;
 
 /// Words per rank block: 256 nodes share one 16-bit block rank.
@@ -404,7 +406,8 @@ impl FullRank {
         let words = level.words();
         let word = i / NODES_PER_WORD;
         let block = word / WORDS_PER_BLOCK;
-        let mut rank = self.super_rank[block / BLOCKS_PER_SUPER] + u64::from(self.block_rank[block]);
+        let mut rank =
+            self.super_rank[block / BLOCKS_PER_SUPER] + u64::from(self.block_rank[block]);
         for &w in &words[block * WORDS_PER_BLOCK..word] {
             rank += u64::from(full_count(w));
         }
@@ -451,14 +454,17 @@ mod tests {
     }
 
     #[test]
-    fn ranks_of_nodes_with_children_and_of_full_nodes_count_a_valued_level_as_a_plain_vector_does() {
+    fn ranks_of_nodes_with_children_and_of_full_nodes_count_a_valued_level_as_a_plain_vector_does()
+    {
         // Codes 00, 01, 10 and 11 (a mixed node of a valued tree: it has children, it is not full).
         let mut words = Vec::new();
         let mut codes = Vec::new();
         let mut x = 99u64;
         let n = 2 * 65_536 + 4_321;
         for i in 0..n {
-            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             let code = (x >> 61) & 3;
             if i % 32 == 0 {
                 words.push(0u64);

@@ -160,6 +160,19 @@ pub trait Value: Copy + PartialEq + Debug + Send + Sync + 'static + sealed::Seal
         Ok(())
     }
 
+    /// The smaller of two values (channel by channel for [`Rgb`]).
+    fn min_value(self, other: Self) -> Self;
+
+    /// The larger of two values (channel by channel for [`Rgb`]).
+    fn max_value(self, other: Self) -> Self;
+
+    /// The sum of two values, saturating for integers (channel by channel for [`Rgb`]); for `f32` the
+    /// float sum (`inf + -inf` is a NaN, which a tree refuses).
+    fn sum_value(self, other: Self) -> Self;
+
+    /// Whether `lo <= self <= hi` (on every channel for [`Rgb`]).
+    fn in_range(self, lo: Self, hi: Self) -> bool;
+
     /// Appends the value's bytes, little-endian.
     fn write_le(self, out: &mut Vec<u8>);
 
@@ -173,6 +186,16 @@ impl Value for () {
     type Key = ();
     #[inline(always)]
     fn key(self) {}
+    #[inline(always)]
+    fn min_value(self, _: Self) {}
+    #[inline(always)]
+    fn max_value(self, _: Self) {}
+    #[inline(always)]
+    fn sum_value(self, _: Self) {}
+    #[inline(always)]
+    fn in_range(self, _: Self, _: Self) -> bool {
+        true
+    }
     #[inline(always)]
     fn write_le(self, _: &mut Vec<u8>) {}
     #[inline(always)]
@@ -188,6 +211,22 @@ macro_rules! integer_value {
             #[inline(always)]
             fn key(self) -> $t {
                 self
+            }
+            #[inline]
+            fn min_value(self, other: Self) -> Self {
+                self.min(other)
+            }
+            #[inline]
+            fn max_value(self, other: Self) -> Self {
+                self.max(other)
+            }
+            #[inline]
+            fn sum_value(self, other: Self) -> Self {
+                self.saturating_add(other)
+            }
+            #[inline]
+            fn in_range(self, lo: Self, hi: Self) -> bool {
+                lo <= self && self <= hi
             }
             #[inline]
             fn write_le(self, out: &mut Vec<u8>) {
@@ -215,6 +254,22 @@ impl Value for f32 {
         self.to_bits()
     }
     #[inline]
+    fn min_value(self, other: Self) -> Self {
+        self.min(other)
+    }
+    #[inline]
+    fn max_value(self, other: Self) -> Self {
+        self.max(other)
+    }
+    #[inline]
+    fn sum_value(self, other: Self) -> Self {
+        self + other
+    }
+    #[inline]
+    fn in_range(self, lo: Self, hi: Self) -> bool {
+        lo <= self && self <= hi
+    }
+    #[inline]
     fn check(self) -> Result<(), ValueError> {
         if self.is_nan() {
             Err(ValueError::NaN)
@@ -239,6 +294,22 @@ impl Value for Rgb {
     #[inline(always)]
     fn key(self) -> [u8; 3] {
         self
+    }
+    #[inline]
+    fn min_value(self, other: Self) -> Self {
+        std::array::from_fn(|c| self[c].min(other[c]))
+    }
+    #[inline]
+    fn max_value(self, other: Self) -> Self {
+        std::array::from_fn(|c| self[c].max(other[c]))
+    }
+    #[inline]
+    fn sum_value(self, other: Self) -> Self {
+        std::array::from_fn(|c| self[c].saturating_add(other[c]))
+    }
+    #[inline]
+    fn in_range(self, lo: Self, hi: Self) -> bool {
+        (0..3).all(|c| lo[c] <= self[c] && self[c] <= hi[c])
     }
     #[inline]
     fn write_le(self, out: &mut Vec<u8>) {

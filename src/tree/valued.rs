@@ -58,7 +58,11 @@ pub(crate) struct LevelValues<V> {
 impl<V: Value> PartialEq for LevelValues<V> {
     fn eq(&self, other: &Self) -> bool {
         self.values.len() == other.values.len()
-            && self.values.iter().zip(&other.values).all(|(a, b)| a.same(*b))
+            && self
+                .values
+                .iter()
+                .zip(&other.values)
+                .all(|(a, b)| a.same(*b))
     }
 }
 
@@ -547,7 +551,10 @@ impl<const K: usize, V: Value> KTree<K, V> {
                 return Err(TreeError::PartialVoxel { depth });
             }
             if V::STORED {
-                let full: usize = words.iter().map(|&w| full_mask(w).count_ones() as usize).sum();
+                let full: usize = words
+                    .iter()
+                    .map(|&w| full_mask(w).count_ones() as usize)
+                    .sum();
                 let values = &self.values[depth].values;
                 if values.len() != full {
                     return Err(TreeError::ValueCount {
@@ -572,7 +579,11 @@ impl<const K: usize, V: Value> KTree<K, V> {
                 let first = infallible(self.children(depth, index));
                 let codes = u64::from(self.levels[depth + 1].block_codes(first, K));
                 let n = 1usize << K;
-                let mask = if n == 32 { u64::MAX } else { (1u64 << (2 * n)) - 1 };
+                let mask = if n == 32 {
+                    u64::MAX
+                } else {
+                    (1u64 << (2 * n)) - 1
+                };
                 let low = LOW_BITS & mask;
                 let empty_or_partial = !codes & low; // the low bit clear: 00 or 10
                 let all_empty = codes & mask == 0;
@@ -673,7 +684,10 @@ pub(crate) fn reference_pyramid<const K: usize, V: Value>(
         out.push(depth as usize, state);
         if state.has_children() {
             for code in (0..1usize << K).rev() {
-                stack.push((depth + 1, std::array::from_fn(|a| 2 * p[a] + (code >> a & 1) as u32)));
+                stack.push((
+                    depth + 1,
+                    std::array::from_fn(|a| 2 * p[a] + (code >> a & 1) as u32),
+                ));
             }
         }
     }
@@ -694,7 +708,9 @@ pub(crate) fn reference_pyramid<const K: usize, V: Value>(
 pub fn combine<V: Value>(kids: &[ValueState<V>]) -> ValueState<V> {
     let first = kids[0];
     match first {
-        ValueState::Empty if kids.iter().all(|k| matches!(k, ValueState::Empty)) => ValueState::Empty,
+        ValueState::Empty if kids.iter().all(|k| matches!(k, ValueState::Empty)) => {
+            ValueState::Empty
+        }
         ValueState::Full(v)
             if kids
                 .iter()

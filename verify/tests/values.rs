@@ -23,9 +23,7 @@ fn check<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseError
         prop_assert_eq!(tree.value_at(p).map(Value::key), b.map(Value::key));
     }
     // The leaves tile the universe.
-    let volume: u128 = ValueLeaves::new(&tree)
-        .map(|l| l.unwrap().0.volume())
-        .sum();
+    let volume: u128 = ValueLeaves::new(&tree).map(|l| l.unwrap().0.volume()).sum();
     prop_assert_eq!(volume, o.universe().voxels());
     // The shape: the voxels that hold a value.
     let support: Vec<bool> = dense.iter().map(Option::is_some).collect();
@@ -34,7 +32,10 @@ fn check<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseError
     prop_assert_eq!(&shape, &KTree::<K>::from_dense(o.level, &support).unwrap());
     prop_assert_eq!(tree.voxel_count(), shape.voxel_count());
     // A tree of one value everywhere it is not empty is its shape with that value.
-    let one: Vec<Option<V>> = support.iter().map(|&b| b.then_some(V::PALETTE[0])).collect();
+    let one: Vec<Option<V>> = support
+        .iter()
+        .map(|&b| b.then_some(V::PALETTE[0]))
+        .collect();
     let uniform = KTree::<K, V>::from_dense_values(o.level, &one).unwrap();
     prop_assert_eq!(uniform.counts_per_level(), shape.counts_per_level());
     Ok(())
@@ -65,7 +66,9 @@ fn a_binary_tree_has_no_value_column_and_its_memory_is_unchanged() {
     let tree = KTree::<3>::from_dense(3, &(0..512).map(|i| i % 7 < 3).collect::<Vec<_>>()).unwrap();
     let unit = KTree::<3, ()>::from_dense_values(
         3,
-        &(0..512).map(|i| (i % 7 < 3).then_some(())).collect::<Vec<_>>(),
+        &(0..512)
+            .map(|i| (i % 7 < 3).then_some(()))
+            .collect::<Vec<_>>(),
     )
     .unwrap();
     assert_eq!(tree, unit);

@@ -1,0 +1,189 @@
+//! Operations on valued trees against the same operation on dense arrays of values, K = 1 … 4 and several
+//! value types: select (a value, a range), mask, combine by every rule, overlay, map and relabel, and the
+//! per-value statistics. Every result is well formed and minimal (equal, node for node, to the tree of its
+//! dense reference).
+
+use std::collections::{BTreeMap, HashMap};
+
+use ktree::ops::values::Rule;
+use ktree::tree::{Rgb, Value};
+use ktree::{KTree, Universe};
+use ktree_verify::labels::{painted_at, Painted, Palette};
+use proptest::prelude::*;
+
+fn tree_of<const K: usize, V: Value>(level: u32, dense: &[Option<V>]) -> KTree<K, V> {
+    KTree::<K, V>::from_dense_values(level, dense).unwrap()
+}
+
+fn binary_of<const K: usize>(level: u32, dense: &[bool]) -> KTree<K> {
+    KTree::<K>::from_dense(level, dense).unwrap()
+}
+
+fn same<const K: usize, V: Value>(
+    got: &KTree<K, V>,
+    want: &KTree<K, V>,
+) -> Result<(), TestCaseError> {
+    got.assert_well_formed();
+    prop_assert!(
+        got == want,
+        "got {:?}\nwant {:?}",
+        got.to_dense_values(),
+        want.to_dense_values()
+    );
+    Ok(())
+}
+
+/// Voxels, box `[lo, hi)` and the sums of the centres of one value, counted on the dense array.
+type Measured<const K: usize> = (u128, [u32; K], [u32; K], [f64; K]);
+
+#[allow(clippy::needless_range_loop)] // Loops over the axes index several arrays.
+fn check<const K: usize, V: Palette>(a: &Painted<K>, b: &Painted<K>) -> Result<(), TestCaseError> {
+    let level = a.level;
+    let (da, db) = (a.dense::<V>(), b.dense::<V>());
+    let (ta, tb) = (tree_of::<K, V>(level, &da), tree_of::<K, V>(level, &db));
+    let p = V::PALETTE;
+
+    // Select one value, and a range.
+    let want: Vec<bool> = da.iter().map(|v| v.is_some_and(|v| v.same(p[2]))).collect();
+    let got = ta.select(p[2]);
+    got.assert_well_formed();
+    prop_assert_eq!(&got, &binary_of::<K>(level, &want));
+    let (lo, hi) = (p[0].min_value(p[1]), p[0].max_value(p[1]));
+    let want: Vec<bool> = da
+        .iter()
+        .map(|v| v.is_some_and(|v| v.in_range(lo, hi)))
+        .collect();
+    prop_assert_eq!(&ta.select_range(lo, hi), &binary_of::<K>(level, &want));
+
+    // Mask by the other's shape.
+    let mask: Vec<bool> = db.iter().map(Option::is_some).collect();
+    let want: Vec<Option<V>> = da
+        .iter()
+        .zip(&mask)
+        .map(|(v, &m)| v.filter(|_| m))
+        .collect();
+    same(
+        &ta.mask(&binary_of::<K>(level, &mask)),
+        &tree_of::<K, V>(level, &want),
+    )?;
+
+    // Combine by every rule, and overlay.
+    for rule in [Rule::First, Rule::Min, Rule::Max, Rule::Sum] {
+        let want: Vec<Option<V>> = da
+            .iter()
+            .zip(&db)
+            .map(|(x, y)| match (x, y) {
+                (Some(x), Some(y)) => Some(rule.apply(*x, *y)),
+                (x, y) => x.or(*y),
+            })
+            .collect();
+        same(
+            &ta.combine(&tb, rule).unwrap(),
+            &tree_of::<K, V>(level, &want),
+        )?;
+    }
+    let want: Vec<Option<V>> = da.iter().zip(&db).map(|(x, y)| y.or(*x)).collect();
+    same(&ta.overlay(&tb).unwrap(), &tree_of::<K, V>(level, &want))?;
+
+    // Relabel: the second palette value becomes the first, the third is erased.
+    let table: HashMap<V::Key, Option<V>> =
+        HashMap::from([(p[1].key(), Some(p[0])), (p[2].key(), None)]);
+    let want: Vec<Option<V>> = da
+        .iter()
+        .map(|v| v.and_then(|v| table.get(&v.key()).copied().unwrap_or(Some(v))))
+        .collect();
+    same(&ta.relabel(&table).unwrap(), &tree_of::<K, V>(level, &want))?;
+    // A threshold to a binary tree.
+    let want: Vec<bool> = da
+        .iter()
+        .map(|v| v.is_some_and(|v| !v.same(p[3])))
+        .collect();
+    let got: KTree<K> = ta.map_values(|v| (!v.same(p[3])).then_some(())).unwrap();
+    got.assert_well_formed();
+    prop_assert_eq!(&got, &binary_of::<K>(level, &want));
+
+    // Per-value statistics against a count over the dense array.
+    let u = Universe::<K>::new(level).unwrap();
+    let mut want: BTreeMap<V::Key, Measured<K>> = BTreeMap::new();
+    for (i, v) in da.iter().enumerate() {
+        let Some(v) = v else { continue };
+        let q = u.dense_point(i);
+        let e = want
+            .entry(v.key())
+            .or_insert((0, [u32::MAX; K], [0; K], [0.0; K]));
+        e.0 += 1;
+        for a in 0..K {
+            e.1[a] = e.1[a].min(q[a]);
+            e.2[a] = e.2[a].max(q[a] + 1);
+            e.3[a] += f64::from(q[a]) + 0.5;
+        }
+    }
+    let stats = ta.value_stats();
+    prop_assert_eq!(stats.len(), want.len());
+    for (key, (voxels, lo, hi, sums)) in &want {
+        let s = &stats[key];
+        prop_assert_eq!(s.voxels, *voxels);
+        prop_assert_eq!(s.bounding_box, (*lo, *hi));
+        for a in 0..K {
+            prop_assert!((s.centroid[a] - sums[a] / *voxels as f64).abs() < 1e-9);
+        }
+        // Faces between a voxel of the value and one without it, counted on the dense array.
+        let mut faces = 0u128;
+        for (i, v) in da.iter().enumerate() {
+            if v.map(Value::key) != Some(*key) {
+                continue;
+            }
+            let q = u.dense_point(i);
+            for a in 0..K {
+                for step in [-1i64, 1] {
+                    let n = i64::from(q[a]) + step;
+                    let mut r = q;
+                    let outside = n < 0 || n >= u.side() as i64;
+                    if !outside {
+                        r[a] = n as u32;
+                    }
+                    if outside || da[u.dense_index(r)].map(Value::key) != Some(*key) {
+                        faces += 1;
+                    }
+                }
+            }
+        }
+        prop_assert_eq!(s.surface_area, faces);
+    }
+    Ok(())
+}
+
+fn pair<const K: usize>() -> impl Strategy<Value = (Painted<K>, Painted<K>)> {
+    (0..=ktree_verify::objects::max_level(K))
+        .prop_flat_map(|l| (painted_at::<K>(l), painted_at::<K>(l)))
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(48))]
+    #[test]
+    fn value_ops_k1((a, b) in pair::<1>()) { check::<1, u8>(&a, &b)?; check::<1, f32>(&a, &b)?; }
+    #[test]
+    fn value_ops_k2((a, b) in pair::<2>()) { check::<2, u16>(&a, &b)?; check::<2, Rgb>(&a, &b)?; }
+    #[test]
+    fn value_ops_k3((a, b) in pair::<3>()) { check::<3, i8>(&a, &b)?; check::<3, f32>(&a, &b)?; }
+    #[test]
+    fn value_ops_k4((a, b) in pair::<4>()) { check::<4, u32>(&a, &b)?; check::<4, Rgb>(&a, &b)?; }
+}
+
+#[test]
+fn a_float_sum_that_is_nan_is_an_error_and_levels_must_match() {
+    let a = KTree::<1, f32>::from_dense_values(1, &[Some(f32::INFINITY), None]).unwrap();
+    let b = KTree::<1, f32>::from_dense_values(1, &[Some(f32::NEG_INFINITY), None]).unwrap();
+    let e = a.combine(&b, Rule::Sum).unwrap_err();
+    assert!(e.to_string().contains("NaN"), "{e}");
+    let c = KTree::<1, f32>::from_dense_values(2, &[None; 4]).unwrap();
+    assert!(a
+        .combine(&c, Rule::Max)
+        .unwrap_err()
+        .to_string()
+        .contains("levels"));
+    // Saturating integer sums.
+    let x = KTree::<1, u8>::from_dense_values(1, &[Some(200), Some(1)]).unwrap();
+    let s = x.combine(&x, Rule::Sum).unwrap();
+    assert_eq!(s.to_dense_values().unwrap(), [Some(255), Some(2)]);
+}
