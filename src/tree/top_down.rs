@@ -12,11 +12,11 @@
 //! use ktree::tree::top_down::{build_top_down, Decision};
 //! use ktree::KTree;
 //! // The voxels of a bintree of level 3 whose coordinate is below 5, valued by their half.
-//! let tree = build_top_down::<1, u8, (), std::convert::Infallible>(
+//! let tree = build_top_down::<1, u8, (), ktree::tree::TreeError>(
 //!     3,
 //!     (),
 //!     |cell, ()| {
-//!         let (lo, hi) = (cell.origin[0], cell.origin[0] + cell.side() as u32);
+//!         let (lo, hi) = (cell.origin()[0], cell.origin()[0] + cell.side() as u32);
 //!         Ok(if lo >= 5 {
 //!             Decision::Leaf(None)
 //!         } else if hi <= 4 {
