@@ -38,9 +38,9 @@ mod location;
 pub mod mesh;
 #[allow(unsafe_code)]
 mod mmap;
+mod out_of_core;
 #[cfg(any(feature = "cloud", feature = "mesh"))]
 mod ply;
-mod out_of_core;
 pub mod rays;
 #[cfg(any(feature = "cloud", feature = "mesh"))]
 mod scalar;

@@ -7,11 +7,11 @@ use std::ops::Range;
 
 use super::{MeshTransform, TriangleMesh};
 use crate::radix::radix_sort;
+use crate::rays::source::default_split_depth;
 use crate::rays::RaySet;
+use crate::rays::{RaySource, SlabRuns};
 use crate::solid::SolidError;
 use crate::space::Universe;
-use crate::rays::source::default_split_depth;
-use crate::rays::{RaySource, SlabRuns};
 
 /// Bits of sub-voxel precision of placed vertices.
 const FRAC: u32 = 16;
