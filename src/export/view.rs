@@ -8,8 +8,11 @@
 //! time chosen with a slider. The mouse orbits (left button), pans (right button or shift) and zooms
 //! (wheel); sliders clip along each axis; a toggle colours by face normal or by depth in the tree. The
 //! first camera is the one `ktree render --camera NAME` takes (the same orthographic projection and
-//! framing). The URL hash sets the start: `#camera=NAME` another camera, `colour=depth` or `colour=normal`,
-//! `time=T` the slice of a 4-D tree, `bare` no controls (the key `h` hides and shows them). `selftest`
+//! framing): it is framed here, on the boxes of the page, and given to the page in its header. At any
+//! window size, and again after every change of size, the page shows the smallest rectangle of the
+//! window's shape that holds the boxes with a 5 % margin (the wheel zooms from there). The URL hash sets
+//! the start: `#camera=NAME` another camera, `colour=depth` or `colour=normal`, `time=T` the slice of a
+//! 4-D tree, `bare` no controls (the key `h` hides and shows them). `selftest`
 //! drives every control after the first frame with DOM events (drags with both buttons, the wheel, a clip
 //! slider, the camera and colour menus, the time slider) and records in the page's status, for each, whether
 //! the view moved as it should and the frame changed: how the tests check the controls in a browser.
@@ -37,6 +40,7 @@
 //! assert!(page.html.starts_with("<!doctype html>") && page.boxes > 0);
 //! ```
 
+mod camera;
 mod lod;
 
 use std::fmt::Write as _;
@@ -48,6 +52,7 @@ use crate::display::{View, NAMED_VIEWS};
 use crate::fs::write_atomic;
 use crate::space::Cell;
 use crate::tree::cursor::TreeStorage;
+use camera::PageCamera;
 
 pub use lod::{select_boxes, select_boxes_of, Lod};
 
@@ -233,13 +238,14 @@ pub fn view_page<const K: usize, T: TreeStorage<K>>(
         .map(|(name, d)| format!("\"{name}\":{}", v(*d)))
         .collect();
     let header = format!(
-        "{{\"k\":{K},\"level\":{level},\"time_axis\":{},\"budget\":{},\"complete\":{},\"full\":{},\"coarse\":{},\"camera\":{},\"views\":{{{}}},\"groups\":{groups}}}",
+        "{{\"k\":{K},\"level\":{level},\"time_axis\":{},\"budget\":{},\"complete\":{},\"full\":{},\"coarse\":{},\"camera\":{},\"frame\":{},\"views\":{{{}}},\"groups\":{groups}}}",
         time.map_or("null".into(), |t| t.to_string()),
         options.budget,
         lod.complete,
         lod.full.len(),
         lod.coarse.len(),
         v(camera.toward_eye()),
+        PageCamera::framing(&lod, level, time, camera.toward_eye()).json(),
         views.join(","),
     );
     let html = TEMPLATE
