@@ -216,6 +216,30 @@ impl PackedStates {
         Ok(s)
     }
 
+    /// A level of a valued tree from its words (code `11`, mixed, allowed).
+    ///
+    /// # Errors
+    /// [`TreeError::WordCount`] or [`TreeError::StrayBits`] as [`PackedStates::from_words`].
+    pub(crate) fn from_valued_words(words: Vec<u64>, len: usize) -> Result<Self, TreeError> {
+        if words.len() != len.div_ceil(NODES_PER_WORD) {
+            return Err(TreeError::WordCount {
+                words: words.len(),
+                len,
+            });
+        }
+        let used = len % NODES_PER_WORD;
+        if used != 0 && words[words.len() - 1] >> (2 * used) != 0 {
+            return Err(TreeError::StrayBits { len });
+        }
+        let mut s = Self {
+            words,
+            len,
+            ..Self::default()
+        };
+        s.finish();
+        Ok(s)
+    }
+
     /// A level with the same partial nodes as this one and other leaves (`words`, e.g. the leaves
     /// complemented): the rank index is copied, not rebuilt.
     pub(crate) fn with_same_partials(&self, words: Vec<u64>) -> Self {

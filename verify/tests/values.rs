@@ -74,3 +74,69 @@ fn a_binary_tree_has_no_value_column_and_its_memory_is_unchanged() {
     assert_eq!(tree, unit);
     assert_eq!(tree.heap_bytes(), unit.heap_bytes());
 }
+
+/// A valued tree through its `.ktree` file (version 3) and back, equal; a binary tree through the same
+/// calls is version 2, byte for byte what `write_ktree` writes.
+fn file_round_trip<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseError> {
+    use ktree::io::ktree::v3::{read_valued_ktree, write_valued_ktree};
+    let tree = KTree::<K, V>::from_dense_values(o.level, &o.dense::<V>()).unwrap();
+    let mut bytes = Vec::new();
+    write_valued_ktree(&mut bytes, &tree).unwrap();
+    prop_assert_eq!(bytes.len() % 8, 0);
+    prop_assert_eq!(u16::from_le_bytes([bytes[6], bytes[7]]), 3);
+    let back = read_valued_ktree::<K, V>(&bytes, "mem").unwrap();
+    prop_assert!(back == tree);
+    let shape = tree.shape();
+    let mut binary = Vec::new();
+    write_valued_ktree(&mut binary, &shape).unwrap();
+    let mut plain = Vec::new();
+    ktree::io::write_ktree(&mut plain, &shape).unwrap();
+    prop_assert_eq!(&binary, &plain);
+    prop_assert_eq!(read_valued_ktree::<K, ()>(&binary, "mem").unwrap(), shape);
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(32))]
+    #[test]
+    fn files_k1(o in painted::<1>()) { file_round_trip::<1, u8>(&o)?; file_round_trip::<1, f32>(&o)?; }
+    #[test]
+    fn files_k2(o in painted::<2>()) { file_round_trip::<2, Rgb>(&o)?; file_round_trip::<2, i8>(&o)?; }
+    #[test]
+    fn files_k3(o in painted::<3>()) { file_round_trip::<3, u16>(&o)?; file_round_trip::<3, u32>(&o)?; }
+    #[test]
+    fn files_k4(o in painted::<4>()) { file_round_trip::<4, f32>(&o)?; }
+}
+
+#[test]
+fn a_damaged_valued_file_is_an_error_at_a_byte_never_a_panic() {
+    use ktree::io::ktree::v3::{read_valued_ktree, write_valued_ktree};
+    let dense: Vec<Option<u16>> = (0..64u16).map(|i| (i % 5 != 0).then_some(i / 16)).collect();
+    let tree = KTree::<2, u16>::from_dense_values(3, &dense).unwrap();
+    let mut bytes = Vec::new();
+    write_valued_ktree(&mut bytes, &tree).unwrap();
+    for at in 0..bytes.len() {
+        for bit in [0, 3, 7] {
+            let mut bad = bytes.clone();
+            bad[at] ^= 1 << bit;
+            let e = read_valued_ktree::<2, u16>(&bad, "bad.ktree").unwrap_err();
+            assert!(e.to_string().contains("bad.ktree"), "{e}");
+        }
+    }
+    for len in 0..bytes.len() {
+        assert!(
+            read_valued_ktree::<2, u16>(&bytes[..len], "cut").is_err(),
+            "{len}"
+        );
+    }
+    // Another value type, another K, and the binary readers: clear errors.
+    let e = read_valued_ktree::<2, f32>(&bytes, "f")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("uint16") && e.contains("float32"), "{e}");
+    assert!(read_valued_ktree::<3, u16>(&bytes, "k").is_err());
+    let e = ktree::io::read_ktree::<2>(&bytes, "b")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("uint16") && e.contains("without values"), "{e}");
+}

@@ -27,6 +27,7 @@ use crate::tree::{AnyTree, KTree};
 
 pub mod v1;
 pub mod v2;
+pub mod v3;
 
 pub use v2::{AnyMappedTree, KtreeView, KtreeWriter, MappedTree};
 
@@ -44,7 +45,7 @@ pub enum KtreeFileErrorKind {
     #[error("not a .ktree file (bad magic)")]
     BadMagic,
     /// Written by a newer version of ktree.
-    #[error("format version {0} is not supported (this ktree reads versions 1 and 2)")]
+    #[error("format version {0} is not supported (this ktree reads versions 1, 2 and 3)")]
     Version(u16),
     /// `K` or `L` out of range.
     #[error("bad header: {0}")]
@@ -88,9 +89,23 @@ pub enum KtreeFileErrorKind {
         /// K in the file.
         found: usize,
     },
+    /// The file holds values of another type than the reader asked for (`None`: no values, a binary tree).
+    #[error("the file holds {}, {} was expected", dtype_name(*found), dtype_name(*expected))]
+    Dtype {
+        /// The value type asked for.
+        expected: Option<crate::tree::Dtype>,
+        /// The value type in the file.
+        found: Option<crate::tree::Dtype>,
+    },
     /// The file could not be read.
     #[error("cannot read: {0}")]
     Io(crate::fs::IoCause),
+}
+
+fn dtype_name(d: Option<crate::tree::Dtype>) -> String {
+    d.map_or("a tree without values".into(), |d| {
+        format!("values of type {d}")
+    })
 }
 
 /// An error reading a `.ktree` file, with the file and the byte offset.
@@ -169,6 +184,15 @@ pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileErro
     match u16::from_le_bytes([bytes[6], bytes[7]]) {
         v1::VERSION => v1::read_v1_any(bytes, file),
         v2::VERSION => v2::read_v2_any(bytes, file),
+        v3::VERSION => Err(fail(
+            10,
+            KtreeFileErrorKind::Dtype {
+                expected: None,
+                found: bytes
+                    .get(10)
+                    .and_then(|&c| crate::tree::Dtype::from_code(c)),
+            },
+        )),
         other => Err(fail(6, KtreeFileErrorKind::Version(other))),
     }
 }

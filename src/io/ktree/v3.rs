@@ -1,0 +1,432 @@
+//! The `.ktree` file, version 3: a valued tree ([`KTree`] with a [`Value`] type) — the level sections of
+//! version 2 with the mixed code, a rank over full nodes and each level's values. A binary tree is still
+//! written as version 2 (its files are unchanged); version 3 holds a tree with values.
+//!
+//! All integers are little-endian; every section starts at a multiple of 8 bytes.
+//!
+//! | offset | size | content |
+//! |---|---|---|
+//! | 0 | 6 | magic `KTREE\0` |
+//! | 6 | 2 | format version, `u16` (= 3) |
+//! | 8 | 1 | `K` (1…4) |
+//! | 9 | 1 | `L` (0…[`crate::max_level`]`(K)`) |
+//! | 10 | 1 | the value type, [`Dtype::code`] (1 `uint8`, 2 `uint16`, 3 `uint32`, 4 `int8`, 5 `float32`, 6 `rgb8`) |
+//! | 11 | 5 | reserved, 0 |
+//! | 16 | … | section 0 (the root level), then section `d` right after section `d − 1` |
+//! | S | 32·D | directory: per level `d`, nodes `n_d`, full nodes `f_d`, nodes with children `c_d` (`u64` each), CRC-32 of section `d` (`u32`), reserved `u32` = 0 |
+//! | S + 32·D | 8 | the file's length in bytes (`u64`) |
+//! | S + 32·D + 8 | 4 | `D`, the number of levels (`u32`) |
+//! | S + 32·D + 12 | 4 | CRC-32 of the header (bytes 0…15) and of everything from S up to here |
+//!
+//! Section `d` holds `W_d = ⌈n_d / 32⌉` words of 2-bit codes (node `i` in bits `2·(i mod 32)` of word
+//! `i / 32`: `00` empty, `01` full, `10` partial, `11` mixed — every voxel valued, not all alike; unused bits
+//! 0), then `R_d = ⌈W_d / 64⌉` samples of the nodes with children before words `64·b` and `R_d` samples of
+//! the full nodes before them (so a reader through a map finds a node's children and its value with at
+//! most 64 pop-counts), then the `f_d` values of the level's full nodes in level order, each
+//! [`Dtype::bytes`] little-endian bytes, zero-padded to a multiple of 8. The section's CRC covers all of it.
+//!
+//! Reading checks everything version 2 checks, and: the value type is the one asked for, every value is
+//! one a voxel may hold (no NaN), a mixed node has no empty or partial child, and the tree is minimal (no
+//! node with children whose children are all empty or all full of one value).
+//!
+//! ```
+//! use ktree::io::ktree::v3::{read_valued_ktree, write_valued_ktree};
+//! use ktree::KTree;
+//! let tree = KTree::<2, u16>::from_dense_values(1, &[Some(7), None, Some(9), Some(7)]).unwrap();
+//! let mut bytes = Vec::new();
+//! write_valued_ktree(&mut bytes, &tree).unwrap();
+//! assert_eq!(read_valued_ktree::<2, u16>(&bytes, "mem").unwrap(), tree);
+//! assert!(read_valued_ktree::<2, u8>(&bytes, "mem").is_err()); // another value type
+//! ```
+
+use std::io::Write;
+use std::path::Path;
+
+use super::v2::layout::{
+    samples_of, u32_at, u64_at, words_of, ENTRY_BYTES, HEADER_BYTES, TAIL_BYTES,
+};
+use super::{KtreeFileError, KtreeFileErrorKind, MAGIC};
+use crate::space::{max_level, Universe, MAX_K};
+use crate::tree::valued::ValueStorage;
+use crate::tree::words::{children_mask, full_mask};
+use crate::tree::{Dtype, KTree, PackedStates, Value};
+
+/// The format version of valued files.
+pub const VERSION: u16 = 3;
+
+/// Words between two rank samples.
+const WORDS_PER_SAMPLE: usize = 64;
+
+fn padded(bytes: u64) -> Option<u64> {
+    bytes.checked_add(7).map(|b| b / 8 * 8)
+}
+
+/// The bytes of a level's section: codes, both rank samples, values padded.
+fn section_bytes(nodes: u64, full: u64, value_bytes: u64) -> Option<u64> {
+    let words = words_of(nodes);
+    let fixed = 8u64.checked_mul(words.checked_add(2 * samples_of(words))?)?;
+    fixed.checked_add(padded(full.checked_mul(value_bytes)?)?)
+}
+
+/// Writes a valued tree as a version 3 `.ktree` file; a tree without values (`V = ()`) as version 2.
+///
+/// # Errors
+/// Any I/O error.
+pub fn write_valued_ktree<const K: usize, V: Value>(
+    mut out: impl Write,
+    tree: &KTree<K, V>,
+) -> std::io::Result<()> {
+    let Some(dtype) = V::DTYPE else {
+        return super::write_ktree(out, &tree.shape());
+    };
+    let mut header = [0u8; HEADER_BYTES];
+    header[..6].copy_from_slice(MAGIC);
+    header[6..8].copy_from_slice(&VERSION.to_le_bytes());
+    header[8] = K as u8;
+    header[9] = tree.level() as u8;
+    header[10] = dtype.code();
+    out.write_all(&header)?;
+    let mut length = HEADER_BYTES as u64;
+    let mut directory = Vec::with_capacity(tree.depth_count() * ENTRY_BYTES + TAIL_BYTES);
+    let mut section = Vec::new();
+    for depth in 0..tree.depth_count() {
+        let states = tree.level_states(depth);
+        let words = states.words();
+        section.clear();
+        for w in words {
+            section.extend_from_slice(&w.to_le_bytes());
+        }
+        let (mut children, mut full) = (0u64, 0u64);
+        let mut children_samples = Vec::new();
+        let mut full_samples = Vec::new();
+        for (i, &w) in words.iter().enumerate() {
+            if i % WORDS_PER_SAMPLE == 0 {
+                children_samples.push(children);
+                full_samples.push(full);
+            }
+            children += u64::from(children_mask(w).count_ones());
+            full += u64::from(full_mask(w).count_ones());
+        }
+        for s in children_samples.iter().chain(&full_samples) {
+            section.extend_from_slice(&s.to_le_bytes());
+        }
+        for index in 0..states.len() {
+            if states.get(index) == crate::tree::NodeState::Full {
+                let value = match tree.value(depth, index) {
+                    Ok(v) => v,
+                    Err(never) => match never {},
+                };
+                value.write_le(&mut section);
+            }
+        }
+        section.resize(section.len().div_ceil(8) * 8, 0);
+        out.write_all(&section)?;
+        length += section.len() as u64;
+        directory.extend_from_slice(&(states.len() as u64).to_le_bytes());
+        directory.extend_from_slice(&full.to_le_bytes());
+        directory.extend_from_slice(&children.to_le_bytes());
+        directory.extend_from_slice(&crc32fast::hash(&section).to_le_bytes());
+        directory.extend_from_slice(&0u32.to_le_bytes());
+    }
+    length += (directory.len() + TAIL_BYTES) as u64;
+    directory.extend_from_slice(&length.to_le_bytes());
+    directory.extend_from_slice(&(tree.depth_count() as u32).to_le_bytes());
+    let mut hasher = crc32fast::Hasher::new();
+    hasher.update(&header);
+    hasher.update(&directory);
+    directory.extend_from_slice(&hasher.finalize().to_le_bytes());
+    out.write_all(&directory)
+}
+
+/// Writes a valued tree's `.ktree` file atomically (a temporary file, then renamed).
+///
+/// # Errors
+/// Any I/O error, naming the path.
+pub fn write_valued_ktree_file<const K: usize, V: Value>(
+    path: &Path,
+    tree: &KTree<K, V>,
+) -> std::io::Result<()> {
+    crate::fs::write_atomic_with(path, |w| write_valued_ktree(w, tree))
+}
+
+/// The dimension, level and value type of a `.ktree` file's first 16 bytes (`None`: a binary tree, version
+/// 1 or 2).
+///
+/// # Errors
+/// [`KtreeFileErrorKind::BadMagic`], a short header, an unknown version or value type.
+pub fn valued_header(
+    head: &[u8],
+    file: &str,
+) -> Result<(usize, u32, Option<Dtype>), KtreeFileError> {
+    let fail = |offset: u64, kind| KtreeFileError::at_byte(file.to_string(), offset, kind);
+    if head.len() < 6 || &head[..6] != MAGIC {
+        return Err(fail(0, KtreeFileErrorKind::BadMagic));
+    }
+    if head.len() < HEADER_BYTES {
+        return Err(fail(
+            head.len() as u64,
+            KtreeFileErrorKind::Length {
+                expected: HEADER_BYTES as u64,
+                found: head.len() as u64,
+            },
+        ));
+    }
+    let version = u16::from_le_bytes([head[6], head[7]]);
+    let k = head[8] as usize;
+    let level = u32::from(head[9]);
+    match version {
+        1 | 2 => Ok((k, level, None)),
+        VERSION => match Dtype::from_code(head[10]) {
+            Some(d) => Ok((k, level, Some(d))),
+            None => Err(fail(
+                10,
+                KtreeFileErrorKind::Header(format!("value type code {} is not 1 to 6", head[10])),
+            )),
+        },
+        other => Err(fail(6, KtreeFileErrorKind::Version(other))),
+    }
+}
+
+/// Reads a version 3 `.ktree` file's bytes holding a `K`-dimensional tree of values of type `V`. A file of
+/// version 1 or 2 is read as a binary tree when `V` is `()`.
+///
+/// # Errors
+/// [`KtreeFileError`] naming the byte offset of the first inconsistency; [`KtreeFileErrorKind::Dtype`] when
+/// the file holds another value type, [`KtreeFileErrorKind::Dimension`] another `K`.
+pub fn read_valued_ktree<const K: usize, V: Value>(
+    bytes: &[u8],
+    file: &str,
+) -> Result<KTree<K, V>, KtreeFileError> {
+    let fail = |offset: u64, kind| KtreeFileError::at_byte(file.to_string(), offset, kind);
+    let (k, level, dtype) = valued_header(&bytes[..bytes.len().min(HEADER_BYTES)], file)?;
+    if dtype != V::DTYPE {
+        return Err(fail(
+            10,
+            KtreeFileErrorKind::Dtype {
+                expected: V::DTYPE,
+                found: dtype,
+            },
+        ));
+    }
+    let Some(dtype) = dtype else {
+        let tree = super::read_ktree::<K>(bytes, file)?;
+        // V is `()` here (the only type without a dtype): the binary tree is the valued tree of no values.
+        return Ok(KTree::from_valued_levels(
+            tree.universe,
+            tree.levels,
+            Vec::new(),
+        ));
+    };
+    if !(1..=MAX_K).contains(&k) {
+        return Err(fail(
+            8,
+            KtreeFileErrorKind::Header(format!("K = {k} is not 1 to {MAX_K}")),
+        ));
+    }
+    if k != K {
+        return Err(fail(
+            8,
+            KtreeFileErrorKind::Dimension {
+                expected: K,
+                found: k,
+            },
+        ));
+    }
+    if level > max_level(k) {
+        return Err(fail(
+            9,
+            KtreeFileErrorKind::Header(format!("L = {level} exceeds {} for K = {k}", max_level(k))),
+        ));
+    }
+    if bytes[11..HEADER_BYTES].iter().any(|&b| b != 0) {
+        return Err(fail(
+            11,
+            KtreeFileErrorKind::Header("reserved bytes are not 0".into()),
+        ));
+    }
+    let len = bytes.len() as u64;
+    let minimum = (HEADER_BYTES + ENTRY_BYTES + TAIL_BYTES) as u64;
+    if len < minimum {
+        return Err(fail(
+            len,
+            KtreeFileErrorKind::Length {
+                expected: minimum,
+                found: len,
+            },
+        ));
+    }
+    let tail_at = bytes.len() - TAIL_BYTES;
+    let recorded = u64_at(bytes, tail_at);
+    if recorded != len {
+        return Err(fail(
+            len.min(recorded),
+            KtreeFileErrorKind::Length {
+                expected: recorded,
+                found: len,
+            },
+        ));
+    }
+    let depth = u64::from(u32_at(bytes, tail_at + 8));
+    let directory_bytes = depth * ENTRY_BYTES as u64;
+    if depth == 0
+        || depth > u64::from(level) + 1
+        || directory_bytes + minimum - ENTRY_BYTES as u64 > len
+    {
+        return Err(fail(
+            tail_at as u64 + 8,
+            KtreeFileErrorKind::Header(format!(
+                "{depth} levels recorded for a level-{level} universe in a {len}-byte file"
+            )),
+        ));
+    }
+    let directory_at = tail_at - directory_bytes as usize;
+    let stored = u32_at(bytes, bytes.len() - 4);
+    let mut hasher = crc32fast::Hasher::new();
+    hasher.update(&bytes[..HEADER_BYTES]);
+    hasher.update(&bytes[directory_at..bytes.len() - 4]);
+    let computed = hasher.finalize();
+    if stored != computed {
+        return Err(fail(
+            len - 4,
+            KtreeFileErrorKind::Checksum { stored, computed },
+        ));
+    }
+    let value_bytes = dtype.bytes();
+    let mut levels = Vec::with_capacity(depth as usize);
+    let mut values: Vec<Vec<V>> = Vec::with_capacity(depth as usize);
+    let mut offset = HEADER_BYTES as u64;
+    let mut above_children: Option<u64> = None;
+    for d in 0..depth as usize {
+        let entry_at = directory_at + d * ENTRY_BYTES;
+        let e = &bytes[entry_at..entry_at + ENTRY_BYTES];
+        let (nodes, full, children) = (u64_at(e, 0), u64_at(e, 8), u64_at(e, 16));
+        let shape_error =
+            |message: String| fail(entry_at as u64, KtreeFileErrorKind::Tree(message));
+        if u32_at(e, 28) != 0 {
+            return Err(shape_error(format!("reserved field of level {d} is not 0")));
+        }
+        let expected = match above_children {
+            None => Some(1),
+            Some(c) => c.checked_mul(1 << K),
+        };
+        if Some(nodes) != expected {
+            return Err(shape_error(format!(
+                "level {d} has {nodes} nodes, the level above calls for {expected:?}"
+            )));
+        }
+        if !matches!(full.checked_add(children), Some(n) if n <= nodes) {
+            return Err(shape_error(format!(
+                "level {d}: more full nodes and nodes with children than nodes"
+            )));
+        }
+        if d + 1 == depth as usize && children > 0 {
+            return Err(shape_error(format!(
+                "the last level ({d}) has {children} nodes with children below it"
+            )));
+        }
+        let size = match section_bytes(nodes, full, value_bytes as u64) {
+            Some(s) if offset + s <= directory_at as u64 => s,
+            _ => {
+                return Err(fail(
+                    offset,
+                    KtreeFileErrorKind::Tree(format!(
+                        "the section of level {d} ({nodes} nodes, {full} values) runs past the directory at byte {directory_at}"
+                    )),
+                ))
+            }
+        };
+        // Sizes are within the file from here on: allocating them is bounded by its length.
+        let section = &bytes[offset as usize..(offset + size) as usize];
+        let stored = u32_at(e, 24);
+        let computed = crc32fast::hash(section);
+        if stored != computed {
+            return Err(fail(
+                offset,
+                KtreeFileErrorKind::SectionChecksum {
+                    level: d,
+                    stored,
+                    computed,
+                },
+            ));
+        }
+        let words_n = words_of(nodes) as usize;
+        let words: Vec<u64> = (0..words_n).map(|i| u64_at(section, 8 * i)).collect();
+        let samples_n = samples_of(words_n as u64) as usize;
+        let (mut c, mut f) = (0u64, 0u64);
+        for (i, &w) in words.iter().enumerate() {
+            if i % WORDS_PER_SAMPLE == 0 {
+                let b = i / WORDS_PER_SAMPLE;
+                let at = 8 * (words_n + b);
+                if u64_at(section, at) != c || u64_at(section, at + 8 * samples_n) != f {
+                    return Err(fail(
+                        offset + at as u64,
+                        KtreeFileErrorKind::Tree(format!("rank sample {b} of level {d} is wrong")),
+                    ));
+                }
+            }
+            c += u64::from(children_mask(w).count_ones());
+            f += u64::from(full_mask(w).count_ones());
+        }
+        if c != children || f != full {
+            return Err(fail(
+                offset,
+                KtreeFileErrorKind::Tree(format!(
+                    "level {d} holds {f} full nodes and {c} with children, the directory says {full} and {children}"
+                )),
+            ));
+        }
+        let level_states = PackedStates::from_valued_words(words, nodes as usize)
+            .map_err(|e| fail(offset, KtreeFileErrorKind::Tree(format!("level {d}: {e}"))))?;
+        let values_at = 8 * (words_n + 2 * samples_n);
+        let mut column = Vec::with_capacity(full as usize);
+        for j in 0..full as usize {
+            let at = values_at + j * value_bytes;
+            let v = V::read_le(&section[at..at + value_bytes]);
+            if let Err(e) = v.check() {
+                return Err(fail(
+                    offset + at as u64,
+                    KtreeFileErrorKind::Tree(format!("level {d}: {e}")),
+                ));
+            }
+            column.push(v);
+        }
+        let end = values_at + full as usize * value_bytes;
+        if section[end..].iter().any(|&b| b != 0) {
+            return Err(fail(
+                offset + end as u64,
+                KtreeFileErrorKind::Tree(format!("padding of level {d} is not 0")),
+            ));
+        }
+        levels.push(level_states);
+        values.push(column);
+        above_children = Some(children);
+        offset += size;
+    }
+    if offset != directory_at as u64 {
+        return Err(fail(
+            offset,
+            KtreeFileErrorKind::Tree(format!(
+                "the sections end at byte {offset} but the directory starts at {directory_at}"
+            )),
+        ));
+    }
+    let universe = Universe::<K>::new(level)
+        .map_err(|e| fail(9, KtreeFileErrorKind::Header(e.to_string())))?;
+    let tree = KTree::from_valued_levels(universe, levels, values);
+    tree.check()
+        .map_err(|e| fail(HEADER_BYTES as u64, KtreeFileErrorKind::Tree(e.to_string())))?;
+    Ok(tree)
+}
+
+/// Reads a valued `.ktree` file from disk ([`read_valued_ktree`]).
+///
+/// # Errors
+/// As [`read_valued_ktree`]; an unreadable file is [`KtreeFileErrorKind::Io`].
+pub fn read_valued_ktree_file<const K: usize, V: Value>(
+    path: &Path,
+) -> Result<KTree<K, V>, KtreeFileError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path)
+        .map_err(|e| KtreeFileError::at_byte(name.clone(), 0, KtreeFileErrorKind::Io(e.into())))?;
+    read_valued_ktree(&bytes, &name)
+}
