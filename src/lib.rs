@@ -39,8 +39,8 @@
 //! # Layers
 //! Each layer imports only those below it, with the exceptions listed after the picture:
 //! ```text
-//!  io/                files by format: .ktree (v1 read, v2 written and mapped), interop grids, ray text,
-//!                     point clouds and meshes in (into solid/'s PointCloud and TriangleMesh);
+//!  io/                files by format: .ktree (v1 read, v2 written and mapped, v3 with values), interop
+//!                     grids, ray text, point clouds and meshes in (into solid/'s PointCloud and TriangleMesh);
 //!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in,
 //!                     meshes written through export/); spill files, one level a file, and the level
 //!                     sink over them; the out-of-core builder's files (Builder::to_file)
@@ -52,15 +52,18 @@
 //!  stacking/          Builder (cells on all threads, in memory or out of core through a piece store and
 //!                     a level-order sink; KTree::from_rays), paper/
 //!  solid/             quadrics, meshes, volumes → rays, slab by slab
-//!  tree/              KTree, AnyTree, the storage trait, the walks, the level sink, packed 2-bit words
+//!  tree/              KTree (binary, or with a value per voxel: tree::value, tree::valued), AnyTree, the
+//!                     storage trait, the walks, the level sink, the top-down builder, packed 2-bit words
 //!  rays/   space   fs (atomic writes, spill folders)
 //! ```
-//! Not yet so: the ray sources of `solid/` implement `stacking::RaySource` (solid → stacking); the
-//! streamed Booleans spill through `io`'s level files, write their output through `io::KtreeWriter` and
-//! read their inputs through `io::KtreeView` (ops → io). (The out-of-core builder writes through its own
-//! traits, `stacking::PieceStore` and `stacking::LevelOrderSink`, which `io` implements with spill files
-//! and the `.ktree` writer: `Builder::to_file` is defined in `io`.) (`KTree::from_rays` and `KTree::from_dense` are
-//! defined beside their builders, in `stacking/` and `reference/`: the tree knows no builder.)
+//! Not yet so: the operators `|`, `&`, `-`, `^`, `!` on trees are defined in `tree/` and call `ops`
+//! (tree → ops); the streamed Booleans spill through `io`'s level files, write their output through
+//! `io::KtreeWriter` and read their inputs through `io::KtreeView` (ops → io). Both are listed in
+//! `verify/tests/layers.rs`, which fails on any other upward import. (The out-of-core builder writes through
+//! its own traits, `stacking::PieceStore` and `stacking::LevelOrderSink`, which `io` implements with spill
+//! files and the `.ktree` writer: `Builder::to_file` is defined in `io`. Ray sources implement
+//! `rays::RaySource`, below every producer and consumer of rays. `KTree::from_rays` and `KTree::from_dense`
+//! are defined beside their builders, in `stacking/` and `reference/`: the tree knows no builder.)
 //!
 //! # Example
 //! ```

@@ -137,8 +137,9 @@ fn full_on_face<const K: usize, T: TreeStorage<K>>(
 }
 
 /// The number of `(K − 1)`-faces between a full voxel and an empty one, outside the universe counting as
-/// empty: the perimeter for `K = 2`, the count of boundary squares for `K = 3` (see the [module
-/// docs](self) for the method: `O(K · nodes)`, whatever the size of the leaves).
+/// empty: the perimeter for `K = 2`, the count of boundary squares for `K = 3`. Counted on the tree's nodes
+/// (full leaves from the counts per level, pairs across sibling faces by descending both sides of the face
+/// only): `O(K · nodes)`, whatever the size of the leaves.
 ///
 /// ```
 /// use ktree::{shape::surface_area, KTree};
