@@ -1,14 +1,18 @@
 //! # ktree — k-trees from rays, for any dimension
 //!
 //! Bintrees (K = 1), quadtrees (K = 2), octrees (K = 3) and 4-D time-space trees (K = 4) from one
-//! const-generic code base, built by Akman & Franklin's *stacking* algorithm and checked against naive
-//! references.
+//! const-generic code base, built from rays and checked against naive references. Two algorithms build the
+//! same tree, node for node: by default [`stacking::Builder`] cuts the universe into cells of about 2^18
+//! voxels, builds each cell the boundary passes through from a bitmap pyramid of its voxels on all threads,
+//! and joins them level by level (in memory or out of core); Akman & Franklin's *stacking* — rays to
+//! maximal rows, combined and split through the dimension-level lists — is [`stacking::paper`], which the
+//! reproductions run and the builder can use per cell ([`stacking::CellStacking::Lists`]).
 //!
 //! ```text
-//!  solids & data            1-D                 K-D
-//!  ray file ──► RaySet<K> ─► maximal rows ─► stacking ─► KTree<K> ─► stats, .ktree files
-//!               (z-runs per    (1-D trees)   (combine/split
-//!                column)                      per dim & level)
+//!  solids & data             cells, each a bitmap pyramid, on all threads ─► join by level ─┐
+//!  ray file ──► RaySet<K> ─┤                                                                 ├─► KTree<K>
+//!               (z-runs per └─► maximal rows ─► stacking (combine/split per dim & level) ────┘
+//!                column)
 //!  reference builders (tests): naive voxel insertion, dense pyramid ──► KTree<K>
 //! ```
 //!
@@ -19,14 +23,17 @@
 //!   to a file), and [`stacking::paper`], Akman & Franklin's stacking as the paper gives it.
 //! * [`reference`](mod@reference): the reference builders the tests compare against (naive insertion, dense pyramid).
 //! * [`solid`]: quadrics, boxes, triangle meshes and volumes to rays, exactly (with [`rays`] Boolean operations).
-//! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers.
+//! * [`tree`]: [`KTree`], level-order, 2 bits a node, navigable without pointers; with a value per voxel
+//!   (`KTree<K, V>`: labels, colours, densities; [`tree::valued`]), minimal, the values of full nodes in
+//!   level order beside the bits.
 //! * [`io`]: files, one module per format — `.ktree` (version 2 written, streamed and memory-mapped; version 1
-//!   read), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb`, point clouds and meshes in — and the spill
+//!   read; version 3 for valued trees), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb`, point clouds and meshes in — and the spill
 //!   files of trees larger than memory (one level a file), which the out-of-core builder and the streamed
 //!   Booleans both write.
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
-//!   mass properties, complexity.
+//!   mass properties, complexity — and those of valued trees ([`ops::values`]: select, mask, combine,
+//!   overlay, map, per-value statistics).
 //! * [`query`]: questions asked of a map — batch point queries, boxes and counts, ray casting, the
 //!   nearest full voxel — on trees in memory and on mapped files.
 //! * [`shape`]: morphology (dilate, erode, opening, closing), connected components, surface area and Euler number, on the runs;
