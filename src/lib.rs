@@ -102,6 +102,7 @@ pub mod solid;
 pub mod space;
 pub mod stacking;
 pub mod tree;
+pub mod value;
 
 /// The traits every tree storage answers through, to `use ktree::prelude::*` at once: [`TreeStorage`]
 /// (the reads) and [`Query`] (the questions of [`query`]), so that a `.ktree` file read in place

@@ -123,5 +123,5 @@ pub enum OpsError {
     },
     /// An operation made a value no voxel may hold (a sum of floats `inf + -inf` is a NaN).
     #[error("the result would hold {0}")]
-    Value(#[from] crate::tree::value::ValueError),
+    Value(#[from] crate::value::ValueError),
 }

@@ -25,6 +25,7 @@ mod rayset;
 mod rows;
 pub mod source;
 mod split;
+pub mod valued;
 
 pub use any::AnyRaySet;
 pub use ball::ball_rays;
@@ -35,3 +36,4 @@ pub use merge::{joined, merge_runs, stretches, Cause, Joined, Stretch, Stretches
 pub use rayset::{ColumnGroups, Normal, Ray, RayError, RaySet};
 pub use rows::{maximal_rows, MaximalRows, Row};
 pub use source::{RaySource, SlabRuns};
+pub use valued::{ValueRun, ValueRuns};

@@ -93,6 +93,24 @@ pub enum RayError {
         /// End.
         z2: u32,
     },
+    /// Two valued runs of one column share a voxel (each voxel holds at most one value).
+    #[error("run {index}: [{z1}, {z2}) overlaps another run of its column")]
+    Overlap {
+        /// The 0-based position of the run in the input.
+        index: usize,
+        /// Start.
+        z1: u32,
+        /// End.
+        z2: u32,
+    },
+    /// A run's value is one no voxel may hold.
+    #[error("run {index}: {error}")]
+    Value {
+        /// The 0-based position of the run (or of the voxel, in a dense array) in the input.
+        index: usize,
+        /// Why the value is refused.
+        error: crate::value::ValueError,
+    },
     /// The normals given do not match the rays one for one.
     #[error("{rays} rays but {normals} pairs of normals")]
     NormalCount {

@@ -101,6 +101,7 @@ mod out_of_core;
 pub mod paper;
 mod partition;
 mod solids;
+mod values;
 
 pub use builder::{Builder, CellStacking};
 pub(crate) use out_of_core::BUFFER_BYTES;

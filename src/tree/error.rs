@@ -96,7 +96,7 @@ pub enum TreeError {
     },
     /// A value no voxel may hold.
     #[error(transparent)]
-    Value(super::value::ValueError),
+    Value(crate::value::ValueError),
     /// A cell belongs to a universe of another level.
     #[error("cell {index} belongs to a level-{found} universe, not level {expected}")]
     CellUniverse {

@@ -4,9 +4,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::cursor::Leaves;
 use super::states::{node_out_of_range, NodeState, PackedStates};
-use super::value::Value;
 use super::valued::LevelValues;
 use super::TreeError;
+use crate::value::Value;
 
 use crate::space::{Cell, DimCheck, SpaceError, Universe};
 

@@ -25,7 +25,8 @@ mod states;
 pub mod storage;
 mod to_rays;
 pub mod top_down;
-pub mod value;
+/// The values a voxel can hold (defined below the tree, in [`crate::value`]).
+pub use crate::value;
 pub mod valued;
 pub(crate) mod words;
 

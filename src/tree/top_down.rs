@@ -38,10 +38,10 @@
 use super::ktree::KTree;
 use super::states::PackedStates;
 use super::storage::TreeStorage;
-use super::value::Value;
 use super::valued::{combine, ValueState, ValueStorage};
 use super::{NodeState, TreeError};
 use crate::space::{Cell, Universe};
+use crate::value::Value;
 
 /// What a cell of the tree being built is.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -42,10 +42,10 @@ use super::ktree::{KTree, TreeId};
 use super::sink::{LevelSink, MemorySink};
 use super::states::{FullRank, NodeState, PackedStates};
 use super::storage::infallible;
-use super::value::{Value, ValueError};
 use super::words::{children_mask, full_mask, unused_mask, LOW_BITS};
 use super::TreeError;
 use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
+use crate::value::{Value, ValueError};
 
 /// The values of a level's full nodes, in level order, and the rank over the level's full nodes that finds
 /// a node's value.

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// The layers, lowest first; a module may import the modules of the layers before its own.
 const LAYERS: &[&[&str]] = &[
-    &["space", "fs", "radix", "dim"],
+    &["space", "fs", "radix", "dim", "value"],
     &["rays"],
     &["tree"],
     &["solid"],

@@ -140,3 +140,59 @@ fn a_damaged_valued_file_is_an_error_at_a_byte_never_a_panic() {
         .to_string();
     assert!(e.contains("uint16") && e.contains("without values"), "{e}");
 }
+
+/// Building from valued runs: the runs of the dense array (maximal stretches of equal values), and the same
+/// voxels as one run each (touching runs of one value), give the tree of the dense array.
+fn from_runs<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseError> {
+    use ktree::rays::ValueRuns;
+    use ktree::Ray;
+    let dense = o.dense::<V>();
+    let want = KTree::<K, V>::from_dense_values(o.level, &dense).unwrap();
+    let runs = ValueRuns::<K, V>::from_dense(o.level, &dense).unwrap();
+    let got = KTree::from_value_runs(&runs);
+    got.assert_well_formed();
+    prop_assert!(got == want);
+    prop_assert_eq!(runs.voxel_count(), want.voxel_count());
+    let u = o.universe();
+    let voxels = dense.iter().enumerate().filter_map(|(i, v)| {
+        let p = u.dense_point(i);
+        v.map(|v| (Ray::new(p, p[K - 1] + 1), v))
+    });
+    let single =
+        ValueRuns::<K, V>::from_runs(o.level, voxels.collect::<Vec<_>>().into_iter().rev())
+            .unwrap();
+    let got = KTree::from_value_runs(&single);
+    got.assert_well_formed();
+    prop_assert!(got == want);
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(48))]
+    #[test]
+    fn runs_k1(o in painted::<1>()) { from_runs::<1, u8>(&o)?; from_runs::<1, f32>(&o)?; }
+    #[test]
+    fn runs_k2(o in painted::<2>()) { from_runs::<2, Rgb>(&o)?; from_runs::<2, u16>(&o)?; }
+    #[test]
+    fn runs_k3(o in painted::<3>()) { from_runs::<3, i8>(&o)?; from_runs::<3, u32>(&o)?; }
+    #[test]
+    fn runs_k4(o in painted::<4>()) { from_runs::<4, f32>(&o)?; from_runs::<4, u8>(&o)?; }
+}
+
+#[test]
+fn valued_runs_that_overlap_or_hold_nan_are_errors() {
+    use ktree::rays::ValueRuns;
+    use ktree::Ray;
+    let e = ValueRuns::<2, u8>::from_runs(2, [(Ray::new([1, 0], 3), 1), (Ray::new([1, 2], 4), 2)])
+        .unwrap_err();
+    assert!(e.to_string().contains("overlaps"), "{e}");
+    // Touching runs are fine, in any order.
+    assert!(
+        ValueRuns::<2, u8>::from_runs(2, [(Ray::new([1, 2], 4), 2), (Ray::new([1, 0], 2), 1)])
+            .is_ok()
+    );
+    let e = ValueRuns::<1, f32>::from_runs(1, [(Ray::new([0], 1), f32::NAN)]).unwrap_err();
+    assert!(e.to_string().contains("NaN"), "{e}");
+    let e = ValueRuns::<1, f32>::from_dense(1, &[None, Some(f32::NAN)]).unwrap_err();
+    assert!(e.to_string().contains("NaN"), "{e}");
+}

@@ -1,0 +1,190 @@
+//! Runs that carry values: an object whose voxels hold values, as runs `[z1, z2)` along the last axis, each
+//! with one value — a row of a label volume, a scan line of a density. Runs of one column are disjoint;
+//! two runs may touch (a label change along the row). The builder stacks them into a minimal valued tree
+//! ([`KTree::from_value_runs`](crate::KTree::from_value_runs)).
+//!
+//! ```
+//! use ktree::rays::ValueRuns;
+//! use ktree::Ray;
+//! // A quadtree row: labels 1 on [0, 2), 2 on [2, 3) in column x = 1.
+//! let runs = ValueRuns::<2, u8>::from_runs(2, [(Ray::new([1, 0], 2), 1), (Ray::new([1, 2], 3), 2)]).unwrap();
+//! assert_eq!(runs.len(), 2);
+//! // Axis 0 fastest: voxel (1, z) is at 1 + 4·z.
+//! let mut dense = [None; 16];
+//! (dense[1], dense[5], dense[9]) = (Some(1), Some(1), Some(2));
+//! assert_eq!(ValueRuns::<2, u8>::from_dense(2, &dense).unwrap(), runs);
+//! ```
+
+use super::{ColumnKeys, Ray, RayError};
+use crate::space::{Universe, DENSE_LIMIT};
+use crate::value::Value;
+
+/// One run of a [`ValueRuns`]: its column's key ([`ColumnKeys`]), `[z1, z2)` and its value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ValueRun<V> {
+    /// The column's key.
+    pub column: u64,
+    /// Where the run starts (inclusive).
+    pub z1: u32,
+    /// Where it ends (exclusive).
+    pub z2: u32,
+    /// What its voxels hold.
+    pub value: V,
+}
+
+/// Valued runs sorted by column (axis 0 most significant) and by `z1`, disjoint in each column.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValueRuns<const K: usize, V> {
+    universe: Universe<K>,
+    runs: Vec<ValueRun<V>>,
+}
+
+impl<const K: usize, V: Value> ValueRuns<K, V> {
+    /// The runs of a universe of level `level`, each a ray and its value, in any order.
+    ///
+    /// # Errors
+    /// As [`RaySet::from_rays`](super::RaySet::from_rays) for a run outside the universe or empty;
+    /// [`RayError::Overlap`] for two runs of one column that share a voxel; [`RayError::Value`] for a value
+    /// no voxel may hold (a NaN).
+    pub fn from_runs(
+        level: u32,
+        runs: impl IntoIterator<Item = (Ray<K>, V)>,
+    ) -> Result<Self, RayError> {
+        let universe = Universe::<K>::new(level)?;
+        let keys = ColumnKeys::<K>::new(level);
+        let side = universe.side();
+        let mut out: Vec<(ValueRun<V>, usize)> = Vec::new();
+        for (index, (ray, value)) in runs.into_iter().enumerate() {
+            for (axis, &v) in ray.start[..K - 1].iter().enumerate() {
+                if u64::from(v) >= side {
+                    return Err(RayError::ColumnOutside {
+                        index,
+                        axis,
+                        value: v,
+                        side,
+                    });
+                }
+            }
+            let (z1, z2) = (ray.z1(), ray.z2);
+            if u64::from(z1) > side || u64::from(z2) > side {
+                return Err(RayError::RunOutside {
+                    index,
+                    z1,
+                    z2,
+                    side,
+                });
+            }
+            if z1 >= z2 {
+                return Err(RayError::EmptyRun { index, z1, z2 });
+            }
+            value
+                .check()
+                .map_err(|e| RayError::Value { index, error: e })?;
+            out.push((
+                ValueRun {
+                    column: keys.pack(ray.start),
+                    z1,
+                    z2,
+                    value,
+                },
+                index,
+            ));
+        }
+        out.sort_unstable_by_key(|(r, _)| (r.column, r.z1));
+        for pair in out.windows(2) {
+            let ((a, _), (b, index)) = (&pair[0], &pair[1]);
+            if a.column == b.column && b.z1 < a.z2 {
+                return Err(RayError::Overlap {
+                    index: *index,
+                    z1: b.z1,
+                    z2: b.z2,
+                });
+            }
+        }
+        Ok(Self {
+            universe,
+            runs: out.into_iter().map(|(r, _)| r).collect(),
+        })
+    }
+
+    /// The runs of a dense array of voxels (axis 0 fastest, see [`Universe::dense_index`]): in each
+    /// column, each stretch of equal values (bit-equal, [`Value::same`]) one run.
+    ///
+    /// # Errors
+    /// [`RayError::Space`] for a level beyond the largest, a universe beyond
+    /// [`DENSE_LIMIT`](crate::space::DENSE_LIMIT) voxels or an array of another length; [`RayError::Value`]
+    /// for a NaN.
+    pub fn from_dense(level: u32, dense: &[Option<V>]) -> Result<Self, RayError> {
+        let universe = Universe::<K>::new(level)?;
+        let len = universe.dense_len(DENSE_LIMIT)?;
+        if dense.len() != len {
+            return Err(RayError::Space(
+                crate::space::SpaceError::TooLargeForDense {
+                    voxels: dense.len() as u128,
+                    limit: len as u128,
+                },
+            ));
+        }
+        let keys = ColumnKeys::<K>::new(level);
+        let side = universe.side() as usize;
+        // The last axis is the slowest of the dense order: voxel z of column c is at c + z · side^(K−1).
+        let stride = len / side;
+        let mut runs = Vec::new();
+        for c in 0..stride {
+            let column = keys.pack(universe.dense_point(c));
+            let mut current: Option<ValueRun<V>> = None;
+            for z in 0..side {
+                let v = dense[c + z * stride];
+                if let Some(v) = v {
+                    v.check().map_err(|e| RayError::Value {
+                        index: c + z * stride,
+                        error: e,
+                    })?;
+                }
+                match (&mut current, v) {
+                    (Some(run), Some(v)) if run.value.same(v) => run.z2 += 1,
+                    (cur, v) => {
+                        if let Some(run) = cur.take() {
+                            runs.push(run);
+                        }
+                        *cur = v.map(|value| ValueRun {
+                            column,
+                            z1: z as u32,
+                            z2: z as u32 + 1,
+                            value,
+                        });
+                    }
+                }
+            }
+            runs.extend(current);
+        }
+        // Columns in key order: dense order has axis 0 fastest, keys axis 0 most significant.
+        runs.sort_by_key(|r| (r.column, r.z1));
+        Ok(Self { universe, runs })
+    }
+
+    /// The universe.
+    pub fn universe(&self) -> Universe<K> {
+        self.universe
+    }
+
+    /// The runs, by column and `z1`.
+    pub fn runs(&self) -> &[ValueRun<V>] {
+        &self.runs
+    }
+
+    /// The number of runs.
+    pub fn len(&self) -> usize {
+        self.runs.len()
+    }
+
+    /// Whether there is no run.
+    pub fn is_empty(&self) -> bool {
+        self.runs.is_empty()
+    }
+
+    /// The number of voxels that hold a value.
+    pub fn voxel_count(&self) -> u128 {
+        self.runs.iter().map(|r| u128::from(r.z2 - r.z1)).sum()
+    }
+}
