@@ -173,6 +173,15 @@ pub trait Value: Copy + PartialEq + Debug + Send + Sync + 'static + sealed::Seal
     /// Whether `lo <= self <= hi` (on every channel for [`Rgb`]).
     fn in_range(self, lo: Self, hi: Self) -> bool;
 
+    /// The value written as [`Value::parse`] reads it: a number, or `r,g,b` for a colour.
+    fn text(self) -> String;
+
+    /// The value of a text: a number of the type (`-3`, `255`, `0.25`, `inf`), or `r,g,b` for a colour.
+    ///
+    /// # Errors
+    /// A message saying what was expected (a NaN is refused).
+    fn parse(text: &str) -> Result<Self, String>;
+
     /// Appends the value's bytes, little-endian.
     fn write_le(self, out: &mut Vec<u8>);
 
@@ -195,6 +204,16 @@ impl Value for () {
     #[inline(always)]
     fn in_range(self, _: Self, _: Self) -> bool {
         true
+    }
+    fn text(self) -> String {
+        String::new()
+    }
+    fn parse(text: &str) -> Result<Self, String> {
+        if text.is_empty() {
+            Ok(())
+        } else {
+            Err(format!("'{text}': a tree without values holds no value"))
+        }
     }
     #[inline(always)]
     fn write_le(self, _: &mut Vec<u8>) {}
@@ -227,6 +246,19 @@ macro_rules! integer_value {
             #[inline]
             fn in_range(self, lo: Self, hi: Self) -> bool {
                 lo <= self && self <= hi
+            }
+            fn text(self) -> String {
+                self.to_string()
+            }
+            fn parse(text: &str) -> Result<Self, String> {
+                text.trim().parse::<$t>().map_err(|_| {
+                    format!(
+                        "'{text}' is not a {} value ({} to {})",
+                        $d.name(),
+                        <$t>::MIN,
+                        <$t>::MAX
+                    )
+                })
             }
             #[inline]
             fn write_le(self, out: &mut Vec<u8>) {
@@ -277,6 +309,17 @@ impl Value for f32 {
             Ok(())
         }
     }
+    fn text(self) -> String {
+        self.to_string()
+    }
+    fn parse(text: &str) -> Result<Self, String> {
+        match text.trim().parse::<f32>() {
+            Ok(v) if !v.is_nan() => Ok(v),
+            _ => Err(format!(
+                "'{text}' is not a float32 value (a number, not NaN)"
+            )),
+        }
+    }
     #[inline]
     fn write_le(self, out: &mut Vec<u8>) {
         out.extend_from_slice(&self.to_le_bytes());
@@ -311,6 +354,18 @@ impl Value for Rgb {
     fn in_range(self, lo: Self, hi: Self) -> bool {
         (0..3).all(|c| lo[c] <= self[c] && self[c] <= hi[c])
     }
+    fn text(self) -> String {
+        format!("{},{},{}", self[0], self[1], self[2])
+    }
+    fn parse(text: &str) -> Result<Self, String> {
+        let parts: Vec<Result<u8, _>> = text.split(',').map(|c| c.trim().parse::<u8>()).collect();
+        match parts.as_slice() {
+            [Ok(r), Ok(g), Ok(b)] => Ok([*r, *g, *b]),
+            _ => Err(format!(
+                "'{text}' is not an rgb8 colour (r,g,b, each 0 to 255)"
+            )),
+        }
+    }
     #[inline]
     fn write_le(self, out: &mut Vec<u8>) {
         out.extend_from_slice(&self);
@@ -342,6 +397,14 @@ mod tests {
         round_trip(&[-128i8, 0, 127]);
         round_trip(&[0.0f32, -0.0, 1.5, f32::INFINITY, f32::MIN_POSITIVE]);
         round_trip(&[[1u8, 2, 3]]);
+        assert_eq!(u8::parse("255"), Ok(255));
+        assert!(u8::parse("256").is_err() && i8::parse("-129").is_err());
+        assert_eq!(f32::parse("-0.5"), Ok(-0.5));
+        assert!(f32::parse("nan").is_err());
+        assert_eq!(Rgb::parse("1, 2,3"), Ok([1, 2, 3]));
+        assert!(Rgb::parse("1,2").is_err());
+        assert_eq!(Rgb::parse(&[0u8, 9, 255].text()), Ok([0, 9, 255]));
+        assert_eq!(u16::parse(&7u16.text()), Ok(7));
         for d in Dtype::ALL {
             assert_eq!(Dtype::parse(d.name()), Some(d));
             assert_eq!(Dtype::from_code(d.code()), Some(d));

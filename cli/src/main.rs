@@ -24,6 +24,7 @@ mod shape;
 mod stats;
 mod table;
 mod transform;
+mod values;
 mod view;
 mod voxelize;
 
@@ -64,6 +65,8 @@ enum Command {
     Rays(rays::Args),
     /// A triangle mesh (OBJ, STL, PLY), a volume (raw + JSON, NIfTI) or a point cloud (PLY, PCD, XYZ/CSV, LAS/LAZ) to rays or a .ktree.
     Voxelize(voxelize::Args),
+    /// The voxels of one value, or of a range of values, of a tree with values: a tree without values.
+    Select(values::SelectArgs),
     /// Point queries on a tree file: inside or not, with --distance and --nearest the nearest full voxel.
     Query(query::QueryArgs),
     /// Cast rays (origin, direction) into a tree file: the first full voxel each enters.
@@ -111,6 +114,7 @@ fn main() -> ExitCode {
         Command::Morph(args) => shape::run_morph(args),
         Command::Components(args) => shape::run_components(args),
         Command::Distance(args) => distance::run(args),
+        Command::Select(args) => values::run_select(args),
         Command::Query(args) => query::run_query(args),
         Command::Raycast(args) => query::run_raycast(args),
     };

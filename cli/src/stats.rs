@@ -4,7 +4,9 @@
 //! the box may lie); a file of another format `ktree` reads (`.vdb`, `.bt`, binvox, …) is read into memory.
 //! With `--measures`, the surface area and the Euler number (`surface_area`, `euler_number`) too, measured
 //! on the file as it is read (in place for a version 2 file): the surface area on the nodes alone, the
-//! Euler number on the tree's runs when they fit the memory budget.
+//! Euler number on the tree's runs when they fit the memory budget. A `.ktree` with values gives the counts
+//! of its own nodes, its value type (`dtype`) and, per value (`values`), the voxels, bounding box, centroid
+//! and surface area.
 
 use crate::common::error::CliResult;
 use crate::outln;
@@ -38,6 +40,16 @@ pub struct Args {
 
 /// Prints the statistics.
 pub fn run(args: Args) -> CliResult {
+    if let Some(path) = args.tree.as_deref().filter(|p| crate::values::is_valued(p)) {
+        if args.measures {
+            return Err(format!(
+                "{}: --measures is for trees without values; a tree with values gives each value's surface area under `values`",
+                path.display()
+            )
+            .into());
+        }
+        return crate::values::print_valued_stats(path, args.json);
+    }
     // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
     let (stats, measures) = match (&args.tree, &args.rays) {
         (Some(path), None) => {

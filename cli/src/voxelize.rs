@@ -35,6 +35,12 @@ pub struct Args {
     /// Mesh: voxel coordinate = s·v + t, given as s,tx,ty,tz.
     #[arg(long)]
     transform: Option<String>,
+    /// Volume: every sample's label kept, 0 the background: a tree with values (a .ktree output).
+    #[arg(long, conflicts_with_all = ["threshold", "label"])]
+    labels: bool,
+    /// With --labels: the label type, uint8, uint16 or uint32 (default: the smallest that holds them).
+    #[arg(long, requires = "labels")]
+    dtype: Option<String>,
     /// Volume: samples with value ≥ this are inside.
     #[arg(long, conflicts_with = "label")]
     threshold: Option<f64>,
@@ -93,26 +99,29 @@ pub fn run(a: Args) -> CliResult {
             (None, false) => return Err("a mesh needs --fit or --transform s,tx,ty,tz".into()),
         };
     } else {
+        if a.labels {
+            let offset = parse_offset(&a.offset)?;
+            if !is_tree_file(&a.out) {
+                return Err(format!(
+                    "--labels writes a tree with values: the output must be a .ktree, not {}",
+                    a.out.display()
+                )
+                .into());
+            }
+            return crate::values::voxelize_labels(
+                &a.input,
+                a.level,
+                offset,
+                a.dtype.as_deref(),
+                &a.out,
+            );
+        }
         options.select = match (a.threshold, a.label) {
             (Some(t), _) => Some(Select::AtLeast(t)),
             (None, Some(l)) => Some(Select::Label(l)),
             (None, None) => return Err("a volume needs --threshold T or --label V".into()),
         };
-        let off: Vec<u32> = a
-            .offset
-            .split(',')
-            .map(|x| x.trim().parse::<u32>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| {
-                format!(
-                    "--offset '{}': expected x,y,z (non-negative integers)",
-                    a.offset
-                )
-            })?;
-        let off: [u32; 3] = off
-            .try_into()
-            .map_err(|_| format!("--offset '{}': expected three numbers", a.offset))?;
-        options.offset = Some(off.map(i64::from));
+        options.offset = Some(parse_offset(&a.offset)?.map(i64::from));
     }
     // In a run over several MPI ranks, rank 0 alone reports.
     let root = crate::distributed::ranks().is_root();
@@ -128,6 +137,17 @@ pub fn run(a: Args) -> CliResult {
     remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
     crate::common::output::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?)?;
     Ok(())
+}
+
+/// A volume's `--offset x,y,z`.
+fn parse_offset(text: &str) -> Result<[u32; 3], String> {
+    let off: Vec<u32> = text
+        .split(',')
+        .map(|x| x.trim().parse::<u32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("--offset '{text}': expected x,y,z (non-negative integers)"))?;
+    off.try_into()
+        .map_err(|_| format!("--offset '{text}': expected three numbers"))
 }
 
 /// Voxelizes a point cloud and writes it.

@@ -27,8 +27,9 @@ use std::path::Path;
 use serde::Deserialize;
 
 use super::SolidError;
-use crate::rays::{ColumnKeys, RaySet, RaySource, SlabRuns};
+use crate::rays::{ColumnKeys, Ray, RaySet, RaySource, SlabRuns, ValueRuns};
 use crate::space::Universe;
+use crate::value::{Dtype, Value};
 
 /// Which samples are inside.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -383,6 +384,95 @@ impl Volume {
         let universe = self.placed(level, offset)?;
         let (columns, runs) = self.slab_runs(level, offset, select, 0..universe.side());
         Ok(RaySet::from_sorted_parts(universe, columns, runs, None))
+    }
+
+    /// The smallest label type that holds every sample as a label: `uint8`, `uint16` or `uint32`.
+    ///
+    /// # Errors
+    /// [`SolidError::BadParameter`] naming the first sample that is not a label (a non-negative integer up
+    /// to `u32::MAX`), with its `(x, y, z)`.
+    pub fn label_dtype(&self) -> Result<Dtype, SolidError> {
+        let mut largest = 0f64;
+        for (i, &v) in self.values.iter().enumerate() {
+            if !(v >= 0.0 && v <= f64::from(u32::MAX) && v.fract() == 0.0) {
+                return Err(self.not_a_label(i, v));
+            }
+            largest = largest.max(v);
+        }
+        Ok(if largest <= f64::from(u8::MAX) {
+            Dtype::U8
+        } else if largest <= f64::from(u16::MAX) {
+            Dtype::U16
+        } else {
+            Dtype::U32
+        })
+    }
+
+    fn not_a_label(&self, i: usize, v: f64) -> SolidError {
+        let [nx, ny, _] = self.shape;
+        let (x, y, z) = (i % nx, i / nx % ny, i / (nx * ny));
+        SolidError::BadParameter(format!(
+            "sample ({x}, {y}, {z}) is {v}: labels are whole numbers from 0 (the background) up"
+        ))
+    }
+
+    /// The samples as labels of type `V`, placed at `offset` in a universe of level `level`: each run of
+    /// equal non-zero samples along z one valued run; 0 is the background (empty).
+    ///
+    /// ```
+    /// use ktree::solid::volume::Volume;
+    /// use ktree::KTree;
+    /// let v = Volume::new([2, 1, 2], vec![0.0, 3.0, 7.0, 3.0], [1.0; 3]).unwrap();
+    /// let tree = KTree::from_value_runs(&v.to_label_runs::<u8>(1, [0, 0, 0]).unwrap());
+    /// assert_eq!(tree.value_at([1, 0, 1]), Some(3));
+    /// assert_eq!(tree.value_at([0, 0, 0]), None);
+    /// ```
+    ///
+    /// # Errors
+    /// [`SolidError::BadParameter`] for a sample that is not a label of `V` (naming it) or a volume that
+    /// does not fit; [`SolidError::Space`] for a bad level.
+    pub fn to_label_runs<V: Value + TryFrom<u32>>(
+        &self,
+        level: u32,
+        offset: [u32; 3],
+    ) -> Result<ValueRuns<3, V>, SolidError> {
+        self.placed(level, offset)?;
+        let [nx, ny, nz] = self.shape;
+        let mut runs = Vec::new();
+        for y in 0..ny {
+            for x in 0..nx {
+                let mut current: Option<(usize, u32)> = None;
+                for z in 0..=nz {
+                    let label = if z < nz {
+                        let i = x + nx * (y + ny * z);
+                        let v = self.values[i];
+                        if !(v >= 0.0 && v <= f64::from(u32::MAX) && v.fract() == 0.0) {
+                            return Err(self.not_a_label(i, v));
+                        }
+                        v as u32
+                    } else {
+                        0
+                    };
+                    match current {
+                        Some((_, l)) if l == label => continue,
+                        Some((start, l)) => {
+                            let value = V::try_from(l).map_err(|_| {
+                                self.not_a_label(x + nx * (y + ny * start), f64::from(l))
+                            })?;
+                            let p = [
+                                offset[0] + x as u32,
+                                offset[1] + y as u32,
+                                offset[2] + start as u32,
+                            ];
+                            runs.push((Ray::new(p, offset[2] + z as u32), value));
+                        }
+                        None => {}
+                    }
+                    current = (label != 0).then_some((z, label));
+                }
+            }
+        }
+        ValueRuns::from_runs(level, runs).map_err(|e| SolidError::BadParameter(e.to_string()))
     }
 
     /// The universe of level `level`, checked to hold the volume at `offset`.

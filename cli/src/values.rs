@@ -1,0 +1,263 @@
+//! Trees with values on the command line: `ktree voxelize VOLUME --labels` (a label volume into one valued
+//! tree), `ktree select FILE --value V | --range LO:HI --out OUT` (the voxels of a value or a range, as a
+//! tree without values) and the per-value statistics of `ktree stats` on a valued file.
+//!
+//! A valued `.ktree` (version 3) carries its dimension and value type; each command reads them from the
+//! header and runs the same generic code for every `K` and type ([`with_valued!`]).
+
+use std::path::{Path, PathBuf};
+
+use ktree::io::ktree::v3::{read_valued_ktree, valued_header, write_valued_ktree_file};
+use ktree::query::{stats, TreeStats};
+use ktree::solid::volume::Volume;
+use ktree::value::{Dtype, Rgb, Value};
+use ktree::KTree;
+
+use crate::common::error::CliResult;
+use crate::outln;
+
+/// Runs `$f::<K, V>($args)` for the dimension `$k` and value type `$dtype` of a file.
+macro_rules! with_valued {
+    ($k:expr, $dtype:expr, $f:ident($($arg:expr),*)) => {
+        match $k {
+            1 => with_valued!(@v 1, $dtype, $f($($arg),*)),
+            2 => with_valued!(@v 2, $dtype, $f($($arg),*)),
+            3 => with_valued!(@v 3, $dtype, $f($($arg),*)),
+            4 => with_valued!(@v 4, $dtype, $f($($arg),*)),
+            other => Err(format!("K = {other} is not 1 to 4").into()),
+        }
+    };
+    (@v $n:literal, $dtype:expr, $f:ident($($arg:expr),*)) => {
+        match $dtype {
+            Dtype::U8 => $f::<$n, u8>($($arg),*),
+            Dtype::U16 => $f::<$n, u16>($($arg),*),
+            Dtype::U32 => $f::<$n, u32>($($arg),*),
+            Dtype::I8 => $f::<$n, i8>($($arg),*),
+            Dtype::F32 => $f::<$n, f32>($($arg),*),
+            Dtype::Rgb => $f::<$n, Rgb>($($arg),*),
+        }
+    };
+}
+
+/// The dimension and value type of a `.ktree` file (`None`: no values).
+pub fn file_dtype(path: &Path) -> Result<(usize, Option<Dtype>), String> {
+    let mut head = [0u8; 16];
+    let read = std::fs::File::open(path).and_then(|mut f| {
+        use std::io::Read;
+        let mut n = 0;
+        while n < head.len() {
+            match f.read(&mut head[n..])? {
+                0 => break,
+                m => n += m,
+            }
+        }
+        Ok(n)
+    });
+    let n = read.map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let (k, _, dtype) =
+        valued_header(&head[..n], &path.display().to_string()).map_err(|e| e.to_string())?;
+    Ok((k, dtype))
+}
+
+/// Whether `path` names a `.ktree` file that holds values.
+pub fn is_valued(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "ktree") && matches!(file_dtype(path), Ok((_, Some(_))))
+}
+
+fn read<const K: usize, V: Value>(path: &Path) -> Result<KTree<K, V>, String> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
+    read_valued_ktree::<K, V>(&bytes, &name).map_err(|e| e.to_string())
+}
+
+/// A label volume into a valued tree of the smallest label type that holds it (or `dtype`).
+pub fn voxelize_labels(
+    input: &Path,
+    level: Option<u32>,
+    offset: [u32; 3],
+    dtype: Option<&str>,
+    out: &Path,
+) -> CliResult {
+    let volume = Volume::read(input).map_err(|e| e.to_string())?;
+    let smallest = volume
+        .label_dtype()
+        .map_err(|e| format!("{}: {e}", input.display()))?;
+    let dtype = match dtype {
+        None => smallest,
+        Some(name) => match Dtype::parse(name) {
+            Some(d @ (Dtype::U8 | Dtype::U16 | Dtype::U32)) => d,
+            _ => {
+                return Err(format!("--dtype '{name}': labels are uint8, uint16 or uint32").into())
+            }
+        },
+    };
+    let fits = [0, 1, 2].map(|a| offset[a] as usize + volume.shape()[a]);
+    let level = level.unwrap_or_else(|| {
+        let m = fits.into_iter().max().unwrap_or(1).max(1);
+        m.next_power_of_two().trailing_zeros()
+    });
+    fn build<V: Value + TryFrom<u32>>(
+        volume: &Volume,
+        input: &Path,
+        level: u32,
+        offset: [u32; 3],
+        out: &Path,
+    ) -> CliResult {
+        let runs = volume
+            .to_label_runs::<V>(level, offset)
+            .map_err(|e| format!("{}: {e}", input.display()))?;
+        let tree = KTree::from_value_runs(&runs);
+        write_valued_ktree_file(out, &tree)
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        let labels = tree.value_stats().len();
+        outln!(
+            "{}: {} voxels labelled with {labels} labels ({}), L = {level}, {} nodes",
+            out.display(),
+            tree.voxel_count(),
+            V::DTYPE.map_or("", Dtype::name),
+            tree.node_count()
+        );
+        Ok(())
+    }
+    match dtype {
+        Dtype::U8 => build::<u8>(&volume, input, level, offset, out),
+        Dtype::U16 => build::<u16>(&volume, input, level, offset, out),
+        _ => build::<u32>(&volume, input, level, offset, out),
+    }
+}
+
+/// Arguments of `ktree select`.
+#[derive(Debug, clap::Args)]
+#[command(group(clap::ArgGroup::new("which").required(true).args(["value", "range"])))]
+pub struct SelectArgs {
+    /// A `.ktree` file with values.
+    input: PathBuf,
+    /// The value whose voxels are kept (a number, or r,g,b for a colour).
+    #[arg(long, allow_hyphen_values = true)]
+    value: Option<String>,
+    /// The values kept, LO:HI, both included (on every channel for colours).
+    #[arg(long, allow_hyphen_values = true)]
+    range: Option<String>,
+    /// The output `.ktree`: the selected voxels, without values.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// `ktree select`.
+pub fn run_select(a: SelectArgs) -> CliResult {
+    let (k, dtype) = file_dtype(&a.input)?;
+    let Some(dtype) = dtype else {
+        return Err(format!(
+            "{}: the tree holds no values (select takes a tree made with values, e.g. voxelize --labels)",
+            a.input.display()
+        )
+        .into());
+    };
+    with_valued!(k, dtype, select(&a))
+}
+
+fn select<const K: usize, V: Value>(a: &SelectArgs) -> CliResult {
+    let tree = read::<K, V>(&a.input)?;
+    let chosen = match (&a.value, &a.range) {
+        (Some(v), _) => tree.select(V::parse(v).map_err(|e| format!("--value {e}"))?),
+        (None, Some(r)) => {
+            let (lo, hi) = r
+                .split_once(':')
+                .ok_or_else(|| format!("--range '{r}': expected LO:HI"))?;
+            let lo = V::parse(lo).map_err(|e| format!("--range {e}"))?;
+            let hi = V::parse(hi).map_err(|e| format!("--range {e}"))?;
+            tree.select_range(lo, hi)
+        }
+        (None, None) => unreachable!("clap requires --value or --range"),
+    };
+    ktree::io::write_ktree_file(&a.out, &chosen)
+        .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+    outln!(
+        "{}: {} voxels selected, {} nodes",
+        a.out.display(),
+        chosen.voxel_count(),
+        chosen.node_count()
+    );
+    Ok(())
+}
+
+/// What `ktree stats` prints of a valued file: the statistics of its own nodes, the voxels and box of those
+/// that hold a value, its value type and, per value, its voxels, box, centroid and surface area.
+#[derive(serde::Serialize)]
+pub struct ValuedStats {
+    #[serde(flatten)]
+    stats: TreeStats,
+    dtype: &'static str,
+    values: serde_json::Map<String, serde_json::Value>,
+}
+
+/// The statistics of a valued `.ktree` file.
+pub fn valued_stats(path: &Path) -> Result<ValuedStats, String> {
+    let (k, dtype) = file_dtype(path)?;
+    let dtype = dtype.ok_or_else(|| format!("{}: the tree holds no values", path.display()))?;
+    with_valued!(k, dtype, stats_of(path))
+}
+
+fn stats_of<const K: usize, V: Value>(path: &Path) -> Result<ValuedStats, String> {
+    let tree = read::<K, V>(path)?;
+    let shape = tree.shape();
+    let Ok(mut s) = stats(&shape, None);
+    // The file's own nodes (mixed nodes counted with the partial ones: both have children).
+    let per_level = tree.counts_per_level();
+    let total = ktree::LevelCounts::total(tree.level(), &per_level);
+    (s.full, s.empty, s.partial, s.nodes) = (total.full, total.empty, total.partial, total.nodes());
+    s.bytes_at_2_bits = total.nodes().div_ceil(4);
+    s.memory_bytes = tree.heap_bytes() as u64;
+    s.per_level = per_level;
+    let mut values = serde_json::Map::new();
+    for v in tree.value_stats().into_values() {
+        values.insert(
+            v.value.text(),
+            serde_json::json!({
+                "voxels": v.voxels,
+                "bounding_box": [v.bounding_box.0.to_vec(), v.bounding_box.1.to_vec()],
+                "centroid": v.centroid.to_vec(),
+                "surface_area": v.surface_area,
+            }),
+        );
+    }
+    Ok(ValuedStats {
+        stats: s,
+        dtype: V::DTYPE.map_or("", Dtype::name),
+        values,
+    })
+}
+
+/// Prints a valued file's statistics, as JSON or as text.
+pub fn print_valued_stats(path: &Path, json: bool) -> CliResult {
+    let s = valued_stats(path)?;
+    if json {
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&s).map_err(|e| e.to_string())?
+        );
+        return Ok(());
+    }
+    outln!(
+        "K = {}, L = {}, values {}: {} nodes ({} full, {} with children, {} empty), {} voxels with a value",
+        s.stats.k,
+        s.stats.level,
+        s.dtype,
+        s.stats.nodes,
+        s.stats.full,
+        s.stats.partial,
+        s.stats.empty,
+        s.stats.voxels
+    );
+    for (value, m) in &s.values {
+        outln!(
+            "  {value}: {} voxels, box {} to {}, centroid {}, surface area {}",
+            m["voxels"],
+            m["bounding_box"][0],
+            m["bounding_box"][1],
+            m["centroid"],
+            m["surface_area"]
+        );
+    }
+    Ok(())
+}

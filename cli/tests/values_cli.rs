@@ -1,0 +1,254 @@
+//! Trees with values end to end: a label volume made in the test (raw + JSON) through `ktree voxelize
+//! --labels`, `ktree stats --json` (per-value voxels, boxes, centroids, surface areas against a count over
+//! the samples), and `ktree select --value/--range`, whose trees must be byte for byte those of `ktree
+//! voxelize --label` and `--threshold` on the same volume (the binary path, independent of the values).
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use common::ktree;
+
+/// A 5 × 6 × 7 volume of labels 0 (background), 1, 2, 3 and 300 in blobs and stripes.
+fn labels() -> ([usize; 3], Vec<u16>) {
+    let shape = [5usize, 6, 7];
+    let mut v = Vec::new();
+    for z in 0..shape[2] {
+        for y in 0..shape[1] {
+            for x in 0..shape[0] {
+                let label = if (x + y) % 4 == 0 && z > 1 {
+                    3
+                } else if x < 2 && y < 3 {
+                    1
+                } else if z == 6 {
+                    300
+                } else if x + z > 7 {
+                    2
+                } else {
+                    0
+                };
+                v.push(label);
+            }
+        }
+    }
+    (shape, v)
+}
+
+fn write_volume(dir: &Path, shape: [usize; 3], values: &[u16]) -> std::path::PathBuf {
+    let raw: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir.join("labels.raw"), raw).unwrap();
+    let json = dir.join("labels.json");
+    std::fs::write(
+        &json,
+        format!(
+            r#"{{"file": "labels.raw", "dtype": "uint16", "endianness": "little", "shape_xyz": [{}, {}, {}]}}"#,
+            shape[0], shape[1], shape[2]
+        ),
+    )
+    .unwrap();
+    json
+}
+
+fn run(args: &[&str]) -> String {
+    let (ok, out, err) = ktree(args);
+    assert!(ok, "ktree {args:?} failed: {err}");
+    out
+}
+
+/// Voxels, box `[lo, hi)` and the sums of the centres of one label, counted on the samples.
+type Measured = (u64, [usize; 3], [usize; 3], [f64; 3]);
+
+#[test]
+#[allow(clippy::needless_range_loop)] // Loops over the axes index several arrays.
+fn a_label_volume_becomes_one_tree_whose_values_select_and_measure_as_the_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let (shape, values) = labels();
+    let json = write_volume(dir.path(), shape, &values);
+    let labels = dir.path().join("labels.ktree");
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    run(&[
+        "voxelize",
+        json.to_str().unwrap(),
+        "--labels",
+        "--out",
+        labels.to_str().unwrap(),
+    ]);
+
+    // Per-value statistics against the samples.
+    let stats: serde_json::Value =
+        serde_json::from_str(&run(&["stats", labels.to_str().unwrap(), "--json"])).unwrap();
+    assert_eq!(stats["dtype"], "uint16");
+    assert_eq!(stats["level"], 3);
+    let mut want: BTreeMap<u16, Measured> = BTreeMap::new();
+    let mut inside = 0u64;
+    for (i, &v) in values.iter().enumerate() {
+        if v == 0 {
+            continue;
+        }
+        inside += 1;
+        let q = [
+            i % shape[0],
+            i / shape[0] % shape[1],
+            i / (shape[0] * shape[1]),
+        ];
+        let e = want
+            .entry(v)
+            .or_insert((0, [usize::MAX; 3], [0; 3], [0.0; 3]));
+        e.0 += 1;
+        for a in 0..3 {
+            e.1[a] = e.1[a].min(q[a]);
+            e.2[a] = e.2[a].max(q[a] + 1);
+            e.3[a] += q[a] as f64 + 0.5;
+        }
+    }
+    assert_eq!(stats["voxels"], inside);
+    let got = stats["values"].as_object().unwrap();
+    assert_eq!(got.len(), want.len());
+    for (label, (n, lo, hi, sums)) in &want {
+        let s = &got[&label.to_string()];
+        assert_eq!(s["voxels"], *n, "label {label}");
+        assert_eq!(
+            s["bounding_box"],
+            serde_json::json!([lo, hi]),
+            "label {label}"
+        );
+        for a in 0..3 {
+            let c = s["centroid"][a].as_f64().unwrap();
+            assert!((c - sums[a] / *n as f64).abs() < 1e-9, "label {label}");
+        }
+    }
+
+    // select --value 3 is the binary tree of --label 3, byte for byte; --range 2:3 that of the union.
+    run(&[
+        "select",
+        labels.to_str().unwrap(),
+        "--value",
+        "3",
+        "--out",
+        &p("three.ktree"),
+    ]);
+    run(&[
+        "voxelize",
+        json.to_str().unwrap(),
+        "--label",
+        "3",
+        "--out",
+        &p("three_direct.ktree"),
+    ]);
+    assert_eq!(
+        std::fs::read(p("three.ktree")).unwrap(),
+        std::fs::read(p("three_direct.ktree")).unwrap()
+    );
+    run(&[
+        "select",
+        labels.to_str().unwrap(),
+        "--range",
+        "1:300",
+        "--out",
+        &p("all.ktree"),
+    ]);
+    run(&[
+        "voxelize",
+        json.to_str().unwrap(),
+        "--threshold",
+        "1",
+        "--out",
+        &p("all_direct.ktree"),
+    ]);
+    assert_eq!(
+        std::fs::read(p("all.ktree")).unwrap(),
+        std::fs::read(p("all_direct.ktree")).unwrap()
+    );
+    // The surface area of label 3 is that of its binary tree.
+    let three: serde_json::Value =
+        serde_json::from_str(&run(&["stats", &p("three.ktree"), "--json", "--measures"])).unwrap();
+    assert_eq!(got["3"]["surface_area"], three["surface_area"]);
+}
+
+#[test]
+fn values_on_the_command_line_fail_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    let (shape, values) = labels();
+    let json = write_volume(dir.path(), shape, &values);
+    run(&[
+        "voxelize",
+        json.to_str().unwrap(),
+        "--labels",
+        "--out",
+        &p("l.ktree"),
+    ]);
+    // A value of another type, a range without a colon, a tree without values.
+    let (ok, _, err) = ktree(&[
+        "select",
+        &p("l.ktree"),
+        "--value",
+        "70000",
+        "--out",
+        &p("x.ktree"),
+    ]);
+    assert!(!ok && err.contains("uint16"), "{err}");
+    let (ok, _, err) = ktree(&[
+        "select",
+        &p("l.ktree"),
+        "--range",
+        "3",
+        "--out",
+        &p("x.ktree"),
+    ]);
+    assert!(!ok && err.contains("LO:HI"), "{err}");
+    run(&[
+        "voxelize",
+        json.to_str().unwrap(),
+        "--label",
+        "3",
+        "--out",
+        &p("b.ktree"),
+    ]);
+    let (ok, _, err) = ktree(&[
+        "select",
+        &p("b.ktree"),
+        "--value",
+        "3",
+        "--out",
+        &p("x.ktree"),
+    ]);
+    assert!(!ok && err.contains("no values"), "{err}");
+    // A label that does not fit the type asked for, named with its sample.
+    let (ok, _, err) = ktree(&[
+        "voxelize",
+        json.to_str().unwrap(),
+        "--labels",
+        "--dtype",
+        "uint8",
+        "--out",
+        &p("u8.ktree"),
+    ]);
+    assert!(!ok && err.contains("300"), "{err}");
+    // A volume of floats is not labels.
+    let dir2 = tempfile::tempdir().unwrap();
+    let raw: Vec<u8> = [0.5f32, 1.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir2.path().join("f.raw"), raw).unwrap();
+    let f = dir2.path().join("f.json");
+    std::fs::write(
+        &f,
+        r#"{"file": "f.raw", "dtype": "float32", "endianness": "little", "shape_xyz": [2, 1, 1]}"#,
+    )
+    .unwrap();
+    let (ok, _, err) = ktree(&[
+        "voxelize",
+        f.to_str().unwrap(),
+        "--labels",
+        "--out",
+        &p("f.ktree"),
+    ]);
+    assert!(
+        !ok && err.contains("(0, 0, 0)") && err.contains("whole numbers"),
+        "{err}"
+    );
+    // The binary readers name the value type.
+    std::fs::write(p("points.csv"), "0,0,0\n").unwrap();
+    let (ok, _, err) = ktree(&["query", &p("l.ktree"), "--points", &p("points.csv")]);
+    assert!(!ok && err.contains("uint16"), "{err}");
+}
