@@ -20,12 +20,14 @@
 use std::collections::BTreeMap;
 
 use super::OpsError;
+use crate::rays::ValueRuns;
 use crate::space::Cell;
 use crate::tree::storage::infallible;
 use crate::tree::top_down::{build_top_down, Decision, InputNode};
 use crate::tree::valued::{ValueState, ValueStorage};
 use crate::tree::{TreeError, Value};
 use crate::KTree;
+use crate::Ray;
 
 /// How [`KTree::combine`] makes a voxel's value where both trees have one (where only one has a value, the
 /// voxel takes it).
@@ -291,6 +293,66 @@ impl<const K: usize, V: Value> KTree<K, V> {
         other.combine(self, Rule::First)
     }
 
+    /// The values at `points` (`None` where a voxel is empty or outside the universe), on the threads of
+    /// the current rayon pool.
+    ///
+    /// ```
+    /// use ktree::KTree;
+    /// let t = KTree::<1, u8>::from_dense_values(2, &[Some(5), Some(5), None, Some(6)]).unwrap();
+    /// assert_eq!(t.values_at(&[[0], [2], [3], [9]]), [Some(5), None, Some(6), None]);
+    /// ```
+    pub fn values_at(&self, points: &[[u32; K]]) -> Vec<Option<V>> {
+        use rayon::prelude::*;
+        points.par_iter().map(|&p| self.value_at(p)).collect()
+    }
+
+    /// The tree as valued runs along the last axis: each full leaf's columns, one run each (touching runs
+    /// of one value are not joined; [`KTree::from_value_runs`] gives this tree back).
+    pub fn to_value_runs(&self) -> ValueRuns<K, V> {
+        let mut runs = Vec::new();
+        for (cell, value) in self.value_leaves() {
+            let Some(value) = value else { continue };
+            let side = cell.side() as u32;
+            for_each_column(&cell, |start| {
+                runs.push((Ray::new(start, start[K - 1] + side), value))
+            });
+        }
+        ValueRuns::from_runs(self.level(), runs)
+            .expect("a tree's leaves are disjoint runs of valid values")
+    }
+
+    /// The tree moved by `t` voxels (any integer vector, negative allowed); voxels moved out of the
+    /// universe are lost.
+    ///
+    /// ```
+    /// use ktree::KTree;
+    /// let t = KTree::<1, u8>::from_dense_values(2, &[Some(5), Some(6), None, None]).unwrap();
+    /// assert_eq!(t.translate_values([1]).to_dense_values().unwrap(), [None, Some(5), Some(6), None]);
+    /// assert_eq!(t.translate_values([-1]).to_dense_values().unwrap(), [Some(6), None, None, None]);
+    /// ```
+    pub fn translate_values(&self, t: [i64; K]) -> KTree<K, V> {
+        let side = self.universe().side() as i64;
+        let mut runs = Vec::new();
+        for (cell, value) in self.value_leaves() {
+            let Some(value) = value else { continue };
+            let s = cell.side() as i64;
+            // The cell's box moved and clipped to the universe; nothing left: dropped.
+            let lo: [i64; K] = std::array::from_fn(|a| (i64::from(cell.origin[a]) + t[a]).max(0));
+            let hi: [i64; K] =
+                std::array::from_fn(|a| (i64::from(cell.origin[a]) + s + t[a]).min(side));
+            if (0..K).any(|a| lo[a] >= hi[a]) {
+                continue;
+            }
+            let origin: [u32; K] = std::array::from_fn(|a| lo[a] as u32);
+            let extent: [u32; K] = std::array::from_fn(|a| (hi[a] - lo[a]) as u32);
+            for_each_column_of_box(&origin, &extent, |start| {
+                runs.push((Ray::new(start, start[K - 1] + extent[K - 1]), value))
+            });
+        }
+        let runs = ValueRuns::from_runs(self.level(), runs).expect("moved leaves stay disjoint");
+        KTree::from_value_runs(&runs)
+    }
+
     /// For each value, its voxels, bounding box, centroid and surface area, in one walk of the leaves (and
     /// one selection per value for the surface area).
     pub fn value_stats(&self) -> BTreeMap<V::Key, ValueStats<K, V>> {
@@ -307,6 +369,37 @@ impl<const K: usize, V: Value> KTree<K, V> {
             s.surface_area = self.select(s.value).surface_area();
         }
         stats
+    }
+}
+
+/// Calls `f` with the first voxel of every column (line along the last axis) of `cell`.
+fn for_each_column<const K: usize>(cell: &Cell<K>, f: impl FnMut([u32; K])) {
+    let side = cell.side() as u32;
+    for_each_column_of_box(&cell.origin, &[side; K], f);
+}
+
+/// Calls `f` with the first voxel of every column of the box at `origin` of sides `extent`.
+fn for_each_column_of_box<const K: usize>(
+    origin: &[u32; K],
+    extent: &[u32; K],
+    mut f: impl FnMut([u32; K]),
+) {
+    let mut offset = [0u32; K];
+    loop {
+        f(std::array::from_fn(|a| origin[a] + offset[a]));
+        // Odometer over the first K − 1 axes.
+        let mut axis = 0;
+        loop {
+            if axis + 1 >= K {
+                return;
+            }
+            offset[axis] += 1;
+            if offset[axis] < extent[axis] {
+                break;
+            }
+            offset[axis] = 0;
+            axis += 1;
+        }
     }
 }
 

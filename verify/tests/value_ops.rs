@@ -102,8 +102,29 @@ fn check<const K: usize, V: Palette>(a: &Painted<K>, b: &Painted<K>) -> Result<(
     got.assert_well_formed();
     prop_assert_eq!(&got, &binary_of::<K>(level, &want));
 
-    // Per-value statistics against a count over the dense array.
+    // Values at points, the runs and back, a translation.
     let u = Universe::<K>::new(level).unwrap();
+    let points: Vec<[u32; K]> = (0..da.len()).map(|i| u.dense_point(i)).collect();
+    let got = ta.values_at(&points);
+    for (g, w) in got.iter().zip(&da) {
+        prop_assert_eq!(g.map(Value::key), w.map(Value::key));
+    }
+    same(&KTree::from_value_runs(&ta.to_value_runs()), &ta)?;
+    let side = u.side() as i64;
+    let t: [i64; K] = std::array::from_fn(|a| {
+        [1, -2, 3, -1][a] % side.max(1) * if level % 2 == 0 { 1 } else { -1 }
+    });
+    let mut moved = vec![None; da.len()];
+    for (i, v) in da.iter().enumerate() {
+        let q = u.dense_point(i);
+        let r: [i64; K] = std::array::from_fn(|a| i64::from(q[a]) + t[a]);
+        if r.iter().all(|&c| (0..side).contains(&c)) {
+            moved[u.dense_index(std::array::from_fn(|a| r[a] as u32))] = *v;
+        }
+    }
+    same(&ta.translate_values(t), &tree_of::<K, V>(level, &moved))?;
+
+    // Per-value statistics against a count over the dense array.
     let mut want: BTreeMap<V::Key, Measured<K>> = BTreeMap::new();
     for (i, v) in da.iter().enumerate() {
         let Some(v) = v else { continue };
