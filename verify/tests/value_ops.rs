@@ -112,7 +112,7 @@ fn check<const K: usize, V: Palette>(a: &Painted<K>, b: &Painted<K>) -> Result<(
     same(&KTree::from_value_runs(&ta.to_value_runs()), &ta)?;
     let side = u.side() as i64;
     let t: [i64; K] = std::array::from_fn(|a| {
-        [1, -2, 3, -1][a] % side.max(1) * if level % 2 == 0 { 1 } else { -1 }
+        [1, -2, 3, -1][a] % side.max(1) * if level.is_multiple_of(2) { 1 } else { -1 }
     });
     let mut moved = vec![None; da.len()];
     for (i, v) in da.iter().enumerate() {
