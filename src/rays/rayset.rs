@@ -121,6 +121,38 @@ pub enum RayError {
     },
 }
 
+/// Checks the `index`-th run of an input against a universe of side `side`: its column inside, `z1 < z2`,
+/// both ends in `[0, side]`.
+pub(crate) fn check_ray<const K: usize>(
+    index: usize,
+    ray: &Ray<K>,
+    side: u64,
+) -> Result<(), RayError> {
+    for (axis, &value) in ray.start[..K - 1].iter().enumerate() {
+        if u64::from(value) >= side {
+            return Err(RayError::ColumnOutside {
+                index,
+                axis,
+                value,
+                side,
+            });
+        }
+    }
+    let (z1, z2) = (ray.z1(), ray.z2);
+    if u64::from(z1) > side || u64::from(z2) > side {
+        return Err(RayError::RunOutside {
+            index,
+            z1,
+            z2,
+            side,
+        });
+    }
+    if z1 >= z2 {
+        return Err(RayError::EmptyRun { index, z1, z2 });
+    }
+    Ok(())
+}
+
 /// An object as rays: for each column (the first `K − 1` coordinates), sorted, disjoint, non-touching
 /// half-open runs `[z1, z2)` along the last axis, optionally with a surface normal at each end.
 ///
@@ -208,28 +240,8 @@ impl<const K: usize> RaySet<K> {
         let mut entries: Vec<(u64, u32, u32, Option<[Normal<K>; 2]>)> = Vec::new();
         let mut with_normals = None;
         for (index, (ray, normals)) in rays.enumerate() {
-            for (axis, &value) in ray.start[..K - 1].iter().enumerate() {
-                if u64::from(value) >= side {
-                    return Err(RayError::ColumnOutside {
-                        index,
-                        axis,
-                        value,
-                        side,
-                    });
-                }
-            }
+            check_ray(index, &ray, side)?;
             let (z1, z2) = (ray.z1(), ray.z2);
-            if u64::from(z1) > side || u64::from(z2) > side {
-                return Err(RayError::RunOutside {
-                    index,
-                    z1,
-                    z2,
-                    side,
-                });
-            }
-            if z1 >= z2 {
-                return Err(RayError::EmptyRun { index, z1, z2 });
-            }
             if *with_normals.get_or_insert(normals.is_some()) != normals.is_some() {
                 return Err(RayError::NormalCount {
                     rays: index + 1,
