@@ -15,6 +15,7 @@
 //! assert_eq!(ValueRuns::<2, u8>::from_dense(2, &dense).unwrap(), runs);
 //! ```
 
+use super::rayset::check_ray;
 use super::{ColumnKeys, Ray, RayError};
 use crate::space::{Universe, DENSE_LIMIT};
 use crate::value::Value;
@@ -55,28 +56,8 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
         let side = universe.side();
         let mut out: Vec<(ValueRun<V>, usize)> = Vec::new();
         for (index, (ray, value)) in runs.into_iter().enumerate() {
-            for (axis, &v) in ray.start[..K - 1].iter().enumerate() {
-                if u64::from(v) >= side {
-                    return Err(RayError::ColumnOutside {
-                        index,
-                        axis,
-                        value: v,
-                        side,
-                    });
-                }
-            }
+            check_ray(index, &ray, side)?;
             let (z1, z2) = (ray.z1(), ray.z2);
-            if u64::from(z1) > side || u64::from(z2) > side {
-                return Err(RayError::RunOutside {
-                    index,
-                    z1,
-                    z2,
-                    side,
-                });
-            }
-            if z1 >= z2 {
-                return Err(RayError::EmptyRun { index, z1, z2 });
-            }
             value
                 .check()
                 .map_err(|e| RayError::Value { index, error: e })?;
