@@ -7,11 +7,11 @@
 //!
 //! The class is defined here with what makes it a value (equality, hash, repr); its methods are grouped by
 //! concern, each module one `#[pymethods]` block of a thin layer over one library call per method:
-//! [`construct`] (trees from arrays, meshes, points and volumes), [`files`] (files, bytes, pickling),
-//! [`query`] (points, windows, boxes, rays, distances, statistics), [`shape`] (Booleans, morphology,
-//! components, measures), [`geometry`] (translations, rotations, scales, matrices), [`export`] (runs,
-//! meshes, the viewer page) and [`display`] (pictures and line drawings). Arrays come in through
-//! [`arrays`] (borrowed from numpy where its memory allows) and errors go out through [`failure`].
+//! `construct` (trees from arrays, meshes, points and volumes), `files` (files, bytes, pickling),
+//! `query` (points, windows, boxes, rays, distances, statistics), `shape` (Booleans, morphology,
+//! components, measures), `geometry` (translations, rotations, scales, matrices), `export` (runs,
+//! meshes, the viewer page) and `display` (pictures and line drawings). Arrays come in through
+//! `arrays` (borrowed from numpy where its memory allows) and errors go out through `failure`.
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
