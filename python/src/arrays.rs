@@ -3,8 +3,9 @@
 //! (`numpy.asarray(a, dtype)`) and, when not C-contiguous, copied once; then seen as rows of `N` numbers
 //! (points, ray origins, vertices, runs) without another copy.
 
-use numpy::ndarray::Dimension;
-use numpy::{AllowTypeChange, Element, PyArrayLike, PyUntypedArrayMethods};
+use numpy::ndarray::{Dimension, IxDyn};
+use numpy::{AllowTypeChange, Element, PyArray, PyArrayLike, PyUntypedArrayMethods};
+use pyo3::prelude::*;
 
 use crate::failure::Failure;
 
@@ -47,6 +48,18 @@ impl<'py, T: Element + Copy, D: Dimension> Numbers<'py, T, D> {
                 format!("{what} must be (n, {k}), got {shape:?}")
             })),
         }
+    }
+}
+
+impl<'py> Numbers<'py, u32, IxDyn> {
+    /// The numbers of `object` when it is already a C-contiguous array of dtype uint32 (read in place),
+    /// otherwise `None`.
+    pub(crate) fn in_place(object: &Bound<'py, PyAny>) -> Option<Self> {
+        let array = object.cast::<PyArray<u32, IxDyn>>().ok()?;
+        if !array.is_c_contiguous() {
+            return None;
+        }
+        Some(Self::new(object.extract().ok()?))
     }
 }
 

@@ -115,13 +115,29 @@ impl Tree {
     fn contains<'py>(
         &self,
         py: Python<'py>,
-        points: PyArrayLikeDyn<'py, i64, AllowTypeChange>,
+        points: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let k = self.inner.k();
-        let points = Numbers::new(points);
-        let single = points.rows_of(k, true, &format!("contains: the points of a K = {k} tree"))?;
-        let flat = points.flat();
-        let inside = py.detach(|| with_dim!(&self.inner, AnyTree, t => contains(t, flat)));
+        let what = format!("contains: the points of a K = {k} tree");
+        let (inside, single) = match Numbers::in_place(points) {
+            // The library's own points (`[u32; K]`), read in place.
+            Some(points) => {
+                let single = points.rows_of(k, true, &what)?;
+                let flat = points.flat();
+                let inside =
+                    py.detach(|| with_dim!(&self.inner, AnyTree, t => t.contains_many(rows(flat))));
+                (inside, single)
+            }
+            // Any other array (int64 C-ordered read in place), converted by numpy where it must be.
+            None => {
+                let points: PyArrayLikeDyn<'py, i64, AllowTypeChange> = points.extract()?;
+                let points = Numbers::new(points);
+                let single = points.rows_of(k, true, &what)?;
+                let flat = points.flat();
+                let inside = py.detach(|| with_dim!(&self.inner, AnyTree, t => contains(t, flat)));
+                (inside, single)
+            }
+        };
         if single {
             return Ok(PyBool::new(py, inside[0]).to_owned().into_any());
         }

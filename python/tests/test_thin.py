@@ -146,6 +146,8 @@ def test_point_arrays_of_every_dtype_and_layout(rng, k):
         "float": (points.astype(np.float64), expected),
         "list": (points.tolist(), expected),
         "uint32": (nonneg.astype(np.uint32), nonneg_expected),
+        "uint32 fortran": (np.asfortranarray(nonneg.astype(np.uint32)), nonneg_expected),
+        "uint32 strided": (np.repeat(nonneg.astype(np.uint32), 2, axis=0)[::2], nonneg_expected),
         "readonly": (np.require(nonneg, requirements="C"), nonneg_expected),
     }
     variants["readonly"][0].flags.writeable = False
