@@ -48,9 +48,18 @@ class _Stats(TypedDict):
     partial: int
     nodes: int
     bytes_at_2_bits: int
+    memory_bytes: int
+    voxels: int
+    bounding_box: Optional[list[list[int]]]
     per_level: list[_LevelCounts]
     surface_area: int
     euler_number: NotRequired[int]
+
+class _ViewPage(TypedDict):
+    boxes: int
+    coarse: int
+    complete: bool
+    bytes: int
 
 class _ProgressiveLevel(TypedDict):
     level: int
@@ -174,6 +183,10 @@ class Tree:
         """tree[x, y, z]: one voxel; with slices, the dense window of those voxels."""
     def bounding_box(self) -> Optional[Tuple[list[int], list[int]]]:
         """(lo, hi) of the full voxels, hi exclusive; None when empty."""
+    def count(self, lo: Sequence[int], hi: Sequence[int]) -> int:
+        """The number of full voxels in the box [lo, hi) (K integers each, hi exclusive)."""
+    def crop(self, lo: Sequence[int], hi: Sequence[int]) -> Tree:
+        """The object cut to the box [lo, hi), in the same universe."""
     def cells(self) -> npt.NDArray[np.int64]:
         """The full leaves as an (n, K + 1) array: corner coordinates, then side."""
     def cast_rays(
@@ -185,7 +198,7 @@ class Tree:
     def nearest(self, points: npt.ArrayLike) -> npt.NDArray[np.int64]:
         """A nearest full voxel per point (rows of -1 when empty; ties: the smallest Morton key)."""
     def stats(self) -> _Stats:
-        """Node counts, with the keys of `ktree stats --json`."""
+        """Node counts, voxels, bounding box and measures, with the keys of `ktree stats --json --measures`."""
     def translate(self, offset: Sequence[float]) -> Tree:
         """Translated by K numbers (exact for integers)."""
     def rotate(self, degrees: float, axes: Union[str, Tuple[int, int], None] = None) -> Tree:
@@ -243,6 +256,16 @@ class Tree:
         method: str = "bucketed",
     ) -> str:
         """An SVG line drawing of an octree with hidden lines removed."""
+    def view(
+        self,
+        path: _Path,
+        *,
+        budget: int = 100000,
+        camera: Optional[_View] = None,
+        time_axis: int = 3,
+        title: str = "ktree",
+    ) -> _ViewPage:
+        """Writes the interactive 3-D viewer page (HTML, as `ktree view`) of a K = 2, 3 or 4 tree."""
     def __or__(self, other: Tree, /) -> Tree: ...
     def __and__(self, other: Tree, /) -> Tree: ...
     def __sub__(self, other: Tree, /) -> Tree: ...
@@ -253,3 +276,4 @@ class Tree:
     def __rxor__(self, other: Tree, /) -> Tree: ...
     def __invert__(self) -> Tree: ...
     def __eq__(self, other: object, /) -> bool: ...
+    def __hash__(self) -> int: ...

@@ -1,10 +1,111 @@
 //! Geometric transforms of a tree of any `K`: exact integer operations where the parameters allow (integer
-//! translations, quarter turns, rational scales), one affine (or projective) overlay pass otherwise.
+//! translations, quarter turns, rational scales), one affine (or projective) overlay pass otherwise: the
+//! methods `translate`, `rotate`, `scale` and `affine`.
 
 use ktree::ops::{self, Affine, AxisMap, Projective};
-use ktree::KTree;
+use ktree::{with_dim, AnyTree, KTree};
+use numpy::{AllowTypeChange, PyArrayLike2};
+use pyo3::prelude::*;
+use pyo3::types::PyString;
 
 use crate::failure::Failure;
+use crate::Tree;
+
+#[pymethods]
+impl Tree {
+    /// Translated by `offset` (K numbers): exactly by whole voxels when all are integers (voxels leaving the
+    /// universe are lost), by an affine pass otherwise.
+    fn translate(&self, py: Python<'_>, offset: Vec<f64>) -> PyResult<Self> {
+        let out = py.detach(
+            || with_dim!(&self.inner, AnyTree, t => translate(t, &offset).map(AnyTree::from)),
+        )?;
+        Ok(Self { inner: out })
+    }
+
+    /// Rotated by `degrees` about the universe's centre, in the plane of `axes` = (i, j) (turning axis i
+    /// towards axis j; default (0, 1)) or, in 3-D, about the axis 'x', 'y' or 'z'. Multiples of 90 degrees
+    /// are exact (children reordered); other angles take an affine pass.
+    #[pyo3(signature = (degrees, axes = None))]
+    fn rotate(
+        &self,
+        py: Python<'_>,
+        degrees: f64,
+        axes: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let (from, to) = match axes {
+            Some(a) => rotation_plane(self.inner.k(), &a)?,
+            None => (0, 1),
+        };
+        let out = py.detach(|| with_dim!(&self.inner, AnyTree, t => rotate(t, degrees, from, to).map(AnyTree::from)))?;
+        Ok(Self { inner: out })
+    }
+
+    /// Scaled by `factor` about the universe's origin corner: an int or a `fractions.Fraction` p/q is exact
+    /// (p, q up to 2**20), a float takes an affine pass unless it is a whole number.
+    fn scale(&self, py: Python<'_>, factor: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let ratio = || -> PyResult<(u32, u32)> {
+            Ok((
+                factor.getattr("numerator")?.extract()?,
+                factor.getattr("denominator")?.extract()?,
+            ))
+        };
+        let factor = match ratio() {
+            Ok((p, q)) => Factor::Ratio(p, q),
+            Err(_) => {
+                let s: f64 = factor.extract()?;
+                if s.fract() == 0.0 && s >= 1.0 && s <= f64::from(u32::MAX) {
+                    Factor::Ratio(s as u32, 1)
+                } else {
+                    Factor::Real(s)
+                }
+            }
+        };
+        let out = py
+            .detach(|| with_dim!(&self.inner, AnyTree, t => scale(t, factor).map(AnyTree::from)))?;
+        Ok(Self { inner: out })
+    }
+
+    /// Mapped by a homogeneous (K + 1) x (K + 1) matrix acting on column vectors [x; 1], in one overlay
+    /// pass: affine when the last row is 0 ... 0 1, projective otherwise.
+    fn affine(
+        &self,
+        py: Python<'_>,
+        matrix: PyArrayLike2<'_, f64, AllowTypeChange>,
+    ) -> PyResult<Self> {
+        let m: Vec<f64> = matrix.as_array().iter().copied().collect();
+        let n = self.inner.k() + 1;
+        if matrix.as_array().shape() != [n, n] {
+            return Err(Failure::Value(format!(
+                "a K = {} tree needs a {n} x {n} matrix, got shape {:?}",
+                self.inner.k(),
+                matrix.as_array().shape()
+            ))
+            .into());
+        }
+        let out = py.detach(
+            || with_dim!(&self.inner, AnyTree, t => self::matrix(t, &m).map(AnyTree::from)),
+        )?;
+        Ok(Self { inner: out })
+    }
+}
+
+/// The plane of a rotation: an axis name in 3-D or a pair of axes.
+fn rotation_plane(k: usize, axes: &Bound<'_, PyAny>) -> PyResult<(usize, usize)> {
+    if let Ok(name) = axes.cast::<PyString>() {
+        return match (name.to_str()?, k) {
+            ("x", 3) => Ok((1, 2)),
+            ("y", 3) => Ok((2, 0)),
+            ("z", 3) => Ok((0, 1)),
+            (other, _) => Err(Failure::Value(format!(
+                "axis '{other}': named axes x, y, z are for K = 3; give a pair of axes (i, j) for K = {k}"
+            ))
+            .into()),
+        };
+    }
+    axes.extract::<(usize, usize)>().map_err(|_| {
+        Failure::Value("axes must be a pair (i, j) (or 'x', 'y', 'z' in 3-D)".into()).into()
+    })
+}
 
 /// A uniform scale factor: an exact ratio `p/q`, or any positive number.
 #[derive(Debug, Clone, Copy)]

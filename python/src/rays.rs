@@ -5,20 +5,17 @@ use ktree::shape::run_count;
 use ktree::tree::rays_of;
 use ktree::tree::storage::infallible;
 use ktree::{KTree, Ray, RaySet};
-use numpy::ndarray::{Array2, ArrayView2};
+use numpy::ndarray::Array2;
 
 use crate::failure::Failure;
 
 /// Most runs a tree is turned into (counted before anything is allocated).
 const MAX_RUNS: u128 = 1 << 27;
 
-/// The ray set of an `(n, K + 1)` array's rows in a universe of level `level`.
-pub(crate) fn rays_of_array<const K: usize>(
-    rows: ArrayView2<'_, i64>,
-    level: u32,
-) -> Result<RaySet<K>, Failure> {
-    let mut rays = Vec::with_capacity(rows.nrows());
-    for (i, row) in rows.outer_iter().enumerate() {
+/// The ray set of an `(n, K + 1)` array's rows (`flat`: row after row) in a universe of level `level`.
+pub(crate) fn rays_of_rows<const K: usize>(flat: &[i64], level: u32) -> Result<RaySet<K>, Failure> {
+    let mut rays = Vec::with_capacity(flat.len() / (K + 1));
+    for (i, row) in flat.chunks_exact(K + 1).enumerate() {
         let mut v = [0u32; K];
         let mut z2 = 0u32;
         for (j, &x) in row.iter().enumerate() {

@@ -34,7 +34,7 @@ pub mod stats;
 pub use boxes::{bounding_box, count, crop, VoxelBox};
 pub use dense::{dense_window, dense_window_into, window_voxels, DenseError, DenseOrder};
 pub use nearest::{distance, nearest, nearest_many, nearest_many_signed, nearest_signed, Nearest};
-pub use points::{contains, contains_many, PointCursor};
+pub use points::{contains, contains_many, contains_many_signed, PointCursor};
 pub use ray::{cast_ray, cast_rays, Face, RayCast, RayError, RayHit};
 pub use stats::{stats, TreeStats};
 

@@ -1,7 +1,8 @@
-//! Point queries: one voxel ([`contains`]), many at once ([`contains_many`]: most answered from a table of
-//! the tree's top levels, the rest ordered by Morton key and answered on all threads, each thread walking
-//! its share of the tree once), and a cursor that remembers its last path for coherent queries
-//! ([`PointCursor`], the one point descent of [`locate`](crate::tree::locate)).
+//! Point queries: one voxel ([`contains`]), many at once ([`contains_many`], from anywhere:
+//! [`contains_many_signed`]; most answered from a table of the tree's top levels, the rest ordered by
+//! Morton key and answered on all threads, each thread walking its share of the tree once), and a cursor
+//! that remembers its last path for coherent queries ([`PointCursor`], the one point descent of
+//! [`locate`](crate::tree::locate)).
 
 use rayon::prelude::*;
 
@@ -112,20 +113,63 @@ pub fn contains_many<const K: usize, T>(
 where
     T: TreeStorage<K> + Sync,
 {
+    contains_many_by(tree, points, |p| Some(*p))
+}
+
+/// [`contains_many`] of points anywhere (negative coordinates too: outside), read as they are given
+/// (a caller's `i64` array is not converted first).
+///
+/// ```
+/// use ktree::query::contains_many_signed;
+/// use ktree::KTree;
+/// let tree = KTree::<1>::from_dense(2, &[true, false, false, true]).unwrap();
+/// assert_eq!(contains_many_signed(&tree, &[[3], [-1], [0], [1 << 40]]), Ok(vec![true, false, true, false]));
+/// ```
+///
+/// # Errors
+/// The storage's first read error.
+pub fn contains_many_signed<const K: usize, T>(
+    tree: &T,
+    points: &[[i64; K]],
+) -> Result<Vec<bool>, T::Error>
+where
+    T: TreeStorage<K> + Sync,
+{
+    contains_many_by(tree, points, |p| {
+        let mut voxel = [0u32; K];
+        for (v, &c) in voxel.iter_mut().zip(p) {
+            *v = u32::try_from(c).ok()?;
+        }
+        Some(voxel)
+    })
+}
+
+/// [`contains_many`] of points of any type, `voxel` giving each one's voxel (`None`: not a voxel of any
+/// universe, outside).
+fn contains_many_by<const K: usize, T, P>(
+    tree: &T,
+    points: &[P],
+    voxel: impl Fn(&P) -> Option<[u32; K]> + Sync,
+) -> Result<Vec<bool>, T::Error>
+where
+    T: TreeStorage<K> + Sync,
+    P: Sync,
+{
     let top = if points.len() >= TOP_FROM {
         Some(TopStates::new(tree)?)
     } else {
         None
     };
     let side = 1u64 << tree.level();
+    let inside = |p: &P| voxel(p).filter(|v| v.iter().all(|&c| u64::from(c) < side));
     let mut out = vec![false; points.len()];
-    let answer = |(points, out): (&[[u32; K]], &mut [bool])| -> Result<(), T::Error> {
+    let answer = |(points, out): (&[P], &mut [bool])| -> Result<(), T::Error> {
         let mut order: Vec<(u64, u32)> = Vec::with_capacity(points.len());
         for (i, p) in points.iter().enumerate() {
-            if p.iter().any(|&c| u64::from(c) >= side) {
+            let Some(v) = inside(p) else {
                 continue;
-            }
-            let key = morton_encode(*p);
+            };
+            let key = morton_encode(v);
             match top.as_ref().map_or(NodeState::Partial, |t| t.state(key)) {
                 NodeState::Partial => order.push((key, i as u32)),
                 state => out[i] = state == NodeState::Full,
@@ -136,7 +180,9 @@ where
         });
         let mut cursor = PointCursor::new(tree)?;
         for (_, i) in order {
-            out[i as usize] = cursor.contains(points[i as usize])?;
+            if let Some(v) = inside(&points[i as usize]) {
+                out[i as usize] = cursor.contains(v)?;
+            }
         }
         Ok(())
     };

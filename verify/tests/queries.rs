@@ -76,6 +76,29 @@ fn check_points<const K: usize>(o: &Obj<K>, points: &[[u32; K]]) -> Result<(), T
         .collect();
     let expect_many: Vec<bool> = many.iter().map(|&p| dense_at(&u, &dense, p)).collect();
     prop_assert_eq!(tree.contains_many(&many), expect_many);
+    // The same points given signed, some coordinates moved below 0 or past 2^32 - 1 (outside).
+    let signed: Vec<[i64; K]> = many
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            std::array::from_fn(|a| match (i + a) % 7 {
+                0 => -1 - i64::from(p[a]),
+                1 => i64::from(p[a]) + (1 << 32),
+                _ => i64::from(p[a]),
+            })
+        })
+        .collect();
+    let expect_signed: Vec<bool> = signed
+        .iter()
+        .map(|p| {
+            let voxel: Option<Vec<u32>> = p.iter().map(|&c| u32::try_from(c).ok()).collect();
+            voxel.is_some_and(|v| dense_at(&u, &dense, std::array::from_fn(|a| v[a])))
+        })
+        .collect();
+    prop_assert_eq!(
+        query::contains_many_signed(&tree, &signed),
+        Ok(expect_signed)
+    );
     // A cursor on a random walk (neighbour after neighbour) and on the points as given.
     let mut cursor = tree.cursor();
     let mut p = points[0];
