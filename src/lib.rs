@@ -32,8 +32,9 @@
 //!   Booleans both write.
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
-//!   mass properties, complexity — and those of valued trees ([`ops::values`]: select, mask, combine,
-//!   overlay, map, per-value statistics).
+//!   mass properties, complexity — on trees in memory and on mapped files, the trees they make written
+//!   through a level sink (into memory, or level by level to files); and those of valued trees
+//!   ([`ops::values`]: select, mask, combine, overlay, map, per-value statistics).
 //! * [`query`]: questions asked of a map — batch point queries, boxes and counts, ray casting, the
 //!   nearest full voxel — on trees in memory and on mapped files.
 //! * [`shape`]: morphology (dilate, erode, opening, closing), connected components, surface area and Euler number, on the runs;
@@ -44,16 +45,17 @@
 //!   interactive 3-D view in one self-contained HTML page ([`export::view`]).
 //!
 //! # Layers
-//! Each layer imports only those below it, with the exceptions listed after the picture:
+//! Each layer imports only those below it:
 //! ```text
 //!  io/                files by format: .ktree (v1 read, v2 written and mapped, v3 with values), interop
 //!                     grids, ray text, point clouds and meshes in (into solid/'s PointCloud and TriangleMesh);
 //!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in,
 //!                     meshes written through export/); spill files, one level a file, and the level
-//!                     sink over them; the out-of-core builder's files (Builder::to_file)
+//!                     sink over them; the out-of-core builder's files (Builder::to_file); the Booleans
+//!                     of files larger than memory (ops' merge, mapped inputs, spilled output)
 //!  export/            boundaries as meshes and outlines, and their files (over display's neighbours);
 //!                     the 3-D view page (over the storage trait and display's named views)
-//!  ops/  display/     operations; Booleans are one merge visitor over the storage trait, into a level sink
+//!  ops/  display/     operations over the storage trait, each tree made written through a level sink
 //!  query/  shape/     questions asked of a map (points, boxes, rays, nearest), over the storage trait;
 //!                     morphology, components, surface area, Euler number, on the runs
 //!  stacking/          Builder (cells on all threads, in memory or out of core through a piece store and
@@ -63,14 +65,14 @@
 //!                     storage trait, the walks, the level sink, the top-down builder, packed 2-bit words
 //!  rays/   space   fs (atomic writes, spill folders)
 //! ```
-//! Not yet so: the operators `|`, `&`, `-`, `^`, `!` on trees are defined in `tree/` and call `ops`
-//! (tree → ops); the streamed Booleans spill through `io`'s level files, write their output through
-//! `io::KtreeWriter` and read their inputs through `io::KtreeView` (ops → io). Both are listed in
-//! `verify/tests/layers.rs`, which fails on any other upward import. (The out-of-core builder writes through
-//! its own traits, `stacking::PieceStore` and `stacking::LevelOrderSink`, which `io` implements with spill
-//! files and the `.ktree` writer: `Builder::to_file` is defined in `io`. Ray sources implement
+//! `verify/tests/layers.rs` fails on any upward import. The operators `|`, `&`, `-`,
+//! `^`, `!` on trees are defined in `ops/`, beside the Booleans they call. The streamed Booleans of files
+//! are one merge in `ops/` (`ops::boolean_into`, any two storages into any level sink); `io` opens the
+//! files, spills the levels and writes the `.ktree` (`io::boolean_files`). The out-of-core builder writes
+//! through its own traits, `stacking::PieceStore` and `stacking::LevelOrderSink`, which `io` implements with
+//! spill files and the `.ktree` writer: `Builder::to_file` is defined in `io`. Ray sources implement
 //! `rays::RaySource`, below every producer and consumer of rays. `KTree::from_rays` and `KTree::from_dense`
-//! are defined beside their builders, in `stacking/` and `reference/`: the tree knows no builder.)
+//! are defined beside their builders, in `stacking/` and `reference/`: the tree knows no builder.
 //!
 //! # Example
 //! ```

@@ -8,9 +8,9 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::{ktree_file_version, KtreeView, VERSION};
+use ktree::io::{ktree_file_version, AnyMappedTree, VERSION};
 use ktree::ops;
-use ktree::KTree;
+use ktree::tree::storage::{infallible, TreeStorage};
 use serde::Serialize;
 
 use crate::common::tree_file::read;
@@ -51,13 +51,6 @@ struct Report {
     measures: Option<crate::shape::Measures>,
 }
 
-/// The exact properties of a memory-mapped version 2 file, from its leaves.
-fn view_report<const K: usize>(view: &KtreeView) -> Result<Report, String> {
-    let m = ops::mass_of_leaves(view.level(), |visit| view.for_each_leaf::<K>(visit))
-        .map_err(|e| e.to_string())?;
-    Ok(Report::exact(&m, view.node_count()))
-}
-
 impl Report {
     /// The exact properties of a tree of `nodes` nodes, without progressive bounds.
     fn exact<const K: usize>(m: &ops::MassProperties<K>, nodes: u64) -> Self {
@@ -75,9 +68,15 @@ impl Report {
     }
 }
 
-fn report<const K: usize>(t: &KTree<K>, tolerance: Option<f64>) -> Report {
-    let progressive = tolerance.map(|tol| ops::mass_progressive(t, tol));
-    Report {
+/// The properties of a tree in any storage, with the progressive bounds if a tolerance is given.
+fn report<const K: usize, T: TreeStorage<K>>(
+    t: &T,
+    tolerance: Option<f64>,
+) -> Result<Report, T::Error> {
+    let progressive = tolerance
+        .map(|tol| ops::mass_progressive(t, tol))
+        .transpose()?;
+    Ok(Report {
         estimate: progressive.as_ref().map(|p| p.estimate),
         progressive: progressive.map(|p| {
             p.levels
@@ -90,8 +89,8 @@ fn report<const K: usize>(t: &KTree<K>, tolerance: Option<f64>) -> Report {
                 })
                 .collect()
         }),
-        ..Report::exact(&ops::mass_properties(t), t.node_count())
-    }
+        ..Report::exact(&ops::mass_properties(t)?, t.node_count())
+    })
 }
 
 /// Prints the mass properties.
@@ -101,19 +100,14 @@ pub fn run(args: Args) -> CliResult {
             return Err(format!("--tolerance must be a number ≥ 0, got {t}").into());
         }
     }
-    let mapped = args.tolerance.is_none()
-        && ktree_file_version(&args.tree).map_err(|e| e.to_string())? == VERSION;
+    let mapped = ktree_file_version(&args.tree).map_err(|e| e.to_string())? == VERSION;
     let mut r = if mapped {
-        let view = KtreeView::open(&args.tree).map_err(|e| e.to_string())?;
-        match view.k() {
-            1 => view_report::<1>(&view)?,
-            2 => view_report::<2>(&view)?,
-            3 => view_report::<3>(&view)?,
-            _ => view_report::<4>(&view)?,
-        }
+        let tree = AnyMappedTree::open(&args.tree).map_err(|e| e.to_string())?;
+        ktree::with_dim!(&tree, AnyMappedTree, t => report(t, args.tolerance))
+            .map_err(|e| e.to_string())?
     } else {
         let tree = read(&args.tree)?;
-        ktree::with_dim!(&tree, AnyTree, t => report(t, args.tolerance))
+        ktree::with_dim!(&tree, AnyTree, t => infallible(report(t, args.tolerance)))
     };
     r.measures = crate::shape::measures_of_file(&args.tree)?;
     if args.json {

@@ -2,15 +2,15 @@
 //! `.ktree` files.
 //!
 //! When the inputs are `.ktree` version 2 files and the output is one too, the operation streams from the
-//! inputs' memory maps to the output in bounded memory ([`ktree::ops::boolean_files`]), with its spill
+//! inputs' memory maps to the output in bounded memory ([`ktree::io::boolean_files`]), with its spill
 //! files in `--temp-dir`; it is also faster than loading the trees. Otherwise (a version 1 file) the trees
 //! are read into memory, if they and the result fit in the budget (`--max-memory`).
 
 use crate::common::error::{CliError, CliResult};
 use std::path::PathBuf;
 
-use ktree::io::ktree_file_version;
-use ktree::ops::{self, BoolOp, BooleanFileReport};
+use ktree::io::{self, ktree_file_version, BooleanFileReport};
+use ktree::ops::BoolOp;
 
 use crate::common::tree_file::{pair_error, print_summary, read, write};
 
@@ -101,8 +101,8 @@ fn stream_op(args: &Args) -> Option<CliResult> {
     }
     let temp = args.temp_dir.as_deref();
     let report: Result<BooleanFileReport, _> = match args.inputs.as_slice() {
-        [a] if args.operation == Operation::Not => ops::complement_file(a, &args.out, temp),
-        [a, b] => ops::boolean_files(a, b, args.operation.binary()?, &args.out, temp),
+        [a] if args.operation == Operation::Not => io::complement_file(a, &args.out, temp),
+        [a, b] => io::boolean_files(a, b, args.operation.binary()?, &args.out, temp),
         _ => return None,
     };
     Some(

@@ -10,6 +10,7 @@ use crate::common::error::CliResult;
 use std::path::PathBuf;
 
 use ktree::ops::{self, Affine, AxisMap, Projective};
+use ktree::tree::storage::infallible;
 use ktree::KTree;
 
 use crate::common::tree_file::{read, write};
@@ -165,11 +166,11 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
             let turns = ((deg / 90.0) as i64).rem_euclid(4);
             let q = AxisMap::<K>::quarter_turn(from, to).map_err(|e| e.to_string())?;
             for _ in 0..turns {
-                t = ops::rotate_axes(&t, &q);
+                t = infallible(ops::rotate_axes(&t, &q));
             }
         }
         if let Some(v) = &translate {
-            t = ops::translate(&t, std::array::from_fn(|i| v[i] as i64));
+            t = infallible(ops::translate(&t, std::array::from_fn(|i| v[i] as i64)));
         }
         return Ok(t);
     }

@@ -1,7 +1,8 @@
 //! `--format-version`: the commands that write trees write `.ktree` version 2 by default and version 1 on
 //! request; `stats` reads both (version 2 through a memory map) and prints the same counts; a damaged
 //! version 2 file is an error naming the level's section and its byte offset; `mass` of a version 2 file,
-//! summed from its memory map, equals `mass` of the same tree loaded from version 1, in K = 2, 3 and 4.
+//! summed from its memory map (with or without the progressive bounds), equals `mass` of the same tree
+//! loaded from version 1, in K = 2, 3 and 4.
 
 mod common;
 
@@ -79,12 +80,21 @@ fn mass_of_a_mapped_file_equals_mass_of_the_loaded_tree() {
             );
             assert!(ok, "{err}");
         }
-        let (ok2, mapped, err) = ktree(&["mass", v2.to_str().unwrap(), "--json"]);
-        assert!(ok2, "{err}");
-        let (ok1, loaded, err) = ktree(&["mass", v1.to_str().unwrap(), "--json"]);
-        assert!(ok1, "{err}");
-        assert_eq!(mapped, loaded, "K = {k}");
-        assert!(mapped.contains("\"volume\""), "{mapped}");
+        for tolerance in [&[][..], &["--tolerance", "0.05"], &["--tolerance", "0"]] {
+            let (ok2, mapped, err) =
+                ktree(&[&["mass", v2.to_str().unwrap(), "--json"], tolerance].concat());
+            assert!(ok2, "{err}");
+            let (ok1, loaded, err) =
+                ktree(&[&["mass", v1.to_str().unwrap(), "--json"], tolerance].concat());
+            assert!(ok1, "{err}");
+            assert_eq!(mapped, loaded, "K = {k}, {tolerance:?}");
+            assert!(mapped.contains("\"volume\""), "{mapped}");
+            assert_eq!(
+                mapped.contains("\"progressive\": ["),
+                !tolerance.is_empty(),
+                "{mapped}"
+            );
+        }
     }
 }
 

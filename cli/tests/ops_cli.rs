@@ -61,9 +61,10 @@ fn op_transform_collide_mass_agree_with_the_library() {
     ]);
     assert!(ok, "{err}");
     let expect = ops::translate(
-        &ops::rotate_axes(&a, &AxisMap::quarter_turn(0, 1).unwrap()),
+        &ops::rotate_axes(&a, &AxisMap::quarter_turn(0, 1).unwrap()).unwrap(),
         [1, -2, 3],
-    );
+    )
+    .unwrap();
     assert_eq!(load3(&pc), expect);
     // Affine path: an arbitrary angle.
     let (ok, _, err) = ktree(&["transform", s(&pa), "--rotate", "x:30", "--out", s(&pc)]);
@@ -80,7 +81,7 @@ fn op_transform_collide_mass_agree_with_the_library() {
         s(&pc),
     ]);
     assert!(ok, "{err}");
-    assert_eq!(load3(&pc), ops::translate(&a, [2, 0, 0]));
+    assert_eq!(load3(&pc), ops::translate(&a, [2, 0, 0]).unwrap());
 
     // A projective matrix: Meagher's perspective deformation along z.
     let p = ops::Projective::<3>::perspective(5, 2, 40.0).unwrap();
@@ -164,7 +165,7 @@ fn other_dimensions_work_through_the_cli() {
     assert!(ok, "{err}");
     assert_eq!(
         load2(&pc),
-        ops::rotate_axes(&a, &AxisMap::quarter_turn(0, 1).unwrap())
+        ops::rotate_axes(&a, &AxisMap::quarter_turn(0, 1).unwrap()).unwrap()
     );
     let (ok, _, err) = ktree(&["transform", s(&pa), "--rotate", "z:30", "--out", s(&pc)]);
     assert!(!ok && err.contains("axis"), "named axes are for 3-D: {err}");

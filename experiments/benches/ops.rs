@@ -35,9 +35,14 @@ fn check(a: &KTree<3>, b: &KTree<3>) {
     assert_eq!(ops::intersection(a, b).unwrap(), law);
     let q = AxisMap::<3>::quarter_turn(0, 1).unwrap();
     let m = Affine::rotation_about(0, 1, 90.0, Affine::<3>::universe_centre(a.level())).unwrap();
-    assert_eq!(ops::rotate_axes(a, &q), ops::transform(a, &m).unwrap());
+    assert_eq!(
+        ops::rotate_axes(a, &q).unwrap(),
+        ops::transform(a, &m).unwrap()
+    );
     // Translating there and back keeps exactly the part that stays inside the universe.
-    let there_and_back = |t: &KTree<3>| ops::translate(&ops::translate(t, [3, -5, 7]), [-3, 5, -7]);
+    let there_and_back = |t: &KTree<3>| {
+        ops::translate(&ops::translate(t, [3, -5, 7]).unwrap(), [-3, 5, -7]).unwrap()
+    };
     let stays = there_and_back(&KTree::full(b.level()).unwrap());
     assert_eq!(there_and_back(b), ops::intersection(b, &stays).unwrap());
 }
@@ -55,17 +60,17 @@ fn benches(c: &mut Criterion) {
             group.bench_with_input(
                 BenchmarkId::new(op.name(), level),
                 &(&a, &b),
-                |bn, (a, b)| bn.iter(|| ops::boolean(a, b, op).unwrap()),
+                |bn, (a, b)| bn.iter(|| ops::boolean(*a, *b, op).unwrap()),
             );
         }
         group.throughput(Throughput::Elements(a.node_count()));
         let q = AxisMap::<3>::quarter_turn(0, 1).unwrap();
         group.bench_with_input(BenchmarkId::new("rotate90", level), &a, |bn, a| {
-            bn.iter(|| ops::rotate_axes(a, &q))
+            bn.iter(|| ops::rotate_axes(a, &q).unwrap())
         });
         if level <= 9 {
             group.bench_with_input(BenchmarkId::new("translate", level), &a, |bn, a| {
-                bn.iter(|| ops::translate(a, [3, -5, 7]))
+                bn.iter(|| ops::translate(a, [3, -5, 7]).unwrap())
             });
             let m =
                 Affine::rotation_about(0, 1, 30.0, Affine::<3>::universe_centre(level)).unwrap();

@@ -2,7 +2,7 @@
 //!
 //! * [`ktree`](mod@ktree): ktree's own `.ktree` format, 2 bits a node and checksummed — version 2 (written,
 //!   streamed out level by level and memory-mapped in: [`KtreeWriter`], [`KtreeView`], [`MappedTree`]) and
-//!   version 1 (read);
+//!   version 1 (read); Booleans of files larger than memory ([`boolean_files`], [`complement_file`]);
 //! * [`rays`](mod@rays): the ray text format;
 //! * [`interop`]: other tools' grids — binvox, OctoMap `.bt`, OpenVDB `.vdb`;
 //! * [`cloud`](mod@cloud) and [`mesh`](mod@mesh): point clouds (PLY, PCD, XYZ/CSV, LAS/LAZ) and triangle
@@ -67,9 +67,10 @@ pub use interop::{
 };
 pub use ktree::v1::{write_ktree_v1, write_ktree_v1_view};
 pub use ktree::{
-    ktree_file_version, read_ktree, read_ktree_any, read_ktree_file, write_ktree, write_ktree_file,
-    AnyMappedTree, KtreeFileError, KtreeFileErrorKind, KtreeView, KtreeWriter, MappedTree, MAGIC,
-    VERSION,
+    boolean_files, boolean_views, complement_file, ktree_file_version, read_ktree, read_ktree_any,
+    read_ktree_file, write_ktree, write_ktree_file, AnyMappedTree, BooleanFileError,
+    BooleanFileReport, KtreeFileError, KtreeFileErrorKind, KtreeView, KtreeWriter, MappedTree,
+    ViewOperation, MAGIC, VERSION,
 };
 pub use location::{FileError, Location, Place, ProblemKind};
 pub use out_of_core::{SpilledFiles, SpilledLevel};

@@ -23,15 +23,19 @@
 //! // A quarter turn about the universe's centre, by an affine map and by reordering children: the same tree.
 //! let m = Affine::rotation_about(0, 1, 90.0, Affine::<2>::universe_centre(4)).unwrap();
 //! let turned = transform(&ball, &m).unwrap();
-//! assert_eq!(turned, rotate_axes(&ball, &AxisMap::quarter_turn(0, 1).unwrap()));
+//! assert_eq!(turned, rotate_axes(&ball, &AxisMap::quarter_turn(0, 1).unwrap()).unwrap());
 //! assert_eq!(turned.voxel_count(), ball.voxel_count());
 //! ```
 
 // Matrix and per-axis code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-use super::overlay::{resample, Preimage};
+use super::output::Memory;
+use super::overlay::{resample_into, Preimage};
 use super::OpsError;
+use crate::space::Universe;
+use crate::tree::sink::LevelSink;
+use crate::tree::storage::TreeStorage;
 use crate::tree::KTree;
 
 /// An affine map `x ↦ A·x + b` of continuous coordinates (voxel units, origin at the universe's corner).
@@ -219,6 +223,20 @@ impl<const K: usize> Preimage<K> for Inverse<K> {
     }
 }
 
+impl<const K: usize> Inverse<K> {
+    /// The preimage of `m` over `universe`: its inverse, cell boxes widened by a bound on the rounding.
+    fn of(m: &Affine<K>, universe: Universe<K>) -> Result<Self, OpsError> {
+        let inv = m.inverse()?;
+        let side = universe.side() as f64;
+        let slack = std::array::from_fn(|i| {
+            let magnitude =
+                inv.b[i].abs() + (0..K).map(|j| inv.a[i][j].abs()).sum::<f64>() * (side + 1.0);
+            1e-9 + 64.0 * f64::EPSILON * magnitude
+        });
+        Ok(Self { map: inv, slack })
+    }
+}
+
 /// Applies the affine map `m` (source → target coordinates) to the object, in the same universe; parts
 /// mapped outside are cut off. Target voxel `q` is full iff source voxel `m⁻¹`-[`Affine::source_voxel`]`(q)`
 /// is. The output is reduced.
@@ -232,16 +250,32 @@ impl<const K: usize> Preimage<K> for Inverse<K> {
 /// ```
 ///
 /// # Errors
-/// [`OpsError::Singular`] if `m` is singular.
-pub fn transform<const K: usize>(tree: &KTree<K>, m: &Affine<K>) -> Result<KTree<K>, OpsError> {
-    let inv = m.inverse()?;
-    let side = tree.universe().side() as f64;
-    let slack = std::array::from_fn(|i| {
-        let magnitude =
-            inv.b[i].abs() + (0..K).map(|j| inv.a[i][j].abs()).sum::<f64>() * (side + 1.0);
-        1e-9 + 64.0 * f64::EPSILON * magnitude
-    });
-    Ok(resample(tree, &Inverse { map: inv, slack }))
+/// [`OpsError::Singular`] if `m` is singular; [`OpsError::Storage`] if a read of `tree` fails.
+pub fn transform<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    m: &Affine<K>,
+) -> Result<KTree<K>, OpsError> {
+    let map = Inverse::of(m, tree.universe())?;
+    resample_into::<K, _, _, _, T::Error>(tree, &map, Memory::new(tree.universe()))
+        .map_err(OpsError::storage)
+}
+
+/// [`transform`] written to `sink`.
+///
+/// # Errors
+/// As [`transform`], and the sink's write error.
+pub fn transform_into<const K: usize, T, S, E>(
+    tree: &T,
+    m: &Affine<K>,
+    sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<OpsError> + From<T::Error> + From<S::Error>,
+{
+    let map = Inverse::of(m, tree.universe())?;
+    resample_into(tree, &map, sink)
 }
 
 /// Checks that `m` holds the `(k+1)²` finite entries of a homogeneous matrix.

@@ -12,13 +12,11 @@
 //! Two trees of different universe levels are an error ([`OpsError::LevelMismatch`]); trees of different
 //! dimension `K` cannot be combined at all — `KTree<2>` and `KTree<3>` are different types.
 
-use std::convert::Infallible;
-
-use super::emit::{collapse, leaf};
+use super::output::{collapse, leaf, Memory};
 use super::OpsError;
 use crate::tree::cursor::{try_walk_pair, PairNode, PairVisitor, Walk};
-use crate::tree::sink::{copy_subtree, LevelSink, MemorySink};
-use crate::tree::storage::{infallible, TreeStorage};
+use crate::tree::sink::{copy_subtree, LevelSink};
+use crate::tree::storage::TreeStorage;
 use crate::tree::words::{self, NODES_PER_WORD};
 use crate::tree::{KTree, NodeState};
 
@@ -196,12 +194,22 @@ where
 }
 
 /// `a op b` written to `sink`, for trees of the same universe in any storages: the one Boolean behind
-/// [`boolean`] (in memory) and [`boolean_files`](super::boolean_files) (mapped files, spilled levels).
-/// The output is reduced.
+/// [`boolean`] (in memory) and `io::boolean_files` (mapped files, levels spilled to files). The output is
+/// reduced. The levels are not compared: see [`boolean`].
+///
+/// ```
+/// use ktree::{KTree, ops::{boolean, boolean_into, BoolOp}};
+/// use ktree::tree::sink::MemorySink;
+/// let a = KTree::<1>::from_dense(2, &[true, true, false, false]).unwrap();
+/// let b = KTree::<1>::from_dense(2, &[false, true, true, false]).unwrap();
+/// let sink = MemorySink::new(a.universe());
+/// let x: KTree<1> = boolean_into::<1, _, _, _, std::convert::Infallible>(&a, &b, BoolOp::Difference, sink).unwrap();
+/// assert_eq!(x, boolean(&a, &b, BoolOp::Difference).unwrap());
+/// ```
 ///
 /// # Errors
 /// The first read error of `a` or `b`, or write error of `sink`.
-pub(crate) fn boolean_into<const K: usize, A, B, S, E>(
+pub fn boolean_into<const K: usize, A, B, S, E>(
     a: &A,
     b: &B,
     op: BoolOp,
@@ -231,11 +239,12 @@ where
     Ok(m.out.finish(root)?)
 }
 
-/// The complement of `a` written to `sink`: the root's subtree copied with full and empty swapped.
+/// The complement of `a` written to `sink`, from any storage: the root's subtree copied with full and
+/// empty swapped. For a tree in memory, [`complement`] flips the words in place of a copy.
 ///
 /// # Errors
 /// The first read error of `a` or write error of `sink`.
-pub(crate) fn complement_into<const K: usize, A, S, E>(a: &A, mut sink: S) -> Result<S::Output, E>
+pub fn complement_into<const K: usize, A, S, E>(a: &A, mut sink: S) -> Result<S::Output, E>
 where
     A: TreeStorage<K>,
     S: LevelSink,
@@ -253,7 +262,10 @@ where
 }
 
 /// Checks that two trees share a universe level.
-pub(crate) fn same_level<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<(), OpsError> {
+pub(crate) fn same_level<const K: usize, A: TreeStorage<K>, B: TreeStorage<K>>(
+    a: &A,
+    b: &B,
+) -> Result<(), OpsError> {
     if a.level() != b.level() {
         return Err(OpsError::LevelMismatch {
             left: a.level(),
@@ -263,7 +275,8 @@ pub(crate) fn same_level<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<(
     Ok(())
 }
 
-/// Applies a binary Boolean operation. The output is reduced; the cost is linear in the input nodes.
+/// Applies a binary Boolean operation to two trees of any storages (with one read error type: two trees
+/// in memory, two mapped files, …). The output is reduced; the cost is linear in the input nodes.
 ///
 /// ```
 /// use ktree::{KTree, ops::{boolean, BoolOp}};
@@ -276,49 +289,62 @@ pub(crate) fn same_level<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<(
 /// ```
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`] when the trees' levels differ.
-pub fn boolean<const K: usize>(
-    a: &KTree<K>,
-    b: &KTree<K>,
-    op: BoolOp,
-) -> Result<KTree<K>, OpsError> {
+/// [`OpsError::LevelMismatch`] when the trees' levels differ; [`OpsError::Storage`] if a read fails.
+pub fn boolean<const K: usize, A, B>(a: &A, b: &B, op: BoolOp) -> Result<KTree<K>, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     same_level(a, b)?;
-    let merged: Result<_, Infallible> = boolean_into(a, b, op, MemorySink::new(a.universe()));
-    Ok(infallible(merged))
+    boolean_into::<K, _, _, _, A::Error>(a, b, op, Memory::new(a.universe()))
+        .map_err(OpsError::storage)
 }
 
 /// `A ∪ B`. See [`boolean`].
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`].
-pub fn union<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<KTree<K>, OpsError> {
+/// As [`boolean`].
+pub fn union<const K: usize, A, B>(a: &A, b: &B) -> Result<KTree<K>, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     boolean(a, b, BoolOp::Union)
 }
 
 /// `A ∩ B`. See [`boolean`].
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`].
-pub fn intersection<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<KTree<K>, OpsError> {
+/// As [`boolean`].
+pub fn intersection<const K: usize, A, B>(a: &A, b: &B) -> Result<KTree<K>, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     boolean(a, b, BoolOp::Intersection)
 }
 
 /// `A ∖ B`. See [`boolean`].
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`].
-pub fn difference<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<KTree<K>, OpsError> {
+/// As [`boolean`].
+pub fn difference<const K: usize, A, B>(a: &A, b: &B) -> Result<KTree<K>, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     boolean(a, b, BoolOp::Difference)
 }
 
 /// `A △ B`. See [`boolean`].
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`].
-pub fn symmetric_difference<const K: usize>(
-    a: &KTree<K>,
-    b: &KTree<K>,
-) -> Result<KTree<K>, OpsError> {
+/// As [`boolean`].
+pub fn symmetric_difference<const K: usize, A, B>(a: &A, b: &B) -> Result<KTree<K>, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     boolean(a, b, BoolOp::SymmetricDifference)
 }
 

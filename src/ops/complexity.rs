@@ -1,16 +1,17 @@
 //! Meagher's complexity metric (§5, claim M9): the number of nodes, one value per level, and its
 //! normalisations — over placements of the object at sub-cell offsets, and over a set of rotations (or any
-//! maps): the node count as a function of the placement, with its minimum, mean and maximum.
-// Matrix and per-axis code reads best with explicit indices.
-#![allow(clippy::needless_range_loop)]
+//! maps): the node count as a function of the placement, with its minimum, mean and maximum. Each reads
+//! any [`TreeStorage`].
 
 use super::affine::{transform, Affine};
 use super::translate::translate;
 use super::OpsError;
-use crate::tree::{KTree, LevelCounts, NodeState};
+use crate::query::bounding_box;
+use crate::tree::storage::{infallible, TreeStorage};
+use crate::tree::{KTree, LevelCounts};
 
 /// The metric itself: node counts per level (from the root), as [`KTree::counts_per_level`] gives.
-pub fn complexity<const K: usize>(tree: &KTree<K>) -> Vec<LevelCounts> {
+pub fn complexity<const K: usize, T: TreeStorage<K>>(tree: &T) -> Vec<LevelCounts> {
     tree.counts_per_level()
 }
 
@@ -50,29 +51,22 @@ impl Normalised {
     }
 }
 
-/// The bounding box of the object's voxels, `(lo, hi)` inclusive per axis, or `None` if it is empty.
-pub fn bounding_box<const K: usize>(tree: &KTree<K>) -> Option<[(u32, u32); K]> {
-    let mut bx: Option<[(u32, u32); K]> = None;
-    tree.for_each_leaf(|cell, state| {
-        if state == NodeState::Full {
-            let side = cell.side() as u32;
-            let b = bx.get_or_insert([(u32::MAX, 0); K]);
-            for i in 0..K {
-                b[i].0 = b[i].0.min(cell.origin[i]);
-                b[i].1 = b[i].1.max(cell.origin[i] + side - 1);
-            }
-        }
-    });
-    bx
-}
-
 /// Meagher's first normalisation: the object translated so that it touches the `K` faces of the universe
-/// through the origin.
-pub fn normalise_to_origin<const K: usize>(tree: &KTree<K>) -> KTree<K> {
-    match bounding_box(tree) {
-        None => tree.clone(),
-        Some(bx) => translate(tree, bx.map(|b| -i64::from(b.0))),
-    }
+/// through the origin (the lower corner of its bounding box, [`bounding_box`], moved to the origin).
+///
+/// ```
+/// use ktree::{KTree, ops::normalise_to_origin};
+/// let a = KTree::<1>::from_dense(2, &[false, false, true, false]).unwrap();
+/// assert_eq!(normalise_to_origin(&a).unwrap().to_dense().unwrap(), [true, false, false, false]);
+/// ```
+///
+/// # Errors
+/// The storage's read error (none for a [`KTree`]).
+pub fn normalise_to_origin<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+) -> Result<KTree<K>, T::Error> {
+    let lo = bounding_box(tree)?.map_or([0; K], |(lo, _)| lo);
+    translate(tree, lo.map(|v| -i64::from(v)))
 }
 
 /// Node counts over all `2^(K·bits)` translations by offsets in `[0, 2^bits)` per axis of the object first
@@ -80,9 +74,10 @@ pub fn normalise_to_origin<const K: usize>(tree: &KTree<K>) -> KTree<K> {
 /// fastest.
 ///
 /// # Errors
-/// [`OpsError::TooManyPlacements`] if `2^(K·bits)` exceeds 65 536 placements.
-pub fn over_translations<const K: usize>(
-    tree: &KTree<K>,
+/// [`OpsError::TooManyPlacements`] if `2^(K·bits)` exceeds 65 536 placements; [`OpsError::Storage`] if a
+/// read of `tree` fails.
+pub fn over_translations<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
     bits: u32,
 ) -> Result<Normalised, OpsError> {
     if K as u32 * bits > 16 {
@@ -91,7 +86,7 @@ pub fn over_translations<const K: usize>(
             k: K,
         });
     }
-    let base = normalise_to_origin(tree);
+    let base = normalise_to_origin(tree).map_err(OpsError::storage)?;
     let voxels = base.voxel_count();
     let n = 1usize << (K as u32 * bits);
     let mut counts = Vec::with_capacity(n);
@@ -99,7 +94,7 @@ pub fn over_translations<const K: usize>(
     for i in 0..n {
         let t: [i64; K] =
             std::array::from_fn(|a| ((i >> (a as u32 * bits)) & ((1 << bits) - 1)) as i64);
-        let moved = translate(&base, t);
+        let moved = infallible(translate(&base, t));
         if moved.voxel_count() != voxels {
             clipped += 1;
         }
@@ -142,9 +137,9 @@ pub fn over_placements<const K: usize, E: From<OpsError>>(
 /// normalisation Meagher proposes.
 ///
 /// # Errors
-/// [`OpsError::Singular`] for a singular map.
-pub fn over_maps<const K: usize>(
-    tree: &KTree<K>,
+/// [`OpsError::Singular`] for a singular map; [`OpsError::Storage`] if a read of `tree` fails.
+pub fn over_maps<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
     maps: &[Affine<K>],
 ) -> Result<Normalised, OpsError> {
     let mut counts = Vec::with_capacity(maps.len());

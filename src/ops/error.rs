@@ -2,10 +2,17 @@
 
 use thiserror::Error;
 
-/// What can go wrong in an operation on k-trees. Every variant says how to fix the input.
-#[derive(Debug, Clone, PartialEq, Error)]
+use crate::tree::StorageError;
+
+/// What can go wrong in an operation on k-trees. Every variant but [`OpsError::Storage`] says how to fix
+/// the input.
+#[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum OpsError {
+    /// A read of an input tree failed: a tree read in place from a file found the file changed (the error
+    /// names the file and the byte offset). Trees in memory never fail.
+    #[error(transparent)]
+    Storage(#[from] StorageError),
     /// Two trees of different dimensions were combined.
     #[error("{0}: both trees must have the same dimension")]
     DimensionMismatch(crate::tree::DimensionMismatch),
@@ -124,4 +131,11 @@ pub enum OpsError {
     /// An operation made a value no voxel may hold (a sum of floats `inf + -inf` is a NaN).
     #[error("the result would hold {0}")]
     Value(#[from] crate::value::ValueError),
+}
+
+impl OpsError {
+    /// A storage's read error as an operation's error (for `map_err`).
+    pub fn storage(error: impl Into<StorageError>) -> Self {
+        Self::Storage(error.into())
+    }
 }

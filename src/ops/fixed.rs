@@ -13,8 +13,11 @@
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-use super::overlay::{resample_incremental, IncrementalPreimage};
+use super::output::Memory;
+use super::overlay::{resample_incremental_into, IncrementalPreimage};
 use super::{Affine, OpsError};
+use crate::tree::sink::LevelSink;
+use crate::tree::storage::TreeStorage;
 use crate::tree::KTree;
 
 /// The inverse of an affine map in fixed point, ready for integer-only traversal.
@@ -144,12 +147,32 @@ impl<const K: usize> IncrementalPreimage<K> for FixedAffine<K> {
 /// ```
 ///
 /// # Errors
-/// As [`FixedAffine::new`].
-pub fn transform_fixed<const K: usize>(
-    tree: &KTree<K>,
+/// As [`FixedAffine::new`]; [`OpsError::Storage`] if a read of `tree` fails.
+pub fn transform_fixed<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
     m: &Affine<K>,
     frac_bits: u32,
 ) -> Result<KTree<K>, OpsError> {
     let map = FixedAffine::new(m, frac_bits)?;
-    Ok(resample_incremental(tree, &map))
+    resample_incremental_into::<K, _, _, _, T::Error>(tree, &map, Memory::new(tree.universe()))
+        .map_err(OpsError::storage)
+}
+
+/// [`transform_fixed`] written to `sink`.
+///
+/// # Errors
+/// As [`transform_fixed`], and the sink's write error.
+pub fn transform_fixed_into<const K: usize, T, S, E>(
+    tree: &T,
+    m: &Affine<K>,
+    frac_bits: u32,
+    sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<OpsError> + From<T::Error> + From<S::Error>,
+{
+    let map = FixedAffine::new(m, frac_bits)?;
+    resample_incremental_into(tree, &map, sink)
 }

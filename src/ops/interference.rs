@@ -3,12 +3,15 @@
 //!
 //! A simultaneous traversal like the Booleans', stopping at the first full–full or full–partial pair.
 //! Both trees are pre-sorted, so no search is needed: cost linear in the nodes reached, usually far fewer.
+//! The trees are read through any storages with one read error type (two trees in memory, two mapped
+//! files, …).
 
 use super::boolean::{intersection, same_level};
 use super::OpsError;
 use crate::space::Cell;
-use crate::tree::cursor::{walk_pair, ChildOrder, PairNode, PairVisitor, Walk};
-use crate::tree::{KTree, NodeState};
+use crate::tree::cursor::{try_walk_pair, ChildOrder, PairNode, PairVisitor, Walk};
+use crate::tree::storage::TreeStorage;
+use crate::tree::NodeState;
 
 /// Whether the objects share at least one voxel (regularized: touching along a face is not interference).
 /// Stops at the first overlap found.
@@ -21,11 +24,15 @@ use crate::tree::{KTree, NodeState};
 /// ```
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`] when the trees' levels differ.
-pub fn interferes<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<bool, OpsError> {
+/// [`OpsError::LevelMismatch`] when the trees' levels differ; [`OpsError::Storage`] if a read fails.
+pub fn interferes<const K: usize, A, B>(a: &A, b: &B) -> Result<bool, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     same_level(a, b)?;
     let mut meet = Meet(false);
-    walk_pair(a, b, &mut meet);
+    try_walk_pair(a, b, &mut meet).map_err(OpsError::storage)?;
     Ok(meet.0)
 }
 
@@ -52,8 +59,12 @@ impl<const K: usize> PairVisitor<K> for Meet {
 /// The cells where the objects overlap (the full leaves of `A ∩ B`), in Morton order.
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`].
-pub fn overlap_cells<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Vec<Cell<K>>, OpsError> {
+/// As [`interferes`].
+pub fn overlap_cells<const K: usize, A, B>(a: &A, b: &B) -> Result<Vec<Cell<K>>, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     Ok(intersection(a, b)?.full_cells().collect())
 }
 
@@ -62,12 +73,16 @@ pub fn overlap_cells<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Vec<C
 /// with the lower `time_axis` half first and stops at the first overlap, so it visits few nodes.
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`]; [`OpsError::BadAxis`] if `time_axis ≥ K`.
-pub fn first_contact<const K: usize>(
-    a: &KTree<K>,
-    b: &KTree<K>,
+/// As [`interferes`]; [`OpsError::BadAxis`] if `time_axis ≥ K`.
+pub fn first_contact<const K: usize, A, B>(
+    a: &A,
+    b: &B,
     time_axis: usize,
-) -> Result<Option<u32>, OpsError> {
+) -> Result<Option<u32>, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     same_level(a, b)?;
     if time_axis >= K {
         return Err(OpsError::BadAxis {
@@ -80,7 +95,7 @@ pub fn first_contact<const K: usize>(
         order: ChildOrder::lower_half_first::<K>(time_axis),
         best: None,
     };
-    walk_pair(a, b, &mut query);
+    try_walk_pair(a, b, &mut query).map_err(OpsError::storage)?;
     Ok(query.best)
 }
 
@@ -145,14 +160,18 @@ pub struct Collision {
 /// ```
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`]; a time axis not below `K`.
-pub fn collision<const K: usize>(
-    a: &KTree<K>,
-    b: &KTree<K>,
+/// As [`interferes`]; a time axis not below `K`.
+pub fn collision<const K: usize, A, B>(
+    a: &A,
+    b: &B,
     time_axis: Option<usize>,
-) -> Result<Collision, OpsError> {
-    let overlap = super::intersection(a, b)?;
-    let collide = overlap.root_state() != crate::NodeState::Empty;
+) -> Result<Collision, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
+    let overlap = intersection(a, b)?;
+    let collide = overlap.root_state() != NodeState::Empty;
     let first_contact = match time_axis {
         Some(axis) => first_contact(a, b, axis)?,
         None => None,

@@ -10,11 +10,12 @@
 //! cells follow from those sums. The second moments are taken about the voxel holding the centroid, so
 //! that a small object far from the origin keeps its central moments exact to `f64` precision (summed
 //! about the origin, they would cancel).
+//!
+//! Both read any [`TreeStorage`]: a tree larger than memory is measured from its mapped file, leaf by leaf.
 
-use std::convert::Infallible;
-
-use crate::space::Cell;
-use crate::tree::{KTree, NodeState};
+use crate::tree::cursor::TryLeaves;
+use crate::tree::storage::TreeStorage;
+use crate::tree::NodeState;
 
 /// Exact volume, centroid and second moments of an object.
 #[derive(Debug, Clone, PartialEq)]
@@ -157,47 +158,24 @@ impl<const K: usize> Sums<K> {
 /// ```
 /// use ktree::{KTree, ops::mass_properties};
 /// let a = KTree::<2>::from_dense(1, &[true, true, false, false]).unwrap(); // bottom row of a 2×2
-/// let m = mass_properties(&a);
+/// let m = mass_properties(&a).unwrap();
 /// assert_eq!(m.volume, 2);
 /// assert_eq!(m.centroid, [1.0, 0.5]);
 /// ```
-pub fn mass_properties<const K: usize>(tree: &KTree<K>) -> MassProperties<K> {
-    let walk = |visit: &mut dyn FnMut(Cell<K>, NodeState)| {
-        tree.for_each_leaf(visit);
-        Ok::<(), Infallible>(())
-    };
-    match mass_of_leaves(tree.level(), walk) {
-        Ok(m) => m,
-        Err(never) => match never {},
-    }
-}
-
-/// [`mass_properties`] of the leaves that `walk` reports (each leaf once, in any order) for a universe of
-/// level `level`: for trees that are not held in memory, such as a memory-mapped `.ktree`
-/// ([`KtreeView::for_each_leaf`](crate::io::KtreeView::for_each_leaf)).
-///
-/// ```
-/// use ktree::{KTree, ops::{mass_of_leaves, mass_properties}};
-/// let a = KTree::<2>::from_dense(2, &[true; 16]).unwrap();
-/// let walk = |visit: &mut dyn FnMut(_, _)| {
-///     a.for_each_leaf(visit);
-///     Ok::<(), ()>(())
-/// };
-/// assert_eq!(mass_of_leaves(a.level(), walk), Ok(mass_properties(&a)));
-/// ```
 ///
 /// # Errors
-/// The walk's.
-pub fn mass_of_leaves<const K: usize, E>(
-    level: u32,
-    walk: impl FnOnce(&mut dyn FnMut(Cell<K>, NodeState)) -> Result<(), E>,
-) -> Result<MassProperties<K>, E> {
+/// The storage's read error (none for a [`KTree`](crate::KTree)).
+pub fn mass_properties<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+) -> Result<MassProperties<K>, T::Error> {
+    let level = tree.level();
     let mut per_depth = vec![SizeSums::<K>::new(); level as usize + 1];
-    walk(&mut |cell, state| {
+    for leaf in TryLeaves::new(tree) {
+        let (cell, state) = leaf?;
         if state == NodeState::Full {
             per_depth[cell.level as usize].add(cell.origin);
         }
-    })?;
+    }
     let sum_about = |reference: [i128; K]| {
         let mut sums = Sums::<K>::about(reference);
         for (depth, cells) in per_depth.iter().enumerate() {
@@ -275,12 +253,18 @@ pub struct ProgressiveMass<const K: usize> {
 /// ```
 /// use ktree::{stacking::paper::stack, rays::ball_rays, ops::{mass_progressive, mass_properties}};
 /// let tree = stack(&ball_rays::<3>(8, [256, 256, 256], 240).unwrap());
-/// let p = mass_progressive(&tree, 0.05);
-/// let exact = mass_properties(&tree).volume as f64;
+/// let p = mass_progressive(&tree, 0.05).unwrap();
+/// let exact = mass_properties(&tree).unwrap().volume as f64;
 /// assert!(p.met && (p.estimate - exact).abs() <= 0.05 * exact);
 /// assert!(p.levels.last().unwrap().nodes_touched < p.total_nodes);
 /// ```
-pub fn mass_progressive<const K: usize>(tree: &KTree<K>, tolerance: f64) -> ProgressiveMass<K> {
+///
+/// # Errors
+/// The storage's read error (none for a [`KTree`](crate::KTree)).
+pub fn mass_progressive<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    tolerance: f64,
+) -> Result<ProgressiveMass<K>, T::Error> {
     let level = tree.level();
     let mut full = Sums::<K>::about([0; K]);
     // The partial nodes of the current depth, in index order: the `j`-th one's children are `j·2^K ..`.
@@ -289,7 +273,7 @@ pub fn mass_progressive<const K: usize>(tree: &KTree<K>, tolerance: f64) -> Prog
     let mut levels = Vec::new();
     let mut depth = 0usize;
     // The root itself.
-    match tree.root_state() {
+    match tree.root_state()? {
         NodeState::Full => {
             let mut root = SizeSums::new();
             root.add([0; K]);
@@ -327,21 +311,21 @@ pub fn mass_progressive<const K: usize>(tree: &KTree<K>, tolerance: f64) -> Prog
         let estimate = (lower + upper) as f64 / 2.0;
         let met = (upper - lower) as f64 <= tolerance * estimate;
         if met || frontier.is_empty() {
-            return ProgressiveMass {
+            return Ok(ProgressiveMass {
                 estimate,
                 levels,
                 met,
                 total_nodes: tree.node_count(),
-            };
+            });
         }
         let mut next = Vec::with_capacity(frontier.len() << K);
         let mut full_children = SizeSums::new();
         for (j, cell) in frontier.iter().enumerate() {
-            let first = j << K;
+            let codes = tree.block_codes(depth + 1, j << K)?;
             for c in 0..1usize << K {
                 touched += 1;
                 let child = cell.child(c);
-                match tree.state(depth + 1, first + c) {
+                match NodeState::from_bits(codes >> (2 * c)) {
                     NodeState::Full => full_children.add(child.origin),
                     NodeState::Partial => next.push(child),
                     NodeState::Empty => {}

@@ -11,7 +11,8 @@
 //! ([`Preimage::voxel`]) and the source voxel containing it looked up. So the output equals the brute-force
 //! resampling of every voxel centre, while the work follows the output's nodes, not its voxels.
 //!
-//! Children are decided before they are pushed, so the output is reduced.
+//! Children are decided before they are appended, so the output is reduced. The source is read through
+//! any [`TreeStorage`] and the output written through any [`LevelSink`] ([`resample_into`]).
 //!
 //! ```
 //! use ktree::ops::overlay::{resample, Preimage};
@@ -28,14 +29,15 @@
 //!     }
 //! }
 //! let a = KTree::<1>::from_dense(2, &[true, true, false, false]).unwrap();
-//! assert_eq!(resample(&a, &ShiftOne).to_dense().unwrap(), [false, true, true, false]);
+//! assert_eq!(resample(&a, &ShiftOne).unwrap().to_dense().unwrap(), [false, true, true, false]);
 //! ```
 
-use super::emit::{collapse, leaf, LevelWriter};
+use super::output::{collapse, leaf, Memory};
 use crate::space::Cell;
 use crate::tree::locate::PointCursor;
-use crate::tree::storage::infallible;
-use crate::tree::{KTree, NodeState};
+use crate::tree::sink::LevelSink;
+use crate::tree::storage::TreeStorage;
+use crate::tree::{KTree, NodeRef, NodeState};
 
 /// How target voxels map back into the source universe.
 pub trait Preimage<const K: usize> {
@@ -78,18 +80,21 @@ impl<const K: usize, P: Preimage<K>> IncrementalPreimage<K> for Stateless<'_, P>
     }
 }
 
+/// A source node of an overlay.
 #[derive(Clone, Copy)]
 struct Entry<const K: usize> {
-    depth: usize,
     index: usize,
     cell: Cell<K>,
+    state: NodeState,
 }
 
-struct Engine<'a, const K: usize, P> {
-    src: &'a KTree<K>,
+struct Engine<'a, const K: usize, T, P, S> {
+    src: &'a T,
+    /// The source's root, whose identity the nodes handed to the point cursor carry.
+    root: NodeRef<K>,
     map: &'a P,
     side: i64,
-    out: LevelWriter,
+    out: S,
     overlay: Vec<Entry<K>>,
 }
 
@@ -101,7 +106,12 @@ fn meets<const K: usize>(cell: &Cell<K>, bx: &[(i64, i64); K]) -> bool {
     })
 }
 
-impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
+impl<const K: usize, T, P, S> Engine<'_, K, T, P, S>
+where
+    T: TreeStorage<K>,
+    P: IncrementalPreimage<K>,
+    S: LevelSink,
+{
     /// Adds `e` (meeting `bx`) to the overlay, partial nodes refined to nodes no larger than `extent`;
     /// leaves set `seen` (`[empty, full]`); returns the number of partial nodes added.
     fn refine(
@@ -110,59 +120,74 @@ impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
         bx: &[(i64, i64); K],
         extent: i64,
         seen: &mut [bool; 2],
-    ) -> usize {
-        match self.src.state(e.depth, e.index) {
+    ) -> Result<usize, T::Error> {
+        match e.state {
             NodeState::Empty => {
                 seen[0] = true;
                 self.overlay.push(e);
-                0
+                Ok(0)
             }
             NodeState::Full => {
                 seen[1] = true;
                 self.overlay.push(e);
-                0
+                Ok(0)
             }
             NodeState::Partial => {
                 if (e.cell.side() as i64) <= extent {
                     self.overlay.push(e);
-                    return 1;
+                    return Ok(1);
                 }
                 let mut partial = 0;
-                let first = self.src.first_child(e.depth, e.index);
+                let depth = e.cell.level as usize;
+                let first = self.src.first_child(depth, e.index)?;
+                let codes = self.src.block_codes(depth + 1, first)?;
                 for c in 0..1usize << K {
                     let cell = e.cell.child(c);
                     if meets(&cell, bx) {
                         let child = Entry {
-                            depth: e.depth + 1,
                             index: first + c,
                             cell,
+                            state: NodeState::from_bits(codes >> (2 * c)),
                         };
-                        partial += self.refine(child, bx, extent, seen);
+                        partial += self.refine(child, bx, extent, seen)?;
                     }
                 }
-                partial
+                Ok(partial)
             }
         }
     }
 
     /// Whether source voxel `p` is full, starting from the overlay entry (in `near`) that holds it — a
     /// few levels above the voxel — rather than from the root.
-    fn lookup(&self, p: [i64; K], near: std::ops::Range<usize>) -> bool {
+    fn lookup(&self, p: [i64; K], near: std::ops::Range<usize>) -> Result<bool, T::Error> {
         if p.iter().any(|&c| c < 0 || c >= self.side) {
-            return false;
+            return Ok(false);
         }
         let p = p.map(|c| c as u32);
-        let Some(e) = near.map(|k| self.overlay[k]).find(|e| e.cell.contains(p)) else {
-            return self.src.contains(p);
+        let start = match near.map(|k| self.overlay[k]).find(|e| e.cell.contains(p)) {
+            Some(e) if e.state != NodeState::Partial => return Ok(e.state == NodeState::Full),
+            Some(e) => NodeRef {
+                index: e.index,
+                cell: e.cell,
+                state: e.state,
+                tree: self.root.tree,
+            },
+            None => self.root,
         };
-        let start = self.src.node_at(e.index, e.cell);
-        infallible(PointCursor::at(self.src, start).and_then(|mut c| c.state(p))) == NodeState::Full
+        Ok(PointCursor::at(self.src, start)?.state(p)? == NodeState::Full)
     }
 
     /// Decides target cell `cell` given its parent's overlay `parent` (a range of `self.overlay`).
-    fn node(&mut self, cell: Cell<K>, ctx: P::Ctx, parent: std::ops::Range<usize>) -> NodeState {
+    fn node<E: From<T::Error> + From<S::Error>>(
+        &mut self,
+        cell: Cell<K>,
+        ctx: P::Ctx,
+        parent: std::ops::Range<usize>,
+    ) -> Result<NodeState, E> {
         if cell.log_side == 0 {
-            return leaf(self.lookup(self.map.voxel(&ctx, cell.origin), parent));
+            return Ok(leaf(
+                self.lookup(self.map.voxel(&ctx, cell.origin), parent)?,
+            ));
         }
         let mut bx = self.map.cell_box(&ctx, cell.origin, cell.side());
         let mut seen = [false; 2];
@@ -173,7 +198,7 @@ impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
             b.0 = b.0.max(0);
             b.1 = b.1.min(self.side - 1);
             if b.0 > b.1 {
-                return NodeState::Empty;
+                return Ok(NodeState::Empty);
             }
         }
         let extent = bx.iter().map(|b| b.1 - b.0 + 1).max().unwrap_or(1);
@@ -182,58 +207,101 @@ impl<const K: usize, P: IncrementalPreimage<K>> Engine<'_, K, P> {
         for k in parent {
             let e = self.overlay[k];
             if meets(&e.cell, &bx) {
-                partial += self.refine(e, &bx, extent, &mut seen);
+                partial += self.refine(e, &bx, extent, &mut seen)?;
             }
         }
         let end = self.overlay.len();
         if partial == 0 {
             match seen {
-                [_, false] => return NodeState::Empty,
-                [false, true] => return NodeState::Full,
+                [_, false] => return Ok(NodeState::Empty),
+                [false, true] => return Ok(NodeState::Full),
                 _ => {}
             }
         }
         let mut kids = [NodeState::Empty; 16];
         for (c, kid) in kids.iter_mut().enumerate().take(1 << K) {
             let child_ctx = self.map.child(&ctx, c, cell.log_side);
-            *kid = self.node(cell.child(c), child_ctx, start..end);
+            *kid = self.node::<E>(cell.child(c), child_ctx, start..end)?;
         }
         self.overlay.truncate(start);
         let kids = &kids[..1 << K];
-        match collapse(kids) {
+        Ok(match collapse(kids) {
             Some(s) => s,
             None => {
-                self.out.push_block(cell.level as usize + 1, kids);
+                self.out.push_block(cell.level as usize + 1, kids)?;
                 NodeState::Partial
             }
-        }
+        })
     }
 }
 
 /// Resamples `src` through `map` into a tree of the same universe: target voxel `q` is full iff the source
 /// voxel `map.voxel(q)` is inside the universe and full. The output is reduced.
-pub fn resample<const K: usize, P: Preimage<K>>(src: &KTree<K>, map: &P) -> KTree<K> {
-    resample_incremental(src, &Stateless(map))
+///
+/// # Errors
+/// The storage's read error (none for a [`KTree`]).
+pub fn resample<const K: usize, T: TreeStorage<K>, P: Preimage<K>>(
+    src: &T,
+    map: &P,
+) -> Result<KTree<K>, T::Error> {
+    resample_into(src, map, Memory::new(src.universe()))
+}
+
+/// [`resample`] written to `sink`.
+///
+/// # Errors
+/// The first read error of `src` or write error of `sink`.
+pub fn resample_into<const K: usize, T, P, S, E>(src: &T, map: &P, sink: S) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    P: Preimage<K>,
+    S: LevelSink,
+    E: From<T::Error> + From<S::Error>,
+{
+    resample_incremental_into(src, &Stateless(map), sink)
 }
 
 /// Like [`resample`], for a map evaluated incrementally from cell to child.
-pub fn resample_incremental<const K: usize, P: IncrementalPreimage<K>>(
-    src: &KTree<K>,
+///
+/// # Errors
+/// The storage's read error (none for a [`KTree`]).
+pub fn resample_incremental<const K: usize, T: TreeStorage<K>, P: IncrementalPreimage<K>>(
+    src: &T,
     map: &P,
-) -> KTree<K> {
+) -> Result<KTree<K>, T::Error> {
+    resample_incremental_into(src, map, Memory::new(src.universe()))
+}
+
+/// [`resample_incremental`] written to `sink`.
+///
+/// # Errors
+/// The first read error of `src` or write error of `sink`.
+pub fn resample_incremental_into<const K: usize, T, P, S, E>(
+    src: &T,
+    map: &P,
+    sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    P: IncrementalPreimage<K>,
+    S: LevelSink,
+    E: From<T::Error> + From<S::Error>,
+{
     let universe = src.universe();
+    let root = src.root()?;
     let mut engine = Engine {
         src,
+        root,
         map,
         side: universe.side() as i64,
-        out: LevelWriter::new(),
+        out: sink,
         overlay: vec![Entry {
-            depth: 0,
             index: 0,
             cell: universe.root(),
+            state: root.state,
         }],
     };
     let root_ctx = map.root();
-    let root = engine.node(universe.root(), root_ctx, 0..1);
-    engine.out.finish_with_root(universe, root)
+    let state = engine.node::<E>(universe.root(), root_ctx, 0..1)?;
+    Ok(engine.out.finish(state)?)
 }

@@ -12,8 +12,12 @@
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-use super::overlay::{resample, Preimage};
+use super::output::Memory;
+use super::overlay::{resample_into, Preimage};
 use super::OpsError;
+use crate::space::Universe;
+use crate::tree::sink::LevelSink;
+use crate::tree::storage::TreeStorage;
 use crate::tree::KTree;
 
 /// A projective map of a `K`-dimensional universe, as a homogeneous `(K+1)×(K+1)` matrix acting on column
@@ -213,28 +217,52 @@ impl<const K: usize> Preimage<K> for Inverse<K> {
 ///
 /// # Errors
 /// [`OpsError::Singular`] if the matrix is singular, [`OpsError::ToInfinity`] if its inverse's
-/// denominator changes sign (or
-/// vanishes) over the universe — the map would send part of it to infinity.
-pub fn transform_projective<const K: usize>(
-    tree: &KTree<K>,
+/// denominator changes sign (or vanishes) over the universe — the map would send part of it to infinity;
+/// [`OpsError::Storage`] if a read of `tree` fails.
+pub fn transform_projective<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
     m: &Projective<K>,
 ) -> Result<KTree<K>, OpsError> {
-    let inv = m.inverse()?;
-    let u = tree.universe().side() as f64;
-    let mut sign = 0.0f64;
-    for corner in 0..1usize << K {
-        let c: [f64; K] = std::array::from_fn(|i| if corner >> i & 1 == 1 { u } else { 0.0 });
-        let w = inv.w(c);
-        if w == 0.0 || (sign != 0.0 && w.signum() != sign) {
-            return Err(OpsError::ToInfinity);
+    let map = Inverse::of(m, tree.universe())?;
+    resample_into::<K, _, _, _, T::Error>(tree, &map, Memory::new(tree.universe()))
+        .map_err(OpsError::storage)
+}
+
+/// [`transform_projective`] written to `sink`.
+///
+/// # Errors
+/// As [`transform_projective`], and the sink's write error.
+pub fn transform_projective_into<const K: usize, T, S, E>(
+    tree: &T,
+    m: &Projective<K>,
+    sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<OpsError> + From<T::Error> + From<S::Error>,
+{
+    let map = Inverse::of(m, tree.universe())?;
+    resample_into(tree, &map, sink)
+}
+
+impl<const K: usize> Inverse<K> {
+    /// The preimage of `m` over `universe`, or why `m` cannot map it.
+    fn of(m: &Projective<K>, universe: Universe<K>) -> Result<Self, OpsError> {
+        let inv = m.inverse()?;
+        let u = universe.side() as f64;
+        let mut sign = 0.0f64;
+        for corner in 0..1usize << K {
+            let c: [f64; K] = std::array::from_fn(|i| if corner >> i & 1 == 1 { u } else { 0.0 });
+            let w = inv.w(c);
+            if w == 0.0 || (sign != 0.0 && w.signum() != sign) {
+                return Err(OpsError::ToInfinity);
+            }
+            sign = w.signum();
         }
-        sign = w.signum();
-    }
-    Ok(resample(
-        tree,
-        &Inverse {
+        Ok(Self {
             map: inv,
             slack: 1e-9,
-        },
-    ))
+        })
+    }
 }

@@ -6,8 +6,10 @@
 //! voxels: `p'[i] = p[perm[i]]`, or `U − 1 − p[perm[i]]` when flipped — a rotation or reflection about the
 //! universe's centre. On a tree it is a fixed permutation of the `2^K` child codes applied at every node.
 
-use super::emit::LevelWriter;
+use super::output::Memory;
 use super::OpsError;
+use crate::tree::sink::LevelSink;
+use crate::tree::storage::TreeStorage;
 use crate::tree::{KTree, NodeState};
 
 /// An element of the hyperoctahedral group in `K` dimensions: a signed permutation of the axes.
@@ -189,42 +191,60 @@ fn permutations<const K: usize>(
 /// use ktree::{KTree, ops::{rotate_axes, AxisMap}};
 /// // 2×2 quadtree with the voxel (1, 0) set; a quarter turn x → y moves it to (1, 1).
 /// let a = KTree::<2>::from_dense(1, &[false, true, false, false]).unwrap();
-/// let r = rotate_axes(&a, &AxisMap::quarter_turn(0, 1).unwrap());
+/// let r = rotate_axes(&a, &AxisMap::quarter_turn(0, 1).unwrap()).unwrap();
 /// assert!(r.contains([1, 1]));
 /// ```
-pub fn rotate_axes<const K: usize>(tree: &KTree<K>, map: &AxisMap<K>) -> KTree<K> {
+///
+/// # Errors
+/// The storage's read error (none for a [`KTree`]).
+pub fn rotate_axes<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    map: &AxisMap<K>,
+) -> Result<KTree<K>, T::Error> {
+    rotate_axes_into(tree, map, Memory::new(tree.universe()))
+}
+
+/// [`rotate_axes`] written to `sink`. The output is walked depth first in its own child order, so its
+/// blocks reach each level in level order and the memory held is a stack of `2^K` nodes per level.
+///
+/// # Errors
+/// The first read error of `tree` or write error of `sink`.
+pub fn rotate_axes_into<const K: usize, T, S, E>(
+    tree: &T,
+    map: &AxisMap<K>,
+    mut sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<T::Error> + From<S::Error>,
+{
     let table = map.child_table();
     let fanout = 1usize << K;
-    let mut out = LevelWriter::new();
-    out.push(0, tree.root_state());
-    // Level by level: the source indices of the output's partial nodes at `depth`, in output order. Each
-    // one's children are an aligned block of `2^K` states (one piece of a word), permuted by the table.
-    let mut partials: Vec<usize> = Vec::new();
-    if tree.root_state() == NodeState::Partial {
-        partials.push(0);
+    let root = tree.root_state()?;
+    // The source nodes `(depth, index)` of output partial nodes still to expand, the next on top. Each
+    // one's children are an aligned block of `2^K` states, permuted by the table into one word.
+    let mut stack: Vec<(usize, usize)> = Vec::with_capacity(fanout * tree.depth_count());
+    if root == NodeState::Partial {
+        stack.push((0, 0));
     }
-    let mut depth = 0;
-    while !partials.is_empty() {
-        let below = tree.level_states(depth + 1);
-        let mut next = Vec::with_capacity(partials.len() * 2);
-        for &index in &partials {
-            let first = tree.first_child(depth, index);
-            let block = below.block_codes(first, K);
-            let mut kids = [NodeState::Empty; 16];
-            for (kid, &src) in kids.iter_mut().zip(&table[..fanout]) {
-                *kid = match block >> (2 * src) & 3 {
-                    0 => NodeState::Empty,
-                    1 => NodeState::Full,
-                    _ => {
-                        next.push(first + src);
-                        NodeState::Partial
-                    }
-                };
-            }
-            out.push_block(depth + 1, &kids[..fanout]);
+    while let Some((depth, index)) = stack.pop() {
+        let first = tree.first_child(depth, index)?;
+        let block = tree.block_codes(depth + 1, first)?;
+        // The permuted block in one word; bit `code` of `partial` set for each partial output child.
+        let (mut word, mut partial) = (0u64, 0u32);
+        for (code, &src) in table[..fanout].iter().enumerate() {
+            let state = (block >> (2 * src) & 3).min(NodeState::Partial as u32);
+            word |= u64::from(state) << (2 * code);
+            partial |= (state >> 1) << code;
         }
-        partials = next;
-        depth += 1;
+        sink.append(depth + 1, word, fanout)?;
+        // The partial children, last to first in output order: the first comes off the stack first.
+        while partial != 0 {
+            let code = (u32::BITS - 1 - partial.leading_zeros()) as usize;
+            stack.push((depth + 1, first + table[code]));
+            partial &= !(1 << code);
+        }
     }
-    KTree::from_levels(tree.universe(), out.finish())
+    Ok(sink.finish(root)?)
 }

@@ -1,12 +1,14 @@
 //! Scaling (§6 "Scaling", claim M4): by powers of two by adding or removing levels at the root (exact,
-//! touching only the top of the tree), and by other rational factors with overlays.
+//! touching only the top of the tree), and by other rational factors with overlays. Each reads any
+//! [`TreeStorage`] and writes through any [`LevelSink`] (the `*_into` forms).
 
-use super::emit::LevelWriter;
-use super::overlay::{resample, Preimage};
+use super::output::{copy_into, Memory};
+use super::overlay::{resample_into, Preimage};
 use super::OpsError;
 use crate::space::{max_level, Universe};
 use crate::tree::locate::locate;
-use crate::tree::storage::infallible;
+use crate::tree::sink::{copy_subtree_to, LevelSink};
+use crate::tree::storage::TreeStorage;
 use crate::tree::{KTree, NodeState};
 
 fn check_path<const K: usize>(path: &[usize], level: u32) -> Result<(), OpsError> {
@@ -19,6 +21,21 @@ fn check_path<const K: usize>(path: &[usize], level: u32) -> Result<(), OpsError
         });
     }
     Ok(())
+}
+
+/// The universe of level `level` for the result of [`grow`], or why there is none.
+fn grown<const K: usize>(level: u32, path: &[usize]) -> Result<Universe<K>, OpsError> {
+    let level = level + path.len() as u32;
+    let too_large = || OpsError::LevelTooLarge {
+        k: K,
+        level,
+        max: max_level(K),
+    };
+    if level > max_level(K) {
+        return Err(too_large());
+    }
+    check_path::<K>(path, level)?;
+    Universe::<K>::new(level).map_err(|_| too_large())
 }
 
 /// Halves the object `path.len()` times by adding that many levels at the root: the result lives in a
@@ -36,48 +53,60 @@ fn check_path<const K: usize>(path: &[usize], level: u32) -> Result<(), OpsError
 /// ```
 ///
 /// # Errors
-/// [`OpsError::BadPath`] for a child code `≥ 2^K`; [`OpsError::LevelTooLarge`] beyond [`max_level`].
-pub fn grow<const K: usize>(tree: &KTree<K>, path: &[usize]) -> Result<KTree<K>, OpsError> {
+/// [`OpsError::BadPath`] for a child code `≥ 2^K`; [`OpsError::LevelTooLarge`] beyond [`max_level`];
+/// [`OpsError::Storage`] if a read of `tree` fails.
+pub fn grow<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    path: &[usize],
+) -> Result<KTree<K>, OpsError> {
+    let universe = grown::<K>(tree.level(), path)?;
+    grow_checked::<K, _, _, T::Error>(tree, path, Memory::new(universe)).map_err(OpsError::storage)
+}
+
+/// [`grow`] written to `sink`, a sink for a tree of level `L + path.len()`.
+///
+/// # Errors
+/// As [`grow`], and the sink's write error.
+pub fn grow_into<const K: usize, T, S, E>(tree: &T, path: &[usize], sink: S) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<OpsError> + From<T::Error> + From<S::Error>,
+{
+    grown::<K>(tree.level(), path)?;
+    grow_checked(tree, path, sink)
+}
+
+/// [`grow_into`] for a path already checked.
+fn grow_checked<const K: usize, T, S, E>(
+    tree: &T,
+    path: &[usize],
+    mut sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<T::Error> + From<S::Error>,
+{
     let n = path.len();
-    let level = tree.level() + n as u32;
-    if level > max_level(K) {
-        return Err(OpsError::LevelTooLarge {
-            k: K,
-            level,
-            max: max_level(K),
-        });
-    }
-    check_path::<K>(path, level)?;
-    let universe = Universe::<K>::new(level).map_err(|_| OpsError::LevelTooLarge {
-        k: K,
-        level,
-        max: max_level(K),
-    })?;
     if n == 0 {
-        return Ok(tree.clone());
+        return copy_into(tree, sink);
     }
-    if tree.root_state() == NodeState::Empty {
-        return Ok(KTree::empty(level).expect("level checked"));
+    let root = tree.root_state()?;
+    if root == NodeState::Empty {
+        return Ok(sink.finish(NodeState::Empty)?);
     }
-    let mut out = LevelWriter::new();
-    out.push(0, NodeState::Partial);
+    let mut kids = [NodeState::Empty; 16];
     for (d, &code) in path.iter().enumerate() {
-        for c in 0..1usize << K {
-            out.push(
-                d + 1,
-                if c != code {
-                    NodeState::Empty
-                } else if d + 1 < n {
-                    NodeState::Partial
-                } else {
-                    tree.root_state()
-                },
-            );
-        }
+        kids[..1 << K].fill(NodeState::Empty);
+        kids[code] = if d + 1 < n { NodeState::Partial } else { root };
+        sink.push_block(d + 1, &kids[..1 << K])?;
     }
     // The old root is the only partial node at depth n, so every old level keeps its indices.
-    out.copy_subtree(tree, 0, 0, n, false);
-    Ok(KTree::from_levels(universe, out.finish()))
+    if root == NodeState::Partial {
+        copy_subtree_to::<K, _, _, E>(&mut sink, tree, 0, 0, n, false)?;
+    }
+    Ok(sink.finish(NodeState::Partial)?)
 }
 
 /// Doubles the object `path.len()` times by removing levels at the root: the cell reached by the child
@@ -91,32 +120,65 @@ pub fn grow<const K: usize>(tree: &KTree<K>, path: &[usize]) -> Result<KTree<K>,
 /// ```
 ///
 /// # Errors
-/// [`OpsError::BadPath`] for a code `≥ 2^K` or a path longer than the level.
-pub fn zoom<const K: usize>(tree: &KTree<K>, path: &[usize]) -> Result<KTree<K>, OpsError> {
-    check_path::<K>(path, tree.level())?;
-    let level = tree.level() - path.len() as u32;
-    let universe = Universe::<K>::new(level).expect("a smaller level is valid");
+/// [`OpsError::BadPath`] for a code `≥ 2^K` or a path longer than the level; [`OpsError::Storage`] if a
+/// read of `tree` fails.
+pub fn zoom<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    path: &[usize],
+) -> Result<KTree<K>, OpsError> {
+    let universe = zoomed::<K>(tree.level(), path)?;
+    zoom_checked::<K, _, _, T::Error>(tree, path, Memory::new(universe)).map_err(OpsError::storage)
+}
+
+/// [`zoom`] written to `sink`, a sink for a tree of level `L − path.len()`.
+///
+/// # Errors
+/// As [`zoom`], and the sink's write error.
+pub fn zoom_into<const K: usize, T, S, E>(tree: &T, path: &[usize], sink: S) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<OpsError> + From<T::Error> + From<S::Error>,
+{
+    zoomed::<K>(tree.level(), path)?;
+    zoom_checked(tree, path, sink)
+}
+
+/// The universe of the result of [`zoom`], or why the path is refused.
+fn zoomed<const K: usize>(level: u32, path: &[usize]) -> Result<Universe<K>, OpsError> {
+    check_path::<K>(path, level)?;
+    Ok(Universe::<K>::new(level - path.len() as u32).expect("a smaller level is valid"))
+}
+
+/// [`zoom_into`] for a path already checked.
+fn zoom_checked<const K: usize, T, S, E>(
+    tree: &T,
+    path: &[usize],
+    mut sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<T::Error> + From<S::Error>,
+{
     // Descend to the path's cell.
     let target = path
         .iter()
         .fold(tree.universe().root(), |c, &code| c.child(code));
-    let node = infallible(locate(tree, tree.root(), &target));
+    let node = locate(tree, tree.root()?, &target)?;
     if node.state != NodeState::Partial {
-        return Ok(uniform(level, node.state));
+        return Ok(sink.finish(node.state)?);
     }
     // Copy the subtree, its root becoming the root.
-    let mut out = LevelWriter::new();
-    out.push(0, NodeState::Partial);
-    out.copy_subtree(tree, node.cell.level as usize, node.index, 0, false);
-    Ok(KTree::from_levels(universe, out.finish()))
-}
-
-fn uniform<const K: usize>(level: u32, state: NodeState) -> KTree<K> {
-    if state == NodeState::Full {
-        KTree::full(level).expect("valid level")
-    } else {
-        KTree::empty(level).expect("valid level")
-    }
+    copy_subtree_to::<K, _, _, E>(
+        &mut sink,
+        tree,
+        node.cell.level as usize,
+        node.index,
+        0,
+        false,
+    )?;
+    Ok(sink.finish(NodeState::Partial)?)
 }
 
 /// The preimage of a uniform scaling by `num / den` about the universe's origin corner.
@@ -126,6 +188,17 @@ struct Ratio<const K: usize> {
 }
 
 impl<const K: usize> Ratio<K> {
+    /// The factor `num / den`.
+    fn new(num: u32, den: u32) -> Result<Self, OpsError> {
+        if num == 0 || den == 0 || num > 1 << 20 || den > 1 << 20 {
+            return Err(OpsError::BadScale { num, den });
+        }
+        Ok(Self {
+            num: num.into(),
+            den: den.into(),
+        })
+    }
+
     /// Source voxel of target coordinate `q`: the centre `q + ½` divided by the factor, floored:
     /// `floor((2q + 1)·den / (2·num))` — integer arithmetic.
     fn back(&self, q: i64) -> i64 {
@@ -158,19 +231,49 @@ impl<const K: usize> Preimage<K> for Ratio<K> {
 /// ```
 ///
 /// # Errors
-/// [`OpsError::BadScale`] unless `num` and `den` are both positive and at most 2^20.
-pub fn scale<const K: usize>(tree: &KTree<K>, num: u32, den: u32) -> Result<KTree<K>, OpsError> {
-    if num == 0 || den == 0 || num > 1 << 20 || den > 1 << 20 {
-        return Err(OpsError::BadScale { num, den });
+/// [`OpsError::BadScale`] unless `num` and `den` are both positive and at most 2^20;
+/// [`OpsError::Storage`] if a read of `tree` fails.
+pub fn scale<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    num: u32,
+    den: u32,
+) -> Result<KTree<K>, OpsError> {
+    let ratio = Ratio::<K>::new(num, den)?;
+    scale_checked::<K, _, _, T::Error>(tree, ratio, Memory::new(tree.universe()))
+        .map_err(OpsError::storage)
+}
+
+/// [`scale`] written to `sink`.
+///
+/// # Errors
+/// As [`scale`], and the sink's write error.
+pub fn scale_into<const K: usize, T, S, E>(
+    tree: &T,
+    num: u32,
+    den: u32,
+    sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<OpsError> + From<T::Error> + From<S::Error>,
+{
+    scale_checked(tree, Ratio::<K>::new(num, den)?, sink)
+}
+
+/// [`scale_into`] for a checked factor.
+fn scale_checked<const K: usize, T, S, E>(
+    tree: &T,
+    ratio: Ratio<K>,
+    sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<T::Error> + From<S::Error>,
+{
+    if ratio.num == ratio.den {
+        return copy_into(tree, sink);
     }
-    if num == den {
-        return Ok(tree.clone());
-    }
-    Ok(resample(
-        tree,
-        &Ratio::<K> {
-            num: num.into(),
-            den: den.into(),
-        },
-    ))
+    resample_into(tree, &ratio, sink)
 }

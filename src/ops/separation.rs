@@ -12,7 +12,8 @@ use std::collections::BinaryHeap;
 use super::boolean::same_level;
 use super::OpsError;
 use crate::space::Cell;
-use crate::tree::{KTree, NodeState};
+use crate::tree::storage::TreeStorage;
+use crate::tree::NodeState;
 
 /// Squared distance between the nearest voxel centres of two cells.
 fn gap2<const K: usize>(a: &Cell<K>, b: &Cell<K>) -> u128 {
@@ -43,39 +44,62 @@ fn gap2<const K: usize>(a: &Cell<K>, b: &Cell<K>) -> u128 {
 /// ```
 ///
 /// # Errors
-/// [`OpsError::LevelMismatch`] when the levels differ.
-pub fn min_separation<const K: usize>(a: &KTree<K>, b: &KTree<K>) -> Result<Option<f64>, OpsError> {
+/// [`OpsError::LevelMismatch`] when the levels differ; [`OpsError::Storage`] if a read fails.
+pub fn min_separation<const K: usize, A, B>(a: &A, b: &B) -> Result<Option<f64>, OpsError>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     same_level(a, b)?;
-    // A pair: (depth, index, cell) of a node of a, of b; the heap pops the smallest bound first.
-    type Side<const K: usize> = (usize, usize, Cell<K>);
-    let node = |tree: &KTree<K>, s: Side<K>| tree.node_at(s.1, s.2);
+    min_separation_of(a, b).map_err(OpsError::storage)
+}
+
+/// One side of a pair of nodes: a node's index in its level, its cell (whose level is the node's depth)
+/// and its state.
+type Side<const K: usize> = (usize, Cell<K>, NodeState);
+
+/// [`min_separation`] of two trees of one level.
+fn min_separation_of<const K: usize, A, B>(a: &A, b: &B) -> Result<Option<f64>, A::Error>
+where
+    A: TreeStorage<K>,
+    B: TreeStorage<K, Error = A::Error>,
+{
     let root = a.universe().root();
     // The heap orders small entries (bound, shallowness, place in `pairs`); the pairs stay put. Among
     // equal bounds the deepest pair comes first: it is the nearest to a pair of full leaves.
-    let mut pairs: Vec<(Side<K>, Side<K>)> = vec![((0, 0, root), (0, 0, root))];
+    let mut pairs: Vec<(Side<K>, Side<K>)> =
+        vec![((0, root, a.root_state()?), (0, root, b.root_state()?))];
     let mut heap: BinaryHeap<Reverse<(u128, usize, usize)>> = BinaryHeap::new();
     heap.push(Reverse((0, usize::MAX, 0)));
     while let Some(Reverse((bound, _, at))) = heap.pop() {
-        let (sa, sb) = pairs[at];
-        let (na, nb) = (node(a, sa), node(b, sb));
-        if na.state == NodeState::Empty || nb.state == NodeState::Empty {
+        let (na, nb) = pairs[at];
+        if na.2 == NodeState::Empty || nb.2 == NodeState::Empty {
             continue;
         }
-        if na.state == NodeState::Full && nb.state == NodeState::Full {
+        if na.2 == NodeState::Full && nb.2 == NodeState::Full {
             return Ok(Some((bound as f64).sqrt()));
         }
         // Split the partial node with the larger cell (a if tied and partial).
-        let split_a = na.state == NodeState::Partial
-            && (nb.state != NodeState::Partial || na.cell.log_side >= nb.cell.log_side);
-        let (tree, split) = if split_a { (a, &na) } else { (b, &nb) };
-        for child in tree.children(split) {
-            if child.state == NodeState::Empty {
+        let split_a = na.2 == NodeState::Partial
+            && (nb.2 != NodeState::Partial || na.1.log_side >= nb.1.log_side);
+        let split = if split_a { na } else { nb };
+        let depth = split.1.level as usize;
+        let (first, codes) = if split_a {
+            let first = a.first_child(depth, split.0)?;
+            (first, a.block_codes(depth + 1, first)?)
+        } else {
+            let first = b.first_child(depth, split.0)?;
+            (first, b.block_codes(depth + 1, first)?)
+        };
+        for code in 0..1usize << K {
+            let state = NodeState::from_bits(codes >> (2 * code));
+            if state == NodeState::Empty {
                 continue;
             }
-            let side = (child.cell.level as usize, child.index, child.cell);
-            let (ca, cb) = if split_a { (side, sb) } else { (sa, side) };
-            let shallowness = usize::MAX - (ca.0 + cb.0);
-            heap.push(Reverse((gap2(&ca.2, &cb.2), shallowness, pairs.len())));
+            let child = (first + code, split.1.child(code), state);
+            let (ca, cb) = if split_a { (child, nb) } else { (na, child) };
+            let shallowness = usize::MAX - (ca.1.level as usize + cb.1.level as usize);
+            heap.push(Reverse((gap2(&ca.1, &cb.1), shallowness, pairs.len())));
             pairs.push((ca, cb));
         }
     }

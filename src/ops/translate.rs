@@ -7,9 +7,12 @@
 //! empty (or in the void beyond the universe) the target is empty; if all are full it is full; otherwise
 //! each of its `2^K` children gets its own overlay, made of children of the parent's overlay obels (or of
 //! the same leaves). Parts moved outside the universe are cut off. Integer-only: additions, comparisons,
-//! masks and shifts. The output is reduced (children are decided before they are pushed).
+//! masks and shifts. The output is reduced (children are decided before they are appended), written
+//! through any [`LevelSink`] ([`translate_into`]).
 
-use super::emit::{collapse, LevelWriter};
+use super::output::{collapse, copy_into, Memory};
+use crate::tree::sink::LevelSink;
+use crate::tree::storage::TreeStorage;
 use crate::tree::{KTree, NodeState};
 
 /// One overlay obel: the index of a source node at the target's depth (overlays stay on the target's
@@ -37,24 +40,30 @@ const TERN: [usize; 17] = {
     t
 };
 
-struct Mover<'a, const K: usize> {
-    src: &'a KTree<K>,
+struct Mover<'a, const K: usize, T, S> {
+    src: &'a T,
     t: [i64; K],
     level: u32,
-    out: LevelWriter,
+    out: S,
 }
 
-impl<const K: usize> Mover<'_, K> {
-    fn state(&self, depth: u32, slot: Slot) -> NodeState {
-        match slot {
+impl<const K: usize, T: TreeStorage<K>, S: LevelSink> Mover<'_, K, T, S> {
+    #[inline(always)]
+    fn state(&self, depth: u32, slot: Slot) -> Result<NodeState, T::Error> {
+        Ok(match slot {
             EMPTY => NodeState::Empty,
             FULL => NodeState::Full,
-            i => self.src.state(depth as usize, i),
-        }
+            i => self.src.state(depth as usize, i)?,
+        })
     }
 
     /// Decides the target cell at `depth` with origin `origin`, given its overlay.
-    fn node(&mut self, depth: u32, origin: [i64; K], overlay: &[Slot; 16]) -> NodeState {
+    fn node<E: From<T::Error> + From<S::Error>>(
+        &mut self,
+        depth: u32,
+        origin: [i64; K],
+        overlay: &[Slot; 16],
+    ) -> Result<NodeState, E> {
         let log = self.level - depth;
         // Offsets of the target's preimage inside the base cell, per axis.
         let mask = (1i64 << log) - 1;
@@ -69,24 +78,24 @@ impl<const K: usize> Mover<'_, K> {
             if code & !meets_upper != 0 {
                 continue;
             }
-            match self.state(depth, slot) {
+            match self.state(depth, slot)? {
                 NodeState::Empty => empty = true,
                 NodeState::Full => full = true,
                 NodeState::Partial => partial = true,
             }
         }
         if !(partial || empty && full) {
-            return if full {
+            return Ok(if full {
                 NodeState::Full
             } else {
                 NodeState::Empty
-            };
+            });
         }
         // Each overlay obel resolved once: a leaf, or the index of its first child one level down.
         let mut resolved = [EMPTY; 16];
         for (code, &slot) in overlay.iter().enumerate().take(1 << K) {
-            resolved[code] = match self.state(depth, slot) {
-                NodeState::Partial => self.src.first_child(depth as usize, slot),
+            resolved[code] = match self.state(depth, slot)? {
+                NodeState::Partial => self.src.first_child(depth as usize, slot)?,
                 NodeState::Full => FULL,
                 NodeState::Empty => EMPTY,
             };
@@ -117,42 +126,73 @@ impl<const K: usize> Mover<'_, K> {
             for (code, slot) in sub.iter_mut().enumerate().take(1 << K) {
                 *slot = grid[TERN[c] + TERN[code]];
             }
-            *kid = self.node(depth + 1, child_origin, &sub);
+            *kid = self.node::<E>(depth + 1, child_origin, &sub)?;
         }
         let kids = &kids[..1 << K];
-        match collapse(kids) {
+        Ok(match collapse(kids) {
             Some(s) => s,
             None => {
-                self.out.push_block(depth as usize + 1, kids);
+                self.out.push_block(depth as usize + 1, kids)?;
                 NodeState::Partial
             }
-        }
+        })
     }
 }
 
 /// Translates the object by `t` voxels (any integer vector, negative allowed); voxels moved out of the
-/// universe are lost. The output is reduced.
+/// universe are lost. The output is reduced. Reads any storage; [`translate_into`] writes to any sink.
 ///
 /// ```
 /// use ktree::{KTree, ops::translate};
 /// let a = KTree::<1>::from_dense(2, &[true, true, false, false]).unwrap();
-/// assert_eq!(translate(&a, [1]).to_dense().unwrap(), [false, true, true, false]);
-/// assert_eq!(translate(&a, [-1]).to_dense().unwrap(), [true, false, false, false]);
+/// assert_eq!(translate(&a, [1]).unwrap().to_dense().unwrap(), [false, true, true, false]);
+/// assert_eq!(translate(&a, [-1]).unwrap().to_dense().unwrap(), [true, false, false, false]);
 /// ```
-pub fn translate<const K: usize>(tree: &KTree<K>, t: [i64; K]) -> KTree<K> {
+///
+/// # Errors
+/// The storage's read error (none for a [`KTree`]).
+pub fn translate<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    t: [i64; K],
+) -> Result<KTree<K>, T::Error> {
+    translate_into(tree, t, Memory::new(tree.universe()))
+}
+
+/// [`translate`] written to `sink`, for instance a sink that spills each level to its own file.
+///
+/// ```
+/// use ktree::{KTree, ops::{translate, translate_into}};
+/// use ktree::tree::sink::MemorySink;
+/// let a = KTree::<2>::from_dense(2, &(0..16).map(|i| i % 3 == 0).collect::<Vec<_>>()).unwrap();
+/// let sink = MemorySink::new(a.universe());
+/// let moved: KTree<2> = translate_into::<2, _, _, std::convert::Infallible>(&a, [1, -1], sink).unwrap();
+/// assert_eq!(moved, translate(&a, [1, -1]).unwrap());
+/// ```
+///
+/// # Errors
+/// The first read error of `tree` or write error of `sink`.
+pub fn translate_into<const K: usize, T, S, E>(
+    tree: &T,
+    t: [i64; K],
+    sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<T::Error> + From<S::Error>,
+{
     let side = tree.universe().side() as i64;
     if t.iter().all(|&v| v == 0) {
-        return tree.clone();
+        return copy_into(tree, sink);
     }
     if t.iter().any(|&v| v.unsigned_abs() >= side as u64) {
-        return KTree::empty(tree.level()).expect("the tree's own level is valid");
+        return Ok(sink.finish(NodeState::Empty)?);
     }
-    let level = tree.level();
     let mut m = Mover {
         src: tree,
         t,
-        level,
-        out: LevelWriter::new(),
+        level: tree.level(),
+        out: sink,
     };
     // The root's overlay: the source root sits in the slot whose cell index is 0 on every axis.
     let base: [i64; K] = std::array::from_fn(|i| (-t[i]).div_euclid(side));
@@ -162,8 +202,8 @@ pub fn translate<const K: usize>(tree: &KTree<K>, t: [i64; K]) -> KTree<K> {
             *slot = 0;
         }
     }
-    let root = m.node(0, [0; K], &overlay);
-    m.out.finish_with_root(tree.universe(), root)
+    let root = m.node::<E>(0, [0; K], &overlay)?;
+    Ok(m.out.finish(root)?)
 }
 
 /// The whole-voxel shift used for an offset of `t / 2^sub_level` voxels: the target voxel whose centre,
@@ -187,6 +227,31 @@ pub fn fine_shift(t: i64, sub_level: u32) -> i64 {
 /// Translates by a vector given at a finer level: `t[i] / 2^sub_level` voxels on axis `i`, applied as the
 /// whole-voxel shift of [`fine_shift`] (a voxel grid can only move by whole voxels; the rounding rule is
 /// that of sampling each target voxel at its centre).
-pub fn translate_fine<const K: usize>(tree: &KTree<K>, t: [i64; K], sub_level: u32) -> KTree<K> {
+///
+/// # Errors
+/// The storage's read error (none for a [`KTree`]).
+pub fn translate_fine<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    t: [i64; K],
+    sub_level: u32,
+) -> Result<KTree<K>, T::Error> {
     translate(tree, t.map(|v| fine_shift(v, sub_level)))
+}
+
+/// [`translate_fine`] written to `sink`.
+///
+/// # Errors
+/// The first read error of `tree` or write error of `sink`.
+pub fn translate_fine_into<const K: usize, T, S, E>(
+    tree: &T,
+    t: [i64; K],
+    sub_level: u32,
+    sink: S,
+) -> Result<S::Output, E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<T::Error> + From<S::Error>,
+{
+    translate_into(tree, t.map(|v| fine_shift(v, sub_level)), sink)
 }

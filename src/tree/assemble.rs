@@ -7,7 +7,7 @@
 use super::cursor::subtree_ranges;
 use super::ktree::KTree;
 use super::states::{NodeState, PackedStates};
-use super::words::{pack, LevelWords};
+use super::words::LevelWords;
 use super::TreeError;
 use crate::space::{Cell, DimCheck, SpaceError, Universe};
 
@@ -85,12 +85,6 @@ impl LevelWriter {
     #[inline]
     pub(crate) fn append_word(&mut self, depth: usize, chunk: u64, slots: usize) {
         self.level(depth).push(chunk, slots);
-    }
-
-    /// Appends a block of sibling states (at most 32) at `depth`.
-    #[inline]
-    pub(crate) fn push_block(&mut self, depth: usize, kids: &[NodeState]) {
-        self.level(depth).push(pack(kids), kids.len());
     }
 
     /// Appends the descendants of node `index` at `depth` of `tree` (not the node itself), the node's

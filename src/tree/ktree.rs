@@ -405,17 +405,6 @@ impl<const K: usize> KTree<K> {
         }
     }
 
-    /// The node `index` of the level of `cell` (the caller vouches that the node's cell is `cell`).
-    #[inline]
-    pub(crate) fn node_at(&self, index: usize, cell: Cell<K>) -> NodeRef<K> {
-        NodeRef {
-            index,
-            cell,
-            state: self.state(cell.level as usize, index),
-            tree: self.id,
-        }
-    }
-
     /// The root's state.
     pub fn root_state(&self) -> NodeState {
         self.levels[0].get(0)

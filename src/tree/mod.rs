@@ -1,5 +1,5 @@
 //! The compact k-tree: node states, the level-order `KTree<K>`, assembling one from a depth-first stream of
-//! nodes or from full cells, and its Boolean operators.
+//! nodes or from full cells.
 //!
 //! ```
 //! use ktree::{stacking::paper::stack, NodeState, Ray, RaySet};
@@ -19,7 +19,6 @@ pub mod cursor;
 mod error;
 mod ktree;
 pub mod locate;
-mod operators;
 pub mod sink;
 mod states;
 pub mod storage;

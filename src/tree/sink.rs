@@ -78,6 +78,38 @@ where
     S: LevelSink,
     E: From<T::Error> + From<S::Error>,
 {
+    copy_subtree_to::<K, T, S, E>(sink, tree, depth, index, depth, invert)
+}
+
+/// [`copy_subtree`] with the node's level written as `to_depth` (its descendants one level below it and
+/// so on): a subtree moved up or down the tree, as zooming and growing do.
+///
+/// ```
+/// use ktree::tree::sink::{copy_subtree_to, LevelSink, MemorySink};
+/// use ktree::{KTree, NodeState};
+/// // The upper half of a bintree, made the whole of a universe one level smaller.
+/// let tree = KTree::<1>::from_dense(3, &[true, false, false, false, true, false, true, true]).unwrap();
+/// let mut sink = MemorySink::<1>::new(ktree::Universe::new(2).unwrap());
+/// copy_subtree_to::<1, _, _, std::convert::Infallible>(&mut sink, &tree, 1, 1, 0, false).unwrap();
+/// let half = sink.finish(NodeState::Partial).unwrap();
+/// assert_eq!(half.to_dense().unwrap(), [true, false, true, true]);
+/// ```
+///
+/// # Errors
+/// The first read error of `tree` or write error of `sink`.
+pub fn copy_subtree_to<const K: usize, T, S, E>(
+    sink: &mut S,
+    tree: &T,
+    depth: usize,
+    index: usize,
+    to_depth: usize,
+    invert: bool,
+) -> Result<(), E>
+where
+    T: TreeStorage<K>,
+    S: LevelSink,
+    E: From<T::Error> + From<S::Error>,
+{
     let mut start = tree.first_child(depth, index)?;
     let mut nodes = 1usize << K;
     let mut d = depth + 1;
@@ -99,7 +131,7 @@ where
             } else {
                 word
             };
-            sink.append(d, word, take)?;
+            sink.append(d - depth + to_depth, word, take)?;
             at += take;
         }
         let Some(first_partial) = first_partial else {

@@ -111,17 +111,19 @@ impl<const K: usize> Boxes<K> {
         inclusion_exclusion(&self.boxes, |b| b.doubled_first_moment(axis))
     }
 
-    /// The inclusive bounding box `(lo, hi)` per axis of the union, or `None` if it is empty.
-    pub fn bounding_box(&self) -> Option<[(u64, u64); K]> {
+    /// The bounding box `[lo, hi)` of the union (the upper bound excluded, as the library's), or `None`
+    /// if it is empty.
+    pub fn bounding_box(&self) -> Option<([u64; K], [u64; K])> {
         let mut full = self.boxes.iter().filter(|b| !b.is_empty());
         let first = full.next()?;
-        let mut bx: [(u64, u64); K] = std::array::from_fn(|i| (first.lo[i], first.hi[i] - 1));
+        let (mut lo, mut hi) = (first.lo, first.hi);
         for b in full {
-            for (i, r) in bx.iter_mut().enumerate() {
-                *r = (r.0.min(b.lo[i]), r.1.max(b.hi[i] - 1));
+            for i in 0..K {
+                lo[i] = lo[i].min(b.lo[i]);
+                hi[i] = hi[i].max(b.hi[i]);
             }
         }
-        Some(bx)
+        Some((lo, hi))
     }
 
     /// The rays of the union: one run per column of every box (runs of one column are merged by

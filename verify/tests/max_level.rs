@@ -50,7 +50,9 @@ fn check_build<const K: usize>(a: &Boxes<K>, p: [u64; K]) -> Result<(), TestCase
     same_at(&t, a.probe_points().into_iter().chain([p]), |q| {
         a.contains(q)
     })?;
-    let bx = ops::bounding_box(&t).map(|bx| bx.map(|(lo, hi)| (u64::from(lo), u64::from(hi))));
+    let bx = t
+        .bounding_box()
+        .map(|(lo, hi)| (lo.map(u64::from), hi.map(u64::from)));
     prop_assert_eq!(bx, a.bounding_box());
     Ok(())
 }
@@ -96,7 +98,7 @@ fn check_booleans<const K: usize>(
     prop_assert_eq!(not_a.voxel_count(), universe_volume::<K>(a.level) - na);
     same_at(&not_a, probes.iter().copied(), |q| !a.contains(q))?;
     prop_assert_eq!(
-        ops::mass_properties(&not_a).volume,
+        ops::mass_properties(&not_a).unwrap().volume,
         universe_volume::<K>(a.level) - na
     );
     // The ray sets' own Booleans agree with the trees'.
@@ -125,14 +127,14 @@ fn check_translate<const K: usize>(
             })
             .collect(),
     };
-    let out = ops::translate(&tree(a)?, shift);
+    let out = ops::translate(&tree(a)?, shift).unwrap();
     out.check()
         .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(out.voxel_count(), moved.voxel_count());
     let probes = moved.probe_points().into_iter().chain([p]);
     same_at(&out, probes, |q| moved.contains(q))?;
     // Translating back restores every voxel that stayed inside.
-    let back = ops::translate(&out, shift.map(|v| -v));
+    let back = ops::translate(&out, shift.map(|v| -v)).unwrap();
     prop_assert_eq!(back.voxel_count(), moved.voxel_count());
     same_at(&back, a.probe_points(), |q| {
         a.contains(q) && moved.contains(std::array::from_fn(|i| (q[i] as i64 + shift[i]) as u64))
@@ -163,7 +165,7 @@ fn check_axis_map<const K: usize>(
             })
             .collect(),
     };
-    let out = ops::rotate_axes(&tree(a)?, &map);
+    let out = ops::rotate_axes(&tree(a)?, &map).unwrap();
     out.check()
         .map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(out.voxel_count(), a.voxel_count());
@@ -275,7 +277,7 @@ fn check_zoom<const K: usize>(a: &Boxes<K>, path: Vec<usize>) -> Result<(), Test
 }
 
 fn check_mass<const K: usize>(a: &Boxes<K>) -> Result<(), TestCaseError> {
-    let m = ops::mass_properties(&tree(a)?);
+    let m = ops::mass_properties(&tree(a)?).unwrap();
     let volume = a.voxel_count();
     prop_assert_eq!(m.volume, volume);
     for axis in 0..K {

@@ -4,8 +4,11 @@
 
 use std::path::Path;
 
-use ktree::io::{read_ktree_file, write_ktree, write_ktree_file, KtreeView};
-use ktree::ops::{self, BoolOp, BooleanFileError, ViewOperation};
+use ktree::io::{
+    self, read_ktree_file, write_ktree, write_ktree_file, BooleanFileError, KtreeView,
+    ViewOperation,
+};
+use ktree::ops::{self, BoolOp};
 use ktree::rays::ball_rays;
 use ktree::stacking::paper::stack;
 use ktree::AnyTree;
@@ -29,7 +32,7 @@ fn check_streamed<const K: usize>(a: &KTree<K>, b: &KTree<K>, dir: &Path) {
     write_ktree_file(&pa, a).unwrap();
     write_ktree_file(&pb, b).unwrap();
     for op in BoolOp::ALL {
-        let report = ops::boolean_files(&pa, &pb, op, &out, None).unwrap();
+        let report = io::boolean_files(&pa, &pb, op, &out, None).unwrap();
         let expect = ops::boolean(a, b, op).unwrap();
         assert!(
             std::fs::read(&out).unwrap() == v2_bytes(&expect),
@@ -37,7 +40,7 @@ fn check_streamed<const K: usize>(a: &KTree<K>, b: &KTree<K>, dir: &Path) {
         );
         assert_eq!(report.counts_per_level, expect.counts_per_level(), "{op:?}");
     }
-    ops::complement_file(&pa, &out, None).unwrap();
+    io::complement_file(&pa, &out, None).unwrap();
     assert!(std::fs::read(&out).unwrap() == v2_bytes(&ops::complement(a)));
     // Nothing is left beside the inputs and the output.
     assert_eq!(std::fs::read_dir(dir).unwrap().count(), 3);
@@ -59,13 +62,13 @@ where
     let (va, vb) = (KtreeView::open(&pa).unwrap(), KtreeView::open(&pb).unwrap());
     let read = |path: &Path| read_ktree_file(path).unwrap();
     for op in BoolOp::ALL {
-        ops::boolean_views(&va, ViewOperation::Binary(op, &vb), &out, None).unwrap();
+        io::boolean_views(&va, ViewOperation::Binary(op, &vb), &out, None).unwrap();
         let expect = ops::boolean(a, b, op).unwrap();
         assert_eq!(read(&out), AnyTree::from(expect.clone()), "{op:?}");
         let dense: Vec<bool> = da.iter().zip(db).map(|(&x, &y)| op.apply(x, y)).collect();
         assert_eq!(expect.to_dense().unwrap(), dense, "{op:?}");
     }
-    ops::boolean_views(&va, ViewOperation::Complement, &out, None).unwrap();
+    io::boolean_views(&va, ViewOperation::Complement, &out, None).unwrap();
     assert_eq!(read(&out), AnyTree::from(ops::complement(a)));
     let dense: Vec<bool> = da.iter().map(|&x| !x).collect();
     assert_eq!(ops::complement(a).to_dense().unwrap(), dense);
@@ -135,7 +138,7 @@ fn mismatched_inputs_are_an_error_and_leave_the_target() {
     write_ktree_file(&pa, &KTree::<3>::full(3).unwrap()).unwrap();
     write_ktree_file(&pb, &KTree::<3>::full(4).unwrap()).unwrap();
     std::fs::write(&out, b"keep").unwrap();
-    let e = ops::boolean_files(&pa, &pb, BoolOp::Union, &out, None).unwrap_err();
+    let e = io::boolean_files(&pa, &pb, BoolOp::Union, &out, None).unwrap_err();
     assert!(matches!(e, BooleanFileError::Mismatch { .. }), "{e}");
     assert!(e.to_string().contains("L = 4"), "{e}");
     assert_eq!(std::fs::read(&out).unwrap(), b"keep");
@@ -143,7 +146,7 @@ fn mismatched_inputs_are_an_error_and_leave_the_target() {
     let mut bytes = std::fs::read(&pa).unwrap();
     bytes[20] ^= 1;
     std::fs::write(&pa, &bytes).unwrap();
-    let e = ops::boolean_files(&pa, &pb, BoolOp::Union, &out, None).unwrap_err();
+    let e = io::boolean_files(&pa, &pb, BoolOp::Union, &out, None).unwrap_err();
     assert!(e.to_string().contains("a.ktree"), "{e}");
     assert_eq!(std::fs::read(&out).unwrap(), b"keep");
 }

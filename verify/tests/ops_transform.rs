@@ -35,13 +35,13 @@ fn same<const K: usize>(out: &KTree<K>, level: u32, expect: &[bool]) -> Result<(
 
 fn check_translate<const K: usize>(a: &Obj<K>, t: [i64; K]) -> Result<(), TestCaseError> {
     let (tree, dense) = (a.tree(), a.dense());
-    let out = ops::translate(&tree, t);
+    let out = ops::translate(&tree, t).unwrap();
     let expect = resample_dense::<K>(a.level, &dense, |q: [u32; K]| {
         std::array::from_fn(|i| i64::from(q[i]) - t[i])
     });
     same(&out, a.level, &expect)?;
     // translate(−t) ∘ translate(t) = the part that stayed inside.
-    let back = ops::translate(&out, t.map(|v| -v));
+    let back = ops::translate(&out, t.map(|v| -v)).unwrap();
     let side = 1i64 << a.level;
     let u = a.universe();
     let kept: Vec<bool> = (0..dense.len())
@@ -54,7 +54,7 @@ fn check_translate<const K: usize>(a: &Obj<K>, t: [i64; K]) -> Result<(), TestCa
     // A finer-level vector is the whole-voxel shift of `fine_shift`, which is the voxel-centre rule.
     let sub = 2;
     let fine: [i64; K] = t.map(|v| v * 4 + (v.rem_euclid(4)));
-    let by_fine = ops::translate_fine(&tree, fine, sub);
+    let by_fine = ops::translate_fine(&tree, fine, sub).unwrap();
     let by_affine =
         ops::transform(&tree, &Affine::translation(fine.map(|v| v as f64 / 4.0))).unwrap();
     prop_assert_eq!(by_fine, by_affine);
@@ -65,7 +65,7 @@ fn check_axis_maps<const K: usize>(a: &Obj<K>, pick: usize) -> Result<(), TestCa
     let (tree, dense) = (a.tree(), a.dense());
     let group = AxisMap::<K>::all();
     let g = group[pick % group.len()];
-    let out = ops::rotate_axes(&tree, &g);
+    let out = ops::rotate_axes(&tree, &g).unwrap();
     let side = 1u32 << a.level;
     let inv = g.inverse();
     let expect = resample_dense::<K>(a.level, &dense, |q: [u32; K]| {
@@ -76,23 +76,23 @@ fn check_axis_maps<const K: usize>(a: &Obj<K>, pick: usize) -> Result<(), TestCa
     // Composition acts like applying in turn; the inverse undoes.
     let h = group[(pick * 7 + 3) % group.len()];
     prop_assert_eq!(
-        ops::rotate_axes(&out, &h),
-        ops::rotate_axes(&tree, &h.compose(&g))
+        ops::rotate_axes(&out, &h).unwrap(),
+        ops::rotate_axes(&tree, &h.compose(&g)).unwrap()
     );
-    prop_assert_eq!(ops::rotate_axes(&out, &inv), tree.clone());
+    prop_assert_eq!(ops::rotate_axes(&out, &inv).unwrap(), tree.clone());
     // Four quarter turns are the identity.
     if K >= 2 {
         let q = AxisMap::<K>::quarter_turn(0, K - 1).unwrap();
         let mut r = tree.clone();
         for _ in 0..4 {
-            r = ops::rotate_axes(&r, &q);
+            r = ops::rotate_axes(&r, &q).unwrap();
         }
         prop_assert_eq!(r, tree.clone());
         // A quarter turn by reordering equals the affine rotation by 90° about the centre.
         let m =
             Affine::rotation_about(0, K - 1, 90.0, Affine::<K>::universe_centre(a.level)).unwrap();
         prop_assert_eq!(
-            ops::rotate_axes(&tree, &q),
+            ops::rotate_axes(&tree, &q).unwrap(),
             ops::transform(&tree, &m).unwrap()
         );
     }

@@ -661,9 +661,7 @@ fn check_max_level<const K: usize>(b: &Boxes<K>, p: [u64; K]) -> Result<(), Test
     let side = b.side();
     prop_assert_eq!(tree.level(), ktree::max_level(K));
     prop_assert_eq!(tree.voxel_count(), b.voxel_count());
-    let expect_box = b
-        .bounding_box()
-        .map(|bx| (bx.map(|r| r.0 as u32), bx.map(|r| (r.1 + 1) as u32)));
+    let expect_box = b.bounding_box().map(|(lo, hi)| (to_u32(lo), to_u32(hi)));
     prop_assert_eq!(tree.bounding_box(), expect_box);
     let probes: Vec<[u64; K]> = b.probe_points().into_iter().chain([p]).collect();
     let points: Vec<[u32; K]> = probes.iter().map(|&q| to_u32(q)).collect();

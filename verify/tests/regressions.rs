@@ -76,7 +76,7 @@ fn central_moments_of_a_small_far_box_are_exact() {
         (lo[0]..hi[0]).map(|x| ktree::Ray::new([x, lo[1]], hi[1])),
     )
     .unwrap();
-    let m = ktree::ops::mass_properties(&ktree::stacking::paper::stack(&rays));
+    let m = ktree::ops::mass_properties(&ktree::stacking::paper::stack(&rays)).unwrap();
     let v = m.volume as f64;
     for axis in 0..2 {
         let w = f64::from(hi[axis] - lo[axis]);

@@ -84,7 +84,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         "interferes" => {
             let (a, b) = two_spheres(level);
             // Disjoint pair: no early exit, the worst case.
-            let far = ops::translate(&b, [1 << (level - 1), 0, 0]);
+            let far = ops::translate(&b, [1 << (level - 1), 0, 0]).unwrap();
             let small = ops::intersection(&a, &ops::complement(&far)).unwrap();
             facts.push((
                 "input_nodes".into(),
@@ -94,7 +94,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         }
         "separation" => {
             let (a, b) = two_spheres(level);
-            let far = ops::translate(&b, [1 << (level - 1), 0, 0]);
+            let far = ops::translate(&b, [1 << (level - 1), 0, 0]).unwrap();
             let small = ops::intersection(&a, &ops::complement(&far)).unwrap();
             facts.push((
                 "input_nodes".into(),
@@ -117,7 +117,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             facts.push(("input_nodes".into(), a.node_count().to_string()));
             best_of(
                 repeats,
-                || ops::rotate_axes(&a, &q),
+                || ops::rotate_axes(&a, &q).unwrap(),
                 |t| keep(t, &mut out_nodes),
             )
         }
@@ -126,7 +126,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             facts.push(("input_nodes".into(), b.node_count().to_string()));
             best_of(
                 1,
-                || ops::translate(&b, [3, -5, 7]),
+                || ops::translate(&b, [3, -5, 7]).unwrap(),
                 |t| keep(t, &mut out_nodes),
             )
         }
@@ -162,7 +162,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         "mass" => {
             let (a, _) = two_spheres(level);
             facts.push(("input_nodes".into(), a.node_count().to_string()));
-            best_of(repeats, || ops::mass_properties(&a), |_| {})
+            best_of(repeats, || ops::mass_properties(&a).unwrap(), |_| {})
         }
         "progressive" => {
             let (a, _) = two_spheres(level);
@@ -170,7 +170,7 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
             let mut touched = 0;
             let s = best_of(
                 repeats,
-                || ops::mass_progressive(&a, 0.01),
+                || ops::mass_progressive(&a, 0.01).unwrap(),
                 |p| touched = p.levels.last().map_or(0, |l| l.nodes_touched),
             );
             facts.push(("touched".into(), touched.to_string()));

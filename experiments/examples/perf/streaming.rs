@@ -1,5 +1,5 @@
 //! Streaming: Booleans of two `.ktree` version 2 files, loaded into memory (`ops::boolean`, as for version 1
-//! files) against streamed from the files' memory maps to the output (`ops::boolean_files`), L = 11 … 13.
+//! files) against streamed from the files' memory maps to the output (`io::boolean_files`), L = 11 … 13.
 //! Each case is end to end, as `ktree op` runs it: read, operate, write the `.ktree`.
 
 use std::fmt::Write as _;
@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 
-use ktree::io::{read_ktree_file, write_ktree_file};
+use ktree::io::{self, read_ktree_file, write_ktree_file};
 use ktree::ops::{self, BoolOp};
 use ktree::solid::{Frame, Quadric, Rational, Sample, Solid, SolidSource};
 use ktree::stacking::Builder;
@@ -119,8 +119,8 @@ pub fn run_case(case: &str) -> Result<(f64, Vec<(String, String)>), String> {
         }
         "stream" => {
             let report = match bool_op {
-                Some(o) => ops::boolean_files(&a, &b, o, &out, None),
-                None => ops::complement_file(&a, &out, None),
+                Some(o) => io::boolean_files(&a, &b, o, &out, None),
+                None => io::complement_file(&a, &out, None),
             };
             report.map_err(|e| e.to_string())?.counts_per_level
         }
@@ -158,7 +158,7 @@ pub fn report() -> Result<String, String> {
          radius 7U/16) and sphere b (centre shifted by (U/8, 0, −U/16), radius 3U/8), voxel centres, built out \
          of core to `.ktree` version 2 files. Each case runs end to end in a fresh process, once, as `ktree \
          op` runs it: *in memory* reads both files into trees, runs `ops::boolean` (or `ops::complement` for \
-         `not`) and writes the result; *streamed* runs `ops::boolean_files` (or `ops::complement_file`) from \
+         `not`) and writes the result; *streamed* runs `io::boolean_files` (or `io::complement_file`) from \
          the files' memory maps to the output, its levels spilled to temporary files (what `ktree op` does \
          for version 2 files). Both write the same bytes (tested in `verify/tests/ops_boolean_files.rs`; \
          here the node counts are compared). Peak: the process's high-water resident set (VmHWM), which \

@@ -7,6 +7,7 @@ use std::time::Instant;
 use super::solids::{ball, cuboid, cylinder};
 use super::Out;
 use ktree::ops::{self, Affine};
+use ktree::tree::storage::infallible;
 use ktree::tree::KTree;
 
 /// Universe level of the milling scene (256³).
@@ -124,7 +125,7 @@ pub fn milling(out: &Out) -> Result<(String, KTree<3>), String> {
     let t0 = Instant::now();
     let mut swept = start.bit.clone();
     for dx in 1..=(PATH.1 - PATH.0) {
-        let moved = ops::translate(&start.bit, [i64::from(dx), 0, 0]);
+        let moved = infallible(ops::translate(&start.bit, [i64::from(dx), 0, 0]));
         swept = ops::union(&swept, &moved).map_err(|e| e.to_string())?;
     }
     let sweep_s = t0.elapsed().as_secs_f64();

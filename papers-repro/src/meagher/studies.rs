@@ -11,6 +11,7 @@ use crate::common::{fit_line, LineFit};
 use ktree::ops::{self, Affine, AxisMap};
 use ktree::rays::{ball_rays, Ray, RaySet};
 use ktree::stacking::paper::stack;
+use ktree::tree::storage::infallible;
 use ktree::tree::KTree;
 
 fn e(x: impl std::fmt::Display) -> String {
@@ -179,8 +180,17 @@ pub fn timing(out: &Out, max_level: u32) -> Result<String, String> {
                 ab,
                 best(5, || ops::intersection(&a, &b).map(|t| t.node_count())).0,
             ),
-            (n, best(5, || ops::rotate_axes(&a, &q).node_count()).0),
-            (n, best(2, || ops::translate(&a, [3, -5, 7]).node_count()).0),
+            (
+                n,
+                best(5, || infallible(ops::rotate_axes(&a, &q)).node_count()).0,
+            ),
+            (
+                n,
+                best(2, || {
+                    infallible(ops::translate(&a, [3, -5, 7])).node_count()
+                })
+                .0,
+            ),
             (
                 n,
                 best(1, || ops::transform(&a, &m).map(|t| t.node_count())).0,
@@ -376,7 +386,10 @@ pub fn checks() -> Result<String, String> {
     );
     // M3: translation and back.
     let s = ball(7, [120, 130, 128], 60)?;
-    let moved = ops::translate(&ops::translate(&s, [17, -9, 5]), [-17, 9, -5]);
+    let moved = infallible(ops::translate(
+        &infallible(ops::translate(&s, [17, -9, 5])),
+        [-17, 9, -5],
+    ));
     check(
         "M3",
         "sphere (L = 7) translated by (17, −9, 5) with 2^3-obel overlays and back",
@@ -397,11 +410,11 @@ pub fn checks() -> Result<String, String> {
     let q = AxisMap::<3>::quarter_turn(0, 1).map_err(e)?;
     let mut r = s.clone();
     for _ in 0..4 {
-        r = ops::rotate_axes(&r, &q);
+        r = infallible(ops::rotate_axes(&r, &q));
     }
     let same_counts = all
         .iter()
-        .all(|g| ops::rotate_axes(&s, g).counts_per_level() == s.counts_per_level());
+        .all(|g| infallible(ops::rotate_axes(&s, g)).counts_per_level() == s.counts_per_level());
     check(
         "M5",
         "the 48 rotations/reflections by child reordering keep node counts; 4 quarter turns = identity",
@@ -460,8 +473,8 @@ pub fn checks() -> Result<String, String> {
     let p = ops::Projective::<3>::perspective(l, 2, d).map_err(e)?;
     let width = |t: &KTree<3>| -> Result<u32, String> {
         let out = ops::transform_projective(t, &p).map_err(e)?;
-        let bx = ops::bounding_box(&out).ok_or("a deformed cube vanished")?;
-        Ok(bx[0].1 - bx[0].0 + 1)
+        let (lo, hi) = out.bounding_box().ok_or("a deformed cube vanished")?;
+        Ok(hi[0] - lo[0])
     };
     let (wn, wf) = (width(&near)?, width(&far)?);
     let (en, ef) = (32.0 * d / (8.0 + d), 32.0 * d / (100.0 + d));
@@ -497,8 +510,8 @@ pub fn checks() -> Result<String, String> {
 
 /// M10: progressive mass bounds on `tree`.
 pub fn progressive(tree: &KTree<3>, name: &str, tolerance: f64) -> String {
-    let p = ops::mass_progressive(tree, tolerance);
-    let exact = ops::mass_properties(tree);
+    let p = infallible(ops::mass_progressive(tree, tolerance));
+    let exact = infallible(ops::mass_properties(tree));
     let mut md = String::new();
     let _ = writeln!(
         md,

@@ -4,7 +4,8 @@
 //!
 //! * [`v2`]: one word-aligned section per level with rank samples, written as a stream ([`KtreeWriter`]) and
 //!   read in place through a memory map ([`KtreeView`], [`MappedTree`]), for trees larger than memory;
-//! * [`v1`]: one body for the whole tree, read into memory; written only by [`v1::write_ktree_v1`].
+//! * [`v1`]: one body for the whole tree, read into memory; written only by [`v1::write_ktree_v1`];
+//! * [`streamed`]: Booleans of version 2 files written to a third in bounded memory ([`boolean_files`]).
 //!
 //! ```
 //! use ktree::{io, KTree};
@@ -25,10 +26,15 @@ use thiserror::Error;
 
 use crate::tree::{AnyTree, KTree};
 
+pub mod streamed;
 pub mod v1;
 pub mod v2;
 pub mod v3;
 
+pub use streamed::{
+    boolean_files, boolean_views, complement_file, BooleanFileError, BooleanFileReport,
+    ViewOperation,
+};
 pub use v2::{AnyMappedTree, KtreeView, KtreeWriter, MappedTree};
 
 /// The format version [`write_ktree`] writes.

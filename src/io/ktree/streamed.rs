@@ -1,9 +1,10 @@
 //! Booleans of two `.ktree` version 2 files streamed to a third in bounded memory, for trees larger than
-//! memory.
+//! memory: the files' side of [`ops::boolean_into`](crate::ops::boolean_into) (the algorithm, over any
+//! storages and any sink), which this module runs on mapped inputs into spilled levels.
 //!
 //! # How it runs
-//! The inputs are read through their memory maps ([`KtreeView`]) as a [`TreeStorage`] whose every read is
-//! checked, by the Boolean that [`boolean`](super::boolean) runs on trees in memory — the same pair walk,
+//! The inputs are read through their memory maps ([`KtreeView`]) as [`MappedTree`]s, whose every read is
+//! checked, by the Boolean that [`ops::boolean`](crate::ops::boolean) runs on trees in memory — the same pair walk,
 //! merge and truth table: where one side is a leaf, the result under it is a leaf, a copy of the other
 //! side's subtree or its complement (level ranges copied word by word), and two partial nodes are walked
 //! child by child. The result is produced in *post-order*: a node's `2^K` child states are appended to the
@@ -29,17 +30,16 @@
 //! let b = KTree::<2>::from_dense(2, &(0..16).map(|i| i % 3 == 0).collect::<Vec<_>>()).unwrap();
 //! io::write_ktree_file(&pa, &a).unwrap();
 //! io::write_ktree_file(&pb, &b).unwrap();
-//! ops::boolean_files(&pa, &pb, ops::BoolOp::Difference, &pc, None).unwrap();
+//! io::boolean_files(&pa, &pb, ops::BoolOp::Difference, &pc, None).unwrap();
 //! assert_eq!(io::read_ktree_file(&pc).unwrap(), ktree::AnyTree::K2(ops::difference(&a, &b).unwrap()));
 //! ```
 
-use crate::fs::SpillError;
 use std::path::Path;
 
-use super::boolean::{boolean_into, complement_into};
-use super::BoolOp;
+use super::{KtreeFileError, KtreeView, MappedTree};
+use crate::fs::SpillError;
 use crate::io::spill::{SpillLevels, SpilledTree};
-use crate::io::{KtreeFileError, KtreeView, MappedTree};
+use crate::ops::{boolean_into, complement_into, BoolOp};
 use crate::tree::LevelCounts;
 
 /// Why a streamed Boolean failed. The target file is untouched and the spill files are removed.
@@ -95,7 +95,7 @@ pub enum ViewOperation<'a> {
 /// Writes `a op b` to the `.ktree` version 2 file `out`, reading the version 2 files `a` and `b` through
 /// their memory maps, in bounded memory (see the module's notes). Spill files go to a hidden folder in
 /// `temp_dir` (default: the output's folder), removed at the end. The bytes are those of
-/// [`write_ktree`](crate::io::write_ktree) of [`boolean`](super::boolean) of the trees.
+/// [`write_ktree`](crate::io::write_ktree) of [`ops::boolean`](crate::ops::boolean) of the trees.
 ///
 /// # Errors
 /// [`BooleanFileError`]; the target is then untouched.
@@ -134,7 +134,7 @@ pub fn complement_file(
 /// let a = KTree::<1>::from_dense(2, &[true, false, false, true]).unwrap();
 /// io::write_ktree_file(&pa, &a).unwrap();
 /// let view = io::KtreeView::open(&pa).unwrap();
-/// ops::boolean_views(&view, ops::ViewOperation::Complement, &pc, None).unwrap();
+/// io::boolean_views(&view, io::ViewOperation::Complement, &pc, None).unwrap();
 /// assert_eq!(io::read_ktree_file(&pc).unwrap(), ktree::AnyTree::K1(ops::complement(&a)));
 /// ```
 ///
