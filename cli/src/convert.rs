@@ -19,6 +19,8 @@ use ktree::solid::volume::Select;
 use ktree::tree::storage::TreeStorage;
 use ktree::{with_tree, AnyTree};
 
+use crate::common::vector::vector;
+
 /// Arguments of `ktree convert`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -34,19 +36,19 @@ pub struct Args {
     level: Option<u32>,
     /// Grids and volumes: ktree voxel = grid index + offset, as x,y,z (default 0, or what moves negative
     /// indices to 0).
-    #[arg(long, allow_hyphen_values = true)]
-    offset: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<i64, 3>)]
+    offset: Option<[i64; 3]>,
     /// Grid output: grid index = ktree voxel − offset, as x,y,z (default: .vdb keeps the input's grid
     /// indices, binvox and .bt use 0).
-    #[arg(long, allow_hyphen_values = true)]
-    out_offset: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<i64, 3>)]
+    out_offset: Option<[i64; 3]>,
     /// Grid and mesh output: the edge of a voxel in world units (default: the input grid's, else 1).
     #[arg(long)]
     voxel_size: Option<f64>,
     /// Grid and mesh output: the world position of the universe's corner (ktree voxel 0), as x,y,z
     /// (default: where the input grid puts it, else 0,0,0).
-    #[arg(long, allow_hyphen_values = true)]
-    origin: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    origin: Option<[f64; 3]>,
     /// 4-D trees: write the slices along this axis as a VTK time series — OUT.pvd (a collection of
     /// OUT_NNNN.vtu slices), or OUT_NNNN.vtu / OUT_NNNN.htg files only.
     #[arg(long)]
@@ -55,13 +57,13 @@ pub struct Args {
     #[arg(long, value_parser = ["empty", "full"], default_value = "empty")]
     unknown: String,
     /// Mesh: voxel coordinate = s·v + t, given as s,tx,ty,tz (default: fit into the universe).
-    #[arg(long)]
-    transform: Option<String>,
+    #[arg(long, value_name = "S,TX,TY,TZ", allow_hyphen_values = true, value_parser = MeshTransform::parse)]
+    transform: Option<MeshTransform>,
     /// Volume: samples with value ≥ this are inside.
-    #[arg(long, conflicts_with = "label")]
+    #[arg(long, conflicts_with = "label", allow_negative_numbers = true)]
     threshold: Option<f64>,
     /// Volume: samples equal to this label are inside.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     label: Option<f64>,
     /// Mesh output (.ply, .obj, .stl, .glb) of an octree: a smooth surface for display (surface nets,
     /// relaxed within half a voxel) instead of the exact boundary; not for round trips.
@@ -72,44 +74,13 @@ pub struct Args {
 /// Relaxation steps of `--smooth`.
 const SMOOTH_ITERATIONS: usize = 10;
 
-fn parse_xyz(name: &str, text: &str) -> Result<[i64; 3], String> {
-    let v: Vec<i64> = text
-        .split(',')
-        .map(|x| x.trim().parse::<i64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("--{name} '{text}': expected x,y,z (integers)"))?;
-    v.try_into()
-        .map_err(|_| format!("--{name} '{text}': expected three integers"))
-}
-
-fn parse_point(name: &str, text: &str) -> Result<[f64; 3], String> {
-    let v: Vec<f64> = text
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("--{name} '{text}': expected x,y,z (numbers)"))?;
-    match <[f64; 3]>::try_from(v) {
-        Ok(p) if p.iter().all(|x| x.is_finite()) => Ok(p),
-        _ => Err(format!("--{name} '{text}': expected three finite numbers")),
-    }
-}
-
 /// Reads the input, writes the output, prints a one-line summary.
 pub fn run(a: Args) -> CliResult {
     let options = ReadOptions {
         level: a.level,
-        offset: a
-            .offset
-            .as_deref()
-            .map(|t| parse_xyz("offset", t))
-            .transpose()?,
+        offset: a.offset,
         unknown_full: a.unknown == "full",
-        mesh_placement: a
-            .transform
-            .as_deref()
-            .map(MeshTransform::parse)
-            .transpose()
-            .map_err(|e| e.to_string())?,
+        mesh_placement: a.transform,
         select: match (a.threshold, a.label) {
             (Some(t), _) => Some(Select::AtLeast(t)),
             (None, Some(l)) => Some(Select::Label(l)),
@@ -137,7 +108,7 @@ pub fn run(a: Args) -> CliResult {
         (FileTree::Memory(read.tree), read.placement, read.meta)
     };
     let out_offset = match (&a.out_offset, format, placement) {
-        (Some(t), _, _) => parse_xyz("out-offset", t)?,
+        (Some(o), _, _) => *o,
         (
             None,
             Some(
@@ -154,8 +125,7 @@ pub fn run(a: Args) -> CliResult {
         }
         meta.voxel_size = v;
     }
-    if let Some(t) = &a.origin {
-        let origin = parse_point("origin", t)?;
+    if let Some(origin) = a.origin {
         // The grid's index 0 is ktree voxel `out_offset`.
         meta.origin = std::array::from_fn(|i| origin[i] + out_offset[i] as f64 * meta.voxel_size);
     }

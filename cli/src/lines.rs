@@ -22,7 +22,12 @@ pub struct Args {
     file: PathBuf,
     /// Where the viewer looks from (parallel projection): iso, top, bottom, front, back, left, right, or a
     /// direction X,Y,Z from the object towards the viewer.
-    #[arg(long, default_value = "iso")]
+    #[arg(
+        long,
+        default_value = "iso",
+        value_name = "VIEW|X,Y,Z",
+        allow_hyphen_values = true
+    )]
     view: String,
     /// Output file: .svg (vector lines) or .png (default: the input's name with .svg).
     #[arg(long)]

@@ -11,6 +11,7 @@ use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSourc
 use ktree::stacking::default_split_depth;
 
 use crate::common::output::{is_tree_file, TreeOutput};
+use crate::common::vector::{list, List};
 
 /// Arguments of `ktree rays`.
 #[derive(Debug, clap::Args)]
@@ -26,14 +27,14 @@ pub struct Args {
     level: u32,
     /// Centre (ball, ellipsoid, cylinder) or apex (paraboloid, cone): K comma-separated numbers
     /// (decimals or fractions, exact). Default: the universe's centre.
-    #[arg(long, alias = "centre")]
-    center: Option<String>,
+    #[arg(long, alias = "centre", value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    center: Option<List<Rational>>,
     /// Radius (ball, cylinder; paraboloid and cone: radius at --height from the apex).
     #[arg(long)]
     radius: Option<String>,
     /// Semi-axes of an ellipsoid: K numbers.
-    #[arg(long)]
-    radii: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    radii: Option<List<Rational>>,
     /// Height (paraboloid, cone).
     #[arg(long)]
     height: Option<String>,
@@ -41,19 +42,19 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     axis: usize,
     /// Half-space n·x ≤ offset: the normal n (K numbers).
-    #[arg(long)]
-    normal: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    normal: Option<List<Rational>>,
     /// Half-space offset.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     offset: Option<String>,
     /// Box lower corner (K numbers).
-    #[arg(long)]
-    lo: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    lo: Option<List<Rational>>,
     /// Box upper corner (K numbers).
-    #[arg(long)]
-    hi: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    hi: Option<List<Rational>>,
     /// A raw quadric matrix Ξ, (K+1)×(K+1), rows separated by ';', entries by ',' (solid: VᵀΞV ≤ 0).
-    #[arg(long)]
+    #[arg(long, value_name = "A,B,…;…", allow_hyphen_values = true)]
     quadric: Option<String>,
     /// Parameters are in the unit cube (the universe is [0,1]^K) instead of voxels.
     #[arg(long)]
@@ -71,12 +72,8 @@ pub struct Args {
     build: crate::common::memory::BuildArgs,
 }
 
-fn numbers(text: &str, n: usize, what: &str) -> Result<Vec<Rational>, String> {
-    let v: Vec<Rational> = text
-        .split(',')
-        .map(|x| x.parse::<Rational>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("--{what}: {e}"))?;
+/// The `n` numbers of `--what`.
+fn numbers(v: Vec<Rational>, n: usize, what: &str) -> Result<Vec<Rational>, String> {
     if v.len() != n {
         return Err(format!("--{what} needs {n} numbers, got {}", v.len()));
     }
@@ -90,9 +87,13 @@ fn one(text: &Option<String>, what: &str) -> Result<Rational, String> {
         .map_err(|e| format!("--{what}: {e}"))
 }
 
-fn arr<const K: usize>(text: &Option<String>, what: &str) -> Result<Option<[Rational; K]>, String> {
-    text.as_deref()
-        .map(|t| numbers(t, K, what).map(|v| std::array::from_fn(|i| v[i])))
+fn arr<const K: usize>(
+    given: &Option<List<Rational>>,
+    what: &str,
+) -> Result<Option<[Rational; K]>, String> {
+    given
+        .as_ref()
+        .map(|l| numbers(l.0.clone(), K, what).map(|v| std::array::from_fn(|i| v[i])))
         .transpose()
 }
 
@@ -133,7 +134,10 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
             let text = a.quadric.as_deref().ok_or("--quadric MATRIX is required for --solid quadric")?;
             let rows: Vec<Vec<Rational>> = text
                 .split(';')
-                .map(|r| numbers(r, K + 1, "quadric"))
+                .map(|r| {
+                    let row = list::<Rational>(r).map_err(|e| format!("--quadric: {e}"))?;
+                    numbers(row.0, K + 1, "quadric")
+                })
                 .collect::<Result<_, _>>()?;
             Quadric::from_rational_matrix(&rows, frame).map_err(e)?
         }

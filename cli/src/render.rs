@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 
 use indicatif::ProgressBar;
 
-use crate::common::picture::{parse_size, parse_vec3, parse_view};
+use crate::common::picture::{parse_size, parse_view};
 use crate::common::progress::progress_bar;
+use crate::common::vector::vector;
 use ktree::display::{
     default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
     RenderOptions,
@@ -27,20 +28,25 @@ pub struct Args {
     file: PathBuf,
     /// Where the camera looks from: iso, top, bottom, front, back, left, right, or a direction X,Y,Z from
     /// the object towards the eye. The camera frames the object.
-    #[arg(long, default_value = "iso")]
+    #[arg(
+        long,
+        default_value = "iso",
+        value_name = "VIEW|X,Y,Z",
+        allow_hyphen_values = true
+    )]
     camera: String,
     /// Perspective projection with this vertical field of view in degrees (default: orthographic).
     #[arg(long, value_name = "FOV")]
     perspective: Option<f64>,
     /// Put the eye at this point X,Y,Z (voxel coordinates) instead of framing automatically.
-    #[arg(long, value_name = "X,Y,Z")]
-    eye: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    eye: Option<[f64; 3]>,
     /// The point looked at with --eye (default: the object's centre).
-    #[arg(long, value_name = "X,Y,Z")]
-    target: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    target: Option<[f64; 3]>,
     /// The up direction (default: z, or y when looking along z).
-    #[arg(long, value_name = "X,Y,Z")]
-    up: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    up: Option<[f64; 3]>,
     /// Image size in pixels (for a 4-D tree: the size of each frame).
     #[arg(long, default_value = "800x800", value_name = "WxH")]
     size: String,
@@ -154,13 +160,13 @@ fn render_octree<T: TreeStorage<3>>(
     let mut camera =
         default_camera(tree, toward, args.perspective, w, h).map_err(|e| e.to_string())?;
     if let Some(eye) = &args.eye {
-        camera.eye = parse_vec3(eye, "eye")?;
+        camera.eye = *eye;
         let side = tree.universe().side() as f64;
         let (lo, hi) = object_bounds(tree)
             .map_err(read_error)?
             .unwrap_or(([0.0; 3], [side; 3]));
         camera.target = match &args.target {
-            Some(t) => parse_vec3(t, "target")?,
+            Some(t) => *t,
             None => [0, 1, 2].map(|i| (lo[i] + hi[i]) / 2.0),
         };
         if let Projection::Orthographic { .. } = camera.projection {
@@ -173,7 +179,7 @@ fn render_octree<T: TreeStorage<3>>(
         }
     }
     if let Some(up) = &args.up {
-        camera.up = parse_vec3(up, "up")?;
+        camera.up = *up;
     }
     let camera: Camera = camera;
     camera.check().map_err(|e| e.to_string())?;

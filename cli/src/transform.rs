@@ -13,6 +13,7 @@ use ktree::ops::{self, Affine, AxisMap, Projective};
 use ktree::KTree;
 
 use crate::common::tree_file::{read, write};
+use crate::common::vector::{list, List};
 
 /// Arguments of `ktree transform`.
 #[derive(Debug, clap::Args)]
@@ -20,8 +21,8 @@ pub struct Args {
     /// The input tree file.
     input: PathBuf,
     /// Translation: K numbers separated by commas (integers move exactly; fractions use the affine pass).
-    #[arg(long, allow_hyphen_values = true)]
-    translate: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<f64>)]
+    translate: Option<List<f64>>,
     /// Rotations about the universe's centre, applied left to right: `AXIS:DEGREES` about a named axis in
     /// 3-D (`x:30,z:-45`), or `I-J:DEGREES` in the plane of axes I → J in any K (`0-1:90`).
     #[arg(long, allow_hyphen_values = true)]
@@ -31,23 +32,11 @@ pub struct Args {
     scale: Option<String>,
     /// A homogeneous (K+1)×(K+1) matrix, row-major, comma-separated, acting on column vectors [x; 1]. A last
     /// row other than 0 … 0 1 makes it projective (e.g. Meagher's perspective deformation).
-    #[arg(long, allow_hyphen_values = true)]
-    matrix: Option<String>,
+    #[arg(long, value_name = "M11,M12,…", allow_hyphen_values = true, value_parser = list::<f64>)]
+    matrix: Option<List<f64>>,
     /// The tree file to write.
     #[arg(long)]
     out: PathBuf,
-}
-
-fn numbers(flag: &str, text: &str) -> Result<Vec<f64>, String> {
-    text.split(',')
-        .map(|s| {
-            s.trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| format!("--{flag}: '{s}' is not a number"))
-        })
-        .collect()
 }
 
 /// One parsed rotation: the plane (from, to) and the angle.
@@ -102,15 +91,14 @@ fn rational(text: &str) -> Option<(u32, u32)> {
 fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, String> {
     let level = tree.level();
     let translate = match &args.translate {
-        Some(t) => {
-            let v = numbers("translate", t)?;
+        Some(List(v)) => {
             if v.len() != K {
                 return Err(format!(
                     "--translate needs {K} numbers for a K = {K} tree, got {}",
                     v.len()
                 ));
             }
-            Some(v)
+            Some(v.clone())
         }
         None => None,
     };
@@ -137,16 +125,13 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     };
     // A matrix whose last row is not 0 … 0 1 is projective (e.g. a perspective deformation).
     let (matrix, projective) = match &args.matrix {
-        Some(m) => {
-            let v = numbers("matrix", m)?;
-            match Affine::<K>::from_homogeneous(&v) {
-                Ok(a) => (Some(a), None),
-                Err(_) => (
-                    None,
-                    Some(Projective::<K>::from_homogeneous(&v).map_err(|e| e.to_string())?),
-                ),
-            }
-        }
+        Some(List(v)) => match Affine::<K>::from_homogeneous(v) {
+            Ok(a) => (Some(a), None),
+            Err(_) => (
+                None,
+                Some(Projective::<K>::from_homogeneous(v).map_err(|e| e.to_string())?),
+            ),
+        },
         None => (None, None),
     };
     let exact = matrix.is_none()

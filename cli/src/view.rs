@@ -27,7 +27,7 @@ pub struct Args {
     budget: usize,
     /// The first camera, as `ktree render --camera` takes it: iso, top, bottom, front, back, left, right
     /// or X,Y,Z (default: iso; top for a quadtree).
-    #[arg(long)]
+    #[arg(long, value_name = "VIEW|X,Y,Z", allow_hyphen_values = true)]
     camera: Option<String>,
     /// 4-D trees: the axis the slider moves along.
     #[arg(long, default_value_t = 3)]

@@ -19,6 +19,7 @@ use ktree::solid::volume::Select;
 use ktree::Universe;
 
 use crate::common::output::{is_tree_file, write_output, TreeOutput};
+use crate::common::vector::vector;
 
 /// Arguments of `ktree voxelize`.
 #[derive(Debug, clap::Args)]
@@ -33,23 +34,24 @@ pub struct Args {
     #[arg(long, conflicts_with = "transform")]
     fit: bool,
     /// Mesh: voxel coordinate = s·v + t, given as s,tx,ty,tz.
-    #[arg(long)]
-    transform: Option<String>,
+    #[arg(long, value_name = "S,TX,TY,TZ", allow_hyphen_values = true, value_parser = MeshTransform::parse)]
+    transform: Option<MeshTransform>,
     /// Volume: samples with value ≥ this are inside.
-    #[arg(long, conflicts_with = "label")]
+    #[arg(long, conflicts_with = "label", allow_negative_numbers = true)]
     threshold: Option<f64>,
     /// Volume: samples equal to this label are inside.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     label: Option<f64>,
     /// Volume: where the volume's sample (0, 0, 0) goes in the universe, as x,y,z.
-    #[arg(long, default_value = "0,0,0")]
-    offset: String,
+    #[arg(long, default_value = "0,0,0", value_name = "X,Y,Z", allow_hyphen_values = true,
+          value_parser = vector::<u32, 3>)]
+    offset: [u32; 3],
     /// Point cloud: the side of a voxel; a point p is in voxel floor((p - origin) / S).
     #[arg(long)]
     voxel_size: Option<f64>,
     /// Point cloud: the corner of voxel (0, 0, 0), as x,y,z (default: the minimum corner of the points).
-    #[arg(long)]
-    origin: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    origin: Option<[f64; 3]>,
     /// Point cloud: the points a voxel must hold to be full.
     #[arg(long, default_value_t = 1)]
     min_points: u64,
@@ -87,8 +89,8 @@ pub fn run(a: Args) -> CliResult {
         if a.level.is_none() {
             return Err("--level L is required for a mesh".into());
         }
-        options.mesh_placement = match (&a.transform, a.fit) {
-            (Some(t), _) => Some(MeshTransform::parse(t).map_err(|e| e.to_string())?),
+        options.mesh_placement = match (a.transform, a.fit) {
+            (Some(t), _) => Some(t),
             (None, true) => None,
             (None, false) => return Err("a mesh needs --fit or --transform s,tx,ty,tz".into()),
         };
@@ -98,21 +100,7 @@ pub fn run(a: Args) -> CliResult {
             (None, Some(l)) => Some(Select::Label(l)),
             (None, None) => return Err("a volume needs --threshold T or --label V".into()),
         };
-        let off: Vec<u32> = a
-            .offset
-            .split(',')
-            .map(|x| x.trim().parse::<u32>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| {
-                format!(
-                    "--offset '{}': expected x,y,z (non-negative integers)",
-                    a.offset
-                )
-            })?;
-        let off: [u32; 3] = off
-            .try_into()
-            .map_err(|_| format!("--offset '{}': expected three numbers", a.offset))?;
-        options.offset = Some(off.map(i64::from));
+        options.offset = Some(a.offset.map(i64::from));
     }
     // In a run over several MPI ranks, rank 0 alone reports.
     let root = crate::distributed::ranks().is_root();
@@ -144,15 +132,7 @@ fn run_cloud(a: &Args) -> CliResult {
     if a.crop && a.level.is_none() {
         return Err("--crop needs --level L (without it the universe holds every point)".into());
     }
-    if let Some(text) = &a.origin {
-        let o: Vec<f64> = text
-            .split(',')
-            .map(|x| x.trim().parse::<f64>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| format!("--origin '{text}': expected x,y,z"))?;
-        let o: [f64; 3] = o
-            .try_into()
-            .map_err(|_| format!("--origin '{text}': expected three numbers"))?;
+    if let Some(o) = a.origin {
         v = v.origin(o);
     }
     if let Some(l) = a.level {

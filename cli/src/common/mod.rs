@@ -8,3 +8,4 @@ pub mod picture;
 pub mod progress;
 pub mod threads;
 pub mod tree_file;
+pub mod vector;
