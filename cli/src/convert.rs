@@ -15,7 +15,6 @@ use ktree::io::{
     WriteOptions, VERSION,
 };
 use ktree::solid::mesh::MeshTransform;
-use ktree::solid::volume::Select;
 use ktree::tree::storage::TreeStorage;
 use ktree::{with_tree, AnyTree};
 
@@ -59,12 +58,8 @@ pub struct Args {
     /// Mesh: voxel coordinate = s·v + t, given as s,tx,ty,tz (default: fit into the universe).
     #[arg(long, value_name = "S,TX,TY,TZ", allow_hyphen_values = true, value_parser = MeshTransform::parse)]
     transform: Option<MeshTransform>,
-    /// Volume: samples with value ≥ this are inside.
-    #[arg(long, conflicts_with = "label", allow_negative_numbers = true)]
-    threshold: Option<f64>,
-    /// Volume: samples equal to this label are inside.
-    #[arg(long, allow_negative_numbers = true)]
-    label: Option<f64>,
+    #[command(flatten)]
+    volume: crate::common::args::VolumeArgs,
     /// Mesh output (.ply, .obj, .stl, .glb) of an octree: a smooth surface for display (surface nets,
     /// relaxed within half a voxel) instead of the exact boundary; not for round trips.
     #[arg(long)]
@@ -81,11 +76,7 @@ pub fn run(a: Args) -> CliResult {
         offset: a.offset,
         unknown_full: a.unknown == "full",
         mesh_placement: a.transform,
-        select: match (a.threshold, a.label) {
-            (Some(t), _) => Some(Select::AtLeast(t)),
-            (None, Some(l)) => Some(Select::Label(l)),
-            (None, None) => None,
-        },
+        select: a.volume.select(),
     };
     let format = Format::of(&a.output);
     let exported = matches!(

@@ -3,8 +3,6 @@
 use crate::common::error::CliResult;
 use crate::outln;
 
-use std::path::PathBuf;
-
 use ktree::fs::write_atomic_with;
 use ktree::io::write_rays_source;
 use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSource};
@@ -62,12 +60,8 @@ pub struct Args {
     /// Test each voxel's lowest corner instead of its centre.
     #[arg(long)]
     corner: bool,
-    /// Output: rays in the text format, or a tree if the name ends in .ktree.
-    #[arg(long)]
-    out: PathBuf,
-    /// Worker threads (default: all cores). The output is the same for any number.
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    out: crate::common::args::RaysOrTreeOut,
     #[command(flatten)]
     build: crate::common::memory::BuildArgs,
 }
@@ -157,11 +151,11 @@ fn go<const K: usize>(a: &Args) -> CliResult {
     } else {
         Sample::Centre
     };
-    if is_tree_file(&a.out) {
+    if is_tree_file(&a.out.out) {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole
         // (across MPI ranks, each rank makes the rays of its own slabs only).
         let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
-        let built = TreeOutput::new(&a.out, a.threads, &a.build).write(&source, None)?;
+        let built = TreeOutput::new(&a.out.out, &a.build).write(&source, None)?;
         if let Some(built) = built {
             outln!("{}", built.summary(None));
         }
@@ -182,17 +176,17 @@ fn go<const K: usize>(a: &Args) -> CliResult {
     };
     let mut written = (0, 0);
     let depth = default_split_depth(K, a.level);
-    write_atomic_with(&a.out, |w| {
+    write_atomic_with(&a.out.out, |w| {
         written = write_rays_source(w, &source, depth, &progress)?;
         Ok(())
     })
-    .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+    .map_err(|e| format!("cannot write {}: {e}", a.out.out.display()))?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
     outln!(
         "{}: K = {K}, L = {}, {} rays, {} voxels",
-        a.out.display(),
+        a.out.out.display(),
         a.level,
         written.0,
         written.1

@@ -35,9 +35,8 @@ pub struct MorphArgs {
     /// The element: ball (|d|² ≤ r²), box (max |d_i| ≤ r) or cross (Σ |d_i| ≤ r).
     #[arg(long, default_value = "ball")]
     shape: Element,
-    /// The tree file to write.
-    #[arg(long)]
-    out: PathBuf,
+    #[command(flatten)]
+    out: crate::common::args::TreeOut,
 }
 
 fn morph<const K: usize, T: TreeStorage<K> + Sync>(t: &T, args: &MorphArgs) -> CliResult {
@@ -49,7 +48,7 @@ fn morph<const K: usize, T: TreeStorage<K> + Sync>(t: &T, args: &MorphArgs) -> C
         _ => shape::closing(t, r, e),
     }
     .map_err(|err| format!("{}: {err}", args.tree.display()))?;
-    write(&args.out, &out)
+    write(&args.out.out, &out)
 }
 
 /// Runs `ktree morph`.

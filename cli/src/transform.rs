@@ -34,9 +34,8 @@ pub struct Args {
     /// row other than 0 … 0 1 makes it projective (e.g. Meagher's perspective deformation).
     #[arg(long, value_name = "M11,M12,…", allow_hyphen_values = true, value_parser = list::<f64>)]
     matrix: Option<List<f64>>,
-    /// The tree file to write.
-    #[arg(long)]
-    out: PathBuf,
+    #[command(flatten)]
+    out: crate::common::args::TreeOut,
 }
 
 /// One parsed rotation: the plane (from, to) and the angle.
@@ -194,6 +193,6 @@ pub fn run(args: Args) -> CliResult {
     let tree = read(&args.input)?;
     ktree::with_dim!(&tree, AnyTree, t => {
         let out = apply(t, &args).map_err(|e| format!("{}: {e}", args.input.display()))?;
-        write(&args.out, &out)
+        write(&args.out.out, &out)
     })
 }

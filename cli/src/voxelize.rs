@@ -15,7 +15,6 @@ use std::sync::{Mutex, PoisonError};
 use ktree::io::{voxel_source, voxelize, Format, ReadOptions, VoxelSource};
 use ktree::rays::{RaySource, SlabRuns};
 use ktree::solid::mesh::MeshTransform;
-use ktree::solid::volume::Select;
 use ktree::Universe;
 
 use crate::common::output::{is_tree_file, write_output, TreeOutput};
@@ -36,12 +35,8 @@ pub struct Args {
     /// Mesh: voxel coordinate = s·v + t, given as s,tx,ty,tz.
     #[arg(long, value_name = "S,TX,TY,TZ", allow_hyphen_values = true, value_parser = MeshTransform::parse)]
     transform: Option<MeshTransform>,
-    /// Volume: samples with value ≥ this are inside.
-    #[arg(long, conflicts_with = "label", allow_negative_numbers = true)]
-    threshold: Option<f64>,
-    /// Volume: samples equal to this label are inside.
-    #[arg(long, allow_negative_numbers = true)]
-    label: Option<f64>,
+    #[command(flatten)]
+    volume: crate::common::args::VolumeArgs,
     /// Volume: where the volume's sample (0, 0, 0) goes in the universe, as x,y,z.
     #[arg(long, default_value = "0,0,0", value_name = "X,Y,Z", allow_hyphen_values = true,
           value_parser = vector::<u32, 3>)]
@@ -58,12 +53,8 @@ pub struct Args {
     /// Point cloud with --level: drop the points outside the universe (default: they are an error).
     #[arg(long)]
     crop: bool,
-    /// Output: rays in the text format, or a tree if the name ends in .ktree.
-    #[arg(long)]
-    out: PathBuf,
-    /// Worker threads for stacking a tree (default: all cores). The output is the same for any number.
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    out: crate::common::args::RaysOrTreeOut,
     #[command(flatten)]
     build: crate::common::memory::BuildArgs,
 }
@@ -95,16 +86,16 @@ pub fn run(a: Args) -> CliResult {
             (None, false) => return Err("a mesh needs --fit or --transform s,tx,ty,tz".into()),
         };
     } else {
-        options.select = match (a.threshold, a.label) {
-            (Some(t), _) => Some(Select::AtLeast(t)),
-            (None, Some(l)) => Some(Select::Label(l)),
-            (None, None) => return Err("a volume needs --threshold T or --label V".into()),
-        };
+        options.select = Some(
+            a.volume
+                .select()
+                .ok_or("a volume needs --threshold T or --label V")?,
+        );
         options.offset = Some(a.offset.map(i64::from));
     }
     // In a run over several MPI ranks, rank 0 alone reports.
     let root = crate::distributed::ranks().is_root();
-    if is_tree_file(&a.out) && crate::distributed::ranks().size == 1 {
+    if is_tree_file(&a.out.out) && crate::distributed::ranks().size == 1 {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
         // (Across MPI ranks, every rank makes the rays whole and keeps its slabs: `write_output`.)
         let v = voxel_source(&a.input, &options).map_err(|e| e.to_string())?;
@@ -114,7 +105,7 @@ pub fn run(a: Args) -> CliResult {
     }
     let v = voxelize(&a.input, &options).map_err(|e| e.to_string())?;
     remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
-    crate::common::output::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?)?;
+    crate::common::output::print_summary(&write_output(&v.rays, &a.out.out, &a.build)?)?;
     Ok(())
 }
 
@@ -177,12 +168,7 @@ fn run_cloud(a: &Args) -> CliResult {
             }
         );
     }
-    crate::common::output::print_summary(&write_output(
-        &voxels.rays,
-        &a.out,
-        a.threads,
-        &a.build,
-    )?)?;
+    crate::common::output::print_summary(&write_output(&voxels.rays, &a.out.out, &a.build)?)?;
     Ok(())
 }
 
@@ -211,7 +197,7 @@ fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
     };
     let counted = CountedRuns::new(source);
     let held = (what.as_str(), source.heap_bytes());
-    let built = TreeOutput::new(&a.out, a.threads, &a.build).write(&counted, Some(held))?;
+    let built = TreeOutput::new(&a.out.out, &a.build).write(&counted, Some(held))?;
     Ok(built
         .map(|b| b.summary(Some(counted.runs())))
         .unwrap_or_default())

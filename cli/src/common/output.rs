@@ -45,9 +45,13 @@ pub struct Built {
 }
 
 impl<'a> TreeOutput<'a> {
-    /// The output `out`, on `threads` worker threads, with the build options `args`.
-    pub fn new(out: &'a Path, threads: Option<usize>, args: &'a BuildArgs) -> Self {
-        Self { out, threads, args }
+    /// The output `out`, with the build options `args` (worker threads, budget, spill folder, progress).
+    pub fn new(out: &'a Path, args: &'a BuildArgs) -> Self {
+        Self {
+            out,
+            threads: args.threads.threads,
+            args,
+        }
     }
 
     /// Builds the tree of `source` and writes it to the output: out of core in the budget less what the
@@ -185,12 +189,11 @@ pub fn describe<E: Display>(out: &Path, e: BuildError<E>, held: u64) -> String {
 pub fn write_output<const K: usize>(
     rays: &RaySet<K>,
     out: &Path,
-    threads: Option<usize>,
     build: &BuildArgs,
 ) -> Result<String, String> {
     if is_tree_file(out) {
         let held = ("the rays", crate::common::memory::ray_bytes(rays));
-        let built = TreeOutput::new(out, threads, build).write(rays, Some(held))?;
+        let built = TreeOutput::new(out, build).write(rays, Some(held))?;
         return Ok(built
             .map(|b| b.summary(Some(rays.len() as u64)))
             .unwrap_or_default());
