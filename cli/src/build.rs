@@ -1,7 +1,7 @@
 //! `ktree build --rays FILE --out FILE.ktree [--threads N] [--max-memory SIZE] [--temp-dir DIR]
 //! [--progress]`: stack a ray file into a tree file (out of core: see [`crate::common::memory`]).
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 
 use std::path::PathBuf;
 
@@ -26,7 +26,7 @@ pub struct Args {
 /// MPI ranks, every rank reads the whole ray file; rank 0 alone writes and prints).
 pub fn run(args: Args) -> CliResult {
     // A sorted file is read slab by slab as the cells are stacked; another is read whole.
-    let summary = match open_rays_file(&args.rays).map_err(|e| e.to_string())? {
+    let summary = match open_rays_file(&args.rays).map_err(CliError::caused)? {
         RaysFile::Sorted(source) => {
             ktree::with_dim!(&source, AnyRaysFileSource, s => build_source(s, &args))?
         }

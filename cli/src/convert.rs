@@ -2,7 +2,7 @@
 //! `.vdb`; meshes voxelized as inputs and the tree's boundary as outputs, `.glb` and `.svg` outputs only;
 //! volumes as inputs).
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -89,17 +89,17 @@ pub fn run(a: Args) -> CliResult {
         && Format::of(&a.input) == Some(Format::Ktree)
         && ktree_file_version(&a.input).is_ok_and(|v| v == VERSION)
     {
-        let mapped = AnyMappedTree::open(&a.input).map_err(|e| e.to_string())?;
+        let mapped = AnyMappedTree::open(&a.input).map_err(CliError::caused)?;
         (FileTree::Mapped(mapped), None, None)
     } else {
-        let read = read_tree_placed(&a.input, &options).map_err(|e| e.to_string())?;
+        let read = read_tree_placed(&a.input, &options).map_err(CliError::caused)?;
         for r in &read.remarks {
             eprintln!("note: {}: {r}", a.input.display());
         }
         (FileTree::Memory(read.tree), read.placement, read.meta)
     };
-    let out_offset = match (&a.out_offset, format, placement) {
-        (Some(o), _, _) => *o,
+    let out_offset = match (a.out_offset, format, placement) {
+        (Some(o), _, _) => o,
         (
             None,
             Some(
@@ -137,7 +137,7 @@ pub fn run(a: Args) -> CliResult {
                 .into())
             }
         }
-        .map_err(|e| e.to_string())?;
+        .map_err(CliError::caused)?;
         outln!(
             "{}: K = 4, L = {}, {} slices along axis {axis} ({} files)",
             a.output.display(),
@@ -165,9 +165,9 @@ pub fn run(a: Args) -> CliResult {
                 .into())
             }
         }
-        .map_err(|e| format!("{}: {e}", a.input.display()))?
+        .map_err(|e| format!("{}: {}", a.input.display(), crate::common::error::chain(&e)))?
         .placed(&frame);
-        let written = write_surface(&a.output, &mesh).map_err(|e| e.to_string())?;
+        let written = write_surface(&a.output, &mesh).map_err(CliError::caused)?;
         outln!(
             "{}: smooth surface of {} vertices, {} triangles",
             a.output.display(),
@@ -177,7 +177,7 @@ pub fn run(a: Args) -> CliResult {
         return Ok(());
     }
     if exported {
-        with_tree!(&file, t => export(&a.output, t, &frame)).map_err(|e| e.to_string())?;
+        with_tree!(&file, t => export(&a.output, t, &frame)).map_err(CliError::caused)?;
     } else {
         let FileTree::Memory(tree) = &file else {
             unreachable!("only meshes and VTK files are made from a file read in place")
@@ -185,13 +185,13 @@ pub fn run(a: Args) -> CliResult {
         if format == Some(Format::Ktree) {
             // The version --format-version asks for, as every command that writes trees.
             ktree::with_dim!(tree, AnyTree, t => crate::common::tree_file::write_tree(&a.output, t))
-                .map_err(|e| format!("cannot write {}: {e}", a.output.display()))?;
+                .map_err(CliError::caused)?;
         } else {
             let write_options = WriteOptions {
                 offset: out_offset,
                 meta: Some(meta),
             };
-            write_tree(&a.output, tree, &write_options).map_err(|e| e.to_string())?;
+            write_tree(&a.output, tree, &write_options).map_err(CliError::caused)?;
         }
     }
     let (c, voxels) = with_tree!(&file, t => (TreeStorage::counts(t), TreeStorage::voxel_count(t)));

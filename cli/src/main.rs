@@ -126,8 +126,8 @@ fn main() -> ExitCode {
     };
     match outcome {
         Ok(()) | Err(CliError::OutputClosed) => ExitCode::SUCCESS,
-        Err(CliError::Failed(message)) => {
-            distributed::report_failure(&message);
+        Err(e) => {
+            distributed::report_failure(&e.to_string());
             ExitCode::FAILURE
         }
     }

@@ -3,7 +3,7 @@
 //! exact properties of a version 2 file are summed from its memory map, leaf by leaf, so a tree larger
 //! than memory is measured without being loaded.
 
-use crate::common::error::CliResult;
+use crate::common::error::{chain, CliError, CliResult};
 use crate::outln;
 
 use std::path::PathBuf;
@@ -54,7 +54,7 @@ struct Report {
 /// The exact properties of a memory-mapped version 2 file, from its leaves.
 fn view_report<const K: usize>(view: &KtreeView) -> Result<Report, String> {
     let m = ops::mass_of_leaves(view.level(), |visit| view.for_each_leaf::<K>(visit))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| chain(&e))?;
     Ok(Report::exact(&m, view.node_count()))
 }
 
@@ -102,9 +102,9 @@ pub fn run(args: Args) -> CliResult {
         }
     }
     let mapped = args.tolerance.is_none()
-        && ktree_file_version(&args.tree).map_err(|e| e.to_string())? == VERSION;
+        && ktree_file_version(&args.tree).map_err(CliError::caused)? == VERSION;
     let mut r = if mapped {
-        let view = KtreeView::open(&args.tree).map_err(|e| e.to_string())?;
+        let view = KtreeView::open(&args.tree).map_err(CliError::caused)?;
         match view.k() {
             1 => view_report::<1>(&view)?,
             2 => view_report::<2>(&view)?,
@@ -119,7 +119,7 @@ pub fn run(args: Args) -> CliResult {
     if args.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&r).map_err(CliError::caused)?
         );
         return Ok(());
     }

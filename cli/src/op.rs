@@ -105,7 +105,7 @@ fn stream_op(args: &Args) -> Option<CliResult> {
     };
     Some(
         report
-            .map_err(|e| CliError::from(e.to_string()))
+            .map_err(CliError::caused)
             .and_then(|r| print_summary(&args.out.out, r.k, r.level, &r.counts_per_level)),
     )
 }

@@ -1,6 +1,6 @@
 //! `ktree rays --solid NAME ... --level L --out FILE`: an analytic solid (quadric or box) to rays.
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use ktree::fs::write_atomic_with;
@@ -154,7 +154,7 @@ fn go<const K: usize>(a: &Args) -> CliResult {
     if is_tree_file(&a.out.out) {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole
         // (across MPI ranks, each rank makes the rays of its own slabs only).
-        let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
+        let source = SolidSource::new(&s, a.level, sample).map_err(CliError::caused)?;
         let built = TreeOutput::new(&a.out.out, &a.build).write(&source, None)?;
         if let Some(built) = built {
             outln!("{}", built.summary(None));
@@ -166,7 +166,7 @@ fn go<const K: usize>(a: &Args) -> CliResult {
         return Ok(());
     }
     // A ray file, written slab by slab: one slab's runs held at a time, no cap on their number.
-    let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
+    let source = SolidSource::new(&s, a.level, sample).map_err(CliError::caused)?;
     let bar = crate::common::progress::progress_bar(a.build.progress, "writing slabs");
     let progress = |done: u64, total: u64| {
         if let Some(bar) = &bar {
@@ -180,7 +180,7 @@ fn go<const K: usize>(a: &Args) -> CliResult {
         written = write_rays_source(w, &source, depth, &progress)?;
         Ok(())
     })
-    .map_err(|e| format!("cannot write {}: {e}", a.out.out.display()))?;
+    .map_err(CliError::caused)?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }

@@ -2,7 +2,7 @@
 //! hidden-surface image of an octree; a quadtree is drawn as a picture of its cells, a 4-D tree as a strip
 //! of time slices.
 
-use crate::common::error::{read_error, CliResult};
+use crate::common::error::{read_error, CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -89,8 +89,8 @@ pub fn run(args: Args) -> CliResult {
         }
     };
     // A version 2 file is drawn from its memory map, whatever its size.
-    let file = FileTree::open(&args.file, &ktree::io::ReadOptions::default())
-        .map_err(|e| e.to_string())?;
+    let file =
+        FileTree::open(&args.file, &ktree::io::ReadOptions::default()).map_err(CliError::caused)?;
     match &file {
         FileTree::Memory(AnyTree::K3(t)) => {
             render_octree(t, &args, &out, w, h, bar.as_ref(), &mut tick)
@@ -110,8 +110,8 @@ pub fn run(args: Args) -> CliResult {
 
 /// Draws a quadtree's cells, `size` pixels square, to the PNG `out`.
 fn render_quadtree<T: TreeStorage<2>>(tree: &T, out: &Path, size: u32) -> CliResult {
-    let canvas = plane::quadtree_canvas(tree, size).map_err(|e| e.to_string())?;
-    canvas.write_png(out).map_err(|e| e.to_string())?;
+    let canvas = plane::quadtree_canvas(tree, size).map_err(CliError::caused)?;
+    canvas.write_png(out).map_err(CliError::caused)?;
     // Every leaf is full or empty: the counts say how many there are, without a walk.
     let counts = tree.counts();
     outln!(
@@ -126,13 +126,13 @@ fn render_quadtree<T: TreeStorage<2>>(tree: &T, out: &Path, size: u32) -> CliRes
 /// to the frames' folder if asked).
 fn render_strip<T: TreeStorage<4>>(tree: &T, args: &Args, out: &Path, size: u32) -> CliResult {
     let (strip, frames) =
-        slices::time_strip(tree, args.time_axis, args.frames, size).map_err(|e| e.to_string())?;
-    strip.write_png(out).map_err(|e| e.to_string())?;
+        slices::time_strip(tree, args.time_axis, args.frames, size).map_err(CliError::caused)?;
+    strip.write_png(out).map_err(CliError::caused)?;
     if let Some(dir) = &args.frames_dir {
         for (i, (_, frame)) in frames.iter().enumerate() {
             let path = dir.join(format!("frame_{i:03}.png"));
             png::write_rgb_png(&path, frame.width, frame.height, &frame.rgb)
-                .map_err(|e| e.to_string())?;
+                .map_err(CliError::caused)?;
         }
     }
     let positions: Vec<String> = frames.iter().map(|(p, _)| p.to_string()).collect();
@@ -158,7 +158,7 @@ fn render_octree<T: TreeStorage<3>>(
 ) -> CliResult {
     let toward = parse_view(&args.camera)?;
     let mut camera =
-        default_camera(tree, toward, args.perspective, w, h).map_err(|e| e.to_string())?;
+        default_camera(tree, toward, args.perspective, w, h).map_err(CliError::caused)?;
     if let Some(eye) = &args.eye {
         camera.eye = *eye;
         let side = tree.universe().side() as f64;
@@ -182,7 +182,7 @@ fn render_octree<T: TreeStorage<3>>(
         camera.up = *up;
     }
     let camera: Camera = camera;
-    camera.check().map_err(|e| e.to_string())?;
+    camera.check().map_err(CliError::caused)?;
     let options = RenderOptions {
         width: w,
         height: h,
@@ -191,7 +191,7 @@ fn render_octree<T: TreeStorage<3>>(
     };
     let rays = match &args.rays {
         None => None,
-        Some(path) => match read_rays_file(path).map_err(|e| e.to_string())? {
+        Some(path) => match read_rays_file(path).map_err(CliError::caused)? {
             AnyRaySet::K3(r) if r.level() != tree.level() => {
                 return Err(format!(
                     "{}: level {} does not match the tree's level {}",
@@ -227,10 +227,10 @@ fn render_octree<T: TreeStorage<3>>(
         },
         tick,
     )
-    .map_err(|e| e.to_string())?;
-    png::write_rgb_png(out, w, h, &image.rgb).map_err(|e| e.to_string())?;
+    .map_err(CliError::caused)?;
+    png::write_rgb_png(out, w, h, &image.rgb).map_err(CliError::caused)?;
     if let (Some(path), Some(grey)) = (&args.depth, image.depth_grey()) {
-        png::write_grey_png(path, w, h, &grey).map_err(|e| e.to_string())?;
+        png::write_grey_png(path, w, h, &grey).map_err(CliError::caused)?;
     }
     if let Some(b) = bar {
         b.finish_and_clear();

@@ -6,7 +6,7 @@
 //! the exact integer operations (rational overlays, child reordering, translation overlays). Otherwise all
 //! steps are concatenated into one affine matrix applied in a single overlay pass (Meagher's M6).
 
-use crate::common::error::CliResult;
+use crate::common::error::{chain, CliResult};
 use std::path::PathBuf;
 
 use ktree::ops::{self, Affine, AxisMap, Projective};
@@ -128,7 +128,7 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
             Ok(a) => (Some(a), None),
             Err(_) => (
                 None,
-                Some(Projective::<K>::from_homogeneous(v).map_err(|e| e.to_string())?),
+                Some(Projective::<K>::from_homogeneous(v).map_err(|e| chain(&e))?),
             ),
         },
         None => (None, None),
@@ -143,11 +143,11 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     if exact {
         let mut t = tree.clone();
         if let Some(Some((p, q))) = scale_ratio {
-            t = ops::scale(&t, p, q).map_err(|e| e.to_string())?;
+            t = ops::scale(&t, p, q).map_err(|e| chain(&e))?;
         }
         for &(from, to, deg) in &rotate {
             let turns = ((deg / 90.0) as i64).rem_euclid(4);
-            let q = AxisMap::<K>::quarter_turn(from, to).map_err(|e| e.to_string())?;
+            let q = AxisMap::<K>::quarter_turn(from, to).map_err(|e| chain(&e))?;
             for _ in 0..turns {
                 t = ops::rotate_axes(&t, &q);
             }
@@ -165,7 +165,7 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     let centre = Affine::<K>::universe_centre(level);
     for &(from, to, deg) in &rotate {
         m = Affine::rotation_about(from, to, deg, centre)
-            .map_err(|e| e.to_string())?
+            .map_err(|e| chain(&e))?
             .after(&m);
     }
     if let Some(v) = &translate {
@@ -176,9 +176,9 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     }
     if let Some(p) = projective {
         let all = p.after(&Projective::from_affine(&m));
-        return ops::transform_projective(tree, &all).map_err(|e| e.to_string());
+        return ops::transform_projective(tree, &all).map_err(|e| chain(&e));
     }
-    ops::transform(tree, &m).map_err(|e| e.to_string())
+    ops::transform(tree, &m).map_err(|e| chain(&e))
 }
 
 /// Applies the transforms and writes the result.

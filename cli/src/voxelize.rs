@@ -4,7 +4,7 @@
 //! `ktree voxelize CLOUD --voxel-size S [--origin x,y,z] [--level L] [--min-points N] [--crop] --out FILE`: a
 //! point cloud (PLY without faces, PCD, XYZ/CSV, LAS/LAZ) to the voxels holding at least N points.
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::collections::BTreeMap;
@@ -62,7 +62,7 @@ pub struct Args {
 /// Voxelizes the input and writes it.
 pub fn run(a: Args) -> CliResult {
     // A `.ply` is a cloud or a mesh by its header: a broken one is said as such.
-    if ktree::io::is_cloud_file(&a.input).map_err(|e| e.to_string())? {
+    if ktree::io::is_cloud_file(&a.input).map_err(CliError::caused)? {
         return run_cloud(&a);
     }
     if a.voxel_size.is_some() || a.origin.is_some() || a.crop {
@@ -98,12 +98,12 @@ pub fn run(a: Args) -> CliResult {
     if is_tree_file(&a.out.out) && crate::distributed::ranks().size == 1 {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
         // (Across MPI ranks, every rank makes the rays whole and keeps its slabs: `write_output`.)
-        let v = voxel_source(&a.input, &options).map_err(|e| e.to_string())?;
+        let v = voxel_source(&a.input, &options).map_err(CliError::caused)?;
         remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
         outln!("{}", build_out_of_core(&v.source, &a)?);
         return Ok(());
     }
-    let v = voxelize(&a.input, &options).map_err(|e| e.to_string())?;
+    let v = voxelize(&a.input, &options).map_err(CliError::caused)?;
     remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
     crate::common::output::print_summary(&write_output(&v.rays, &a.out.out, &a.build)?)?;
     Ok(())
@@ -129,7 +129,7 @@ fn run_cloud(a: &Args) -> CliResult {
     if let Some(l) = a.level {
         v = v.level(l);
     }
-    let cloud = ktree::io::read_cloud(&a.input).map_err(|e| e.to_string())?;
+    let cloud = ktree::io::read_cloud(&a.input).map_err(CliError::caused)?;
     let voxels = v.voxelize(cloud.points()).map_err(|e| {
         let hint = match e {
             SolidError::PointsOutside { .. } => {

@@ -6,7 +6,7 @@
 //! Grid formats index voxels by integers: ktree voxel = grid index + offset (see [`GridPlacement`]).
 //! binvox, `.bt` and `.vdb` hold octrees only.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
@@ -141,47 +141,51 @@ pub enum IoError {
     #[cfg(any(feature = "cloud", feature = "mesh"))]
     #[error(transparent)]
     Geometry(#[from] super::GeometryFileError),
-    /// A mesh or volume that could not be read or voxelized.
-    #[error("{}", with_file(.file, .source))]
+    /// A mesh or volume that could not be parsed or voxelized (one that cannot be read is
+    /// [`IoError::Read`]).
+    #[error("{}", with_file(.file, .error))]
     Solid {
         /// The file.
-        file: String,
-        /// The cause.
-        source: SolidError,
+        file: PathBuf,
+        /// What is wrong (part of the message: it names the file where it can).
+        error: SolidError,
     },
+    /// A file could not be read.
+    #[error(transparent)]
+    Read(crate::fs::FileOpError),
     /// The format or the options do not fit the file: an unknown extension, an output-only or input-only
     /// format, a dimension the format cannot hold, a missing option.
-    #[error("{file}: {message}")]
+    #[error("{}: {message}", file.display())]
     Usage {
         /// The file.
-        file: String,
+        file: PathBuf,
         /// What is wrong.
         message: String,
     },
     /// Writing failed (the message names the file).
-    #[error("{0}")]
-    Write(#[source] std::io::Error),
+    #[error(transparent)]
+    Write(#[from] crate::fs::FileOpError),
     /// The file holds a tree of another dimension than the one asked for.
-    #[error("{file}: {source}")]
+    #[error("{}", file.display())]
     Dimension {
         /// The file.
-        file: String,
+        file: PathBuf,
         /// The dimensions.
         source: DimensionMismatch,
     },
 }
 
 /// A solid's error naming its file once (a file that cannot be read or parsed names itself).
-fn with_file(file: &str, e: &SolidError) -> String {
+fn with_file(file: &Path, e: &SolidError) -> String {
     match e {
         SolidError::Io { .. } | SolidError::Parse { .. } => e.to_string(),
-        _ => format!("{file}: {e}"),
+        _ => format!("{}: {e}", file.display()),
     }
 }
 
 fn usage(path: &Path, message: impl Into<String>) -> IoError {
     IoError::Usage {
-        file: path.display().to_string(),
+        file: path.to_path_buf(),
         message: message.into(),
     }
 }
@@ -323,9 +327,16 @@ fn readable(path: &Path) -> Result<(), SolidError> {
 
 #[cfg(any(feature = "mesh", feature = "volume"))]
 fn solid_error(path: &Path) -> impl Fn(SolidError) -> IoError + '_ {
-    move |source| IoError::Solid {
-        file: path.display().to_string(),
-        source,
+    move |error| match error {
+        SolidError::Io { path, source } => IoError::Read(crate::fs::FileOpError::new(
+            crate::fs::FileOp::Read,
+            &path,
+            source,
+        )),
+        error => IoError::Solid {
+            file: path.to_path_buf(),
+            error,
+        },
     }
 }
 
@@ -657,7 +668,7 @@ impl<const K: usize> KTree<K> {
         read_tree(path, &ReadOptions::default())?
             .try_into()
             .map_err(|source| IoError::Dimension {
-                file: path.display().to_string(),
+                file: path.to_path_buf(),
                 source,
             })
     }

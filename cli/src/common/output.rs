@@ -8,10 +8,9 @@
 //! with the `mpi` feature, in a run of several ranks, the same step is taken by every rank together
 //! ([`crate::distributed`]). [`write_output`] writes rays as text or as a tree, by the output's extension.
 
-use crate::common::error::CliResult;
+use crate::common::error::{chain, CliResult};
 use crate::outln;
 
-use std::fmt::Display;
 use std::path::{Path, PathBuf};
 
 use ktree::fs::SpillError;
@@ -68,7 +67,7 @@ impl<'a> TreeOutput<'a> {
     ) -> Result<Option<Built>, String>
     where
         S: RaySource<K>,
-        S::Error: Display,
+        S::Error: std::error::Error + Send + Sync + 'static,
     {
         let budget = match held {
             Some((what, bytes)) => self.args.budget.left_after(what, bytes)?,
@@ -99,7 +98,7 @@ impl<'a> TreeOutput<'a> {
     ) -> Result<Option<OutOfCoreReport>, String>
     where
         S: RaySource<K>,
-        S::Error: Display,
+        S::Error: std::error::Error + Send + Sync + 'static,
     {
         #[cfg(feature = "mpi")]
         if crate::distributed::ranks().size > 1 {
@@ -168,7 +167,11 @@ impl Built {
 
 /// The message of a failed out-of-core build of `out`; `held` bytes were set apart from the budget before
 /// the build (message buffers) and are added back to the budgets it names.
-pub fn describe<E: Display>(out: &Path, e: BuildError<E>, held: u64) -> String {
+pub fn describe<E: std::error::Error + Send + Sync + 'static>(
+    out: &Path,
+    e: BuildError<E>,
+    held: u64,
+) -> String {
     match e {
         BuildError::BudgetTooSmall { budget, needed } => format!(
             "{}: {} (--max-memory)",
@@ -178,8 +181,8 @@ pub fn describe<E: Display>(out: &Path, e: BuildError<E>, held: u64) -> String {
                 needed: needed.saturating_add(held),
             }
         ),
-        BuildError::Files(output @ SpillError::Output { .. }) => output.to_string(),
-        other => format!("{}: {other}", out.display()),
+        BuildError::Files(output @ SpillError::Output { .. }) => chain(&output),
+        other => format!("{}: {}", out.display(), chain(&other)),
     }
 }
 
@@ -201,7 +204,7 @@ pub fn write_output<const K: usize>(
     if !crate::distributed::ranks().is_root() {
         return Ok(String::new());
     }
-    write_rays_file(out, rays).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    write_rays_file(out, rays).map_err(|e| chain(&e))?;
     Ok(format!(
         "{}: K = {K}, L = {}, {} rays, {} voxels",
         out.display(),

@@ -1,4 +1,6 @@
-//! The arguments of the commands that draw pictures: image sizes, vectors, views.
+//! The arguments of the commands that draw pictures: image sizes and views.
+
+use crate::common::error::chain;
 
 /// Parses `WxH`.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -11,7 +13,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
             .map_err(|_| format!("size '{s}' must be WIDTHxHEIGHT with whole numbers"))
     };
     let (w, h) = (p(w)?, p(h)?);
-    ktree::display::check_size(w, h).map_err(|e| e.to_string())?;
+    ktree::display::check_size(w, h).map_err(|e| chain(&e))?;
     Ok((w, h))
 }
 
@@ -19,5 +21,5 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 pub fn parse_view(s: &str) -> Result<[f64; 3], String> {
     s.parse::<ktree::display::View>()
         .map(|v| v.toward_eye())
-        .map_err(|e| e.to_string())
+        .map_err(|e| chain(&e))
 }
