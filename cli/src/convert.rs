@@ -37,8 +37,8 @@ pub struct Args {
     /// indices to 0).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<i64, 3>)]
     offset: Option<[i64; 3]>,
-    /// Grid output: grid index = ktree voxel − offset, as x,y,z (default: .vdb keeps the input's grid
-    /// indices, binvox and .bt use 0).
+    /// Grid output: grid index = ktree voxel − offset, as x,y,z (default: .vdb and .bt keep the input's
+    /// grid indices, binvox uses 0). The world stays where it is.
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<i64, 3>)]
     out_offset: Option<[i64; 3]>,
     /// Grid and mesh output: the edge of a voxel in world units (default: the input grid's, else 1).
@@ -98,15 +98,24 @@ pub fn run(a: Args) -> CliResult {
         }
         (FileTree::Memory(read.tree), read.placement, read.meta)
     };
-    let out_offset = match (a.out_offset, format, placement) {
-        (Some(o), _, _) => o,
+    // The input grid's index 0 is ktree voxel `read_offset`; the output grid's, `out_offset`: by default
+    // the input's grid indices are kept where the output has indices of its own (.vdb, .bt; binvox starts
+    // at 0).
+    let read_offset = placement.map_or([0; 3], |p| p.offset);
+    let out_offset = match (a.out_offset, format) {
+        (Some(o), _) => o,
         (
             None,
             Some(
-                Format::Vdb | Format::Mesh | Format::Glb | Format::Svg | Format::Vtu | Format::Htg,
+                Format::Vdb
+                | Format::OctomapBt
+                | Format::Mesh
+                | Format::Glb
+                | Format::Svg
+                | Format::Vtu
+                | Format::Htg,
             ),
-            Some(p),
-        ) => p.offset,
+        ) => read_offset,
         _ => [0; 3],
     };
     let mut meta = read_meta.unwrap_or_default();
@@ -116,9 +125,32 @@ pub fn run(a: Args) -> CliResult {
         }
         meta.voxel_size = v;
     }
-    if let Some(origin) = a.origin {
-        // The grid's index 0 is ktree voxel `out_offset`.
-        meta.origin = std::array::from_fn(|i| origin[i] + out_offset[i] as f64 * meta.voxel_size);
+    // The world stays where it is: ktree voxel 0 is at --origin, or where the input grid puts it.
+    let corner = match a.origin {
+        Some(origin) => origin,
+        None => meta.counted_from(read_offset.map(|o| -o)).origin,
+    };
+    meta = Frame {
+        voxel_size: meta.voxel_size,
+        origin: corner,
+    }
+    .counted_from(out_offset);
+    if matches!(format, Some(Format::Ktree | Format::Rays))
+        && (read_meta.is_some_and(|m| m != Frame::default())
+            || read_offset != [0; 3]
+            || a.origin.is_some()
+            || a.voxel_size.is_some()
+            || a.out_offset.is_some())
+    {
+        // Say what is lost: these files hold voxels only.
+        eprintln!(
+            "note: {}: a {} file holds no world placement: voxel size {}, ktree voxel 0 at {:?} are not \
+             kept (give --voxel-size and --origin when converting it back to a grid or a mesh)",
+            a.output.display(),
+            if format == Some(Format::Ktree) { ".ktree" } else { "ray" },
+            meta.voxel_size,
+            corner
+        );
     }
     if let Some(axis) = a.time_axis {
         let frame = Frame {

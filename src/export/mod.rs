@@ -28,25 +28,10 @@ use crate::space::Universe;
 use crate::tree::storage::TreeStorage;
 use crate::tree::{AnyTree, LevelCounts, NodeState, StorageError};
 
-/// Where voxels are in the world: voxel coordinate `v` is at `origin + voxel_size · v` (the universe's
-/// corner at `origin`; quadtrees use the first two coordinates).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Frame {
-    /// The edge of a voxel in world units.
-    pub voxel_size: f64,
-    /// The world position of the universe's corner (voxel coordinate 0).
-    pub origin: [f64; 3],
-}
-
-impl Default for Frame {
-    /// Unit voxels, the universe's corner at the world origin.
-    fn default() -> Self {
-        Self {
-            voxel_size: 1.0,
-            origin: [0.0; 3],
-        }
-    }
-}
+/// Where voxels are in the world for an export: ktree voxel `v` is at `origin + voxel_size · v` (the
+/// universe's corner at `origin`; quadtrees use the first two coordinates). The crate's one world frame,
+/// [`WorldFrame`](crate::space::WorldFrame).
+pub type Frame = crate::space::WorldFrame;
 
 /// A mesh file format, by extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
