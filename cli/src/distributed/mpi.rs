@@ -190,12 +190,14 @@ where
         moved += 8 * words.len() as u64;
         match part.add_part(&words) {
             Ok(total) => streams.push(Stream::new(from, total)),
-            Err(e) if added.is_ok() => added = Err(format!("rank {r}: {e}")),
+            Err(e) if added.is_ok() => {
+                added = Err(format!("rank {r}: {}", crate::common::error::chain(&e)))
+            }
             Err(_) => {}
         }
     }
     agree(w, added)?;
-    let written = part.write::<String>(
+    let written = part.write::<std::convert::Infallible>(
         out,
         &mut |owner, words| streams[owner - 1].fill(owner, words),
         &progress,
