@@ -25,8 +25,8 @@ const TEMP_SUFFIX: &str = ".ktree-tmp";
 /// ```
 ///
 /// # Errors
-/// Any I/O error, with the path in the message.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+/// A [`FileOpError`] naming the path, its source the I/O error as the system gave it.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileOpError> {
     write_atomic_with(path, |w| w.write_all(bytes))
 }
 
@@ -34,13 +34,22 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 /// [`AtomicFile`]).
 ///
 /// # Errors
-/// Any I/O error from `fill` or the file system, with the path in the message; the target is untouched.
+/// A [`FileOpError`] naming the path, its source the I/O error from `fill` or the file system as it was
+/// given (its kind and `raw_os_error` kept); the target is untouched.
+///
+/// ```
+/// let dir = tempfile::tempdir().unwrap();
+/// std::fs::write(dir.path().join("plain"), b"").unwrap();
+/// let e = ktree::fs::write_atomic(&dir.path().join("plain/out.txt"), b"x").unwrap_err();
+/// assert_eq!(e.path(), dir.path().join("plain/out.txt"));
+/// # #[cfg(target_os = "linux")]
+/// assert_eq!(e.io().raw_os_error(), Some(20)); // ENOTDIR
+/// ```
 pub fn write_atomic_with(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    let with_path =
-        |e: std::io::Error| std::io::Error::new(e.kind(), format!("{}: {e}", path.display()));
+) -> Result<(), FileOpError> {
+    let with_path = |e| FileOpError::new(FileOp::Write, path, e);
     let mut file = AtomicFile::create(path).map_err(with_path)?;
     {
         let mut w = std::io::BufWriter::new(&mut file);
@@ -82,7 +91,14 @@ impl AtomicFile {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
-        std::fs::create_dir_all(dir)?;
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            // A plain file where the folder should be: say "not a directory" as the system does, not
+            // "file exists".
+            return Err(match std::fs::read_dir(dir) {
+                Err(not_dir) if dir.exists() => not_dir,
+                _ => e,
+            });
+        }
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
@@ -210,7 +226,7 @@ pub(crate) fn remove_stale(dir: &Path, name: &str, suffix: &str) {
 #[derive(Debug, thiserror::Error)]
 pub enum SpillError {
     /// The folder for the spill files cannot be used.
-    #[error("cannot create spill files in the temporary folder {}: {source}", path.display())]
+    #[error("cannot create spill files in the temporary folder {}", path.display())]
     TempDir {
         /// The folder.
         path: PathBuf,
@@ -218,7 +234,7 @@ pub enum SpillError {
         source: std::io::Error,
     },
     /// A spill file cannot be written or read back.
-    #[error("spill file {}: {source}", path.display())]
+    #[error("spill file {}", path.display())]
     Spill {
         /// The spill file.
         path: PathBuf,
@@ -226,7 +242,7 @@ pub enum SpillError {
         source: std::io::Error,
     },
     /// The output cannot be written.
-    #[error("cannot write {}: {source}", path.display())]
+    #[error("cannot write {}", path.display())]
     Output {
         /// The output file.
         path: PathBuf,
@@ -249,6 +265,75 @@ impl SpillError {
 impl From<SpillError> for std::io::Error {
     /// The error as an I/O error of the same kind, its message naming the file.
     fn from(e: SpillError) -> Self {
+        std::io::Error::new(e.kind(), e)
+    }
+}
+
+/// What was being done to a file when it failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum FileOp {
+    /// Opening or reading it.
+    Read,
+    /// Creating or writing it (for an atomic write: its folder, its temporary file, the rename).
+    Write,
+    /// Creating a folder.
+    CreateFolder,
+}
+
+/// A file operation that failed: the path and the [`std::io::Error`] as the system gave it, kept whole as
+/// the [`source`](std::error::Error::source) (its [`kind`](std::io::Error::kind) and
+/// [`raw_os_error`](std::io::Error::raw_os_error) intact). Its message names the operation and the path
+/// only; the cause is its source (print the chain: `cannot write out.ktree: No space left on device`).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot {} {}", match .op { FileOp::Read => "read", FileOp::Write => "write", FileOp::CreateFolder => "create the folder" }, .path.display())]
+pub struct FileOpError {
+    op: FileOp,
+    path: PathBuf,
+    #[source]
+    source: std::io::Error,
+}
+
+impl FileOpError {
+    /// The failure `source` of `op` on `path`.
+    pub fn new(op: FileOp, path: &Path, source: std::io::Error) -> Self {
+        Self {
+            op,
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    /// What was being done.
+    pub fn op(&self) -> FileOp {
+        self.op
+    }
+
+    /// The file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The I/O error as the system gave it.
+    pub fn io(&self) -> &std::io::Error {
+        &self.source
+    }
+
+    /// The I/O error as the system gave it, taken out.
+    pub fn into_io(self) -> std::io::Error {
+        self.source
+    }
+
+    /// The kind of the I/O error.
+    pub fn kind(&self) -> std::io::ErrorKind {
+        self.source.kind()
+    }
+}
+
+impl From<FileOpError> for std::io::Error {
+    /// The error as an I/O error of the same kind, its message naming the file (its source is the
+    /// original error).
+    fn from(e: FileOpError) -> Self {
         std::io::Error::new(e.kind(), e)
     }
 }
@@ -348,6 +433,27 @@ mod tests {
         assert_eq!(std::fs::read(&kept).unwrap(), b"new");
     }
 
+    /// The cause of a failed write is the system's error itself: its kind and errno survive.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn writing_below_a_plain_file_keeps_the_system_error() {
+        use std::error::Error as _;
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("plain"), b"").unwrap();
+        for target in ["plain/out.ktree", "plain/sub/out.ktree"] {
+            let e = write_atomic(&dir.path().join(target), b"x").unwrap_err();
+            let io = e
+                .source()
+                .unwrap()
+                .downcast_ref::<std::io::Error>()
+                .unwrap();
+            assert_eq!(io.raw_os_error(), Some(20), "{target}: ENOTDIR, got {io}");
+            assert_eq!(io.kind(), std::io::ErrorKind::NotADirectory);
+            assert!(e.to_string().ends_with(target), "{e}");
+            assert!(!e.to_string().contains(&io.to_string()), "{e}");
+        }
+    }
+
     #[test]
     fn a_failed_write_leaves_the_old_file_and_no_temporary() {
         let dir = tempfile::tempdir().unwrap();
@@ -359,6 +465,7 @@ mod tests {
         })
         .unwrap_err();
         assert!(e.to_string().contains("keep.txt"), "{e}");
+        assert_eq!(e.io().to_string(), "disk full");
         assert_eq!(std::fs::read(&target).unwrap(), b"old");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }

@@ -51,6 +51,52 @@ pub const fn max_level(k: usize) -> u32 {
     }
 }
 
+/// Where voxels are in the world, the one frame of clouds, meshes, grid files and exports: the voxel (or
+/// grid index) with coordinates `c` covers `origin + voxel_size · [c, c + 1)` on each axis, so coordinate 0's
+/// lower corner is at `origin` (quadtrees use the first two coordinates). Known as
+/// [`export::Frame`](crate::export::Frame) where a tree is placed for export and as
+/// [`io::GridMeta`](crate::io::GridMeta) where a grid file states it (binvox `translate` and `scale / D`,
+/// OctoMap `res`, OpenVDB's linear transform).
+///
+/// ```
+/// let f = ktree::space::WorldFrame { voxel_size: 0.5, origin: [1.0, 0.0, -2.0] };
+/// assert_eq!(f.corner_of([2, 0, 4]), [2.0, 0.0, 0.0]);
+/// assert_eq!(ktree::space::WorldFrame::default().corner_of([3, 1, 2]), [3.0, 1.0, 2.0]);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WorldFrame {
+    /// The edge of a voxel in world units.
+    pub voxel_size: f64,
+    /// The world position of the lower corner of coordinate 0.
+    pub origin: [f64; 3],
+}
+
+impl Default for WorldFrame {
+    /// Unit voxels, coordinate 0 at the world origin.
+    fn default() -> Self {
+        Self {
+            voxel_size: 1.0,
+            origin: [0.0; 3],
+        }
+    }
+}
+
+impl WorldFrame {
+    /// The world position of the lower corner of the voxel at `c`.
+    pub fn corner_of(&self, c: [i64; 3]) -> [f64; 3] {
+        std::array::from_fn(|a| self.origin[a] + c[a] as f64 * self.voxel_size)
+    }
+
+    /// The same placement with coordinates counted from `offset` (coordinate `c` here is `c − offset` in
+    /// the frame returned): the world does not move.
+    pub fn counted_from(&self, offset: [i64; 3]) -> Self {
+        Self {
+            voxel_size: self.voxel_size,
+            origin: self.corner_of(offset),
+        }
+    }
+}
+
 /// Compile-time guard used by every `K`-generic type: `1 ≤ K ≤ MAX_K`.
 pub(crate) struct DimCheck<const K: usize>;
 

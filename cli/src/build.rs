@@ -1,7 +1,7 @@
 //! `ktree build --rays FILE --out FILE.ktree [--threads N] [--max-memory SIZE] [--temp-dir DIR]
 //! [--progress]`: stack a ray file into a tree file (out of core: see [`crate::common::memory`]).
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 
 use std::path::PathBuf;
 
@@ -16,12 +16,8 @@ pub struct Args {
     /// The ray file (text format: `# ktree rays v1`, then `K L`, then one run per line).
     #[arg(long)]
     rays: PathBuf,
-    /// The tree file to write (written to a temporary file, then renamed).
-    #[arg(long)]
-    out: PathBuf,
-    /// Worker threads (default: all cores). The tree is the same for any number.
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    out: crate::common::args::TreeOut,
     #[command(flatten)]
     build: crate::common::memory::BuildArgs,
 }
@@ -30,7 +26,7 @@ pub struct Args {
 /// MPI ranks, every rank reads the whole ray file; rank 0 alone writes and prints).
 pub fn run(args: Args) -> CliResult {
     // A sorted file is read slab by slab as the cells are stacked; another is read whole.
-    let summary = match open_rays_file(&args.rays).map_err(|e| e.to_string())? {
+    let summary = match open_rays_file(&args.rays).map_err(CliError::caused)? {
         RaysFile::Sorted(source) => {
             ktree::with_dim!(&source, AnyRaysFileSource, s => build_source(s, &args))?
         }
@@ -43,7 +39,7 @@ pub fn run(args: Args) -> CliResult {
 fn build_rays<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<String, String> {
     let what = format!("the rays of {}", args.rays.display());
     let held = (what.as_str(), crate::common::memory::ray_bytes(rays));
-    let built = TreeOutput::new(&args.out, args.threads, &args.build).write(rays, Some(held))?;
+    let built = TreeOutput::new(&args.out.out, &args.build).write(rays, Some(held))?;
     Ok(built
         .map(|b| b.summary_with_size(rays.len() as u64))
         .unwrap_or_default())
@@ -54,7 +50,7 @@ fn build_rays<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<String, S
 fn build_source<const K: usize>(source: &RaysFileSource<K>, args: &Args) -> Result<String, String> {
     let what = format!("the index of {}", args.rays.display());
     let held = (what.as_str(), source.heap_bytes());
-    let built = TreeOutput::new(&args.out, args.threads, &args.build).write(source, Some(held))?;
+    let built = TreeOutput::new(&args.out.out, &args.build).write(source, Some(held))?;
     Ok(built
         .map(|b| b.summary_with_size(source.runs()))
         .unwrap_or_default())

@@ -1,7 +1,7 @@
 //! `ktree collide A B [--time-axis N] [--json]`: interference detection between two `.ktree` files, with
 //! the minimum separation when they do not overlap (JSON keys: those of [`ktree::ops::Collision`]).
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::PathBuf;
@@ -33,7 +33,7 @@ pub fn run(args: Args) -> CliResult {
     if args.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&r).map_err(CliError::caused)?
         );
         return Ok(());
     }

@@ -2,7 +2,7 @@
 //! `.vdb`; meshes voxelized as inputs and the tree's boundary as outputs, `.glb` and `.svg` outputs only;
 //! volumes as inputs).
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -15,9 +15,10 @@ use ktree::io::{
     WriteOptions, VERSION,
 };
 use ktree::solid::mesh::MeshTransform;
-use ktree::solid::volume::Select;
 use ktree::tree::storage::TreeStorage;
 use ktree::{with_tree, AnyTree};
+
+use crate::common::vector::vector;
 
 /// Arguments of `ktree convert`.
 #[derive(Debug, clap::Args)]
@@ -34,19 +35,19 @@ pub struct Args {
     level: Option<u32>,
     /// Grids and volumes: ktree voxel = grid index + offset, as x,y,z (default 0, or what moves negative
     /// indices to 0).
-    #[arg(long, allow_hyphen_values = true)]
-    offset: Option<String>,
-    /// Grid output: grid index = ktree voxel − offset, as x,y,z (default: .vdb keeps the input's grid
-    /// indices, binvox and .bt use 0).
-    #[arg(long, allow_hyphen_values = true)]
-    out_offset: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<i64, 3>)]
+    offset: Option<[i64; 3]>,
+    /// Grid output: grid index = ktree voxel − offset, as x,y,z (default: .vdb and .bt keep the input's
+    /// grid indices, binvox uses 0). The world stays where it is.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<i64, 3>)]
+    out_offset: Option<[i64; 3]>,
     /// Grid and mesh output: the edge of a voxel in world units (default: the input grid's, else 1).
     #[arg(long)]
     voxel_size: Option<f64>,
     /// Grid and mesh output: the world position of the universe's corner (ktree voxel 0), as x,y,z
     /// (default: where the input grid puts it, else 0,0,0).
-    #[arg(long, allow_hyphen_values = true)]
-    origin: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    origin: Option<[f64; 3]>,
     /// 4-D trees: write the slices along this axis as a VTK time series — OUT.pvd (a collection of
     /// OUT_NNNN.vtu slices), or OUT_NNNN.vtu / OUT_NNNN.htg files only.
     #[arg(long)]
@@ -55,14 +56,10 @@ pub struct Args {
     #[arg(long, value_parser = ["empty", "full"], default_value = "empty")]
     unknown: String,
     /// Mesh: voxel coordinate = s·v + t, given as s,tx,ty,tz (default: fit into the universe).
-    #[arg(long)]
-    transform: Option<String>,
-    /// Volume: samples with value ≥ this are inside.
-    #[arg(long, conflicts_with = "label")]
-    threshold: Option<f64>,
-    /// Volume: samples equal to this label are inside.
-    #[arg(long)]
-    label: Option<f64>,
+    #[arg(long, value_name = "S,TX,TY,TZ", allow_hyphen_values = true, value_parser = MeshTransform::parse)]
+    transform: Option<MeshTransform>,
+    #[command(flatten)]
+    volume: crate::common::args::VolumeArgs,
     /// Mesh output (.ply, .obj, .stl, .glb) of an octree: a smooth surface for display (surface nets,
     /// relaxed within half a voxel) instead of the exact boundary; not for round trips.
     #[arg(long)]
@@ -72,49 +69,14 @@ pub struct Args {
 /// Relaxation steps of `--smooth`.
 const SMOOTH_ITERATIONS: usize = 10;
 
-fn parse_xyz(name: &str, text: &str) -> Result<[i64; 3], String> {
-    let v: Vec<i64> = text
-        .split(',')
-        .map(|x| x.trim().parse::<i64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("--{name} '{text}': expected x,y,z (integers)"))?;
-    v.try_into()
-        .map_err(|_| format!("--{name} '{text}': expected three integers"))
-}
-
-fn parse_point(name: &str, text: &str) -> Result<[f64; 3], String> {
-    let v: Vec<f64> = text
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("--{name} '{text}': expected x,y,z (numbers)"))?;
-    match <[f64; 3]>::try_from(v) {
-        Ok(p) if p.iter().all(|x| x.is_finite()) => Ok(p),
-        _ => Err(format!("--{name} '{text}': expected three finite numbers")),
-    }
-}
-
 /// Reads the input, writes the output, prints a one-line summary.
 pub fn run(a: Args) -> CliResult {
     let options = ReadOptions {
         level: a.level,
-        offset: a
-            .offset
-            .as_deref()
-            .map(|t| parse_xyz("offset", t))
-            .transpose()?,
+        offset: a.offset,
         unknown_full: a.unknown == "full",
-        mesh_placement: a
-            .transform
-            .as_deref()
-            .map(MeshTransform::parse)
-            .transpose()
-            .map_err(|e| e.to_string())?,
-        select: match (a.threshold, a.label) {
-            (Some(t), _) => Some(Select::AtLeast(t)),
-            (None, Some(l)) => Some(Select::Label(l)),
-            (None, None) => None,
-        },
+        mesh_placement: a.transform,
+        select: a.volume.select(),
     };
     let format = Format::of(&a.output);
     let exported = matches!(
@@ -127,24 +89,33 @@ pub fn run(a: Args) -> CliResult {
         && Format::of(&a.input) == Some(Format::Ktree)
         && ktree_file_version(&a.input).is_ok_and(|v| v == VERSION)
     {
-        let mapped = AnyMappedTree::open(&a.input).map_err(|e| e.to_string())?;
+        let mapped = AnyMappedTree::open(&a.input).map_err(CliError::caused)?;
         (FileTree::Mapped(mapped), None, None)
     } else {
-        let read = read_tree_placed(&a.input, &options).map_err(|e| e.to_string())?;
+        let read = read_tree_placed(&a.input, &options).map_err(CliError::caused)?;
         for r in &read.remarks {
             eprintln!("note: {}: {r}", a.input.display());
         }
         (FileTree::Memory(read.tree), read.placement, read.meta)
     };
-    let out_offset = match (&a.out_offset, format, placement) {
-        (Some(t), _, _) => parse_xyz("out-offset", t)?,
+    // The input grid's index 0 is ktree voxel `read_offset`; the output grid's, `out_offset`: by default
+    // the input's grid indices are kept where the output has indices of its own (.vdb, .bt; binvox starts
+    // at 0).
+    let read_offset = placement.map_or([0; 3], |p| p.offset);
+    let out_offset = match (a.out_offset, format) {
+        (Some(o), _) => o,
         (
             None,
             Some(
-                Format::Vdb | Format::Mesh | Format::Glb | Format::Svg | Format::Vtu | Format::Htg,
+                Format::Vdb
+                | Format::OctomapBt
+                | Format::Mesh
+                | Format::Glb
+                | Format::Svg
+                | Format::Vtu
+                | Format::Htg,
             ),
-            Some(p),
-        ) => p.offset,
+        ) => read_offset,
         _ => [0; 3],
     };
     let mut meta = read_meta.unwrap_or_default();
@@ -154,10 +125,32 @@ pub fn run(a: Args) -> CliResult {
         }
         meta.voxel_size = v;
     }
-    if let Some(t) = &a.origin {
-        let origin = parse_point("origin", t)?;
-        // The grid's index 0 is ktree voxel `out_offset`.
-        meta.origin = std::array::from_fn(|i| origin[i] + out_offset[i] as f64 * meta.voxel_size);
+    // The world stays where it is: ktree voxel 0 is at --origin, or where the input grid puts it.
+    let corner = match a.origin {
+        Some(origin) => origin,
+        None => meta.counted_from(read_offset.map(|o| -o)).origin,
+    };
+    meta = Frame {
+        voxel_size: meta.voxel_size,
+        origin: corner,
+    }
+    .counted_from(out_offset);
+    if matches!(format, Some(Format::Ktree | Format::Rays))
+        && (read_meta.is_some_and(|m| m != Frame::default())
+            || read_offset != [0; 3]
+            || a.origin.is_some()
+            || a.voxel_size.is_some()
+            || a.out_offset.is_some())
+    {
+        // Say what is lost: these files hold voxels only.
+        eprintln!(
+            "note: {}: a {} file holds no world placement: voxel size {}, ktree voxel 0 at {:?} are not \
+             kept (give --voxel-size and --origin when converting it back to a grid or a mesh)",
+            a.output.display(),
+            if format == Some(Format::Ktree) { ".ktree" } else { "ray" },
+            meta.voxel_size,
+            corner
+        );
     }
     if let Some(axis) = a.time_axis {
         let frame = Frame {
@@ -176,7 +169,7 @@ pub fn run(a: Args) -> CliResult {
                 .into())
             }
         }
-        .map_err(|e| e.to_string())?;
+        .map_err(CliError::caused)?;
         outln!(
             "{}: K = 4, L = {}, {} slices along axis {axis} ({} files)",
             a.output.display(),
@@ -204,9 +197,9 @@ pub fn run(a: Args) -> CliResult {
                 .into())
             }
         }
-        .map_err(|e| format!("{}: {e}", a.input.display()))?
+        .map_err(|e| format!("{}: {}", a.input.display(), crate::common::error::chain(&e)))?
         .placed(&frame);
-        let written = write_surface(&a.output, &mesh).map_err(|e| e.to_string())?;
+        let written = write_surface(&a.output, &mesh).map_err(CliError::caused)?;
         outln!(
             "{}: smooth surface of {} vertices, {} triangles",
             a.output.display(),
@@ -216,7 +209,7 @@ pub fn run(a: Args) -> CliResult {
         return Ok(());
     }
     if exported {
-        with_tree!(&file, t => export(&a.output, t, &frame)).map_err(|e| e.to_string())?;
+        with_tree!(&file, t => export(&a.output, t, &frame)).map_err(CliError::caused)?;
     } else {
         let FileTree::Memory(tree) = &file else {
             unreachable!("only meshes and VTK files are made from a file read in place")
@@ -224,13 +217,13 @@ pub fn run(a: Args) -> CliResult {
         if format == Some(Format::Ktree) {
             // The version --format-version asks for, as every command that writes trees.
             ktree::with_dim!(tree, AnyTree, t => crate::common::tree_file::write_tree(&a.output, t))
-                .map_err(|e| format!("cannot write {}: {e}", a.output.display()))?;
+                .map_err(CliError::caused)?;
         } else {
             let write_options = WriteOptions {
                 offset: out_offset,
                 meta: Some(meta),
             };
-            write_tree(&a.output, tree, &write_options).map_err(|e| e.to_string())?;
+            write_tree(&a.output, tree, &write_options).map_err(CliError::caused)?;
         }
     }
     let (c, voxels) = with_tree!(&file, t => (TreeStorage::counts(t), TreeStorage::voxel_count(t)));

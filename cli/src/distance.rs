@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 
 use ktree::io::write_vdb_level_set;
 use ktree::AnyTree;
@@ -56,6 +56,5 @@ pub fn run(args: DistanceArgs) -> CliResult {
     let mut bytes = Vec::new();
     write_vdb_level_set(&mut bytes, &tree, args.band, args.voxel_size)
         .map_err(|e| format!("{}: {e}", args.out.display()))?;
-    ktree::fs::write_atomic(&args.out, &bytes)
-        .map_err(|e| format!("{}: {e}", args.out.display()).into())
+    ktree::fs::write_atomic(&args.out, &bytes).map_err(CliError::caused)
 }

@@ -1,7 +1,7 @@
 //! `ktree lines FILE.ktree [--view VIEW] [--out drawing.svg]`: a line drawing of an octree with hidden
 //! lines removed (Veenstra & Ahuja), as SVG (vector) or PNG (by the output's extension).
 
-use crate::common::error::CliResult;
+use crate::common::error::{chain, CliError, CliResult};
 use crate::outln;
 
 use std::path::PathBuf;
@@ -22,7 +22,12 @@ pub struct Args {
     file: PathBuf,
     /// Where the viewer looks from (parallel projection): iso, top, bottom, front, back, left, right, or a
     /// direction X,Y,Z from the object towards the viewer.
-    #[arg(long, default_value = "iso")]
+    #[arg(
+        long,
+        default_value = "iso",
+        value_name = "VIEW|X,Y,Z",
+        allow_hyphen_values = true
+    )]
     view: String,
     /// Output file: .svg (vector lines) or .png (default: the input's name with .svg).
     #[arg(long)]
@@ -54,8 +59,8 @@ pub fn run(args: Args) -> CliResult {
         return Err("--stroke must be a positive number".into());
     }
     // A version 2 file is drawn from its memory map, whatever its size.
-    let file = FileTree::open(&args.file, &ktree::io::ReadOptions::default())
-        .map_err(|e| e.to_string())?;
+    let file =
+        FileTree::open(&args.file, &ktree::io::ReadOptions::default()).map_err(CliError::caused)?;
     let out = args
         .out
         .clone()
@@ -89,10 +94,10 @@ pub fn run(args: Args) -> CliResult {
     if is_png {
         png::lines_canvas(&segments, w, h)
             .and_then(|c| c.write_png(&out))
-            .map_err(|e| e.to_string())?;
+            .map_err(CliError::caused)?;
     } else {
         svg::write_svg(&out, &svg::lines_svg(&segments, w, h, args.stroke))
-            .map_err(|e| e.to_string())?;
+            .map_err(CliError::caused)?;
     }
     let s = drawing.stats;
     outln!(
@@ -114,5 +119,5 @@ fn draw<T: TreeStorage<3>>(
     method: HiddenLineMethod,
     tick: &mut dyn FnMut(u64, u64),
 ) -> Result<LineDrawing, String> {
-    line_drawing_with_progress(tree, toward, method, tick).map_err(|e| e.to_string())
+    line_drawing_with_progress(tree, toward, method, tick).map_err(|e| chain(&e))
 }

@@ -93,7 +93,17 @@ macro_rules! outln {
 pub(crate) use outln;
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // A bad value (a vector that is not three numbers, …) is a one-line error like any other bad input.
+        Err(e) if e.kind() == clap::error::ErrorKind::ValueValidation => {
+            let text = e.render().to_string();
+            let line = text.lines().next().unwrap_or_default();
+            eprintln!("ktree: {}", line.strip_prefix("error: ").unwrap_or(line));
+            return ExitCode::from(2);
+        }
+        Err(e) => e.exit(),
+    };
     let _mpi = distributed::init();
     common::tree_file::set(&cli.format);
     let outcome = match cli.command {
@@ -120,8 +130,8 @@ fn main() -> ExitCode {
     };
     match outcome {
         Ok(()) | Err(CliError::OutputClosed) => ExitCode::SUCCESS,
-        Err(CliError::Failed(message)) => {
-            distributed::report_failure(&message);
+        Err(e) => {
+            distributed::report_failure(&e.to_string());
             ExitCode::FAILURE
         }
     }

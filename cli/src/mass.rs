@@ -3,7 +3,7 @@
 //! exact properties of a version 2 file are summed from its memory map, leaf by leaf, so a tree larger
 //! than memory is measured without being loaded.
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::PathBuf;
@@ -100,11 +100,11 @@ pub fn run(args: Args) -> CliResult {
             return Err(format!("--tolerance must be a number ≥ 0, got {t}").into());
         }
     }
-    let mapped = ktree_file_version(&args.tree).map_err(|e| e.to_string())? == VERSION;
+    let mapped = ktree_file_version(&args.tree).map_err(CliError::caused)? == VERSION;
     let mut r = if mapped {
-        let tree = AnyMappedTree::open(&args.tree).map_err(|e| e.to_string())?;
+        let tree = AnyMappedTree::open(&args.tree).map_err(CliError::caused)?;
         ktree::with_dim!(&tree, AnyMappedTree, t => report(t, args.tolerance))
-            .map_err(|e| e.to_string())?
+            .map_err(CliError::caused)?
     } else {
         let tree = read(&args.tree)?;
         ktree::with_dim!(&tree, AnyTree, t => infallible(report(t, args.tolerance)))
@@ -113,7 +113,7 @@ pub fn run(args: Args) -> CliResult {
     if args.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&r).map_err(CliError::caused)?
         );
         return Ok(());
     }

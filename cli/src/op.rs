@@ -22,12 +22,10 @@ pub struct Args {
     /// The input tree files: two for union/intersect/diff/xor, one for not.
     #[arg(required = true, num_args = 1..=2)]
     inputs: Vec<PathBuf>,
-    /// The tree file to write.
-    #[arg(long)]
-    out: PathBuf,
-    /// Worker threads (default: all cores). The output is the same for any number.
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    out: crate::common::args::TreeOut,
+    #[command(flatten)]
+    threads: crate::common::args::ThreadsArg,
     #[command(flatten)]
     budget: crate::common::memory::BudgetArgs,
     /// Folder for the temporary spill files of an operation streamed out of core (default: the output's
@@ -101,20 +99,20 @@ fn stream_op(args: &Args) -> Option<CliResult> {
     }
     let temp = args.temp_dir.as_deref();
     let report: Result<BooleanFileReport, _> = match args.inputs.as_slice() {
-        [a] if args.operation == Operation::Not => io::complement_file(a, &args.out, temp),
-        [a, b] => io::boolean_files(a, b, args.operation.binary()?, &args.out, temp),
+        [a] if args.operation == Operation::Not => io::complement_file(a, &args.out.out, temp),
+        [a, b] => io::boolean_files(a, b, args.operation.binary()?, &args.out.out, temp),
         _ => return None,
     };
     Some(
         report
-            .map_err(|e| CliError::from(e.to_string()))
-            .and_then(|r| print_summary(&args.out, r.k, r.level, &r.counts_per_level)),
+            .map_err(CliError::caused)
+            .and_then(|r| print_summary(&args.out.out, r.k, r.level, &r.counts_per_level)),
     )
 }
 
 /// Runs the operation and writes the result, on a pool of `--threads` worker threads.
 pub fn run(args: Args) -> CliResult {
-    let threads = args.threads;
+    let threads = args.threads.threads;
     crate::common::threads::with_threads(threads, || run_op(args))?
 }
 
@@ -128,12 +126,12 @@ fn run_op(args: Args) -> CliResult {
             return Err("`ktree op not` takes exactly one input tree".into());
         };
         let out = read(a)?.complement();
-        return ktree::with_dim!(&out, AnyTree, t => write(&args.out, t));
+        return ktree::with_dim!(&out, AnyTree, t => write(&args.out.out, t));
     };
     let [a, b] = args.inputs.as_slice() else {
         return Err(format!("`ktree op {}` takes exactly two input trees", op.name()).into());
     };
     let (ta, tb) = (read(a)?, read(b)?);
     let out = ta.boolean(&tb, op).map_err(|e| pair_error(a, b, e))?;
-    ktree::with_dim!(&out, AnyTree, t => write(&args.out, t))
+    ktree::with_dim!(&out, AnyTree, t => write(&args.out.out, t))
 }

@@ -3,7 +3,7 @@
 //! on a tree file. A version 2 file is read through its memory map (so a tree larger than memory is
 //! queried without being loaded); others are loaded.
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -54,7 +54,7 @@ pub struct RaycastArgs {
 
 /// The tree of a file: mapped (version 2) or loaded; the queries run on either.
 fn open(path: &Path) -> CliResult<FileTree> {
-    FileTree::open(path, &ktree::io::ReadOptions::default()).map_err(|e| e.to_string().into())
+    FileTree::open(path, &ktree::io::ReadOptions::default()).map_err(CliError::caused)
 }
 
 /// Standard output, buffered; writes end the command quietly on a closed pipe.

@@ -1,9 +1,7 @@
 //! `ktree rays --solid NAME ... --level L --out FILE`: an analytic solid (quadric or box) to rays.
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
-
-use std::path::PathBuf;
 
 use ktree::fs::write_atomic_with;
 use ktree::io::write_rays_source;
@@ -11,6 +9,7 @@ use ktree::solid::{BoxSolid, Frame, Quadric, Rational, Sample, Solid, SolidSourc
 use ktree::stacking::default_split_depth;
 
 use crate::common::output::{is_tree_file, TreeOutput};
+use crate::common::vector::{list, List};
 
 /// Arguments of `ktree rays`.
 #[derive(Debug, clap::Args)]
@@ -26,14 +25,14 @@ pub struct Args {
     level: u32,
     /// Centre (ball, ellipsoid, cylinder) or apex (paraboloid, cone): K comma-separated numbers
     /// (decimals or fractions, exact). Default: the universe's centre.
-    #[arg(long, alias = "centre")]
-    center: Option<String>,
+    #[arg(long, alias = "centre", value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    center: Option<List<Rational>>,
     /// Radius (ball, cylinder; paraboloid and cone: radius at --height from the apex).
     #[arg(long)]
     radius: Option<String>,
     /// Semi-axes of an ellipsoid: K numbers.
-    #[arg(long)]
-    radii: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    radii: Option<List<Rational>>,
     /// Height (paraboloid, cone).
     #[arg(long)]
     height: Option<String>,
@@ -41,19 +40,19 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     axis: usize,
     /// Half-space n·x ≤ offset: the normal n (K numbers).
-    #[arg(long)]
-    normal: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    normal: Option<List<Rational>>,
     /// Half-space offset.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     offset: Option<String>,
     /// Box lower corner (K numbers).
-    #[arg(long)]
-    lo: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    lo: Option<List<Rational>>,
     /// Box upper corner (K numbers).
-    #[arg(long)]
-    hi: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<Rational>)]
+    hi: Option<List<Rational>>,
     /// A raw quadric matrix Ξ, (K+1)×(K+1), rows separated by ';', entries by ',' (solid: VᵀΞV ≤ 0).
-    #[arg(long)]
+    #[arg(long, value_name = "A,B,…;…", allow_hyphen_values = true)]
     quadric: Option<String>,
     /// Parameters are in the unit cube (the universe is [0,1]^K) instead of voxels.
     #[arg(long)]
@@ -61,22 +60,14 @@ pub struct Args {
     /// Test each voxel's lowest corner instead of its centre.
     #[arg(long)]
     corner: bool,
-    /// Output: rays in the text format, or a tree if the name ends in .ktree.
-    #[arg(long)]
-    out: PathBuf,
-    /// Worker threads (default: all cores). The output is the same for any number.
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    out: crate::common::args::RaysOrTreeOut,
     #[command(flatten)]
     build: crate::common::memory::BuildArgs,
 }
 
-fn numbers(text: &str, n: usize, what: &str) -> Result<Vec<Rational>, String> {
-    let v: Vec<Rational> = text
-        .split(',')
-        .map(|x| x.parse::<Rational>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("--{what}: {e}"))?;
+/// The `n` numbers of `--what`.
+fn numbers(v: Vec<Rational>, n: usize, what: &str) -> Result<Vec<Rational>, String> {
     if v.len() != n {
         return Err(format!("--{what} needs {n} numbers, got {}", v.len()));
     }
@@ -90,9 +81,13 @@ fn one(text: &Option<String>, what: &str) -> Result<Rational, String> {
         .map_err(|e| format!("--{what}: {e}"))
 }
 
-fn arr<const K: usize>(text: &Option<String>, what: &str) -> Result<Option<[Rational; K]>, String> {
-    text.as_deref()
-        .map(|t| numbers(t, K, what).map(|v| std::array::from_fn(|i| v[i])))
+fn arr<const K: usize>(
+    given: &Option<List<Rational>>,
+    what: &str,
+) -> Result<Option<[Rational; K]>, String> {
+    given
+        .as_ref()
+        .map(|l| numbers(l.0.clone(), K, what).map(|v| std::array::from_fn(|i| v[i])))
         .transpose()
 }
 
@@ -133,7 +128,10 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
             let text = a.quadric.as_deref().ok_or("--quadric MATRIX is required for --solid quadric")?;
             let rows: Vec<Vec<Rational>> = text
                 .split(';')
-                .map(|r| numbers(r, K + 1, "quadric"))
+                .map(|r| {
+                    let row = list::<Rational>(r).map_err(|e| format!("--quadric: {e}"))?;
+                    numbers(row.0, K + 1, "quadric")
+                })
                 .collect::<Result<_, _>>()?;
             Quadric::from_rational_matrix(&rows, frame).map_err(e)?
         }
@@ -153,11 +151,11 @@ fn go<const K: usize>(a: &Args) -> CliResult {
     } else {
         Sample::Centre
     };
-    if is_tree_file(&a.out) {
+    if is_tree_file(&a.out.out) {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole
         // (across MPI ranks, each rank makes the rays of its own slabs only).
-        let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
-        let built = TreeOutput::new(&a.out, a.threads, &a.build).write(&source, None)?;
+        let source = SolidSource::new(&s, a.level, sample).map_err(CliError::caused)?;
+        let built = TreeOutput::new(&a.out.out, &a.build).write(&source, None)?;
         if let Some(built) = built {
             outln!("{}", built.summary(None));
         }
@@ -168,7 +166,7 @@ fn go<const K: usize>(a: &Args) -> CliResult {
         return Ok(());
     }
     // A ray file, written slab by slab: one slab's runs held at a time, no cap on their number.
-    let source = SolidSource::new(&s, a.level, sample).map_err(|e| e.to_string())?;
+    let source = SolidSource::new(&s, a.level, sample).map_err(CliError::caused)?;
     let bar = crate::common::progress::progress_bar(a.build.progress, "writing slabs");
     let progress = |done: u64, total: u64| {
         if let Some(bar) = &bar {
@@ -178,17 +176,17 @@ fn go<const K: usize>(a: &Args) -> CliResult {
     };
     let mut written = (0, 0);
     let depth = default_split_depth(K, a.level);
-    write_atomic_with(&a.out, |w| {
+    write_atomic_with(&a.out.out, |w| {
         written = write_rays_source(w, &source, depth, &progress)?;
         Ok(())
     })
-    .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+    .map_err(CliError::caused)?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
     outln!(
         "{}: K = {K}, L = {}, {} rays, {} voxels",
-        a.out.display(),
+        a.out.out.display(),
         a.level,
         written.0,
         written.1

@@ -2,15 +2,16 @@
 //! hidden-surface image of an octree; a quadtree is drawn as a picture of its cells, a 4-D tree as a strip
 //! of time slices.
 
-use crate::common::error::{read_error, CliResult};
+use crate::common::error::{read_error, CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
 
 use indicatif::ProgressBar;
 
-use crate::common::picture::{parse_size, parse_vec3, parse_view};
+use crate::common::picture::{parse_size, parse_view};
 use crate::common::progress::progress_bar;
+use crate::common::vector::vector;
 use ktree::display::{
     default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
     RenderOptions,
@@ -27,20 +28,25 @@ pub struct Args {
     file: PathBuf,
     /// Where the camera looks from: iso, top, bottom, front, back, left, right, or a direction X,Y,Z from
     /// the object towards the eye. The camera frames the object.
-    #[arg(long, default_value = "iso")]
+    #[arg(
+        long,
+        default_value = "iso",
+        value_name = "VIEW|X,Y,Z",
+        allow_hyphen_values = true
+    )]
     camera: String,
     /// Perspective projection with this vertical field of view in degrees (default: orthographic).
     #[arg(long, value_name = "FOV")]
     perspective: Option<f64>,
     /// Put the eye at this point X,Y,Z (voxel coordinates) instead of framing automatically.
-    #[arg(long, value_name = "X,Y,Z")]
-    eye: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    eye: Option<[f64; 3]>,
     /// The point looked at with --eye (default: the object's centre).
-    #[arg(long, value_name = "X,Y,Z")]
-    target: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    target: Option<[f64; 3]>,
     /// The up direction (default: z, or y when looking along z).
-    #[arg(long, value_name = "X,Y,Z")]
-    up: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    up: Option<[f64; 3]>,
     /// Image size in pixels (for a 4-D tree: the size of each frame).
     #[arg(long, default_value = "800x800", value_name = "WxH")]
     size: String,
@@ -83,8 +89,8 @@ pub fn run(args: Args) -> CliResult {
         }
     };
     // A version 2 file is drawn from its memory map, whatever its size.
-    let file = FileTree::open(&args.file, &ktree::io::ReadOptions::default())
-        .map_err(|e| e.to_string())?;
+    let file =
+        FileTree::open(&args.file, &ktree::io::ReadOptions::default()).map_err(CliError::caused)?;
     match &file {
         FileTree::Memory(AnyTree::K3(t)) => {
             render_octree(t, &args, &out, w, h, bar.as_ref(), &mut tick)
@@ -104,8 +110,8 @@ pub fn run(args: Args) -> CliResult {
 
 /// Draws a quadtree's cells, `size` pixels square, to the PNG `out`.
 fn render_quadtree<T: TreeStorage<2>>(tree: &T, out: &Path, size: u32) -> CliResult {
-    let canvas = plane::quadtree_canvas(tree, size).map_err(|e| e.to_string())?;
-    canvas.write_png(out).map_err(|e| e.to_string())?;
+    let canvas = plane::quadtree_canvas(tree, size).map_err(CliError::caused)?;
+    canvas.write_png(out).map_err(CliError::caused)?;
     // Every leaf is full or empty: the counts say how many there are, without a walk.
     let counts = tree.counts();
     outln!(
@@ -120,13 +126,13 @@ fn render_quadtree<T: TreeStorage<2>>(tree: &T, out: &Path, size: u32) -> CliRes
 /// to the frames' folder if asked).
 fn render_strip<T: TreeStorage<4>>(tree: &T, args: &Args, out: &Path, size: u32) -> CliResult {
     let (strip, frames) =
-        slices::time_strip(tree, args.time_axis, args.frames, size).map_err(|e| e.to_string())?;
-    strip.write_png(out).map_err(|e| e.to_string())?;
+        slices::time_strip(tree, args.time_axis, args.frames, size).map_err(CliError::caused)?;
+    strip.write_png(out).map_err(CliError::caused)?;
     if let Some(dir) = &args.frames_dir {
         for (i, (_, frame)) in frames.iter().enumerate() {
             let path = dir.join(format!("frame_{i:03}.png"));
             png::write_rgb_png(&path, frame.width, frame.height, &frame.rgb)
-                .map_err(|e| e.to_string())?;
+                .map_err(CliError::caused)?;
         }
     }
     let positions: Vec<String> = frames.iter().map(|(p, _)| p.to_string()).collect();
@@ -152,15 +158,15 @@ fn render_octree<T: TreeStorage<3>>(
 ) -> CliResult {
     let toward = parse_view(&args.camera)?;
     let mut camera =
-        default_camera(tree, toward, args.perspective, w, h).map_err(|e| e.to_string())?;
+        default_camera(tree, toward, args.perspective, w, h).map_err(CliError::caused)?;
     if let Some(eye) = &args.eye {
-        camera.eye = parse_vec3(eye, "eye")?;
+        camera.eye = *eye;
         let side = tree.universe().side() as f64;
         let (lo, hi) = object_bounds(tree)
             .map_err(read_error)?
             .unwrap_or(([0.0; 3], [side; 3]));
         camera.target = match &args.target {
-            Some(t) => parse_vec3(t, "target")?,
+            Some(t) => *t,
             None => [0, 1, 2].map(|i| (lo[i] + hi[i]) / 2.0),
         };
         if let Projection::Orthographic { .. } = camera.projection {
@@ -173,10 +179,10 @@ fn render_octree<T: TreeStorage<3>>(
         }
     }
     if let Some(up) = &args.up {
-        camera.up = parse_vec3(up, "up")?;
+        camera.up = *up;
     }
     let camera: Camera = camera;
-    camera.check().map_err(|e| e.to_string())?;
+    camera.check().map_err(CliError::caused)?;
     let options = RenderOptions {
         width: w,
         height: h,
@@ -185,7 +191,7 @@ fn render_octree<T: TreeStorage<3>>(
     };
     let rays = match &args.rays {
         None => None,
-        Some(path) => match read_rays_file(path).map_err(|e| e.to_string())? {
+        Some(path) => match read_rays_file(path).map_err(CliError::caused)? {
             AnyRaySet::K3(r) if r.level() != tree.level() => {
                 return Err(format!(
                     "{}: level {} does not match the tree's level {}",
@@ -221,10 +227,10 @@ fn render_octree<T: TreeStorage<3>>(
         },
         tick,
     )
-    .map_err(|e| e.to_string())?;
-    png::write_rgb_png(out, w, h, &image.rgb).map_err(|e| e.to_string())?;
+    .map_err(CliError::caused)?;
+    png::write_rgb_png(out, w, h, &image.rgb).map_err(CliError::caused)?;
     if let (Some(path), Some(grey)) = (&args.depth, image.depth_grey()) {
-        png::write_grey_png(path, w, h, &grey).map_err(|e| e.to_string())?;
+        png::write_grey_png(path, w, h, &grey).map_err(CliError::caused)?;
     }
     if let Some(b) = bar {
         b.finish_and_clear();

@@ -3,7 +3,7 @@
 //! of a tree file (a version 2 `.ktree` read in place through its memory map, any other format read into
 //! memory); and the measures (`surface_area`, `euler_number`) that `stats` and `mass` report.
 
-use crate::common::error::{read_error, CliResult};
+use crate::common::error::{chain, read_error, CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -18,7 +18,7 @@ use crate::common::tree_file::write;
 
 /// Opens a tree file: a version 2 `.ktree` through its memory map, any other format read into memory.
 fn open(path: &Path) -> Result<FileTree, String> {
-    FileTree::open(path, &ReadOptions::default()).map_err(|e| e.to_string())
+    FileTree::open(path, &ReadOptions::default()).map_err(|e| chain(&e))
 }
 
 /// Arguments of `ktree morph`.
@@ -35,9 +35,8 @@ pub struct MorphArgs {
     /// The element: ball (|d|² ≤ r²), box (max |d_i| ≤ r) or cross (Σ |d_i| ≤ r).
     #[arg(long, default_value = "ball")]
     shape: Element,
-    /// The tree file to write.
-    #[arg(long)]
-    out: PathBuf,
+    #[command(flatten)]
+    out: crate::common::args::TreeOut,
 }
 
 fn morph<const K: usize, T: TreeStorage<K> + Sync>(t: &T, args: &MorphArgs) -> CliResult {
@@ -49,7 +48,7 @@ fn morph<const K: usize, T: TreeStorage<K> + Sync>(t: &T, args: &MorphArgs) -> C
         _ => shape::closing(t, r, e),
     }
     .map_err(|err| format!("{}: {err}", args.tree.display()))?;
-    write(&args.out, &out)
+    write(&args.out.out, &out)
 }
 
 /// Runs `ktree morph`.
@@ -100,12 +99,17 @@ fn components<const K: usize, T: TreeStorage<K>>(
         });
     };
     let parts = shape::components(t, args.connectivity).map_err(name)?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| {
+        chain(&ktree::fs::FileOpError::new(
+            ktree::fs::FileOp::CreateFolder,
+            dir,
+            e,
+        ))
+    })?;
     let mut files = Vec::new();
     for (i, part) in parts.iter().enumerate() {
         let path = dir.join(format!("component-{}.ktree", i + 1));
-        crate::common::tree_file::write_tree(&path, &part.tree)
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        crate::common::tree_file::write_tree(&path, &part.tree).map_err(|e| chain(&e))?;
         files.push(path);
     }
     Ok(ComponentsReport {
@@ -123,7 +127,7 @@ pub fn run_components(args: ComponentsArgs) -> CliResult {
     if args.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&report).map_err(CliError::caused)?
         );
         return Ok(());
     }
@@ -167,7 +171,7 @@ fn measures_of<const K: usize, T: TreeStorage<K>>(t: &T, budget: u64) -> Result<
         Ok(runs.saturating_mul(BYTES_PER_RUN) <= u128::from(budget))
     };
     let (euler_number, euler_skipped) = if matches!(K, 2 | 3) && fits()? {
-        let e = shape::euler_number(t, K).map_err(|e| e.to_string())?;
+        let e = shape::euler_number(t, K).map_err(|e| chain(&e))?;
         (Some(e), false)
     } else {
         (None, matches!(K, 2 | 3))

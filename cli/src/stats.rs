@@ -8,7 +8,7 @@
 //! of its own nodes, its value type (`dtype`) and, per value (`values`), the voxels, bounding box, centroid
 //! and surface area.
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::PathBuf;
@@ -54,7 +54,7 @@ pub fn run(args: Args) -> CliResult {
     let (stats, measures) = match (&args.tree, &args.rays) {
         (Some(path), None) => {
             let file = FileTree::open(path, &ktree::io::ReadOptions::default())
-                .map_err(|e| e.to_string())?;
+                .map_err(CliError::caused)?;
             let stats = with_tree!(&file, t => stats(t, None).map_err(read_error))?;
             let measures = if args.measures {
                 Some(crate::shape::measures(&file)?)
@@ -64,7 +64,7 @@ pub fn run(args: Args) -> CliResult {
             (stats, measures)
         }
         (None, Some(path)) => {
-            let rays = read_rays_file(path).map_err(|e| e.to_string())?;
+            let rays = read_rays_file(path).map_err(CliError::caused)?;
             let tree = rays.build();
             let measures = if args.measures {
                 Some(crate::shape::measures_in_memory(&tree)?)
@@ -90,7 +90,7 @@ pub fn run(args: Args) -> CliResult {
         };
         outln!(
             "{}",
-            serde_json::to_string_pretty(&out).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&out).map_err(CliError::caused)?
         );
         return Ok(());
     }

@@ -6,7 +6,7 @@
 //! the exact integer operations (rational overlays, child reordering, translation overlays). Otherwise all
 //! steps are concatenated into one affine matrix applied in a single overlay pass (Meagher's M6).
 
-use crate::common::error::CliResult;
+use crate::common::error::{chain, CliResult};
 use std::path::PathBuf;
 
 use ktree::ops::{self, Affine, AxisMap, Projective};
@@ -14,6 +14,7 @@ use ktree::tree::storage::infallible;
 use ktree::KTree;
 
 use crate::common::tree_file::{read, write};
+use crate::common::vector::{list, List};
 
 /// Arguments of `ktree transform`.
 #[derive(Debug, clap::Args)]
@@ -21,8 +22,8 @@ pub struct Args {
     /// The input tree file.
     input: PathBuf,
     /// Translation: K numbers separated by commas (integers move exactly; fractions use the affine pass).
-    #[arg(long, allow_hyphen_values = true)]
-    translate: Option<String>,
+    #[arg(long, value_name = "X,…", allow_hyphen_values = true, value_parser = list::<f64>)]
+    translate: Option<List<f64>>,
     /// Rotations about the universe's centre, applied left to right: `AXIS:DEGREES` about a named axis in
     /// 3-D (`x:30,z:-45`), or `I-J:DEGREES` in the plane of axes I → J in any K (`0-1:90`).
     #[arg(long, allow_hyphen_values = true)]
@@ -32,23 +33,10 @@ pub struct Args {
     scale: Option<String>,
     /// A homogeneous (K+1)×(K+1) matrix, row-major, comma-separated, acting on column vectors [x; 1]. A last
     /// row other than 0 … 0 1 makes it projective (e.g. Meagher's perspective deformation).
-    #[arg(long, allow_hyphen_values = true)]
-    matrix: Option<String>,
-    /// The tree file to write.
-    #[arg(long)]
-    out: PathBuf,
-}
-
-fn numbers(flag: &str, text: &str) -> Result<Vec<f64>, String> {
-    text.split(',')
-        .map(|s| {
-            s.trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| format!("--{flag}: '{s}' is not a number"))
-        })
-        .collect()
+    #[arg(long, value_name = "M11,M12,…", allow_hyphen_values = true, value_parser = list::<f64>)]
+    matrix: Option<List<f64>>,
+    #[command(flatten)]
+    out: crate::common::args::TreeOut,
 }
 
 /// One parsed rotation: the plane (from, to) and the angle.
@@ -103,15 +91,14 @@ fn rational(text: &str) -> Option<(u32, u32)> {
 fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, String> {
     let level = tree.level();
     let translate = match &args.translate {
-        Some(t) => {
-            let v = numbers("translate", t)?;
+        Some(List(v)) => {
             if v.len() != K {
                 return Err(format!(
                     "--translate needs {K} numbers for a K = {K} tree, got {}",
                     v.len()
                 ));
             }
-            Some(v)
+            Some(v.clone())
         }
         None => None,
     };
@@ -138,16 +125,13 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     };
     // A matrix whose last row is not 0 … 0 1 is projective (e.g. a perspective deformation).
     let (matrix, projective) = match &args.matrix {
-        Some(m) => {
-            let v = numbers("matrix", m)?;
-            match Affine::<K>::from_homogeneous(&v) {
-                Ok(a) => (Some(a), None),
-                Err(_) => (
-                    None,
-                    Some(Projective::<K>::from_homogeneous(&v).map_err(|e| e.to_string())?),
-                ),
-            }
-        }
+        Some(List(v)) => match Affine::<K>::from_homogeneous(v) {
+            Ok(a) => (Some(a), None),
+            Err(_) => (
+                None,
+                Some(Projective::<K>::from_homogeneous(v).map_err(|e| chain(&e))?),
+            ),
+        },
         None => (None, None),
     };
     let exact = matrix.is_none()
@@ -160,11 +144,11 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     if exact {
         let mut t = tree.clone();
         if let Some(Some((p, q))) = scale_ratio {
-            t = ops::scale(&t, p, q).map_err(|e| e.to_string())?;
+            t = ops::scale(&t, p, q).map_err(|e| chain(&e))?;
         }
         for &(from, to, deg) in &rotate {
             let turns = ((deg / 90.0) as i64).rem_euclid(4);
-            let q = AxisMap::<K>::quarter_turn(from, to).map_err(|e| e.to_string())?;
+            let q = AxisMap::<K>::quarter_turn(from, to).map_err(|e| chain(&e))?;
             for _ in 0..turns {
                 t = infallible(ops::rotate_axes(&t, &q));
             }
@@ -182,7 +166,7 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     let centre = Affine::<K>::universe_centre(level);
     for &(from, to, deg) in &rotate {
         m = Affine::rotation_about(from, to, deg, centre)
-            .map_err(|e| e.to_string())?
+            .map_err(|e| chain(&e))?
             .after(&m);
     }
     if let Some(v) = &translate {
@@ -193,9 +177,9 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     }
     if let Some(p) = projective {
         let all = p.after(&Projective::from_affine(&m));
-        return ops::transform_projective(tree, &all).map_err(|e| e.to_string());
+        return ops::transform_projective(tree, &all).map_err(|e| chain(&e));
     }
-    ops::transform(tree, &m).map_err(|e| e.to_string())
+    ops::transform(tree, &m).map_err(|e| chain(&e))
 }
 
 /// Applies the transforms and writes the result.
@@ -210,6 +194,6 @@ pub fn run(args: Args) -> CliResult {
     let tree = read(&args.input)?;
     ktree::with_dim!(&tree, AnyTree, t => {
         let out = apply(t, &args).map_err(|e| format!("{}: {e}", args.input.display()))?;
-        write(&args.out, &out)
+        write(&args.out.out, &out)
     })
 }

@@ -13,7 +13,7 @@ use ktree::solid::volume::Volume;
 use ktree::value::{Dtype, Rgb, Value};
 use ktree::KTree;
 
-use crate::common::error::CliResult;
+use crate::common::error::{chain, CliError, CliResult};
 use crate::outln;
 
 /// Runs `$f::<K, V>($args)` for the dimension `$k` and value type `$dtype` of a file.
@@ -55,7 +55,7 @@ pub fn file_dtype(path: &Path) -> Result<(usize, Option<Dtype>), String> {
     });
     let n = read.map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
     let (k, _, dtype) =
-        valued_header(&head[..n], &path.display().to_string()).map_err(|e| e.to_string())?;
+        valued_header(&head[..n], &path.display().to_string()).map_err(|e| chain(&e))?;
     Ok((k, dtype))
 }
 
@@ -67,7 +67,7 @@ pub fn is_valued(path: &Path) -> bool {
 fn read<const K: usize, V: Value>(path: &Path) -> Result<KTree<K, V>, String> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
-    read_valued_ktree::<K, V>(&bytes, &name).map_err(|e| e.to_string())
+    read_valued_ktree::<K, V>(&bytes, &name).map_err(|e| chain(&e))
 }
 
 /// A label volume into a valued tree of the smallest label type that holds it (or `dtype`).
@@ -78,7 +78,7 @@ pub fn voxelize_labels(
     dtype: Option<&str>,
     out: &Path,
 ) -> CliResult {
-    let volume = Volume::read(input).map_err(|e| e.to_string())?;
+    let volume = Volume::read(input).map_err(CliError::caused)?;
     let smallest = volume
         .label_dtype()
         .map_err(|e| format!("{}: {e}", input.display()))?;
@@ -107,8 +107,7 @@ pub fn voxelize_labels(
             .to_label_runs::<V>(level, offset)
             .map_err(|e| format!("{}: {e}", input.display()))?;
         let tree = KTree::from_value_runs(&runs);
-        write_valued_ktree_file(out, &tree)
-            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
         let labels = tree.value_stats().len();
         outln!(
             "{}: {} voxels labelled with {labels} labels ({}), L = {level}, {} nodes",
@@ -170,8 +169,7 @@ fn select<const K: usize, V: Value>(a: &SelectArgs) -> CliResult {
         }
         (None, None) => unreachable!("clap requires --value or --range"),
     };
-    ktree::io::write_ktree_file(&a.out, &chosen)
-        .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+    ktree::io::write_ktree_file(&a.out, &chosen).map_err(CliError::caused)?;
     outln!(
         "{}: {} voxels selected, {} nodes",
         a.out.display(),
@@ -234,7 +232,7 @@ pub fn print_valued_stats(path: &Path, json: bool) -> CliResult {
     if json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&s).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&s).map_err(CliError::caused)?
         );
         return Ok(());
     }

@@ -1,7 +1,7 @@
 //! `ktree view FILE [--out view.html] [--budget N] [--camera VIEW] [--time-axis A] [--open]`: an
 //! interactive 3-D view of a tree in one self-contained HTML page (see `ktree::export::view`).
 
-use crate::common::error::CliResult;
+use crate::common::error::{chain, CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -27,7 +27,7 @@ pub struct Args {
     budget: usize,
     /// The first camera, as `ktree render --camera` takes it: iso, top, bottom, front, back, left, right
     /// or X,Y,Z (default: iso; top for a quadtree).
-    #[arg(long)]
+    #[arg(long, value_name = "VIEW|X,Y,Z", allow_hyphen_values = true)]
     camera: Option<String>,
     /// 4-D trees: the axis the slider moves along.
     #[arg(long, default_value_t = 3)]
@@ -40,7 +40,7 @@ pub struct Args {
 /// Writes the page.
 pub fn run(args: Args) -> CliResult {
     let camera = match &args.camera {
-        Some(name) => Some(name.parse::<View>().map_err(|e| e.to_string())?),
+        Some(name) => Some(name.parse::<View>().map_err(CliError::caused)?),
         None => None,
     };
     let out = args
@@ -57,8 +57,8 @@ pub fn run(args: Args) -> CliResult {
             .map_or_else(|| "ktree".into(), |n| n.to_string_lossy().into_owned()),
     };
     // A version 2 file is read through its memory map, whatever its size.
-    let file = FileTree::open(&args.file, &ktree::io::ReadOptions::default())
-        .map_err(|e| e.to_string())?;
+    let file =
+        FileTree::open(&args.file, &ktree::io::ReadOptions::default()).map_err(CliError::caused)?;
     let page = with_tree!(&file, t => page_of(t, &out, &options))?;
     outln!(
         "wrote {} ({} boxes{}, {} bytes)",
@@ -85,7 +85,7 @@ fn page_of<const K: usize, T: TreeStorage<K>>(
     out: &Path,
     options: &ViewOptions,
 ) -> Result<Page, String> {
-    write_view(out, tree, options).map_err(|e| e.to_string())
+    write_view(out, tree, options).map_err(|e| chain(&e))
 }
 
 /// A new page's path in the temporary folder, named after the input.

@@ -4,7 +4,7 @@
 //! `ktree voxelize CLOUD --voxel-size S [--origin x,y,z] [--level L] [--min-points N] [--crop] --out FILE`: a
 //! point cloud (PLY without faces, PCD, XYZ/CSV, LAS/LAZ) to the voxels holding at least N points.
 
-use crate::common::error::CliResult;
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::collections::BTreeMap;
@@ -15,10 +15,10 @@ use std::sync::{Mutex, PoisonError};
 use ktree::io::{voxel_source, voxelize, Format, ReadOptions, VoxelSource};
 use ktree::rays::{RaySource, SlabRuns};
 use ktree::solid::mesh::MeshTransform;
-use ktree::solid::volume::Select;
 use ktree::Universe;
 
 use crate::common::output::{is_tree_file, write_output, TreeOutput};
+use crate::common::vector::vector;
 
 /// Arguments of `ktree voxelize`.
 #[derive(Debug, clap::Args)]
@@ -33,41 +33,34 @@ pub struct Args {
     #[arg(long, conflicts_with = "transform")]
     fit: bool,
     /// Mesh: voxel coordinate = s·v + t, given as s,tx,ty,tz.
-    #[arg(long)]
-    transform: Option<String>,
+    #[arg(long, value_name = "S,TX,TY,TZ", allow_hyphen_values = true, value_parser = MeshTransform::parse)]
+    transform: Option<MeshTransform>,
+    #[command(flatten)]
+    volume: crate::common::args::VolumeArgs,
     /// Volume: every sample's label kept, 0 the background: a tree with values (a .ktree output).
     #[arg(long, conflicts_with_all = ["threshold", "label"])]
     labels: bool,
     /// With --labels: the label type, uint8, uint16 or uint32 (default: the smallest that holds them).
     #[arg(long, requires = "labels")]
     dtype: Option<String>,
-    /// Volume: samples with value ≥ this are inside.
-    #[arg(long, conflicts_with = "label")]
-    threshold: Option<f64>,
-    /// Volume: samples equal to this label are inside.
-    #[arg(long)]
-    label: Option<f64>,
     /// Volume: where the volume's sample (0, 0, 0) goes in the universe, as x,y,z.
-    #[arg(long, default_value = "0,0,0")]
-    offset: String,
+    #[arg(long, default_value = "0,0,0", value_name = "X,Y,Z", allow_hyphen_values = true,
+          value_parser = vector::<u32, 3>)]
+    offset: [u32; 3],
     /// Point cloud: the side of a voxel; a point p is in voxel floor((p - origin) / S).
     #[arg(long)]
     voxel_size: Option<f64>,
     /// Point cloud: the corner of voxel (0, 0, 0), as x,y,z (default: the minimum corner of the points).
-    #[arg(long)]
-    origin: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>)]
+    origin: Option<[f64; 3]>,
     /// Point cloud: the points a voxel must hold to be full.
     #[arg(long, default_value_t = 1)]
     min_points: u64,
     /// Point cloud with --level: drop the points outside the universe (default: they are an error).
     #[arg(long)]
     crop: bool,
-    /// Output: rays in the text format, or a tree if the name ends in .ktree.
-    #[arg(long)]
-    out: PathBuf,
-    /// Worker threads for stacking a tree (default: all cores). The output is the same for any number.
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    out: crate::common::args::RaysOrTreeOut,
     #[command(flatten)]
     build: crate::common::memory::BuildArgs,
 }
@@ -75,7 +68,7 @@ pub struct Args {
 /// Voxelizes the input and writes it.
 pub fn run(a: Args) -> CliResult {
     // A `.ply` is a cloud or a mesh by its header: a broken one is said as such.
-    if ktree::io::is_cloud_file(&a.input).map_err(|e| e.to_string())? {
+    if ktree::io::is_cloud_file(&a.input).map_err(CliError::caused)? {
         return run_cloud(&a);
     }
     if a.voxel_size.is_some() || a.origin.is_some() || a.crop {
@@ -93,61 +86,49 @@ pub fn run(a: Args) -> CliResult {
         if a.level.is_none() {
             return Err("--level L is required for a mesh".into());
         }
-        options.mesh_placement = match (&a.transform, a.fit) {
-            (Some(t), _) => Some(MeshTransform::parse(t).map_err(|e| e.to_string())?),
+        options.mesh_placement = match (a.transform, a.fit) {
+            (Some(t), _) => Some(t),
             (None, true) => None,
             (None, false) => return Err("a mesh needs --fit or --transform s,tx,ty,tz".into()),
         };
     } else {
         if a.labels {
-            let offset = parse_offset(&a.offset)?;
-            if !is_tree_file(&a.out) {
+            if !is_tree_file(&a.out.out) {
                 return Err(format!(
                     "--labels writes a tree with values: the output must be a .ktree, not {}",
-                    a.out.display()
+                    a.out.out.display()
                 )
                 .into());
             }
             return crate::values::voxelize_labels(
                 &a.input,
                 a.level,
-                offset,
+                a.offset,
                 a.dtype.as_deref(),
-                &a.out,
+                &a.out.out,
             );
         }
-        options.select = match (a.threshold, a.label) {
-            (Some(t), _) => Some(Select::AtLeast(t)),
-            (None, Some(l)) => Some(Select::Label(l)),
-            (None, None) => return Err("a volume needs --threshold T or --label V".into()),
-        };
-        options.offset = Some(parse_offset(&a.offset)?.map(i64::from));
+        options.select = Some(
+            a.volume
+                .select()
+                .ok_or("a volume needs --threshold T or --label V")?,
+        );
+        options.offset = Some(a.offset.map(i64::from));
     }
     // In a run over several MPI ranks, rank 0 alone reports.
     let root = crate::distributed::ranks().is_root();
-    if is_tree_file(&a.out) && crate::distributed::ranks().size == 1 {
+    if is_tree_file(&a.out.out) && crate::distributed::ranks().size == 1 {
         // Straight to a tree: the rays are made slab by slab as the cells are stacked, never held whole.
         // (Across MPI ranks, every rank makes the rays whole and keeps its slabs: `write_output`.)
-        let v = voxel_source(&a.input, &options).map_err(|e| e.to_string())?;
+        let v = voxel_source(&a.input, &options).map_err(CliError::caused)?;
         remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
         outln!("{}", build_out_of_core(&v.source, &a)?);
         return Ok(());
     }
-    let v = voxelize(&a.input, &options).map_err(|e| e.to_string())?;
+    let v = voxelize(&a.input, &options).map_err(CliError::caused)?;
     remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
-    crate::common::output::print_summary(&write_output(&v.rays, &a.out, a.threads, &a.build)?)?;
+    crate::common::output::print_summary(&write_output(&v.rays, &a.out.out, &a.build)?)?;
     Ok(())
-}
-
-/// A volume's `--offset x,y,z`.
-fn parse_offset(text: &str) -> Result<[u32; 3], String> {
-    let off: Vec<u32> = text
-        .split(',')
-        .map(|x| x.trim().parse::<u32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("--offset '{text}': expected x,y,z (non-negative integers)"))?;
-    off.try_into()
-        .map_err(|_| format!("--offset '{text}': expected three numbers"))
 }
 
 /// Voxelizes a point cloud and writes it.
@@ -164,21 +145,13 @@ fn run_cloud(a: &Args) -> CliResult {
     if a.crop && a.level.is_none() {
         return Err("--crop needs --level L (without it the universe holds every point)".into());
     }
-    if let Some(text) = &a.origin {
-        let o: Vec<f64> = text
-            .split(',')
-            .map(|x| x.trim().parse::<f64>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| format!("--origin '{text}': expected x,y,z"))?;
-        let o: [f64; 3] = o
-            .try_into()
-            .map_err(|_| format!("--origin '{text}': expected three numbers"))?;
+    if let Some(o) = a.origin {
         v = v.origin(o);
     }
     if let Some(l) = a.level {
         v = v.level(l);
     }
-    let cloud = ktree::io::read_cloud(&a.input).map_err(|e| e.to_string())?;
+    let cloud = ktree::io::read_cloud(&a.input).map_err(CliError::caused)?;
     let voxels = v.voxelize(cloud.points()).map_err(|e| {
         let hint = match e {
             SolidError::PointsOutside { .. } => {
@@ -217,12 +190,7 @@ fn run_cloud(a: &Args) -> CliResult {
             }
         );
     }
-    crate::common::output::print_summary(&write_output(
-        &voxels.rays,
-        &a.out,
-        a.threads,
-        &a.build,
-    )?)?;
+    crate::common::output::print_summary(&write_output(&voxels.rays, &a.out.out, &a.build)?)?;
     Ok(())
 }
 
@@ -251,7 +219,7 @@ fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
     };
     let counted = CountedRuns::new(source);
     let held = (what.as_str(), source.heap_bytes());
-    let built = TreeOutput::new(&a.out, a.threads, &a.build).write(&counted, Some(held))?;
+    let built = TreeOutput::new(&a.out.out, &a.build).write(&counted, Some(held))?;
     Ok(built
         .map(|b| b.summary(Some(counted.runs())))
         .unwrap_or_default())

@@ -343,3 +343,50 @@ fn closed_meshes_with_repeated_vertices_give_no_warning() {
     assert!(!err.contains("not closed"), "{err}");
     assert_eq!(tree(&out).voxel_count(), 14 * 14 * 14);
 }
+
+/// The README's example as written, `--origin -1,-1,0` with a space: a vector beginning with a minus is the
+/// flag's value, not another flag.
+#[test]
+fn a_negative_origin_is_taken_as_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let points = helix();
+    let out = dir.path().join("o.ktree");
+    let o = out.to_str().unwrap();
+    let f = &files(dir.path(), &points)[1];
+    let (ok, stdout, err) = ktree(&[
+        "voxelize",
+        f,
+        "--voxel-size",
+        "0.05",
+        "--origin",
+        "-3,-6,-1",
+        "--out",
+        o,
+    ]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("origin -3,-6,-1,"), "{stdout}");
+    let got = tree(&out);
+    assert_eq!(
+        got,
+        reference(&points, 0.05, [-3.0, -6.0, -1.0], 1, got.level())
+    );
+    // A vector that is not three numbers is still refused, naming the flag.
+    for bad in ["-1,-1", "-1,a,0"] {
+        let (ok, _, err) = ktree(&[
+            "voxelize",
+            f,
+            "--voxel-size",
+            "0.05",
+            "--origin",
+            bad,
+            "--out",
+            o,
+        ]);
+        assert!(!ok, "{bad}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(
+            err.starts_with("ktree: ") && err.contains("--origin"),
+            "{err}"
+        );
+    }
+}

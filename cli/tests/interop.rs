@@ -119,7 +119,9 @@ fn a_bt_written_by_ktree_opens_in_octomap_with_the_same_occupied_voxels() {
         return;
     };
     for (name, tree) in objects() {
-        for offset in [[0, 0, 0], [64, -128, 0]] {
+        // The last offset is not a multiple of the universe's side: the universe is written as the
+        // smallest one on OctoMap's keys around it.
+        for offset in [[0, 0, 0], [64, -128, 0], [3, -5, 1]] {
             let path = dir.path().join(format!("{name}.bt"));
             let options = WriteOptions {
                 offset,
@@ -130,8 +132,10 @@ fn a_bt_written_by_ktree_opens_in_octomap_with_the_same_occupied_voxels() {
             // OctoMap's grid index + offset = ktree voxel.
             assert_same_voxels(&tree, &occupied, offset);
             // The nodes OctoMap counts: the tree's, plus one per level above the universe.
-            let above = 16 - u64::from(tree.level());
-            assert_eq!(nodes, tree.node_count() + above, "{name}");
+            if offset.iter().all(|o| o % (1 << tree.level()) == 0) {
+                let above = 16 - u64::from(tree.level());
+                assert_eq!(nodes, tree.node_count() + above, "{name}");
+            }
         }
     }
 }

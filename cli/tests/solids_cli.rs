@@ -48,6 +48,40 @@ fn rays_writes_the_library_result() {
     );
 }
 
+/// Vectors and numbers beginning with a minus are the values of their flags, given with a space.
+#[test]
+fn negative_vectors_and_numbers_are_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("h.txt");
+    let o = out.to_str().unwrap();
+    let (ok, _, err) = ktree(&[
+        "rays",
+        "--solid",
+        "half-space",
+        "--normal",
+        "-1,0,-1/2",
+        "--offset",
+        "-3",
+        "--level",
+        "4",
+        "--out",
+        o,
+    ]);
+    assert!(ok, "{err}");
+    let n = ["-1", "0", "-1/2"].map(|x| x.parse::<Rational>().unwrap());
+    let want = Quadric::<3>::half_space(n, "-3".parse().unwrap(), Frame::Voxel)
+        .unwrap()
+        .to_rays(4, Sample::Centre, false)
+        .unwrap();
+    match read_rays_file(&out).unwrap() {
+        AnyRaySet::K3(got) => {
+            assert!(got.voxel_count() > 0);
+            assert_eq!(got, want);
+        }
+        _ => panic!("wrong K"),
+    }
+}
+
 #[test]
 fn bad_input_is_a_one_line_error() {
     let dir = tempfile::tempdir().unwrap();

@@ -29,27 +29,57 @@ pub(crate) enum Failure {
 }
 
 impl Failure {
-    /// A `ValueError` with the error's message.
-    pub(crate) fn value(e: impl std::fmt::Display) -> Self {
-        Self::Value(e.to_string())
+    /// The failure of an error or a message: an `OSError` (or subclass) if a [`std::io::Error`] is among
+    /// the error's causes, else a `ValueError`; the message is the error with its causes (`A: B: C`).
+    pub(crate) fn value(e: impl Into<Box<dyn std::error::Error + Send + Sync + 'static>>) -> Self {
+        let e = e.into();
+        let path = e
+            .downcast_ref::<ktree::fs::FileOpError>()
+            .map(|f| f.path().to_path_buf())
+            .unwrap_or_default();
+        Self::of_error(e.as_ref(), &path)
     }
 
-    /// An `OSError` (or subclass) if an `std::io::Error` is `e` or among its sources, else a `ValueError`.
+    /// An `OSError` (or subclass) for `path` if an `std::io::Error` is `e` or among its causes (the one the
+    /// system gave, with its errno, where there is one), else a `ValueError`; the message is `e` with its
+    /// causes.
     pub(crate) fn of_error(e: &(dyn std::error::Error + 'static), path: &Path) -> Self {
+        let mut io: Option<&std::io::Error> = None;
         let mut cause = Some(e);
         while let Some(c) = cause {
-            if let Some(io) = c.downcast_ref::<std::io::Error>() {
-                return Self::Os {
-                    kind: io.kind(),
-                    errno: io.raw_os_error().unwrap_or(0),
-                    message: e.to_string(),
-                    filename: path.display().to_string(),
-                };
+            if let Some(found) = c.downcast_ref::<std::io::Error>() {
+                if io.is_none() || found.raw_os_error().is_some() {
+                    io = Some(found);
+                }
             }
             cause = c.source();
         }
-        Self::value(e)
+        match io {
+            Some(io) => Self::Os {
+                kind: io.kind(),
+                errno: io.raw_os_error().unwrap_or(0),
+                message: chain(e),
+                filename: path.display().to_string(),
+            },
+            None => Self::Value(chain(e)),
+        }
     }
+}
+
+/// An error and its causes in one line, `A: B: C` (a message that already ends with its cause's is not
+/// repeated).
+fn chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let next = c.to_string();
+        if !next.is_empty() && !text.ends_with(&next) {
+            text.push_str(": ");
+            text.push_str(&next);
+        }
+        cause = c.source();
+    }
+    text
 }
 
 impl From<Failure> for PyErr {

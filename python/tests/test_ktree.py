@@ -3,6 +3,7 @@ by sums, transforms by array shifts and rotations, files by round trips, and the
 tool is missing (the `ktree` binary, `setpriv` as root) is skipped, or fails when the environment variable
 KTREE_REQUIRE_TOOLS is set to anything but empty or 0, as `.ci/run` sets it (see `missing`)."""
 
+import errno
 import json
 import os
 import shutil
@@ -737,3 +738,7 @@ def test_saving_into_a_file_in_place_of_a_folder_raises_an_os_error(tmp_path):
         ktree.Tree.from_dense(np.ones((2, 2), dtype=bool)).save(str(blocker / "out.ktree"))
     assert caught.value.filename == str(blocker / "out.ktree")
     assert not isinstance(caught.value, ValueError)
+    # The system's own error, its errno kept (Linux: ENOTDIR).
+    if sys.platform.startswith("linux"):
+        assert isinstance(caught.value, NotADirectoryError)
+        assert caught.value.errno == errno.ENOTDIR

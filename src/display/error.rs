@@ -36,19 +36,14 @@ pub enum DisplayError {
     #[error("at least one frame is needed")]
     NoFrames,
     /// Writing an image file failed.
-    #[error("cannot write {}: {source}", path.display())]
-    Write {
-        /// The file.
-        path: std::path::PathBuf,
-        /// What went wrong.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Write(#[from] crate::fs::FileOpError),
     /// Reading the tree failed (a file read in place was changed after it was opened).
     #[error(transparent)]
     Storage(#[from] crate::tree::StorageError),
     /// Encoding an image failed.
     #[cfg(feature = "png")]
-    #[error("cannot encode the image: {0}")]
+    #[error("cannot encode the image")]
     Encode(#[source] image::ImageError),
 }
 

@@ -38,10 +38,7 @@ pub fn encode_rgb_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, Di
 /// As [`encode_rgb_png`], and [`DisplayError::Write`] for I/O errors.
 pub fn write_rgb_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), DisplayError> {
     let bytes = encode_rgb_png(width, height, rgb)?;
-    crate::fs::write_atomic(path, &bytes).map_err(|source| DisplayError::Write {
-        path: path.to_path_buf(),
-        source,
-    })
+    crate::fs::write_atomic(path, &bytes).map_err(DisplayError::Write)
 }
 
 #[cfg(feature = "png")]

@@ -114,8 +114,5 @@ pub fn header(width: u32, height: u32) -> String {
 /// # Errors
 /// [`DisplayError::Write`] on an I/O error.
 pub fn write_svg(path: &Path, svg: &str) -> Result<(), DisplayError> {
-    crate::fs::write_atomic(path, svg.as_bytes()).map_err(|source| DisplayError::Write {
-        path: path.to_path_buf(),
-        source,
-    })
+    crate::fs::write_atomic(path, svg.as_bytes()).map_err(DisplayError::Write)
 }

@@ -28,25 +28,10 @@ use crate::space::Universe;
 use crate::tree::storage::TreeStorage;
 use crate::tree::{AnyTree, LevelCounts, NodeState, StorageError};
 
-/// Where voxels are in the world: voxel coordinate `v` is at `origin + voxel_size · v` (the universe's
-/// corner at `origin`; quadtrees use the first two coordinates).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Frame {
-    /// The edge of a voxel in world units.
-    pub voxel_size: f64,
-    /// The world position of the universe's corner (voxel coordinate 0).
-    pub origin: [f64; 3],
-}
-
-impl Default for Frame {
-    /// Unit voxels, the universe's corner at the world origin.
-    fn default() -> Self {
-        Self {
-            voxel_size: 1.0,
-            origin: [0.0; 3],
-        }
-    }
-}
+/// Where voxels are in the world for an export: ktree voxel `v` is at `origin + voxel_size · v` (the
+/// universe's corner at `origin`; quadtrees use the first two coordinates). The crate's one world frame,
+/// [`WorldFrame`](crate::space::WorldFrame).
+pub type Frame = crate::space::WorldFrame;
 
 /// A mesh file format, by extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,16 +83,16 @@ pub struct Written {
 #[non_exhaustive]
 pub enum ExportError {
     /// The format does not fit the file or the tree.
-    #[error("{file}: {message}")]
+    #[error("{}: {message}", file.display())]
     Usage {
         /// The file.
-        file: String,
+        file: std::path::PathBuf,
         /// What is wrong.
         message: String,
     },
     /// Writing failed (the message names the file).
-    #[error("{0}")]
-    Write(#[source] std::io::Error),
+    #[error(transparent)]
+    Write(#[from] crate::fs::FileOpError),
     /// A smooth surface ([`surface::smooth_mesh`]) would have more unit faces than it makes at most; the
     /// exact boundary ([`surface::boundary_mesh`]) merges them and has no such bound.
     #[error("a smooth surface of {faces} unit faces is more than the {limit} made at most; write the exact boundary")]
@@ -144,7 +129,7 @@ pub fn write_mesh_of<const K: usize, T: TreeStorage<K>>(
     frame: &Frame,
 ) -> Result<Written, ExportError> {
     let usage = |message: &str| ExportError::Usage {
-        file: path.display().to_string(),
+        file: path.to_path_buf(),
         message: message.into(),
     };
     let format = MeshFormat::of(path)
@@ -272,7 +257,7 @@ pub fn write_surface(path: &Path, mesh: &surface::SurfaceMesh) -> Result<Written
         Some(MeshFormat::Glb) => write(&|w| files::write_glb(w, mesh))?,
         _ => {
             return Err(ExportError::Usage {
-                file: path.display().to_string(),
+                file: path.to_path_buf(),
                 message: "a triangle mesh is written as .ply, .obj, .stl or .glb".into(),
             })
         }

@@ -118,11 +118,11 @@ pub enum ViewError {
         k: usize,
     },
     /// Reading the tree failed.
-    #[error("{0}")]
-    Read(#[source] Box<dyn std::error::Error + Send + Sync>),
+    #[error(transparent)]
+    Read(Box<dyn std::error::Error + Send + Sync>),
     /// Writing the page failed (the message names the file).
-    #[error("{0}")]
-    Write(#[source] std::io::Error),
+    #[error(transparent)]
+    Write(#[from] crate::fs::FileOpError),
 }
 
 /// Standard base64 with padding (RFC 4648 §4).

@@ -412,7 +412,7 @@ pub fn write_vtk_file<const K: usize, T: TreeStorage<K>>(
     frame: &Frame,
 ) -> Result<(), ExportError> {
     let usage = |message: String| ExportError::Usage {
-        file: path.display().to_string(),
+        file: path.to_path_buf(),
         message,
     };
     let ext = path
@@ -464,7 +464,7 @@ pub fn write_time_slices<T: TreeStorage<4>>(
     frame: &Frame,
 ) -> Result<Vec<PathBuf>, ExportError> {
     let usage = |message: String| ExportError::Usage {
-        file: path.display().to_string(),
+        file: path.to_path_buf(),
         message,
     };
     let ext = path

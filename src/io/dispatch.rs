@@ -6,7 +6,7 @@
 //! Grid formats index voxels by integers: ktree voxel = grid index + offset (see [`GridPlacement`]).
 //! binvox, `.bt` and `.vdb` hold octrees only.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
@@ -104,7 +104,8 @@ pub struct ReadOptions {
 #[derive(Debug, Clone, Default)]
 pub struct WriteOptions {
     /// Grids: grid index = ktree voxel − `offset` (the inverse of [`ReadOptions::offset`]). binvox needs 0;
-    /// OctoMap needs multiples of `2^L` that keep the universe inside its keys.
+    /// OctoMap takes any offset that keeps the universe inside its keys (a universe that is not at a
+    /// multiple of its side there is written as the smallest one around it that is).
     pub offset: [i64; 3],
     /// Grids: voxel size and world origin (binvox `translate`/`scale`, OctoMap `res`, OpenVDB's transform).
     /// Default: unit voxels at the origin.
@@ -141,47 +142,51 @@ pub enum IoError {
     #[cfg(any(feature = "cloud", feature = "mesh"))]
     #[error(transparent)]
     Geometry(#[from] super::GeometryFileError),
-    /// A mesh or volume that could not be read or voxelized.
-    #[error("{}", with_file(.file, .source))]
+    /// A mesh or volume that could not be parsed or voxelized (one that cannot be read is
+    /// [`IoError::Read`]).
+    #[error("{}", with_file(.file, .error))]
     Solid {
         /// The file.
-        file: String,
-        /// The cause.
-        source: SolidError,
+        file: PathBuf,
+        /// What is wrong (part of the message: it names the file where it can).
+        error: SolidError,
     },
+    /// A file could not be read.
+    #[error(transparent)]
+    Read(crate::fs::FileOpError),
     /// The format or the options do not fit the file: an unknown extension, an output-only or input-only
     /// format, a dimension the format cannot hold, a missing option.
-    #[error("{file}: {message}")]
+    #[error("{}: {message}", file.display())]
     Usage {
         /// The file.
-        file: String,
+        file: PathBuf,
         /// What is wrong.
         message: String,
     },
     /// Writing failed (the message names the file).
-    #[error("{0}")]
-    Write(#[source] std::io::Error),
+    #[error(transparent)]
+    Write(#[from] crate::fs::FileOpError),
     /// The file holds a tree of another dimension than the one asked for.
-    #[error("{file}: {source}")]
+    #[error("{}", file.display())]
     Dimension {
         /// The file.
-        file: String,
+        file: PathBuf,
         /// The dimensions.
         source: DimensionMismatch,
     },
 }
 
 /// A solid's error naming its file once (a file that cannot be read or parsed names itself).
-fn with_file(file: &str, e: &SolidError) -> String {
+fn with_file(file: &Path, e: &SolidError) -> String {
     match e {
         SolidError::Io { .. } | SolidError::Parse { .. } => e.to_string(),
-        _ => format!("{file}: {e}"),
+        _ => format!("{}: {e}", file.display()),
     }
 }
 
 fn usage(path: &Path, message: impl Into<String>) -> IoError {
     IoError::Usage {
-        file: path.display().to_string(),
+        file: path.to_path_buf(),
         message: message.into(),
     }
 }
@@ -323,9 +328,16 @@ fn readable(path: &Path) -> Result<(), SolidError> {
 
 #[cfg(any(feature = "mesh", feature = "volume"))]
 fn solid_error(path: &Path) -> impl Fn(SolidError) -> IoError + '_ {
-    move |source| IoError::Solid {
-        file: path.display().to_string(),
-        source,
+    move |error| match error {
+        SolidError::Io { path, source } => IoError::Read(crate::fs::FileOpError::new(
+            crate::fs::FileOp::Read,
+            &path,
+            source,
+        )),
+        error => IoError::Solid {
+            file: path.to_path_buf(),
+            error,
+        },
     }
 }
 
@@ -607,7 +619,31 @@ fn write_typed<const K: usize>(
         }
         Format::OctomapBt => {
             let t = octree()?;
-            write(&|w| write_bt(w, t, options.offset, meta.voxel_size))
+            // OctoMap puts grid index 0 at the world origin: a world origin is carried by shifting the
+            // indices by whole voxels, and refused where it is not a whole number of them.
+            let shift = whole_voxels(&meta).ok_or_else(|| {
+                usage(
+                    path,
+                    format!(
+                        "OctoMap .bt files put their voxels at multiples of the voxel size ({}) from the \
+                         world origin; the origin {:?} is not one: give an origin that is (e.g. --origin \
+                         0,0,0)",
+                        meta.voxel_size, meta.origin
+                    ),
+                )
+            })?;
+            let offset = std::array::from_fn(|a| options.offset[a] - shift[a]);
+            let (t, offset) = on_octomap_keys(t, offset).ok_or_else(|| {
+                usage(
+                    path,
+                    format!(
+                        "grid index = ktree voxel − {offset:?} puts the level-{} universe outside \
+                         OctoMap's keys (−32768 … 32767 on each axis)",
+                        t.level()
+                    ),
+                )
+            })?;
+            write(&|w| write_bt(w, &t, offset, meta.voxel_size))
         }
         Format::Vdb => {
             let t = octree()?;
@@ -625,6 +661,51 @@ fn write_typed<const K: usize>(
             "volumes are inputs only: write .ktree, .rays, .binvox, .bt, .vdb or a mesh",
         )),
     }
+}
+
+/// The tree and offset to write to a `.bt` so that grid index = ktree voxel − `offset`: OctoMap's keys hold
+/// a universe only at multiples of its side, so a universe elsewhere is written as the smallest one around
+/// it that is (the tree grown and moved into it; the larger universe is marked known). `None` if no
+/// universe of OctoMap's 16 levels holds it.
+fn on_octomap_keys(tree: &KTree<3>, offset: [i64; 3]) -> Option<(KTree<3>, [i64; 3])> {
+    use crate::io::BT_DEPTH;
+    let centre = 1i64 << (BT_DEPTH - 1);
+    let side = 1i64 << tree.level();
+    // The universe's lowest key on each axis.
+    let corner: [i64; 3] = std::array::from_fn(|a| centre - offset[a]);
+    for level in tree.level()..=BT_DEPTH {
+        let big = 1i64 << level;
+        let base: [i64; 3] = std::array::from_fn(|a| corner[a].div_euclid(big) * big);
+        let fits = (0..3).all(|a| {
+            corner[a] + side <= base[a] + big && base[a] >= 0 && base[a] + big <= 2 * centre
+        });
+        if fits {
+            if level == tree.level() {
+                return Some((tree.clone(), offset));
+            }
+            let grown = crate::ops::grow(tree, &vec![0; (level - tree.level()) as usize]).ok()?;
+            let moved = crate::tree::storage::infallible(crate::ops::translate(
+                &grown,
+                std::array::from_fn(|a| corner[a] - base[a]),
+            ));
+            return Some((moved, std::array::from_fn(|a| centre - base[a])));
+        }
+    }
+    None
+}
+
+/// The frame's origin as a whole number of voxels, if it is one (to a millionth of a voxel).
+fn whole_voxels(meta: &GridMeta) -> Option<[i64; 3]> {
+    let mut shift = [0i64; 3];
+    for (s, o) in shift.iter_mut().zip(meta.origin) {
+        let v = o / meta.voxel_size;
+        let r = v.round();
+        if !(r.is_finite() && (v - r).abs() <= 1e-6 && r.abs() < (1u64 << 40) as f64) {
+            return None;
+        }
+        *s = r as i64;
+    }
+    Some(shift)
 }
 
 /// An export's error as a file error of `path`.
@@ -657,7 +738,7 @@ impl<const K: usize> KTree<K> {
         read_tree(path, &ReadOptions::default())?
             .try_into()
             .map_err(|source| IoError::Dimension {
-                file: path.display().to_string(),
+                file: path.to_path_buf(),
                 source,
             })
     }

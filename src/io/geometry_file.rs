@@ -27,7 +27,7 @@ pub enum GeometryFileErrorKind {
     #[error("{0}")]
     Malformed(String),
     /// The file could not be read.
-    #[error("cannot read: {0}")]
+    #[error("cannot read")]
     Io(IoCause),
 }
 

@@ -387,9 +387,9 @@ impl SpillLevels {
             counts = writer.counts_per_level();
             writer.finish()?.flush()
         })
-        .map_err(|source| SpillError::Output {
+        .map_err(|e| SpillError::Output {
             path: self.out.clone(),
-            source,
+            source: e.into_io(),
         })?;
         Ok(SpilledTree {
             counts_per_level: counts,

@@ -129,7 +129,7 @@ pub enum OpsError {
         distance: f64,
     },
     /// An operation made a value no voxel may hold (a sum of floats `inf + -inf` is a NaN).
-    #[error("the result would hold {0}")]
+    #[error("the result would hold a value the tree cannot")]
     Value(#[from] crate::value::ValueError),
 }
 

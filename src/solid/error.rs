@@ -74,7 +74,7 @@ pub enum SolidError {
         axis: usize,
     },
     /// A file could not be read.
-    #[error("{path}: {source}")]
+    #[error("cannot read {}", path.display())]
     Io {
         /// The file.
         path: PathBuf,

@@ -196,7 +196,10 @@ fn a_float_sum_that_is_nan_is_an_error_and_levels_must_match() {
     let a = KTree::<1, f32>::from_dense_values(1, &[Some(f32::INFINITY), None]).unwrap();
     let b = KTree::<1, f32>::from_dense_values(1, &[Some(f32::NEG_INFINITY), None]).unwrap();
     let e = a.combine(&b, Rule::Sum).unwrap_err();
-    assert!(e.to_string().contains("NaN"), "{e}");
+    let cause = std::error::Error::source(&e)
+        .expect("the value's error")
+        .to_string();
+    assert!(cause.contains("NaN"), "{e}: {cause}");
     let c = KTree::<1, f32>::from_dense_values(2, &[None; 4]).unwrap();
     assert!(a
         .combine(&c, Rule::Max)

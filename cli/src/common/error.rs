@@ -1,21 +1,30 @@
-//! Why a command failed: the one error type every subcommand returns.
+//! Why a command failed: the one error type every subcommand returns, printed with its causes in one line
+//! (`ktree: cannot write out.ktree: No space left on device`).
 
+use std::error::Error;
 use std::fmt;
 
 /// Why a command failed.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug)]
 pub enum CliError {
     /// Standard output was closed by its reader (`ktree stats A | head` takes what it wants and goes): the
     /// command ends quietly and successfully.
     OutputClosed,
-    /// Anything else, as the one line written to standard error.
+    /// A message of the command's own, the one line written to standard error.
     Failed(String),
+    /// An error of the library, kept whole: written with its causes after it ([`chain`]).
+    Caused(Box<dyn Error + Send + Sync>),
 }
 
 /// What a subcommand returns.
 pub type CliResult<T = ()> = Result<T, CliError>;
 
 impl CliError {
+    /// A library error as a command's error, its causes kept.
+    pub fn caused(e: impl Error + Send + Sync + 'static) -> Self {
+        Self::Caused(Box::new(e))
+    }
+
     /// What a failed write to standard output is reported as: a closed pipe ends the command quietly.
     pub fn from_output(e: std::io::Error) -> Self {
         if e.kind() == std::io::ErrorKind::BrokenPipe {
@@ -31,16 +40,32 @@ impl fmt::Display for CliError {
         match self {
             Self::OutputClosed => f.write_str("standard output closed"),
             Self::Failed(message) => f.write_str(message),
+            Self::Caused(e) => f.write_str(&chain(e.as_ref())),
         }
     }
 }
 
-impl std::error::Error for CliError {}
+/// An error and its causes in one line, `A: B: C`: each error's message says its own part only, its
+/// cause is its [`source`](Error::source). (A message that already ends with its cause's, as some errors
+/// of other crates write theirs, is not repeated.)
+pub fn chain(e: &(dyn Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let next = c.to_string();
+        if !next.is_empty() && !text.ends_with(&next) {
+            text.push_str(": ");
+            text.push_str(&next);
+        }
+        cause = c.source();
+    }
+    text
+}
 
 /// A failed read of a tree (a file read in place that changed after it was opened), as a command's
 /// error: what the generic code over any storage maps its reads' errors with.
 pub fn read_error(e: impl Into<ktree::tree::StorageError>) -> CliError {
-    CliError::Failed(e.into().to_string())
+    CliError::caused(e.into())
 }
 
 impl From<String> for CliError {
@@ -62,11 +87,29 @@ mod tests {
     #[test]
     fn a_broken_pipe_is_a_quiet_end_and_other_write_errors_fail() {
         let closed = std::io::Error::from(std::io::ErrorKind::BrokenPipe);
-        assert_eq!(CliError::from_output(closed), CliError::OutputClosed);
+        assert!(matches!(
+            CliError::from_output(closed),
+            CliError::OutputClosed
+        ));
         let full = std::io::Error::other("disk full");
         let CliError::Failed(message) = CliError::from_output(full) else {
             panic!("a full disk is a failure");
         };
         assert!(message.contains("disk full"), "{message}");
+    }
+
+    #[test]
+    fn a_chain_is_one_line_with_every_cause_once() {
+        let io = std::io::Error::from_raw_os_error(20);
+        let e = ktree::fs::FileOpError::new(
+            ktree::fs::FileOp::Write,
+            std::path::Path::new("plain/out.ktree"),
+            io,
+        );
+        let text = CliError::caused(e).to_string();
+        assert!(text.starts_with("cannot write plain/out.ktree: "), "{text}");
+        assert_eq!(text.matches("plain/out.ktree").count(), 1, "{text}");
+        assert!(text.to_lowercase().contains("not a directory"), "{text}");
+        assert!(!text.contains('\n'));
     }
 }

@@ -49,9 +49,11 @@ impl BudgetArgs {
     }
 }
 
-/// The options of the commands that build trees: budget, spill folder, progress bar.
+/// The options of the commands that build trees: worker threads, budget, spill folder, progress bar.
 #[derive(Debug, Clone, clap::Args)]
 pub struct BuildArgs {
+    #[command(flatten)]
+    pub threads: crate::common::args::ThreadsArg,
     #[command(flatten)]
     pub budget: BudgetArgs,
     /// Folder for the temporary spill files of a tree built out of core (default: the output's folder).

@@ -1,6 +1,7 @@
 //! What the subcommands share: worker threads, progress bars, the memory budget and out-of-core builds,
 //! the `.ktree` format version written, and where outputs go.
 
+pub mod args;
 pub mod error;
 pub mod memory;
 pub mod output;
@@ -8,3 +9,4 @@ pub mod picture;
 pub mod progress;
 pub mod threads;
 pub mod tree_file;
+pub mod vector;

@@ -8,10 +8,9 @@
 //! with the `mpi` feature, in a run of several ranks, the same step is taken by every rank together
 //! ([`crate::distributed`]). [`write_output`] writes rays as text or as a tree, by the output's extension.
 
-use crate::common::error::CliResult;
+use crate::common::error::{chain, CliResult};
 use crate::outln;
 
-use std::fmt::Display;
 use std::path::{Path, PathBuf};
 
 use ktree::fs::SpillError;
@@ -45,9 +44,13 @@ pub struct Built {
 }
 
 impl<'a> TreeOutput<'a> {
-    /// The output `out`, on `threads` worker threads, with the build options `args`.
-    pub fn new(out: &'a Path, threads: Option<usize>, args: &'a BuildArgs) -> Self {
-        Self { out, threads, args }
+    /// The output `out`, with the build options `args` (worker threads, budget, spill folder, progress).
+    pub fn new(out: &'a Path, args: &'a BuildArgs) -> Self {
+        Self {
+            out,
+            threads: args.threads.threads,
+            args,
+        }
     }
 
     /// Builds the tree of `source` and writes it to the output: out of core in the budget less what the
@@ -64,7 +67,7 @@ impl<'a> TreeOutput<'a> {
     ) -> Result<Option<Built>, String>
     where
         S: RaySource<K>,
-        S::Error: Display,
+        S::Error: std::error::Error + Send + Sync + 'static,
     {
         let budget = match held {
             Some((what, bytes)) => self.args.budget.left_after(what, bytes)?,
@@ -95,7 +98,7 @@ impl<'a> TreeOutput<'a> {
     ) -> Result<Option<OutOfCoreReport>, String>
     where
         S: RaySource<K>,
-        S::Error: Display,
+        S::Error: std::error::Error + Send + Sync + 'static,
     {
         #[cfg(feature = "mpi")]
         if crate::distributed::ranks().size > 1 {
@@ -164,7 +167,11 @@ impl Built {
 
 /// The message of a failed out-of-core build of `out`; `held` bytes were set apart from the budget before
 /// the build (message buffers) and are added back to the budgets it names.
-pub fn describe<E: Display>(out: &Path, e: BuildError<E>, held: u64) -> String {
+pub fn describe<E: std::error::Error + Send + Sync + 'static>(
+    out: &Path,
+    e: BuildError<E>,
+    held: u64,
+) -> String {
     match e {
         BuildError::BudgetTooSmall { budget, needed } => format!(
             "{}: {} (--max-memory)",
@@ -174,8 +181,8 @@ pub fn describe<E: Display>(out: &Path, e: BuildError<E>, held: u64) -> String {
                 needed: needed.saturating_add(held),
             }
         ),
-        BuildError::Files(output @ SpillError::Output { .. }) => output.to_string(),
-        other => format!("{}: {other}", out.display()),
+        BuildError::Files(output @ SpillError::Output { .. }) => chain(&output),
+        other => format!("{}: {}", out.display(), chain(&other)),
     }
 }
 
@@ -185,12 +192,11 @@ pub fn describe<E: Display>(out: &Path, e: BuildError<E>, held: u64) -> String {
 pub fn write_output<const K: usize>(
     rays: &RaySet<K>,
     out: &Path,
-    threads: Option<usize>,
     build: &BuildArgs,
 ) -> Result<String, String> {
     if is_tree_file(out) {
         let held = ("the rays", crate::common::memory::ray_bytes(rays));
-        let built = TreeOutput::new(out, threads, build).write(rays, Some(held))?;
+        let built = TreeOutput::new(out, build).write(rays, Some(held))?;
         return Ok(built
             .map(|b| b.summary(Some(rays.len() as u64)))
             .unwrap_or_default());
@@ -198,7 +204,7 @@ pub fn write_output<const K: usize>(
     if !crate::distributed::ranks().is_root() {
         return Ok(String::new());
     }
-    write_rays_file(out, rays).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    write_rays_file(out, rays).map_err(|e| chain(&e))?;
     Ok(format!(
         "{}: K = {K}, L = {}, {} rays, {} voxels",
         out.display(),

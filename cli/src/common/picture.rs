@@ -1,4 +1,6 @@
-//! The arguments of the commands that draw pictures: image sizes, vectors, views.
+//! The arguments of the commands that draw pictures: image sizes and views.
+
+use crate::common::error::chain;
 
 /// Parses `WxH`.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -11,30 +13,13 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
             .map_err(|_| format!("size '{s}' must be WIDTHxHEIGHT with whole numbers"))
     };
     let (w, h) = (p(w)?, p(h)?);
-    ktree::display::check_size(w, h).map_err(|e| e.to_string())?;
+    ktree::display::check_size(w, h).map_err(|e| chain(&e))?;
     Ok((w, h))
-}
-
-/// Parses `X,Y,Z`.
-pub fn parse_vec3(s: &str, what: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    let bad = || format!("{what} '{s}' must be three numbers X,Y,Z");
-    if parts.len() != 3 {
-        return Err(bad());
-    }
-    let mut v = [0.0f64; 3];
-    for (x, p) in v.iter_mut().zip(parts) {
-        *x = p.trim().parse().map_err(|_| bad())?;
-        if !x.is_finite() {
-            return Err(bad());
-        }
-    }
-    Ok(v)
 }
 
 /// A named view or a direction `X,Y,Z`, from the object towards the eye ([`ktree::display::View`]).
 pub fn parse_view(s: &str) -> Result<[f64; 3], String> {
     s.parse::<ktree::display::View>()
         .map(|v| v.toward_eye())
-        .map_err(|e| e.to_string())
+        .map_err(|e| chain(&e))
 }

@@ -1,7 +1,7 @@
 //! Trees in and out of the commands: reading `.ktree` files, writing them in the format version asked for
 //! (`--format-version`, default 2), and the one-line summary of a tree written.
 
-use crate::common::error::CliResult;
+use crate::common::error::{chain, CliError, CliResult};
 use crate::outln;
 
 use std::path::Path;
@@ -38,8 +38,11 @@ pub fn version() -> u16 {
 /// Writes a tree file atomically in the chosen format version.
 ///
 /// # Errors
-/// Any I/O error, naming the path.
-pub fn write_tree<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
+/// The file operation that failed, naming the path.
+pub fn write_tree<const K: usize>(
+    path: &Path,
+    tree: &KTree<K>,
+) -> Result<(), ktree::fs::FileOpError> {
     match version() {
         1 => write_atomic_with(path, |w| write_ktree_v1(w, tree)),
         _ => write_ktree_file(path, tree),
@@ -62,10 +65,9 @@ pub fn as_version_1<R>(
     if built.is_some() {
         // This process wrote the version 2 file (the other ranks of an MPI run return `None` and leave it).
         let written = KtreeView::open(&v2)
-            .map_err(|e| e.to_string())
+            .map_err(|e| chain(&e))
             .and_then(|view| {
-                write_atomic_with(out, |w| write_ktree_v1_view(w, &view))
-                    .map_err(|e| format!("cannot write {}: {e}", out.display()))
+                write_atomic_with(out, |w| write_ktree_v1_view(w, &view)).map_err(|e| chain(&e))
             });
         let _ = std::fs::remove_file(&v2);
         written?;
@@ -75,12 +77,12 @@ pub fn as_version_1<R>(
 
 /// Reads a tree file, with the path in any error.
 pub fn read(path: &Path) -> Result<AnyTree, String> {
-    read_ktree_file(path).map_err(|e| e.to_string())
+    read_ktree_file(path).map_err(|e| chain(&e))
 }
 
 /// Writes a tree file and prints a one-line summary.
 pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> CliResult {
-    write_tree(path, tree).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    write_tree(path, tree).map_err(CliError::caused)?;
     print_summary(path, K, tree.level(), &tree.counts_per_level())
 }
 

@@ -89,7 +89,7 @@ pub fn build_across_ranks<const K: usize, S>(
 ) -> Result<Option<OutOfCoreReport>, String>
 where
     S: RaySource<K>,
-    S::Error: std::fmt::Display,
+    S::Error: std::error::Error + Send + Sync + 'static,
 {
     let pool = crate::common::threads::thread_pool(tree.threads)?;
     let w = world();
@@ -113,7 +113,7 @@ fn run<const K: usize, S>(
 ) -> Result<Option<OutOfCoreReport>, String>
 where
     S: RaySource<K>,
-    S::Error: std::fmt::Display,
+    S::Error: std::error::Error + Send + Sync + 'static,
 {
     let Ranks { rank, size } = ranks();
     let chunk = chunk_words(budget, size);
@@ -136,7 +136,7 @@ where
                 .map(|(i, &b0)| builder.slab_cost(b0).map(|c| (i, c)))
                 .collect::<Result<Vec<_>, _>>()
         })
-        .map_err(|e| format!("{}: {e}", out.display()));
+        .map_err(|e| format!("{}: {}", out.display(), crate::common::error::chain(&e)));
     let measured = agree(w, measured)?;
     for (i, c) in measured {
         costs[i] = c;
@@ -170,7 +170,13 @@ where
         drop(part);
         agree(
             w,
-            streamed.map_err(|e| format!("{}: sending the levels: {e}", out.display())),
+            streamed.map_err(|e| {
+                format!(
+                    "{}: sending the levels: {}",
+                    out.display(),
+                    crate::common::error::chain(&e)
+                )
+            }),
         )?;
         root.gather_into(&crate::common::memory::peak_rss_bytes().unwrap_or(0));
         return Ok(None);
@@ -184,12 +190,14 @@ where
         moved += 8 * words.len() as u64;
         match part.add_part(&words) {
             Ok(total) => streams.push(Stream::new(from, total)),
-            Err(e) if added.is_ok() => added = Err(format!("rank {r}: {e}")),
+            Err(e) if added.is_ok() => {
+                added = Err(format!("rank {r}: {}", crate::common::error::chain(&e)))
+            }
             Err(_) => {}
         }
     }
     agree(w, added)?;
-    let written = part.write::<String>(
+    let written = part.write::<std::convert::Infallible>(
         out,
         &mut |owner, words| streams[owner - 1].fill(owner, words),
         &progress,

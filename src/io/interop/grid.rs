@@ -35,7 +35,7 @@ pub enum GridFileErrorKind {
     #[error("placement: {0}")]
     GridPlacement(String),
     /// The file could not be read.
-    #[error("cannot read: {0}")]
+    #[error("cannot read")]
     Io(crate::fs::IoCause),
 }
 
@@ -639,24 +639,9 @@ impl BoxWriter {
 }
 
 /// Where a grid's voxels are in the world: grid index `i` covers `origin + voxel_size · [i, i + 1)` on each
-/// axis (binvox `translate` and `scale / D`, OctoMap `res`, OpenVDB's linear transform).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GridMeta {
-    /// The edge length of a voxel in world units.
-    pub voxel_size: f64,
-    /// The world position of the corner of grid index (0, 0, 0).
-    pub origin: [f64; 3],
-}
-
-impl Default for GridMeta {
-    /// Unit voxels, grid index (0, 0, 0) at the world origin.
-    fn default() -> Self {
-        Self {
-            voxel_size: 1.0,
-            origin: [0.0; 3],
-        }
-    }
-}
+/// axis (binvox `translate` and `scale / D`, OctoMap `res`, OpenVDB's linear transform). The crate's one
+/// world frame, [`WorldFrame`](crate::space::WorldFrame).
+pub type GridMeta = crate::space::WorldFrame;
 
 /// An octree read from a grid file, with where it was placed and the grid's world metadata.
 #[derive(Debug, Clone, PartialEq)]

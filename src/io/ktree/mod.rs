@@ -104,7 +104,7 @@ pub enum KtreeFileErrorKind {
         found: Option<crate::tree::Dtype>,
     },
     /// The file could not be read.
-    #[error("cannot read: {0}")]
+    #[error("cannot read")]
     Io(crate::fs::IoCause),
 }
 
@@ -137,8 +137,11 @@ pub fn write_ktree<const K: usize>(out: impl Write, tree: &KTree<K>) -> std::io:
 /// Writes a `.ktree` file of the current version atomically (temporary file, then rename).
 ///
 /// # Errors
-/// Any I/O error, naming the path.
-pub fn write_ktree_file<const K: usize>(path: &Path, tree: &KTree<K>) -> std::io::Result<()> {
+/// A [`FileOpError`](crate::fs::FileOpError) naming the path, its source the I/O error.
+pub fn write_ktree_file<const K: usize>(
+    path: &Path,
+    tree: &KTree<K>,
+) -> Result<(), crate::fs::FileOpError> {
     crate::fs::write_atomic_with(path, |w| write_ktree(w, tree))
 }
 

@@ -46,7 +46,7 @@ use crate::tree::LevelCounts;
 #[derive(Debug, thiserror::Error)]
 pub enum BooleanFileError {
     /// An input cannot be opened or read (the error names it and the byte offset).
-    #[error("{0}")]
+    #[error(transparent)]
     Input(#[from] KtreeFileError),
     /// The inputs do not have the same `K` and `L`.
     #[error("{a} is a K = {ka}, L = {la} tree but {b} is K = {kb}, L = {lb}: both must have the same dimension and level")]

@@ -141,11 +141,11 @@ pub fn write_valued_ktree<const K: usize, V: Value>(
 /// Writes a valued tree's `.ktree` file atomically (a temporary file, then renamed).
 ///
 /// # Errors
-/// Any I/O error, naming the path.
+/// A [`FileOpError`](crate::fs::FileOpError) naming the path, its source the I/O error.
 pub fn write_valued_ktree_file<const K: usize, V: Value>(
     path: &Path,
     tree: &KTree<K, V>,
-) -> std::io::Result<()> {
+) -> Result<(), crate::fs::FileOpError> {
     crate::fs::write_atomic_with(path, |w| write_valued_ktree(w, tree))
 }
 

@@ -70,7 +70,7 @@ pub enum RaysTextErrorKind {
     #[error("{0}")]
     BadRun(String),
     /// The file could not be read.
-    #[error("cannot read: {0}")]
+    #[error("cannot read")]
     Io(crate::fs::IoCause),
 }
 
@@ -250,8 +250,11 @@ fn write_ray_lines<const K: usize>(mut w: impl Write, rays: &RaySet<K>) -> std::
 /// Writes a ray file atomically (temporary file, then rename).
 ///
 /// # Errors
-/// Any I/O error, naming the path.
-pub fn write_rays_file<const K: usize>(path: &Path, rays: &RaySet<K>) -> std::io::Result<()> {
+/// A [`FileOpError`](crate::fs::FileOpError) naming the path, its source the I/O error.
+pub fn write_rays_file<const K: usize>(
+    path: &Path,
+    rays: &RaySet<K>,
+) -> Result<(), crate::fs::FileOpError> {
     crate::fs::write_atomic_with(path, |w| write_rays(w, rays))
 }
 

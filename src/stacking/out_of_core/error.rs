@@ -9,11 +9,11 @@ use super::budget::bytes_text;
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError<E, F = crate::fs::SpillError> {
     /// The source could not produce its rays.
-    #[error("{0}")]
-    Source(E),
+    #[error("the source could not make its rays")]
+    Source(#[source] E),
     /// The worker threads asked for ([`Builder::threads`](crate::stacking::Builder::threads)) could not
     /// be started.
-    #[error("cannot start worker threads: {0}")]
+    #[error("cannot start worker threads")]
     Threads(#[source] rayon::ThreadPoolBuildError),
     /// Not even one slab of cells (or the index of the stacked cells, or the I/O buffers) fits in the
     /// budget.
