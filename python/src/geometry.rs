@@ -3,6 +3,7 @@
 //! methods `translate`, `rotate`, `scale` and `affine`.
 
 use ktree::ops::{self, Affine, AxisMap, Projective};
+use ktree::tree::storage::infallible;
 use ktree::{with_dim, AnyTree, KTree};
 use numpy::{AllowTypeChange, PyArrayLike2};
 use pyo3::prelude::*;
@@ -129,7 +130,7 @@ pub(crate) fn translate<const K: usize>(tree: &KTree<K>, t: &[f64]) -> Result<KT
         return Err(Failure::Value(format!("translation {t:?} is not finite")));
     }
     if t.iter().all(|v| v.fract() == 0.0 && v.abs() < 9.0e15) {
-        return Ok(ops::translate(tree, t.map(|v| v as i64)));
+        return Ok(infallible(ops::translate(tree, t.map(|v| v as i64))));
     }
     Ok(ops::transform(tree, &Affine::translation(t))?)
 }
@@ -150,7 +151,7 @@ pub(crate) fn rotate<const K: usize>(
         let turns = ((degrees / 90.0) % 4.0) as i64;
         let mut out = tree.clone();
         for _ in 0..turns.rem_euclid(4) {
-            out = ops::rotate_axes(&out, &quarter);
+            out = infallible(ops::rotate_axes(&out, &quarter));
         }
         return Ok(out);
     }

@@ -153,9 +153,9 @@ impl Tree {
             Option<(Vec<(u32, u128, u128, u64)>, f64)>,
         ) = py.detach(|| {
             with_dim!(&self.inner, AnyTree, t => {
-                let m = ops::mass_properties(t);
+                let m = ktree::tree::storage::infallible(ops::mass_properties(t));
                 let p = tolerance.map(|tol| {
-                    let p = ops::mass_progressive(t, tol);
+                    let p = ktree::tree::storage::infallible(ops::mass_progressive(t, tol));
                     let levels = p.levels.iter().map(|l| (l.level, l.lower, l.upper, l.nodes_touched)).collect();
                     (levels, p.estimate)
                 });
