@@ -93,7 +93,7 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
     ///
     /// # Errors
     /// [`RayError::Space`] for a level beyond the largest, a universe beyond
-    /// [`DENSE_LIMIT`](crate::space::DENSE_LIMIT) voxels or an array of another length; [`RayError::Value`]
+    /// [`DENSE_LIMIT`] voxels or an array of another length; [`RayError::Value`]
     /// for a NaN.
     pub fn from_dense(level: u32, dense: &[Option<V>]) -> Result<Self, RayError> {
         let universe = Universe::<K>::new(level)?;
