@@ -206,13 +206,16 @@ pub(super) fn decode(frame: &[u8], expected: usize) -> Result<Vec<u8>, BloscErro
             target
         };
         let mut at = i32::from_le_bytes(frame[start_at..start_at + 4].try_into().expect("4 bytes"));
+        // Where the current stream's start was given: the block's start for the first stream, the
+        // previous stream's length for the others.
+        let mut start_given_at = start_at;
         for s in 0..splits {
             let len_at = usize::try_from(at)
                 .ok()
                 .filter(|&a| a <= cbytes.saturating_sub(4));
             let Some(len_at) = len_at else {
                 return Err(truncated(
-                    if s == 0 { start_at } else { cbytes },
+                    start_given_at,
                     format!(
                         "Blosc block {j}, stream {s} starts at byte {at}, past the frame of {cbytes} bytes"
                     ),
@@ -248,14 +251,16 @@ pub(super) fn decode(frame: &[u8], expected: usize) -> Result<Vec<u8>, BloscErro
                         ))
                     }
                     Err(e) => {
+                        // An empty stream's data would start at the frame's end: its length is wrong.
                         return Err(data(
-                            bytes_at,
+                            if len == 0 { len_at } else { bytes_at },
                             format!("Blosc block {j}, stream {s}: bad LZ4 data ({e})"),
                         ))
                     }
                 }
             }
             at = (bytes_at + len) as i32;
+            start_given_at = len_at;
         }
         if shuffle {
             unshuffle(
@@ -369,28 +374,65 @@ pub(super) mod tests {
             split: bool,
             compress: bool,
         ) {
-            // As c-blosc chooses: at most the data, a multiple of the type size when above it.
-            let mut blocksize = blocksize.min(data.len()).max(1);
-            if blocksize > typesize {
-                blocksize = blocksize / typesize * typesize;
-            }
-            let frame = encode(&data, typesize, blocksize, shuffle, split, compress);
-            prop_assert_eq!(decode(&frame, data.len()).unwrap(), data.clone());
-            // Every cut and every changed byte is an error or some bytes of the expected length.
-            for cut in 0..frame.len() {
-                if let Ok(d) = decode(&frame[..cut], data.len()) {
-                    prop_assert_eq!(d.len(), data.len());
-                }
-            }
-            for at in 0..frame.len().min(64) {
-                let mut bad = frame.clone();
-                bad[at] ^= 0x5a;
-                match decode(&bad, data.len()) {
-                    Ok(d) => prop_assert_eq!(d.len(), data.len()),
-                    Err(e) => prop_assert!(e.at < frame.len()),
-                }
+            check_frame(&data, typesize, blocksize, shuffle, split, compress)?;
+        }
+    }
+
+    /// A frame of `data` decodes to it; every cut and every changed byte among the first 64 is an error
+    /// at a byte inside the frame, or bytes of the expected length.
+    fn check_frame(
+        data: &[u8],
+        typesize: usize,
+        blocksize: usize,
+        shuffle: bool,
+        split: bool,
+        compress: bool,
+    ) -> Result<(), TestCaseError> {
+        // As c-blosc chooses: at most the data, a multiple of the type size when above it.
+        let mut blocksize = blocksize.min(data.len()).max(1);
+        if blocksize > typesize {
+            blocksize = blocksize / typesize * typesize;
+        }
+        let frame = encode(data, typesize, blocksize, shuffle, split, compress);
+        prop_assert_eq!(decode(&frame, data.len()).unwrap(), data.to_vec());
+        for cut in 0..frame.len() {
+            if let Ok(d) = decode(&frame[..cut], data.len()) {
+                prop_assert_eq!(d.len(), data.len());
             }
         }
+        for at in 0..frame.len().min(64) {
+            let mut bad = frame.clone();
+            bad[at] ^= 0x5a;
+            match decode(&bad, data.len()) {
+                Ok(d) => prop_assert_eq!(d.len(), data.len()),
+                Err(e) => prop_assert!(e.at < frame.len(), "byte {at} changed: {e:?}"),
+            }
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn a_stream_length_that_leaves_no_room_is_named_at_its_byte() {
+        // Found by the property above: a changed stream length made the next stream start past the
+        // frame, and the error named the frame's end.
+        let runs: [(u8, usize); 11] = [
+            (0, 36),
+            (1, 8),
+            (2, 6),
+            (3, 17),
+            (4, 25),
+            (5, 4),
+            (6, 21),
+            (4, 25),
+            (7, 25),
+            (8, 32),
+            (0, 159),
+        ];
+        let data: Vec<u8> = runs
+            .iter()
+            .flat_map(|&(b, n)| std::iter::repeat_n(b, n))
+            .collect();
+        check_frame(&data, 2, 358, false, true, true).unwrap();
     }
 
     #[test]
