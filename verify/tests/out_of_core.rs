@@ -784,7 +784,17 @@ fn a_stream_that_breaks_off_fails_the_write_and_keeps_the_target() {
         matches!(e, BuildError::Files(SpillError::Output { .. })),
         "{e:?}"
     );
-    assert!(e.to_string().contains("the sender stopped"), "{e}");
+    // The sender's error is the cause, kept in the error's chain.
+    let BuildError::Files(files) = &e else {
+        unreachable!("checked above")
+    };
+    let mut chain = files.to_string();
+    let mut cause = std::error::Error::source(files);
+    while let Some(c) = cause {
+        chain = format!("{chain}: {c}");
+        cause = c.source();
+    }
+    assert!(chain.contains("the sender stopped"), "{chain}");
     assert_eq!(std::fs::read(&out).unwrap(), b"old".to_vec());
     assert_eq!(entries(dir.path()), vec!["tree.ktree".to_string()]);
 }
