@@ -191,29 +191,16 @@ impl PackedStates {
     /// [`TreeError::WordCount`], [`TreeError::UnusedCode`] or [`TreeError::StrayBits`] if the word count does not fit `len`, a slot holds the unused code `11`, or bits beyond
     /// `len` are set.
     pub fn from_words(words: Vec<u64>, len: usize) -> Result<Self, TreeError> {
-        if words.len() != len.div_ceil(NODES_PER_WORD) {
-            return Err(TreeError::WordCount {
-                words: words.len(),
-                len,
-            });
+        // The word count first (as the valued form checks it), then the code a binary tree never uses.
+        if words.len() == len.div_ceil(NODES_PER_WORD) {
+            if let Some(w) = words.iter().position(|&w| unused_mask(w) != 0) {
+                let slot = unused_mask(words[w]).trailing_zeros() as usize / 2;
+                return Err(TreeError::UnusedCode {
+                    node: w * NODES_PER_WORD + slot,
+                });
+            }
         }
-        if let Some(w) = words.iter().position(|&w| unused_mask(w) != 0) {
-            let slot = unused_mask(words[w]).trailing_zeros() as usize / 2;
-            return Err(TreeError::UnusedCode {
-                node: w * NODES_PER_WORD + slot,
-            });
-        }
-        let used = len % NODES_PER_WORD;
-        if used != 0 && words[words.len() - 1] >> (2 * used) != 0 {
-            return Err(TreeError::StrayBits { len });
-        }
-        let mut s = Self {
-            words,
-            len,
-            ..Self::default()
-        };
-        s.finish();
-        Ok(s)
+        Self::from_valued_words(words, len)
     }
 
     /// A level of a valued tree from its words (code `11`, mixed, allowed).
