@@ -281,6 +281,33 @@ pub enum FileOp {
     CreateFolder,
 }
 
+/// An error and its causes in one line, `A: B: C`: each error's message says its own part only, its
+/// cause is its [`source`](std::error::Error::source). A message that already ends with its cause's, as
+/// some errors of other crates write theirs, is not repeated.
+///
+/// ```
+/// let dir = tempfile::tempdir().unwrap();
+/// let plain = dir.path().join("plain");
+/// std::fs::write(&plain, b"").unwrap();
+/// let e = ktree::fs::write_atomic(&plain.join("x"), b"").unwrap_err(); // below a plain file
+/// // The operation and path, then the system's reason.
+/// let text = ktree::fs::error_chain(&e);
+/// assert!(text.starts_with(&e.to_string()) && text.len() > e.to_string().len(), "{text}");
+/// ```
+pub fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let next = c.to_string();
+        if !next.is_empty() && !text.ends_with(&next) {
+            text.push_str(": ");
+            text.push_str(&next);
+        }
+        cause = c.source();
+    }
+    text
+}
+
 /// A file operation that failed: the path and the [`std::io::Error`] as the system gave it, kept whole as
 /// the [`source`](std::error::Error::source) (its [`kind`](std::io::Error::kind) and
 /// [`raw_os_error`](std::io::Error::raw_os_error) intact). Its message names the operation and the path

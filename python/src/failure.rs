@@ -1,5 +1,6 @@
 //! Errors of the bindings, made without the interpreter lock and turned into Python exceptions after.
 
+use ktree::fs::error_chain;
 use std::io::ErrorKind;
 use std::path::Path;
 
@@ -58,28 +59,12 @@ impl Failure {
             Some(io) => Self::Os {
                 kind: io.kind(),
                 errno: io.raw_os_error().unwrap_or(0),
-                message: chain(e),
+                message: error_chain(e),
                 filename: path.display().to_string(),
             },
-            None => Self::Value(chain(e)),
+            None => Self::Value(error_chain(e)),
         }
     }
-}
-
-/// An error and its causes in one line, `A: B: C` (a message that already ends with its cause's is not
-/// repeated).
-fn chain(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut text = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let next = c.to_string();
-        if !next.is_empty() && !text.ends_with(&next) {
-            text.push_str(": ");
-            text.push_str(&next);
-        }
-        cause = c.source();
-    }
-    text
 }
 
 impl From<Failure> for PyErr {

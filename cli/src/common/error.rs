@@ -45,22 +45,7 @@ impl fmt::Display for CliError {
     }
 }
 
-/// An error and its causes in one line, `A: B: C`: each error's message says its own part only, its
-/// cause is its [`source`](Error::source). (A message that already ends with its cause's, as some errors
-/// of other crates write theirs, is not repeated.)
-pub fn chain(e: &(dyn Error + 'static)) -> String {
-    let mut text = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let next = c.to_string();
-        if !next.is_empty() && !text.ends_with(&next) {
-            text.push_str(": ");
-            text.push_str(&next);
-        }
-        cause = c.source();
-    }
-    text
-}
+pub use ktree::fs::error_chain as chain;
 
 /// A failed read of a tree (a file read in place that changed after it was opened), as a command's
 /// error: what the generic code over any storage maps its reads' errors with.
