@@ -1,6 +1,6 @@
 //! `ktree convert IN OUT`: any format to any format, chosen by extension (`.ktree`, `.rays`, `.binvox`, `.bt`,
 //! `.vdb`; meshes voxelized as inputs and the tree's boundary as outputs, `.glb` and `.svg` outputs only;
-//! volumes as inputs).
+//! volumes as inputs, NIfTI also as outputs; trees with values to NIfTI or `.ktree`).
 
 use crate::common::error::{CliError, CliResult};
 use crate::outln;
@@ -71,6 +71,16 @@ const SMOOTH_ITERATIONS: usize = 10;
 
 /// Reads the input, writes the output, prints a one-line summary.
 pub fn run(a: Args) -> CliResult {
+    if crate::values::is_valued(&a.input) {
+        if let Some(v) = a.voxel_size.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(format!("--voxel-size {v}: expected a positive number").into());
+        }
+        let frame = Frame {
+            voxel_size: a.voxel_size.unwrap_or(1.0),
+            origin: a.origin.unwrap_or([0.0; 3]),
+        };
+        return crate::convert_values::convert_valued(&a.input, &a.output, &frame);
+    }
     let options = ReadOptions {
         level: a.level,
         offset: a.offset,

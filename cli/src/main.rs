@@ -10,6 +10,7 @@ mod build;
 mod collide;
 mod common;
 mod convert;
+mod convert_values;
 mod distance;
 mod distributed;
 mod lines;

@@ -40,6 +40,12 @@ pub struct Args {
     /// Volume: every sample's label kept, 0 the background: a tree with values (a .ktree output).
     #[arg(long, conflicts_with_all = ["threshold", "label"])]
     labels: bool,
+    /// Volume: the samples from LO to HI (both included) kept as float32 values, the rest the
+    /// background: a tree with values (a .ktree output).
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true,
+          value_parser = crate::convert_values::parse_window,
+          conflicts_with_all = ["threshold", "label", "labels"])]
+    window: Option<(f64, f64)>,
     /// With --labels: the label type, uint8, uint16 or uint32 (default: the smallest that holds them).
     #[arg(long, requires = "labels")]
     dtype: Option<String>,
@@ -92,14 +98,20 @@ pub fn run(a: Args) -> CliResult {
             (None, false) => return Err("a mesh needs --fit or --transform s,tx,ty,tz".into()),
         };
     } else {
+        if (a.labels || a.window.is_some()) && !is_tree_file(&a.out.out) {
+            return Err(format!(
+                "--{} writes a tree with values: the output must be a .ktree, not {}",
+                if a.labels { "labels" } else { "window" },
+                a.out.out.display()
+            )
+            .into());
+        }
+        if let Some(window) = a.window {
+            return crate::convert_values::voxelize_window(
+                &a.input, window, a.level, a.offset, &a.out.out,
+            );
+        }
         if a.labels {
-            if !is_tree_file(&a.out.out) {
-                return Err(format!(
-                    "--labels writes a tree with values: the output must be a .ktree, not {}",
-                    a.out.out.display()
-                )
-                .into());
-            }
             return crate::values::voxelize_labels(
                 &a.input,
                 a.level,

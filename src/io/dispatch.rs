@@ -45,7 +45,7 @@ pub enum Format {
     Vtu,
     /// `.htg`: a VTK hyper tree grid, for ParaView (output only).
     Htg,
-    /// `.json` (+ raw samples), `.raw`, `.nii`, `.nii.gz`: a volume (input only).
+    /// `.json` (+ raw samples), `.raw`, `.nii`, `.nii.gz`: a volume (input; NIfTI also output).
     Volume,
 }
 
@@ -166,6 +166,10 @@ pub enum IoError {
     /// Writing failed (the message names the file).
     #[error(transparent)]
     Write(#[from] crate::fs::FileOpError),
+    /// A NIfTI file could not be written (the message names it).
+    #[cfg(feature = "volume")]
+    #[error(transparent)]
+    Nifti(#[from] super::NiftiWriteError),
     /// The file holds a tree of another dimension than the one asked for.
     #[error("{}", file.display())]
     Dimension {
@@ -656,11 +660,23 @@ fn write_typed<const K: usize>(
                 .map(drop)
                 .map_err(|e| export_error(path, e))
         }
+        #[cfg(feature = "volume")]
+        Format::Volume if is_nifti(path) => {
+            crate::io::write_nifti_file(path, octree()?, &frame).map_err(IoError::Nifti)
+        }
         Format::Volume => Err(usage(
             path,
-            "volumes are inputs only: write .ktree, .rays, .binvox, .bt, .vdb or a mesh",
+            "volumes are written as NIfTI (.nii, .nii.gz) only: write .ktree, .rays, .binvox, .bt, .vdb, .nii, \
+             VTK or a mesh",
         )),
     }
+}
+
+/// Whether `path` names a NIfTI file (`.nii`, `.nii.gz`).
+#[cfg(feature = "volume")]
+fn is_nifti(path: &Path) -> bool {
+    let name = path.to_string_lossy();
+    name.ends_with(".nii") || name.ends_with(".nii.gz")
 }
 
 /// The tree and offset to write to a `.bt` so that grid index = ktree voxel − `offset`: OctoMap's keys hold

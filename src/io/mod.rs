@@ -65,6 +65,8 @@ pub use interop::{
     GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree, BINVOX_MAX_DIM,
     BT_DEPTH, BT_HEADER,
 };
+#[cfg(feature = "volume")]
+pub use interop::{write_nifti_file, NiftiWriteError};
 pub use ktree::v1::{write_ktree_v1, write_ktree_v1_view};
 pub use ktree::{
     boolean_files, boolean_views, complement_file, ktree_file_version, read_ktree, read_ktree_any,

@@ -436,39 +436,87 @@ impl Volume {
         level: u32,
         offset: [u32; 3],
     ) -> Result<ValueRuns<3, V>, SolidError> {
+        self.to_value_runs(level, offset, |i, v| {
+            if !(v >= 0.0 && v <= f64::from(u32::MAX) && v.fract() == 0.0) {
+                return Err(self.not_a_label(i, v));
+            }
+            let label = v as u32;
+            if label == 0 {
+                return Ok(None);
+            }
+            V::try_from(label)
+                .map(Some)
+                .map_err(|_| self.not_a_label(i, v))
+        })
+    }
+
+    /// The samples from `lo` to `hi` (both included) as `f32` values, placed at `offset` in a universe
+    /// of level `level`; every other sample (and a NaN) is the background. A CT's window of intensities
+    /// kept as they are, the rest of the scan left out.
+    ///
+    /// ```
+    /// use ktree::solid::volume::Volume;
+    /// use ktree::KTree;
+    /// let v = Volume::new([2, 1, 2], vec![0.5, 3.0, 7.25, 3.0], [1.0; 3]).unwrap();
+    /// let tree = KTree::from_value_runs(&v.to_window_runs(1, [0, 0, 0], 1.0, 8.0).unwrap());
+    /// assert_eq!(tree.value_at([0, 0, 1]), Some(7.25));
+    /// assert_eq!(tree.value_at([0, 0, 0]), None); // 0.5 is below the window
+    /// ```
+    ///
+    /// # Errors
+    /// [`SolidError::BadParameter`] for a window that is empty, not finite, or a volume that does not fit;
+    /// [`SolidError::Space`] for a bad level.
+    pub fn to_window_runs(
+        &self,
+        level: u32,
+        offset: [u32; 3],
+        lo: f64,
+        hi: f64,
+    ) -> Result<ValueRuns<3, f32>, SolidError> {
+        if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+            return Err(SolidError::BadParameter(format!(
+                "the window {lo}:{hi} is not two finite numbers, the first no larger"
+            )));
+        }
+        self.to_value_runs(level, offset, |_, v| {
+            Ok((lo <= v && v <= hi).then_some(v as f32))
+        })
+    }
+
+    /// The samples as valued runs along z, placed at `offset`: `value_of(index, sample)` gives each
+    /// sample's value (`None`: the background); runs of equal values are joined.
+    fn to_value_runs<V: Value>(
+        &self,
+        level: u32,
+        offset: [u32; 3],
+        value_of: impl Fn(usize, f64) -> Result<Option<V>, SolidError>,
+    ) -> Result<ValueRuns<3, V>, SolidError> {
         self.placed(level, offset)?;
         let [nx, ny, nz] = self.shape;
         let mut runs = Vec::new();
         for y in 0..ny {
             for x in 0..nx {
-                let mut current: Option<(usize, u32)> = None;
+                let mut current: Option<(usize, V)> = None;
                 for z in 0..=nz {
-                    let label = if z < nz {
+                    let value = if z < nz {
                         let i = x + nx * (y + ny * z);
-                        let v = self.values[i];
-                        if !(v >= 0.0 && v <= f64::from(u32::MAX) && v.fract() == 0.0) {
-                            return Err(self.not_a_label(i, v));
-                        }
-                        v as u32
+                        value_of(i, self.values[i])?
                     } else {
-                        0
+                        None
                     };
-                    match current {
-                        Some((_, l)) if l == label => continue,
-                        Some((start, l)) => {
-                            let value = V::try_from(l).map_err(|_| {
-                                self.not_a_label(x + nx * (y + ny * start), f64::from(l))
-                            })?;
+                    match (current, value) {
+                        (Some((_, a)), Some(b)) if a.same(b) => continue,
+                        (Some((start, a)), _) => {
                             let p = [
                                 offset[0] + x as u32,
                                 offset[1] + y as u32,
                                 offset[2] + start as u32,
                             ];
-                            runs.push((Ray::new(p, offset[2] + z as u32), value));
+                            runs.push((Ray::new(p, offset[2] + z as u32), a));
                         }
-                        None => {}
+                        (None, _) => {}
                     }
-                    current = (label != 0).then_some((z, label));
+                    current = value.map(|v| (z, v));
                 }
             }
         }

@@ -179,3 +179,36 @@ fn openvdb_module(python: &Path) -> Result<String, String> {
         ))
     }
 }
+
+/// A Python interpreter that imports `module` (the first of `python3` on the `PATH` and Debian's
+/// `/usr/bin/python3` that does, where Debian's `python3-…` packages install), or `None` after [`missing`]
+/// with `install`.
+///
+/// ```
+/// // `sys` is always there; a test asks for e.g. `nibabel`.
+/// if let Some(python) = ktree_verify::tools::require_python_module("sys", "install Python 3") {
+///     assert!(std::process::Command::new(python).arg("-V").status().unwrap().success());
+/// }
+/// ```
+#[track_caller]
+pub fn require_python_module(module: &str, install: &str) -> Option<PathBuf> {
+    let mut tried = Vec::new();
+    for python in ["python3", "/usr/bin/python3"] {
+        let ok = Command::new(python)
+            .args(["-c", &format!("import {module}")])
+            .output()
+            .is_ok_and(|o| o.status.success());
+        if ok {
+            return Some(PathBuf::from(python));
+        }
+        tried.push(python);
+    }
+    missing(
+        &format!(
+            "a Python that imports {module} (tried {})",
+            tried.join(", ")
+        ),
+        install,
+    );
+    None
+}

@@ -1,4 +1,4 @@
-//! Other tools' grid formats: binvox, OctoMap's `.bt` and OpenVDB's `.vdb`, all octrees, placed in a ktree
+//! Other tools' grid formats: binvox, OctoMap's `.bt` and OpenVDB's `.vdb`, all octrees, and NIfTI volumes out, placed in a ktree
 //! universe by a shared [`GridPlacement`] (ktree voxel = grid index + offset) with their world metadata
 //! ([`GridMeta`]).
 //!
@@ -20,6 +20,8 @@
 mod binvox;
 mod blosc;
 mod grid;
+#[cfg(feature = "volume")]
+mod nifti;
 mod octomap;
 mod vdb;
 mod vdb_level_set;
@@ -27,6 +29,8 @@ mod vdb_values;
 
 pub use binvox::{read_binvox, write_binvox, BINVOX_MAX_DIM};
 pub use grid::{GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree};
+#[cfg(feature = "volume")]
+pub use nifti::{write_nifti_file, NiftiWriteError};
 pub use octomap::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
 pub use vdb::{read_vdb, write_vdb};
 pub use vdb_level_set::write_vdb_level_set;

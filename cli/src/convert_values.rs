@@ -1,0 +1,123 @@
+//! `ktree convert` of a tree with values (a version 3 `.ktree`) and `ktree voxelize VOLUME --window LO:HI`:
+//! the values go to a NIfTI volume (`.nii`, `.nii.gz`: labels, densities or colours as its samples) or to
+//! another `.ktree`; a volume's window of intensities comes in as `float32` values.
+
+use std::path::Path;
+
+use ktree::io::ktree::v3::{read_valued_ktree, write_valued_ktree_file};
+use ktree::io::write_nifti_file;
+use ktree::solid::volume::Volume;
+use ktree::space::WorldFrame;
+use ktree::value::{Dtype, Rgb, Value};
+use ktree::KTree;
+
+use crate::common::error::{chain, CliError, CliResult};
+use crate::outln;
+
+/// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz` or `.ktree`), placed by `frame`.
+pub fn convert_valued(input: &Path, output: &Path, frame: &WorldFrame) -> CliResult {
+    let (k, dtype) = crate::values::file_dtype(input)?;
+    let dtype = dtype.ok_or_else(|| format!("{}: the tree holds no values", input.display()))?;
+    let name = output.to_string_lossy();
+    let nifti = name.ends_with(".nii") || name.ends_with(".nii.gz");
+    let ktree = name.ends_with(".ktree");
+    if !(nifti || ktree) {
+        return Err(format!(
+            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz) or .ktree",
+            output.display(),
+            dtype.name()
+        )
+        .into());
+    }
+    if nifti && k != 3 {
+        return Err(format!(
+            "{}: NIfTI volumes hold octrees (K = 3); {} has K = {k}",
+            output.display(),
+            input.display()
+        )
+        .into());
+    }
+    match (k, dtype) {
+        (3, Dtype::U8) => write_octree::<u8>(input, output, frame),
+        (3, Dtype::U16) => write_octree::<u16>(input, output, frame),
+        (3, Dtype::U32) => write_octree::<u32>(input, output, frame),
+        (3, Dtype::I8) => write_octree::<i8>(input, output, frame),
+        (3, Dtype::F32) => write_octree::<f32>(input, output, frame),
+        (3, Dtype::Rgb) => write_octree::<Rgb>(input, output, frame),
+        _ => {
+            // Any other K: a .ktree to a .ktree is a checked copy.
+            let bytes = std::fs::read(input)
+                .map_err(|e| format!("{}: cannot read: {e}", input.display()))?;
+            ktree::fs::write_atomic(output, &bytes).map_err(CliError::caused)?;
+            outln!("{}: copied (K = {k}, {})", output.display(), dtype.name());
+            Ok(())
+        }
+    }
+}
+
+fn write_octree<V: Value>(input: &Path, output: &Path, frame: &WorldFrame) -> CliResult {
+    let name = input.display().to_string();
+    let bytes = std::fs::read(input).map_err(|e| format!("{name}: cannot read: {e}"))?;
+    let tree = read_valued_ktree::<3, V>(&bytes, &name).map_err(|e| chain(&e))?;
+    if output.extension().is_some_and(|e| e == "ktree") {
+        write_valued_ktree_file(output, &tree).map_err(CliError::caused)?;
+    } else {
+        write_nifti_file(output, &tree, frame).map_err(CliError::caused)?;
+    }
+    outln!(
+        "{}: K = 3, L = {}, {} values, {} nodes, {} voxels",
+        output.display(),
+        tree.level(),
+        V::DTYPE.map_or("", Dtype::name),
+        tree.node_count(),
+        tree.voxel_count()
+    );
+    Ok(())
+}
+
+/// `ktree voxelize VOLUME --window LO:HI`: the samples from `lo` to `hi` kept as `float32` values.
+pub fn voxelize_window(
+    input: &Path,
+    window: (f64, f64),
+    level: Option<u32>,
+    offset: [u32; 3],
+    out: &Path,
+) -> CliResult {
+    let volume = Volume::read(input).map_err(CliError::caused)?;
+    let fits = [0, 1, 2].map(|a| offset[a] as usize + volume.shape()[a]);
+    let level = level.unwrap_or_else(|| {
+        let m = fits.into_iter().max().unwrap_or(1).max(1);
+        m.next_power_of_two().trailing_zeros()
+    });
+    let runs = volume
+        .to_window_runs(level, offset, window.0, window.1)
+        .map_err(|e| format!("{}: {e}", input.display()))?;
+    let tree = KTree::from_value_runs(&runs);
+    write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
+    outln!(
+        "{}: {} voxels from {} to {} kept as float32, L = {level}, {} nodes",
+        out.display(),
+        tree.voxel_count(),
+        window.0,
+        window.1,
+        tree.node_count()
+    );
+    Ok(())
+}
+
+/// A window `LO:HI` of two numbers.
+pub fn parse_window(text: &str) -> Result<(f64, f64), String> {
+    let (lo, hi) = text
+        .split_once(':')
+        .ok_or_else(|| format!("'{text}': expected LO:HI"))?;
+    let number = |t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{t}' in '{text}' is not a number"))
+    };
+    let (lo, hi) = (number(lo)?, number(hi)?);
+    if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+        return Err(format!("'{text}': LO and HI are finite and LO ≤ HI"));
+    }
+    Ok((lo, hi))
+}
