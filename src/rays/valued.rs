@@ -96,13 +96,45 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
     /// [`DENSE_LIMIT`] voxels or an array of another length; [`RayError::Value`]
     /// for a NaN.
     pub fn from_dense(level: u32, dense: &[Option<V>]) -> Result<Self, RayError> {
+        Self::from_dense_by(level, dense.len(), |i| dense[i])
+    }
+
+    /// The runs of a dense array of values (axis 0 fastest, see [`Universe::dense_index`]) where
+    /// `background` means empty: a numpy or NIfTI volume as it is stored.
+    ///
+    /// ```
+    /// use ktree::rays::ValueRuns;
+    /// use ktree::KTree;
+    /// // A 2 × 2 quadtree universe: (0,0) = 5, (1,0) = 0, (0,1) = 5, (1,1) = 9; 0 is the background.
+    /// let runs = ValueRuns::<2, u16>::from_dense_background(1, &[5, 0, 5, 9], 0).unwrap();
+    /// assert_eq!(runs.len(), 2); // column x = 0 is one run of 5s; column x = 1 holds the 9
+    /// let tree = KTree::from_value_runs(&runs);
+    /// assert_eq!(tree.to_dense_values().unwrap(), [Some(5), None, Some(5), Some(9)]);
+    /// ```
+    ///
+    /// # Errors
+    /// As [`ValueRuns::from_dense`].
+    pub fn from_dense_background(level: u32, dense: &[V], background: V) -> Result<Self, RayError> {
+        Self::from_dense_by(level, dense.len(), |i| {
+            let v = dense[i];
+            (!v.same(background)).then_some(v)
+        })
+    }
+
+    /// The runs of a dense array of `len` voxels whose voxel `i` is `at(i)`. The array is read in its
+    /// order (one pass, the runs of every column open at once), then the runs are sorted by column.
+    fn from_dense_by(
+        level: u32,
+        len: usize,
+        at: impl Fn(usize) -> Option<V>,
+    ) -> Result<Self, RayError> {
         let universe = Universe::<K>::new(level)?;
-        let len = universe.dense_len(DENSE_LIMIT)?;
-        if dense.len() != len {
+        let want = universe.dense_len(DENSE_LIMIT)?;
+        if len != want {
             return Err(RayError::Space(
                 crate::space::SpaceError::TooLargeForDense {
-                    voxels: dense.len() as u128,
-                    limit: len as u128,
+                    voxels: len as u128,
+                    limit: want as u128,
                 },
             ));
         }
@@ -110,26 +142,26 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
         let side = universe.side() as usize;
         // The last axis is the slowest of the dense order: voxel z of column c is at c + z · side^(K−1).
         let stride = len / side;
+        let mut open: Vec<Option<ValueRun<V>>> = vec![None; stride];
         let mut runs = Vec::new();
-        for c in 0..stride {
-            let column = keys.pack(universe.dense_point(c));
-            let mut current: Option<ValueRun<V>> = None;
-            for z in 0..side {
-                let v = dense[c + z * stride];
+        for z in 0..=side {
+            for (c, current) in open.iter_mut().enumerate() {
+                let v = if z < side { at(c + z * stride) } else { None };
                 if let Some(v) = v {
                     v.check().map_err(|e| RayError::Value {
                         index: c + z * stride,
                         error: e,
                     })?;
                 }
-                match (&mut current, v) {
+                match (&mut *current, v) {
                     (Some(run), Some(v)) if run.value.same(v) => run.z2 += 1,
+                    (None, None) => {}
                     (cur, v) => {
                         if let Some(run) = cur.take() {
                             runs.push(run);
                         }
                         *cur = v.map(|value| ValueRun {
-                            column,
+                            column: keys.pack(universe.dense_point(c)),
                             z1: z as u32,
                             z2: z as u32 + 1,
                             value,
@@ -137,10 +169,8 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
                     }
                 }
             }
-            runs.extend(current);
         }
-        // Columns in key order: dense order has axis 0 fastest, keys axis 0 most significant.
-        runs.sort_by_key(|r| (r.column, r.z1));
+        runs.sort_unstable_by_key(|r| (r.column, r.z1));
         Ok(Self { universe, runs })
     }
 

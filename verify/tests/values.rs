@@ -164,6 +164,18 @@ fn from_runs<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseE
     let got = KTree::from_value_runs(&single);
     got.assert_well_formed();
     prop_assert!(got == want);
+    // A dense array of plain values with a background: the palette's first value is empty there.
+    let background = V::PALETTE[0];
+    let plain: Vec<V> = dense.iter().map(|v| v.unwrap_or(background)).collect();
+    let emptied: Vec<Option<V>> = plain
+        .iter()
+        .map(|&v| (!v.same(background)).then_some(v))
+        .collect();
+    let want = KTree::<K, V>::from_dense_values(o.level, &emptied).unwrap();
+    let runs = ValueRuns::<K, V>::from_dense_background(o.level, &plain, background).unwrap();
+    let got = KTree::from_value_runs(&runs);
+    got.assert_well_formed();
+    prop_assert!(got == want);
     Ok(())
 }
 
