@@ -302,8 +302,7 @@ impl<const K: usize, V: Value> KTree<K, V> {
     /// assert_eq!(t.values_at(&[[0], [2], [3], [9]]), [Some(5), None, Some(6), None]);
     /// ```
     pub fn values_at(&self, points: &[[u32; K]]) -> Vec<Option<V>> {
-        use rayon::prelude::*;
-        points.par_iter().map(|&p| self.value_at(p)).collect()
+        crate::tree::storage::infallible(crate::query::values_at(self, points))
     }
 
     /// The tree as valued runs along the last axis: each full leaf's columns, one run each (touching runs

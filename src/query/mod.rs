@@ -30,6 +30,7 @@ pub mod nearest;
 pub mod points;
 pub mod ray;
 pub mod stats;
+pub mod values;
 
 pub use boxes::{bounding_box, count, crop, VoxelBox};
 pub use dense::{dense_window, dense_window_into, window_voxels, DenseError, DenseOrder};
@@ -37,6 +38,7 @@ pub use nearest::{distance, nearest, nearest_many, nearest_many_signed, nearest_
 pub use points::{contains, contains_many, contains_many_signed, PointCursor};
 pub use ray::{cast_ray, cast_rays, Face, RayCast, RayError, RayHit};
 pub use stats::{stats, TreeStats};
+pub use values::values_at;
 
 use crate::tree::storage::{infallible, TreeStorage};
 use crate::KTree;

@@ -115,10 +115,71 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
     /// # Errors
     /// As [`ValueRuns::from_dense`].
     pub fn from_dense_background(level: u32, dense: &[V], background: V) -> Result<Self, RayError> {
-        Self::from_dense_by(level, dense.len(), |i| {
-            let v = dense[i];
-            (!v.same(background)).then_some(v)
-        })
+        let universe = Universe::<K>::new(level)?;
+        let len = check_dense_len(universe, dense.len())?;
+        let keys = ColumnKeys::<K>::new(level);
+        let side = universe.side() as usize;
+        let stride = len / side;
+        // Row by row of the slowest axis: a voxel equal to the one below it (the same column, one step
+        // down the last axis) extends that column's run or its emptiness, so only the voxels that differ
+        // from the one below — few in a volume of regions — are looked at further. `start[c]` is where the
+        // run open in column c started.
+        let mut start = vec![0u32; stride];
+        let mut runs = Vec::new();
+        let filled = |v: V| (!v.same(background)).then_some(v);
+        // Where column c's value changes from `before` (at z − 1) to `now` (at z).
+        let mut change = |c: usize, z: usize, before: Option<V>, now: Option<V>| {
+            if let Some(value) = before {
+                runs.push(ValueRun {
+                    column: keys.pack(universe.dense_point(c)),
+                    z1: start[c],
+                    z2: z as u32,
+                    value,
+                });
+            }
+            if let Some(v) = now {
+                v.check().map_err(|e| RayError::Value {
+                    index: c + z * stride,
+                    error: e,
+                })?;
+                start[c] = z as u32;
+            }
+            Ok::<(), RayError>(())
+        };
+        for (c, &v) in dense[..stride].iter().enumerate() {
+            if let Some(v) = filled(v) {
+                change(c, 0, None, Some(v))?;
+            }
+        }
+        const CHUNK: usize = 16;
+        for z in 1..side {
+            let below = &dense[(z - 1) * stride..z * stride];
+            let row = &dense[z * stride..(z + 1) * stride];
+            for (i, (b, r)) in below.chunks(CHUNK).zip(row.chunks(CHUNK)).enumerate() {
+                // Compared without stopping early, so that the loop is vectorised.
+                if b.iter().zip(r).fold(true, |all, (x, y)| all & x.same(*y)) {
+                    continue;
+                }
+                for (j, (&x, &y)) in b.iter().zip(r).enumerate() {
+                    if !x.same(y) {
+                        let (before, now) = (filled(x), filled(y));
+                        match (before, now) {
+                            (Some(_), Some(_)) | (None, Some(_)) | (Some(_), None) => {
+                                change(i * CHUNK + j, z, before, now)?;
+                            }
+                            (None, None) => {}
+                        }
+                    }
+                }
+            }
+        }
+        for (c, &v) in dense[(side - 1) * stride..].iter().enumerate() {
+            if let Some(v) = filled(v) {
+                change(c, side, Some(v), None)?;
+            }
+        }
+        runs.sort_unstable_by_key(|r| (r.column, r.z1));
+        Ok(Self { universe, runs })
     }
 
     /// The runs of a dense array of `len` voxels whose voxel `i` is `at(i)`. The array is read in its
@@ -129,15 +190,7 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
         at: impl Fn(usize) -> Option<V>,
     ) -> Result<Self, RayError> {
         let universe = Universe::<K>::new(level)?;
-        let want = universe.dense_len(DENSE_LIMIT)?;
-        if len != want {
-            return Err(RayError::Space(
-                crate::space::SpaceError::TooLargeForDense {
-                    voxels: len as u128,
-                    limit: want as u128,
-                },
-            ));
-        }
+        check_dense_len(universe, len)?;
         let keys = ColumnKeys::<K>::new(level);
         let side = universe.side() as usize;
         // The last axis is the slowest of the dense order: voxel z of column c is at c + z · side^(K−1).
@@ -198,4 +251,18 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
     pub fn voxel_count(&self) -> u128 {
         self.runs.iter().map(|r| u128::from(r.z2 - r.z1)).sum()
     }
+}
+
+/// The universe's voxel count, checked to be `len` and to fit a dense array.
+fn check_dense_len<const K: usize>(universe: Universe<K>, len: usize) -> Result<usize, RayError> {
+    let want = universe.dense_len(DENSE_LIMIT)?;
+    if len != want {
+        return Err(RayError::Space(
+            crate::space::SpaceError::TooLargeForDense {
+                voxels: len as u128,
+                limit: want as u128,
+            },
+        ));
+    }
+    Ok(want)
 }

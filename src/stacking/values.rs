@@ -1,11 +1,14 @@
-//! Building a valued tree from valued runs ([`ValueRuns`]): from the root down, each cell holds the pieces
-//! of the runs inside it; a cell is a leaf when no run enters it (empty) or when every column of the cell
-//! is covered by one piece, all of one value (full of it); otherwise its pieces are cut among its `2^K`
-//! children. Blocks of children that turn out alike are joined from the bottom up
-//! ([`build_top_down`]), so the tree is minimal whatever the runs (touching runs of one value included).
+//! Building a valued tree from valued runs ([`ValueRuns`]), depth first: a cell is a leaf when no run
+//! enters it (empty) or when every column of the cell is covered by one piece of a run, all of one value
+//! (full of it); otherwise its pieces are distributed among its `2^K` children (a piece crossing the
+//! middle of the last axis is cut in two) and each child is built in turn. A block of children that turns
+//! out alike (all empty, or all full of one value) is taken back and its parent becomes that leaf, so the
+//! tree is minimal whatever the runs (touching runs of one value included) — Akman & Franklin's
+//! combination of aligned equal blocks, generalised to values.
 //!
-//! Cost: each run is cut once per level it crosses a cell boundary in, and each cell with children sorts
-//! its pieces among its children — about `O(2^K · pieces)` per level.
+//! The nodes of a level are met in the order of a depth-first walk, which is the level order. Cost: each
+//! piece is placed once per level it lives in (a counting sort among the children, no allocation past one
+//! buffer a level) — `O(pieces · L)`.
 //!
 //! ```
 //! use ktree::rays::ValueRuns;
@@ -17,8 +20,8 @@
 
 use crate::rays::{ColumnKeys, ValueRun, ValueRuns};
 use crate::space::Cell;
-use crate::tree::top_down::{build_top_down, Decision};
-use crate::tree::TreeError;
+use crate::tree::top_down::pack;
+use crate::tree::valued::{combine, ValueState};
 use crate::value::Value;
 use crate::KTree;
 
@@ -26,63 +29,100 @@ impl<const K: usize, V: Value> KTree<K, V> {
     /// The minimal valued tree of `runs`.
     pub fn from_value_runs(runs: &ValueRuns<K, V>) -> KTree<K, V> {
         let universe = runs.universe();
-        let keys = ColumnKeys::<K>::new(universe.level());
-        let out = build_top_down::<K, V, (Cell<K>, Vec<ValueRun<V>>), TreeError>(
-            universe.level(),
-            (universe.root(), runs.runs().to_vec()),
-            |_, (cell, pieces)| Ok(decide(cell, pieces)),
-            |(cell, pieces), code| Ok(cut(&keys, cell, pieces, code)),
-        );
-        out.expect("the runs' values were checked when the runs were made")
+        let depths = universe.level() as usize + 1;
+        let mut builder = DepthFirst {
+            keys: ColumnKeys::<K>::new(universe.level()),
+            levels: vec![Vec::new(); depths],
+            scratch: vec![Vec::new(); depths + 1],
+        };
+        let root = builder.node(universe.root(), runs.runs(), 0);
+        builder.levels[0].push(root);
+        pack(universe, builder.levels)
     }
 }
 
-/// The pieces of a cell's pieces inside its child `code`, clipped to the child's `z` range.
-fn cut<const K: usize, V: Value>(
-    keys: &ColumnKeys<K>,
-    cell: &Cell<K>,
-    pieces: &[ValueRun<V>],
-    code: usize,
-) -> (Cell<K>, Vec<ValueRun<V>>) {
-    let child = cell.child(code);
-    let half = child.side() as u32;
-    let (z0, z1) = (child.origin[K - 1], child.origin[K - 1] + half);
-    let inside = pieces
-        .iter()
-        .filter(|p| {
-            p.z1 < z1
-                && p.z2 > z0
-                && (0..K - 1).all(|a| {
-                    let x = keys.axis(p.column, a);
-                    x >= child.origin[a] && x < child.origin[a] + half
-                })
-        })
-        .map(|p| ValueRun {
-            z1: p.z1.max(z0),
-            z2: p.z2.min(z1),
-            ..*p
-        })
-        .collect();
-    (child, inside)
+/// The state of a depth-first build: the settled states of each level so far, and one buffer a level for
+/// the pieces of the children of the cell being built there.
+struct DepthFirst<const K: usize, V> {
+    keys: ColumnKeys<K>,
+    levels: Vec<Vec<ValueState<V>>>,
+    scratch: Vec<Vec<ValueRun<V>>>,
 }
 
-/// A cell's decision from the pieces of runs inside it (clipped to its `z` range).
-fn decide<const K: usize, V: Value>(cell: &Cell<K>, pieces: &[ValueRun<V>]) -> Decision<V> {
-    let Some(first) = pieces.first() else {
-        return Decision::Leaf(None);
-    };
-    let side = cell.side();
-    let columns = u128::from(side).pow(K as u32 - 1);
-    let z0 = cell.origin[K - 1];
-    let uniform = pieces.len() as u128 == columns
-        && pieces.iter().all(|p| {
-            u64::from(p.z1) == u64::from(z0)
-                && u64::from(p.z2) == u64::from(z0) + side
-                && p.value.same(first.value)
-        });
-    if uniform {
-        Decision::Leaf(Some(first.value))
-    } else {
-        Decision::Split
+impl<const K: usize, V: Value> DepthFirst<K, V> {
+    /// Builds the subtree of `cell` (at `depth`) from the pieces inside it (clipped to its `z` range);
+    /// returns the cell's state, its children (if any) pushed onto the level below.
+    fn node(&mut self, cell: Cell<K>, pieces: &[ValueRun<V>], depth: usize) -> ValueState<V> {
+        let Some(first) = pieces.first() else {
+            return ValueState::Empty;
+        };
+        let side = cell.side();
+        let z0 = cell.origin()[K - 1];
+        let columns = u128::from(side).pow(K as u32 - 1);
+        if pieces.len() as u128 == columns
+            && pieces.iter().all(|p| {
+                p.z1 == z0 && u64::from(p.z2) == u64::from(z0) + side && p.value.same(first.value)
+            })
+        {
+            return ValueState::Full(first.value);
+        }
+        // Not a leaf, so not a voxel (a voxel's one piece covers it): distribute among the children.
+        let half_log = cell.log_side() - 1;
+        let mid = z0 + (1u32 << half_log);
+        let z_bit = 1usize << (K - 1);
+        let code_of = |p: &ValueRun<V>| {
+            (0..K - 1).fold(0usize, |code, a| {
+                code | (((self.keys.axis(p.column, a) >> half_log) & 1) as usize) << a
+            })
+        };
+        let n = 1usize << K;
+        let mut start = [0usize; 17];
+        for p in pieces {
+            let c = code_of(p);
+            if p.z1 < mid {
+                start[c + 1] += 1;
+            }
+            if p.z2 > mid {
+                start[(c | z_bit) + 1] += 1;
+            }
+        }
+        for c in 0..n {
+            start[c + 1] += start[c];
+        }
+        let mut buffer = std::mem::take(&mut self.scratch[depth + 1]);
+        buffer.clear();
+        buffer.resize(start[n], *first);
+        let mut at = start;
+        for p in pieces {
+            let c = code_of(p);
+            if p.z1 < mid {
+                buffer[at[c]] = ValueRun {
+                    z2: p.z2.min(mid),
+                    ..*p
+                };
+                at[c] += 1;
+            }
+            if p.z2 > mid {
+                buffer[at[c | z_bit]] = ValueRun {
+                    z1: p.z1.max(mid),
+                    ..*p
+                };
+                at[c | z_bit] += 1;
+            }
+        }
+        let mut kids = [ValueState::Empty; 16];
+        for (code, kid) in kids.iter_mut().enumerate().take(n) {
+            *kid = self.node(
+                cell.child(code),
+                &buffer[start[code]..start[code + 1]],
+                depth + 1,
+            );
+        }
+        self.scratch[depth + 1] = buffer;
+        let state = combine(&kids[..n]);
+        if state.has_children() {
+            self.levels[depth + 1].extend_from_slice(&kids[..n]);
+        }
+        state
     }
 }

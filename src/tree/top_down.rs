@@ -123,6 +123,15 @@ fn settle<const K: usize, V: Value>(
         }
         children.truncate(kept * n);
     }
+    pack(universe, levels)
+}
+
+/// Packs settled levels of states (level order, a node with children followed by its `2^K` children in
+/// the level below) into a tree; trailing empty levels are dropped.
+pub(crate) fn pack<const K: usize, V: Value>(
+    universe: Universe<K>,
+    mut levels: Vec<Vec<ValueState<V>>>,
+) -> KTree<K, V> {
     while levels.len() > 1 && levels.last().is_some_and(Vec::is_empty) {
         levels.pop();
     }

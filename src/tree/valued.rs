@@ -406,9 +406,13 @@ impl<const K: usize, V: Value> KTree<K, V> {
             levels
                 .iter()
                 .zip(values)
-                .map(|(level, values)| LevelValues {
-                    rank: FullRank::new(level),
-                    values,
+                .map(|(level, mut values)| {
+                    // Built by pushing: the slack of growth is given back.
+                    values.shrink_to_fit();
+                    LevelValues {
+                        rank: FullRank::new(level),
+                        values,
+                    }
                 })
                 .collect()
         } else {

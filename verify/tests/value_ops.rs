@@ -109,6 +109,22 @@ fn check<const K: usize, V: Palette>(a: &Painted<K>, b: &Painted<K>) -> Result<(
     for (g, w) in got.iter().zip(&da) {
         prop_assert_eq!(g.map(Value::key), w.map(Value::key));
     }
+    // A batch large enough to be answered through the table of the top levels, with points outside.
+    let many: Vec<[u32; K]> = (0..70_000usize)
+        .map(|i| {
+            let p = u.dense_point(i.wrapping_mul(7919) % da.len());
+            if i % 97 == 0 {
+                std::array::from_fn(|a| p[a] + if a == i % K { u.side() as u32 } else { 0 })
+            } else {
+                p
+            }
+        })
+        .collect();
+    let got = ta.values_at(&many);
+    for (g, p) in got.iter().zip(&many) {
+        let want = u.check_point(*p).ok().and_then(|()| da[u.dense_index(*p)]);
+        prop_assert_eq!(g.map(Value::key), want.map(Value::key), "at {:?}", p);
+    }
     same(&KTree::from_value_runs(&ta.to_value_runs()), &ta)?;
     let side = u.side() as i64;
     let t: [i64; K] = std::array::from_fn(|a| {

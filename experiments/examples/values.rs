@@ -1,0 +1,219 @@
+//! The ktree side of `experiments/values.sh` (results/performance/values.md): trees with values built from a
+//! dense volume, and values read at random points, timed on one thread beside OpenVDB
+//! (experiments/values/peers.cpp) reading the same files.
+//!
+//! ```text
+//! values phantom L DIR                 write DIR/labels-L.raw (u32) and DIR/density-L.raw (f32), x fastest
+//! values build labels|density L DIR R  build from the raw file (best of R), then 10^7 values (best of R)
+//! values bits L DIR                    bits a node of the phantom's tree for every value type
+//! ```
+//!
+//! The volume is the 3-D Shepp–Logan head phantom (ten ellipsoids, Kak & Slaney's table as extended to 3-D
+//! by Schabel's `phantom3d`, the "modified" intensities; the rotations about z only): its density is the sum
+//! of the intensities of the ellipsoids holding a voxel's centre, its label the last such ellipsoid (1–10),
+//! 0 outside. `build` prints `key=value` lines: `seconds`, `nodes`, `voxels`, `heap_bytes`,
+//! `query_seconds`, `checksum` (the sum of the values at the points, 0 where empty).
+
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+use ktree::rays::ValueRuns;
+use ktree::value::{Rgb, Value};
+use ktree::KTree;
+
+/// Points asked for.
+const POINTS: usize = 10_000_000;
+
+/// `[intensity, a, b, c, x0, y0, z0, phi°]` of the ten ellipsoids, in a cube of side 2 centred on 0.
+const ELLIPSOIDS: [[f64; 8]; 10] = [
+    [1.0, 0.69, 0.92, 0.81, 0.0, 0.0, 0.0, 0.0],
+    [-0.8, 0.6624, 0.874, 0.78, 0.0, -0.0184, 0.0, 0.0],
+    [-0.2, 0.11, 0.31, 0.22, 0.22, 0.0, 0.0, -18.0],
+    [-0.2, 0.16, 0.41, 0.28, -0.22, 0.0, 0.0, 18.0],
+    [0.1, 0.21, 0.25, 0.41, 0.0, 0.35, -0.15, 0.0],
+    [0.1, 0.046, 0.046, 0.05, 0.0, 0.1, 0.25, 0.0],
+    [0.1, 0.046, 0.046, 0.05, 0.0, -0.1, 0.25, 0.0],
+    [0.1, 0.046, 0.023, 0.05, -0.08, -0.605, 0.0, 0.0],
+    [0.1, 0.023, 0.023, 0.02, 0.0, -0.606, 0.0, 0.0],
+    [0.1, 0.023, 0.046, 0.02, 0.06, -0.605, 0.0, 0.0],
+];
+
+/// The phantom's label (0 outside) and density at voxel `(x, y, z)` of a universe of side `u`.
+fn phantom(u: usize, x: usize, y: usize, z: usize) -> (u32, f32) {
+    let c = |i: usize| (2.0 * i as f64 + 1.0) / u as f64 - 1.0;
+    let (px, py, pz) = (c(x), c(y), c(z));
+    let (mut label, mut density) = (0, 0.0f64);
+    for (n, e) in ELLIPSOIDS.iter().enumerate() {
+        let (s, co) = e[7].to_radians().sin_cos();
+        let (dx, dy, dz) = (px - e[4], py - e[5], pz - e[6]);
+        let (rx, ry) = (co * dx + s * dy, -s * dx + co * dy);
+        if (rx / e[1]).powi(2) + (ry / e[2]).powi(2) + (dz / e[3]).powi(2) <= 1.0 {
+            label = n as u32 + 1;
+            density += e[0];
+        }
+    }
+    // Rounded to a thousandth: the sums of the table's intensities without floating-point noise.
+    // (+ 0.0 turns a -0.0 into 0.0: the background.)
+    (label, ((density * 1000.0).round() / 1000.0 + 0.0) as f32)
+}
+
+fn write_phantom(level: u32, dir: &Path) {
+    let u = 1usize << level;
+    let mut labels = std::io::BufWriter::new(
+        std::fs::File::create(dir.join(format!("labels-{level}.raw"))).unwrap(),
+    );
+    let mut density = std::io::BufWriter::new(
+        std::fs::File::create(dir.join(format!("density-{level}.raw"))).unwrap(),
+    );
+    for z in 0..u {
+        for y in 0..u {
+            for x in 0..u {
+                let (l, d) = phantom(u, x, y, z);
+                labels.write_all(&l.to_le_bytes()).unwrap();
+                density.write_all(&d.to_le_bytes()).unwrap();
+            }
+        }
+    }
+    labels.flush().unwrap();
+    density.flush().unwrap();
+}
+
+/// The raw file's values.
+fn read_raw<V: Value>(path: &Path) -> Vec<V> {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    bytes.chunks_exact(4).map(V::read_le).collect()
+}
+
+/// The value whose bytes are all 0: the background.
+fn zero<V: Value>() -> V {
+    V::read_le(&vec![0; V::DTYPE.map_or(0, |d| d.bytes())])
+}
+
+/// splitmix64: the same points as the OpenVDB program's.
+fn points(level: u32) -> Vec<[u32; 3]> {
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    };
+    let mask = (1u64 << level) - 1;
+    (0..POINTS)
+        .map(|_| {
+            let r = next();
+            [r & mask, (r >> 21) & mask, (r >> 42) & mask].map(|c| c as u32)
+        })
+        .collect()
+}
+
+fn build<V: Value>(level: u32, raw: &Path, repeats: usize, as_f64: impl Fn(V) -> f64) {
+    let dense: Vec<V> = read_raw(raw);
+    let background = zero::<V>();
+    let mut best = f64::INFINITY;
+    let mut tree = None;
+    for _ in 0..repeats {
+        drop(tree.take());
+        let start = Instant::now();
+        let runs = ValueRuns::<3, V>::from_dense_background(level, &dense, background).unwrap();
+        let scanned = start.elapsed().as_secs_f64();
+        let built = KTree::from_value_runs(&runs);
+        best = best.min(start.elapsed().as_secs_f64());
+        if std::env::var_os("VALUES_SPLIT").is_some() {
+            eprintln!(
+                "scan {scanned:.4} s, {} runs, total {:.4} s",
+                runs.len(),
+                start.elapsed().as_secs_f64()
+            );
+        }
+        tree = Some(built);
+    }
+    let tree = tree.unwrap();
+    drop(dense);
+    println!("seconds={best}");
+    println!("nodes={}", tree.node_count());
+    println!("voxels={}", tree.voxel_count());
+    println!("heap_bytes={}", tree.heap_bytes());
+    let points = points(level);
+    let mut best = f64::INFINITY;
+    let mut checksum = 0.0;
+    for _ in 0..repeats {
+        let start = Instant::now();
+        let values = tree.values_at(&points);
+        best = best.min(start.elapsed().as_secs_f64());
+        checksum = values.iter().map(|v| v.map_or(0.0, &as_f64)).sum();
+    }
+    println!("query_seconds={best}");
+    println!("checksum={checksum}");
+}
+
+/// Bits a node of the phantom's labels as each value type (the labels' colours from a palette for RGB),
+/// and of its density as `f32`; and of the shape without values.
+fn bits(level: u32, dir: &Path) {
+    let labels: Vec<u32> = read_raw(&dir.join(format!("labels-{level}.raw")));
+    fn report<V: Value>(name: &str, dense: &[V], level: u32) {
+        let runs = ValueRuns::<3, V>::from_dense_background(level, dense, zero::<V>()).unwrap();
+        let tree = KTree::from_value_runs(&runs);
+        let c = tree.counts();
+        println!(
+            "bits {name} {} {} {}",
+            tree.node_count(),
+            c.full,
+            tree.heap_bytes()
+        );
+    }
+    let u8s: Vec<u8> = labels.iter().map(|&l| l as u8).collect();
+    let u16s: Vec<u16> = labels.iter().map(|&l| l as u16).collect();
+    let i8s: Vec<i8> = labels.iter().map(|&l| l as i8).collect();
+    let rgbs: Vec<Rgb> = labels
+        .iter()
+        .map(|&l| {
+            if l == 0 {
+                [0; 3]
+            } else {
+                [l as u8 * 20, 255 - l as u8 * 20, 128]
+            }
+        })
+        .collect();
+    report("uint8", &u8s, level);
+    report("int8", &i8s, level);
+    report("uint16", &u16s, level);
+    report("uint32", &labels, level);
+    report("rgb", &rgbs, level);
+    let density: Vec<f32> = read_raw(&dir.join(format!("density-{level}.raw")));
+    report("float32", &density, level);
+    let shape: Vec<bool> = labels.iter().map(|&l| l != 0).collect();
+    let tree = KTree::<3>::from_dense(level, &shape).unwrap();
+    println!(
+        "bits none {} {} {}",
+        tree.node_count(),
+        tree.counts().full,
+        tree.heap_bytes()
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let arg = |i: usize| args.get(i).map(String::as_str).unwrap_or_default();
+    let level = |i: usize| -> u32 { arg(i).parse().expect("a level") };
+    match arg(0) {
+        "phantom" => write_phantom(level(1), Path::new(arg(2))),
+        "bits" => bits(level(1), Path::new(arg(2))),
+        "build" => {
+            let (l, dir) = (level(2), Path::new(arg(3)));
+            let repeats = arg(4).parse().unwrap_or(3);
+            match arg(1) {
+                "labels" => {
+                    build::<u32>(l, &dir.join(format!("labels-{l}.raw")), repeats, f64::from)
+                }
+                _ => build::<f32>(l, &dir.join(format!("density-{l}.raw")), repeats, f64::from),
+            }
+        }
+        _ => {
+            eprintln!("usage: values phantom L DIR | build labels|density L DIR R | bits L DIR");
+            std::process::exit(2);
+        }
+    }
+}
