@@ -79,10 +79,21 @@ fn write_phantom(level: u32, dir: &Path) {
     density.flush().unwrap();
 }
 
-/// The raw file's values.
+/// The raw file's values (4 bytes each), read a block at a time: the process holds the values once.
 fn read_raw<V: Value>(path: &Path) -> Vec<V> {
-    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    bytes.chunks_exact(4).map(V::read_le).collect()
+    use std::io::Read;
+    let mut file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let len = file.metadata().unwrap().len() as usize;
+    let mut values = Vec::with_capacity(len / 4);
+    let mut block = vec![0u8; 1 << 20];
+    let mut left = len - len % 4;
+    while left > 0 {
+        let n = left.min(block.len());
+        file.read_exact(&mut block[..n]).unwrap();
+        values.extend(block[..n].chunks_exact(4).map(V::read_le));
+        left -= n;
+    }
+    values
 }
 
 /// The value whose bytes are all 0: the background.

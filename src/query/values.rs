@@ -2,10 +2,11 @@
 //!
 //! A large batch first tabulates the tree's top levels (about 2^18 cells: each an empty or full leaf, or
 //! the node to descend from), so that a point's answer is one look-up in the table and a descent of the
-//! few levels below it; the points are answered in chunks on all threads.
+//! few levels below it; the points are answered in chunks on all threads, each chunk in Morton order.
 
 use rayon::prelude::*;
 
+use crate::radix::sort_by_key;
 use crate::space::morton_encode;
 use crate::tree::cursor::Walk;
 use crate::tree::valued::{try_walk_values, ValueNode, ValueState, ValueStorage, ValueVisitor};
@@ -60,13 +61,19 @@ where
         .par_chunks(CHUNK)
         .zip(out.par_chunks_mut(CHUNK))
         .try_for_each(|(points, out)| {
-            for (p, o) in points.iter().zip(out) {
-                if p.iter().any(|&c| u64::from(c) >= side) {
-                    continue;
+            // In Morton order, so that neighbouring points read neighbouring cells of the table and
+            // parts of the levels.
+            let mut order: Vec<(u64, u32)> = Vec::with_capacity(points.len());
+            for (i, p) in points.iter().enumerate() {
+                if p.iter().all(|&c| u64::from(c) < side) {
+                    order.push((morton_encode(*p), i as u32));
                 }
-                *o = match table[(morton_encode(*p) >> shift) as usize] {
+            }
+            sort_by_key(&mut order, K as u32 * level, &mut Vec::new(), |p| p.0);
+            for (key, i) in order {
+                out[i as usize] = match table[(key >> shift) as usize] {
                     Top::Leaf(v) => v,
-                    Top::Node(index) => descend(tree, *p, depth as usize, index)?,
+                    Top::Node(index) => descend(tree, points[i as usize], depth as usize, index)?,
                 };
             }
             Ok(())

@@ -1,0 +1,138 @@
+#!/usr/bin/env bash
+# Trees with values against OpenVDB on one thread, and writes results/performance/values.md: building from
+# a dense label volume (u32 → ktree uint32 / OpenVDB Int32Grid) and a dense float volume (f32 → float32 /
+# FloatGrid), L = 8 and 9, and the values at 10^7 random points; memory of the structures and of the
+# processes; bits a node per value type. The volume: the 3-D Shepp–Logan phantom
+# (experiments/examples/values.rs). ktree: `ValueRuns::from_dense_background` + `KTree::from_value_runs`,
+# `KTree::values_at`. OpenVDB: experiments/values/peers.cpp (`tools::copyFromDense` serial + `prune`, one
+# ValueAccessor), given the array in its own default layout (ZYX) and as the file holds it (XYZ). Best of 3
+# inside each process, the three programs alternating over 3 rounds, best kept. Answers checked equal
+# (voxel counts, checksums of the values read).
+#
+# Needs Debian's libopenvdb-dev, libboost-dev and libtbb-dev and a C++ compiler; about 2 GB of scratch.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release -p ktree-experiments --example values
+target=${CARGO_TARGET_DIR:-target}
+ktree_bin=$target/release/examples/values
+peers=$target/values-peers
+g++ -O2 -std=c++17 -o "$peers" experiments/values/peers.cpp -lopenvdb -ltbb -lImath-3_1
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+out=results/performance/values.md
+openvdb_version=$(dpkg-query -W -f='${Version}' libopenvdb-dev 2>/dev/null || echo unknown)
+load=$(cut -d' ' -f1-3 /proc/loadavg)
+for level in 8 9; do "$ktree_bin" phantom "$level" "$scratch"; done
+rows=$scratch/rows.txt
+: >"$rows"
+for level in 8 9; do
+  for kind in labels density; do
+    file=$scratch/$kind-$level.raw
+    for round in 1 2 3; do
+      {
+        echo "program=ktree level=$level kind=$kind"
+        RAYON_NUM_THREADS=1 /usr/bin/time -f "rss_kb=%M" "$ktree_bin" build "$kind" "$level" "$scratch" 3 2>&1
+        for layout in zyx xyz; do
+          echo "program=openvdb-$layout level=$level kind=$kind"
+          /usr/bin/time -f "rss_kb=%M" "$peers" "$kind" "$level" "$file" "$layout" 3 2>&1
+        done
+      } >>"$rows"
+    done
+    echo "L = $level $kind done" >&2
+  done
+done
+"$ktree_bin" bits 9 "$scratch" >"$scratch/bits.txt"
+python3 - "$rows" "$scratch/bits.txt" "$openvdb_version" "$load" "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')" "$(nproc)" >"$out.tmp" <<'PY'
+import sys
+rows_path, bits_path, version, load, cpu, cores = sys.argv[1:]
+runs = {}
+current = None
+for line in open(rows_path):
+    line = line.strip()
+    if line.startswith("program="):
+        fields = dict(f.split("=") for f in line.split())
+        current = {}
+        runs.setdefault((fields["level"], fields["kind"], fields["program"]), []).append(current)
+    elif "=" in line and current is not None:
+        k, v = line.split("=", 1)
+        current[k] = float(v)
+
+def best(level, kind, program, key):
+    return min(r[key] for r in runs[(level, kind, program)])
+
+def one(level, kind, program, key):
+    values = {r[key] for r in runs[(level, kind, program)]}
+    assert len(values) == 1, (level, kind, program, key, values)
+    return values.pop()
+
+print("# Trees with values against OpenVDB: building from a dense volume, values at points, memory")
+print()
+print("Regenerate with `experiments/values.sh`. The volume: the 3-D Shepp–Logan head phantom at U³ voxels, U = 2^L (ten")
+print("ellipsoids, the table of Kak & Slaney as extended to 3-D by Schabel's `phantom3d`, with the \"modified\" intensities")
+print("and the rotations about z only: `experiments/examples/values.rs`), as **labels** (the last ellipsoid holding a voxel's")
+print("centre, 1–10, 0 outside; stored as u32) and as a **density** (the sum of the intensities, float32, 0 outside). Both")
+print("programs read the same raw file (x fastest) before the clock starts, and 0 is the background of both.")
+print(f"**ktree**: `ValueRuns::from_dense_background` then `KTree::from_value_runs`, one thread. **OpenVDB**")
+print(f"(libopenvdb-dev {version}, `experiments/values/peers.cpp`): `tools::copyFromDense` (serial, tolerance 0) into an")
+print("`Int32Grid` / `FloatGrid`, then `tools::prune` (tolerance 0), TBB limited to one thread; it is given the array in its")
+print("default layout (ZYX, z fastest: transposed before the clock starts) and as the file holds it (`LayoutXYZ`); the faster")
+print("is compared. Times: best of 3 runs inside a process, the three programs alternating over 3 rounds, best kept.")
+print("Memory: the structure (ktree `KTree::heap_bytes`, OpenVDB `Grid::memUsage`) and the peak resident memory of the")
+print("whole process (which holds the dense input too, 4 bytes a voxel, and 10^7 points of 12 bytes; ktree's keeps its")
+print("answers as well, an array of 10^7 optional values, where OpenVDB's program adds them up as it reads them).")
+print()
+print(f"Machine: {cpu}, {cores} cores. Load average when started: {load}.")
+print()
+print("## Building")
+print()
+print("| volume | L | voxels with a value | ktree s | OpenVDB ZYX s | OpenVDB XYZ s | OpenVDB best / ktree | ktree bytes | OpenVDB bytes | ktree / OpenVDB bytes | ktree peak MB | OpenVDB peak MB |")
+print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+query_rows = []
+for level in ("8", "9"):
+    for kind in ("labels", "density"):
+        k = best(level, kind, "ktree", "seconds")
+        z = best(level, kind, "openvdb-zyx", "seconds")
+        x = best(level, kind, "openvdb-xyz", "seconds")
+        voxels = one(level, kind, "ktree", "voxels")
+        for p in ("openvdb-zyx", "openvdb-xyz"):
+            assert one(level, kind, p, "active") == voxels, (level, kind, p)
+        kb = one(level, kind, "ktree", "heap_bytes")
+        vb = one(level, kind, "openvdb-zyx", "mem_bytes")
+        kr = best(level, kind, "ktree", "rss_kb") / 1024
+        vr = min(best(level, kind, "openvdb-zyx", "rss_kb"), best(level, kind, "openvdb-xyz", "rss_kb")) / 1024
+        ks = one(level, kind, "ktree", "checksum")
+        for p in ("openvdb-zyx", "openvdb-xyz"):
+            vs = one(level, kind, p, "checksum")
+            assert abs(ks - vs) <= 1e-6 * max(1.0, abs(ks)), (level, kind, p, ks, vs)
+        print(f"| {kind} | {level} | {int(voxels)} | {k:.4f} | {z:.4f} | {x:.4f} | {min(z, x) / k:.1f}× | {int(kb)} | {int(vb)} | {kb / vb:.3f} | {kr:.0f} | {vr:.0f} |")
+        kq = best(level, kind, "ktree", "query_seconds")
+        vq = min(best(level, kind, "openvdb-zyx", "query_seconds"), best(level, kind, "openvdb-xyz", "query_seconds"))
+        query_rows.append(f"| {kind} | {level} | {kq:.4f} | {vq:.4f} | {kq / 1e7 * 1e9:.1f} | {vq / 1e7 * 1e9:.1f} | {vq / kq:.2f}× |")
+print()
+print("## Values at 10^7 random points")
+print()
+print("The same points (splitmix64, uniform in the universe) in the same order; ktree `KTree::values_at` (one thread: a")
+print("table of the top levels, then a descent), OpenVDB one `ValueAccessor` (`getValue`, its cache of the last nodes).")
+print("The sums of the values read are checked equal.")
+print()
+print("| volume | L | ktree s | OpenVDB s | ktree ns a point | OpenVDB ns a point | OpenVDB / ktree |")
+print("|---|---:|---:|---:|---:|---:|---:|")
+for r in query_rows:
+    print(r)
+print()
+print("## Bits a node per value type")
+print()
+print("The L = 9 phantom's labels stored as each type (the colours a palette of the labels), its density as float32, and the")
+print("tree of its voxels without values. Bits a node = `heap_bytes` × 8 / nodes: the 2-bit codes, the rank indexes and the")
+print("value column (the value's bits for each full node).")
+print()
+print("| type | nodes | full nodes | bytes | bits a node | bits a full node |")
+print("|---|---:|---:|---:|---:|---:|")
+for line in open(bits_path):
+    _, name, nodes, full, heap = line.split()
+    nodes, full, heap = int(nodes), int(full), int(heap)
+    label = "none (the shape)" if name == "none" else name
+    print(f"| {label} | {nodes} | {full} | {heap} | {heap * 8 / nodes:.2f} | {heap * 8 / full:.2f} |")
+PY
+mv "$out.tmp" "$out"
+echo "wrote $out"
