@@ -93,6 +93,30 @@ fn file_round_trip<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), Tes
     ktree::io::write_ktree(&mut plain, &shape).unwrap();
     prop_assert_eq!(&binary, &plain);
     prop_assert_eq!(read_valued_ktree::<K, ()>(&binary, "mem").unwrap(), shape);
+    // Read in place: the values at every voxel (and outside), in a small and in a large batch (through
+    // the table of the top levels), and the leaves of a walk, as the tree in memory has them.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.ktree");
+    std::fs::write(&path, &bytes).unwrap();
+    let mapped = ktree::io::ktree::v3::MappedValuedTree::<K, V>::open(&path).unwrap();
+    let u = tree.universe();
+    let mut points: Vec<[u32; K]> = (0..u.voxels() as usize).map(|i| u.dense_point(i)).collect();
+    points.push([u.side() as u32; K]);
+    let key = |v: &Option<V>| v.map(Value::key);
+    let want: Vec<_> = points.iter().map(|&p| key(&tree.value_at(p))).collect();
+    let got = ktree::query::values_at(&mapped, &points).unwrap();
+    prop_assert_eq!(got.iter().map(key).collect::<Vec<_>>(), want.clone());
+    let many: Vec<[u32; K]> = points.iter().copied().cycle().take(70_000).collect();
+    let got = ktree::query::values_at(&mapped, &many).unwrap();
+    for (g, p) in got.iter().zip(&many) {
+        prop_assert_eq!(key(g), key(&tree.value_at(*p)));
+    }
+    let leaves: Vec<_> = ktree::tree::valued::ValueLeaves::new(&mapped)
+        .map(|l| l.map(|(c, v)| (c, key(&v))))
+        .collect::<Result<_, _>>()
+        .unwrap();
+    let in_memory: Vec<_> = tree.value_leaves().map(|(c, v)| (c, key(&v))).collect();
+    prop_assert_eq!(leaves, in_memory);
     Ok(())
 }
 
@@ -129,6 +153,18 @@ fn a_damaged_valued_file_is_an_error_at_a_byte_never_a_panic() {
             "{len}"
         );
     }
+    // Mapped: the same checks when the file is opened.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.ktree");
+    for at in (0..bytes.len()).step_by(5) {
+        let mut bad = bytes.clone();
+        bad[at] ^= 0x10;
+        std::fs::write(&path, &bad).unwrap();
+        let e = ktree::io::ktree::v3::MappedValuedTree::<2, u16>::open(&path).unwrap_err();
+        assert!(e.to_string().contains("bad.ktree"), "{e}");
+    }
+    std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
+    assert!(ktree::io::ktree::v3::MappedValuedTree::<2, u16>::open(&path).is_err());
     // Another value type, another K, and the binary readers: clear errors.
     let e = read_valued_ktree::<2, f32>(&bytes, "f")
         .unwrap_err()

@@ -30,6 +30,7 @@ pub mod streamed;
 pub mod v1;
 pub mod v2;
 pub mod v3;
+mod v3_mapped;
 
 pub use streamed::{
     boolean_files, boolean_views, complement_file, BooleanFileError, BooleanFileReport,

@@ -51,6 +51,8 @@ use crate::tree::valued::ValueStorage;
 use crate::tree::words::{children_mask, full_mask};
 use crate::tree::{Dtype, KTree, PackedStates, Value};
 
+pub use super::v3_mapped::MappedValuedTree;
+
 /// The format version of valued files.
 pub const VERSION: u16 = 3;
 
@@ -197,6 +199,47 @@ pub fn read_valued_ktree<const K: usize, V: Value>(
     bytes: &[u8],
     file: &str,
 ) -> Result<KTree<K, V>, KtreeFileError> {
+    match check_valued::<K, V>(bytes, file, true)? {
+        Checked::Binary(tree) => Ok(tree),
+        Checked::Valued { tree, .. } => {
+            Ok(tree.expect("the levels were kept: check_valued built the tree"))
+        }
+    }
+}
+
+/// Where a level of a valued file lies, found and checked when the file was read.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ValuedLevel {
+    /// The section's first byte.
+    pub(crate) offset: usize,
+    /// Its nodes, full nodes and nodes with children.
+    pub(crate) nodes: u64,
+    pub(crate) full: u64,
+    pub(crate) children: u64,
+    /// Words of codes, and rank samples of each kind.
+    pub(crate) words: usize,
+    pub(crate) samples: usize,
+}
+
+/// What [`check_valued`] found.
+pub(crate) enum Checked<const K: usize, V: Value> {
+    /// A version 1 or 2 file, read as a binary tree (`V` is `()`).
+    Binary(KTree<K, V>),
+    /// A version 3 file: its universe, its levels and, when asked for, the tree.
+    Valued {
+        universe: Universe<K>,
+        levels: Vec<ValuedLevel>,
+        tree: Option<KTree<K, V>>,
+    },
+}
+
+/// Checks a `.ktree` file's bytes holding a `K`-dimensional tree of `V` values — everything but, unless
+/// `keep`, the tree's minimality and its mixed nodes' children (checked on the tree built when `keep`).
+pub(crate) fn check_valued<const K: usize, V: Value>(
+    bytes: &[u8],
+    file: &str,
+    keep: bool,
+) -> Result<Checked<K, V>, KtreeFileError> {
     let fail = |offset: u64, kind| KtreeFileError::at_byte(file.to_string(), offset, kind);
     let (k, level, dtype) = valued_header(&bytes[..bytes.len().min(HEADER_BYTES)], file)?;
     if dtype != V::DTYPE {
@@ -211,11 +254,11 @@ pub fn read_valued_ktree<const K: usize, V: Value>(
     let Some(dtype) = dtype else {
         let tree = super::read_ktree::<K>(bytes, file)?;
         // V is `()` here (the only type without a dtype): the binary tree is the valued tree of no values.
-        return Ok(KTree::from_valued_levels(
+        return Ok(Checked::Binary(KTree::from_valued_levels(
             tree.universe,
             tree.levels,
             Vec::new(),
-        ));
+        )));
     };
     if !(1..=MAX_K).contains(&k) {
         return Err(fail(
@@ -292,8 +335,9 @@ pub fn read_valued_ktree<const K: usize, V: Value>(
         ));
     }
     let value_bytes = dtype.bytes();
-    let mut levels = Vec::with_capacity(depth as usize);
-    let mut values: Vec<Vec<V>> = Vec::with_capacity(depth as usize);
+    let mut levels = Vec::with_capacity(if keep { depth as usize } else { 0 });
+    let mut values: Vec<Vec<V>> = Vec::with_capacity(if keep { depth as usize } else { 0 });
+    let mut found = Vec::with_capacity(depth as usize);
     let mut offset = HEADER_BYTES as u64;
     let mut above_children: Option<u64> = None;
     for d in 0..depth as usize {
@@ -375,10 +419,25 @@ pub fn read_valued_ktree<const K: usize, V: Value>(
                 )),
             ));
         }
-        let level_states = PackedStates::from_valued_words(words, nodes as usize)
-            .map_err(|e| fail(offset, KtreeFileErrorKind::Tree(format!("level {d}: {e}"))))?;
+        found.push(ValuedLevel {
+            offset: offset as usize,
+            nodes,
+            full,
+            children,
+            words: words_n,
+            samples: samples_n,
+        });
+        let level_states = if keep {
+            Some(
+                PackedStates::from_valued_words(words, nodes as usize).map_err(|e| {
+                    fail(offset, KtreeFileErrorKind::Tree(format!("level {d}: {e}")))
+                })?,
+            )
+        } else {
+            None
+        };
         let values_at = 8 * (words_n + 2 * samples_n);
-        let mut column = Vec::with_capacity(full as usize);
+        let mut column = Vec::with_capacity(if keep { full as usize } else { 0 });
         for j in 0..full as usize {
             let at = values_at + j * value_bytes;
             let v = V::read_le(&section[at..at + value_bytes]);
@@ -388,7 +447,9 @@ pub fn read_valued_ktree<const K: usize, V: Value>(
                     KtreeFileErrorKind::Tree(format!("level {d}: {e}")),
                 ));
             }
-            column.push(v);
+            if keep {
+                column.push(v);
+            }
         }
         let end = values_at + full as usize * value_bytes;
         if section[end..].iter().any(|&b| b != 0) {
@@ -397,7 +458,7 @@ pub fn read_valued_ktree<const K: usize, V: Value>(
                 KtreeFileErrorKind::Tree(format!("padding of level {d} is not 0")),
             ));
         }
-        levels.push(level_states);
+        levels.extend(level_states);
         values.push(column);
         above_children = Some(children);
         offset += size;
@@ -412,10 +473,21 @@ pub fn read_valued_ktree<const K: usize, V: Value>(
     }
     let universe = Universe::<K>::new(level)
         .map_err(|e| fail(9, KtreeFileErrorKind::Header(e.to_string())))?;
+    if !keep {
+        return Ok(Checked::Valued {
+            universe,
+            levels: found,
+            tree: None,
+        });
+    }
     let tree = KTree::from_valued_levels(universe, levels, values);
     tree.check()
         .map_err(|e| fail(HEADER_BYTES as u64, KtreeFileErrorKind::Tree(e.to_string())))?;
-    Ok(tree)
+    Ok(Checked::Valued {
+        universe,
+        levels: found,
+        tree: Some(tree),
+    })
 }
 
 /// Reads a valued `.ktree` file from disk ([`read_valued_ktree`]).
