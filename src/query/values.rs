@@ -141,3 +141,35 @@ fn top_table<const K: usize, T: ValueStorage<K>>(
     try_walk_values(tree, &mut fill)?;
     Ok(fill.cells)
 }
+
+/// The first voxel holding a value that each ray meets, with its value (`None`: the ray meets none), on
+/// all threads, in the order given: the rays are cast on the tree's shape ([`KTree::shape`], made once for
+/// the batch) as [`cast_rays`](super::cast_rays) casts them, and each hit voxel's value is read.
+///
+/// ```
+/// use ktree::query::{first_values, RayCast};
+/// use ktree::KTree;
+/// // A bintree row: empty, 3, 3, 8.
+/// let t = KTree::<1, u8>::from_dense_values(2, &[None, Some(3), Some(3), Some(8)]).unwrap();
+/// let rays = [RayCast::new([0.5], [1.0], f64::INFINITY).unwrap(), RayCast::new([3.9], [-1.0], 0.5).unwrap()];
+/// let hits = first_values(&t, &rays);
+/// assert_eq!(hits[0].map(|(h, v)| (h.voxel, v)), Some(([1], 3)));
+/// assert_eq!(hits[1].map(|(h, v)| (h.voxel, v)), Some(([3], 8)));
+/// ```
+pub fn first_values<const K: usize, V: crate::value::Value>(
+    tree: &crate::KTree<K, V>,
+    rays: &[super::RayCast<K>],
+) -> Vec<Option<(super::RayHit<K>, V)>> {
+    let shape = tree.shape();
+    let hits = crate::tree::storage::infallible(super::cast_rays(&shape, rays));
+    hits.into_iter()
+        .map(|hit| {
+            hit.map(|h| {
+                let value = tree
+                    .value_at(h.voxel)
+                    .expect("a voxel of the shape holds a value");
+                (h, value)
+            })
+        })
+        .collect()
+}

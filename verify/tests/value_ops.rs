@@ -125,6 +125,26 @@ fn check<const K: usize, V: Palette>(a: &Painted<K>, b: &Painted<K>) -> Result<(
         let want = u.check_point(*p).ok().and_then(|()| da[u.dense_index(*p)]);
         prop_assert_eq!(g.map(Value::key), want.map(Value::key), "at {:?}", p);
     }
+    // The first value along rays parallel to axis 0, from outside, through every row of voxels: the
+    // first voxel of the row holding a value.
+    let rows: Vec<[u32; K]> = points.iter().copied().filter(|p| p[0] == 0).collect();
+    let rays: Vec<ktree::query::RayCast<K>> = rows
+        .iter()
+        .map(|p| {
+            let origin = std::array::from_fn(|a| if a == 0 { -0.5 } else { f64::from(p[a]) + 0.5 });
+            let direction = std::array::from_fn(|a| if a == 0 { 1.0 } else { 0.0 });
+            ktree::query::RayCast::new(origin, direction, f64::INFINITY).unwrap()
+        })
+        .collect();
+    let hits = ktree::query::first_values(&ta, &rays);
+    for (row, hit) in rows.iter().zip(&hits) {
+        let want = (0..u.side() as u32).find_map(|x| {
+            let mut q = *row;
+            q[0] = x;
+            da[u.dense_index(q)].map(|v| (q, v.key()))
+        });
+        prop_assert_eq!(hit.map(|(h, v)| (h.voxel, v.key())), want);
+    }
     same(&KTree::from_value_runs(&ta.to_value_runs()), &ta)?;
     let side = u.side() as i64;
     let t: [i64; K] = std::array::from_fn(|a| {

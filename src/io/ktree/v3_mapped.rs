@@ -65,7 +65,9 @@ impl<const K: usize, V: Value> MappedValuedTree<K, V> {
             KtreeFileError::at_byte(
                 name.clone(),
                 0,
-                KtreeFileErrorKind::Header("the file is larger than this machine's addresses".into()),
+                KtreeFileErrorKind::Header(
+                    "the file is larger than this machine's addresses".into(),
+                ),
             )
         })?;
         let map = FileMap::map(&file, 0, len).map_err(io)?;
@@ -90,7 +92,9 @@ impl<const K: usize, V: Value> MappedValuedTree<K, V> {
                 value_bytes: dtype.bytes(),
                 values: PhantomData,
             }),
-            Checked::Binary(_) => unreachable!("V has a dtype: a binary file fails the dtype check"),
+            Checked::Binary(_) => {
+                unreachable!("V has a dtype: a binary file fails the dtype check")
+            }
         }
     }
 
@@ -172,7 +176,10 @@ impl<const K: usize, V: Value> ValueStorage<K> for MappedValuedTree<K, V> {
         let first = usize::try_from(rank << K).unwrap_or(usize::MAX);
         let below = self.levels.get(depth + 1).map_or(0, |l| l.nodes);
         if rank >= self.levels[depth].children || (first + (1 << K)) as u64 > below {
-            return Err(self.changed(depth, &format!("node {index}'s children are not in the file")));
+            return Err(self.changed(
+                depth,
+                &format!("node {index}'s children are not in the file"),
+            ));
         }
         Ok(first)
     }
@@ -183,9 +190,8 @@ impl<const K: usize, V: Value> ValueStorage<K> for MappedValuedTree<K, V> {
         if rank >= level.full {
             return Err(self.changed(depth, &format!("node {index}'s value is not in the file")));
         }
-        let at = level.offset
-            + 8 * (level.words + 2 * level.samples)
-            + rank as usize * self.value_bytes;
+        let at =
+            level.offset + 8 * (level.words + 2 * level.samples) + rank as usize * self.value_bytes;
         let bytes = self
             .map
             .bytes()
