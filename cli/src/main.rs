@@ -16,6 +16,7 @@ mod distributed;
 mod lines;
 mod mass;
 mod op;
+mod project;
 mod query;
 mod rays;
 mod render;
@@ -68,6 +69,10 @@ enum Command {
     Voxelize(voxelize::Args),
     /// The voxels of one value, or of a range of values, of a tree with values: a tree without values.
     Select(values::SelectArgs),
+    /// The union of a tree's slices along an axis over a range: a tree of one dimension fewer (or a .png occupancy grid with its .yaml).
+    Project(project::ProjectArgs),
+    /// A tree's slice at one position along an axis: a tree of one dimension fewer (or a .png occupancy grid).
+    Slice(project::SliceArgs),
     /// Point queries on a tree file: inside or not, with --distance and --nearest the nearest full voxel.
     Query(query::QueryArgs),
     /// Cast rays (origin, direction) into a tree file: the first full voxel each enters.
@@ -126,6 +131,8 @@ fn main() -> ExitCode {
         Command::Components(args) => shape::run_components(args),
         Command::Distance(args) => distance::run(args),
         Command::Select(args) => values::run_select(args),
+        Command::Project(args) => project::run_project(args),
+        Command::Slice(args) => project::run_slice(args),
         Command::Query(args) => query::run_query(args),
         Command::Raycast(args) => query::run_raycast(args),
     };

@@ -14,6 +14,8 @@
 //! ```
 
 pub mod files;
+#[cfg(feature = "png")]
+pub mod grid_map;
 pub mod outline;
 pub mod surface;
 pub mod view;

@@ -76,6 +76,16 @@ pub enum OpsError {
     /// of the universe to infinity. Move the viewer out of the universe.
     #[error("the map sends part of the universe to infinity (its denominator changes sign)")]
     ToInfinity,
+    /// A slice's position is outside the universe.
+    #[error("position {position} along axis {axis} is outside the universe (0 to {side} − 1)")]
+    SliceOutside {
+        /// The axis.
+        axis: usize,
+        /// The position given.
+        position: u32,
+        /// The universe's side.
+        side: u64,
+    },
     /// An axis is not below the dimension `K`.
     #[error("axis {axis} is not below K = {k}")]
     BadAxis {

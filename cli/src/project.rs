@@ -1,0 +1,194 @@
+//! `ktree project FILE --axis A [--range LO:HI] --out OUT` and `ktree slice FILE --axis A --at C --out
+//! OUT`: a K-tree seen in K − 1 dimensions — the union of its slices along an axis over a range of
+//! positions, or one slice. The output is any tree file; a quadtree (from an octree) may also be written as
+//! a `.png` occupancy grid with its `.yaml` (ROS's map_server: occupied black, free white).
+
+use std::path::{Path, PathBuf};
+
+use ktree::export::grid_map::write_grid_map;
+use ktree::export::Frame;
+use ktree::io::{AnyMappedTree, FileTree, ReadOptions};
+use ktree::ops::project;
+use ktree::tree::storage::TreeStorage;
+use ktree::{AnyTree, KTree};
+
+use crate::common::error::{CliError, CliResult};
+use crate::common::vector::vector;
+use crate::outln;
+
+/// Arguments of `ktree project`.
+#[derive(Debug, clap::Args)]
+pub struct ProjectArgs {
+    /// The tree file (K = 2, 3 or 4).
+    input: PathBuf,
+    /// The axis projected along: x, y, z, w or 0–3.
+    #[arg(long, value_parser = parse_axis)]
+    axis: usize,
+    /// The positions along the axis, LO:HI in voxels, both included (default: all).
+    #[arg(long, value_name = "LO:HI", value_parser = parse_range)]
+    range: Option<(u32, u32)>,
+    #[command(flatten)]
+    out: OutArgs,
+}
+
+/// Arguments of `ktree slice`.
+#[derive(Debug, clap::Args)]
+pub struct SliceArgs {
+    /// The tree file (K = 2, 3 or 4).
+    input: PathBuf,
+    /// The axis cut across: x, y, z, w or 0–3.
+    #[arg(long, value_parser = parse_axis)]
+    axis: usize,
+    /// The position along the axis, in voxels.
+    #[arg(long)]
+    at: u32,
+    #[command(flatten)]
+    out: OutArgs,
+}
+
+/// Where the tree of K − 1 dimensions goes.
+#[derive(Debug, clap::Args)]
+struct OutArgs {
+    /// The output: a tree file (.ktree, .rays, …), or for a quadtree a .png occupancy grid (+ .yaml).
+    #[arg(long)]
+    out: PathBuf,
+    /// A .png map: the side of a cell in metres (the YAML's resolution).
+    #[arg(long, default_value_t = 1.0)]
+    voxel_size: f64,
+    /// A .png map: the world position of cell (0, 0)'s lower corner, as x,y.
+    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, value_parser = vector::<f64, 2>)]
+    origin: Option<[f64; 2]>,
+}
+
+fn parse_axis(text: &str) -> Result<usize, String> {
+    match text {
+        "x" | "0" => Ok(0),
+        "y" | "1" => Ok(1),
+        "z" | "2" => Ok(2),
+        "w" | "t" | "3" => Ok(3),
+        _ => Err(format!("'{text}': an axis is x, y, z, w or 0 to 3")),
+    }
+}
+
+fn parse_range(text: &str) -> Result<(u32, u32), String> {
+    let (lo, hi) = text
+        .split_once(':')
+        .ok_or_else(|| format!("'{text}': expected LO:HI"))?;
+    let number = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{t}' in '{text}' is not a voxel coordinate"))
+    };
+    let (lo, hi) = (number(lo)?, number(hi)?);
+    if lo > hi {
+        return Err(format!("'{text}': LO is larger than HI"));
+    }
+    Ok((lo, hi))
+}
+
+/// `ktree project`.
+pub fn run_project(a: ProjectArgs) -> CliResult {
+    let range = a
+        .range
+        .map_or(0..u32::MAX, |(lo, hi)| lo..hi.saturating_add(1));
+    run(&a.input, a.axis, range, &a.out, "projection")
+}
+
+/// `ktree slice`.
+pub fn run_slice(a: SliceArgs) -> CliResult {
+    let file = open(&a.input)?;
+    let side = 1u64 << file.level();
+    if u64::from(a.at) >= side {
+        return Err(format!(
+            "{}: --at {} is outside the universe (0 to {})",
+            a.input.display(),
+            a.at,
+            side - 1
+        )
+        .into());
+    }
+    run(&a.input, a.axis, a.at..a.at + 1, &a.out, "slice")
+}
+
+fn open(path: &Path) -> CliResult<FileTree> {
+    FileTree::open(path, &ReadOptions::default()).map_err(CliError::caused)
+}
+
+fn run(
+    input: &Path,
+    axis: usize,
+    range: std::ops::Range<u32>,
+    out: &OutArgs,
+    what: &str,
+) -> CliResult {
+    let file = open(input)?;
+    let k = file.k();
+    if axis >= k {
+        return Err(format!("{}: axis {axis} is not below K = {k}", input.display()).into());
+    }
+    fn down<const K: usize, const J: usize, T: TreeStorage<K>>(
+        tree: &T,
+        axis: usize,
+        range: std::ops::Range<u32>,
+    ) -> CliResult<KTree<J>> {
+        project::<K, J, T>(tree, axis, range).map_err(CliError::caused)
+    }
+    let lower: AnyTree = match &file {
+        FileTree::Memory(AnyTree::K2(t)) => down::<2, 1, _>(t, axis, range)?.into(),
+        FileTree::Memory(AnyTree::K3(t)) => down::<3, 2, _>(t, axis, range)?.into(),
+        FileTree::Memory(AnyTree::K4(t)) => down::<4, 3, _>(t, axis, range)?.into(),
+        FileTree::Mapped(AnyMappedTree::K2(t)) => down::<2, 1, _>(t, axis, range)?.into(),
+        FileTree::Mapped(AnyMappedTree::K3(t)) => down::<3, 2, _>(t, axis, range)?.into(),
+        FileTree::Mapped(AnyMappedTree::K4(t)) => down::<4, 3, _>(t, axis, range)?.into(),
+        _ => {
+            return Err(format!(
+                "{}: a bintree (K = 1) has no {what} of fewer dimensions",
+                input.display()
+            )
+            .into())
+        }
+    };
+    let png = out.out.extension().is_some_and(|e| e == "png");
+    if png {
+        let AnyTree::K2(quad) = &lower else {
+            return Err(format!(
+                "{}: a .png map is a quadtree; the {what} of this K = {k} tree has K = {}",
+                out.out.display(),
+                k - 1
+            )
+            .into());
+        };
+        if !(out.voxel_size.is_finite() && out.voxel_size > 0.0) {
+            return Err(format!(
+                "--voxel-size {}: expected a positive number",
+                out.voxel_size
+            )
+            .into());
+        }
+        let [x, y] = out.origin.unwrap_or([0.0; 2]);
+        let frame = Frame {
+            voxel_size: out.voxel_size,
+            origin: [x, y, 0.0],
+        };
+        let yaml = write_grid_map(&out.out, quad, None, &frame).map_err(CliError::caused)?;
+        outln!(
+            "{} and {}: {what} along axis {axis}, {} occupied cells of {}²",
+            out.out.display(),
+            yaml.display(),
+            quad.voxel_count(),
+            1u64 << quad.level()
+        );
+        return Ok(());
+    }
+    ktree::with_dim!(&lower, AnyTree, t => crate::common::tree_file::write_tree(&out.out, t))
+        .map_err(CliError::caused)?;
+    outln!(
+        "{}: {what} along axis {axis}: K = {}, L = {}, {} voxels, {} nodes",
+        out.out.display(),
+        lower.k(),
+        lower.level(),
+        ktree::with_dim!(&lower, AnyTree, t => t.voxel_count()),
+        ktree::with_dim!(&lower, AnyTree, t => t.node_count())
+    );
+    Ok(())
+}

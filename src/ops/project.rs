@@ -1,0 +1,175 @@
+//! A `K`-tree seen in `K − 1` dimensions: the **slice** at one position along an axis, and the
+//! **projection** along an axis over a range of positions (the union of the slices in the range) — an
+//! octree's floor plan between two heights, a 4-D history's 3-D map at one time or over a span of times.
+//! The remaining axes keep their order.
+//!
+//! One walk of the tree skips every subtree outside the range; the full leaves inside it, their cells
+//! with the axis dropped, are nested or disjoint (they are cells of one grid), so the union is the
+//! outermost of them, joined into maximal cells.
+//!
+//! ```
+//! use ktree::ops::{project, slice};
+//! use ktree::KTree;
+//! // A 4 × 4 quadtree: an L of voxels.
+//! let tree = KTree::<2>::from_dense(2, &[
+//!     true, false, false, false, //  y = 0
+//!     true, false, false, false, //  y = 1
+//!     true, true, true, false,   //  y = 2
+//!     false, false, false, false,
+//! ]).unwrap();
+//! // Along y (axis 1): which x are full in rows 0..=1, and in any row.
+//! let rows: KTree<1> = project(&tree, 1, 0..2).unwrap();
+//! assert_eq!(rows.to_dense().unwrap(), [true, false, false, false]);
+//! let all: KTree<1> = project(&tree, 1, 0..4).unwrap();
+//! assert_eq!(all.to_dense().unwrap(), [true, true, true, false]);
+//! // The slice at x = 0 (axis 0): the column of y.
+//! let column: KTree<1> = slice(&tree, 0, 0).unwrap();
+//! assert_eq!(column.to_dense().unwrap(), [true, true, true, false]);
+//! ```
+
+use std::ops::Range;
+
+use super::OpsError;
+use crate::space::{Cell, Universe};
+use crate::tree::cursor::{try_walk, Visitor, Walk};
+use crate::tree::storage::TreeStorage;
+use crate::tree::{DimensionMismatch, KTree, NodeRef, NodeState};
+
+/// The `J = K − 1`-dimensional tree of the voxels of `tree` at `position` along `axis`.
+///
+/// # Errors
+/// [`OpsError::BadAxis`] for an axis not below `K`; [`OpsError::SliceOutside`] for a position outside
+/// the universe; [`OpsError::DimensionMismatch`] unless `J + 1 = K`; [`OpsError::Storage`] for a failed
+/// read.
+pub fn slice<const K: usize, const J: usize, T: TreeStorage<K>>(
+    tree: &T,
+    axis: usize,
+    position: u32,
+) -> Result<KTree<J>, OpsError> {
+    let side = tree.universe().side();
+    if axis < K && u64::from(position) >= side {
+        return Err(OpsError::SliceOutside {
+            axis,
+            position,
+            side,
+        });
+    }
+    project(tree, axis, position..position + 1)
+}
+
+/// The `J = K − 1`-dimensional tree of the positions (the other axes' coordinates) where `tree` has a
+/// full voxel at some coordinate of `range` along `axis`: the union of the slices in the range (clipped to
+/// the universe; an empty range gives an empty tree).
+///
+/// # Errors
+/// [`OpsError::BadAxis`] for an axis not below `K`; [`OpsError::DimensionMismatch`] unless `J + 1 = K`;
+/// [`OpsError::Storage`] for a failed read.
+pub fn project<const K: usize, const J: usize, T: TreeStorage<K>>(
+    tree: &T,
+    axis: usize,
+    range: Range<u32>,
+) -> Result<KTree<J>, OpsError> {
+    if J + 1 != K {
+        return Err(OpsError::DimensionMismatch(DimensionMismatch {
+            expected: K - 1,
+            found: J,
+        }));
+    }
+    if axis >= K {
+        return Err(OpsError::BadAxis { axis, k: K });
+    }
+    let universe = Universe::<J>::new(tree.level()).map_err(|_| OpsError::LevelTooLarge {
+        k: J,
+        level: tree.level(),
+        max: crate::max_level(J),
+    })?;
+    struct Range1<const K: usize> {
+        axis: usize,
+        lo: u64,
+        hi: u64,
+        cells: Vec<Cell<K>>,
+    }
+    impl<const K: usize> Visitor<K> for Range1<K> {
+        const LEAVES: bool = false;
+        fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+            let o = u64::from(node.cell.origin[self.axis]);
+            if o >= self.hi || o + node.cell.side() <= self.lo || node.state == NodeState::Empty {
+                return Walk::Skip;
+            }
+            if node.state == NodeState::Full {
+                self.cells.push(node.cell);
+                return Walk::Skip;
+            }
+            Walk::Descend
+        }
+    }
+    let mut walk = Range1 {
+        axis,
+        lo: u64::from(range.start),
+        hi: u64::from(range.end),
+        cells: Vec::new(),
+    };
+    if range.start < range.end {
+        try_walk(tree, &mut walk).map_err(|e| OpsError::Storage(e.into()))?;
+    }
+    let mut cells: Vec<Cell<J>> = walk
+        .cells
+        .iter()
+        .map(|c| Cell {
+            origin: std::array::from_fn(|i| c.origin[if i < axis { i } else { i + 1 }]),
+            level: c.level,
+            log_side: c.log_side,
+        })
+        .collect();
+    // Nested or disjoint: sorted by Morton key, larger first where two start alike, each cell inside the
+    // last one kept is dropped.
+    cells.sort_unstable_by_key(|c| (c.morton(), c.level));
+    let mut outer: Vec<Cell<J>> = Vec::with_capacity(cells.len());
+    let mut end = 0u128;
+    for c in cells {
+        let key = u128::from(c.morton());
+        if !outer.is_empty() && key < end {
+            continue;
+        }
+        end = key + c.volume();
+        outer.push(c);
+    }
+    Ok(KTree::from_sorted_cells(universe, &maximal(outer)))
+}
+
+/// Joins every complete block of `2^J` sibling cells into their parent, repeatedly. `cells` must be
+/// disjoint and sorted by Morton key.
+fn maximal<const J: usize>(cells: Vec<Cell<J>>) -> Vec<Cell<J>> {
+    let n = 1usize << J;
+    let mut out: Vec<Cell<J>> = Vec::with_capacity(cells.len());
+    for cell in cells {
+        out.push(cell);
+        while out.len() >= n {
+            let first = out[out.len() - n];
+            if first.level == 0 {
+                break;
+            }
+            let parent_side = first.side() * 2;
+            let block = &out[out.len() - n..];
+            let complete = first
+                .origin
+                .iter()
+                .all(|&c| u64::from(c) % parent_side == 0)
+                && block.iter().enumerate().all(|(i, c)| {
+                    c.level == first.level
+                        && u128::from(c.morton())
+                            == u128::from(first.morton()) + i as u128 * first.volume()
+                });
+            if !complete {
+                break;
+            }
+            out.truncate(out.len() - n);
+            out.push(Cell {
+                origin: first.origin,
+                level: first.level - 1,
+                log_side: first.log_side + 1,
+            });
+        }
+    }
+    out
+}
