@@ -13,10 +13,11 @@ use crate::common::picture::{parse_size, parse_view};
 use crate::common::progress::progress_bar;
 use crate::common::vector::vector;
 use ktree::display::{
-    default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Projection,
-    RenderOptions,
+    default_camera, object_bounds, plane, png, render_with_progress, slices, Camera, Paint,
+    Projection, RenderOptions,
 };
 use ktree::io::{read_rays_file, AnyMappedTree, FileTree};
+use ktree::space::Cell;
 use ktree::tree::storage::TreeStorage;
 use ktree::{AnyRaySet, AnyTree};
 
@@ -68,9 +69,29 @@ pub struct Args {
     /// Shade with the surface normals carried by this ray file (the rays the octree was built from).
     #[arg(long, value_name = "FILE")]
     rays: Option<PathBuf>,
+    /// The object's colour: `value` (a tree with values: a palette for labels, a colour ramp from the
+    /// smallest to the largest float, colours as they are; the default for such a tree) or R,G,B.
+    #[arg(long, value_name = "value|R,G,B")]
+    colour: Option<String>,
     /// Show a progress bar.
     #[arg(long)]
     progress: bool,
+}
+
+/// The colour asked for: by value (`None`) or one colour.
+fn parse_colour(text: Option<&str>) -> Result<Option<[u8; 3]>, String> {
+    match text {
+        None | Some("value") => Ok(None),
+        Some(t) => {
+            let parts: Vec<_> = t.split(',').map(|p| p.trim().parse::<u8>()).collect();
+            match parts.as_slice() {
+                [Ok(r), Ok(g), Ok(b)] => Ok(Some([*r, *g, *b])),
+                _ => Err(format!(
+                    "--colour '{t}': expected value or R,G,B (0 to 255 each)"
+                )),
+            }
+        }
+    }
 }
 
 fn default_out(file: &Path) -> PathBuf {
@@ -88,16 +109,57 @@ pub fn run(args: Args) -> CliResult {
             b.set_position(done);
         }
     };
+    let colour = parse_colour(args.colour.as_deref())?;
+    if crate::values::is_valued(&args.file) {
+        let (k, dtype) = crate::values::file_dtype(&args.file)?;
+        if k != 3 {
+            return Err(format!(
+                "{}: pictures of trees with values are of octrees (K = 3); this one has K = {k}",
+                args.file.display()
+            )
+            .into());
+        }
+        use ktree::value::{Dtype, Rgb};
+        let go = |tick: &mut dyn FnMut(u64, u64)| match dtype {
+            Some(Dtype::U8) => render_valued::<u8>(&args, &out, w, h, colour, bar.as_ref(), tick),
+            Some(Dtype::U16) => render_valued::<u16>(&args, &out, w, h, colour, bar.as_ref(), tick),
+            Some(Dtype::U32) => render_valued::<u32>(&args, &out, w, h, colour, bar.as_ref(), tick),
+            Some(Dtype::I8) => render_valued::<i8>(&args, &out, w, h, colour, bar.as_ref(), tick),
+            Some(Dtype::F32) => render_valued::<f32>(&args, &out, w, h, colour, bar.as_ref(), tick),
+            Some(Dtype::Rgb) => render_valued::<Rgb>(&args, &out, w, h, colour, bar.as_ref(), tick),
+            None => unreachable!("a valued file has a value type"),
+        };
+        return go(&mut tick);
+    }
+    if args.colour.as_deref() == Some("value") {
+        return Err(format!(
+            "{}: --colour value colours a tree with values; this tree holds none",
+            args.file.display()
+        )
+        .into());
+    }
     // A version 2 file is drawn from its memory map, whatever its size.
     let file =
         FileTree::open(&args.file, &ktree::io::ReadOptions::default()).map_err(CliError::caused)?;
     match &file {
-        FileTree::Memory(AnyTree::K3(t)) => {
-            render_octree(t, &args, &out, w, h, bar.as_ref(), &mut tick)
-        }
-        FileTree::Mapped(AnyMappedTree::K3(t)) => {
-            render_octree(t, &args, &out, w, h, bar.as_ref(), &mut tick)
-        }
+        FileTree::Memory(AnyTree::K3(t)) => render_octree(
+            t,
+            &args,
+            &out,
+            (w, h),
+            (colour, None),
+            bar.as_ref(),
+            &mut tick,
+        ),
+        FileTree::Mapped(AnyMappedTree::K3(t)) => render_octree(
+            t,
+            &args,
+            &out,
+            (w, h),
+            (colour, None),
+            bar.as_ref(),
+            &mut tick,
+        ),
         FileTree::Memory(AnyTree::K2(t)) => render_quadtree(t, &out, w.min(h)),
         FileTree::Mapped(AnyMappedTree::K2(t)) => render_quadtree(t, &out, w.min(h)),
         FileTree::Memory(AnyTree::K4(t)) => render_strip(t, &args, &out, h),
@@ -147,12 +209,42 @@ fn render_strip<T: TreeStorage<4>>(tree: &T, args: &Args, out: &Path, size: u32)
 }
 
 /// Renders an octree, in memory or memory-mapped, to the PNG `out` (and the depth image if asked).
-fn render_octree<T: TreeStorage<3>>(
-    tree: &T,
+/// Draws an octree with values, each leaf in its value's colour (or `colour`).
+fn render_valued<V: ktree::value::Value>(
     args: &Args,
     out: &Path,
     w: u32,
     h: u32,
+    colour: Option<[u8; 3]>,
+    bar: Option<&ProgressBar>,
+    tick: &mut dyn FnMut(u64, u64),
+) -> CliResult {
+    let name = args.file.display().to_string();
+    let bytes = std::fs::read(&args.file).map_err(|e| format!("{name}: cannot read: {e}"))?;
+    let tree = ktree::io::ktree::v3::read_valued_ktree::<3, V>(&bytes, &name)
+        .map_err(|e| crate::common::error::chain(&e))?;
+    let of_value = ktree::display::palette::value_colours(&tree);
+    let paint = |cell: &Cell<3>| {
+        colour.unwrap_or_else(|| tree.value_at(cell.origin()).map_or([0; 3], &of_value))
+    };
+    let view = ktree::tree::valued::LeavesOfValues(&tree);
+    render_octree(
+        &view,
+        args,
+        out,
+        (w, h),
+        (None, Some(Paint(&paint))),
+        bar,
+        tick,
+    )
+}
+
+fn render_octree<T: TreeStorage<3>>(
+    tree: &T,
+    args: &Args,
+    out: &Path,
+    (w, h): (u32, u32),
+    (colour, paint): (Option<[u8; 3]>, Option<Paint<'_>>),
     bar: Option<&ProgressBar>,
     tick: &mut dyn FnMut(u64, u64),
 ) -> CliResult {
@@ -187,6 +279,7 @@ fn render_octree<T: TreeStorage<3>>(
         width: w,
         height: h,
         depth: args.depth.is_some(),
+        colour: colour.unwrap_or(RenderOptions::default().colour),
         ..Default::default()
     };
     let rays = match &args.rays {
@@ -223,6 +316,7 @@ fn render_octree<T: TreeStorage<3>>(
         &camera,
         &RenderOptions {
             normals: rays.as_ref(),
+            paint,
             ..options
         },
         tick,

@@ -29,6 +29,7 @@ pub mod lines;
 pub mod neighbours;
 pub mod order;
 mod painter;
+pub mod palette;
 pub mod plane;
 pub mod png;
 pub mod raster;
@@ -52,6 +53,6 @@ pub use order::{
 pub use painter::render_back_to_front;
 #[cfg(feature = "png")]
 pub use raster::render_png;
-pub use raster::{render, render_with_progress, RenderOptions, RenderStats, Rendered};
+pub use raster::{render, render_with_progress, Paint, RenderOptions, RenderStats, Rendered};
 pub use view::{View, ViewError, NAMED_VIEWS};
 pub use zbuffer::render_zbuffer;

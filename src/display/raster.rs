@@ -64,6 +64,26 @@ pub struct RenderOptions<'a> {
     /// The rays the tree was built from, if they carry surface normals: [`render`] then shades by them
     /// (elsewhere, and by default, shading is by face orientation).
     pub normals: Option<&'a RaySet<3>>,
+    /// The base colour of each full leaf, instead of `colour` (e.g. its value's colour, for a valued tree
+    /// drawn through [`LeavesOfValues`](crate::tree::valued::LeavesOfValues)).
+    pub paint: Option<Paint<'a>>,
+}
+
+/// A full leaf's base colour in a picture ([`RenderOptions::paint`]).
+#[derive(Clone, Copy)]
+pub struct Paint<'a>(pub &'a dyn Fn(&Cell<3>) -> [u8; 3]);
+
+impl std::fmt::Debug for Paint<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Paint(..)")
+    }
+}
+
+impl PartialEq for Paint<'_> {
+    /// The same function.
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::addr_eq(self.0, other.0)
+    }
 }
 
 impl Default for RenderOptions<'_> {
@@ -76,6 +96,7 @@ impl Default for RenderOptions<'_> {
             depth: false,
             cells: false,
             normals: None,
+            paint: None,
         }
     }
 }
@@ -262,6 +283,11 @@ fn front_to_back<T: TreeStorage<3>>(
         }
         // A full leaf: paint the uncovered pixels its box is hit at.
         stats.leaves_drawn += 1;
+        let base = options
+            .paint
+            .map_or(options.colour, |Paint(paint)| paint(&cell));
+        let painted_faces = options.paint.map(|_| FaceColours::new(light, base));
+        let faces = painted_faces.as_ref().unwrap_or(&faces);
         let (lo, hi) = cell_box(&cell);
         for y in r.y0..=r.y1 {
             let row = y as usize * w as usize;
@@ -292,7 +318,7 @@ fn front_to_back<T: TreeStorage<3>>(
                     })
                     .map_or_else(
                         || faces.entered(axis, d),
-                        |normal| shade(normal, light, options.colour),
+                        |normal| shade(normal, light, base),
                     );
                 rgb[3 * (row + x as usize)..3 * (row + x as usize) + 3].copy_from_slice(&c);
                 if let Some(dep) = depth.as_mut() {

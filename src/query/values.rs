@@ -143,7 +143,7 @@ fn top_table<const K: usize, T: ValueStorage<K>>(
 }
 
 /// The first voxel holding a value that each ray meets, with its value (`None`: the ray meets none), on
-/// all threads, in the order given: the rays are cast on the tree's shape ([`KTree::shape`], made once for
+/// all threads, in the order given: the rays are cast on the tree's shape ([`crate::KTree::shape`], made once for
 /// the batch) as [`cast_rays`](super::cast_rays) casts them, and each hit voxel's value is read.
 ///
 /// ```

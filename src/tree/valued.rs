@@ -738,3 +738,62 @@ impl From<ValueError> for TreeError {
         TreeError::Value(e)
     }
 }
+
+/// A valued tree read as a tree without values of the same nodes — a mixed node (`11`) reads as a node
+/// with children (`10`) — so every walk, picture and query of a [`TreeStorage`](super::storage::TreeStorage)
+/// sees each full leaf of the valued tree as one full leaf: the leaves where one value holds. The tree it
+/// shows is the valued tree's [shape](KTree::shape), not reduced where a mixed node stands.
+///
+/// ```
+/// use ktree::tree::valued::LeavesOfValues;
+/// use ktree::tree::cursor::TryLeaves;
+/// use ktree::KTree;
+/// let t = KTree::<1, u8>::from_dense_values(1, &[Some(1), Some(2)]).unwrap(); // a mixed root
+/// let leaves: Vec<_> = TryLeaves::new(&LeavesOfValues(&t)).collect::<Result<_, _>>().unwrap();
+/// assert_eq!(leaves.len(), 2); // the shape alone has one full leaf
+/// ```
+#[derive(Debug, Clone, Copy)]
+pub struct LeavesOfValues<'a, const K: usize, V: Value>(pub &'a KTree<K, V>);
+
+/// Each mixed code (`11`) of `codes` turned into `10`.
+#[inline]
+fn mixed_as_partial(codes: u32) -> u32 {
+    let mixed = codes & (codes >> 1) & 0x5555_5555;
+    codes & !mixed
+}
+
+impl<const K: usize, V: Value> super::storage::TreeStorage<K> for LeavesOfValues<'_, K, V> {
+    type Error = Infallible;
+
+    fn universe(&self) -> Universe<K> {
+        self.0.universe
+    }
+
+    fn depth_count(&self) -> usize {
+        self.0.levels.len()
+    }
+
+    fn level_len(&self, depth: usize) -> usize {
+        self.0.levels[depth].len()
+    }
+
+    fn counts_per_level(&self) -> Vec<super::LevelCounts> {
+        self.0.counts_per_level()
+    }
+
+    fn root_state(&self) -> Result<NodeState, Infallible> {
+        Ok(NodeState::from_bits(mixed_as_partial(infallible(
+            self.0.root_code(),
+        ))))
+    }
+
+    #[inline(always)]
+    fn partial_rank(&self, depth: usize, index: usize) -> Result<usize, Infallible> {
+        Ok(self.0.levels[depth].partial_rank(index))
+    }
+
+    #[inline(always)]
+    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Infallible> {
+        Ok(mixed_as_partial(self.0.levels[depth].block_codes(first, K)))
+    }
+}

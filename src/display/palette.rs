@@ -1,0 +1,76 @@
+//! Colours of values for pictures: a categorical palette for labels (neighbouring labels far apart in
+//! hue), a colour ramp for floats (dark blue through green to yellow, as viridis), and colours as they are.
+//!
+//! ```
+//! use ktree::display::palette::{label_colour, ramp, value_colours};
+//! use ktree::KTree;
+//! assert_ne!(label_colour(1), label_colour(2));
+//! assert_eq!(ramp(0.0), [68, 1, 84]);
+//! let t = KTree::<3, f32>::from_dense_values(1, &[Some(0.0), None, None, None, None, None, None, Some(2.0)]).unwrap();
+//! let colour = value_colours(&t);
+//! assert_eq!(colour(0.0), ramp(0.0)); // the smallest value at one end of the ramp
+//! assert_eq!(colour(2.0), ramp(1.0)); // the largest at the other
+//! ```
+
+use crate::value::{Dtype, Value};
+use crate::KTree;
+
+/// The colour of label `label`: hues a golden angle apart, so consecutive labels differ clearly.
+pub fn label_colour(label: u64) -> [u8; 3] {
+    let hue = (label as f64 * 0.618_033_988_749_895).fract() * 6.0;
+    let (s, v) = (0.65, 0.95);
+    let (i, f) = (hue.floor() as u32 % 6, hue.fract());
+    let (p, q, t) = (v * (1.0 - s), v * (1.0 - s * f), v * (1.0 - s * (1.0 - f)));
+    let (r, g, b) = match i {
+        0 => (v, t, p),
+        1 => (q, v, p),
+        2 => (p, v, t),
+        3 => (p, q, v),
+        4 => (t, p, v),
+        _ => (v, p, q),
+    };
+    [r, g, b].map(|c| (c * 255.0).round() as u8)
+}
+
+/// The colour at `t` (clamped to 0…1) of a ramp through viridis's colours at 0, ¼, ½, ¾ and 1.
+pub fn ramp(t: f64) -> [u8; 3] {
+    const STOPS: [[f64; 3]; 5] = [
+        [68.0, 1.0, 84.0],
+        [59.0, 82.0, 139.0],
+        [33.0, 145.0, 140.0],
+        [94.0, 201.0, 98.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) } * 4.0;
+    let i = (t.floor() as usize).min(3);
+    let f = t - i as f64;
+    std::array::from_fn(|c| (STOPS[i][c] + f * (STOPS[i + 1][c] - STOPS[i][c])).round() as u8)
+}
+
+/// The colouring of `tree`'s values: labels (integer types) by [`label_colour`], floats by [`ramp`] from
+/// the tree's smallest value to its largest, colours as they are.
+pub fn value_colours<V: Value>(tree: &KTree<3, V>) -> impl Fn(V) -> [u8; 3] {
+    let number = |v: V| -> f64 { v.text().parse().unwrap_or(0.0) };
+    let (lo, hi) = if V::DTYPE == Some(Dtype::F32) {
+        tree.value_leaves()
+            .filter_map(|(_, v)| v)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(number(v)), hi.max(number(v)))
+            })
+    } else {
+        (0.0, 1.0)
+    };
+    move |v: V| match V::DTYPE {
+        Some(Dtype::Rgb) => {
+            let mut bytes = Vec::with_capacity(3);
+            v.write_le(&mut bytes);
+            [bytes[0], bytes[1], bytes[2]]
+        }
+        Some(Dtype::F32) => ramp(if hi > lo {
+            (number(v) - lo) / (hi - lo)
+        } else {
+            0.5
+        }),
+        _ => label_colour(number(v) as i64 as u64),
+    }
+}
