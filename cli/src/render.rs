@@ -71,7 +71,7 @@ pub struct Args {
     rays: Option<PathBuf>,
     /// The object's colour: `value` (a tree with values: a palette for labels, a colour ramp from the
     /// smallest to the largest float, colours as they are; the default for such a tree) or R,G,B.
-    #[arg(long, value_name = "value|R,G,B")]
+    #[arg(long, value_name = "value|R,G,B", allow_hyphen_values = true)]
     colour: Option<String>,
     /// Show a progress bar.
     #[arg(long)]
