@@ -172,14 +172,12 @@ fn run_cloud(a: &Args) -> CliResult {
     if let Some(l) = a.level {
         v = v.level(l);
     }
-    if a.value.is_some() {
-        if !is_tree_file(&a.out.out) {
-            return Err(format!(
-                "--value writes a tree with values: the output must be a .ktree, not {}",
-                a.out.out.display()
-            )
-            .into());
-        }
+    if a.value.is_some() && !is_tree_file(&a.out.out) {
+        return Err(format!(
+            "--value writes a tree with values: the output must be a .ktree, not {}",
+            a.out.out.display()
+        )
+        .into());
     }
     let cloud = ktree::io::read_cloud(&a.input).map_err(CliError::caused)?;
     if let Some(value) = a.value {
