@@ -1,5 +1,6 @@
 //! Trees with values on the command line: `ktree voxelize VOLUME --labels` (a label volume into one valued
-//! tree), `ktree select FILE --value V | --range LO:HI --out OUT` (the voxels of a value or a range, as a
+//! tree), `ktree voxelize CLOUD --value rgb|intensity|class|count` (a point cloud's voxels holding a value
+//! reduced from their points'), `ktree select FILE --value V | --range LO:HI --out OUT` (the voxels of a value or a range, as a
 //! tree without values) and the per-value statistics of `ktree stats` on a valued file.
 //!
 //! A valued `.ktree` (version 3) carries its dimension and value type; each command reads them from the
@@ -9,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use ktree::io::ktree::v3::{read_valued_ktree, valued_header, write_valued_ktree_file};
 use ktree::query::{stats, TreeStats};
+use ktree::solid::cloud::{self, CloudVoxelizer, PointCloud};
 use ktree::solid::volume::Volume;
 use ktree::value::{Dtype, Rgb, Value};
 use ktree::KTree;
@@ -123,6 +125,136 @@ pub fn voxelize_labels(
         Dtype::U16 => build::<u16>(&volume, input, level, offset, out),
         _ => build::<u32>(&volume, input, level, offset, out),
     }
+}
+
+/// What a point cloud's voxel holds (`ktree voxelize CLOUD --value`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CloudValue {
+    /// The mean colour of its points (rgb8).
+    Rgb,
+    /// The mean or largest intensity of its points (float32, --reduce).
+    Intensity,
+    /// The most frequent class of its points, ties to the smallest (uint8).
+    Class,
+    /// How many points it holds (uint32).
+    Count,
+}
+
+/// How `--value intensity` reduces a voxel's points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Reduce {
+    /// Their mean.
+    Mean,
+    /// The largest.
+    Max,
+}
+
+/// Voxelizes `cloud` (read from `input`) with `voxelizer`, each voxel holding `value` of its points, into
+/// the valued tree `out`.
+pub fn voxelize_cloud_values(
+    input: &Path,
+    cloud: &PointCloud,
+    voxelizer: &CloudVoxelizer,
+    (value, reduce): (CloudValue, Option<Reduce>),
+    out: &Path,
+) -> CliResult {
+    if reduce.is_some() && value != CloudValue::Intensity {
+        return Err("--reduce is for --value intensity".into());
+    }
+    let missing = |what: &str| -> CliError {
+        let has = cloud.attributes().names();
+        format!(
+            "{}: --value {}: the file has no {what} (it has {})",
+            input.display(),
+            match value {
+                CloudValue::Rgb => "rgb",
+                CloudValue::Intensity => "intensity",
+                CloudValue::Class => "class",
+                CloudValue::Count => "count",
+            },
+            if has.is_empty() {
+                "points only".to_string()
+            } else {
+                format!("{} per point", has.join(", "))
+            }
+        )
+        .into()
+    };
+    let points = cloud.points();
+    match value {
+        CloudValue::Rgb => {
+            let colours = cloud.colours().ok_or_else(|| missing("colour"))?;
+            build(input, voxelizer, points, colours, cloud::mean_colour, out)
+        }
+        CloudValue::Intensity => {
+            let intensities = cloud.intensities().ok_or_else(|| missing("intensity"))?;
+            let reduce = match reduce.unwrap_or(Reduce::Mean) {
+                Reduce::Mean => cloud::mean_intensity,
+                Reduce::Max => cloud::max_intensity,
+            };
+            build(input, voxelizer, points, intensities, reduce, out)
+        }
+        CloudValue::Class => {
+            let classes = cloud.classes().ok_or_else(|| missing("class"))?;
+            build(
+                input,
+                voxelizer,
+                points,
+                classes,
+                cloud::most_frequent_class,
+                out,
+            )
+        }
+        CloudValue::Count => {
+            let ones = vec![(); points.len()];
+            build(
+                input,
+                voxelizer,
+                points,
+                &ones,
+                |g: &[()]| g.len() as u32,
+                out,
+            )
+        }
+    }
+}
+
+/// Voxelizes `points` with their values `per_point` reduced by `reduce`, writes the tree to `out` and
+/// says what it holds.
+fn build<T: Copy, V: Value>(
+    input: &Path,
+    voxelizer: &CloudVoxelizer,
+    points: &[[f64; 3]],
+    per_point: &[T],
+    reduce: impl FnMut(&[T]) -> V,
+    out: &Path,
+) -> CliResult {
+    let voxels = voxelizer
+        .voxelize_values(points, per_point, reduce)
+        .map_err(|e| crate::voxelize::cloud_error(input, e))?;
+    let tree = KTree::from_value_runs(&voxels.runs);
+    write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
+    let o = voxels.origin;
+    outln!(
+        "{}: {} points, origin {},{},{}, level {}, {} voxels of {} ({} distinct values){}; {}: {} nodes",
+        input.display(),
+        points.len(),
+        o[0],
+        o[1],
+        o[2],
+        tree.level(),
+        tree.voxel_count(),
+        V::DTYPE.map_or("", Dtype::name),
+        tree.value_stats().len(),
+        if voxels.cropped > 0 {
+            format!(", {} points outside the universe dropped", voxels.cropped)
+        } else {
+            String::new()
+        },
+        out.display(),
+        tree.node_count()
+    );
+    Ok(())
 }
 
 /// Arguments of `ktree select`.

@@ -2,7 +2,9 @@
 //! STL, PLY) or a volume (raw + JSON sidecar, NIfTI) to rays or a tree.
 //!
 //! `ktree voxelize CLOUD --voxel-size S [--origin x,y,z] [--level L] [--min-points N] [--crop] --out FILE`: a
-//! point cloud (PLY without faces, PCD, XYZ/CSV, LAS/LAZ) to the voxels holding at least N points.
+//! point cloud (PLY without faces, PCD, XYZ/CSV, LAS/LAZ) to the voxels holding at least N points;
+//! with `--value rgb|intensity|class|count [--reduce mean|max]`, a tree whose voxels hold a value reduced
+//! from their points' (a `.ktree` output).
 
 use crate::common::error::{CliError, CliResult};
 use crate::outln;
@@ -65,6 +67,14 @@ pub struct Args {
     /// Point cloud with --level: drop the points outside the universe (default: they are an error).
     #[arg(long)]
     crop: bool,
+    /// Point cloud: each voxel holds a value from its points (a .ktree output): rgb (their mean colour),
+    /// intensity (their mean or largest, float32: --reduce), class (the most frequent, ties to the
+    /// smallest; uint8) or count (how many, uint32).
+    #[arg(long, value_enum)]
+    value: Option<crate::values::CloudValue>,
+    /// With --value intensity: mean or max.
+    #[arg(long, value_enum, requires = "value")]
+    reduce: Option<crate::values::Reduce>,
     #[command(flatten)]
     out: crate::common::args::RaysOrTreeOut,
     #[command(flatten)]
@@ -77,9 +87,9 @@ pub fn run(a: Args) -> CliResult {
     if ktree::io::is_cloud_file(&a.input).map_err(CliError::caused)? {
         return run_cloud(&a);
     }
-    if a.voxel_size.is_some() || a.origin.is_some() || a.crop {
+    if a.voxel_size.is_some() || a.origin.is_some() || a.crop || a.value.is_some() {
         return Err(format!(
-            "{}: --voxel-size, --origin and --crop are for point clouds (.ply without faces, .pcd, .xyz, .csv, .txt, .las, .laz)",
+            "{}: --voxel-size, --origin, --crop and --value are for point clouds (.ply without faces, .pcd, .xyz, .csv, .txt, .las, .laz)",
             a.input.display()
         )
         .into());
@@ -146,7 +156,6 @@ pub fn run(a: Args) -> CliResult {
 /// Voxelizes a point cloud and writes it.
 fn run_cloud(a: &Args) -> CliResult {
     use ktree::solid::cloud::CloudVoxelizer;
-    use ktree::solid::SolidError;
     let size = a
         .voxel_size
         .ok_or_else(|| format!("{}: a point cloud needs --voxel-size S", a.input.display()))?;
@@ -163,19 +172,26 @@ fn run_cloud(a: &Args) -> CliResult {
     if let Some(l) = a.level {
         v = v.level(l);
     }
+    if a.value.is_some() && !is_tree_file(&a.out.out) {
+        return Err(format!(
+            "--value writes a tree with values: the output must be a .ktree, not {}",
+            a.out.out.display()
+        )
+        .into());
+    }
     let cloud = ktree::io::read_cloud(&a.input).map_err(CliError::caused)?;
-    let voxels = v.voxelize(cloud.points()).map_err(|e| {
-        let hint = match e {
-            SolidError::PointsOutside { .. } => {
-                ": use a larger --level or --voxel-size, another --origin, or --crop to drop them"
-            }
-            SolidError::PointBelowOrigin { .. } => {
-                ": give --level and --crop to drop such points, or another --origin"
-            }
-            _ => "",
-        };
-        format!("{}: {e}{hint}", a.input.display())
-    })?;
+    if let Some(value) = a.value {
+        return crate::values::voxelize_cloud_values(
+            &a.input,
+            &cloud,
+            &v,
+            (value, a.reduce),
+            &a.out.out,
+        );
+    }
+    let voxels = v
+        .voxelize(cloud.points())
+        .map_err(|e| cloud_error(&a.input, e))?;
     let root = crate::distributed::ranks().is_root();
     if root {
         let o = voxels.origin;
@@ -204,6 +220,21 @@ fn run_cloud(a: &Args) -> CliResult {
     }
     crate::common::output::print_summary(&write_output(&voxels.rays, &a.out.out, &a.build)?)?;
     Ok(())
+}
+
+/// A voxelizer's error on the cloud `input`, with a hint of the flags that avoid it.
+pub(crate) fn cloud_error(input: &Path, e: ktree::solid::SolidError) -> String {
+    use ktree::solid::SolidError;
+    let hint = match e {
+        SolidError::PointsOutside { .. } => {
+            ": use a larger --level or --voxel-size, another --origin, or --crop to drop them"
+        }
+        SolidError::PointBelowOrigin { .. } => {
+            ": give --level and --crop to drop such points, or another --origin"
+        }
+        _ => "",
+    };
+    format!("{}: {e}{hint}", input.display())
 }
 
 /// Prints the transform `--fit` chose and warns about a mesh that is not closed (`root`: this process

@@ -1,5 +1,6 @@
 //! ASPRS LAS 1.0–1.4, and LAZ (LASzip-compressed LAS): every point's `X`, `Y`, `Z` (the first 12 bytes of
-//! every point format), scaled and offset as the header says.
+//! every point format), scaled and offset as the header says, and its intensity, classification and, in
+//! the point formats that have it, its RGB colour (see [`super`] for how colours become 8 bits).
 //!
 //! The header is read by the `las` crate; everything it declares is checked against the file before
 //! anything is allocated for it:
@@ -21,8 +22,10 @@ use laz::record::{
     LayeredPointRecordDecompressor, RecordDecompressor, SequentialPointRecordDecompressor,
 };
 
-use super::finite;
+use super::{finite, Points};
 use crate::io::geometry_file::Fault;
+use crate::solid::cloud::PointAttributes;
+use crate::value::Rgb;
 
 /// Byte offsets of header fields (ASPRS LAS 1.4 R15, table 3).
 const LEGACY_POINT_COUNT: usize = 107;
@@ -37,7 +40,7 @@ const VLR_HEADER: usize = 54;
 const EVLR_HEADER: usize = 60;
 
 /// The points of a LAS or LAZ file.
-pub(super) fn read(bytes: &[u8]) -> Result<Vec<[f64; 3]>, Fault> {
+pub(super) fn read(bytes: &[u8]) -> Result<Points, Fault> {
     let header = las::raw::Header::read_from(bytes)
         .map_err(|e| Fault::byte(0, format!("LAS header: {e}")))?;
     let legacy = u64::from(header.number_of_point_records);
@@ -120,6 +123,7 @@ pub(super) fn read(bytes: &[u8]) -> Result<Vec<[f64; 3]>, Fault> {
         });
         finite(p, |why| Fault::byte(at, format!("LAS point {i} {why}")))
     };
+    let mut columns = Columns::new(&format);
     if !format.is_compressed {
         let need = count.saturating_mul(record as u64);
         let have = (end - start) as u64;
@@ -132,11 +136,13 @@ pub(super) fn read(bytes: &[u8]) -> Result<Vec<[f64; 3]>, Fault> {
             ));
         }
         let mut points = Vec::with_capacity(count as usize);
+        columns.reserve(count as usize);
         for i in 0..count {
             let at = start + i as usize * record;
             points.push(point(i, &bytes[at..at + 12], at)?);
+            columns.push(&bytes[at..at + record]);
         }
-        return Ok(points);
+        return Ok((points, columns.finish()));
     }
     let laszip = vlrs.laszip.ok_or_else(|| {
         Fault::byte(
@@ -165,7 +171,7 @@ pub(super) fn read(bytes: &[u8]) -> Result<Vec<[f64; 3]>, Fault> {
     let mut raw = vec![0u8; record];
     for (k, chunk) in chunks.iter().enumerate() {
         let data = &bytes[chunk.bytes.clone()];
-        let mut decoder = decoder(data, &vlr, record, chunk.points)
+        let mut decoder = decoder(data, &vlr, (record, format.has_color), chunk.points)
             .map_err(|why| Fault::byte(chunk.bytes.start, format!("LAZ chunk {k}: {why}")))?;
         for j in 0..chunk.points {
             decoder.decompress_next(&mut raw).map_err(|e| {
@@ -182,9 +188,83 @@ pub(super) fn read(bytes: &[u8]) -> Result<Vec<[f64; 3]>, Fault> {
             })?;
             let i = points.len() as u64;
             points.push(point(i, &raw, chunk.bytes.start)?);
+            columns.push(&raw);
         }
     }
-    Ok(points)
+    Ok((points, columns.finish()))
+}
+
+/// The attributes of the points read so far: intensity, class, and the colour as stored (16 bits a
+/// channel), made 8 bits when all are read.
+struct Columns {
+    /// Where the class is in a record, and the mask of its bits.
+    class: (usize, u8),
+    /// Where the colour is, in the formats that have one.
+    rgb: Option<usize>,
+    intensities: Vec<f32>,
+    classes: Vec<u8>,
+    colours: Vec<[u16; 3]>,
+}
+
+impl Columns {
+    /// The columns of points of `format` (ASPRS LAS 1.4 R15, tables 7 to 17).
+    fn new(format: &las::point::Format) -> Self {
+        let rgb = format
+            .has_color
+            .then_some(match (format.is_extended, format.has_gps_time) {
+                (true, _) => 30,
+                (false, true) => 28,
+                (false, false) => 20,
+            });
+        Self {
+            class: if format.is_extended {
+                (16, 0xff)
+            } else {
+                (15, 0x1f)
+            },
+            rgb,
+            intensities: Vec::new(),
+            classes: Vec::new(),
+            colours: Vec::new(),
+        }
+    }
+
+    fn reserve(&mut self, n: usize) {
+        self.intensities.reserve_exact(n);
+        self.classes.reserve_exact(n);
+        if self.rgb.is_some() {
+            self.colours.reserve_exact(n);
+        }
+    }
+
+    /// Keeps the attributes of one point's record (at least as long as its format's).
+    fn push(&mut self, record: &[u8]) {
+        let u16_at = |at: usize| u16::from_le_bytes([record[at], record[at + 1]]);
+        self.intensities.push(f32::from(u16_at(12)));
+        self.classes.push(record[self.class.0] & self.class.1);
+        if let Some(at) = self.rgb {
+            self.colours
+                .push([u16_at(at), u16_at(at + 2), u16_at(at + 4)]);
+        }
+    }
+
+    /// The attributes: colours by their high byte, unless every channel is below 256 (8-bit colours
+    /// stored in 16 bits, kept as they are).
+    fn finish(self) -> PointAttributes {
+        let eight_bits = self.colours.iter().flatten().all(|&c| c < 256);
+        let shift = if eight_bits { 0 } else { 8 };
+        let colours = self.rgb.map(|_| {
+            self.colours
+                .iter()
+                .map(|c| c.map(|v| (v >> shift) as u8))
+                .collect::<Vec<Rgb>>()
+        });
+        PointAttributes {
+            colours,
+            intensities: Some(self.intensities),
+            classes: Some(self.classes),
+        }
+    }
 }
 
 /// What the variable-length records hold for this reader: where the LASzip record's data lie.
@@ -361,18 +441,19 @@ fn chunks(
     Ok(chunks)
 }
 
-/// A decoder of one chunk's `points` points from its bytes `data`, only the coordinates asked for.
+/// A decoder of one chunk's `points` points from its bytes `data`, only the coordinates, intensity,
+/// classification and (`rgb`) colour asked for.
 fn decoder<'a>(
     data: &'a [u8],
     vlr: &LazVlr,
-    record: usize,
+    (record, rgb): (usize, bool),
     points: u64,
 ) -> Result<Box<dyn RecordDecompressor<Cursor<&'a [u8]>> + 'a>, String> {
     let version = vlr.items().first().map_or(0, |item| item.version());
     let mut decoder: Box<dyn RecordDecompressor<Cursor<&'a [u8]>> + 'a> = match version {
         1 | 2 => Box::new(SequentialPointRecordDecompressor::new(Cursor::new(data))),
         3 | 4 => {
-            check_layers(data, record, points)?;
+            check_layers(data, record, points, rgb)?;
             Box::new(LayeredPointRecordDecompressor::new(Cursor::new(data)))
         }
         v => return Err(format!("unknown LASzip item version {v}")),
@@ -380,15 +461,23 @@ fn decoder<'a>(
     decoder
         .set_fields_from(vlr.items())
         .map_err(|e| e.to_string())?;
-    decoder.set_selection(DecompressionSelection::xy_returns_channel().decompress_z());
+    let mut selection = DecompressionSelection::xy_returns_channel()
+        .decompress_z()
+        .decompress_classification()
+        .decompress_intensity();
+    if rgb {
+        selection = selection.decompress_rgb();
+    }
+    decoder.set_selection(selection);
     Ok(decoder)
 }
 
 /// A layered chunk (LAS 1.4 point formats) starts with its first point whole, then its point count and
-/// the byte counts of its layers, the coordinates' first (`x`, `y` with the returns and channel; `z`).
-/// Those two layers are the ones read into memory: their sizes are checked against the chunk here, and
-/// the count against the chunk table.
-fn check_layers(data: &[u8], record: usize, points: u64) -> Result<(), String> {
+/// the byte counts of its layers: the nine of the point (`x`, `y` with the returns and channel; `z`;
+/// classification; flags; intensity; scan angle; user data; point source; GPS time), then the colour's
+/// (`rgb`: the formats with colour). The layers read into memory are among those: their sizes are
+/// checked against the chunk here, and the count against the chunk table.
+fn check_layers(data: &[u8], record: usize, points: u64, rgb: bool) -> Result<(), String> {
     if points == 0 {
         return Ok(());
     }
@@ -403,10 +492,14 @@ fn check_layers(data: &[u8], record: usize, points: u64) -> Result<(), String> {
             "the chunk says it holds {held} points, the header and the chunk table give it {points}"
         ));
     }
-    let layers = u64::from(u32_at(record + 4)?) + u64::from(u32_at(record + 8)?);
+    let n = if rgb { 10 } else { 9 };
+    let mut layers = 0u64;
+    for k in 0..n {
+        layers += u64::from(u32_at(record + 4 + 4 * k)?);
+    }
     if layers > data.len() as u64 {
         return Err(format!(
-            "its coordinates' layers declare {layers} bytes, more than its {} bytes",
+            "its layers declare {layers} bytes, more than its {} bytes",
             data.len()
         ));
     }

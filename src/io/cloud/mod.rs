@@ -11,6 +11,19 @@
 //! * `.las`, `.laz`: ASPRS LAS 1.0–1.4, compressed or not, coordinates scaled and offset as the header says
 //!   (the header read by the `las` crate, compressed points decoded chunk by chunk by the `laz` crate).
 //!
+//! **Attributes.** Besides the points, the readers keep the attributes a file gives them
+//! ([`PointCloud::colours`], [`PointCloud::intensities`], [`PointCloud::classes`]); a file without one has
+//! none (`None`, no memory):
+//! * colour: PLY `red`, `green`, `blue` (8-bit types as they are, 16-bit ones scaled by 255/65535, 32-bit
+//!   integers by 255/(2³²−1), floats taken as 0…1 and scaled by 255; rounded, clamped to 0…255); PCD's
+//!   packed `rgb` or `rgba` field (PCL's `0x00RRGGBB` in the bits of a `F 4` or a `U 4`/`I 4`); LAS RGB
+//!   (point formats 2, 3, 5, 7, 8, 10), 16 bits a channel: as laspy reads them, then to 8 bits by the high
+//!   byte — unless every channel of every point of the file is below 256, which is 8-bit colour stored in
+//!   16 bits (as in laspy's `simple.las`) and kept as it is;
+//! * intensity: PLY and PCD `intensity`, LAS intensity (`u16`), as `f32`;
+//! * class: PLY and PCD `label` or `class` (a whole number 0…255, else an error naming the point), LAS
+//!   classification (point formats 0–5: its low 5 bits; 6–10: the byte).
+//!
 //! Errors name the file and the line (text) or byte offset (binary) of the first fault. Counts from headers
 //! are checked against the bytes that must hold what they count before anything is allocated for them: a
 //! LAS file's points against its point data, a LAZ file's against its chunk table, each chunk decoded from
@@ -37,7 +50,12 @@ use std::io::Read;
 use std::path::Path;
 
 use super::geometry_file::{extension, io_error, Fault, GeometryFileError, GeometryFileErrorKind};
-use crate::solid::cloud::PointCloud;
+use super::scalar::Scalar;
+use crate::solid::cloud::{PointAttributes, PointCloud};
+use crate::value::Rgb;
+
+/// What a parser reads: the points and their attributes.
+type Points = (Vec<[f64; 3]>, PointAttributes);
 
 /// The file extensions [`read_cloud`] knows.
 pub const CLOUD_FORMATS: [&str; 7] = ["ply", "pcd", "xyz", "csv", "txt", "las", "laz"];
@@ -66,11 +84,11 @@ pub fn read_cloud_bytes(
     format: &str,
     file: &Path,
 ) -> Result<PointCloud, GeometryFileError> {
-    let points = match format.to_ascii_lowercase().as_str() {
+    let (points, attributes) = match format.to_ascii_lowercase().as_str() {
         "ply" => ply::read(bytes),
         "pcd" => pcd::read(bytes),
-        "xyz" | "txt" => text::read(bytes, false),
-        "csv" => text::read(bytes, true),
+        "xyz" | "txt" => text::read(bytes, false).map(|p| (p, PointAttributes::default())),
+        "csv" => text::read(bytes, true).map(|p| (p, PointAttributes::default())),
         "las" | "laz" => las::read(bytes),
         other => {
             return Err(GeometryFileError::at_line(
@@ -86,7 +104,8 @@ pub fn read_cloud_bytes(
     }
     .map_err(|fault| fault.in_file(file))?;
     // Every parser has refused a coordinate that is not finite already, naming its line or byte.
-    PointCloud::new(points).map_err(|e| Fault::whole(e.to_string()).in_file(file))
+    PointCloud::with_attributes(points, attributes)
+        .map_err(|e| Fault::whole(e.to_string()).in_file(file))
 }
 
 /// Whether a file is read as a point cloud by [`read_cloud`]: `.pcd`, `.xyz`, `.csv`, `.txt`, `.las`,
@@ -131,5 +150,31 @@ fn finite(p: [f64; 3], fault: impl FnOnce(String) -> Fault) -> Result<[f64; 3], 
             "has a coordinate that is not finite ({} {} {})",
             p[0], p[1], p[2]
         )))
+    }
+}
+
+/// A colour channel of a PLY property of type `kind` to 8 bits (see the [module docs](self)).
+fn channel(kind: Scalar, v: f64) -> u8 {
+    let scaled = match kind {
+        Scalar::U8 | Scalar::I8 => v,
+        Scalar::U16 | Scalar::I16 => v * 255.0 / 65535.0,
+        Scalar::F32 | Scalar::F64 => v * 255.0,
+        _ => v * 255.0 / f64::from(u32::MAX),
+    };
+    // `as` saturates, and takes NaN to 0.
+    scaled.round().clamp(0.0, 255.0) as u8
+}
+
+/// PCL's packed colour `0x00RRGGBB` (the alpha of `rgba` in the high byte is dropped).
+fn unpack(bits: u32) -> Rgb {
+    [(bits >> 16) as u8, (bits >> 8) as u8, bits as u8]
+}
+
+/// A class: a whole number 0…255, or the reason why not.
+fn class(v: f64) -> Result<u8, String> {
+    if v.fract() == 0.0 && (0.0..=255.0).contains(&v) {
+        Ok(v as u8)
+    } else {
+        Err(format!("has class {v}: expected a whole number 0…255"))
     }
 }

@@ -3,13 +3,16 @@
 //! point's first field, then every point's second, …, padding fields named `_` left out).
 //!
 //! A point whose `x`, `y` and `z` are all NaN is PCL's mark of a pixel without a measurement in an
-//! organized cloud (`is_dense` false): it has no position and is skipped. Any other coordinate that is not
-//! finite is an error.
+//! organized cloud (`is_dense` false): it has no position and is skipped (with its attributes). Any other
+//! coordinate that is not finite is an error.
+//!
+//! The fields `rgb` or `rgba` (PCL's packed colour), `intensity` and `label` or `class` are kept when
+//! present, each from its first value.
 
-use super::finite;
-use super::lzf;
+use super::{class, finite, lzf, unpack, Points};
 use crate::io::geometry_file::Fault;
 use crate::io::scalar::Scalar;
+use crate::solid::cloud::PointAttributes;
 
 /// A field of a PCD point: its name, type and number of values.
 struct Field<'a> {
@@ -157,43 +160,140 @@ impl<'a> Header<'a> {
     }
 }
 
+/// A field's first value of one point as stored: its bytes (binary) or its word (ASCII).
+#[derive(Clone, Copy)]
+enum Raw<'a> {
+    Bytes(&'a [u8]),
+    Word(&'a str),
+}
+
+impl Raw<'_> {
+    /// The value as a number.
+    fn number(self, kind: Scalar) -> Result<f64, String> {
+        match self {
+            Raw::Bytes(b) => Ok(kind.get(b, false)),
+            Raw::Word(w) => w.parse().map_err(|_| format!("'{w}' is not a number")),
+        }
+    }
+
+    /// The 32 bits of a packed colour: those of the float (`F 4`) or of the integer.
+    fn bits(self, kind: Scalar) -> Result<u32, String> {
+        match (self, kind) {
+            (Raw::Bytes(b), _) => Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+            (Raw::Word(w), Scalar::F32) => w
+                .parse::<f32>()
+                .map(f32::to_bits)
+                .map_err(|_| format!("'{w}' is not a number")),
+            (Raw::Word(w), _) => w
+                .parse::<i64>()
+                .map(|v| v as u32)
+                .map_err(|_| format!("'{w}' is not a whole number")),
+        }
+    }
+}
+
+/// The attribute fields a PCD file has, and their values as read.
+struct Attributes {
+    rgb: Option<usize>,
+    intensity: Option<usize>,
+    label: Option<usize>,
+    read: PointAttributes,
+}
+
+impl Attributes {
+    fn new(header: &Header) -> Result<Self, Fault> {
+        let find = |names: &[&str]| header.fields.iter().position(|f| names.contains(&f.name));
+        let rgb = find(&["rgb", "rgba"]);
+        if let Some(f) = rgb.filter(|&f| header.fields[f].kind.size() != 4) {
+            return Err(Fault::line(
+                header.lines,
+                format!(
+                    "PCD: field '{}' holds a packed colour in 4 bytes, not {}",
+                    header.fields[f].name,
+                    header.fields[f].kind.size()
+                ),
+            ));
+        }
+        let (intensity, label) = (find(&["intensity"]), find(&["label", "class"]));
+        // Columns grow with the points read (a count from a header is not trusted to allocate).
+        Ok(Self {
+            rgb,
+            intensity,
+            label,
+            read: PointAttributes {
+                colours: rgb.map(|_| Vec::new()),
+                intensities: intensity.map(|_| Vec::new()),
+                classes: label.map(|_| Vec::new()),
+            },
+        })
+    }
+
+    /// Keeps the attributes of a point whose fields' first values `raw(f)` gives; `Err` the reason why
+    /// one cannot be read.
+    fn push<'a>(&mut self, header: &Header, raw: impl Fn(usize) -> Raw<'a>) -> Result<(), String> {
+        let kind = |f: usize| header.fields[f].kind;
+        if let (Some(f), Some(c)) = (self.rgb, &mut self.read.colours) {
+            c.push(unpack(raw(f).bits(kind(f))?));
+        }
+        if let (Some(f), Some(c)) = (self.intensity, &mut self.read.intensities) {
+            c.push(raw(f).number(kind(f))? as f32);
+        }
+        if let (Some(f), Some(c)) = (self.label, &mut self.read.classes) {
+            c.push(class(raw(f).number(kind(f))?).map_err(|why| format!("the point {why}"))?);
+        }
+        Ok(())
+    }
+}
+
 /// The points of a PCD file.
-pub(super) fn read(bytes: &[u8]) -> Result<Vec<[f64; 3]>, Fault> {
+pub(super) fn read(bytes: &[u8]) -> Result<Points, Fault> {
     let header = Header::parse(bytes)?;
     let xyz = [header.field("x")?, header.field("y")?, header.field("z")?];
+    let mut attributes = Attributes::new(&header)?;
     let (body, count) = (header.body, header.count);
-    match header.data {
-        "ascii" => read_ascii(bytes, &header, xyz),
+    let points = match header.data {
+        "ascii" => read_ascii(bytes, &header, xyz, &mut attributes),
         "binary" => {
             let record: usize = header.fields.iter().map(Field::size).sum();
             records(bytes, body, count, record)?;
-            // The first value of x, y, z: its byte offset in a record.
-            let offsets = xyz.map(|f| header.fields[..f].iter().map(Field::size).sum::<usize>());
+            // The first value of each field: its byte offset in a record.
+            let offsets: Vec<usize> = (0..header.fields.len())
+                .map(|f| header.fields[..f].iter().map(Field::size).sum())
+                .collect();
             let mut out = Vec::with_capacity(count as usize);
             for i in 0..count as usize {
                 let at = body + i * record;
                 let p = std::array::from_fn(|a| {
                     header.fields[xyz[a]]
                         .kind
-                        .get(&bytes[at + offsets[a]..], false)
+                        .get(&bytes[at + offsets[xyz[a]]..], false)
                 });
                 if measured(p) {
                     out.push(finite(p, |why| {
                         Fault::byte(at, format!("point {i} {why}"))
                     })?);
+                    attributes
+                        .push(&header, |f| Raw::Bytes(&bytes[at + offsets[f]..]))
+                        .map_err(|why| Fault::byte(at, format!("PCD point {i}: {why}")))?;
                 }
             }
             Ok(out)
         }
-        "binary_compressed" => read_compressed(bytes, &header, xyz),
+        "binary_compressed" => read_compressed(bytes, &header, xyz, &mut attributes),
         other => Err(Fault::line(
             header.lines,
             format!("unknown PCD DATA '{other}' (expected ascii, binary or binary_compressed)"),
         )),
-    }
+    }?;
+    Ok((points, attributes.read))
 }
 
-fn read_ascii(bytes: &[u8], header: &Header, xyz: [usize; 3]) -> Result<Vec<[f64; 3]>, Fault> {
+fn read_ascii(
+    bytes: &[u8],
+    header: &Header,
+    xyz: [usize; 3],
+    attributes: &mut Attributes,
+) -> Result<Vec<[f64; 3]>, Fault> {
     let (body, count) = (header.body, header.count);
     if count > (bytes.len() - body) as u64 {
         return Err(Fault::byte(
@@ -204,8 +304,10 @@ fn read_ascii(bytes: &[u8], header: &Header, xyz: [usize; 3]) -> Result<Vec<[f64
             ),
         ));
     }
-    // The first value of x, y, z: its index among a point's values.
-    let index = xyz.map(|f| header.fields[..f].iter().map(|f| f.count).sum::<usize>());
+    // The first value of each field: its index among a point's values.
+    let index: Vec<usize> = (0..header.fields.len())
+        .map(|f| header.fields[..f].iter().map(|f| f.count).sum())
+        .collect();
     let values: usize = header.fields.iter().map(|f| f.count).sum();
     let mut out = Vec::with_capacity(count as usize);
     let mut rows = bytes[body..]
@@ -227,13 +329,16 @@ fn read_ascii(bytes: &[u8], header: &Header, xyz: [usize; 3]) -> Result<Vec<[f64
         }
         let mut p = [0.0; 3];
         for a in 0..3 {
-            let w = words[index[a]];
+            let w = words[index[xyz[a]]];
             p[a] = w
                 .parse()
                 .map_err(|_| Fault::line(n, format!("'{w}' is not a number")))?;
         }
         if measured(p) {
             out.push(finite(p, |why| Fault::line(n, format!("point {i} {why}")))?);
+            attributes
+                .push(header, |f| Raw::Word(words[index[f]]))
+                .map_err(|why| Fault::line(n, format!("point {i}: {why}")))?;
         }
     }
     Ok(out)
@@ -241,7 +346,12 @@ fn read_ascii(bytes: &[u8], header: &Header, xyz: [usize; 3]) -> Result<Vec<[f64
 
 /// `binary_compressed`: the sizes, checked against the file and the fields before the LZF data are
 /// decompressed, then each point's x, y, z from their columns.
-fn read_compressed(bytes: &[u8], header: &Header, xyz: [usize; 3]) -> Result<Vec<[f64; 3]>, Fault> {
+fn read_compressed(
+    bytes: &[u8],
+    header: &Header,
+    xyz: [usize; 3],
+    attributes: &mut Attributes,
+) -> Result<Vec<[f64; 3]>, Fault> {
     let body = header.body;
     let u32_at = |at: usize| {
         bytes
@@ -292,11 +402,12 @@ fn read_compressed(bytes: &[u8], header: &Header, xyz: [usize; 3]) -> Result<Vec
             .sum();
         (before * count, header.fields[f].size())
     };
-    let columns_of = xyz.map(column);
+    // Padding fields hold no attribute: their column is never asked for.
+    let columns_of: Vec<(usize, usize)> = (0..header.fields.len()).map(column).collect();
     let mut out = Vec::with_capacity(count);
     for i in 0..count {
         let p = std::array::from_fn(|a| {
-            let (start, step) = columns_of[a];
+            let (start, step) = columns_of[xyz[a]];
             header.fields[xyz[a]]
                 .kind
                 .get(&columns[start + i * step..], false)
@@ -305,6 +416,14 @@ fn read_compressed(bytes: &[u8], header: &Header, xyz: [usize; 3]) -> Result<Vec
             out.push(finite(p, |why| {
                 Fault::byte(data, format!("PCD: the compressed point {i} {why}"))
             })?);
+            attributes
+                .push(header, |f| {
+                    let (start, step) = columns_of[f];
+                    Raw::Bytes(&columns[start + i * step..])
+                })
+                .map_err(|why| {
+                    Fault::byte(data, format!("PCD: the compressed point {i}: {why}"))
+                })?;
         }
     }
     Ok(out)
