@@ -364,10 +364,57 @@ impl<const K: usize, V: Value> KTree<K, V> {
                     .add(&cell);
             }
         }
-        for s in stats.values_mut() {
-            s.surface_area = self.select(s.value).surface_area();
+        for (key, faces) in self.faces_per_value() {
+            if let Some(s) = stats.get_mut(&key) {
+                s.surface_area = faces;
+            }
         }
         stats
+    }
+
+    /// The unit faces of each value's voxels that meet a voxel of another value, an empty voxel or the
+    /// universe's edge, all values at once: along each axis, every maximal run of one value (the leaves'
+    /// columns along that axis, sorted and joined where they touch with the same value) has two such
+    /// faces.
+    fn faces_per_value(&self) -> BTreeMap<V::Key, u128> {
+        let level = self.level();
+        let mut faces: BTreeMap<V::Key, u128> = BTreeMap::new();
+        let mut runs: Vec<(u64, u32, u32, V::Key)> = Vec::new();
+        for axis in 0..K {
+            runs.clear();
+            for (cell, value) in self.value_leaves() {
+                let Some(v) = value else { continue };
+                let side = cell.side() as u32;
+                let start = cell.origin[axis];
+                // Every line of the cell along `axis`: an odometer over the other axes.
+                let mut offset = [0u32; K];
+                'lines: loop {
+                    let column = (0..K).filter(|&a| a != axis).fold(0u64, |key, a| {
+                        (key << level) | u64::from(cell.origin[a] + offset[a])
+                    });
+                    runs.push((column, start, start + side, v.key()));
+                    for a in (0..K).filter(|&a| a != axis) {
+                        offset[a] += 1;
+                        if offset[a] < side {
+                            continue 'lines;
+                        }
+                        offset[a] = 0;
+                    }
+                    break;
+                }
+            }
+            runs.sort_unstable_by_key(|r| (r.0, r.1));
+            let mut previous: Option<(u64, u32, V::Key)> = None;
+            for &(column, start, end, key) in &runs {
+                let joined =
+                    previous.is_some_and(|(c, e, k)| c == column && e == start && k == key);
+                if !joined {
+                    *faces.entry(key).or_default() += 2;
+                }
+                previous = Some((column, end, key));
+            }
+        }
+        faces
     }
 }
 
