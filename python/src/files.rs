@@ -40,7 +40,7 @@ impl Tree {
     /// `tree.shape()` for them).
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         if let Some(values) = &self.values {
-            if !path.extension().is_some_and(|e| e == "ktree") {
+            if path.extension().is_none_or(|e| e != "ktree") {
                 return Err(Failure::Value(format!(
                     "{}: a tree with values is saved as .ktree (save tree.shape() for other formats)",
                     path.display()
@@ -83,9 +83,7 @@ impl Tree {
     }
 
     /// Pickling: the tree is rebuilt from its `.ktree` bytes (and its background).
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>, f64))> {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Rebuild<'py>> {
         let rebuild = slf.get_type().getattr("from_bytes")?;
         Ok((
             rebuild,
@@ -112,6 +110,9 @@ fn file_holds_values(path: &Path) -> bool {
     let read = std::fs::File::open(path).and_then(|f| f.take(16).read_to_end(&mut head));
     read.is_ok() && matches!(valued_header(&head, ""), Ok((_, _, Some(_))))
 }
+
+/// What pickling calls to rebuild a tree, and its arguments (the `.ktree` bytes and the background).
+type Rebuild<'py> = (Bound<'py, PyAny>, (Bound<'py, PyBytes>, f64));
 
 /// Reads a tree from a file of any format the library reads, chosen by extension, with `options`.
 pub(crate) fn read_tree_with(path: &Path, options: &ReadOptions) -> Result<AnyTree, Failure> {
