@@ -83,7 +83,7 @@ any_valued!(
 /// use ktree::value::Dtype;
 /// use ktree::{with_valued, AnyValuedTree, KTree};
 /// let any = with_valued!(3, Dtype::F32, K, V => {
-///     AnyValuedTree::from(KTree::<K, V>::empty(2).unwrap())
+///     AnyValuedTree::from(KTree::<K, V>::from_dense_values(0, &[None]).unwrap())
 /// }, else unreachable!());
 /// assert_eq!(with_valued!(&any, t => t.node_count()), 1);
 /// assert_eq!(any.dtype(), Dtype::F32);
