@@ -86,14 +86,26 @@ class _Collision(TypedDict):
     first_contact: Optional[int]
     min_separation: Optional[float]
 
+class _ValueStats(TypedDict):
+    voxels: int
+    bounding_box: tuple[list[int], list[int]]
+    centroid: list[float]
+    surface_area: int
+
 @final
 class Tree:
-    """A k-tree of dimension K = 1...4 over a universe of side 2**level; immutable, compared by content."""
+    """A k-tree of dimension K = 1...4 over a universe of side 2**level; immutable, compared by content.
+
+    A tree made from a numeric array holds a value per voxel (`dtype`); the value methods (values,
+    to_dense, select, mask, overlay, combine, relabel, value_stats) use the values, every other method
+    works on its shape (the voxels with a value) and returns trees without values."""
 
     @staticmethod
-    def from_dense(array: npt.ArrayLike, level: Optional[int] = None) -> Tree:
-        """The tree of a boolean array indexed [x, y, z, ...] (K = ndim), placed at the origin of a universe
-        of level `level` (default: the smallest holding the longest axis)."""
+    def from_dense(array: npt.ArrayLike, level: Optional[int] = None, background: float = 0.0) -> Tree:
+        """The tree of an array indexed [x, y, z, ...] (K = ndim), placed at the origin of a universe of
+        level `level` (default: the smallest holding the longest axis). A boolean array gives a tree without
+        values; a numeric one a tree with values (uint8, uint16, uint32, int8, float32; other integers the
+        smallest of these holding them, float64 float32) where voxels equal to `background` are empty."""
     @staticmethod
     def empty(k: int, level: int) -> Tree:
         """The empty tree."""
@@ -143,11 +155,31 @@ class Tree:
     def save(self, path: _Path) -> None:
         """Writes the tree atomically, the format chosen by the extension (meshes: the tree's boundary)."""
     def to_bytes(self) -> bytes:
-        """The tree in the .ktree format (version 2: 2 bits a node, checksums per level)."""
+        """The tree in the .ktree format (version 2: 2 bits a node, checksums per level; version 3 with
+        values)."""
     @staticmethod
-    def from_bytes(data: bytes) -> Tree:
-        """The tree of .ktree bytes."""
-    def __reduce__(self) -> tuple[Any, tuple[bytes]]: ...
+    def from_bytes(data: bytes, background: float = 0.0) -> Tree:
+        """The tree of .ktree bytes (`background`: of a tree with values' dense arrays)."""
+    def __reduce__(self) -> tuple[Any, tuple[bytes, float]]: ...
+    @property
+    def dtype(self) -> Optional[str]:
+        """The value type ("uint8", "uint16", "uint32", "int8", "float32", "rgb8"), None without values."""
+    def shape(self) -> Tree:
+        """The voxels holding a value, as a tree without values."""
+    def values(self, points: npt.ArrayLike, background: Optional[float] = None) -> npt.NDArray[Any]:
+        """The values at an (n, K) integer array of points (the background where empty)."""
+    def select(self, value: Any, hi: Any = None) -> Tree:
+        """The voxels holding `value` (or a value in value..=hi), as a tree without values."""
+    def mask(self, tree: Tree) -> Tree:
+        """The values of the voxels inside `tree`."""
+    def overlay(self, tree: Tree) -> Tree:
+        """`tree`'s values where it has them, this tree's elsewhere."""
+    def combine(self, tree: Tree, rule: Literal["first", "min", "max", "sum"]) -> Tree:
+        """The voxels of either tree; where both hold a value, `rule` decides."""
+    def relabel(self, mapping: dict[Any, Any]) -> Tree:
+        """Values replaced by `mapping` (a value mapped to None is removed)."""
+    def value_stats(self) -> dict[Any, _ValueStats]:
+        """Per value: voxels, bounding_box (lo, hi), centroid, surface_area."""
     @property
     def k(self) -> int:
         """The dimension K."""
@@ -164,10 +196,14 @@ class Tree:
     def node_count(self) -> int:
         """Nodes of the tree."""
     def to_dense(
-        self, origin: Optional[Sequence[int]] = None, shape: Optional[Sequence[int]] = None
-    ) -> npt.NDArray[np.bool_]:
+        self,
+        origin: Optional[Sequence[int]] = None,
+        shape: Optional[Sequence[int]] = None,
+        background: Optional[float] = None,
+    ) -> npt.NDArray[Any]:
         """The voxels of a window (`shape` from `origin`; default the bounding box, not the universe)
-        as a boolean array indexed [x, y, z, ...]; voxels outside the universe are False."""
+        as a boolean array indexed [x, y, z, ...]; voxels outside the universe are False. For a tree with
+        values, its values with `background` (default: the one it was made with) where empty."""
     def signed_distance(
         self, origin: Optional[Sequence[int]] = None, shape: Optional[Sequence[int]] = None
     ) -> npt.NDArray[np.float32]:

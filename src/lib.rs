@@ -119,4 +119,4 @@ pub mod prelude {
 
 pub use rays::{AnyRaySet, Ray, RaySet};
 pub use space::{max_level, Cell, Universe, MAX_K};
-pub use tree::{AnyTree, KTree, LevelCounts, NodeState, Octree, Quadtree};
+pub use tree::{AnyTree, AnyValuedTree, KTree, LevelCounts, NodeState, Octree, Quadtree};

@@ -4,42 +4,20 @@
 //! tree without values) and the per-value statistics of `ktree stats` on a valued file.
 //!
 //! A valued `.ktree` (version 3) carries its dimension and value type; each command reads them from the
-//! header and runs the same generic code for every `K` and type ([`with_valued!`]).
+//! header and runs the same generic code for every `K` and type (`ktree::with_valued!` on the
+//! `ktree::AnyValuedTree` read).
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::ktree::v3::{read_valued_ktree, valued_header, write_valued_ktree_file};
+use ktree::io::ktree::v3::{read_any_ktree, valued_header, write_valued_ktree_file, AnyKtree};
 use ktree::query::{stats, TreeStats};
 use ktree::solid::cloud::{self, CloudVoxelizer, PointCloud};
 use ktree::solid::volume::Volume;
-use ktree::value::{Dtype, Rgb, Value};
-use ktree::KTree;
+use ktree::value::{Dtype, Value};
+use ktree::{with_valued, AnyValuedTree, KTree};
 
 use crate::common::error::{chain, CliError, CliResult};
 use crate::outln;
-
-/// Runs `$f::<K, V>($args)` for the dimension `$k` and value type `$dtype` of a file.
-macro_rules! with_valued {
-    ($k:expr, $dtype:expr, $f:ident($($arg:expr),*)) => {
-        match $k {
-            1 => with_valued!(@v 1, $dtype, $f($($arg),*)),
-            2 => with_valued!(@v 2, $dtype, $f($($arg),*)),
-            3 => with_valued!(@v 3, $dtype, $f($($arg),*)),
-            4 => with_valued!(@v 4, $dtype, $f($($arg),*)),
-            other => Err(format!("K = {other} is not 1 to 4").into()),
-        }
-    };
-    (@v $n:literal, $dtype:expr, $f:ident($($arg:expr),*)) => {
-        match $dtype {
-            Dtype::U8 => $f::<$n, u8>($($arg),*),
-            Dtype::U16 => $f::<$n, u16>($($arg),*),
-            Dtype::U32 => $f::<$n, u32>($($arg),*),
-            Dtype::I8 => $f::<$n, i8>($($arg),*),
-            Dtype::F32 => $f::<$n, f32>($($arg),*),
-            Dtype::Rgb => $f::<$n, Rgb>($($arg),*),
-        }
-    };
-}
 
 /// The dimension and value type of a `.ktree` file (`None`: no values).
 pub fn file_dtype(path: &Path) -> Result<(usize, Option<Dtype>), String> {
@@ -66,10 +44,16 @@ pub fn is_valued(path: &Path) -> bool {
     path.extension().is_some_and(|e| e == "ktree") && matches!(file_dtype(path), Ok((_, Some(_))))
 }
 
-fn read<const K: usize, V: Value>(path: &Path) -> Result<KTree<K, V>, String> {
+/// A valued `.ktree` file's tree, of the dimension and value type its header names.
+fn read_valued(path: &Path) -> Result<AnyValuedTree, String> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
-    read_valued_ktree::<K, V>(&bytes, &name).map_err(|e| chain(&e))
+    match read_any_ktree(&bytes, &name).map_err(|e| chain(&e))? {
+        AnyKtree::Valued(tree) => Ok(tree),
+        AnyKtree::Binary(_) => Err(format!(
+            "{name}: the tree holds no values (this takes a tree made with values, e.g. voxelize --labels)"
+        )),
+    }
 }
 
 /// A label volume into a valued tree of the smallest label type that holds it (or `dtype`).
@@ -276,19 +260,11 @@ pub struct SelectArgs {
 
 /// `ktree select`.
 pub fn run_select(a: SelectArgs) -> CliResult {
-    let (k, dtype) = file_dtype(&a.input)?;
-    let Some(dtype) = dtype else {
-        return Err(format!(
-            "{}: the tree holds no values (select takes a tree made with values, e.g. voxelize --labels)",
-            a.input.display()
-        )
-        .into());
-    };
-    with_valued!(k, dtype, select(&a))
+    let tree = read_valued(&a.input)?;
+    with_valued!(&tree, t => select(t, &a))
 }
 
-fn select<const K: usize, V: Value>(a: &SelectArgs) -> CliResult {
-    let tree = read::<K, V>(&a.input)?;
+fn select<const K: usize, V: Value>(tree: &KTree<K, V>, a: &SelectArgs) -> CliResult {
     let chosen = match (&a.value, &a.range) {
         (Some(v), _) => tree.select(V::parse(v).map_err(|e| format!("--value {e}"))?),
         (None, Some(r)) => {
@@ -323,13 +299,11 @@ pub struct ValuedStats {
 
 /// The statistics of a valued `.ktree` file.
 pub fn valued_stats(path: &Path) -> Result<ValuedStats, String> {
-    let (k, dtype) = file_dtype(path)?;
-    let dtype = dtype.ok_or_else(|| format!("{}: the tree holds no values", path.display()))?;
-    with_valued!(k, dtype, stats_of(path))
+    let tree = read_valued(path)?;
+    with_valued!(&tree, t => stats_of(t))
 }
 
-fn stats_of<const K: usize, V: Value>(path: &Path) -> Result<ValuedStats, String> {
-    let tree = read::<K, V>(path)?;
+fn stats_of<const K: usize, V: Value>(tree: &KTree<K, V>) -> Result<ValuedStats, String> {
     let shape = tree.shape();
     let Ok(mut s) = stats(&shape, None);
     // The file's own nodes (mixed nodes counted with the partial ones: both have children).

@@ -23,38 +23,58 @@ use crate::Tree;
 
 #[pymethods]
 impl Tree {
-    /// The tree of a boolean array indexed `[x, y, z, ...]` (K = `array.ndim`, 1 to 4). The array is placed
-    /// at the origin of a universe of level `level` (default: the smallest whose side 2**level holds the
-    /// longest axis); other values than booleans are converted by numpy (non-zero is inside).
+    /// The tree of an array indexed `[x, y, z, ...]` (K = `array.ndim`, 1 to 4), placed at the origin of a
+    /// universe of level `level` (default: the smallest whose side 2**level holds the longest axis).
+    /// A boolean array gives a tree without values (True is inside). A numeric array gives a tree with
+    /// values where the voxels equal to `background` are empty: uint8, uint16, uint32, int8 and float32
+    /// are kept; other integer types become the smallest of uint8, int8, uint16, uint32 that holds their
+    /// values (a ValueError if none does); float64 and float16 become float32. A NaN is a ValueError.
     #[staticmethod]
-    #[pyo3(signature = (array, level = None))]
+    #[pyo3(signature = (array, level = None, background = 0.0))]
     fn from_dense(
         py: Python<'_>,
-        array: PyArrayLikeDyn<'_, bool, AllowTypeChange>,
+        array: &Bound<'_, PyAny>,
         level: Option<u32>,
+        background: f64,
     ) -> PyResult<Self> {
+        let array = py.import("numpy")?.call_method1("asarray", (array,))?;
+        let name: String = array.getattr("dtype")?.getattr("name")?.extract()?;
+        let (lo, hi) = if array.getattr("size")?.extract::<usize>()? > 0 && name.contains("int") {
+            (
+                array.call_method0("min")?.extract()?,
+                array.call_method0("max")?.extract()?,
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+        let level = level.unwrap_or_else(|| level_for(shape.iter().copied().max().unwrap_or(1)));
+        if let Some(dtype) = crate::values::dtype_for(&name, lo, hi)? {
+            let tree =
+                crate::values::tree_of_array(py, &array, shape.len(), dtype, level, background)?;
+            return Ok(Self::valued(tree, background));
+        }
+        let array: PyArrayLikeDyn<'_, bool, AllowTypeChange> = array.extract()?;
         let view = array.as_array();
-        let level =
-            level.unwrap_or_else(|| level_for(view.shape().iter().copied().max().unwrap_or(1)));
         let tree = with_k!(view.ndim(), "from_dense: an array with that many dimensions", K => {
             let dense = dense_of_view::<K>(&view, level)?;
             py.detach(|| KTree::<K>::from_dense(level, &dense).map(AnyTree::from).map_err(Failure::from))
         })?;
-        Ok(Self { inner: tree })
+        Ok(Self::binary(tree))
     }
 
     /// The empty tree of dimension `k` and level `level`.
     #[staticmethod]
     fn empty(k: usize, level: u32) -> PyResult<Self> {
         let tree = with_k!(k, "empty", K => KTree::<K>::empty(level).map(AnyTree::from).map_err(Failure::from))?;
-        Ok(Self { inner: tree })
+        Ok(Self::binary(tree))
     }
 
     /// The tree of the whole universe of dimension `k` and level `level`.
     #[staticmethod]
     fn full(k: usize, level: u32) -> PyResult<Self> {
         let tree = with_k!(k, "full", K => KTree::<K>::full(level).map(AnyTree::from).map_err(Failure::from))?;
-        Ok(Self { inner: tree })
+        Ok(Self::binary(tree))
     }
 
     /// The tree of runs along the last axis: an `(n, K + 1)` integer array whose rows are a column's `K - 1`
@@ -74,7 +94,7 @@ impl Tree {
             let set = crate::rays::rays_of_rows::<K>(flat, level)?;
             Ok(AnyTree::from(py.detach(|| KTree::from_rays(&set))))
         })?;
-        Ok(Self { inner: tree })
+        Ok(Self::binary(tree))
     }
 
     /// The octree of a triangle mesh file (OBJ, STL, PLY) in a universe of level `level`. `transform`
@@ -196,7 +216,7 @@ impl Tree {
             ..ReadOptions::default()
         };
         let tree = py.detach(|| crate::files::read_tree_with(&path, &options))?;
-        Ok(Self { inner: tree })
+        Ok(Self::binary(tree))
     }
 }
 

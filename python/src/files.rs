@@ -7,6 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
+use ktree::io::ktree::v3::{read_any_ktree, valued_header, write_any_valued_ktree, AnyKtree};
 use ktree::io::{ReadOptions, WriteOptions};
 use ktree::with_dim;
 use ktree::AnyTree;
@@ -18,47 +19,100 @@ use crate::Tree;
 
 #[pymethods]
 impl Tree {
-    /// Reads a tree file; the format is chosen by the extension.
+    /// Reads a tree file; the format is chosen by the extension. A `.ktree` file with values (version 3)
+    /// gives a tree with values (background 0).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        if path.extension().is_some_and(|e| e == "ktree") && file_holds_values(&path) {
+            let tree = py.detach(|| {
+                let name = path.display().to_string();
+                let bytes = std::fs::read(&path).map_err(|e| Failure::of_error(&e, &path))?;
+                read_any_ktree(&bytes, &name).map_err(|e| Failure::of_error(&e, &path))
+            })?;
+            return Ok(Self::of_file(tree, 0.0));
+        }
         let tree = py.detach(|| read_tree_with(&path, &ReadOptions::default()))?;
-        Ok(Self { inner: tree })
+        Ok(Self::binary(tree))
     }
 
-    /// Writes the tree (atomically: a temporary file renamed); the format is chosen by the extension.
+    /// Writes the tree (atomically: a temporary file renamed); the format is chosen by the extension. A
+    /// tree with values is written only as `.ktree` (version 3; other formats would drop the values: save
+    /// `tree.shape()` for them).
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        if let Some(values) = &self.values {
+            if path.extension().is_none_or(|e| e != "ktree") {
+                return Err(Failure::Value(format!(
+                    "{}: a tree with values is saved as .ktree (save tree.shape() for other formats)",
+                    path.display()
+                ))
+                .into());
+            }
+            return Ok(py.detach(|| {
+                ktree::fs::write_atomic_with(&path, |w| write_any_valued_ktree(w, values))
+                    .map_err(|e| Failure::of_error(&e, &path))
+            })?);
+        }
         Ok(py.detach(|| {
             ktree::io::write_tree(&path, &self.inner, &WriteOptions::default())
                 .map_err(|e| Failure::of_error(&e, &path))
         })?)
     }
 
-    /// The tree in the `.ktree` format (version 2: 2 bits a node, checksums per level), as bytes.
+    /// The tree in the `.ktree` format (version 2: 2 bits a node, checksums per level; version 3 with the
+    /// values for a tree with values), as bytes.
     fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
         let bytes = py.detach(|| {
             let mut out = Vec::new();
-            with_dim!(&self.inner, AnyTree, t => ktree::io::write_ktree(&mut out, t)).map(|()| out)
+            match &self.values {
+                Some(values) => write_any_valued_ktree(&mut out, values),
+                None => with_dim!(&self.inner, AnyTree, t => ktree::io::write_ktree(&mut out, t)),
+            }
+            .map(|()| out)
         });
         let bytes = bytes.map_err(Failure::value)?;
         Ok(PyBytes::new(py, &bytes))
     }
 
-    /// The tree of bytes in the `.ktree` format (as `to_bytes` gives).
+    /// The tree of bytes in the `.ktree` format (as `to_bytes` gives); a tree with values gets
+    /// `background` as the background of its dense arrays.
     #[staticmethod]
-    fn from_bytes(py: Python<'_>, data: &[u8]) -> PyResult<Self> {
-        let tree =
-            py.detach(|| ktree::io::read_ktree_any(data, "<bytes>").map_err(Failure::value))?;
-        Ok(Self { inner: tree })
+    #[pyo3(signature = (data, background = 0.0))]
+    fn from_bytes(py: Python<'_>, data: &[u8], background: f64) -> PyResult<Self> {
+        let tree = py.detach(|| read_any_ktree(data, "<bytes>").map_err(Failure::value))?;
+        Ok(Self::of_file(tree, background))
     }
 
-    /// Pickling: the tree is rebuilt from its `.ktree` bytes.
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+    /// Pickling: the tree is rebuilt from its `.ktree` bytes (and its background).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Rebuild<'py>> {
         let rebuild = slf.get_type().getattr("from_bytes")?;
-        Ok((rebuild, (slf.get().to_bytes(slf.py())?,)))
+        Ok((
+            rebuild,
+            (slf.get().to_bytes(slf.py())?, slf.get().background),
+        ))
     }
 }
+
+impl Tree {
+    /// The Python object of a `.ktree` file's tree.
+    fn of_file(tree: AnyKtree, background: f64) -> Self {
+        match tree {
+            AnyKtree::Binary(t) => Self::binary(t),
+            AnyKtree::Valued(t) => Self::valued(t, background),
+        }
+    }
+}
+
+/// Whether a `.ktree` file's header says it holds values (a file that cannot be read says no: the reader
+/// of every format then reports it).
+fn file_holds_values(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = Vec::new();
+    let read = std::fs::File::open(path).and_then(|f| f.take(16).read_to_end(&mut head));
+    read.is_ok() && matches!(valued_header(&head, ""), Ok((_, _, Some(_))))
+}
+
+/// What pickling calls to rebuild a tree, and its arguments (the `.ktree` bytes and the background).
+type Rebuild<'py> = (Bound<'py, PyAny>, (Bound<'py, PyBytes>, f64));
 
 /// Reads a tree from a file of any format the library reads, chosen by extension, with `options`.
 pub(crate) fn read_tree_with(path: &Path, options: &ReadOptions) -> Result<AnyTree, Failure> {

@@ -20,7 +20,7 @@ impl Tree {
         let out = py.detach(
             || with_dim!(&self.inner, AnyTree, t => translate(t, &offset).map(AnyTree::from)),
         )?;
-        Ok(Self { inner: out })
+        Ok(Self::binary(out))
     }
 
     /// Rotated by `degrees` about the universe's centre, in the plane of `axes` = (i, j) (turning axis i
@@ -38,7 +38,7 @@ impl Tree {
             None => (0, 1),
         };
         let out = py.detach(|| with_dim!(&self.inner, AnyTree, t => rotate(t, degrees, from, to).map(AnyTree::from)))?;
-        Ok(Self { inner: out })
+        Ok(Self::binary(out))
     }
 
     /// Scaled by `factor` about the universe's origin corner: an int or a `fractions.Fraction` p/q is exact
@@ -63,7 +63,7 @@ impl Tree {
         };
         let out = py
             .detach(|| with_dim!(&self.inner, AnyTree, t => scale(t, factor).map(AnyTree::from)))?;
-        Ok(Self { inner: out })
+        Ok(Self::binary(out))
     }
 
     /// Mapped by a homogeneous (K + 1) x (K + 1) matrix acting on column vectors [x; 1], in one overlay
@@ -86,7 +86,7 @@ impl Tree {
         let out = py.detach(
             || with_dim!(&self.inner, AnyTree, t => self::matrix(t, &m).map(AnyTree::from)),
         )?;
-        Ok(Self { inner: out })
+        Ok(Self::binary(out))
     }
 }
 

@@ -15,8 +15,8 @@
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
-use ktree::with_dim;
-use ktree::AnyTree;
+use ktree::{with_dim, with_valued};
+use ktree::{AnyTree, AnyValuedTree};
 use pyo3::prelude::*;
 
 /// Runs `$body` with `K` bound as a constant, for `$k` in 1…4, or fails.
@@ -57,31 +57,69 @@ mod geometry;
 mod query;
 mod rays;
 mod shape;
+mod values;
 
 /// A k-tree of dimension K = 1…4 (bintree, quadtree, octree, 4-D tree) over a universe of side 2**level.
 ///
 /// Coordinates are `[x, y, z, ...]` as in the command-line tool: a dense array `a` has `a[x, y, z]` for
 /// voxel (x, y, z), and rays run along the last axis. Trees are immutable: operations return new trees.
 /// Two trees compare equal when they hold the same object in the same universe.
+///
+/// A tree made from a numeric array holds a value per voxel (`dtype` names its type; voxels equal to the
+/// background are empty): `values`, `to_dense`, `select`, `mask`, `overlay`, `combine`, `relabel` and
+/// `value_stats` use the values; every other method works on its shape (the voxels that hold a value) and
+/// returns trees without values.
 #[pyclass(frozen, name = "Tree", module = "ktree")]
 pub(crate) struct Tree {
+    /// The tree, or the shape of a tree with values (the voxels that hold one): what the methods of trees
+    /// without values work on.
     pub(crate) inner: AnyTree,
+    /// The values, for a tree made with them.
+    pub(crate) values: Option<AnyValuedTree>,
+    /// What dense arrays of the values hold where the tree is empty (the background it was made with).
+    pub(crate) background: f64,
 }
 
 impl Tree {
     /// The Python object of a library tree of any `K`.
     pub(crate) fn wrap(inner: impl Into<AnyTree>) -> Self {
+        Self::binary(inner.into())
+    }
+
+    /// The Python object of a tree without values.
+    pub(crate) fn binary(inner: AnyTree) -> Self {
         Self {
-            inner: inner.into(),
+            inner,
+            values: None,
+            background: 0.0,
         }
+    }
+
+    /// The Python object of a tree with values whose dense arrays hold `background` where it is empty.
+    pub(crate) fn valued(values: AnyValuedTree, background: f64) -> Self {
+        Self {
+            inner: values.shape(),
+            values: Some(values),
+            background,
+        }
+    }
+
+    /// A tree with other values and this tree's background.
+    pub(crate) fn with_values(&self, values: AnyValuedTree) -> Self {
+        Self::valued(values, self.background)
     }
 }
 
 #[pymethods]
 impl Tree {
-    /// Same object in the same universe (trees are canonical, so this compares nodes).
+    /// Same object in the same universe (trees are canonical, so this compares nodes) and, for trees with
+    /// values, the same values of the same dtype: a tree with values never equals one without.
     fn __eq__(&self, other: PyRef<'_, Tree>) -> bool {
-        self.inner == other.inner
+        match (&self.values, &other.values) {
+            (None, None) => self.inner == other.inner,
+            (Some(a), Some(b)) => a == b,
+            _ => false,
+        }
     }
 
     /// A hash of the object and its universe: equal trees hash equal (in every process: the hasher's keys
@@ -90,15 +128,25 @@ impl Tree {
         py.detach(|| {
             let mut h = DefaultHasher::new();
             self.inner.k().hash(&mut h);
-            with_dim!(&self.inner, AnyTree, t => t.hash(&mut h));
+            match &self.values {
+                None => with_dim!(&self.inner, AnyTree, t => t.hash(&mut h)),
+                Some(values) => {
+                    values.dtype().hash(&mut h);
+                    with_valued!(values, t => t.hash(&mut h));
+                }
+            }
             h.finish()
         })
     }
 
     fn __repr__(&self) -> String {
         let c = self.inner.counts();
+        let dtype = self
+            .values
+            .as_ref()
+            .map_or(String::new(), |v| format!(", dtype={}", v.dtype().name()));
         format!(
-            "Tree(k={}, level={}, nodes={}, full={}, partial={})",
+            "Tree(k={}, level={}{dtype}, nodes={}, full={}, partial={})",
             self.inner.k(),
             self.inner.level(),
             c.nodes(),

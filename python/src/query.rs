@@ -52,13 +52,18 @@ impl Tree {
     /// integers each; voxels outside the universe are False). By default the window is the bounding box
     /// of the full voxels (from `origin` when only it is given), not the universe: an empty tree gives an
     /// array of shape (0,) * K. `to_dense((0,) * k, (side,) * k)` is the whole universe.
-    #[pyo3(signature = (origin = None, shape = None))]
+    ///
+    /// For a tree with values, the values (of its dtype; colours with a last axis of 3) with `background`
+    /// where the tree is empty (default: the background it was made with), the window by default the
+    /// bounding box of the voxels with a value.
+    #[pyo3(signature = (origin = None, shape = None, background = None))]
     fn to_dense<'py>(
         &self,
         py: Python<'py>,
         origin: Option<Vec<i64>>,
         shape: Option<Vec<usize>>,
-    ) -> PyResult<Bound<'py, PyArrayDyn<bool>>> {
+        background: Option<f64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let k = self.inner.k();
         check_lengths(
             "to_dense",
@@ -68,13 +73,23 @@ impl Tree {
                 ("shape", shape.as_deref().map(<[usize]>::len)),
             ],
         )?;
+        if let Some(values) = &self.values {
+            return crate::values::to_dense(
+                py,
+                self,
+                values,
+                origin.as_deref(),
+                shape.as_deref(),
+                background,
+            );
+        }
         let array = py.detach(|| {
             with_dim!(&self.inner, AnyTree, t => {
                 let (o, s) = default_window(t, origin.as_deref(), shape.as_deref());
                 window(t, o, s)
             })
         })?;
-        Ok(array.into_pyarray(py))
+        Ok(array.into_pyarray(py).into_any())
     }
 
     /// Signed distances of a window as a float32 array indexed `[x, y, z, ...]`: Euclidean between voxel
@@ -243,7 +258,7 @@ impl Tree {
                 AnyTree::from(t.crop(lo, hi))
             })
         });
-        Ok(Self { inner: out })
+        Ok(Self::binary(out))
     }
 
     /// The full leaves as an `(n, K + 1)` int64 array: each row a cell's corner coordinates (its smallest
@@ -492,7 +507,7 @@ fn signed_distance<const K: usize>(
 
 /// The window asked for (`K` numbers each, checked), by default the bounding box (from `origin` when
 /// given), empty for an empty tree.
-fn default_window<const K: usize>(
+pub(crate) fn default_window<const K: usize>(
     tree: &KTree<K>,
     origin: Option<&[i64]>,
     shape: Option<&[usize]>,

@@ -37,7 +37,7 @@ impl Tree {
     fn __invert__(&self, py: Python<'_>) -> Self {
         let out =
             py.detach(|| with_dim!(&self.inner, AnyTree, t => AnyTree::from(ops::complement(t))));
-        Self { inner: out }
+        Self::binary(out)
     }
 
     /// The voxels within the element of radius `r` (a real number >= 0) of a full voxel, clipped to the
@@ -102,7 +102,7 @@ impl Tree {
                 .map(|c| c.into_iter().map(|c| AnyTree::from(c.tree)).collect()))
             .map_err(Failure::value)
         })?;
-        Ok(parts.into_iter().map(|inner| Self { inner }).collect())
+        Ok(parts.into_iter().map(Self::binary).collect())
     }
 
     /// The largest connected component (an empty tree if there is none).
@@ -112,7 +112,7 @@ impl Tree {
             with_dim!(&self.inner, AnyTree, t => t.largest_component(connectivity).map(AnyTree::from))
                 .map_err(Failure::value)
         })?;
-        Ok(Self { inner: out })
+        Ok(Self::binary(out))
     }
 
     /// The number of (K - 1)-faces between a full voxel and an empty one (outside the universe empty).
@@ -226,11 +226,11 @@ fn morph(
 ) -> PyResult<Tree> {
     let element: Element = shape.parse().map_err(Failure::Value)?;
     let out = py.detach(|| op(&tree.inner, r, element).map_err(Failure::value))?;
-    Ok(Tree { inner: out })
+    Ok(Tree::binary(out))
 }
 
 /// Runs a Boolean operation without the interpreter lock.
 fn boolean(py: Python<'_>, a: &Tree, b: &Tree, op: BoolOp) -> PyResult<Tree> {
     let out = py.detach(|| a.inner.boolean(&b.inner, op).map_err(Failure::from))?;
-    Ok(Tree { inner: out })
+    Ok(Tree::binary(out))
 }

@@ -95,9 +95,11 @@ def test_dense_non_square_is_placed_at_the_origin(rng):
         ktree.Tree.from_dense(a, level=2)
 
 
-def test_dense_accepts_non_boolean_arrays():
+def test_dense_of_numbers_holds_values_whose_shape_is_non_zero():
     a = np.array([[0, 2], [0, 0]])
-    np.testing.assert_array_equal(whole(ktree.Tree.from_dense(a)), a != 0)
+    t = ktree.Tree.from_dense(a)
+    assert t.dtype == "uint8"
+    np.testing.assert_array_equal(whole(t.shape()), a != 0)
 
 
 @pytest.mark.parametrize("shape", [(2,) * 5, ()])

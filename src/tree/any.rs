@@ -60,6 +60,11 @@ impl AnyTree {
         Ok(*boxed.downcast::<KTree<K>>().expect("K matched above"))
     }
 
+    /// The tree as `&KTree<K>`, or `None` if it has another dimension.
+    pub fn as_dim<const K: usize>(&self) -> Option<&KTree<K>> {
+        with_dim!(self, AnyTree, t => (t as &dyn std::any::Any).downcast_ref::<KTree<K>>())
+    }
+
     /// The dimension `K`.
     pub fn k(&self) -> usize {
         match self {

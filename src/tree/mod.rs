@@ -14,6 +14,7 @@
 //! ```
 
 mod any;
+mod any_valued;
 mod assemble;
 pub mod cursor;
 mod error;
@@ -30,6 +31,7 @@ pub mod valued;
 pub(crate) mod words;
 
 pub use any::{AnyTree, DimensionMismatch};
+pub use any_valued::AnyValuedTree;
 pub(crate) use assemble::{LevelWriter, TreeAssembler};
 pub use cursor::Leaves;
 pub use error::{StorageError, TreeError};

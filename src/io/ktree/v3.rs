@@ -49,7 +49,7 @@ use super::{KtreeFileError, KtreeFileErrorKind, MAGIC};
 use crate::space::{max_level, Universe, MAX_K};
 use crate::tree::valued::ValueStorage;
 use crate::tree::words::{children_mask, full_mask};
-use crate::tree::{Dtype, KTree, PackedStates, Value};
+use crate::tree::{AnyTree, AnyValuedTree, Dtype, KTree, PackedStates, Value};
 
 pub use super::v3_mapped::MappedValuedTree;
 
@@ -501,4 +501,92 @@ pub fn read_valued_ktree_file<const K: usize, V: Value>(
     let bytes = std::fs::read(path)
         .map_err(|e| KtreeFileError::at_byte(name.clone(), 0, KtreeFileErrorKind::Io(e.into())))?;
     read_valued_ktree(&bytes, &name)
+}
+
+/// A `.ktree` file's tree of whatever dimension and value type its header names: a tree without values
+/// (versions 1 and 2) or a tree with values (version 3).
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnyKtree {
+    /// A tree without values.
+    Binary(AnyTree),
+    /// A tree with values.
+    Valued(AnyValuedTree),
+}
+
+/// Reads a `.ktree` file's bytes of any version, dimension and value type.
+///
+/// ```
+/// use ktree::io::ktree::v3::{read_any_ktree, write_any_valued_ktree, AnyKtree};
+/// use ktree::{AnyValuedTree, KTree};
+/// let tree = AnyValuedTree::from(KTree::<1, i8>::from_dense_values(1, &[Some(-3), None]).unwrap());
+/// let mut bytes = Vec::new();
+/// write_any_valued_ktree(&mut bytes, &tree).unwrap();
+/// assert_eq!(read_any_ktree(&bytes, "mem").unwrap(), AnyKtree::Valued(tree));
+/// ```
+///
+/// # Errors
+/// As [`read_valued_ktree`]; a dimension other than 1…4 is [`KtreeFileErrorKind::Dimension`].
+pub fn read_any_ktree(bytes: &[u8], file: &str) -> Result<AnyKtree, KtreeFileError> {
+    if bytes.get(6..8) != Some(&VERSION.to_le_bytes()[..]) {
+        return super::read_ktree_any(bytes, file).map(AnyKtree::Binary);
+    }
+    let (k, _, dtype) = valued_header(bytes, file)?;
+    let Some(dtype) = dtype else {
+        return super::read_ktree_any(bytes, file).map(AnyKtree::Binary);
+    };
+    crate::with_valued!(k, dtype, K, V => {
+        read_valued_ktree::<K, V>(bytes, file).map(|t| AnyKtree::Valued(AnyValuedTree::from(t)))
+    }, else Err(KtreeFileError::at_byte(
+        file.to_string(),
+        8,
+        KtreeFileErrorKind::Header(format!("K = {k} is not 1 to 4")),
+    )))
+}
+
+/// Writes a tree with values of any dimension and value type as a version 3 `.ktree` file
+/// ([`write_valued_ktree`]).
+///
+/// # Errors
+/// Any I/O error.
+pub fn write_any_valued_ktree(out: impl Write, tree: &AnyValuedTree) -> std::io::Result<()> {
+    crate::with_valued!(tree, t => write_valued_ktree(out, t))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pattern<const K: usize, V: Value>() -> AnyValuedTree {
+        let bytes = V::DTYPE.unwrap().bytes();
+        let dense: Vec<Option<V>> = (0..1usize << (2 * K))
+            .map(|i| (i % 3 != 0).then(|| V::read_le(&vec![(i % 4) as u8; bytes])))
+            .collect();
+        AnyValuedTree::from(KTree::<K, V>::from_dense_values(2, &dense).unwrap())
+    }
+
+    #[test]
+    fn any_tree_of_every_dimension_and_value_type_reads_back() {
+        for k in 1..=4 {
+            for dtype in Dtype::ALL {
+                let tree =
+                    crate::with_valued!(k, dtype, K, V => pattern::<K, V>(), else unreachable!());
+                let mut bytes = Vec::new();
+                write_any_valued_ktree(&mut bytes, &tree).unwrap();
+                assert_eq!(
+                    read_any_ktree(&bytes, "mem").unwrap(),
+                    AnyKtree::Valued(tree.clone())
+                );
+                // A tree without values reads as one.
+                let mut binary = Vec::new();
+                crate::with_dim!(&tree.shape(), AnyTree, t => super::super::write_ktree(&mut binary, t)).unwrap();
+                assert_eq!(
+                    read_any_ktree(&binary, "mem").unwrap(),
+                    AnyKtree::Binary(tree.shape())
+                );
+                // A cut file is refused, not misread.
+                let cut = &bytes[..bytes.len() - 5];
+                assert!(read_any_ktree(cut, "mem").is_err());
+            }
+        }
+    }
 }
