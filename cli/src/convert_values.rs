@@ -8,7 +8,7 @@ use ktree::io::ktree::v3::{read_valued_ktree, write_valued_ktree_file};
 use ktree::io::write_nifti_file;
 use ktree::solid::volume::Volume;
 use ktree::space::WorldFrame;
-use ktree::value::{Dtype, Rgb, Value};
+use ktree::value::{Dtype, Value};
 use ktree::KTree;
 
 use crate::common::error::{chain, CliError, CliResult};
@@ -37,22 +37,17 @@ pub fn convert_valued(input: &Path, output: &Path, frame: &WorldFrame) -> CliRes
         )
         .into());
     }
-    match (k, dtype) {
-        (3, Dtype::U8) => write_octree::<u8>(input, output, frame),
-        (3, Dtype::U16) => write_octree::<u16>(input, output, frame),
-        (3, Dtype::U32) => write_octree::<u32>(input, output, frame),
-        (3, Dtype::I8) => write_octree::<i8>(input, output, frame),
-        (3, Dtype::F32) => write_octree::<f32>(input, output, frame),
-        (3, Dtype::Rgb) => write_octree::<Rgb>(input, output, frame),
-        _ => {
-            // Any other K: a .ktree to a .ktree is a checked copy.
-            let bytes = std::fs::read(input)
-                .map_err(|e| format!("{}: cannot read: {e}", input.display()))?;
-            ktree::fs::write_atomic(output, &bytes).map_err(CliError::caused)?;
-            outln!("{}: copied (K = {k}, {})", output.display(), dtype.name());
-            Ok(())
+    ktree::with_valued!(k, dtype, KK, V => {
+        if KK == 3 {
+            return write_octree::<V>(input, output, frame);
         }
-    }
+        // Any other K: a .ktree to a .ktree is a checked copy.
+        let bytes = std::fs::read(input)
+            .map_err(|e| format!("{}: cannot read: {e}", input.display()))?;
+        ktree::fs::write_atomic(output, &bytes).map_err(CliError::caused)?;
+        outln!("{}: copied (K = {k}, {})", output.display(), dtype.name());
+        Ok(())
+    }, else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()))
 }
 
 fn write_octree<V: Value>(input: &Path, output: &Path, frame: &WorldFrame) -> CliResult {
@@ -84,11 +79,7 @@ pub fn voxelize_window(
     out: &Path,
 ) -> CliResult {
     let volume = Volume::read(input).map_err(CliError::caused)?;
-    let fits = [0, 1, 2].map(|a| offset[a] as usize + volume.shape()[a]);
-    let level = level.unwrap_or_else(|| {
-        let m = fits.into_iter().max().unwrap_or(1).max(1);
-        m.next_power_of_two().trailing_zeros()
-    });
+    let level = level.unwrap_or_else(|| fitting_level(&volume, offset));
     let runs = volume
         .to_window_runs(level, offset, window.0, window.1)
         .map_err(|e| format!("{}: {e}", input.display()))?;
@@ -103,6 +94,13 @@ pub fn voxelize_window(
         tree.node_count()
     );
     Ok(())
+}
+
+/// The smallest level whose universe holds `volume` placed at `offset`.
+pub fn fitting_level(volume: &Volume, offset: [u32; 3]) -> u32 {
+    let fits = [0, 1, 2].map(|a| offset[a] as usize + volume.shape()[a]);
+    let m = fits.into_iter().max().unwrap_or(1).max(1);
+    m.next_power_of_two().trailing_zeros()
 }
 
 /// A window `LO:HI` of two numbers.

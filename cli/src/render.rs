@@ -119,17 +119,10 @@ pub fn run(args: Args) -> CliResult {
             )
             .into());
         }
-        use ktree::value::{Dtype, Rgb};
-        let go = |tick: &mut dyn FnMut(u64, u64)| match dtype {
-            Some(Dtype::U8) => render_valued::<u8>(&args, &out, w, h, colour, bar.as_ref(), tick),
-            Some(Dtype::U16) => render_valued::<u16>(&args, &out, w, h, colour, bar.as_ref(), tick),
-            Some(Dtype::U32) => render_valued::<u32>(&args, &out, w, h, colour, bar.as_ref(), tick),
-            Some(Dtype::I8) => render_valued::<i8>(&args, &out, w, h, colour, bar.as_ref(), tick),
-            Some(Dtype::F32) => render_valued::<f32>(&args, &out, w, h, colour, bar.as_ref(), tick),
-            Some(Dtype::Rgb) => render_valued::<Rgb>(&args, &out, w, h, colour, bar.as_ref(), tick),
-            None => unreachable!("a valued file has a value type"),
-        };
-        return go(&mut tick);
+        let dtype = dtype.ok_or("a valued file has a value type")?;
+        return ktree::with_valued!(3, dtype, KK, V => {
+            render_valued::<V>(&args, &out, w, h, colour, bar.as_ref(), &mut tick)
+        }, else unreachable!("every value type has an arm"));
     }
     if args.colour.as_deref() == Some("value") {
         return Err(format!(

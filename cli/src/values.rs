@@ -77,11 +77,7 @@ pub fn voxelize_labels(
             }
         },
     };
-    let fits = [0, 1, 2].map(|a| offset[a] as usize + volume.shape()[a]);
-    let level = level.unwrap_or_else(|| {
-        let m = fits.into_iter().max().unwrap_or(1).max(1);
-        m.next_power_of_two().trailing_zeros()
-    });
+    let level = level.unwrap_or_else(|| crate::convert_values::fitting_level(&volume, offset));
     fn build<V: Value + TryFrom<u32>>(
         volume: &Volume,
         input: &Path,

@@ -4,13 +4,7 @@
 
 mod common;
 
-use common::{data_dir, ktree};
-
-fn run(args: &[&str]) -> String {
-    let (ok, out, err) = ktree(args);
-    assert!(ok, "ktree {args:?}: {err}");
-    out
-}
+use common::{data_dir, ktree, run};
 
 #[test]
 fn trees_with_values_are_drawn_in_their_values_colours() {

@@ -8,7 +8,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{data_dir, ktree, tools};
+use common::{data_dir, ktree, run, tools};
 use ktree::io::ktree::v3::read_valued_ktree;
 use ktree::value::Value;
 use ktree::KTree;
@@ -84,12 +84,6 @@ fn expected<V: Value>(tree: &KTree<3, V>, sample: impl Fn(V) -> f64) -> Vec<f64>
         .into_iter()
         .map(|v| v.map_or(0.0, &sample))
         .collect()
-}
-
-fn run(args: &[&str]) -> String {
-    let (ok, out, err) = ktree(args);
-    assert!(ok, "ktree {args:?}: {err}");
-    out
 }
 
 #[test]

@@ -5,16 +5,10 @@
 
 mod common;
 
-use common::{data_dir, ktree};
+use common::{data_dir, ktree, run};
 use ktree::io::read_ktree_file;
 use ktree::ops::{project, slice};
 use ktree::KTree;
-
-fn run(args: &[&str]) -> String {
-    let (ok, out, err) = ktree(args);
-    assert!(ok, "ktree {args:?}: {err}");
-    out
-}
 
 #[test]
 fn projections_slices_and_maps_of_the_skull() {

@@ -8,7 +8,7 @@ mod common;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use common::ktree;
+use common::{ktree, run};
 
 /// A 5 × 6 × 7 volume of labels 0 (background), 1, 2, 3 and 300 in blobs and stripes.
 fn labels() -> ([usize; 3], Vec<u16>) {
@@ -48,12 +48,6 @@ fn write_volume(dir: &Path, shape: [usize; 3], values: &[u16]) -> std::path::Pat
     )
     .unwrap();
     json
-}
-
-fn run(args: &[&str]) -> String {
-    let (ok, out, err) = ktree(args);
-    assert!(ok, "ktree {args:?} failed: {err}");
-    out
 }
 
 /// Voxels, box `[lo, hi)` and the sums of the centres of one label, counted on the samples.

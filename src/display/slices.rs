@@ -15,10 +15,8 @@ use super::camera::{Camera, ISO_TOWARD_EYE};
 use super::error::DisplayError;
 use super::png::Canvas;
 use super::raster::{render, RenderOptions, Rendered};
-use crate::space::{Cell, Universe};
-use crate::tree::cursor::{try_walk, Visitor, Walk};
 use crate::tree::storage::TreeStorage;
-use crate::tree::{KTree, NodeRef, NodeState, Octree};
+use crate::tree::Octree;
 
 /// The octree of the 4-D tree's slice at `position` along `axis` (the remaining axes keep their order).
 ///
@@ -46,106 +44,10 @@ pub fn slice_4d<T: TreeStorage<4>>(
             side,
         });
     }
-    let universe = Universe::<3>::new(tree.level()).expect("a 4-D level is a valid 3-D level");
-    let drop_axis = |o: [u32; 4]| -> [u32; 3] {
-        let mut out = [0u32; 3];
-        let mut j = 0;
-        for (i, &c) in o.iter().enumerate() {
-            if i != axis {
-                out[j] = c;
-                j += 1;
-            }
-        }
-        out
-    };
-    // The full leaves whose cells meet the slab `position` on `axis`, found by one walk that skips every
-    // subtree outside the slab.
-    struct Slab<F> {
-        axis: usize,
-        position: u32,
-        full: F,
-    }
-    impl<F: FnMut(&Cell<4>)> Visitor<4> for Slab<F> {
-        const LEAVES: bool = false;
-        fn visit(&mut self, node: &NodeRef<4>) -> Walk {
-            let o = node.cell.origin[self.axis];
-            if self.position < o || u64::from(self.position - o) >= node.cell.side() {
-                return Walk::Skip;
-            }
-            if node.state == NodeState::Full {
-                (self.full)(&node.cell);
-            }
-            Walk::Descend
-        }
-    }
-    let mut cells: Vec<Cell<3>> = Vec::new();
-    try_walk(
-        tree,
-        &mut Slab {
-            axis,
-            position,
-            full: |cell: &Cell<4>| {
-                cells.push(Cell {
-                    origin: drop_axis(cell.origin),
-                    level: cell.level,
-                    log_side: cell.log_side,
-                })
-            },
-        },
-    )
-    .map_err(|e| DisplayError::Storage(e.into()))?;
-    cells.sort_unstable_by_key(|c| c.morton());
-    Ok(KTree::from_sorted_cells(universe, &merge_siblings(cells)))
-}
-
-/// Replaces every complete group of 8 sibling cells by their parent, repeatedly, so that the cells are
-/// maximal and the tree built from them is reduced. `cells` must be disjoint and sorted by Morton key.
-fn merge_siblings(cells: Vec<Cell<3>>) -> Vec<Cell<3>> {
-    let mut out: Vec<Cell<3>> = Vec::with_capacity(cells.len());
-    for cell in cells {
-        out.push(cell);
-        loop {
-            let n = out.len();
-            if n < 8 {
-                break;
-            }
-            let first = out[n - 8];
-            if first.level == 0 {
-                break;
-            }
-            let parent_side = first.side() * 2;
-            let aligned = first
-                .origin
-                .iter()
-                .all(|&c| u64::from(c) % parent_side == 0);
-            let complete = aligned
-                && (0..8).all(|code| {
-                    let c = out[n - 8 + code];
-                    c.level == first.level && c.origin == first_child_origin(&first, code)
-                });
-            if !complete {
-                break;
-            }
-            out.truncate(n - 8);
-            out.push(Cell {
-                origin: first.origin,
-                level: first.level - 1,
-                log_side: first.log_side + 1,
-            });
-        }
-    }
-    out
-}
-
-fn first_child_origin(first: &Cell<3>, code: usize) -> [u32; 3] {
-    let s = first.side() as u32;
-    let mut o = first.origin;
-    for (axis, c) in o.iter_mut().enumerate() {
-        if code >> axis & 1 == 1 {
-            *c += s;
-        }
-    }
-    o
+    crate::ops::slice::<4, 3, T>(tree, axis, position).map_err(|e| match e {
+        crate::ops::OpsError::Storage(e) => DisplayError::Storage(e),
+        other => unreachable!("the axis and position were checked: {other}"),
+    })
 }
 
 /// A strip of `frames` hidden-surface renderings of the 4-D tree's slices at evenly spaced positions along

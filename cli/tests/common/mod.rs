@@ -22,6 +22,16 @@ pub fn ktree(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// Runs the `ktree` binary, which must succeed: its standard output.
+///
+/// # Panics
+/// If the command fails, with its arguments and standard error.
+pub fn run(args: &[&str]) -> String {
+    let (ok, out, err) = ktree(args);
+    assert!(ok, "ktree {args:?} failed: {err}");
+    out
+}
+
 /// Runs `script` with OpenVDB's Python module imported as `vdb`: its standard output.
 ///
 /// # Panics
