@@ -176,3 +176,58 @@ fn a_las_extended_record_longer_than_the_file_is_an_error() {
         "evlr.las: byte 107: LAS: the legacy point count 4294967295 disagrees with the point count 23362423134093312 at byte 247"
     );
 }
+
+/// The byte offset of the first chunk of a LAZ file (after the 8-byte offset of its chunk table) and its
+/// points' record length.
+fn first_laz_chunk(file: &[u8]) -> (usize, usize) {
+    let start = u32::from_le_bytes(file[96..100].try_into().unwrap()) as usize;
+    let record = u16::from_le_bytes(file[105..107].try_into().unwrap()) as usize;
+    (start + 8, record)
+}
+
+fn laz_error(file: &[u8]) -> String {
+    ktree::io::read_cloud_bytes(file, "laz", Path::new("damaged.laz"))
+        .unwrap_err()
+        .to_string()
+}
+
+/// `cloud_las`: a LAZ stream whose first four bytes are `FF FF FF FF` (above any value an arithmetic coder
+/// starts with) made the `laz` crate's decoder index past its model's table: a panic. Each kind of
+/// stream — a chunk of points after its first, a layer of a LAS 1.4 chunk, the chunk table — is refused.
+#[test]
+fn a_laz_stream_starting_above_the_coders_range_is_an_error() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/clouds");
+    let simple = std::fs::read(data.join("simple.laz")).unwrap();
+    assert!(ktree::io::read_cloud_bytes(&simple, "laz", Path::new("simple.laz")).is_ok());
+
+    // LAS 1.2, point format 3: one stream a chunk, after the chunk's first point.
+    let (chunk, record) = first_laz_chunk(&simple);
+    let mut file = simple.clone();
+    file[chunk + record..chunk + record + 4].fill(0xff);
+    let e = laz_error(&file);
+    assert_eq!(
+        e,
+        format!("damaged.laz: byte {chunk}: LAZ chunk 0: its stream (byte {record} of the chunk) starts with FF FF FF FF, which no LASzip encoder writes")
+    );
+
+    // The chunk table's entries.
+    let table = i64::from_le_bytes(simple[chunk - 8..chunk].try_into().unwrap()) as usize;
+    let mut file = simple.clone();
+    file[table + 8..table + 12].fill(0xff);
+    assert!(laz_error(&file).contains("the chunk table's stream starts with FF FF FF FF"));
+
+    // LAS 1.4 (COPC), point format 7: nine layers of the point and one of its colour.
+    let copc = std::fs::read(data.join("simple.copc.laz")).unwrap();
+    let (chunk, record) = first_laz_chunk(&copc);
+    let layers = chunk + record + 4 + 4 * 10;
+    let mut file = copc.clone();
+    file[layers..layers + 4].fill(0xff);
+    let e = laz_error(&file);
+    assert!(
+        e.contains(&format!(
+            "LAZ chunk 0: its layer 0's stream (byte {} of the chunk) starts with FF FF FF FF",
+            layers - chunk
+        )),
+        "{e}"
+    );
+}

@@ -17,7 +17,7 @@
 use std::io::Cursor;
 
 use laz::las::selective::DecompressionSelection;
-use laz::laszip::{ChunkTable, LazVlr};
+use laz::laszip::{ChunkTable, LazItemType, LazVlr};
 use laz::record::{
     LayeredPointRecordDecompressor, RecordDecompressor, SequentialPointRecordDecompressor,
 };
@@ -409,6 +409,13 @@ fn chunks(
             },
         ));
     }
+    // The table's entries are an arithmetic-coded stream after its version and count.
+    if n > 0 && starts_impossibly(&bytes[table..end], 8) {
+        return Err(Fault::byte(
+            table + 8,
+            format!("LAZ: {}", impossible_start("the chunk table's stream")),
+        ));
+    }
     let entries = ChunkTable::read(&mut Cursor::new(&bytes[table..end]), variable)
         .map_err(|e| Fault::byte(table, format!("LAZ: the chunk table: {e}")))?;
     let mut chunks = Vec::with_capacity(entries.len());
@@ -451,9 +458,17 @@ fn decoder<'a>(
 ) -> Result<Box<dyn RecordDecompressor<Cursor<&'a [u8]>> + 'a>, String> {
     let version = vlr.items().first().map_or(0, |item| item.version());
     let mut decoder: Box<dyn RecordDecompressor<Cursor<&'a [u8]>> + 'a> = match version {
-        1 | 2 => Box::new(SequentialPointRecordDecompressor::new(Cursor::new(data))),
+        1 | 2 => {
+            // The first point is stored whole; the arithmetic-coded stream of the others follows.
+            if points > 0 && starts_impossibly(data, record) {
+                return Err(impossible_start(&format!(
+                    "its stream (byte {record} of the chunk)"
+                )));
+            }
+            Box::new(SequentialPointRecordDecompressor::new(Cursor::new(data)))
+        }
         3 | 4 => {
-            check_layers(data, record, points, rgb)?;
+            check_layers(data, vlr, record, points)?;
             Box::new(LayeredPointRecordDecompressor::new(Cursor::new(data)))
         }
         v => return Err(format!("unknown LASzip item version {v}")),
@@ -472,12 +487,27 @@ fn decoder<'a>(
     Ok(decoder)
 }
 
-/// A layered chunk (LAS 1.4 point formats) starts with its first point whole, then its point count and
-/// the byte counts of its layers: the nine of the point (`x`, `y` with the returns and channel; `z`;
-/// classification; flags; intensity; scan angle; user data; point source; GPS time), then the colour's
-/// (`rgb`: the formats with colour). The layers read into memory are among those: their sizes are
-/// checked against the chunk here, and the count against the chunk table.
-fn check_layers(data: &[u8], record: usize, points: u64, rgb: bool) -> Result<(), String> {
+/// Whether the arithmetic-coded stream at byte `at` of `data` starts impossibly. A stream starts with
+/// the decoder's first four bytes, a number below the coder's initial range of 2^32 − 1: no LASzip
+/// encoder writes `FF FF FF FF` there. The `laz` crate's decoder does not check this and panics on the
+/// first symbol it decodes from such a (damaged) stream. A stream shorter than four bytes is left to the
+/// decoder, which reports its end.
+fn starts_impossibly(data: &[u8], at: usize) -> bool {
+    data.get(at..at.saturating_add(4)) == Some(&[0xff; 4])
+}
+
+/// The error for a stream that [`starts_impossibly`].
+fn impossible_start(what: &str) -> String {
+    format!("{what} starts with FF FF FF FF, which no LASzip encoder writes")
+}
+
+/// A layered chunk (LAS 1.4 point formats) starts with its first point whole, then its point count, the
+/// byte counts of all its layers, and the layers one after the other: the point's nine (`x`, `y` with
+/// the returns and channel; `z`; classification; flags; intensity; scan angle; user data; point source;
+/// GPS time), then the colour's, the near infrared's, the wave packet's and one a byte of extra bytes, as
+/// the LASzip record lists its items. The count is checked against the chunk table, the layers against the
+/// chunk, and each layer's stream's start (see [`starts_impossibly`]).
+fn check_layers(data: &[u8], vlr: &LazVlr, record: usize, points: u64) -> Result<(), String> {
     if points == 0 {
         return Ok(());
     }
@@ -492,15 +522,33 @@ fn check_layers(data: &[u8], record: usize, points: u64, rgb: bool) -> Result<()
             "the chunk says it holds {held} points, the header and the chunk table give it {points}"
         ));
     }
-    let n = if rgb { 10 } else { 9 };
-    let mut layers = 0u64;
-    for k in 0..n {
-        layers += u64::from(u32_at(record + 4 + 4 * k)?);
+    let n: usize = vlr
+        .items()
+        .iter()
+        .map(|item| match item.item_type() {
+            LazItemType::Point14 => 9,
+            LazItemType::RGBNIR14 => 2,
+            LazItemType::Byte14(count) => usize::from(count),
+            _ => 1,
+        })
+        .sum();
+    let sizes = (0..n)
+        .map(|k| u32_at(record + 4 + 4 * k))
+        .collect::<Result<Vec<u32>, String>>()?;
+    let mut at = record + 4 + 4 * n;
+    for (k, &size) in sizes.iter().enumerate() {
+        if size > 0 && starts_impossibly(data, at) {
+            return Err(impossible_start(&format!(
+                "its layer {k}'s stream (byte {at} of the chunk)"
+            )));
+        }
+        at = at.saturating_add(size as usize);
     }
-    if layers > data.len() as u64 {
+    if at > data.len() {
         return Err(format!(
-            "its layers declare {layers} bytes, more than its {} bytes",
-            data.len()
+            "its layers declare {} bytes, more than the {} after their sizes",
+            at - (record + 4 + 4 * n),
+            data.len() - (record + 4 + 4 * n)
         ));
     }
     Ok(())
