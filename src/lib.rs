@@ -94,6 +94,7 @@ pub mod display;
 pub mod export;
 pub mod fs;
 pub mod io;
+pub mod map;
 pub mod ops;
 pub mod query;
 pub(crate) mod radix;

@@ -15,6 +15,7 @@ const LAYERS: &[&[&str]] = &[
     &["query"],
     &["shape"],
     &["ops"],
+    &["map"],
     &["display"],
     &["export"],
     &["io"],

@@ -1,0 +1,81 @@
+//! Where a map's voxels are in the world: OctoMap's keys. A map of resolution `r` has `2^16` voxels a side;
+//! voxel key `k` along an axis covers world coordinates `[(k − 2^15)·r, (k − 2^15 + 1)·r)`, so the world's
+//! origin is the corner between the keys `2^15 − 1` and `2^15`. A key is also the voxel's coordinate in the
+//! map's tree (a universe of level [`MAP_LEVEL`]).
+
+/// The level of a map's universe: 16, OctoMap's tree depth.
+pub const MAP_LEVEL: u32 = 16;
+
+/// The key of the voxel just above the world's origin along each axis (OctoMap's `tree_max_val`).
+pub const CENTRE_KEY: u32 = 1 << (MAP_LEVEL - 1);
+
+/// A map's voxel size and the conversion between world coordinates and keys, computed as OctoMap computes
+/// them (so that the same points fall in the same voxels).
+///
+/// ```
+/// use ktree::map::MapGrid;
+/// let grid = MapGrid::new(0.1).unwrap();
+/// assert_eq!(grid.key(0.05), Some(32768));
+/// assert_eq!(grid.key(-0.05), Some(32767));
+/// assert_eq!(grid.key(1e9), None); // beyond the map's 2^16 voxels
+/// assert!((grid.centre(32768) - 0.05).abs() < 1e-12);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapGrid {
+    resolution: f64,
+    factor: f64,
+}
+
+impl MapGrid {
+    /// The grid of voxels of side `resolution` (metres, or the points' unit).
+    ///
+    /// # Errors
+    /// A message if the resolution is not a positive finite number.
+    pub fn new(resolution: f64) -> Result<Self, String> {
+        if !(resolution.is_finite() && resolution > 0.0) {
+            return Err(format!(
+                "a map's resolution must be a positive number, not {resolution}"
+            ));
+        }
+        Ok(Self {
+            resolution,
+            factor: 1.0 / resolution,
+        })
+    }
+
+    /// The side of a voxel.
+    pub fn resolution(&self) -> f64 {
+        self.resolution
+    }
+
+    /// The key of the voxel holding world coordinate `c` along an axis (OctoMap's `coordToKeyChecked`),
+    /// or `None` outside the map's `2^16` voxels.
+    #[inline]
+    pub fn key(&self, c: f64) -> Option<u32> {
+        let scaled = (self.factor * c).floor();
+        let centre = f64::from(CENTRE_KEY);
+        (scaled >= -centre && scaled < centre)
+            .then(|| (scaled as i64 + i64::from(CENTRE_KEY)) as u32)
+    }
+
+    /// The keys of a point, or `None` if any coordinate is outside the map.
+    #[inline]
+    pub fn keys<const K: usize>(&self, point: [f32; K]) -> Option<[u32; K]> {
+        let mut out = [0u32; K];
+        for (o, &c) in out.iter_mut().zip(&point) {
+            *o = self.key(f64::from(c))?;
+        }
+        Some(out)
+    }
+
+    /// The world coordinate of the centre of key `k` along an axis (OctoMap's `keyToCoord`).
+    #[inline]
+    pub fn centre(&self, k: u32) -> f64 {
+        (f64::from(k as i32 - CENTRE_KEY as i32) + 0.5) * self.resolution
+    }
+
+    /// The world coordinate of the lower corner of the map (the voxel of key 0).
+    pub fn corner(&self) -> f64 {
+        -f64::from(CENTRE_KEY) * self.resolution
+    }
+}

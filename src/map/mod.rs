@@ -1,0 +1,190 @@
+//! Occupancy maps from range scans: every voxel unknown (never observed), free or occupied, from log-odds
+//! updated by each scan's hits and misses — OctoMap's semantics ([`SensorModel`], [`MapGrid`],
+//! [`key_ray`]), built on a valued tree ([`KTree<K, f32>`](crate::KTree) of log-odds; unknown voxels are
+//! empty), so every operation of the crate applies to its parts.
+//!
+//! A scan's update ([`ScanUpdate`]) gathers the voxels its rays cross on all threads as sorted Morton keys
+//! and merges them into the map's tree in one pass from the root down.
+//!
+//! ```
+//! use ktree::map::{OccupancyMap, VoxelState};
+//! // A quadtree map of 10 cm voxels; one scan of two points seen from the origin.
+//! let mut map = OccupancyMap::<2>::new(0.1).unwrap();
+//! map.insert(&[[1.05, 0.05], [0.05, 0.55]], [0.05, 0.05], None).unwrap();
+//! assert_eq!(
+//!     map.states(&[[1.05, 0.05], [0.55, 0.05], [-3.0, 2.0]]),
+//!     [VoxelState::Occupied, VoxelState::Free, VoxelState::Unknown]
+//! );
+//! assert_eq!(map.occupied().voxel_count(), 2);
+//! assert_eq!(map.free().voxel_count(), 10 + 5); // the two rays' voxels before their ends
+//! ```
+
+mod grid;
+mod model;
+mod traverse;
+mod update;
+
+pub use grid::{MapGrid, CENTRE_KEY, MAP_LEVEL};
+pub use model::{log_odds, probability, SensorModel};
+pub use traverse::{clipped_end, key_ray};
+pub use update::{apply, ScanUpdate};
+
+use crate::ops::values::select_where;
+use crate::tree::storage::infallible;
+use crate::tree::top_down::{build_top_down, Decision};
+use crate::tree::TreeError;
+use crate::KTree;
+
+/// What a map knows of a voxel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum VoxelState {
+    /// Never observed.
+    Unknown,
+    /// Observed, with log-odds below the occupancy threshold.
+    Free,
+    /// Observed, with log-odds at or above the occupancy threshold.
+    Occupied,
+}
+
+/// An occupancy map of dimension `K` (2 or 3 for floor plans and rooms, any K the tree has): a grid, a
+/// sensor model and the log-odds of the observed voxels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OccupancyMap<const K: usize> {
+    grid: MapGrid,
+    model: SensorModel,
+    log_odds: KTree<K, f32>,
+}
+
+impl<const K: usize> OccupancyMap<K> {
+    /// An empty map (every voxel unknown) of voxels of side `resolution`, OctoMap's default model.
+    ///
+    /// # Errors
+    /// A message for a resolution that is not a positive number.
+    pub fn new(resolution: f64) -> Result<Self, String> {
+        Self::with_model(resolution, SensorModel::default())
+    }
+
+    /// An empty map with the sensor model `model`.
+    ///
+    /// # Errors
+    /// A message for a resolution that is not a positive number or a model that cannot make a map
+    /// ([`SensorModel::check`]).
+    pub fn with_model(resolution: f64, model: SensorModel) -> Result<Self, String> {
+        model.check()?;
+        let grid = MapGrid::new(resolution)?;
+        let unknown = build_top_down::<K, f32, (), TreeError>(
+            MAP_LEVEL,
+            (),
+            |_, ()| Ok(Decision::Leaf(None)),
+            |(), _| Ok(()),
+        )
+        .map_err(|e| e.to_string())?;
+        Ok(Self {
+            grid,
+            model,
+            log_odds: unknown,
+        })
+    }
+
+    /// A map of these log-odds (unknown voxels empty), grid and model.
+    ///
+    /// # Errors
+    /// A message if the tree's universe is not the map's ([`MAP_LEVEL`]) or the model cannot make a map.
+    pub fn from_log_odds(
+        grid: MapGrid,
+        model: SensorModel,
+        log_odds: KTree<K, f32>,
+    ) -> Result<Self, String> {
+        model.check()?;
+        if log_odds.level() != MAP_LEVEL {
+            return Err(format!(
+                "a map's tree has level {MAP_LEVEL}, this one {}",
+                log_odds.level()
+            ));
+        }
+        Ok(Self {
+            grid,
+            model,
+            log_odds,
+        })
+    }
+
+    /// The map's grid.
+    pub fn grid(&self) -> &MapGrid {
+        &self.grid
+    }
+
+    /// The map's sensor model.
+    pub fn model(&self) -> &SensorModel {
+        &self.model
+    }
+
+    /// The log-odds of the observed voxels (unknown voxels are empty), at the map's keys.
+    pub fn log_odds(&self) -> &KTree<K, f32> {
+        &self.log_odds
+    }
+
+    /// Integrates one scan: `points` in world coordinates seen from `origin`, each ray cut at `max_range`
+    /// if given (a point beyond it is no hit). Returns the scan's update (its voxels and the rays that left
+    /// the map).
+    ///
+    /// # Errors
+    /// A message for a coordinate that is not finite.
+    pub fn insert(
+        &mut self,
+        points: &[[f32; K]],
+        origin: [f32; K],
+        max_range: Option<f64>,
+    ) -> Result<ScanUpdate, String> {
+        if let Some(i) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(format!(
+                "point {i} of the scan has a coordinate that is not finite"
+            ));
+        }
+        if origin.iter().any(|c| !c.is_finite()) {
+            return Err("the sensor origin has a coordinate that is not finite".into());
+        }
+        let update = ScanUpdate::compute(&self.grid, points, origin, max_range);
+        self.log_odds = apply(&self.log_odds, &update.voxels, &self.model);
+        Ok(update)
+    }
+
+    /// The state of the voxels holding `points` (world coordinates; outside the map: unknown).
+    pub fn states(&self, points: &[[f32; K]]) -> Vec<VoxelState> {
+        let keys: Vec<[u32; K]> = points
+            .iter()
+            .map(|&p| self.grid.keys(p).unwrap_or([u32::MAX; K]))
+            .collect();
+        self.log_odds
+            .values_at(&keys)
+            .into_iter()
+            .map(|v| self.state_of(v))
+            .collect()
+    }
+
+    /// The state of a voxel of log-odds `l` (`None`: unknown).
+    pub fn state_of(&self, l: Option<f32>) -> VoxelState {
+        match l {
+            None => VoxelState::Unknown,
+            Some(l) if self.model.is_occupied(l) => VoxelState::Occupied,
+            Some(_) => VoxelState::Free,
+        }
+    }
+
+    /// The occupied voxels, as a binary tree at the map's keys.
+    pub fn occupied(&self) -> KTree<K> {
+        let model = self.model;
+        infallible(select_where(&self.log_odds, move |l| model.is_occupied(l)))
+    }
+
+    /// The free voxels (observed, not occupied).
+    pub fn free(&self) -> KTree<K> {
+        let model = self.model;
+        infallible(select_where(&self.log_odds, move |l| !model.is_occupied(l)))
+    }
+
+    /// The unknown voxels (never observed).
+    pub fn unknown(&self) -> KTree<K> {
+        !&self.log_odds.shape()
+    }
+}

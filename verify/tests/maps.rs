@@ -1,0 +1,385 @@
+//! Occupancy maps: the key traversal against the geometry of the segment, the map's integration against
+//! a naive reference (a hash map of voxels updated ray by ray), K = 2 and 3, and OctoMap itself on its
+//! own real scan (`scan.dat` of Debian's liboctomap-dev) and on synthetic scans with a maximum range.
+
+use std::collections::{HashMap, HashSet};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use ktree::map::{key_ray, MapGrid, OccupancyMap, SensorModel, VoxelState};
+use ktree::space::morton_decode;
+use ktree::KTree;
+use ktree_verify::tools;
+use proptest::prelude::*;
+
+/// The smallest and largest world coordinates of voxel `key` along an axis.
+fn bounds(grid: &MapGrid, key: u32) -> (f64, f64) {
+    let lo = grid.corner() + f64::from(key) * grid.resolution();
+    (lo, lo + grid.resolution())
+}
+
+/// Whether the segment from `a` to `b` passes within `slack` of voxel `key` (slab test).
+fn segment_meets<const K: usize>(
+    grid: &MapGrid,
+    a: [f32; K],
+    b: [f32; K],
+    key: [u32; K],
+    slack: f64,
+) -> bool {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for i in 0..K {
+        let (lo, hi) = bounds(grid, key[i]);
+        let (lo, hi) = (lo - slack, hi + slack);
+        let (p, d) = (f64::from(a[i]), f64::from(b[i]) - f64::from(a[i]));
+        if d == 0.0 {
+            if p < lo || p > hi {
+                return false;
+            }
+        } else {
+            let (u, v) = ((lo - p) / d, (hi - p) / d);
+            t0 = t0.max(u.min(v));
+            t1 = t1.min(u.max(v));
+        }
+    }
+    t0 <= t1
+}
+
+fn check_ray<const K: usize>(res: f64, a: [f32; K], b: [f32; K]) -> Result<(), TestCaseError> {
+    let grid = MapGrid::new(res).unwrap();
+    let mut keys = Vec::new();
+    prop_assert!(key_ray(&grid, a, b, &mut keys));
+    let (ka, kb) = (grid.keys(a).unwrap(), grid.keys(b).unwrap());
+    if ka == kb {
+        prop_assert!(keys.is_empty());
+        return Ok(());
+    }
+    prop_assert_eq!(keys[0], ka);
+    prop_assert!(!keys.contains(&kb), "the end's voxel is not crossed");
+    for w in keys.windows(2) {
+        let steps: u32 = (0..K).map(|i| w[0][i].abs_diff(w[1][i])).sum();
+        prop_assert_eq!(steps, 1, "consecutive voxels share a face: {:?}", w);
+    }
+    for &k in &keys {
+        prop_assert!(
+            segment_meets(&grid, a, b, k, res * 1e-4),
+            "{:?} is off the segment",
+            k
+        );
+    }
+    // The last voxel crossed touches the end's (or the traversal stopped at the end's distance).
+    let last = *keys.last().unwrap();
+    let gap: u32 = (0..K).map(|i| last[i].abs_diff(kb[i])).sum();
+    prop_assert!(
+        gap <= K as u32,
+        "the ray stops near its end: {:?} {:?}",
+        last,
+        kb
+    );
+    Ok(())
+}
+
+fn coord() -> impl Strategy<Value = f32> {
+    -40.0f32..40.0
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(256))]
+    #[test]
+    fn key_rays_follow_the_segment_k2(a in [coord(), coord()], b in [coord(), coord()], res in 0.05f64..2.0) {
+        check_ray::<2>(res, a, b)?;
+    }
+    #[test]
+    fn key_rays_follow_the_segment_k3(a in [coord(), coord(), coord()], b in [coord(), coord(), coord()], res in 0.05f64..2.0) {
+        check_ray::<3>(res, a, b)?;
+    }
+}
+
+/// The naive map: a hash map from keys to log-odds, each scan's hits and misses gathered point by point
+/// into sets and applied one voxel at a time.
+fn reference<const K: usize>(
+    grid: &MapGrid,
+    model: &SensorModel,
+    scans: &[(Vec<[f32; K]>, [f32; K])],
+    max_range: Option<f64>,
+) -> HashMap<[u32; K], f32> {
+    let mut map = HashMap::new();
+    for (points, origin) in scans {
+        let (mut hits, mut misses) = (HashSet::new(), HashSet::new());
+        for &p in points {
+            let d: f32 = (0..K)
+                .map(|i| (p[i] - origin[i]) * (p[i] - origin[i]))
+                .sum();
+            let within = max_range.is_none_or(|m| f64::from(d).sqrt() <= m);
+            let end = if within {
+                p
+            } else {
+                ktree::map::clipped_end(*origin, p, max_range.unwrap())
+            };
+            let mut ray = Vec::new();
+            key_ray(grid, *origin, end, &mut ray);
+            misses.extend(ray);
+            if within {
+                if let Some(k) = grid.keys(p) {
+                    hits.insert(k);
+                }
+            }
+        }
+        for k in misses.difference(&hits) {
+            let l = map.entry(*k).or_insert(0.0);
+            *l = model.update(*l, false);
+        }
+        for k in hits {
+            let l = map.entry(k).or_insert(0.0);
+            *l = model.update(*l, true);
+        }
+    }
+    map
+}
+
+/// Every voxel of the map's tree with its log-odds.
+fn voxels<const K: usize>(tree: &KTree<K, f32>) -> HashMap<[u32; K], f32> {
+    let mut out = HashMap::new();
+    for (cell, value) in tree.value_leaves() {
+        let Some(v) = value else { continue };
+        let base = cell.morton();
+        let n = 1u64 << (K as u64 * cell.side().trailing_zeros() as u64);
+        assert!(n <= 1 << 20, "a leaf of {n} voxels in a test map");
+        for i in 0..n {
+            out.insert(morton_decode::<K>(base + i), v);
+        }
+    }
+    out
+}
+
+fn check_map<const K: usize>(
+    res: f64,
+    scans: Vec<(Vec<[f32; K]>, [f32; K])>,
+    max_range: Option<f64>,
+) -> Result<(), TestCaseError> {
+    let mut map = OccupancyMap::<K>::new(res).unwrap();
+    for (points, origin) in &scans {
+        map.insert(points, *origin, max_range).unwrap();
+    }
+    map.log_odds().assert_well_formed();
+    let expected = reference(map.grid(), map.model(), &scans, max_range);
+    let got = voxels(map.log_odds());
+    prop_assert_eq!(got.len(), expected.len());
+    for (k, v) in &expected {
+        prop_assert_eq!(
+            got.get(k).map(|g| g.to_bits()),
+            Some(v.to_bits()),
+            "voxel {:?}",
+            k
+        );
+    }
+    // The three parts partition the map, and states agree with them.
+    let (occupied, free) = (map.occupied(), map.free());
+    prop_assert_eq!((&occupied & &free).unwrap().voxel_count(), 0);
+    prop_assert_eq!(
+        occupied.voxel_count() + free.voxel_count() + map.unknown().voxel_count(),
+        1u128 << (16 * K)
+    );
+    let probes: Vec<[f32; K]> = scans.iter().flat_map(|(p, _)| p.iter().copied()).collect();
+    for (p, s) in probes.iter().zip(map.states(&probes)) {
+        let want = match map.grid().keys(*p).and_then(|k| expected.get(&k)) {
+            None => VoxelState::Unknown,
+            Some(&l) if map.model().is_occupied(l) => VoxelState::Occupied,
+            Some(_) => VoxelState::Free,
+        };
+        prop_assert_eq!(s, want);
+    }
+    Ok(())
+}
+
+fn scan<const K: usize>() -> impl Strategy<Value = (Vec<[f32; K]>, [f32; K])> {
+    (
+        prop::collection::vec(prop::array::uniform::<_, K>(-3.0f32..3.0), 0..24),
+        prop::array::uniform::<_, K>(-1.0f32..1.0),
+    )
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(64))]
+    #[test]
+    fn maps_match_the_naive_reference_k2(scans in prop::collection::vec(scan::<2>(), 1..5), res in 0.1f64..0.7, range in prop::option::of(0.5f64..4.0)) {
+        check_map::<2>(res, scans, range)?;
+    }
+    #[test]
+    fn maps_match_the_naive_reference_k3(scans in prop::collection::vec(scan::<3>(), 1..4), res in 0.2f64..0.7, range in prop::option::of(0.5f64..4.0)) {
+        check_map::<3>(res, scans, range)?;
+    }
+}
+
+/// Builds `octomap_insert` against the installed OctoMap into `dir`; `None` after [`tools::missing`]
+/// without `g++` or OctoMap's headers.
+fn octomap_insert(dir: &Path) -> Option<PathBuf> {
+    let compiler = tools::require(&["g++"], "install g++")?;
+    if !tools::require_file(
+        Path::new("/usr/include/octomap/octomap.h"),
+        "install Debian's liboctomap-dev (OctoMap's headers and library)",
+    ) {
+        return None;
+    }
+    let exe = dir.join("octomap_insert");
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/maps/octomap_insert.cpp");
+    let built = Command::new(compiler)
+        .args(["-O2", "-o"])
+        .arg(&exe)
+        .arg(&src)
+        .args(["-loctomap", "-loctomath"])
+        .status()
+        .expect("g++ runs");
+    assert!(built.success(), "octomap_insert does not build");
+    Some(exe)
+}
+
+/// OctoMap's map of `scans` (each its points and origin) as a valued tree at OctoMap's keys.
+fn octomap_map(
+    exe: &Path,
+    res: f64,
+    max_range: Option<f64>,
+    scans: &[(Vec<[f32; 3]>, [f32; 3])],
+) -> KTree<3, f32> {
+    let mut cmd = Command::new(exe);
+    cmd.arg(res.to_string());
+    if let Some(m) = max_range {
+        cmd.arg(m.to_string());
+    }
+    let mut child = cmd
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("octomap_insert runs");
+    let mut input = String::new();
+    for (points, o) in scans {
+        // Rust prints the shortest text that reads back as the same f32: OctoMap reads the same floats.
+        input += &format!("scan {} {} {}\n", o[0], o[1], o[2]);
+        for p in points {
+            input += &format!("{} {} {}\n", p[0], p[1], p[2]);
+        }
+    }
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
+    let out = child.wait_with_output().expect("octomap_insert finishes");
+    writer.join().unwrap().unwrap();
+    assert!(out.status.success(), "octomap_insert failed");
+    let mut runs = Vec::new();
+    for line in String::from_utf8(out.stdout).unwrap().lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(f[0], "leaf");
+        let k: Vec<u32> = f[1..5].iter().map(|s| s.parse().unwrap()).collect();
+        let l = f32::from_bits(u32::from_str_radix(f[5], 16).unwrap());
+        for x in k[0]..k[0] + k[3] {
+            for y in k[1]..k[1] + k[3] {
+                runs.push((ktree::Ray::new([x, y, k[2]], k[2] + k[3]), l));
+            }
+        }
+    }
+    KTree::from_value_runs(&ktree::rays::ValueRuns::from_runs(16, runs).unwrap())
+}
+
+/// The voxels where two maps differ: in one only, or with other log-odds.
+fn differences(a: &KTree<3, f32>, b: &KTree<3, f32>) -> u128 {
+    let shapes = (&a.shape() ^ &b.shape()).unwrap().voxel_count();
+    let both = (&a.shape() & &b.shape()).unwrap();
+    let a_in = a.mask(&both);
+    let b_in = b.mask(&both);
+    let same = ktree::ops::values::select_where(
+        &a_in
+            .combine(
+                &b_in.map_values(|v| Some(-v)).unwrap(),
+                ktree::ops::values::Rule::Sum,
+            )
+            .unwrap(),
+        |d: f32| d == 0.0,
+    )
+    .unwrap()
+    .voxel_count();
+    shapes + (both.voxel_count() - same)
+}
+
+/// OctoMap's real laser scan (88 206 points, sensor at the origin), as its `scan.dat` lines.
+fn octomap_scan() -> Option<Vec<[f32; 3]>> {
+    let file = Path::new("/usr/share/doc/liboctomap-dev/examples/data/scan.dat.bz2");
+    if !tools::require_file(
+        file,
+        "install Debian's liboctomap-dev (it ships scan.dat.bz2)",
+    ) {
+        return None;
+    }
+    let bzcat = tools::require(&["bzcat"], "install bzip2")?;
+    let out = Command::new(bzcat).arg(file).output().expect("bzcat runs");
+    let text = String::from_utf8(out.stdout).unwrap();
+    Some(
+        text.lines()
+            .map(|l| {
+                let v: Vec<f32> = l.split_whitespace().map(|s| s.parse().unwrap()).collect();
+                [v[0], v[1], v[2]]
+            })
+            .collect(),
+    )
+}
+
+#[test]
+fn octomaps_real_scan_gives_octomaps_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let (Some(exe), Some(points)) = (octomap_insert(dir.path()), octomap_scan()) else {
+        return;
+    };
+    assert_eq!(points.len(), 88_206);
+    let scans = vec![(points, [0.0f32; 3])];
+    for res in [0.1, 0.05] {
+        let mut map = OccupancyMap::<3>::new(res).unwrap();
+        let update = map.insert(&scans[0].0, [0.0; 3], None).unwrap();
+        assert_eq!(update.rays_outside, 0);
+        let theirs = octomap_map(&exe, res, None, &scans);
+        assert_eq!(differences(map.log_odds(), &theirs), 0, "at {res} m");
+        assert_eq!(map.log_odds(), &theirs);
+    }
+}
+
+#[test]
+fn scans_from_several_poses_with_a_maximum_range_give_octomaps_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(exe) = octomap_insert(dir.path()) else {
+        return;
+    };
+    // Points on the walls of a 6 × 4 × 3 m room and a box in it, seen from three poses, rays cut at 3 m.
+    let mut seed = 7u64;
+    let mut next = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let mut scans = Vec::new();
+    for origin in [[1.0f32, 1.0, 1.2], [4.3, 2.1, 1.5], [2.5, 3.2, 0.4]] {
+        let mut points = Vec::new();
+        for _ in 0..4000 {
+            let (u, v) = (next(), next());
+            let p = match (next() * 6.0) as u32 {
+                0 => [0.0, 4.0 * u, 3.0 * v],
+                1 => [6.0, 4.0 * u, 3.0 * v],
+                2 => [6.0 * u, 0.0, 3.0 * v],
+                3 => [6.0 * u, 4.0, 3.0 * v],
+                4 => [6.0 * u, 4.0 * v, 0.0],
+                _ => [2.0 + u, 1.5 + v, 1.0],
+            };
+            points.push(p);
+        }
+        scans.push((points, origin));
+    }
+    for (res, range) in [(0.05, Some(3.0)), (0.1, None), (0.2, Some(2.5))] {
+        let mut map = OccupancyMap::<3>::new(res).unwrap();
+        for (points, origin) in &scans {
+            map.insert(points, *origin, range).unwrap();
+        }
+        let theirs = octomap_map(&exe, res, range, &scans);
+        assert_eq!(
+            differences(map.log_odds(), &theirs),
+            0,
+            "at {res} m, range {range:?}"
+        );
+    }
+}
