@@ -16,7 +16,8 @@
 //!     [VoxelState::Occupied, VoxelState::Free, VoxelState::Unknown]
 //! );
 //! assert_eq!(map.occupied().voxel_count(), 2);
-//! assert_eq!(map.free().voxel_count(), 10 + 5); // the two rays' voxels before their ends
+//! // The voxels the two rays cross before their ends: 10 along x, 5 along y, the sensor's shared.
+//! assert_eq!(map.free().voxel_count(), 10 + 5 - 1);
 //! ```
 
 mod grid;
@@ -26,7 +27,7 @@ mod update;
 
 pub use grid::{MapGrid, CENTRE_KEY, MAP_LEVEL};
 pub use model::{log_odds, probability, SensorModel};
-pub use traverse::{clipped_end, key_ray};
+pub use traverse::{clipped_end, key_ray, visit_key_ray};
 pub use update::{apply, ScanUpdate};
 
 use crate::ops::values::select_where;

@@ -53,13 +53,24 @@ pub fn key_ray<const K: usize>(
     end: [f32; K],
     out: &mut Vec<[u32; K]>,
 ) -> bool {
+    visit_key_ray(grid, origin, end, |k| out.push(k))
+}
+
+/// [`key_ray`] handing each key to `visit` in order instead of collecting them.
+#[inline]
+pub fn visit_key_ray<const K: usize>(
+    grid: &MapGrid,
+    origin: [f32; K],
+    end: [f32; K],
+    mut visit: impl FnMut([u32; K]),
+) -> bool {
     let (Some(key_origin), Some(key_end)) = (grid.keys(origin), grid.keys(end)) else {
         return false;
     };
     if key_origin == key_end {
         return true;
     }
-    out.push(key_origin);
+    visit(key_origin);
     let mut direction = difference(origin, end);
     let length = norm(direction) as f32;
     for d in &mut direction {
@@ -103,7 +114,7 @@ pub fn key_ray<const K: usize>(
         if reached > f64::from(length) {
             break;
         }
-        out.push(key);
+        visit(key);
     }
     true
 }

@@ -7,7 +7,8 @@ use rayon::prelude::*;
 
 use super::grid::MapGrid;
 use super::model::SensorModel;
-use super::traverse::{clipped_end, difference, key_ray, norm};
+use super::traverse::{clipped_end, difference, norm, visit_key_ray};
+use crate::radix::radix_sort;
 use crate::space::{morton_encode, Cell};
 use crate::tree::storage::infallible;
 use crate::tree::top_down::{build_top_down, Decision, InputNode};
@@ -38,32 +39,31 @@ impl ScanUpdate {
         origin: [f32; K],
         max_range: Option<f64>,
     ) -> Self {
+        let bits = K as u32 * super::MAP_LEVEL;
         let parts: Vec<(Vec<u64>, Vec<u64>, usize)> = points
             .par_chunks(POINTS_A_TASK)
             .map(|chunk| {
                 let (mut hits, mut misses, mut outside) = (Vec::new(), Vec::new(), 0usize);
-                let mut ray = Vec::new();
+                let mut seen = RepeatFilter::new();
                 for &p in chunk {
-                    ray.clear();
                     let within = max_range.is_none_or(|m| norm(difference(origin, p)) <= m);
                     let end = match max_range {
                         Some(m) if !within => clipped_end(origin, p, m),
                         _ => p,
                     };
-                    if !key_ray(grid, origin, end, &mut ray) {
-                        outside += 1;
-                    }
-                    misses.extend(ray.iter().map(|&k| morton_encode(k)));
+                    let inside = visit_key_ray(grid, origin, end, |k| {
+                        let key = morton_encode(k);
+                        if seen.is_new(key) {
+                            misses.push(key);
+                        }
+                    });
+                    outside += usize::from(!inside);
                     if within {
                         if let Some(k) = grid.keys(p) {
                             hits.push(morton_encode(k));
                         }
                     }
                 }
-                hits.sort_unstable();
-                hits.dedup();
-                misses.sort_unstable();
-                misses.dedup();
                 (hits, misses, outside)
             })
             .collect();
@@ -73,14 +73,45 @@ impl ScanUpdate {
             hits.extend(h);
             misses.extend(m);
         }
-        hits.par_sort_unstable();
-        hits.dedup();
-        misses.par_sort_unstable();
-        misses.dedup();
+        let ((), ()) = rayon::join(
+            || sort_dedup(&mut hits, bits),
+            || sort_dedup(&mut misses, bits),
+        );
         Self {
             voxels: merge_sorted(&hits, &misses),
             rays_outside,
         }
+    }
+}
+
+/// Sorts keys below `2^bits` and removes repeats.
+fn sort_dedup(keys: &mut Vec<u64>, bits: u32) {
+    radix_sort(keys, bits, &mut Vec::new());
+    keys.dedup();
+}
+
+/// A direct-mapped table of recently seen keys: most voxels a ray crosses were crossed by the rays just
+/// before it (they share the sensor), and a key found here is not gathered again. Lossy — a key pushed
+/// out by another is gathered twice — so the sort still removes the remaining repeats.
+struct RepeatFilter {
+    slots: Vec<u64>,
+}
+
+impl RepeatFilter {
+    const BITS: u32 = 14;
+
+    fn new() -> Self {
+        Self {
+            slots: vec![u64::MAX; 1 << Self::BITS],
+        }
+    }
+
+    #[inline]
+    fn is_new(&mut self, key: u64) -> bool {
+        let slot = (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - Self::BITS)) as usize;
+        let fresh = self.slots[slot] != key;
+        self.slots[slot] = key;
+        fresh
     }
 }
 
