@@ -21,11 +21,13 @@
 //! ```
 
 mod grid;
+mod leaves;
 mod model;
 mod traverse;
 mod update;
 
 pub use grid::{MapGrid, CENTRE_KEY, MAP_LEVEL};
+pub use leaves::{tree_from_leaves, Leaf};
 pub use model::{log_odds, probability, SensorModel};
 pub use traverse::{clipped_end, key_ray, visit_key_ray};
 pub use update::{apply, ScanUpdate};

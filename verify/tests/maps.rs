@@ -214,6 +214,11 @@ proptest! {
 /// Builds `octomap_insert` against the installed OctoMap into `dir`; `None` after [`tools::missing`]
 /// without `g++` or OctoMap's headers.
 fn octomap_insert(dir: &Path) -> Option<PathBuf> {
+    octomap_program(dir, "octomap_insert")
+}
+
+/// Builds the checker `name` (`tests/maps/NAME.cpp`) against the installed OctoMap into `dir`.
+fn octomap_program(dir: &Path, name: &str) -> Option<PathBuf> {
     let compiler = tools::require(&["g++"], "install g++")?;
     if !tools::require_file(
         Path::new("/usr/include/octomap/octomap.h"),
@@ -221,8 +226,8 @@ fn octomap_insert(dir: &Path) -> Option<PathBuf> {
     ) {
         return None;
     }
-    let exe = dir.join("octomap_insert");
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/maps/octomap_insert.cpp");
+    let exe = dir.join(name);
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/maps/{name}.cpp"));
     let built = Command::new(compiler)
         .args(["-O2", "-o"])
         .arg(&exe)
@@ -230,7 +235,7 @@ fn octomap_insert(dir: &Path) -> Option<PathBuf> {
         .args(["-loctomap", "-loctomath"])
         .status()
         .expect("g++ runs");
-    assert!(built.success(), "octomap_insert does not build");
+    assert!(built.success(), "{name} does not build");
     Some(exe)
 }
 
@@ -246,11 +251,12 @@ fn octomap_map(
     if let Some(m) = max_range {
         cmd.arg(m.to_string());
     }
-    let mut child = cmd
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("octomap_insert runs");
+    let out = run_with_input(&mut cmd, scans_text(scans));
+    leaves_tree(&out)
+}
+
+/// Scans as the checkers read them: `scan ox oy oz`, then the points.
+fn scans_text(scans: &[(Vec<[f32; 3]>, [f32; 3])]) -> String {
     let mut input = String::new();
     for (points, o) in scans {
         // Rust prints the shortest text that reads back as the same f32: OctoMap reads the same floats.
@@ -259,13 +265,28 @@ fn octomap_map(
             input += &format!("{} {} {}\n", p[0], p[1], p[2]);
         }
     }
+    input
+}
+
+/// Runs `cmd` with `input` on its standard input; its standard output.
+fn run_with_input(cmd: &mut Command, input: String) -> String {
+    let mut child = cmd
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("the checker runs");
     let mut stdin = child.stdin.take().unwrap();
     let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
-    let out = child.wait_with_output().expect("octomap_insert finishes");
+    let out = child.wait_with_output().expect("the checker finishes");
     writer.join().unwrap().unwrap();
-    assert!(out.status.success(), "octomap_insert failed");
+    assert!(out.status.success(), "the checker failed");
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// The valued tree of a checker's `leaf kx ky kz side bits` lines.
+fn leaves_tree(text: &str) -> KTree<3, f32> {
     let mut runs = Vec::new();
-    for line in String::from_utf8(out.stdout).unwrap().lines() {
+    for line in text.lines() {
         let f: Vec<&str> = line.split_whitespace().collect();
         assert_eq!(f[0], "leaf");
         let k: Vec<u32> = f[1..5].iter().map(|s| s.parse().unwrap()).collect();
@@ -345,7 +366,23 @@ fn scans_from_several_poses_with_a_maximum_range_give_octomaps_map() {
     let Some(exe) = octomap_insert(dir.path()) else {
         return;
     };
-    // Points on the walls of a 6 × 4 × 3 m room and a box in it, seen from three poses, rays cut at 3 m.
+    let scans = room_scans();
+    for (res, range) in [(0.05, Some(3.0)), (0.1, None), (0.2, Some(2.5))] {
+        let mut map = OccupancyMap::<3>::new(res).unwrap();
+        for (points, origin) in &scans {
+            map.insert(points, *origin, range).unwrap();
+        }
+        let theirs = octomap_map(&exe, res, range, &scans);
+        assert_eq!(
+            differences(map.log_odds(), &theirs),
+            0,
+            "at {res} m, range {range:?}"
+        );
+    }
+}
+
+/// Points on the walls of a 6 × 4 × 3 m room and a box in it, seen from three poses.
+fn room_scans() -> Vec<(Vec<[f32; 3]>, [f32; 3])> {
     let mut seed = 7u64;
     let mut next = move || {
         seed = seed
@@ -370,16 +407,81 @@ fn scans_from_several_poses_with_a_maximum_range_give_octomaps_map() {
         }
         scans.push((points, origin));
     }
-    for (res, range) in [(0.05, Some(3.0)), (0.1, None), (0.2, Some(2.5))] {
-        let mut map = OccupancyMap::<3>::new(res).unwrap();
-        for (points, origin) in &scans {
-            map.insert(points, *origin, range).unwrap();
-        }
-        let theirs = octomap_map(&exe, res, range, &scans);
-        assert_eq!(
-            differences(map.log_odds(), &theirs),
-            0,
-            "at {res} m, range {range:?}"
-        );
+    scans
+}
+
+/// A map's maximum-likelihood form: occupied voxels at the upper clamp, free ones at the lower.
+fn max_likelihood(map: &OccupancyMap<3>) -> KTree<3, f32> {
+    let m = *map.model();
+    map.log_odds()
+        .map_values(|l| {
+            Some(if m.is_occupied(l) {
+                m.clamp_max
+            } else {
+                m.clamp_min
+            })
+        })
+        .unwrap()
+}
+
+#[test]
+fn map_files_written_by_ktree_read_in_octomap_and_octomaps_read_in_ktree() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(files) = octomap_program(dir.path(), "octomap_files") else {
+        return;
+    };
+    let scans = room_scans();
+    let mut map = OccupancyMap::<3>::new(0.1).unwrap();
+    for (points, origin) in &scans {
+        map.insert(points, *origin, None).unwrap();
     }
+    let read = |path: &Path| {
+        let out = Command::new(&files).arg("read").arg(path).output().unwrap();
+        assert!(out.status.success(), "OctoMap reads {}", path.display());
+        leaves_tree(&String::from_utf8(out.stdout).unwrap())
+    };
+    // ktree writes, OctoMap reads: every log-odds in .ot, the maximum-likelihood map in .bt.
+    let (ot, bt) = (dir.path().join("ktree.ot"), dir.path().join("ktree.bt"));
+    let mut bytes = Vec::new();
+    ktree::io::write_ot_map(&mut bytes, &map).unwrap();
+    std::fs::write(&ot, &bytes).unwrap();
+    assert_eq!(&read(&ot), map.log_odds());
+    bytes.clear();
+    ktree::io::write_bt_map(&mut bytes, &map).unwrap();
+    std::fs::write(&bt, &bytes).unwrap();
+    assert_eq!(read(&bt), max_likelihood(&map));
+    // OctoMap writes the same scans, ktree reads.
+    let (ot, bt) = (dir.path().join("octomap.ot"), dir.path().join("octomap.bt"));
+    let mut cmd = Command::new(&files);
+    cmd.args(["write", "0.1"]).arg(&ot).arg(&bt);
+    run_with_input(&mut cmd, scans_text(&scans));
+    let model = *map.model();
+    let theirs = ktree::io::read_ot_map(&std::fs::read(&ot).unwrap(), "octomap.ot", model).unwrap();
+    assert_eq!(theirs, map);
+    let theirs = ktree::io::read_bt_map(&std::fs::read(&bt).unwrap(), "octomap.bt", model).unwrap();
+    assert_eq!(theirs.log_odds(), &max_likelihood(&map));
+    assert_eq!(theirs.grid().resolution(), 0.1);
+}
+
+#[test]
+fn octomaps_building_map_reads_with_its_free_space() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(files) = octomap_program(dir.path(), "octomap_files") else {
+        return;
+    };
+    let path = Path::new("/usr/share/doc/liboctomap-dev/examples/data/geb079.bt");
+    if !tools::require_file(path, "install Debian's liboctomap-dev (it ships geb079.bt)") {
+        return;
+    }
+    let map = ktree::io::read_bt_map(
+        &std::fs::read(path).unwrap(),
+        "geb079.bt",
+        SensorModel::default(),
+    )
+    .unwrap();
+    assert_eq!(map.grid().resolution(), 0.08);
+    let out = Command::new(&files).arg("read").arg(path).output().unwrap();
+    let theirs = leaves_tree(&String::from_utf8(out.stdout).unwrap());
+    assert_eq!(map.log_odds(), &theirs);
+    assert!(map.free().voxel_count() > map.occupied().voxel_count());
 }

@@ -149,9 +149,34 @@ pub fn read_bt(
 
 /// Parses the header as OctoMap does (`readHeader`): returns `size`, `res` and the first data byte.
 fn read_header(bytes: &[u8], file: &str) -> Result<(u64, f64, usize), GridFileError> {
+    let (_, size, res, at) = read_octomap_header(bytes, file, BT_HEADER, &["OcTree", "1"])?;
+    // Every node but the root is two bits of an inner node's two bytes: at most 8 per 2 bytes.
+    let room = (bytes.len() - at) as u64 / 2 * 8 + 1;
+    if size > room {
+        return Err(GridFileError::new(
+            file,
+            bytes.len(),
+            GridFileErrorKind::Truncated(format!(
+                "{size} nodes cannot fit in {} data bytes",
+                bytes.len() - at
+            )),
+        ));
+    }
+    Ok((size, res, at))
+}
+
+/// Reads the text header of an OctoMap file whose first line is `first` and whose tree type is one of
+/// `ids`: the type, the node count (`size`), the resolution (`res`) and where the data start (after
+/// `data`).
+pub(super) fn read_octomap_header(
+    bytes: &[u8],
+    file: &str,
+    first: &str,
+    ids: &[&str],
+) -> Result<(String, u64, f64, usize), GridFileError> {
     let fail = |at: usize, m: String| GridFileError::new(file, at, GridFileErrorKind::Header(m));
-    if !bytes.starts_with(BT_HEADER.as_bytes()) {
-        return Err(fail(0, format!("the first line is not {BT_HEADER:?}")));
+    if !bytes.starts_with(first.as_bytes()) {
+        return Err(fail(0, format!("the first line is not {first:?}")));
     }
     let mut at = 0usize;
     let (mut id, mut size, mut res) = (None, None, None);
@@ -185,34 +210,23 @@ fn read_header(bytes: &[u8], file: &str) -> Result<(u64, f64, usize), GridFileEr
             _ => return Err(fail(line_at, format!("unknown header line {line:?}"))),
         }
     }
-    match id.as_deref() {
-        Some("OcTree") | Some("1") => {}
+    let id = match id {
+        Some(id) if ids.contains(&id.as_str()) => id,
         Some(other) => {
             return Err(GridFileError::new(
                 file,
                 0,
                 GridFileErrorKind::Unsupported(format!(
-                    "tree type {other:?} (only OcTree is read)"
+                    "tree type {other:?} (read here: {})",
+                    ids.join(", ")
                 )),
             ))
         }
         None => return Err(fail(0, "no `id` line".into())),
-    }
+    };
     let size = size.ok_or_else(|| fail(0, "no `size` line".into()))?;
     let res = res.ok_or_else(|| fail(0, "no `res` line".into()))?;
-    // Every node but the root is two bits of an inner node's two bytes: at most 8 per 2 bytes.
-    let room = (bytes.len() - at) as u64 / 2 * 8 + 1;
-    if size > room {
-        return Err(GridFileError::new(
-            file,
-            bytes.len(),
-            GridFileErrorKind::Truncated(format!(
-                "{size} nodes cannot fit in {} data bytes",
-                bytes.len() - at
-            )),
-        ));
-    }
-    Ok((size, res, at))
+    Ok((id, size, res, at))
 }
 
 /// Writes an octree as an OctoMap `.bt` file with voxels of edge `res`: ktree voxel `v` is grid index
