@@ -14,6 +14,7 @@ mod convert_values;
 mod distance;
 mod distributed;
 mod lines;
+mod map;
 mod mass;
 mod op;
 mod project;
@@ -69,7 +70,9 @@ enum Command {
     Voxelize(voxelize::Args),
     /// The voxels of one value, or of a range of values, of a tree with values: a tree without values.
     Select(values::SelectArgs),
-    /// The union of a tree's slices along an axis over a range: a tree of one dimension fewer (or a .png occupancy grid with its .yaml).
+    /// An occupancy map (OctoMap's semantics) from range scans: .ot, .bt or .ktree.
+    Map(map::MapArgs),
+    /// The union of a tree's slices along an axis over a range: a tree of one dimension fewer (or a .png occupancy grid with its .yaml); for a map (.ot, .bt), its plane between two heights.
     Project(project::ProjectArgs),
     /// A tree's slice at one position along an axis: a tree of one dimension fewer (or a .png occupancy grid).
     Slice(project::SliceArgs),
@@ -131,6 +134,7 @@ fn main() -> ExitCode {
         Command::Components(args) => shape::run_components(args),
         Command::Distance(args) => distance::run(args),
         Command::Select(args) => values::run_select(args),
+        Command::Map(args) => map::run_map(args),
         Command::Project(args) => project::run_project(args),
         Command::Slice(args) => project::run_slice(args),
         Command::Query(args) => query::run_query(args),

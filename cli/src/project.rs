@@ -24,9 +24,10 @@ pub struct ProjectArgs {
     /// The axis projected along: x, y, z, w or 0–3.
     #[arg(long, value_parser = parse_axis)]
     axis: usize,
-    /// The positions along the axis, LO:HI in voxels, both included (default: all).
-    #[arg(long, value_name = "LO:HI", value_parser = parse_range)]
-    range: Option<(u32, u32)>,
+    /// The positions along the axis, LO:HI both included (default: all): voxels for a tree file, world
+    /// coordinates (metres) for an occupancy map (.ot, .bt).
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true, value_parser = parse_range)]
+    range: Option<(f64, f64)>,
     #[command(flatten)]
     out: OutArgs,
 }
@@ -48,10 +49,10 @@ pub struct SliceArgs {
 
 /// Where the tree of K − 1 dimensions goes.
 #[derive(Debug, clap::Args)]
-struct OutArgs {
+pub struct OutArgs {
     /// The output: a tree file (.ktree, .rays, …), or for a quadtree a .png occupancy grid (+ .yaml).
     #[arg(long)]
-    out: PathBuf,
+    pub out: PathBuf,
     /// A .png map: the side of a cell in metres (the YAML's resolution).
     #[arg(long, default_value_t = 1.0)]
     voxel_size: f64,
@@ -70,14 +71,16 @@ fn parse_axis(text: &str) -> Result<usize, String> {
     }
 }
 
-fn parse_range(text: &str) -> Result<(u32, u32), String> {
+fn parse_range(text: &str) -> Result<(f64, f64), String> {
     let (lo, hi) = text
         .split_once(':')
         .ok_or_else(|| format!("'{text}': expected LO:HI"))?;
     let number = |t: &str| {
         t.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("'{t}' in '{text}' is not a voxel coordinate"))
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{t}' in '{text}' is not a number"))
     };
     let (lo, hi) = (number(lo)?, number(hi)?);
     if lo > hi {
@@ -86,11 +89,31 @@ fn parse_range(text: &str) -> Result<(u32, u32), String> {
     Ok((lo, hi))
 }
 
+/// Whether `path` is an occupancy map file (OctoMap's `.ot` and `.bt`).
+pub fn is_map_file(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("ot") || e.eq_ignore_ascii_case("bt"))
+}
+
 /// `ktree project`.
 pub fn run_project(a: ProjectArgs) -> CliResult {
-    let range = a
-        .range
-        .map_or(0..u32::MAX, |(lo, hi)| lo..hi.saturating_add(1));
+    if is_map_file(&a.input) {
+        return crate::map::project_map(&a.input, a.axis, a.range, &a.out.out);
+    }
+    let range = match a.range {
+        None => 0..u32::MAX,
+        Some((lo, hi)) => {
+            let voxel = |v: f64| {
+                (v >= 0.0 && v.fract() == 0.0 && v <= f64::from(u32::MAX))
+                    .then_some(v as u32)
+                    .ok_or_else(|| {
+                        format!("--range: {v} is not a voxel coordinate (a whole number from 0)")
+                    })
+            };
+            voxel(lo)?..voxel(hi)?.saturating_add(1)
+        }
+    };
     run(&a.input, a.axis, range, &a.out, "projection")
 }
 

@@ -23,12 +23,14 @@
 mod grid;
 mod leaves;
 mod model;
+mod plane;
 mod traverse;
 mod update;
 
 pub use grid::{MapGrid, CENTRE_KEY, MAP_LEVEL};
 pub use leaves::{tree_from_leaves, Leaf};
 pub use model::{log_odds, probability, SensorModel};
+pub use plane::MapPlane;
 pub use traverse::{clipped_end, key_ray, visit_key_ray};
 pub use update::{apply, ScanUpdate};
 
@@ -132,7 +134,7 @@ impl<const K: usize> OccupancyMap<K> {
     /// the map).
     ///
     /// # Errors
-    /// A message for a coordinate that is not finite.
+    /// A message for a coordinate that is not finite or a maximum range that is negative or not a number.
     pub fn insert(
         &mut self,
         points: &[[f32; K]],
@@ -146,6 +148,11 @@ impl<const K: usize> OccupancyMap<K> {
         }
         if origin.iter().any(|c| !c.is_finite()) {
             return Err("the sensor origin has a coordinate that is not finite".into());
+        }
+        if let Some(m) = max_range.filter(|m| !(*m >= 0.0)) {
+            return Err(format!(
+                "the maximum range {m} is not a distance (0 or more)"
+            ));
         }
         let update = ScanUpdate::compute(&self.grid, points, origin, max_range);
         self.log_odds = apply(&self.log_odds, &update.voxels, &self.model);

@@ -1,0 +1,207 @@
+//! `ktree map SCANS… --resolution R [--max-range M] [--sensor-origin X,Y,Z] --out MAP.ot|.bt|.ktree`: an
+//! occupancy map from range scans, integrated as OctoMap's `insertPointCloud` integrates them; and the
+//! map branch of `ktree project` (a map's plane between two heights, as a ROS map or a quadtree).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use ktree::export::grid_map::write_grid_map;
+use ktree::export::Frame;
+use ktree::io::{
+    read_bt_map, read_cloud, read_cloud_bytes, read_ot_map, write_bt_map, write_ot_map,
+};
+use ktree::map::{OccupancyMap, SensorModel};
+
+use crate::common::error::{CliError, CliResult};
+use crate::common::vector::vector;
+use crate::outln;
+
+/// Arguments of `ktree map`.
+#[derive(Debug, clap::Args)]
+pub struct MapArgs {
+    /// The scans, in order: point clouds in world coordinates (PLY, PCD, XYZ/CSV/TXT, OctoMap's `x y z`
+    /// .dat, LAS/LAZ), each seen from the sensor origin.
+    #[arg(required = true)]
+    scans: Vec<PathBuf>,
+    /// The side of a voxel, in the points' unit (metres).
+    #[arg(long, allow_hyphen_values = true)]
+    resolution: f64,
+    /// Rays are cut at this distance from the sensor; points beyond it are no hits (default: no limit).
+    #[arg(long, allow_hyphen_values = true)]
+    max_range: Option<f64>,
+    /// Where the sensor was, X,Y,Z in world coordinates.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>, default_value = "0,0,0")]
+    sensor_origin: [f64; 3],
+    /// The map: .ot (every log-odds, OctoMap's OcTree), .bt (free and occupied, OctoMap's binary) or
+    /// .ktree (the log-odds as a float32 tree at the map's keys; the resolution is not kept).
+    #[arg(long)]
+    out: PathBuf,
+    /// The probability a hit gives.
+    #[arg(long, default_value_t = 0.7)]
+    prob_hit: f64,
+    /// The probability a miss gives.
+    #[arg(long, default_value_t = 0.4)]
+    prob_miss: f64,
+    /// The lowest probability a voxel keeps.
+    #[arg(long, default_value_t = 0.1192)]
+    clamp_min: f64,
+    /// The highest probability a voxel keeps.
+    #[arg(long, default_value_t = 0.971)]
+    clamp_max: f64,
+    /// The probability from which a voxel is occupied.
+    #[arg(long, default_value_t = 0.5)]
+    occupancy: f64,
+}
+
+/// The points of a scan file, as `f32` (OctoMap's precision).
+fn read_points(path: &Path) -> CliResult<Vec<[f32; 3]>> {
+    let dat = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("dat"));
+    let cloud = if dat {
+        let bytes =
+            std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        read_cloud_bytes(&bytes, "xyz", path)
+    } else {
+        read_cloud(path)
+    }
+    .map_err(CliError::caused)?;
+    Ok(cloud
+        .points()
+        .iter()
+        .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32])
+        .collect())
+}
+
+/// `ktree map`.
+pub fn run_map(a: MapArgs) -> CliResult {
+    let model = SensorModel::from_probabilities(
+        a.prob_hit,
+        a.prob_miss,
+        a.clamp_min,
+        a.clamp_max,
+        a.occupancy,
+    );
+    if let Some(m) = a.max_range.filter(|m| !(m.is_finite() && *m > 0.0)) {
+        return Err(format!("--max-range {m}: expected a positive number").into());
+    }
+    let kind = map_kind(&a.out)?;
+    let mut map = OccupancyMap::<3>::with_model(a.resolution, model)
+        .map_err(|e| format!("--resolution/probabilities: {e}"))?;
+    let origin = a.sensor_origin.map(|c| c as f32);
+    let (mut points, mut outside, mut seconds) = (0usize, 0usize, 0.0f64);
+    for scan in &a.scans {
+        let cloud = read_points(scan)?;
+        let start = Instant::now();
+        let update = map
+            .insert(&cloud, origin, a.max_range)
+            .map_err(|e| format!("{}: {e}", scan.display()))?;
+        seconds += start.elapsed().as_secs_f64();
+        points += cloud.len();
+        outside += update.rays_outside;
+    }
+    write_map(&a.out, kind, &map)?;
+    outln!(
+        "{}: {} scans, {points} points integrated in {seconds:.3} s; {} occupied, {} free voxels of {} m",
+        a.out.display(),
+        a.scans.len(),
+        map.occupied().voxel_count(),
+        map.free().voxel_count(),
+        a.resolution
+    );
+    if outside > 0 {
+        outln!("{outside} rays left the map's 2^16 voxels a side and were skipped (as OctoMap skips them)");
+    }
+    Ok(())
+}
+
+#[derive(Debug, Clone, Copy)]
+enum MapKind {
+    Ot,
+    Bt,
+    Ktree,
+}
+
+fn map_kind(out: &Path) -> CliResult<MapKind> {
+    match out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("ot") => Ok(MapKind::Ot),
+        Some("bt") => Ok(MapKind::Bt),
+        Some("ktree") => Ok(MapKind::Ktree),
+        _ => Err(format!("{}: a map is written as .ot, .bt or .ktree", out.display()).into()),
+    }
+}
+
+fn write_map(out: &Path, kind: MapKind, map: &OccupancyMap<3>) -> CliResult {
+    match kind {
+        MapKind::Ot => ktree::fs::write_atomic_with(out, |w| write_ot_map(w, map)),
+        MapKind::Bt => ktree::fs::write_atomic_with(out, |w| write_bt_map(w, map)),
+        MapKind::Ktree => ktree::io::ktree::v3::write_valued_ktree_file(out, map.log_odds()),
+    }
+    .map_err(CliError::caused)
+}
+
+/// Reads an occupancy map file (`.ot` or `.bt`) with OctoMap's default model.
+pub fn read_map(path: &Path) -> CliResult<OccupancyMap<3>> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let name = path.display().to_string();
+    let bt = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("bt"));
+    if bt {
+        read_bt_map(&bytes, &name, SensorModel::default())
+    } else {
+        read_ot_map(&bytes, &name, SensorModel::default())
+    }
+    .map_err(CliError::caused)
+}
+
+/// `ktree project MAP --axis A [--range LO:HI] --out OUT` for an occupancy map: the plane of the map
+/// between world coordinates LO and HI along the axis, as a ROS map (`.png` + `.yaml`: occupied, free and
+/// unknown) or as the quadtree of its occupied cells (any tree file).
+pub fn project_map(input: &Path, axis: usize, range: Option<(f64, f64)>, out: &Path) -> CliResult {
+    if axis > 2 {
+        return Err(format!("{}: a map has axes x, y and z", input.display()).into());
+    }
+    let map = read_map(input)?;
+    let (lo, hi) = range.unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
+    let plane = map
+        .plane(axis, lo, hi)
+        .map_err(|e| format!("{}: {e}", input.display()))?;
+    let png = out.extension().is_some_and(|e| e == "png");
+    if png {
+        let frame = Frame {
+            voxel_size: plane.resolution,
+            origin: [plane.origin[0], plane.origin[1], 0.0],
+        };
+        let yaml = write_grid_map(out, &plane.occupied, Some(&plane.known), &frame)
+            .map_err(CliError::caused)?;
+        outln!(
+            "{} and {}: the map between {lo} and {hi} along axis {axis}: {} occupied and {} free cells of {} m, {}² cells from ({}, {})",
+            out.display(),
+            yaml.display(),
+            plane.occupied.voxel_count(),
+            plane.known.voxel_count() - plane.occupied.voxel_count(),
+            plane.resolution,
+            1u64 << plane.known.level(),
+            plane.origin[0],
+            plane.origin[1]
+        );
+        return Ok(());
+    }
+    crate::common::tree_file::write_tree(out, &plane.occupied).map_err(CliError::caused)?;
+    outln!(
+        "{}: the occupied cells of the map between {lo} and {hi} along axis {axis}: {} of {}², cell (0, 0) at ({}, {}), {} m",
+        out.display(),
+        plane.occupied.voxel_count(),
+        1u64 << plane.occupied.level(),
+        plane.origin[0],
+        plane.origin[1],
+        plane.resolution
+    );
+    Ok(())
+}

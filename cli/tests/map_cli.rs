@@ -1,0 +1,195 @@
+//! `ktree map`: scans in, the map written as .ot, .bt and .ktree equal to the library's map of the same
+//! scans; `ktree project` of a map: its plane between two heights as a ROS map whose pixels are the
+//! plane's occupied, free and unknown cells; bad input as one-line errors.
+
+mod common;
+
+use common::{ktree, run};
+use ktree::io::{read_bt_map, read_ot_map};
+use ktree::map::{OccupancyMap, SensorModel};
+use ktree::KTree;
+
+/// A room's walls (6 × 4 m, 2.5 m high) sampled on a grid, as seen from inside.
+fn walls() -> Vec<[f32; 3]> {
+    let mut points = Vec::new();
+    for i in 0..60 {
+        for k in 0..10 {
+            let (u, z) = (i as f32 * 0.1, 0.05 + k as f32 * 0.25);
+            points.push([u, 0.0, z]);
+            points.push([u, 4.0, z]);
+            if i < 40 {
+                points.push([0.0, u, z]);
+                points.push([6.0, u, z]);
+            }
+        }
+    }
+    points
+}
+
+fn write_xyz(path: &std::path::Path, points: &[[f32; 3]]) {
+    let text: String = points
+        .iter()
+        .map(|p| format!("{} {} {}\n", p[0], p[1], p[2]))
+        .collect();
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn map_files_hold_the_librarys_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let points = walls();
+    let (a, b) = points.split_at(points.len() / 2);
+    write_xyz(&dir.path().join("a.xyz"), a);
+    write_xyz(&dir.path().join("b.xyz"), b);
+    let origin = [2.5f32, 1.5, 1.2];
+    let mut expected = OccupancyMap::<3>::new(0.1).unwrap();
+    expected.insert(a, origin, Some(4.0)).unwrap();
+    expected.insert(b, origin, Some(4.0)).unwrap();
+    for out in ["room.ot", "room.bt", "room.ktree"] {
+        let text = run(&[
+            "map",
+            &s("a.xyz"),
+            &s("b.xyz"),
+            "--resolution",
+            "0.1",
+            "--max-range",
+            "4",
+            "--sensor-origin",
+            "2.5,1.5,1.2",
+            "--out",
+            &s(out),
+        ]);
+        assert!(text.contains("2 scans"), "{text}");
+        let bytes = std::fs::read(dir.path().join(out)).unwrap();
+        let model = SensorModel::default();
+        match out {
+            "room.ot" => assert_eq!(read_ot_map(&bytes, out, model).unwrap(), expected),
+            "room.bt" => {
+                let map = read_bt_map(&bytes, out, model).unwrap();
+                assert_eq!(map.occupied(), expected.occupied());
+                assert_eq!(map.free(), expected.free());
+            }
+            _ => {
+                let tree = ktree::io::ktree::v3::read_valued_ktree::<3, f32>(&bytes, out).unwrap();
+                assert_eq!(&tree, expected.log_odds());
+            }
+        }
+    }
+}
+
+#[test]
+fn a_maps_plane_is_a_ros_map_of_its_three_states() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    write_xyz(&dir.path().join("room.xyz"), &walls());
+    run(&[
+        "map",
+        &s("room.xyz"),
+        "--resolution",
+        "0.1",
+        "--sensor-origin",
+        "2.5,1.5,1.2",
+        "--out",
+        &s("room.ot"),
+    ]);
+    run(&[
+        "project",
+        &s("room.ot"),
+        "--axis",
+        "z",
+        "--range",
+        "0.2:1.8",
+        "--out",
+        &s("floor.png"),
+    ]);
+    let map = read_ot_map(
+        &std::fs::read(dir.path().join("room.ot")).unwrap(),
+        "room.ot",
+        SensorModel::default(),
+    )
+    .unwrap();
+    let plane = map.plane(2, 0.2, 1.8).unwrap();
+    let image = image::open(dir.path().join("floor.png"))
+        .unwrap()
+        .to_luma8();
+    let side = 1u32 << plane.known.level();
+    assert_eq!(image.dimensions(), (side, side));
+    let (mut occupied, mut free) = (0u128, 0u128);
+    for (x, row, p) in image.enumerate_pixels() {
+        let cell = [x, side - 1 - row];
+        let want = if plane.occupied.contains(cell) {
+            occupied += 1;
+            0
+        } else if plane.known.contains(cell) {
+            free += 1;
+            254
+        } else {
+            205
+        };
+        assert_eq!(p.0[0], want, "pixel ({x}, {row})");
+    }
+    assert_eq!(occupied, plane.occupied.voxel_count());
+    assert!(occupied > 100 && free > 1000, "{occupied} {free}");
+    // The walls' cells: the plane's occupied cells are the map's occupied voxels between the heights.
+    let walls_2d: KTree<2> =
+        ktree::ops::project::<3, 2, _>(&map.occupied(), 2, 32770..32786).unwrap();
+    assert_eq!(walls_2d.voxel_count(), occupied);
+    let yaml = std::fs::read_to_string(dir.path().join("floor.yaml")).unwrap();
+    assert!(yaml.contains("resolution: 0.1"), "{yaml}");
+    assert!(
+        yaml.contains(&format!(
+            "origin: [{:?}, {:?}, 0.0]",
+            plane.origin[0], plane.origin[1]
+        )),
+        "{yaml}"
+    );
+}
+
+#[test]
+fn bad_map_arguments_are_one_line_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    write_xyz(&dir.path().join("p.xyz"), &walls()[..10]);
+    for (args, needle) in [
+        (vec!["--resolution", "0", "--out", "m.ot"], "resolution"),
+        (
+            vec!["--resolution", "0.1", "--out", "m.png"],
+            ".ot, .bt or .ktree",
+        ),
+        (
+            vec!["--resolution", "0.1", "--max-range", "-1", "--out", "m.ot"],
+            "--max-range",
+        ),
+        (
+            vec!["--resolution", "0.1", "--prob-hit", "0.3", "--out", "m.ot"],
+            "hit",
+        ),
+    ] {
+        let mut all = vec!["map".to_string(), s("p.xyz")];
+        all.extend(args.iter().map(|a| {
+            if a.starts_with("m.") {
+                s(a)
+            } else {
+                a.to_string()
+            }
+        }));
+        let all: Vec<&str> = all.iter().map(String::as_str).collect();
+        let (ok, _, err) = ktree(&all);
+        assert!(!ok, "{all:?}");
+        assert!(
+            err.contains(needle) && err.trim().lines().count() == 1,
+            "{all:?}: {err}"
+        );
+        assert!(!dir.path().join("m.ot").exists());
+    }
+    let (ok, _, err) = ktree(&[
+        "map",
+        &s("missing.xyz"),
+        "--resolution",
+        "0.1",
+        "--out",
+        &s("m.ot"),
+    ]);
+    assert!(!ok && err.contains("missing.xyz"), "{err}");
+}
