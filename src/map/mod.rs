@@ -149,7 +149,7 @@ impl<const K: usize> OccupancyMap<K> {
         if origin.iter().any(|c| !c.is_finite()) {
             return Err("the sensor origin has a coordinate that is not finite".into());
         }
-        if let Some(m) = max_range.filter(|m| !(*m >= 0.0)) {
+        if let Some(m) = max_range.filter(|m| m.is_nan() || *m < 0.0) {
             return Err(format!(
                 "the maximum range {m} is not a distance (0 or more)"
             ));
