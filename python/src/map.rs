@@ -87,6 +87,9 @@ fn coordinates<const K: usize>(values: &[f64], what: &str) -> Result<[f32; K], F
 /// The parts (`occupied()`, `free()`, `unknown()`) are trees in a level-16 universe whose voxel
 /// coordinates are the keys (`keys(points)` gives them for world points); `log_odds()` is a tree with
 /// float32 values.
+///
+/// A map is changed in place by `insert` only, which releases the interpreter lock: another thread that
+/// uses the same map meanwhile gets a RuntimeError (the map is borrowed), never a map half updated.
 #[pyclass(name = "OccupancyMap", module = "ktree")]
 pub(crate) struct OccupancyMapPy {
     map: AnyMap,
@@ -155,7 +158,7 @@ impl OccupancyMapPy {
         max_range: Option<f64>,
     ) -> PyResult<usize> {
         if let Some(m) = max_range {
-            if !(m >= 0.0) {
+            if m.is_nan() || m < 0.0 {
                 return Err(Failure::Value(format!(
                     "insert: max_range must be a number at least 0 (or None), not {m}"
                 ))
@@ -232,8 +235,9 @@ impl OccupancyMapPy {
 
     /// The log-odds of the observed voxels, as a tree with float32 values (unknown voxels are empty; dense
     /// arrays hold 0, the log-odds of probability 0.5, there).
-    fn log_odds(&self) -> Tree {
-        let values = with_map!(&self.map, m, K => AnyValuedTree::from(m.log_odds().clone()));
+    fn log_odds(&self, py: Python<'_>) -> Tree {
+        let values =
+            with_map!(&self.map, m, K => py.detach(|| AnyValuedTree::from(m.log_odds().clone())));
         Tree::valued(values, 0.0)
     }
 
