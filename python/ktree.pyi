@@ -8,13 +8,13 @@ system says, with ``filename`` set) with the library's message.
 
 from fractions import Fraction
 from os import PathLike
-from typing import Any, Literal, NamedTuple, NotRequired, Optional, Sequence, Tuple, TypedDict, Union, final
+from typing import Any, ClassVar, Literal, NamedTuple, NotRequired, Optional, Sequence, Tuple, TypedDict, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
-__all__ = ["RayHits", "Tree", "__version__"]
+__all__ = ["OccupancyMap", "RayHits", "Tree", "__version__"]
 
 _Path = Union[str, PathLike[str]]
 _View = Union[str, Sequence[float]]
@@ -313,3 +313,50 @@ class Tree:
     def __invert__(self) -> Tree: ...
     def __eq__(self, other: object, /) -> bool: ...
     def __hash__(self) -> int: ...
+
+@final
+class OccupancyMap:
+    """An occupancy map of dimension 2 or 3 from range scans, with OctoMap's semantics: voxels of side
+    `resolution` keyed as OctoMap keys them (2**16 a side; key k along an axis covers world coordinates
+    [(k - 32768) * resolution, (k - 32767) * resolution)), each unknown, free or occupied by its log-odds.
+
+    The parts are trees in a level-16 universe whose voxel coordinates are the keys."""
+
+    UNKNOWN: ClassVar[int]
+    FREE: ClassVar[int]
+    OCCUPIED: ClassVar[int]
+    def __new__(
+        cls,
+        resolution: float,
+        dim: int = 3,
+        prob_hit: float = 0.7,
+        prob_miss: float = 0.4,
+        clamp_min: float = 0.1192,
+        clamp_max: float = 0.971,
+        occupancy: float = 0.5,
+    ) -> OccupancyMap:
+        """An empty map; the sensor model's probabilities default to OctoMap's."""
+    def insert(
+        self, points: npt.ArrayLike, origin: Sequence[float], max_range: Optional[float] = None
+    ) -> int:
+        """Integrates a scan: (N, dim) world points (as float32) seen from `origin`, rays cut at
+        `max_range` (a point beyond it is no hit), as OctoMap's insertPointCloud. Returns the number of
+        voxels updated."""
+    def states(self, points: npt.ArrayLike) -> npt.NDArray[np.uint8]:
+        """The states (UNKNOWN, FREE, OCCUPIED) of the voxels holding (N, dim) world points."""
+    def keys(self, points: npt.ArrayLike) -> npt.NDArray[np.int64]:
+        """The (N, dim) keys of the voxels holding (N, dim) world points (rows of -1 outside the map)."""
+    def occupied(self) -> Tree:
+        """The occupied voxels, as a tree at the map's keys."""
+    def free(self) -> Tree:
+        """The free voxels (observed, not occupied), as a tree."""
+    def unknown(self) -> Tree:
+        """The unknown voxels (never observed), as a tree."""
+    def log_odds(self) -> Tree:
+        """The log-odds of the observed voxels, as a tree with float32 values (unknown voxels empty)."""
+    @property
+    def resolution(self) -> float:
+        """The side of a voxel."""
+    @property
+    def dim(self) -> int:
+        """The dimension (2 or 3)."""

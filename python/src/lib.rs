@@ -12,6 +12,9 @@
 //! components, measures), `geometry` (translations, rotations, scales, matrices), `export` (runs,
 //! meshes, the viewer page) and `display` (pictures and line drawings). Arrays come in through
 //! `arrays` (borrowed from numpy where its memory allows) and errors go out through `failure`.
+//!
+//! A second class, `ktree.OccupancyMap` (module `map`), wraps the library's occupancy maps; its parts are
+//! `Tree` objects.
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
@@ -54,6 +57,7 @@ mod export;
 mod failure;
 mod files;
 mod geometry;
+mod map;
 mod query;
 mod rays;
 mod shape;
@@ -156,11 +160,13 @@ impl Tree {
     }
 }
 
-/// k-trees (bintrees, quadtrees, octrees, 4-D trees) with numpy arrays in and out: see `ktree.Tree`.
+/// k-trees (bintrees, quadtrees, octrees, 4-D trees) with numpy arrays in and out: see `ktree.Tree`, and
+/// occupancy maps made of them: see `ktree.OccupancyMap`.
 #[pymodule]
 #[pyo3(name = "ktree")]
 fn ktree_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Tree>()?;
+    m.add_class::<map::OccupancyMapPy>()?;
     // What `Tree.cast_rays` returns.
     let fields = ["hit", "voxel", "t", "axis", "sign"];
     let hits = m

@@ -1,0 +1,273 @@
+//! Occupancy maps (`ktree.OccupancyMap`): the library's [`OccupancyMap`] of dimension 2 or 3, scans in as
+//! numpy arrays of world coordinates (converted to float32, as OctoMap stores points), voxel states and
+//! keys out as numpy arrays, and the map's parts as `ktree.Tree` objects at the map's keys, so that every
+//! operation of trees applies to them. The dimension is chosen at run time ([`AnyMap`]); each method is
+//! one call of the library on the map inside.
+
+use ktree::map::{probability, OccupancyMap, SensorModel, VoxelState};
+use ktree::{AnyTree, AnyValuedTree};
+use numpy::ndarray::Array2;
+use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLikeDyn};
+use pyo3::prelude::*;
+
+use crate::arrays::{rows, Numbers};
+use crate::failure::Failure;
+use crate::Tree;
+
+/// An occupancy map of a dimension known at run time.
+#[derive(Debug, Clone)]
+enum AnyMap {
+    D2(OccupancyMap<2>),
+    D3(OccupancyMap<3>),
+}
+
+/// Runs `$body` on the `OccupancyMap<K>` inside an [`AnyMap`] (`&` or `&mut`), with `K` bound as a constant.
+macro_rules! with_map {
+    ($map:expr, $m:ident, K => $body:expr) => {
+        match $map {
+            AnyMap::D2($m) => {
+                #[allow(dead_code)]
+                const K: usize = 2;
+                $body
+            }
+            AnyMap::D3($m) => {
+                #[allow(dead_code)]
+                const K: usize = 3;
+                $body
+            }
+        }
+    };
+}
+
+/// The dimensions a map may have.
+const DIMS: [usize; 2] = [2, 3];
+
+/// A voxel's state as `states` returns it.
+fn state_code(s: VoxelState) -> u8 {
+    match s {
+        VoxelState::Unknown => OccupancyMapPy::UNKNOWN,
+        VoxelState::Free => OccupancyMapPy::FREE,
+        VoxelState::Occupied => OccupancyMapPy::OCCUPIED,
+    }
+}
+
+/// The world coordinates of an `(N, dim)` array of numbers (any numeric dtype; numpy converts it to
+/// float32), row after row. `what` names the array in errors.
+fn points_of<'py>(
+    points: &Bound<'py, PyAny>,
+    dim: usize,
+    what: &str,
+) -> Result<Numbers<'py, f32, numpy::ndarray::IxDyn>, Failure> {
+    let array: PyArrayLikeDyn<'py, f32, AllowTypeChange> = points.extract().map_err(|e| {
+        Failure::Value(format!(
+            "{what} must be an (N, {dim}) array of numbers: {e}"
+        ))
+    })?;
+    let numbers = Numbers::new(array);
+    numbers.rows_of(dim, false, what)?;
+    Ok(numbers)
+}
+
+/// `dim` numbers of a sequence as float32.
+fn coordinates<const K: usize>(values: &[f64], what: &str) -> Result<[f32; K], Failure> {
+    if values.len() != K {
+        return Err(Failure::Value(format!(
+            "{what} must have {K} coordinates, got {}",
+            values.len()
+        )));
+    }
+    Ok(std::array::from_fn(|i| values[i] as f32))
+}
+
+/// An occupancy map of dimension 2 or 3 from range scans, with OctoMap's semantics: voxels of side
+/// `resolution` keyed as OctoMap keys them (2**16 a side, voxel key k along an axis covering world
+/// coordinates [(k - 32768) * resolution, (k - 32767) * resolution)), each unknown (never observed), free
+/// or occupied by its log-odds, updated by each scan as OctoMap's insertPointCloud updates them.
+///
+/// The parts (`occupied()`, `free()`, `unknown()`) are trees in a level-16 universe whose voxel
+/// coordinates are the keys (`keys(points)` gives them for world points); `log_odds()` is a tree with
+/// float32 values.
+///
+/// A map is changed in place by `insert` only, which releases the interpreter lock: another thread that
+/// uses the same map meanwhile gets a RuntimeError (the map is borrowed), never a map half updated.
+#[pyclass(name = "OccupancyMap", module = "ktree")]
+pub(crate) struct OccupancyMapPy {
+    map: AnyMap,
+}
+
+impl OccupancyMapPy {
+    /// The map's dimension.
+    fn dim_of(&self) -> usize {
+        with_map!(&self.map, _m, K => K)
+    }
+}
+
+#[pymethods]
+impl OccupancyMapPy {
+    /// What `states` says of a voxel never observed.
+    #[classattr]
+    const UNKNOWN: u8 = 0;
+    /// What `states` says of a voxel observed, with log-odds below the occupancy threshold.
+    #[classattr]
+    const FREE: u8 = 1;
+    /// What `states` says of a voxel with log-odds at or above the occupancy threshold.
+    #[classattr]
+    const OCCUPIED: u8 = 2;
+
+    /// An empty map (every voxel unknown) of dimension `dim` (2 or 3) and voxels of side `resolution`,
+    /// with a sensor model given by probabilities (OctoMap's defaults): of a hit, of a miss, the clamps
+    /// of a voxel's probability, and the probability from which a voxel is occupied.
+    #[new]
+    #[pyo3(signature = (resolution, dim = 3, prob_hit = 0.7, prob_miss = 0.4, clamp_min = 0.1192, clamp_max = 0.971, occupancy = 0.5))]
+    fn new(
+        resolution: f64,
+        dim: usize,
+        prob_hit: f64,
+        prob_miss: f64,
+        clamp_min: f64,
+        clamp_max: f64,
+        occupancy: f64,
+    ) -> PyResult<Self> {
+        let model =
+            SensorModel::from_probabilities(prob_hit, prob_miss, clamp_min, clamp_max, occupancy);
+        let map = match dim {
+            2 => AnyMap::D2(OccupancyMap::with_model(resolution, model).map_err(Failure::Value)?),
+            3 => AnyMap::D3(OccupancyMap::with_model(resolution, model).map_err(Failure::Value)?),
+            _ => {
+                return Err(Failure::Value(format!(
+                    "an occupancy map has dimension {} or {}, not {dim}",
+                    DIMS[0], DIMS[1]
+                ))
+                .into())
+            }
+        };
+        Ok(Self { map })
+    }
+
+    /// Integrates one scan: `points` an (N, dim) array of world coordinates (float64 and other numbers
+    /// are converted to float32) seen from `origin` (dim numbers). Every ray from the origin marks the
+    /// voxels it crosses before its point free (a miss) and the point's voxel occupied (a hit; hits win,
+    /// each voxel is updated once a scan). With `max_range`, a ray is cut at that distance and a point
+    /// beyond it is no hit. Rays leaving the map are skipped. Returns the number of voxels updated.
+    #[pyo3(signature = (points, origin, max_range = None))]
+    fn insert(
+        &mut self,
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        origin: Vec<f64>,
+        max_range: Option<f64>,
+    ) -> PyResult<usize> {
+        if let Some(m) = max_range {
+            if m.is_nan() || m < 0.0 {
+                return Err(Failure::Value(format!(
+                    "insert: max_range must be a number at least 0 (or None), not {m}"
+                ))
+                .into());
+            }
+        }
+        let dim = self.dim_of();
+        let numbers = points_of(points, dim, "insert: points")?;
+        let flat = numbers.flat();
+        let updated = with_map!(&mut self.map, m, K => {
+            let origin = coordinates::<K>(&origin, "insert: origin")?;
+            py.detach(|| m.insert(rows::<K, f32>(flat), origin, max_range))
+                .map_err(|e| Failure::Value(format!("insert: {e}")))?
+                .voxels
+                .len()
+        });
+        Ok(updated)
+    }
+
+    /// The state of the voxels holding `points` (an (N, dim) array of world coordinates, converted to
+    /// float32): a uint8 array of `UNKNOWN` (also outside the map), `FREE` or `OCCUPIED`.
+    fn states<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<u8>>> {
+        let numbers = points_of(points, self.dim_of(), "states: points")?;
+        let flat = numbers.flat();
+        let out: Vec<u8> = with_map!(&self.map, m, K => py.detach(|| {
+            m.states(rows::<K, f32>(flat)).into_iter().map(state_code).collect()
+        }));
+        Ok(out.into_pyarray(py))
+    }
+
+    /// The keys of the voxels holding `points` (an (N, dim) array of world coordinates, converted to
+    /// float32): an (N, dim) int64 array, the voxel coordinates of the map's trees; a row of -1 for a
+    /// point outside the map.
+    fn keys<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let dim = self.dim_of();
+        let numbers = points_of(points, dim, "keys: points")?;
+        let flat = numbers.flat();
+        let out: Vec<i64> = with_map!(&self.map, m, K => {
+            let grid = *m.grid();
+            rows::<K, f32>(flat)
+                .iter()
+                .flat_map(|&p| match grid.keys(p) {
+                    Some(k) => k.map(i64::from),
+                    None => [-1; K],
+                })
+                .collect()
+        });
+        let array = Array2::from_shape_vec((flat.len() / dim, dim), out).map_err(Failure::value)?;
+        Ok(array.into_pyarray(py))
+    }
+
+    /// The occupied voxels, as a tree (level 16, at the map's keys).
+    fn occupied(&self, py: Python<'_>) -> Tree {
+        Tree::binary(with_map!(&self.map, m, K => py.detach(|| AnyTree::from(m.occupied()))))
+    }
+
+    /// The free voxels (observed, not occupied), as a tree.
+    fn free(&self, py: Python<'_>) -> Tree {
+        Tree::binary(with_map!(&self.map, m, K => py.detach(|| AnyTree::from(m.free()))))
+    }
+
+    /// The unknown voxels (never observed), as a tree.
+    fn unknown(&self, py: Python<'_>) -> Tree {
+        Tree::binary(with_map!(&self.map, m, K => py.detach(|| AnyTree::from(m.unknown()))))
+    }
+
+    /// The log-odds of the observed voxels, as a tree with float32 values (unknown voxels are empty; dense
+    /// arrays hold 0, the log-odds of probability 0.5, there).
+    fn log_odds(&self, py: Python<'_>) -> Tree {
+        let values =
+            with_map!(&self.map, m, K => py.detach(|| AnyValuedTree::from(m.log_odds().clone())));
+        Tree::valued(values, 0.0)
+    }
+
+    /// The side of a voxel.
+    #[getter]
+    fn resolution(&self) -> f64 {
+        with_map!(&self.map, m, K => m.grid().resolution())
+    }
+
+    /// The dimension (2 or 3).
+    #[getter]
+    fn dim(&self) -> usize {
+        self.dim_of()
+    }
+
+    fn __repr__(&self) -> String {
+        let (model, observed) =
+            with_map!(&self.map, m, K => (*m.model(), m.log_odds().voxel_count()));
+        // The probabilities as float32: what the model's float32 log-odds hold of the ones given.
+        let p = |l: f32| probability(l) as f32;
+        format!(
+            "OccupancyMap(resolution={}, dim={}, prob_hit={}, prob_miss={}, clamp_min={}, clamp_max={}, \
+             occupancy={}, observed={observed})",
+            self.resolution(),
+            self.dim_of(),
+            p(model.hit),
+            p(model.miss),
+            p(model.clamp_min),
+            p(model.clamp_max),
+            p(model.occupied),
+        )
+    }
+}
