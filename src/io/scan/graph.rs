@@ -15,6 +15,7 @@
 //!
 //! OctoMap keeps every number as an `f32` (the `f64`s are rounded as they are read) and so does ktree.
 
+use std::collections::HashSet;
 use std::path::Path;
 
 use super::pose::Pose;
@@ -110,11 +111,12 @@ fn parse_graph(bytes: &[u8]) -> Result<Vec<ScanNode>, Fault> {
         nodes.push(ScanNode { id, pose, points });
     }
     let edges = r.count("edges", EDGE_BYTES)?;
+    let ids: HashSet<u32> = nodes.iter().map(|n| n.id).collect();
     for _ in 0..edges {
         let at = r.at;
         for _ in 0..2 {
             let id = r.u32("an edge's node")?;
-            if !nodes.iter().any(|n| n.id == id) {
+            if !ids.contains(&id) {
                 return Err(Fault::byte(
                     at,
                     format!("an edge joins node {id}, which the graph does not have"),
