@@ -424,3 +424,17 @@ pub fn edit_body(body: &mut Vec<u8>, edit: &BodyEdit, unit: usize) {
         _ => {}
     }
 }
+
+/// Scans that were accepted: each placed in the world has its node's points, and an identity pose moves
+/// nothing.
+pub fn check_scan_nodes(nodes: &[ktree::io::ScanNode]) {
+    for node in nodes {
+        let scan = node.to_scan();
+        assert_eq!(scan.points.len(), node.points.len());
+        let unmoved = ktree::io::ScanNode {
+            pose: ktree::io::Pose::IDENTITY,
+            ..node.clone()
+        };
+        assert_eq!(unmoved.to_scan().points, node.points);
+    }
+}

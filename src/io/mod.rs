@@ -7,6 +7,8 @@
 //! * [`interop`]: other tools' grids — binvox, OctoMap `.bt`, OpenVDB `.vdb`;
 //! * [`cloud`](mod@cloud) and [`mesh`](mod@mesh): point clouds (PLY, PCD, XYZ/CSV, LAS/LAZ) and triangle
 //!   meshes (OBJ, STL, PLY) in ([`read_cloud`], [`read_mesh`]), one PLY reader for both;
+//! * [`scan`](mod@scan): range scans for occupancy maps — OctoMap's scan graphs and logs, lists of point
+//!   files with their poses ([`read_scans`]);
 //! * [`read_tree`] and [`write_tree`] choose among all of them (and meshes and volumes as inputs) by the
 //!   file's extension.
 //!
@@ -44,6 +46,8 @@ mod ply;
 pub mod rays;
 #[cfg(any(feature = "cloud", feature = "mesh"))]
 mod scalar;
+#[cfg(feature = "cloud")]
+pub mod scan;
 pub(crate) mod spill;
 
 #[cfg(feature = "cloud")]
@@ -52,6 +56,11 @@ pub use cloud::{is_cloud_file, read_cloud, read_cloud_bytes, CLOUD_FORMATS};
 pub use geometry_file::{GeometryFileError, GeometryFileErrorKind};
 #[cfg(feature = "mesh")]
 pub use mesh::{read_mesh, read_mesh_bytes, MESH_FORMATS};
+#[cfg(feature = "cloud")]
+pub use scan::{
+    read_scan_directory, read_scan_graph, read_scan_list, read_scan_log, read_scans, Pose, Scan,
+    ScanNode,
+};
 
 pub use dispatch::{
     read_tree, read_tree_placed, voxelize, write_tree, Format, IoError, ReadOptions, ReadTree,
