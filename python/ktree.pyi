@@ -354,6 +354,18 @@ class OccupancyMap:
         """The unknown voxels (never observed), as a tree."""
     def log_odds(self) -> Tree:
         """The log-odds of the observed voxels, as a tree with float32 values (unknown voxels empty)."""
+    def save(self, path: _Path) -> None:
+        """Writes a 3-D map as OctoMap's .ot (every log-odds) or .bt (free and occupied), atomically."""
+    @staticmethod
+    def load(
+        path: _Path,
+        prob_hit: float = 0.7,
+        prob_miss: float = 0.4,
+        clamp_min: float = 0.1192,
+        clamp_max: float = 0.971,
+        occupancy: float = 0.5,
+    ) -> OccupancyMap:
+        """Reads a 3-D map from OctoMap's .ot or .bt file, with the sensor model of these probabilities."""
     @property
     def resolution(self) -> float:
         """The side of a voxel."""

@@ -1,12 +1,14 @@
-//! `ktree map SCANS… --resolution R [--max-range M] [--sensor-origin X,Y,Z] --out MAP.ot|.bt|.ktree`: an
-//! occupancy map from range scans, integrated as OctoMap's `insertPointCloud` integrates them; and the
-//! map branch of `ktree project` (a map's plane between two heights, as a ROS map or a quadtree).
+//! `ktree map SCANS… --resolution R [--max-range M] [--sensor-origin X,Y,Z | --pose X,Y,Z,ROLL,PITCH,YAW]
+//! --out MAP.ot|.bt|.ktree`: an occupancy map from range scans, integrated as OctoMap's
+//! `insertPointCloud` integrates them; and the map branch of `ktree project` (a map's plane between two
+//! heights, as a ROS map or a quadtree).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use ktree::export::grid_map::write_grid_map;
 use ktree::export::Frame;
+use ktree::io::scan::{read_scan_directory, read_scans, Pose, Scan, ScanNode};
 use ktree::io::{
     read_bt_map, read_cloud, read_cloud_bytes, read_ot_map, write_bt_map, write_ot_map,
 };
@@ -19,8 +21,10 @@ use crate::outln;
 /// Arguments of `ktree map`.
 #[derive(Debug, clap::Args)]
 pub struct MapArgs {
-    /// The scans, in order: point clouds in world coordinates (PLY, PCD, XYZ/CSV/TXT, OctoMap's `x y z`
-    /// .dat, LAS/LAZ), each seen from the sensor origin.
+    /// The scans, in order: OctoMap's scan graphs (.graph) and logs (.log), which carry their poses; scan
+    /// lists (.scans or .list: lines `POINTFILE x y z roll pitch yaw` or `POINTFILE x y z`); folders of
+    /// point files; point files (PLY, PCD, XYZ/CSV/TXT, OctoMap's `x y z` .dat, LAS/LAZ). Point files and
+    /// folders are in world coordinates seen from --sensor-origin, or in the sensor's frame at --pose.
     #[arg(required = true)]
     scans: Vec<PathBuf>,
     /// The side of a voxel, in the points' unit (metres).
@@ -30,8 +34,12 @@ pub struct MapArgs {
     #[arg(long, allow_hyphen_values = true)]
     max_range: Option<f64>,
     /// Where the sensor was, X,Y,Z in world coordinates.
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>, default_value = "0,0,0")]
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<f64, 3>, default_value = "0,0,0", conflicts_with = "pose")]
     sensor_origin: [f64; 3],
+    /// The sensor's pose for point files in its frame: X,Y,Z,ROLL,PITCH,YAW (metres, radians; OctoMap's
+    /// Pose6D).
+    #[arg(long, value_name = "X,Y,Z,ROLL,PITCH,YAW", allow_hyphen_values = true, value_parser = vector::<f64, 6>)]
+    pose: Option<[f64; 6]>,
     /// The map: .ot (every log-odds, OctoMap's OcTree), .bt (free and occupied, OctoMap's binary) or
     /// .ktree (the log-odds as a float32 tree at the map's keys; the resolution is not kept).
     #[arg(long)]
@@ -53,7 +61,7 @@ pub struct MapArgs {
     occupancy: f64,
 }
 
-/// The points of a scan file, as `f32` (OctoMap's precision).
+/// The points of a point file, as `f32` (OctoMap's precision).
 fn read_points(path: &Path) -> CliResult<Vec<[f32; 3]>> {
     let dat = path
         .extension()
@@ -73,6 +81,37 @@ fn read_points(path: &Path) -> CliResult<Vec<[f32; 3]>> {
         .collect())
 }
 
+/// The scans of one argument of `ktree map`.
+fn read_argument(path: &Path, origin: [f32; 3], pose: Option<Pose>) -> CliResult<Vec<Scan>> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let placed = |points: Vec<[f32; 3]>| match pose {
+        Some(pose) => ScanNode {
+            id: 0,
+            pose,
+            points,
+        }
+        .to_scan(),
+        None => Scan { points, origin },
+    };
+    if path.is_dir() {
+        let scans = read_scan_directory(path, origin).map_err(CliError::caused)?;
+        return Ok(match pose {
+            Some(_) => scans.into_iter().map(|s| placed(s.points)).collect(),
+            None => scans,
+        });
+    }
+    match ext.as_str() {
+        "graph" | "log" | "scans" | "list" => read_scans(path)
+            .map_err(CliError::caused)
+            .map_err(Into::into),
+        _ => Ok(vec![placed(read_points(path)?)]),
+    }
+}
+
 /// `ktree map`.
 pub fn run_map(a: MapArgs) -> CliResult {
     let model = SensorModel::from_probabilities(
@@ -89,22 +128,26 @@ pub fn run_map(a: MapArgs) -> CliResult {
     let mut map = OccupancyMap::<3>::with_model(a.resolution, model)
         .map_err(|e| format!("--resolution/probabilities: {e}"))?;
     let origin = a.sensor_origin.map(|c| c as f32);
-    let (mut points, mut outside, mut seconds) = (0usize, 0usize, 0.0f64);
-    for scan in &a.scans {
-        let cloud = read_points(scan)?;
-        let start = Instant::now();
-        let update = map
-            .insert(&cloud, origin, a.max_range)
-            .map_err(|e| format!("{}: {e}", scan.display()))?;
-        seconds += start.elapsed().as_secs_f64();
-        points += cloud.len();
-        outside += update.rays_outside;
+    let pose = a
+        .pose
+        .map(|[x, y, z, r, p, w]| Pose::from_xyz_rpy(x as f32, y as f32, z as f32, r, p, w));
+    let (mut scans, mut points, mut outside, mut seconds) = (0usize, 0usize, 0usize, 0.0f64);
+    for argument in &a.scans {
+        for scan in read_argument(argument, origin, pose)? {
+            let start = Instant::now();
+            let update = map
+                .insert(&scan.points, scan.origin, a.max_range)
+                .map_err(|e| format!("{}: {e}", argument.display()))?;
+            seconds += start.elapsed().as_secs_f64();
+            scans += 1;
+            points += scan.points.len();
+            outside += update.rays_outside;
+        }
     }
     write_map(&a.out, kind, &map)?;
     outln!(
-        "{}: {} scans, {points} points integrated in {seconds:.3} s; {} occupied, {} free voxels of {} m",
+        "{}: {scans} scans, {points} points integrated in {seconds:.3} s; {} occupied, {} free voxels of {} m",
         a.out.display(),
-        a.scans.len(),
         map.occupied().voxel_count(),
         map.free().voxel_count(),
         a.resolution

@@ -193,3 +193,65 @@ fn bad_map_arguments_are_one_line_errors() {
     ]);
     assert!(!ok && err.contains("missing.xyz"), "{err}");
 }
+
+#[test]
+fn scan_graphs_and_posed_point_files_are_placed_as_octomap_places_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let graph = common::data_dir().join("scans/spherical_scan.graph");
+    let graph = graph.to_str().unwrap();
+    run(&["map", graph, "--resolution", "0.2", "--out", &s("g.ot")]);
+    let mut expected = OccupancyMap::<3>::new(0.2).unwrap();
+    for scan in ktree::io::scan::read_scans(graph.as_ref()).unwrap() {
+        expected.insert(&scan.points, scan.origin, None).unwrap();
+    }
+    let got = read_ot_map(
+        &std::fs::read(s("g.ot")).unwrap(),
+        "g.ot",
+        SensorModel::default(),
+    )
+    .unwrap();
+    assert_eq!(got, expected);
+    assert!(got.occupied().voxel_count() > 100);
+
+    // A point file in the sensor's frame at a pose.
+    let points = walls();
+    write_xyz(&dir.path().join("w.xyz"), &points);
+    run(&[
+        "map",
+        &s("w.xyz"),
+        "--pose",
+        "1,-2,0.5,0.1,-0.2,1.5",
+        "--resolution",
+        "0.1",
+        "--out",
+        &s("p.ot"),
+    ]);
+    let pose = ktree::io::scan::Pose::from_xyz_rpy(1.0, -2.0, 0.5, 0.1, -0.2, 1.5);
+    let scan = ktree::io::scan::ScanNode {
+        id: 0,
+        pose,
+        points,
+    }
+    .to_scan();
+    let mut expected = OccupancyMap::<3>::new(0.1).unwrap();
+    expected.insert(&scan.points, scan.origin, None).unwrap();
+    let got = read_ot_map(
+        &std::fs::read(s("p.ot")).unwrap(),
+        "p.ot",
+        SensorModel::default(),
+    )
+    .unwrap();
+    assert_eq!(got, expected);
+    let (ok, _, err) = ktree(&[
+        "map",
+        &s("w.xyz"),
+        "--pose",
+        "1,2,3",
+        "--resolution",
+        "0.1",
+        "--out",
+        &s("q.ot"),
+    ]);
+    assert!(!ok && err.contains("6"), "{err}");
+}

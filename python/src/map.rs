@@ -4,6 +4,9 @@
 //! operation of trees applies to them. The dimension is chosen at run time ([`AnyMap`]); each method is
 //! one call of the library on the map inside.
 
+use std::path::PathBuf;
+
+use ktree::io::{read_bt_map, read_ot_map, write_bt_map, write_ot_map};
 use ktree::map::{probability, OccupancyMap, SensorModel, VoxelState};
 use ktree::{AnyTree, AnyValuedTree};
 use numpy::ndarray::Array2;
@@ -239,6 +242,77 @@ impl OccupancyMapPy {
         let values =
             with_map!(&self.map, m, K => py.detach(|| AnyValuedTree::from(m.log_odds().clone())));
         Tree::valued(values, 0.0)
+    }
+
+    /// Writes a 3-D map as OctoMap's `.ot` (every log-odds) or `.bt` (each known voxel free or occupied),
+    /// atomically.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let AnyMap::D3(map) = &self.map else {
+            return Err(Failure::Value(format!(
+                "{}: OctoMap's files hold 3-D maps; this map has dimension 2",
+                path.display()
+            ))
+            .into());
+        };
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let bt = match ext.as_deref() {
+            Some("ot") => false,
+            Some("bt") => true,
+            _ => {
+                return Err(Failure::Value(format!(
+                    "{}: a map is saved as .ot or .bt",
+                    path.display()
+                ))
+                .into())
+            }
+        };
+        Ok(py.detach(|| {
+            ktree::fs::write_atomic_with(&path, |w| {
+                if bt {
+                    write_bt_map(w, map)
+                } else {
+                    write_ot_map(w, map)
+                }
+            })
+            .map_err(|e| Failure::of_error(&e, &path))
+        })?)
+    }
+
+    /// Reads a 3-D map from OctoMap's `.ot` or `.bt` file, with a sensor model given by probabilities as
+    /// for the constructor (a `.bt` file's occupied voxels take the upper clamp, its free ones the lower).
+    #[staticmethod]
+    #[pyo3(signature = (path, prob_hit = 0.7, prob_miss = 0.4, clamp_min = 0.1192, clamp_max = 0.971, occupancy = 0.5))]
+    fn load(
+        py: Python<'_>,
+        path: PathBuf,
+        prob_hit: f64,
+        prob_miss: f64,
+        clamp_min: f64,
+        clamp_max: f64,
+        occupancy: f64,
+    ) -> PyResult<Self> {
+        let model =
+            SensorModel::from_probabilities(prob_hit, prob_miss, clamp_min, clamp_max, occupancy);
+        model.check().map_err(Failure::Value)?;
+        let bt = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("bt"));
+        let map = py.detach(|| {
+            let bytes = std::fs::read(&path).map_err(|e| Failure::of_error(&e, &path))?;
+            let name = path.display().to_string();
+            if bt {
+                read_bt_map(&bytes, &name, model)
+            } else {
+                read_ot_map(&bytes, &name, model)
+            }
+            .map_err(|e| Failure::of_error(&e, &path))
+        })?;
+        Ok(Self {
+            map: AnyMap::D3(map),
+        })
     }
 
     /// The side of a voxel.

@@ -403,3 +403,29 @@ def test_bad_scans_are_value_errors():
     assert m.unknown() == ktree.Tree.full(3, 16)
     # An empty scan is no error.
     assert m.insert(np.zeros((0, 3)), [0, 0, 0]) == 0
+
+
+def test_save_and_load_through_octomaps_files(tmp_path):
+    rng = np.random.default_rng(5)
+    points = rng.uniform(-2.0, 2.0, size=(300, 3))
+    m = ktree.OccupancyMap(0.1)
+    m.insert(points, [0.05, 0.05, 0.05])
+    m.save(tmp_path / "m.ot")
+    back = ktree.OccupancyMap.load(tmp_path / "m.ot")
+    assert back.resolution == 0.1
+    assert back.log_odds() == m.log_odds()
+    m.save(str(tmp_path / "m.bt"))
+    ml = ktree.OccupancyMap.load(tmp_path / "m.bt")
+    assert ml.occupied() == m.occupied()
+    assert ml.free() == m.free()
+    probes = rng.uniform(-2.5, 2.5, size=(500, 3))
+    assert (ml.states(probes) == m.states(probes)).all()
+    with pytest.raises(ValueError, match=r"\.ot or \.bt"):
+        m.save(tmp_path / "m.png")
+    with pytest.raises(ValueError, match="dimension 2"):
+        ktree.OccupancyMap(0.1, dim=2).save(tmp_path / "flat.ot")
+    (tmp_path / "bad.ot").write_bytes(b"# Octomap OcTree file\nid OcTree\nsize 3\nres 0.1\ndata\n")
+    with pytest.raises(ValueError, match="bad.ot"):
+        ktree.OccupancyMap.load(tmp_path / "bad.ot")
+    with pytest.raises(OSError):
+        ktree.OccupancyMap.load(tmp_path / "missing.ot")
