@@ -105,9 +105,7 @@ fn read_argument(path: &Path, origin: [f32; 3], pose: Option<Pose>) -> CliResult
         });
     }
     match ext.as_str() {
-        "graph" | "log" | "scans" | "list" => read_scans(path)
-            .map_err(CliError::caused)
-            .map_err(Into::into),
+        "graph" | "log" | "scans" | "list" => read_scans(path).map_err(CliError::caused),
         _ => Ok(vec![placed(read_points(path)?)]),
     }
 }
