@@ -35,6 +35,8 @@
 //!   mass properties, complexity — on trees in memory and on mapped files, the trees they make written
 //!   through a level sink (into memory, or level by level to files); and those of valued trees
 //!   ([`ops::values`]: select, mask, combine, overlay, map, per-value statistics).
+//! * [`map`]: occupancy maps from range scans — OctoMap's semantics (sensor model, keys, key traversal),
+//!   log-odds in a valued tree, the occupied, free and unknown parts as trees, a map's plane for navigation.
 //! * [`query`]: questions asked of a map — batch point queries, boxes and counts, ray casting, the
 //!   nearest full voxel — on trees in memory and on mapped files.
 //! * [`shape`]: morphology (dilate, erode, opening, closing), connected components, surface area and Euler number, on the runs;
@@ -47,7 +49,7 @@
 //! # Layers
 //! Each layer imports only those below it:
 //! ```text
-//!  io/                files by format: .ktree (v1 read, v2 written and mapped, v3 with values), interop
+//!  io/                files by format (and OctoMap's map files, scans in: io::scan): .ktree (v1 read, v2 written and mapped, v3 with values), interop
 //!                     grids, ray text, point clouds and meshes in (into solid/'s PointCloud and TriangleMesh);
 //!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in,
 //!                     meshes written through export/); spill files, one level a file, and the level
@@ -55,7 +57,9 @@
 //!                     of files larger than memory (ops' merge, mapped inputs, spilled output)
 //!  export/            boundaries as meshes and outlines, and their files (over display's neighbours);
 //!                     the 3-D view page (over the storage trait and display's named views)
-//!  ops/  display/     operations over the storage trait, each tree made written through a level sink
+//!  display/           pictures, line drawings
+//!  map/               occupancy maps from scans (over ops, query and the valued tree)
+//!  ops/               operations over the storage trait, each tree made written through a level sink
 //!  query/  shape/     questions asked of a map (points, boxes, rays, nearest), over the storage trait;
 //!                     morphology, components, surface area, Euler number, on the runs
 //!  stacking/          Builder (cells on all threads, in memory or out of core through a piece store and

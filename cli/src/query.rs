@@ -1,4 +1,5 @@
-//! `ktree query FILE --points P [--distance] [--nearest] [--json]` and
+//! `ktree query FILE --points P [--distance] [--nearest] [--json]` (on a map file: each point unknown, free
+//! or occupied) and
 //! `ktree raycast FILE --rays R [--max-t T] [--json]`: point queries, nearest full voxels and ray casts
 //! on a tree file. A version 2 file is read through its memory map (so a tree larger than memory is
 //! queried without being loaded); others are loaded.
@@ -18,10 +19,10 @@ use crate::table;
 /// Arguments of `ktree query`.
 #[derive(Debug, clap::Args)]
 pub struct QueryArgs {
-    /// The tree file.
+    /// The tree file, or an occupancy map (.ot, .bt): then each point's state, unknown, free or occupied.
     tree: PathBuf,
     /// The points: a `.csv` or `.txt` of K integers a line, or a `.npy` `(N, K)` integer array; `-` for
-    /// standard input.
+    /// standard input. For a map: three world coordinates a line.
     #[arg(long)]
     points: PathBuf,
     /// Also print the distance to the nearest full voxel (between voxel centres; 0 inside).
@@ -30,7 +31,8 @@ pub struct QueryArgs {
     /// Also print the nearest full voxel.
     #[arg(long)]
     nearest: bool,
-    /// Print a JSON array of objects (`point`, `inside`, and `distance`, `nearest` when asked).
+    /// Print a JSON array of objects (`point`, `inside`, and `distance`, `nearest` when asked; for a map
+    /// `point` and `state`).
     #[arg(long)]
     json: bool,
 }
@@ -148,7 +150,53 @@ fn answer_points<const K: usize, T: Query<K>>(tree: &T, args: &QueryArgs) -> Cli
 
 /// Runs `ktree query`.
 pub fn run_query(args: QueryArgs) -> CliResult {
+    if crate::project::is_map_file(&args.tree) {
+        return answer_map_points(&args);
+    }
     with_tree!(&open(&args.tree)?, t => answer_points(t, &args))
+}
+
+/// `ktree query` of an occupancy map (`.ot`, `.bt`): the state (unknown, free or occupied) of the voxel
+/// holding each point, the points in world coordinates (three numbers a line).
+fn answer_map_points(args: &QueryArgs) -> CliResult {
+    if args.distance || args.nearest {
+        return Err(format!(
+            "{}: --distance and --nearest are for trees; a map's query answers unknown, free or occupied",
+            args.tree.display()
+        )
+        .into());
+    }
+    let map = crate::map::read_map(&args.tree)?;
+    let table = table::read::<f64>(&args.points, 3)?;
+    let pts: Vec<[f32; 3]> = table
+        .rows
+        .iter()
+        .map(|r| [r[0] as f32, r[1] as f32, r[2] as f32])
+        .collect();
+    let states = map.states(&pts);
+    let name = |s: ktree::map::VoxelState| match s {
+        ktree::map::VoxelState::Unknown => "unknown",
+        ktree::map::VoxelState::Free => "free",
+        ktree::map::VoxelState::Occupied => "occupied",
+    };
+    let mut w = out();
+    let io = crate::common::error::CliError::from_output;
+    if args.json {
+        w.write_all(b"[").map_err(io)?;
+    }
+    for (i, (row, state)) in table.rows.iter().zip(&states).enumerate() {
+        if args.json {
+            let sep = if i == 0 { "\n" } else { ",\n" };
+            let o = serde_json::json!({"point": row[..3].to_vec(), "state": name(*state)});
+            write!(w, "{sep}{o}").map_err(io)?;
+        } else {
+            writeln!(w, "{} {} {} {}", row[0], row[1], row[2], name(*state)).map_err(io)?;
+        }
+    }
+    if args.json {
+        writeln!(w, "{}]", if states.is_empty() { "" } else { "\n" }).map_err(io)?;
+    }
+    w.flush().map_err(io)
 }
 
 /// The rays of a table, each of `2K` numbers, checked.

@@ -255,3 +255,55 @@ fn scan_graphs_and_posed_point_files_are_placed_as_octomap_places_them() {
     ]);
     assert!(!ok && err.contains("6"), "{err}");
 }
+
+#[test]
+fn queries_of_a_map_answer_unknown_free_or_occupied() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    write_xyz(&dir.path().join("room.xyz"), &walls());
+    run(&[
+        "map",
+        &s("room.xyz"),
+        "--resolution",
+        "0.1",
+        "--sensor-origin",
+        "2.5,1.5,1.2",
+        "--out",
+        &s("room.bt"),
+    ]);
+    let probes = [
+        [3.0f32, 0.0, 1.05],
+        [2.5, 1.5, 1.2],
+        [-20.0, 5.0, 1.0],
+        [3.0, 2.0, 1.1],
+    ];
+    write_xyz(&dir.path().join("p.txt"), &probes);
+    let text = run(&["query", &s("room.bt"), "--points", &s("p.txt")]);
+    let map = read_bt_map(
+        &std::fs::read(s("room.bt")).unwrap(),
+        "room.bt",
+        SensorModel::default(),
+    )
+    .unwrap();
+    let names: Vec<&str> = map
+        .states(&probes)
+        .iter()
+        .map(|s| match s {
+            ktree::map::VoxelState::Unknown => "unknown",
+            ktree::map::VoxelState::Free => "free",
+            ktree::map::VoxelState::Occupied => "occupied",
+        })
+        .collect();
+    assert_eq!(&names[..3], ["occupied", "free", "unknown"]);
+    let got: Vec<&str> = text
+        .lines()
+        .map(|l| l.rsplit(' ').next().unwrap())
+        .collect();
+    assert_eq!(got, names);
+    let json = run(&["query", &s("room.bt"), "--points", &s("p.txt"), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v[0]["state"], "occupied");
+    assert_eq!(v[2]["point"], serde_json::json!([-20.0, 5.0, 1.0]));
+    let (ok, _, err) = ktree(&["query", &s("room.bt"), "--points", &s("p.txt"), "--nearest"]);
+    assert!(!ok && err.contains("unknown, free or occupied"), "{err}");
+}
