@@ -1,7 +1,7 @@
 //! One scan's update of a map: the voxels its points end in (hits) and the voxels its rays cross on the
 //! way (misses), each once, hits winning — OctoMap's `computeUpdate` and `insertPointCloud` with
 //! `discretize = false` — gathered on all threads as Morton keys, deduplicated by sorting, and merged
-//! into the map's tree in one pass from the root down.
+//! into the map's tree in one depth-first pass.
 
 use rayon::prelude::*;
 
@@ -9,11 +9,10 @@ use super::grid::MapGrid;
 use super::model::SensorModel;
 use super::traverse::{clipped_end, difference, norm, visit_key_ray};
 use crate::radix::radix_sort;
-use crate::space::{morton_encode, Cell};
+use crate::space::morton_encode;
 use crate::tree::storage::infallible;
-use crate::tree::top_down::{build_top_down, Decision, InputNode};
-use crate::tree::valued::ValueState;
-use crate::tree::TreeError;
+use crate::tree::top_down::{pack, InputNode};
+use crate::tree::valued::{combine, ValueState};
 use crate::KTree;
 
 /// The points of a scan handed to one thread at a time.
@@ -143,62 +142,79 @@ fn merge_sorted(hits: &[u64], misses: &[u64]) -> Vec<(u64, bool)> {
 }
 
 /// The map's log-odds after `update`: every updated voxel's log-odds (0 where it was unknown) moved by
-/// one hit or miss of `model`, the others kept; minimal, as always.
+/// one hit or miss of `model`, the others kept; minimal, as always. Depth first: each cell's children are
+/// made before it, a block of alike children joined at once.
 pub fn apply<const K: usize>(
     map: &KTree<K, f32>,
     update: &[(u64, bool)],
     model: &SensorModel,
 ) -> KTree<K, f32> {
     let level = map.level();
-    // The context of a cell: the map's node it lies in, the range of `update` inside it, and the Morton
-    // keys the cell spans (its first and the log of its side).
-    let root = (
-        infallible(InputNode::root(map)),
-        0..update.len(),
-        0u64,
-        level,
-    );
-    let out = build_top_down::<K, f32, _, TreeError>(
-        level,
-        root,
-        |_: &Cell<K>, (node, range, _, log_side)| {
-            let leaf = match node.state {
-                ValueState::Empty => Some(None),
-                ValueState::Full(v) => Some(Some(v)),
-                _ => None,
-            };
-            let here = &update[range.clone()];
-            let Some(&(_, first)) = here.first() else {
-                // Nothing of the scan here: the map's node as it is (its subtree copied below).
-                return Ok(match leaf {
-                    Some(v) => Decision::Leaf(v),
-                    None => Decision::Split,
-                });
-            };
+    let mut merge = Merge {
+        map,
+        model,
+        levels: vec![Vec::new(); level as usize + 1],
+    };
+    let root = merge.node(infallible(InputNode::root(map)), update, 0, level, 0);
+    merge.levels[0].push(root);
+    pack(map.universe(), merge.levels)
+}
+
+/// The state of a depth-first merge: the settled states of each level so far.
+struct Merge<'a, const K: usize> {
+    map: &'a KTree<K, f32>,
+    model: &'a SensorModel,
+    levels: Vec<Vec<ValueState<f32>>>,
+}
+
+impl<const K: usize> Merge<'_, K> {
+    /// The state of the cell of the map's `node` whose voxels' Morton keys start at `base` (a side of
+    /// `2^log_side`, at `depth`) after the updates `update` inside it; its children, if any, pushed onto the
+    /// level below.
+    fn node(
+        &mut self,
+        node: InputNode<f32>,
+        update: &[(u64, bool)],
+        base: u64,
+        log_side: u32,
+        depth: usize,
+    ) -> ValueState<f32> {
+        let leaf = match node.state {
+            ValueState::Empty => Some(None),
+            ValueState::Full(v) => Some(Some(v)),
+            _ => None,
+        };
+        if let (Some(v), Some(&(_, first))) = (leaf, update.first()) {
             let volume = 1u128 << (K as u32 * log_side);
-            let uniform = here.len() as u128 == volume && here.iter().all(|&(_, h)| h == first);
-            Ok(match leaf {
-                Some(v) if uniform => Decision::Leaf(Some(model.update(v.unwrap_or(0.0), first))),
-                _ => Decision::Split,
-            })
-        },
-        |(node, range, base, log_side), code| {
-            let span = 1u64 << (K as u32 * (log_side - 1));
+            if update.len() as u128 == volume && update.iter().all(|&(_, h)| h == first) {
+                return ValueState::Full(self.model.update(v.unwrap_or(0.0), first));
+            }
+        }
+        if update.is_empty() {
+            if let Some(v) = leaf {
+                return v.map_or(ValueState::Empty, ValueState::Full);
+            }
+        }
+        // Not a leaf of the result: its children, each from the map's child and its part of the update.
+        let span = 1u64 << (K as u32 * (log_side - 1));
+        let mut kids = [ValueState::Empty; 16];
+        let mut rest = update;
+        for (code, kid) in kids.iter_mut().enumerate().take(1 << K) {
             let start = base + code as u64 * span;
-            let here = &update[range.clone()];
-            let lo = range.start + here.partition_point(|&(k, _)| k < start);
-            // The last cell of a 4-D root ends at 2^64.
-            let hi = match start.checked_add(span) {
-                Some(end) => range.start + here.partition_point(|&(k, _)| k < end),
-                None => range.end,
+            let here = match start.checked_add(span) {
+                Some(end) => rest.partition_point(|&(k, _)| k < end),
+                // The last cell of a 4-D root ends at 2^64.
+                None => rest.len(),
             };
-            Ok((
-                infallible(node.child(map, code)),
-                lo..hi,
-                start,
-                log_side - 1,
-            ))
-        },
-    );
-    out.expect("log-odds stay finite and a voxel is never split")
+            let child = infallible(node.child(self.map, code));
+            *kid = self.node(child, &rest[..here], start, log_side - 1, depth + 1);
+            rest = &rest[here..];
+        }
+        let kids = &kids[..1 << K];
+        let state = combine(kids);
+        if state.has_children() {
+            self.levels[depth + 1].extend_from_slice(kids);
+        }
+        state
+    }
 }
