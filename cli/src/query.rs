@@ -1,6 +1,7 @@
 //! `ktree query FILE --points P [--distance] [--nearest] [--json]` (on a map file: each point unknown, free
 //! or occupied) and
-//! `ktree raycast FILE --rays R [--max-t T] [--json]`: point queries, nearest full voxels and ray casts
+//! `ktree raycast FILE --rays R [--max-t T] [--json]` (on a map file: OctoMap's castRay,
+//! `--ignore-unknown`, `--max-range`): point queries, nearest full voxels and ray casts
 //! on a tree file. A version 2 file is read through its memory map (so a tree larger than memory is
 //! queried without being loaded); others are loaded.
 
@@ -40,7 +41,8 @@ pub struct QueryArgs {
 /// Arguments of `ktree raycast`.
 #[derive(Debug, clap::Args)]
 pub struct RaycastArgs {
-    /// The tree file.
+    /// The tree file, or an occupancy map (.ot, .bt): then OctoMap's castRay, to the first occupied
+    /// voxel, stopping at unknown ones unless --ignore-unknown.
     tree: PathBuf,
     /// The rays: a `.csv` or `.txt` of 2K numbers a line (origin, then direction), or a `.npy` `(N, 2K)`
     /// array; `-` for standard input.
@@ -49,9 +51,16 @@ pub struct RaycastArgs {
     /// The largest ray parameter `t` (default: no limit).
     #[arg(long, default_value_t = f64::INFINITY)]
     max_t: f64,
-    /// Print a JSON array of objects (`hit`, `voxel`, `t`, `axis`, `sign`).
+    /// Print a JSON array of objects (`hit`, `voxel`, `t`, `axis`, `sign`; for a map `end`, `key`,
+    /// `point`).
     #[arg(long)]
     json: bool,
+    /// A map: rays pass through unknown voxels (OctoMap's ignoreUnknown).
+    #[arg(long)]
+    ignore_unknown: bool,
+    /// A map: rays stop beyond this distance, in world units (default: no limit).
+    #[arg(long)]
+    max_range: Option<f64>,
 }
 
 /// The tree of a file: mapped (version 2) or loaded; the queries run on either.
@@ -265,5 +274,66 @@ fn answer_rays<const K: usize, T: Query<K>>(tree: &T, args: &RaycastArgs) -> Cli
 
 /// Runs `ktree raycast`.
 pub fn run_raycast(args: RaycastArgs) -> CliResult {
+    if crate::project::is_map_file(&args.tree) {
+        return answer_map_rays(&args);
+    }
+    if args.ignore_unknown || args.max_range.is_some() {
+        return Err("--ignore-unknown and --max-range are for occupancy maps (.ot, .bt)".into());
+    }
     with_tree!(&open(&args.tree)?, t => answer_rays(t, &args))
+}
+
+/// `ktree raycast` of an occupancy map: per ray (origin and direction in world coordinates), how it
+/// ended — `occupied` (a hit), `unknown`, `range` (beyond --max-range) or `outside` the map — with the
+/// key and the world centre of the voxel where it ended.
+fn answer_map_rays(args: &RaycastArgs) -> CliResult {
+    let map = crate::map::read_map(&args.tree)?;
+    let table = table::read::<f64>(&args.rays, 6)?;
+    let range = match args.max_range {
+        Some(m) if !(m.is_finite() && m > 0.0) => {
+            return Err(format!("--max-range {m}: expected a positive number").into())
+        }
+        Some(m) => m,
+        None => -1.0,
+    };
+    let mut w = out();
+    let io = crate::common::error::CliError::from_output;
+    if args.json {
+        w.write_all(b"[").map_err(io)?;
+    }
+    for (i, r) in table.rows.iter().enumerate() {
+        let f = |a: usize| r[a] as f32;
+        let end = map.cast_ray(
+            [f(0), f(1), f(2)],
+            [f(3), f(4), f(5)],
+            args.ignore_unknown,
+            range,
+        );
+        let (name, key) = match end {
+            ktree::map::CastEnd::Occupied(k) => ("occupied", Some(k)),
+            ktree::map::CastEnd::Unknown(k) => ("unknown", Some(k)),
+            ktree::map::CastEnd::Range(k) => ("range", Some(k)),
+            ktree::map::CastEnd::Outside => ("outside", None),
+        };
+        let point = key.map(|k| k.map(|c| map.grid().centre(c)));
+        if args.json {
+            let sep = if i == 0 { "\n" } else { ",\n" };
+            let o = serde_json::json!({"end": name, "key": key, "point": point});
+            write!(w, "{sep}{o}").map_err(io)?;
+        } else {
+            match (key, point) {
+                (Some(k), Some(p)) => writeln!(
+                    w,
+                    "{name} {} {} {} {} {} {}",
+                    k[0], k[1], k[2], p[0], p[1], p[2]
+                ),
+                _ => writeln!(w, "{name}"),
+            }
+            .map_err(io)?;
+        }
+    }
+    if args.json {
+        writeln!(w, "{}]", if table.rows.is_empty() { "" } else { "\n" }).map_err(io)?;
+    }
+    w.flush().map_err(io)
 }

@@ -307,3 +307,73 @@ fn queries_of_a_map_answer_unknown_free_or_occupied() {
     let (ok, _, err) = ktree(&["query", &s("room.bt"), "--points", &s("p.txt"), "--nearest"]);
     assert!(!ok && err.contains("unknown, free or occupied"), "{err}");
 }
+
+#[test]
+fn ray_casts_on_a_map_report_where_they_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    write_xyz(&dir.path().join("room.xyz"), &walls());
+    run(&[
+        "map",
+        &s("room.xyz"),
+        "--resolution",
+        "0.1",
+        "--sensor-origin",
+        "2.5,1.5,1.2",
+        "--out",
+        &s("room.ot"),
+    ]);
+    let map = read_ot_map(
+        &std::fs::read(s("room.ot")).unwrap(),
+        "room.ot",
+        SensorModel::default(),
+    )
+    .unwrap();
+    let rays: [[f32; 6]; 3] = [
+        [2.5, 1.5, 1.2, 1.0, 0.0, 0.0],
+        [2.5, 1.5, 1.2, 0.0, 0.0, 1.0],
+        [-9.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+    ];
+    let text: String = rays
+        .iter()
+        .map(|r| r.map(|v| v.to_string()).join(" ") + "\n")
+        .collect();
+    std::fs::write(dir.path().join("r.txt"), text).unwrap();
+    for (extra, ignore, range) in [
+        (vec![], false, -1.0),
+        (vec!["--ignore-unknown", "--max-range", "2"], true, 2.0),
+    ] {
+        let mut args = vec![
+            "raycast".to_string(),
+            s("room.ot"),
+            "--rays".into(),
+            s("r.txt"),
+        ];
+        args.extend(extra.iter().map(|a| a.to_string()));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = run(&args);
+        for (r, line) in rays.iter().zip(out.lines()) {
+            let end = map.cast_ray([r[0], r[1], r[2]], [r[3], r[4], r[5]], ignore, range);
+            let word = line.split(' ').next().unwrap();
+            let want = match end {
+                ktree::map::CastEnd::Occupied(_) => "occupied",
+                ktree::map::CastEnd::Unknown(_) => "unknown",
+                ktree::map::CastEnd::Range(_) => "range",
+                ktree::map::CastEnd::Outside => "outside",
+            };
+            assert_eq!(word, want, "{line}");
+        }
+        // Towards the wall at x = 6, 3.5 m away: a hit, or beyond a range of 2 m.
+        let first = if ignore { "range" } else { "occupied" };
+        assert!(out.lines().next().unwrap().starts_with(first), "{out}");
+    }
+    let (ok, _, err) = ktree(&[
+        "raycast",
+        &s("room.ot"),
+        "--rays",
+        &s("r.txt"),
+        "--max-range",
+        "0",
+    ]);
+    assert!(!ok && err.contains("--max-range"), "{err}");
+}

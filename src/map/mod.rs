@@ -20,6 +20,7 @@
 //! assert_eq!(map.free().voxel_count(), 10 + 5 - 1);
 //! ```
 
+mod cast;
 mod grid;
 mod leaves;
 mod model;
@@ -27,6 +28,7 @@ mod plane;
 mod traverse;
 mod update;
 
+pub use cast::CastEnd;
 pub use grid::{MapGrid, CENTRE_KEY, MAP_LEVEL};
 pub use leaves::{tree_from_leaves, Leaf};
 pub use model::{log_odds, probability, SensorModel};

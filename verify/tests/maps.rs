@@ -485,3 +485,65 @@ fn octomaps_building_map_reads_with_its_free_space() {
     assert_eq!(map.log_odds(), &theirs);
     assert!(map.free().voxel_count() > map.occupied().voxel_count());
 }
+
+#[test]
+fn ray_casts_on_a_map_stop_where_octomaps_cast_ray_stops() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(files) = octomap_program(dir.path(), "octomap_files") else {
+        return;
+    };
+    let mut map = OccupancyMap::<3>::new(0.1).unwrap();
+    for (points, origin) in &room_scans() {
+        map.insert(points, *origin, None).unwrap();
+    }
+    let ot = dir.path().join("room.ot");
+    let mut bytes = Vec::new();
+    ktree::io::write_ot_map(&mut bytes, &map).unwrap();
+    std::fs::write(&ot, &bytes).unwrap();
+    // Rays from points in and around the room in every direction.
+    let mut seed = 11u64;
+    let mut next = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let rays: Vec<([f32; 3], [f32; 3])> = (0..1500)
+        .map(|_| {
+            let o = [next() * 7.0 - 0.5, next() * 5.0 - 0.5, next() * 3.0];
+            let d = [next() - 0.5, next() - 0.5, next() - 0.5];
+            (o, d)
+        })
+        .collect();
+    let text: String = rays
+        .iter()
+        .map(|(o, d)| format!("{} {} {} {} {} {}\n", o[0], o[1], o[2], d[0], d[1], d[2]))
+        .collect();
+    for (ignore, range) in [(false, -1.0), (true, 4.0), (false, 2.0)] {
+        let mut cmd = Command::new(&files);
+        cmd.arg("cast")
+            .arg(&ot)
+            .arg(if ignore { "1" } else { "0" })
+            .arg(range.to_string());
+        let out = run_with_input(&mut cmd, text.clone());
+        let mut kinds = HashSet::new();
+        for ((o, d), line) in rays.iter().zip(out.lines()) {
+            let f: Vec<u32> = line.split(' ').map(|s| s.parse().unwrap()).collect();
+            let end = map.cast_ray(*o, *d, ignore, range);
+            let (hit, key) = match end {
+                ktree::map::CastEnd::Occupied(k) => (1, Some(k)),
+                ktree::map::CastEnd::Unknown(k) | ktree::map::CastEnd::Range(k) => (0, Some(k)),
+                ktree::map::CastEnd::Outside => (0, None),
+            };
+            kinds.insert(std::mem::discriminant(&end));
+            assert_eq!(f[0], hit, "ray {o:?} {d:?}: {end:?}");
+            if let Some(k) = key {
+                assert_eq!(f[1..4], k, "ray {o:?} {d:?}: {end:?}");
+            }
+        }
+        assert!(
+            kinds.len() >= 2,
+            "rays of several outcomes ({ignore}, {range})"
+        );
+    }
+}

@@ -1,6 +1,8 @@
 // OctoMap's own readers and writers of map files, for verify/tests/maps.rs.
 //   octomap_files read FILE.ot|FILE.bt       prints "leaf kx ky kz side logodds_bits" per leaf (lowest keys,
 //                                            the log-odds' float bits in hex)
+//   octomap_files cast FILE.ot IGNORE MAXRANGE  reads rays "ox oy oz dx dy dz" from stdin and prints, per
+//                                            ray, castRay's result (1 or 0) and the key of its end point
 //   octomap_files write RES OUT.ot OUT.bt    reads scans from stdin as octomap_insert does, inserts each
 //                                            with OcTree::insertPointCloud and writes both files with
 //                                            OcTree::write and OcTree::writeBinary
@@ -43,6 +45,22 @@ int main(int argc, char** argv) {
       auto* tree = dynamic_cast<octomap::OcTree*>(read.get());
       if (!tree) return 1;
       print_leaves(*tree);
+    }
+    return 0;
+  }
+  if (mode == "cast" && argc >= 5) {
+    std::unique_ptr<octomap::AbstractOcTree> read(octomap::AbstractOcTree::read(argv[2]));
+    auto* tree = dynamic_cast<octomap::OcTree*>(read.get());
+    if (!tree) return 1;
+    const bool ignore = std::atoi(argv[3]) != 0;
+    const double maxrange = std::atof(argv[4]);
+    float o[3], d[3];
+    while (std::cin >> o[0] >> o[1] >> o[2] >> d[0] >> d[1] >> d[2]) {
+      octomap::point3d end(0, 0, 0);
+      const bool hit = tree->castRay(octomap::point3d(o[0], o[1], o[2]), octomap::point3d(d[0], d[1], d[2]), end,
+                                     ignore, maxrange);
+      const octomap::OcTreeKey k = tree->coordToKey(end);
+      std::cout << (hit ? 1 : 0) << " " << k[0] << " " << k[1] << " " << k[2] << "\n";
     }
     return 0;
   }

@@ -1,0 +1,111 @@
+//! Ray casts on a map, as OctoMap's `castRay`: from the voxel of the origin along a direction, voxel by
+//! voxel (its DDA, its `f32` and `f64` steps), until an occupied voxel (a hit), an unknown one (unless
+//! unknown voxels are passed through), the maximum range or the map's edge.
+
+use super::{OccupancyMap, VoxelState};
+use crate::map::traverse::norm;
+
+/// How a ray cast ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CastEnd {
+    /// The ray entered an occupied voxel (its keys).
+    Occupied([u32; 3]),
+    /// The ray entered an unknown voxel and unknown voxels stop rays (its keys).
+    Unknown([u32; 3]),
+    /// The ray went beyond the maximum range (the keys of the first voxel beyond it).
+    Range([u32; 3]),
+    /// The ray left the map, or its origin is outside it, or its direction is zero.
+    Outside,
+}
+
+impl OccupancyMap<3> {
+    /// Casts a ray from `origin` along `direction` (any length): OctoMap's `castRay(origin, direction,
+    /// end, ignore_unknown, max_range)` — a hit is [`CastEnd::Occupied`] (OctoMap returns true), the
+    /// others are OctoMap's false with its `end` at the voxel given. `max_range` ≤ 0 means none.
+    ///
+    /// ```
+    /// use ktree::map::{CastEnd, OccupancyMap};
+    /// let mut map = OccupancyMap::<3>::new(0.1).unwrap();
+    /// map.insert(&[[2.05, 0.05, 0.05]], [0.05, 0.05, 0.05], None).unwrap();
+    /// let key = map.grid().keys([2.05f32, 0.05, 0.05]).unwrap();
+    /// assert_eq!(map.cast_ray([0.05, 0.05, 0.05], [1.0, 0.0, 0.0], false, -1.0), CastEnd::Occupied(key));
+    /// // Sideways the first voxel is unknown.
+    /// assert!(matches!(map.cast_ray([0.05, 0.05, 0.05], [0.0, 1.0, 0.0], false, -1.0), CastEnd::Unknown(_)));
+    /// ```
+    pub fn cast_ray(
+        &self,
+        origin: [f32; 3],
+        direction: [f32; 3],
+        ignore_unknown: bool,
+        max_range: f64,
+    ) -> CastEnd {
+        let grid = *self.grid();
+        let Some(mut key) = grid.keys(origin) else {
+            return CastEnd::Outside;
+        };
+        let state = |k: [u32; 3]| self.state_of(self.log_odds().value_at(k));
+        match state(key) {
+            VoxelState::Occupied => return CastEnd::Occupied(key),
+            VoxelState::Unknown if !ignore_unknown => return CastEnd::Unknown(key),
+            _ => {}
+        }
+        // OctoMap's normalized(): the norm in f64, the division in f32.
+        let len = norm(direction);
+        let mut d = direction;
+        if len > 0.0 {
+            for c in &mut d {
+                *c /= len as f32;
+            }
+        }
+        let resolution = grid.resolution();
+        let mut step = [0i32; 3];
+        let mut t_max = [f64::MAX; 3];
+        let mut t_delta = [f64::MAX; 3];
+        for i in 0..3 {
+            if d[i] > 0.0 {
+                step[i] = 1;
+            } else if d[i] < 0.0 {
+                step[i] = -1;
+            }
+            if step[i] != 0 {
+                let border = grid.centre(key[i]) + f64::from(step[i]) * resolution * 0.5;
+                t_max[i] = (border - f64::from(origin[i])) / f64::from(d[i]);
+                t_delta[i] = resolution / f64::from(d[i]).abs();
+            }
+        }
+        if step == [0; 3] {
+            return CastEnd::Outside;
+        }
+        let range_sq = max_range * max_range;
+        let last = (1u32 << super::MAP_LEVEL) - 1;
+        loop {
+            let mut dim = 0;
+            for i in 1..3 {
+                if t_max[i] <= t_max[dim] {
+                    dim = i;
+                }
+            }
+            if (step[dim] < 0 && key[dim] == 0) || (step[dim] > 0 && key[dim] == last) {
+                return CastEnd::Outside;
+            }
+            key[dim] = (key[dim] as i32 + step[dim]) as u32;
+            t_max[dim] += t_delta[dim];
+            if max_range > 0.0 {
+                // OctoMap: the voxel's centre as a float point, its squared distance summed in f64.
+                let mut sq = 0.0f64;
+                for j in 0..3 {
+                    let e = grid.centre(key[j]) as f32 - origin[j];
+                    sq += f64::from(e * e);
+                }
+                if sq > range_sq {
+                    return CastEnd::Range(key);
+                }
+            }
+            match state(key) {
+                VoxelState::Occupied => return CastEnd::Occupied(key),
+                VoxelState::Unknown if !ignore_unknown => return CastEnd::Unknown(key),
+                _ => {}
+            }
+        }
+    }
+}
