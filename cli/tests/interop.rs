@@ -22,28 +22,8 @@ use ktree::{KTree, NodeState};
 /// # Panics
 /// If it does not build with both there.
 fn octomap_check(dir: &Path) -> Option<PathBuf> {
-    let compiler = tools::require(&["g++"], "install g++")?;
-    if !tools::require_file(
-        Path::new("/usr/include/octomap/octomap.h"),
-        "install Debian's liboctomap-dev (OctoMap's headers and library)",
-    ) {
-        return None;
-    }
-    let exe = dir.join("octomap_check");
-    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/interop/octomap_check.cpp");
-    let built = Command::new(compiler)
-        .args(["-O1", "-o"])
-        .arg(&exe)
-        .arg(&src)
-        .args(["-loctomap", "-loctomath"])
-        .output()
-        .unwrap();
-    assert!(
-        built.status.success(),
-        "octomap_check does not build: {}",
-        String::from_utf8_lossy(&built.stderr)
-    );
-    Some(exe)
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/interop/octomap_check.cpp");
+    tools::build_octomap_program(dir, &src)
 }
 
 /// The occupied (`"leaf"`) or free leaves OctoMap reads from a file: (grid index of the corner, side).

@@ -49,11 +49,9 @@ impl OccupancyMap<3> {
             return Err(format!("the range {lo}:{hi} is not LO:HI with LO ≤ HI"));
         }
         let grid = self.grid();
-        let side = 1i64 << super::MAP_LEVEL;
-        let key = |c: f64| {
-            ((c / grid.resolution()).floor() + f64::from(super::CENTRE_KEY))
-                .clamp(0.0, (side - 1) as f64) as u32
-        };
+        let side = 1u32 << super::MAP_LEVEL;
+        // The map's key of a coordinate, the nearest edge of the map beyond it.
+        let key = |c: f64| grid.key(c).unwrap_or(if c < 0.0 { 0 } else { side - 1 });
         let (k0, k1) = (key(lo), key(hi));
         let keys = k0..k1 + 1;
         let occupied: KTree<2> =

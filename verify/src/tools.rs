@@ -75,6 +75,37 @@ pub fn require(names: &[&str], install: &str) -> Option<PathBuf> {
     found
 }
 
+/// Builds the C++ program `source` against the installed OctoMap (liboctomap, liboctomath) into
+/// `dir`, named as the source's stem; `None` after [`missing`] without `g++` or OctoMap's headers.
+///
+/// # Panics
+/// If the program does not build with both there (with the compiler's messages).
+#[track_caller]
+pub fn build_octomap_program(dir: &Path, source: &Path) -> Option<PathBuf> {
+    let compiler = require(&["g++"], "install g++")?;
+    if !require_file(
+        Path::new("/usr/include/octomap/octomap.h"),
+        "install Debian's liboctomap-dev (OctoMap's headers and library)",
+    ) {
+        return None;
+    }
+    let exe = dir.join(source.file_stem().expect("a source file"));
+    let built = std::process::Command::new(compiler)
+        .args(["-O2", "-o"])
+        .arg(&exe)
+        .arg(source)
+        .args(["-loctomap", "-loctomath"])
+        .output()
+        .expect("g++ runs");
+    assert!(
+        built.status.success(),
+        "{} does not build: {}",
+        source.display(),
+        String::from_utf8_lossy(&built.stderr)
+    );
+    Some(exe)
+}
+
 /// Whether the file `path` (a library's header, say) exists; `false` after [`missing`] with `install`.
 #[track_caller]
 pub fn require_file(path: &Path, install: &str) -> bool {

@@ -219,24 +219,8 @@ fn octomap_insert(dir: &Path) -> Option<PathBuf> {
 
 /// Builds the checker `name` (`tests/maps/NAME.cpp`) against the installed OctoMap into `dir`.
 fn octomap_program(dir: &Path, name: &str) -> Option<PathBuf> {
-    let compiler = tools::require(&["g++"], "install g++")?;
-    if !tools::require_file(
-        Path::new("/usr/include/octomap/octomap.h"),
-        "install Debian's liboctomap-dev (OctoMap's headers and library)",
-    ) {
-        return None;
-    }
-    let exe = dir.join(name);
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/maps/{name}.cpp"));
-    let built = Command::new(compiler)
-        .args(["-O2", "-o"])
-        .arg(&exe)
-        .arg(&src)
-        .args(["-loctomap", "-loctomath"])
-        .status()
-        .expect("g++ runs");
-    assert!(built.success(), "{name} does not build");
-    Some(exe)
+    tools::build_octomap_program(dir, &src)
 }
 
 /// OctoMap's map of `scans` (each its points and origin) as a valued tree at OctoMap's keys.

@@ -24,24 +24,8 @@ fn spherical_scan() -> PathBuf {
 /// Builds `octomap_scans` against the installed OctoMap into `dir`; `None` after [`tools::missing`]
 /// without `g++` or OctoMap's headers.
 fn octomap_scans(dir: &Path) -> Option<PathBuf> {
-    let compiler = tools::require(&["g++"], "install g++")?;
-    if !tools::require_file(
-        Path::new("/usr/include/octomap/octomap.h"),
-        "install Debian's liboctomap-dev (OctoMap's headers and library)",
-    ) {
-        return None;
-    }
-    let exe = dir.join("octomap_scans");
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/maps/octomap_scans.cpp");
-    let built = Command::new(compiler)
-        .args(["-O2", "-o"])
-        .arg(&exe)
-        .arg(&src)
-        .args(["-loctomap", "-loctomath"])
-        .status()
-        .expect("g++ runs");
-    assert!(built.success(), "octomap_scans does not build");
-    Some(exe)
+    tools::build_octomap_program(dir, &src)
 }
 
 /// Runs `exe` with `args`, `input` on its standard input; its standard output.

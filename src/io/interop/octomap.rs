@@ -148,7 +148,9 @@ pub fn read_bt(
 }
 
 /// Parses the header as OctoMap does (`readHeader`): returns `size`, `res` and the first data byte.
-fn read_header(bytes: &[u8], file: &str) -> Result<(u64, f64, usize), GridFileError> {
+/// Reads a `.bt` file's header: its node count, resolution and where its data start, the count checked
+/// against the bytes that follow.
+pub(super) fn read_header(bytes: &[u8], file: &str) -> Result<(u64, f64, usize), GridFileError> {
     let (_, size, res, at) = read_octomap_header(bytes, file, BT_HEADER, &["OcTree", "1"])?;
     // Every node but the root is two bits of an inner node's two bytes: at most 8 per 2 bytes.
     let room = (bytes.len() - at) as u64 / 2 * 8 + 1;

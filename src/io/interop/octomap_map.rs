@@ -16,7 +16,7 @@
 use std::io::Write;
 
 use super::grid::{GridFileError, GridFileErrorKind};
-use super::octomap::{read_octomap_header, BT_DEPTH, BT_HEADER};
+use super::octomap::{read_header, read_octomap_header, BT_DEPTH, BT_HEADER};
 use crate::map::{tree_from_leaves, Leaf, MapGrid, OccupancyMap, SensorModel, MAP_LEVEL};
 use crate::space::morton_encode;
 use crate::tree::top_down::InputNode;
@@ -117,17 +117,7 @@ pub fn read_bt_map(
     model: SensorModel,
 ) -> Result<OccupancyMap<3>, GridFileError> {
     let fail = |at: usize, kind| GridFileError::new(file, at, kind);
-    let (_, size, res, data_at) = read_octomap_header(bytes, file, BT_HEADER, &["OcTree", "1"])?;
-    let room = (bytes.len() - data_at) as u64 / 2 * 8 + 1;
-    if size > room {
-        return Err(fail(
-            bytes.len(),
-            GridFileErrorKind::Truncated(format!(
-                "{size} nodes cannot fit in {} data bytes",
-                bytes.len() - data_at
-            )),
-        ));
-    }
+    let (size, res, data_at) = read_header(bytes, file)?;
     let mut leaves: Vec<Leaf<f32>> = Vec::new();
     let mut at = data_at;
     let mut nodes = 0u64;
