@@ -22,6 +22,7 @@
 
 mod cast;
 mod grid;
+mod history;
 mod leaves;
 mod model;
 mod plane;
@@ -30,6 +31,7 @@ mod update;
 
 pub use cast::CastEnd;
 pub use grid::{MapGrid, CENTRE_KEY, MAP_LEVEL};
+pub use history::{state_labels, HistoryRecorder, MapHistory, FREE, MAX_STEPS, OCCUPIED};
 pub use leaves::{tree_from_leaves, Leaf};
 pub use model::{log_odds, probability, SensorModel};
 pub use plane::MapPlane;
@@ -193,6 +195,28 @@ impl<const K: usize> OccupancyMap<K> {
     pub fn free(&self) -> KTree<K> {
         let model = self.model;
         infallible(select_where(&self.log_odds, move |l| !model.is_occupied(l)))
+    }
+
+    /// This map with its observed voxels inside `voxels` made free (their log-odds the model's lower
+    /// clamp): the map without what moved ([`MapHistory::moved`]), for instance.
+    ///
+    /// # Errors
+    /// A message if `voxels` is not a tree of the map's level.
+    pub fn cleared(&self, voxels: &KTree<K>) -> Result<Self, String> {
+        if voxels.level() != MAP_LEVEL {
+            return Err(format!(
+                "a map's voxels are a tree of level {MAP_LEVEL}, not {}",
+                voxels.level()
+            ));
+        }
+        let floor = self.model.clamp_min;
+        let free = self
+            .log_odds
+            .mask(voxels)
+            .map_values(|_| Some(floor))
+            .map_err(|e| e.to_string())?;
+        let log_odds = self.log_odds.overlay(&free).map_err(|e| e.to_string())?;
+        Ok(Self { log_odds, ..*self })
     }
 
     /// The unknown voxels (never observed).

@@ -1,7 +1,8 @@
 //! A `K`-tree seen in `K − 1` dimensions: the **slice** at one position along an axis, and the
 //! **projection** along an axis over a range of positions (the union of the slices in the range) — an
 //! octree's floor plan between two heights, a 4-D history's 3-D map at one time or over a span of times.
-//! The remaining axes keep their order.
+//! The remaining axes keep their order. Its inverse, the **extrusion**, stretches a `K − 1`-tree over a
+//! range of positions along a new axis (a 3-D region held over a span of times).
 //!
 //! One walk of the tree skips every subtree outside the range; the full leaves inside it, their cells
 //! with the axis dropped, are nested or disjoint (they are cells of one grid), so the union is the
@@ -25,6 +26,10 @@
 //! // The slice at x = 0 (axis 0): the column of y.
 //! let column: KTree<1> = slice(&tree, 0, 0).unwrap();
 //! assert_eq!(column.to_dense().unwrap(), [true, true, true, false]);
+//! // That column held at x = 1..=2: an extrusion along a new axis 0.
+//! let held: KTree<2> = ktree::ops::extrude(&column, 0, 1..3).unwrap();
+//! assert_eq!(slice::<2, 1, _>(&held, 0, 2).unwrap(), column);
+//! assert!(slice::<2, 1, _>(&held, 0, 0).unwrap().is_empty());
 //! ```
 
 use std::ops::Range;
@@ -33,6 +38,9 @@ use super::OpsError;
 use crate::space::{Cell, Universe};
 use crate::tree::cursor::{try_walk, Visitor, Walk};
 use crate::tree::storage::TreeStorage;
+use crate::tree::top_down::{build_top_down, Decision, InputNode};
+use crate::tree::valued::ValueState;
+use crate::tree::TreeError;
 use crate::tree::{DimensionMismatch, KTree, NodeRef, NodeState};
 
 /// The `J = K − 1`-dimensional tree of the voxels of `tree` at `position` along `axis`.
@@ -135,6 +143,73 @@ pub fn project<const K: usize, const J: usize, T: TreeStorage<K>>(
         outer.push(c);
     }
     Ok(KTree::from_sorted_cells(universe, &maximal(outer)))
+}
+
+/// The `K = J + 1`-dimensional tree of the voxels whose coordinate along `axis` lies in `range` (clipped
+/// to the universe) and whose other coordinates, in order, are a full voxel of `tree`: `tree` held over
+/// the range. Its projection over the range gives `tree` back (for a range that is not empty).
+///
+/// # Errors
+/// [`OpsError::BadAxis`] for an axis not below `K`; [`OpsError::DimensionMismatch`] unless `J + 1 = K`;
+/// [`OpsError::LevelTooLarge`] for a level `K` dimensions cannot have; [`OpsError::Storage`] for a failed
+/// read.
+pub fn extrude<const J: usize, const K: usize, T: TreeStorage<J>>(
+    tree: &T,
+    axis: usize,
+    range: Range<u32>,
+) -> Result<KTree<K>, OpsError> {
+    if J + 1 != K {
+        return Err(OpsError::DimensionMismatch(DimensionMismatch {
+            expected: J + 1,
+            found: K,
+        }));
+    }
+    if axis >= K {
+        return Err(OpsError::BadAxis { axis, k: K });
+    }
+    let level = tree.level();
+    Universe::<K>::new(level).map_err(|_| OpsError::LevelTooLarge {
+        k: K,
+        level,
+        max: crate::max_level(K),
+    })?;
+    enum Failure<E> {
+        Read(E),
+        Tree(TreeError),
+    }
+    impl<E> From<TreeError> for Failure<E> {
+        fn from(e: TreeError) -> Self {
+            Failure::Tree(e)
+        }
+    }
+    let (lo, hi) = (u64::from(range.start), u64::from(range.end));
+    // The child of a K-cell without its bit along `axis` is the child of the J-cell it stands on.
+    let low_bits = (1usize << axis) - 1;
+    let built = build_top_down::<K, (), _, Failure<T::Error>>(
+        level,
+        InputNode::binary_root(tree).map_err(OpsError::storage)?,
+        |cell: &Cell<K>, node: &InputNode<()>| {
+            let o = u64::from(cell.origin[axis]);
+            let end = o + cell.side();
+            if o >= hi || end <= lo {
+                return Ok(Decision::Leaf(None));
+            }
+            Ok(match node.state {
+                ValueState::Empty => Decision::Leaf(None),
+                ValueState::Full(()) if lo <= o && end <= hi => Decision::Leaf(Some(())),
+                _ => Decision::Split,
+            })
+        },
+        |node, code| {
+            let lower = (code & low_bits) | ((code >> (axis + 1)) << axis);
+            node.binary_child(tree, lower).map_err(Failure::Read)
+        },
+    );
+    built.map_err(|e| match e {
+        Failure::Read(e) => OpsError::storage(e),
+        // Its level was checked, it splits no voxel and holds no value.
+        Failure::Tree(e) => unreachable!("an extrusion is a valid tree: {e}"),
+    })
 }
 
 /// Joins every complete block of `2^J` sibling cells into their parent, repeatedly. `cells` must be

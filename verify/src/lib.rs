@@ -9,6 +9,7 @@ pub mod cases;
 mod config;
 pub mod labels;
 pub mod objects;
+pub mod scenes;
 pub mod sparse;
 pub mod tools;
 

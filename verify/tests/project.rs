@@ -1,8 +1,10 @@
 //! Slices and projections (`ops::slice`, `ops::project`) against the dense reference, K = 2, 3, 4: the
 //! projection along each axis over random ranges is the "any full voxel in the range" of the dense array,
-//! the slice its row at one position; the trees are reduced; a mapped file gives the same trees.
+//! the slice its row at one position; the trees are reduced; a mapped file gives the same trees. The
+//! extrusion (`ops::extrude`) of a J-tree along a new axis over a range is the dense array held there, and
+//! projects back to the tree.
 
-use ktree::ops::{project, slice};
+use ktree::ops::{extrude, project, slice};
 use ktree::KTree;
 use ktree_verify::objects::{obj_at, Obj};
 use proptest::prelude::*;
@@ -43,8 +45,49 @@ fn check<const K: usize, const J: usize>(
     Ok(())
 }
 
+fn check_extrude<const J: usize, const K: usize>(
+    o: &Obj<J>,
+    axis: usize,
+    lo: u32,
+    len: u32,
+) -> Result<(), TestCaseError> {
+    let tree = o.tree();
+    let dense = o.dense();
+    let side = o.universe().side() as u32;
+    let axis = axis % K;
+    let lo = lo % side;
+    let hi = lo + len; // past the universe's end too: clipped
+    let got: KTree<K> = extrude(&tree, axis, lo..hi).unwrap();
+    got.assert_well_formed();
+    let u = ktree::space::Universe::<K>::new(o.level).unwrap();
+    let want: Vec<bool> = (0..u.voxels() as usize)
+        .map(|i| {
+            let p = u.dense_point(i);
+            let q: [u32; J] = std::array::from_fn(|a| p[if a < axis { a } else { a + 1 }]);
+            (lo..hi).contains(&p[axis]) && dense[o.universe().dense_index(q)]
+        })
+        .collect();
+    prop_assert_eq!(got.to_dense().unwrap(), want);
+    if lo < hi {
+        prop_assert_eq!(project::<K, J, _>(&got, axis, 0..side).unwrap(), tree);
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ktree_verify::config(64))]
+    #[test]
+    fn extrude_k1_to_k2(o in (0u32..=5).prop_flat_map(obj_at::<1>), axis in 0usize..2, lo in 0u32..64, len in 0u32..40) {
+        check_extrude::<1, 2>(&o, axis, lo, len)?;
+    }
+    #[test]
+    fn extrude_k2_to_k3(o in (0u32..=4).prop_flat_map(obj_at::<2>), axis in 0usize..3, lo in 0u32..16, len in 0u32..20) {
+        check_extrude::<2, 3>(&o, axis, lo, len)?;
+    }
+    #[test]
+    fn extrude_k3_to_k4(o in (0u32..=3).prop_flat_map(obj_at::<3>), axis in 0usize..4, lo in 0u32..8, len in 0u32..10) {
+        check_extrude::<3, 4>(&o, axis, lo, len)?;
+    }
     #[test]
     fn project_k2(o in (0u32..=5).prop_flat_map(obj_at::<2>), axis in 0usize..2, lo in 0u32..64, len in 0u32..40) {
         check::<2, 1>(&o, axis, lo, len)?;
