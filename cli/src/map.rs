@@ -1,6 +1,7 @@
 //! `ktree map SCANS… --resolution R [--max-range M] [--sensor-origin X,Y,Z | --pose X,Y,Z,ROLL,PITCH,YAW]
-//! --out MAP.ot|.bt|.ktree`: an occupancy map from range scans, integrated as OctoMap's
-//! `insertPointCloud` integrates them; and the map branch of `ktree project` (a map's plane between two
+//! --out MAP.ot|.bt|.ktree [--history HISTORY.ktree] [--static-map MAP]`: an occupancy map from range scans,
+//! integrated as OctoMap's `insertPointCloud` integrates them, with its history as a 4-D tree and the
+//! map without what moved; and the map branch of `ktree project` (a map's plane between two
 //! heights, as a ROS map or a quadtree).
 
 use std::path::{Path, PathBuf};
@@ -12,7 +13,7 @@ use ktree::io::scan::{read_scan_directory, read_scans, Pose, Scan, ScanNode};
 use ktree::io::{
     read_bt_map, read_cloud, read_cloud_bytes, read_ot_map, write_bt_map, write_ot_map,
 };
-use ktree::map::{OccupancyMap, SensorModel};
+use ktree::map::{HistoryRecorder, OccupancyMap, SensorModel};
 
 use crate::common::error::{CliError, CliResult};
 use crate::common::vector::vector;
@@ -44,6 +45,17 @@ pub struct MapArgs {
     /// .ktree (the log-odds as a float32 tree at the map's keys; the resolution is not kept).
     #[arg(long)]
     out: PathBuf,
+    /// Also write the map's history: a 4-D tree (.ktree, uint8) with time as its fourth axis, one position
+    /// a step, recording where and when each voxel became free (1) or occupied (2).
+    #[arg(long, value_name = "HISTORY.ktree")]
+    history: Option<PathBuf>,
+    /// Scans a step of the history (the last step may hold fewer).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    scans_per_step: u32,
+    /// Also write the static map (.ot, .bt or .ktree): the map with every voxel that was occupied at some
+    /// step and observed free at another made free — moving objects and their trails removed.
+    #[arg(long, value_name = "MAP")]
+    static_map: Option<PathBuf>,
     /// The probability a hit gives.
     #[arg(long, default_value_t = 0.7)]
     prob_hit: f64,
@@ -123,12 +135,23 @@ pub fn run_map(a: MapArgs) -> CliResult {
         return Err(format!("--max-range {m}: expected a positive number").into());
     }
     let kind = map_kind(&a.out)?;
+    let static_kind = a.static_map.as_deref().map(map_kind).transpose()?;
+    if let Some(h) = a.history.as_deref() {
+        if !h
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ktree"))
+        {
+            return Err(format!("{}: a history is written as .ktree", h.display()).into());
+        }
+    }
     let mut map = OccupancyMap::<3>::with_model(a.resolution, model)
         .map_err(|e| format!("--resolution/probabilities: {e}"))?;
     let origin = a.sensor_origin.map(|c| c as f32);
     let pose = a
         .pose
         .map(|[x, y, z, r, p, w]| Pose::from_xyz_rpy(x as f32, y as f32, z as f32, r, p, w));
+    let keep_history = a.history.is_some() || a.static_map.is_some();
+    let mut recorder = keep_history.then(|| HistoryRecorder::new(*map.grid()));
     let (mut scans, mut points, mut outside, mut seconds) = (0usize, 0usize, 0usize, 0.0f64);
     for argument in &a.scans {
         for scan in read_argument(argument, origin, pose)? {
@@ -140,9 +163,47 @@ pub fn run_map(a: MapArgs) -> CliResult {
             scans += 1;
             points += scan.points.len();
             outside += update.rays_outside;
+            if let Some(r) = recorder
+                .as_mut()
+                .filter(|_| scans % a.scans_per_step as usize == 0)
+            {
+                r.record(&map)
+                    .map_err(|e| format!("{}: {e}", argument.display()))?;
+            }
         }
     }
+    if let Some(r) = recorder
+        .as_mut()
+        .filter(|_| scans % a.scans_per_step as usize != 0)
+    {
+        r.record(&map)?;
+    }
     write_map(&a.out, kind, &map)?;
+    if let Some(recorder) = recorder {
+        let history = recorder.finish();
+        let moved = history.moved();
+        if let Some(path) = &a.history {
+            ktree::io::ktree::v3::write_valued_ktree_file(path, history.tree())
+                .map_err(CliError::caused)?;
+            outln!(
+                "{}: the history of {} steps as a 4-D tree of {} nodes (the map: {} nodes)",
+                path.display(),
+                history.steps(),
+                history.tree().node_count(),
+                map.log_odds().node_count()
+            );
+        }
+        if let (Some(path), Some(kind)) = (&a.static_map, static_kind) {
+            let still = map.cleared(&moved)?;
+            write_map(path, kind, &still)?;
+            outln!(
+                "{}: the static map: {} occupied voxels; {} voxels were occupied at some step and free at another",
+                path.display(),
+                still.occupied().voxel_count(),
+                moved.voxel_count()
+            );
+        }
+    }
     outln!(
         "{}: {scans} scans, {points} points integrated in {seconds:.3} s; {} occupied, {} free voxels of {} m",
         a.out.display(),

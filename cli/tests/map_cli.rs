@@ -377,3 +377,65 @@ fn ray_casts_on_a_map_report_where_they_end() {
     ]);
     assert!(!ok && err.contains("--max-range"), "{err}");
 }
+
+#[test]
+fn a_maps_history_and_static_map_are_written_beside_it() {
+    use ktree::map::{state_labels, HistoryRecorder, MapHistory};
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    std::fs::create_dir(dir.path().join("scans")).unwrap();
+    let scene = ktree_verify::scenes::WalkingPerson::new(10);
+    let mut expected = OccupancyMap::<3>::new(0.1).unwrap();
+    let mut recorder = HistoryRecorder::new(*expected.grid());
+    for t in 0..scene.steps {
+        let scan = scene.scan(t, 180, 32);
+        write_xyz(&dir.path().join(format!("scans/{t:02}.xyz")), &scan.points);
+        expected.insert(&scan.points, scan.origin, None).unwrap();
+        if t % 2 == 1 {
+            recorder.record(&expected).unwrap();
+        }
+    }
+    let origin = scene.sensor.map(|c| (c as f32).to_string()).join(",");
+    let text = run(&[
+        "map",
+        &s("scans"),
+        "--resolution",
+        "0.1",
+        "--sensor-origin",
+        &origin,
+        "--out",
+        &s("room.ot"),
+        "--history",
+        &s("history.ktree"),
+        "--scans-per-step",
+        "2",
+        "--static-map",
+        &s("static.bt"),
+    ]);
+    assert!(text.contains("the history of 5 steps"), "{text}");
+    let history = recorder.finish();
+    let file =
+        ktree::io::ktree::v3::read_valued_ktree_file::<4, u8>(&dir.path().join("history.ktree"))
+            .unwrap();
+    let read = MapHistory::from_tree(*expected.grid(), file, Some(5)).unwrap();
+    assert_eq!(read, history);
+    assert_eq!(read.at(4).unwrap(), state_labels(&expected));
+    let bytes = std::fs::read(s("static.bt")).unwrap();
+    let still = read_bt_map(&bytes, "static.bt", SensorModel::default()).unwrap();
+    let want = expected.cleared(&history.moved()).unwrap();
+    assert_eq!(still.occupied(), want.occupied());
+    assert!(history.moved().voxel_count() > 0);
+    // A history is a .ktree file.
+    let (ok, _, err) = ktree(&[
+        "map",
+        &s("scans/00.xyz"),
+        "--resolution",
+        "0.1",
+        "--out",
+        &s("m.ot"),
+        "--history",
+        &s("h.ot"),
+    ]);
+    assert!(!ok);
+    assert!(err.contains("a history is written as .ktree"), "{err}");
+}
