@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
-__all__ = ["OccupancyMap", "RayHits", "Tree", "__version__"]
+__all__ = ["MapHistory", "OccupancyMap", "RayHits", "Tree", "__version__"]
 
 _Path = Union[str, PathLike[str]]
 _View = Union[str, Sequence[float]]
@@ -315,6 +315,29 @@ class Tree:
     def __hash__(self) -> int: ...
 
 @final
+class MapHistory:
+    """A 3-D map's history as one 4-D tree: time is the fourth axis, one position a step, and voxel
+    (x, y, z, t) holds the state key (x, y, z) took at step t (OccupancyMap.FREE or OCCUPIED) where it
+    changed; empty where nothing changed."""
+
+    @property
+    def steps(self) -> int:
+        """The number of steps."""
+    @property
+    def tree(self) -> Tree:
+        """The 4-D tree with uint8 values (level 16, at the map's keys and steps)."""
+    def at(self, step: int) -> Tree:
+        """The map's states after a step: a 3-D tree with uint8 values FREE and OCCUPIED."""
+    def static_map(self) -> Tree:
+        """The voxels occupied at some step and never observed free."""
+    def moved(self) -> Tree:
+        """The voxels occupied at some step and observed free at another."""
+    def dynamic(self) -> Tree:
+        """Where and when voxels that are free at some step became occupied, as a 4-D tree."""
+    def save(self, path: _Path) -> None:
+        """Writes the 4-D tree as a .ktree file (uint8), atomically."""
+
+@final
 class OccupancyMap:
     """An occupancy map of dimension 2 or 3 from range scans, with OctoMap's semantics: voxels of side
     `resolution` keyed as OctoMap keys them (2**16 a side; key k along an axis covers world coordinates
@@ -334,8 +357,12 @@ class OccupancyMap:
         clamp_min: float = 0.1192,
         clamp_max: float = 0.971,
         occupancy: float = 0.5,
+        history: bool = False,
     ) -> OccupancyMap:
-        """An empty map; the sensor model's probabilities default to OctoMap's."""
+        """An empty map; the sensor model's probabilities default to OctoMap's. With `history=True` (3-D
+        maps) the state after each `insert` is kept as a step of `history()`."""
+    def history(self) -> MapHistory:
+        """The map's history (a map made with history=True): one step for each insert so far."""
     def insert(
         self, points: npt.ArrayLike, origin: Sequence[float], max_range: Optional[float] = None
     ) -> int:

@@ -167,6 +167,7 @@ impl Tree {
 fn ktree_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Tree>()?;
     m.add_class::<map::OccupancyMapPy>()?;
+    m.add_class::<map::MapHistoryPy>()?;
     // What `Tree.cast_rays` returns.
     let fields = ["hit", "voxel", "t", "axis", "sign"];
     let hits = m

@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use ktree::io::{read_bt_map, read_ot_map, write_bt_map, write_ot_map};
-use ktree::map::{probability, OccupancyMap, SensorModel, VoxelState};
+use ktree::map::{probability, HistoryRecorder, MapHistory, OccupancyMap, SensorModel, VoxelState};
 use ktree::{AnyTree, AnyValuedTree};
 use numpy::ndarray::Array2;
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLikeDyn};
@@ -96,6 +96,8 @@ fn coordinates<const K: usize>(values: &[f64], what: &str) -> Result<[f32; K], F
 #[pyclass(name = "OccupancyMap", module = "ktree")]
 pub(crate) struct OccupancyMapPy {
     map: AnyMap,
+    /// The steps recorded, for a map made with `history=True`.
+    recorder: Option<HistoryRecorder>,
 }
 
 impl OccupancyMapPy {
@@ -120,8 +122,12 @@ impl OccupancyMapPy {
     /// An empty map (every voxel unknown) of dimension `dim` (2 or 3) and voxels of side `resolution`,
     /// with a sensor model given by probabilities (OctoMap's defaults): of a hit, of a miss, the clamps
     /// of a voxel's probability, and the probability from which a voxel is occupied.
+    ///
+    /// With `history=True` (3-D maps), the map's state after each `insert` is kept as a step of its
+    /// history (`history()`).
     #[new]
-    #[pyo3(signature = (resolution, dim = 3, prob_hit = 0.7, prob_miss = 0.4, clamp_min = 0.1192, clamp_max = 0.971, occupancy = 0.5))]
+    #[pyo3(signature = (resolution, dim = 3, prob_hit = 0.7, prob_miss = 0.4, clamp_min = 0.1192, clamp_max = 0.971, occupancy = 0.5, history = false))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         resolution: f64,
         dim: usize,
@@ -130,6 +136,7 @@ impl OccupancyMapPy {
         clamp_min: f64,
         clamp_max: f64,
         occupancy: f64,
+        history: bool,
     ) -> PyResult<Self> {
         let model =
             SensorModel::from_probabilities(prob_hit, prob_miss, clamp_min, clamp_max, occupancy);
@@ -144,7 +151,17 @@ impl OccupancyMapPy {
                 .into())
             }
         };
-        Ok(Self { map })
+        let recorder = match (&map, history) {
+            (_, false) => None,
+            (AnyMap::D3(m), true) => Some(HistoryRecorder::new(*m.grid())),
+            (AnyMap::D2(_), true) => {
+                return Err(Failure::Value(
+                    "a history is kept of 3-D maps (its time is the fourth axis)".into(),
+                )
+                .into())
+            }
+        };
+        Ok(Self { map, recorder })
     }
 
     /// Integrates one scan: `points` an (N, dim) array of world coordinates (float64 and other numbers
@@ -178,7 +195,21 @@ impl OccupancyMapPy {
                 .voxels
                 .len()
         });
+        if let (Some(recorder), AnyMap::D3(m)) = (self.recorder.as_mut(), &self.map) {
+            py.detach(|| recorder.record(m))
+                .map_err(|e| Failure::Value(format!("insert: {e}")))?;
+        }
         Ok(updated)
+    }
+
+    /// The map's history (a map made with `history=True`): one step for each `insert` so far.
+    fn history(&self, py: Python<'_>) -> PyResult<MapHistoryPy> {
+        let recorder = self.recorder.as_ref().ok_or_else(|| {
+            Failure::Value("history: this map keeps none (make it with history=True)".into())
+        })?;
+        Ok(MapHistoryPy {
+            history: py.detach(|| recorder.finish()),
+        })
     }
 
     /// The state of the voxels holding `points` (an (N, dim) array of world coordinates, converted to
@@ -312,6 +343,7 @@ impl OccupancyMapPy {
         })?;
         Ok(Self {
             map: AnyMap::D3(map),
+            recorder: None,
         })
     }
 
@@ -342,6 +374,71 @@ impl OccupancyMapPy {
             p(model.clamp_min),
             p(model.clamp_max),
             p(model.occupied),
+        )
+    }
+}
+
+/// A 3-D map's history as one 4-D tree (`tree`): time is the fourth axis, one position a step (an
+/// `insert`), and voxel (x, y, z, t) holds the state key (x, y, z) took at step t (`OccupancyMap.FREE` or
+/// `OccupancyMap.OCCUPIED`) where it changed; empty where nothing changed.
+#[pyclass(name = "MapHistory", module = "ktree", frozen)]
+pub(crate) struct MapHistoryPy {
+    history: MapHistory,
+}
+
+#[pymethods]
+impl MapHistoryPy {
+    /// The number of steps.
+    #[getter]
+    fn steps(&self) -> u32 {
+        self.history.steps()
+    }
+
+    /// The history as a 4-D tree with uint8 values (level 16, at the map's keys and steps).
+    #[getter]
+    fn tree(&self) -> Tree {
+        Tree::valued(AnyValuedTree::from(self.history.tree().clone()), 0.0)
+    }
+
+    /// The map's states after step `step`: a 3-D tree with uint8 values `FREE` and `OCCUPIED` (unknown
+    /// voxels empty).
+    fn at(&self, py: Python<'_>, step: u32) -> PyResult<Tree> {
+        let labels = py
+            .detach(|| self.history.at(step))
+            .map_err(|e| Failure::Value(format!("at: {e}")))?;
+        Ok(Tree::valued(AnyValuedTree::from(labels), 0.0))
+    }
+
+    /// The static map: the voxels occupied at some step and never observed free, as a 3-D tree.
+    fn static_map(&self, py: Python<'_>) -> Tree {
+        Tree::binary(AnyTree::from(py.detach(|| self.history.static_map())))
+    }
+
+    /// The voxels occupied at some step and observed free at another (moving objects and their
+    /// trails), as a 3-D tree.
+    fn moved(&self, py: Python<'_>) -> Tree {
+        Tree::binary(AnyTree::from(py.detach(|| self.history.moved())))
+    }
+
+    /// Where and when voxels that are free at some step became occupied, as a 4-D tree: what moved, by
+    /// one Boolean in 4-D.
+    fn dynamic(&self, py: Python<'_>) -> Tree {
+        Tree::binary(AnyTree::from(py.detach(|| self.history.dynamic())))
+    }
+
+    /// Writes the 4-D tree as a `.ktree` file (uint8), atomically.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        Ok(py.detach(|| {
+            ktree::io::ktree::v3::write_valued_ktree_file(&path, self.history.tree())
+                .map_err(|e| Failure::of_error(&e, &path))
+        })?)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "MapHistory(steps={}, nodes={})",
+            self.history.steps(),
+            self.history.tree().node_count()
         )
     }
 }

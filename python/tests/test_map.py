@@ -429,3 +429,39 @@ def test_save_and_load_through_octomaps_files(tmp_path):
         ktree.OccupancyMap.load(tmp_path / "bad.ot")
     with pytest.raises(OSError):
         ktree.OccupancyMap.load(tmp_path / "missing.ot")
+
+
+def test_a_history_gives_each_steps_states_and_separates_what_moved(tmp_path):
+    m = ktree.OccupancyMap(0.1, history=True)
+    origin = [0.05, 0.05, 0.05]
+    wall = [[1.05, 0.1 * y + 0.05, 0.05] for y in range(-3, 4)]
+    person = [[0.55, 0.05, 0.05]]
+    probes = np.array(wall + person + [[0.35, 0.05, 0.05], [-2.0, 0.0, 0.0]])
+    seen = []
+    for t in range(6):
+        m.insert(np.array(person if t == 0 else wall), origin)
+        seen.append(m.states(probes))
+    h = m.history()
+    assert h.steps == 6
+    keys = m.keys(probes)
+    for t, states in enumerate(seen):
+        assert np.array_equal(h.at(t).values(keys, background=0), states)
+    # Only the scans' points are ever occupied, and all of them are probes.
+    occupied = np.any(np.array(seen) == ktree.OccupancyMap.OCCUPIED, axis=0)
+    free = np.any(np.array(seen) == ktree.OccupancyMap.FREE, axis=0)
+    moved, still = h.moved(), h.static_map()
+    assert np.array_equal(moved.contains(keys), occupied & free)
+    assert np.array_equal(still.contains(keys), occupied & ~free)
+    assert moved.voxel_count == 1 and still.voxel_count == len(wall)
+    assert h.dynamic().k == 4 and h.tree.k == 4
+    h.save(tmp_path / "history.ktree")
+    assert ktree.Tree.load(tmp_path / "history.ktree") == h.tree
+    with pytest.raises(ValueError, match="step 6"):
+        h.at(6)
+
+
+def test_a_history_needs_a_3d_map_made_to_keep_it():
+    with pytest.raises(ValueError, match="history=True"):
+        ktree.OccupancyMap(0.1).history()
+    with pytest.raises(ValueError, match="3-D"):
+        ktree.OccupancyMap(0.1, dim=2, history=True)
