@@ -29,7 +29,7 @@
 //! // That column held at x = 1..=2: an extrusion along a new axis 0.
 //! let held: KTree<2> = ktree::ops::extrude(&column, 0, 1..3).unwrap();
 //! assert_eq!(slice::<2, 1, _>(&held, 0, 2).unwrap(), column);
-//! assert!(slice::<2, 1, _>(&held, 0, 0).unwrap().is_empty());
+//! assert_eq!(slice::<2, 1, _>(&held, 0, 0).unwrap().voxel_count(), 0);
 //! ```
 
 use std::ops::Range;
