@@ -1,11 +1,116 @@
 //! Occupancy-map integration timed, for experiments/maps.sh: `maps insert RES FILE REPEATS` reads a scan
 //! (`x y z` lines in world coordinates, sensor at the origin; OctoMap's `scan.dat`), integrates it into an
 //! empty map REPEATS times and prints the best time, the map's voxel counts and a checksum of its
-//! log-odds (to compare with OctoMap's), and the map's memory.
+//! log-odds (to compare with OctoMap's), and the map's memory. `maps lidar OUT.log SCANS` makes a sequence
+//! of synthetic 64-beam LiDAR scans (1 563 × 64 rays each) ray cast from poses along a loop through a
+//! room holding the meshes of `data/meshes` (voxelized at 2 cm), written as OctoMap's `.log`;
+//! `maps sequence RES FILE.log` integrates them one after the other and prints each scan's time and the
+//! map's size after it. `maps history STEPS RES` times the history of the walking-person scene.
 
 use std::time::Instant;
 
-use ktree::map::OccupancyMap;
+use ktree::map::{HistoryRecorder, OccupancyMap};
+use ktree::query::RayCast;
+use ktree::solid::mesh::MeshTransform;
+use ktree::{KTree, Ray, RaySet};
+
+/// The scene's voxel: 2 cm; its universe: 2^10 voxels a side, x and y centred on the world's origin, z
+/// from the floor's underside at 0.
+const SCENE_VOXEL: f64 = 0.02;
+const SCENE_LEVEL: u32 = 10;
+const SCENE_CENTRE: f64 = 512.0;
+
+/// The voxels of an axis-aligned box given in scene voxels `[lo, hi)`.
+fn box_rays(lo: [u32; 3], hi: [u32; 3]) -> Vec<Ray<3>> {
+    let mut rays = Vec::new();
+    for x in lo[0]..hi[0] {
+        for y in lo[1]..hi[1] {
+            rays.push(Ray::new([x, y, lo[2]], hi[2]));
+        }
+    }
+    rays
+}
+
+/// A room of 16 × 16 × 3 m (walls, floor and ceiling 10 cm thick) holding two copies of each mesh of
+/// `data/meshes` scaled to between 0.9 and 1.8 m and standing on the floor.
+fn scene() -> KTree<3> {
+    let metres = |m: f64| (m / SCENE_VOXEL).round() as u32;
+    let (lo, hi, top) = (metres(2.24), metres(18.24), metres(3.2));
+    let boxes = [
+        ([lo, lo, 0], [hi, hi, 5]), // floor: its top at z = 0.1 m
+        ([lo, lo, top - 5], [hi, hi, top]),
+        ([lo, lo, 0], [lo + 5, hi, top]),
+        ([hi - 5, lo, 0], [hi, hi, top]),
+        ([lo, lo, 0], [hi, lo + 5, top]),
+        ([lo, hi - 5, 0], [hi, hi, top]),
+    ];
+    let union = |a: &KTree<3>, b: &KTree<3>| (a | b).expect("trees of one level");
+    let mut tree = KTree::<3>::empty(SCENE_LEVEL).expect("a level");
+    for (lo, hi) in boxes {
+        let rays = RaySet::from_rays(SCENE_LEVEL, box_rays(lo, hi)).expect("a box's rays");
+        tree = union(&tree, &KTree::from(&rays));
+    }
+    let meshes = [("bunny_npm", 1.2), ("armadillo", 1.8), ("fandisk", 0.9)];
+    let places = [[-4.0, 3.0], [5.0, -2.5], [1.5, 5.5], [-3.5, -5.0], [6.0, 4.0], [-6.0, 0.5]];
+    for (i, (name, size)) in meshes.iter().enumerate() {
+        let path = format!("{}/../data/meshes/{name}.obj", env!("CARGO_MANIFEST_DIR"));
+        let mesh = ktree::io::read_mesh(std::path::Path::new(&path)).expect("a mesh of data/meshes");
+        let (mlo, mhi) = mesh.bounds().expect("vertices");
+        let extent = (0..3).map(|a| mhi[a] - mlo[a]).fold(0.0, f64::max);
+        let scale = size / SCENE_VOXEL / extent;
+        for place in &places[2 * i..2 * i + 2] {
+            let translate = [
+                SCENE_CENTRE + place[0] / SCENE_VOXEL - scale * (mlo[0] + mhi[0]) / 2.0,
+                SCENE_CENTRE + place[1] / SCENE_VOXEL - scale * (mlo[1] + mhi[1]) / 2.0,
+                5.0 - scale * mlo[2],
+            ];
+            let placed = MeshTransform { scale, translate };
+            let rays = mesh.to_rays(SCENE_LEVEL, &placed).expect("a placed mesh").rays;
+            tree = union(&tree, &KTree::from(&rays));
+        }
+    }
+    tree
+}
+
+/// Writes `scans` LiDAR scans of the scene as OctoMap's `.log`: the sensor 1.6 m above the floor on a loop
+/// of radius 3.5 m, 64 beams from 25° below to 15° above the horizon, 1 563 rays a beam.
+fn lidar(out: &str, scans: usize) {
+    let tree = scene();
+    let (beams, azimuths) = (64usize, 1563usize);
+    let mut text = String::new();
+    for s in 0..scans {
+        let angle = std::f64::consts::TAU * s as f64 / scans as f64;
+        let origin_m = [3.5 * angle.cos(), 3.5 * angle.sin(), 1.7];
+        let origin = [
+            SCENE_CENTRE + origin_m[0] / SCENE_VOXEL,
+            SCENE_CENTRE + origin_m[1] / SCENE_VOXEL,
+            origin_m[2] / SCENE_VOXEL,
+        ];
+        let mut casts = Vec::with_capacity(beams * azimuths);
+        for b in 0..beams {
+            let elevation = (-25.0 + 40.0 * b as f64 / (beams - 1) as f64).to_radians();
+            for a in 0..azimuths {
+                let azimuth = std::f64::consts::TAU * (a as f64 + 0.5) / azimuths as f64 + angle;
+                let d = [
+                    elevation.cos() * azimuth.cos(),
+                    elevation.cos() * azimuth.sin(),
+                    elevation.sin(),
+                ];
+                casts.push(RayCast::new(origin, d, 4096.0).expect("a finite ray"));
+            }
+        }
+        let hits = tree.cast_rays(&casts);
+        text += &format!("NODE {} {} {} 0 0 0\n", origin_m[0], origin_m[1], origin_m[2]);
+        for (cast, hit) in casts.iter().zip(&hits) {
+            let Some(hit) = hit else { continue };
+            let d = cast.direction();
+            // The hit in metres, relative to the sensor (the scan's frame: the world's axes).
+            let local: [f64; 3] = std::array::from_fn(|i| hit.t * d[i] * SCENE_VOXEL);
+            text += &format!("{} {} {}\n", local[0] as f32, local[1] as f32, local[2] as f32);
+        }
+    }
+    std::fs::write(out, text).unwrap_or_else(|e| panic!("{out}: {e}"));
+}
 
 fn read_scan(path: &str) -> Vec<[f32; 3]> {
     std::fs::read_to_string(path)
@@ -70,6 +175,63 @@ fn main() {
                 );
             }
         }
-        _ => eprintln!("usage: maps insert|phases RES FILE REPEATS"),
+        Some("lidar") => lidar(&args[2], args[3].parse().expect("scans")),
+        Some("sequence") => {
+            let res: f64 = args[2].parse().expect("resolution");
+            let path = std::path::Path::new(&args[3]);
+            let scans = ktree::io::scan::read_scans(path).expect("a .log of scans");
+            let mut map = OccupancyMap::<3>::new(res).unwrap();
+            let mut total = 0.0;
+            for (i, scan) in scans.iter().enumerate() {
+                let t = Instant::now();
+                map.insert(&scan.points, scan.origin, None).unwrap();
+                let s = t.elapsed().as_secs_f64();
+                total += s;
+                println!(
+                    "scan={i} points={} seconds={s:.6} nodes={}",
+                    scan.points.len(),
+                    map.log_odds().node_count()
+                );
+            }
+            let sum: f64 = map
+                .log_odds()
+                .value_leaves()
+                .filter_map(|(cell, v)| v.map(|v| f64::from(v) * (cell.side() as f64).powi(3)))
+                .sum();
+            println!("seconds={total:.6}");
+            println!("occupied={}", map.occupied().voxel_count());
+            println!("free={}", map.free().voxel_count());
+            println!("checksum={sum:.3}");
+            println!("map_bytes={}", map.log_odds().heap_bytes());
+        }
+        Some("history") => {
+            let steps: usize = args[2].parse().expect("steps");
+            let res: f64 = args[3].parse().expect("resolution");
+            let scene = ktree_verify::scenes::WalkingPerson::new(steps);
+            let mut map = OccupancyMap::<3>::new(res).unwrap();
+            let mut recorder = HistoryRecorder::new(*map.grid());
+            let mut record = 0.0;
+            for t in 0..scene.steps {
+                let scan = scene.scan(t, 360, 64);
+                map.insert(&scan.points, scan.origin, None).unwrap();
+                let start = Instant::now();
+                recorder.record(&map).unwrap();
+                record += start.elapsed().as_secs_f64();
+            }
+            let start = Instant::now();
+            let history = recorder.finish();
+            let build = start.elapsed().as_secs_f64();
+            let start = Instant::now();
+            let (still, moved) = (history.static_map(), history.moved());
+            let split = start.elapsed().as_secs_f64();
+            println!("steps={steps} res={res}");
+            println!("history_nodes={}", history.tree().node_count());
+            println!("history_bytes={}", history.tree().heap_bytes());
+            println!("map_nodes={}", map.log_odds().node_count());
+            println!("static_voxels={}", still.voxel_count());
+            println!("moved_voxels={}", moved.voxel_count());
+            println!("record_seconds={record:.3} build_seconds={build:.3} split_seconds={split:.3}");
+        }
+        _ => eprintln!("usage: maps insert|phases RES FILE REPEATS | lidar OUT.log SCANS | sequence RES FILE.log | history STEPS RES"),
     }
 }

@@ -2,6 +2,9 @@
 // at the origin), inserts it into an empty OcTree REPEATS times with insertPointCloud (discretize = false,
 // lazy_eval = false) and prints the best time, the map's occupied and free voxel counts (leaves expanded),
 // the sum of its log-odds over voxels (to compare with ktree's) and the tree's memory (memoryUsage()).
+// `peers sequence RES FILE.log` reads a sequence of scans (OctoMap's .log, ScanGraph::readPlainASCII),
+// integrates them one after the other (insertPointCloud of each ScanNode, as graph2tree does) and prints
+// each scan's time and the tree's size after it, then the same totals.
 #include <octomap/octomap.h>
 
 #include <chrono>
@@ -11,8 +14,45 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <string>
+
+static void print_map(const octomap::OcTree& tree, size_t points, double seconds) {
+  unsigned long long occupied = 0, free_ = 0;
+  double sum = 0;
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    const double side = std::ldexp(1.0, int(tree.getTreeDepth() - it.getDepth()));
+    const double n = side * side * side;
+    (tree.isNodeOccupied(*it) ? occupied : free_) += (unsigned long long)n;
+    sum += double(it->getLogOdds()) * n;
+  }
+  std::printf("points=%zu\nseconds=%.6f\noccupied=%llu\nfree=%llu\nchecksum=%.3f\nmap_bytes=%zu\n", points,
+              seconds, occupied, free_, sum, tree.memoryUsage());
+}
+
+static int sequence(double res, const char* path) {
+  octomap::ScanGraph graph;
+  graph.readPlainASCII(path);
+  if (graph.size() == 0) {
+    std::cerr << path << ": no scan read\n";
+    return 1;
+  }
+  octomap::OcTree tree(res);
+  double total = 0;
+  size_t points = 0, i = 0;
+  for (auto it = graph.begin(); it != graph.end(); ++it, ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    tree.insertPointCloud(**it);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    total += s;
+    points += (*it)->scan->size();
+    std::printf("scan=%zu points=%zu seconds=%.6f nodes=%zu\n", i, (*it)->scan->size(), s, tree.size());
+  }
+  print_map(tree, points, total);
+  return 0;
+}
 
 int main(int argc, char** argv) {
+  if (argc == 4 && std::string(argv[1]) == "sequence") return sequence(std::atof(argv[2]), argv[3]);
   if (argc < 4) {
     std::cerr << "usage: peers RES FILE REPEATS\n";
     return 2;
@@ -33,15 +73,6 @@ int main(int argc, char** argv) {
     if (s < best) best = s;
     tree = std::move(t);
   }
-  unsigned long long occupied = 0, free_ = 0;
-  double sum = 0;
-  for (auto it = tree->begin_leafs(); it != tree->end_leafs(); ++it) {
-    const double side = std::ldexp(1.0, int(tree->getTreeDepth() - it.getDepth()));
-    const double n = side * side * side;
-    (tree->isNodeOccupied(*it) ? occupied : free_) += (unsigned long long)n;
-    sum += double(it->getLogOdds()) * n;
-  }
-  std::printf("points=%zu\nseconds=%.6f\noccupied=%llu\nfree=%llu\nchecksum=%.3f\nmap_bytes=%zu\n", cloud.size(),
-              best, occupied, free_, sum, tree->memoryUsage());
+  print_map(*tree, cloud.size(), best);
   return 0;
 }
