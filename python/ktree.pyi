@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
-__all__ = ["MapHistory", "OccupancyMap", "RayHits", "Tree", "__version__"]
+__all__ = ["MapHistory", "MapRayHits", "OccupancyMap", "RayHits", "Tree", "__version__"]
 
 _Path = Union[str, PathLike[str]]
 _View = Union[str, Sequence[float]]
@@ -32,6 +32,16 @@ class RayHits(NamedTuple):
     t: npt.NDArray[np.float64]
     axis: npt.NDArray[np.int8]
     sign: npt.NDArray[np.int8]
+
+class MapRayHits(NamedTuple):
+    """What OccupancyMap.cast_rays returns: per ray, whether it hit an occupied voxel, the world centre
+    of the voxel where it ended (NaN for OUTSIDE), that voxel's keys (-1 for OUTSIDE) and why it ended:
+    OccupancyMap.OCCUPIED (a hit), UNKNOWN, BEYOND_RANGE or OUTSIDE."""
+
+    hit: npt.NDArray[np.bool_]
+    end: npt.NDArray[np.float64]
+    key: npt.NDArray[np.int64]
+    reason: npt.NDArray[np.uint8]
 
 class _LevelCounts(TypedDict):
     level: int
@@ -348,6 +358,8 @@ class OccupancyMap:
     UNKNOWN: ClassVar[int]
     FREE: ClassVar[int]
     OCCUPIED: ClassVar[int]
+    BEYOND_RANGE: ClassVar[int]
+    OUTSIDE: ClassVar[int]
     def __new__(
         cls,
         resolution: float,
@@ -371,6 +383,18 @@ class OccupancyMap:
         voxels updated."""
     def states(self, points: npt.ArrayLike) -> npt.NDArray[np.uint8]:
         """The states (UNKNOWN, FREE, OCCUPIED) of the voxels holding (N, dim) world points."""
+    def cast_rays(
+        self,
+        origins: npt.ArrayLike,
+        directions: npt.ArrayLike,
+        ignore_unknown: bool = False,
+        max_range: Optional[float] = None,
+    ) -> MapRayHits:
+        """Casts rays through a 3-D map as OctoMap's castRay: from each origin's voxel along its
+        direction ((N, 3) arrays, or 3 numbers shared by all rays; as float32) to the first occupied
+        voxel (a hit), an unknown voxel (unless ignore_unknown), the first voxel whose centre is beyond
+        max_range, or the map's edge. Non-finite coordinates, a zero direction or a max_range that is not
+        positive are a ValueError."""
     def keys(self, points: npt.ArrayLike) -> npt.NDArray[np.int64]:
         """The (N, dim) keys of the voxels holding (N, dim) world points (rows of -1 outside the map)."""
     def occupied(self) -> Tree:

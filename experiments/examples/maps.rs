@@ -51,10 +51,18 @@ fn scene() -> KTree<3> {
         tree = union(&tree, &KTree::from(&rays));
     }
     let meshes = [("bunny_npm", 1.2), ("armadillo", 1.8), ("fandisk", 0.9)];
-    let places = [[-4.0, 3.0], [5.0, -2.5], [1.5, 5.5], [-3.5, -5.0], [6.0, 4.0], [-6.0, 0.5]];
+    let places = [
+        [-4.0, 3.0],
+        [5.0, -2.5],
+        [1.5, 5.5],
+        [-3.5, -5.0],
+        [6.0, 4.0],
+        [-6.0, 0.5],
+    ];
     for (i, (name, size)) in meshes.iter().enumerate() {
         let path = format!("{}/../data/meshes/{name}.obj", env!("CARGO_MANIFEST_DIR"));
-        let mesh = ktree::io::read_mesh(std::path::Path::new(&path)).expect("a mesh of data/meshes");
+        let mesh =
+            ktree::io::read_mesh(std::path::Path::new(&path)).expect("a mesh of data/meshes");
         let (mlo, mhi) = mesh.bounds().expect("vertices");
         let extent = (0..3).map(|a| mhi[a] - mlo[a]).fold(0.0, f64::max);
         let scale = size / SCENE_VOXEL / extent;
@@ -65,7 +73,10 @@ fn scene() -> KTree<3> {
                 5.0 - scale * mlo[2],
             ];
             let placed = MeshTransform { scale, translate };
-            let rays = mesh.to_rays(SCENE_LEVEL, &placed).expect("a placed mesh").rays;
+            let rays = mesh
+                .to_rays(SCENE_LEVEL, &placed)
+                .expect("a placed mesh")
+                .rays;
             tree = union(&tree, &KTree::from(&rays));
         }
     }
@@ -100,13 +111,19 @@ fn lidar(out: &str, scans: usize) {
             }
         }
         let hits = tree.cast_rays(&casts);
-        text += &format!("NODE {} {} {} 0 0 0\n", origin_m[0], origin_m[1], origin_m[2]);
+        text += &format!(
+            "NODE {} {} {} 0 0 0\n",
+            origin_m[0], origin_m[1], origin_m[2]
+        );
         for (cast, hit) in casts.iter().zip(&hits) {
             let Some(hit) = hit else { continue };
             let d = cast.direction();
             // The hit in metres, relative to the sensor (the scan's frame: the world's axes).
             let local: [f64; 3] = std::array::from_fn(|i| hit.t * d[i] * SCENE_VOXEL);
-            text += &format!("{} {} {}\n", local[0] as f32, local[1] as f32, local[2] as f32);
+            text += &format!(
+                "{} {} {}\n",
+                local[0] as f32, local[1] as f32, local[2] as f32
+            );
         }
     }
     std::fs::write(out, text).unwrap_or_else(|e| panic!("{out}: {e}"));

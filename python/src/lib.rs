@@ -177,6 +177,15 @@ fn ktree_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
         .call1(("RayHits", fields))?;
     hits.setattr("__module__", "ktree")?;
     m.add("RayHits", hits)?;
+    // What `OccupancyMap.cast_rays` returns.
+    let fields = ["hit", "end", "key", "reason"];
+    let hits = m
+        .py()
+        .import("collections")?
+        .getattr("namedtuple")?
+        .call1(("MapRayHits", fields))?;
+    hits.setattr("__module__", "ktree")?;
+    m.add("MapRayHits", hits)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -7,9 +7,11 @@
 use std::path::PathBuf;
 
 use ktree::io::{read_bt_map, read_ot_map, write_bt_map, write_ot_map};
-use ktree::map::{probability, HistoryRecorder, MapHistory, OccupancyMap, SensorModel, VoxelState};
+use ktree::map::{
+    probability, CastEnd, HistoryRecorder, MapHistory, OccupancyMap, SensorModel, VoxelState,
+};
 use ktree::{AnyTree, AnyValuedTree};
-use numpy::ndarray::Array2;
+use numpy::ndarray::{Array1, Array2};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLikeDyn};
 use pyo3::prelude::*;
 
@@ -82,6 +84,84 @@ fn coordinates<const K: usize>(values: &[f64], what: &str) -> Result<[f32; K], F
     Ok(std::array::from_fn(|i| values[i] as f32))
 }
 
+/// Ray casts on a map, as `cast_rays` returns them (`MapRayHits`): per ray whether it hit an occupied
+/// voxel, the world centre and the keys of the voxel where it ended (NaN and -1 when it left the map) and
+/// why it ended (a code of `OccupancyMapPy`).
+struct MapCasts {
+    hit: Array1<bool>,
+    end: Array2<f64>,
+    key: Array2<i64>,
+    reason: Array1<u8>,
+}
+
+/// The rays of flat `(N, 3)` origins and directions (float32, row after row; a single row of either is
+/// the same for every ray of the other) cast on `map` with OctoMap's castRay (`max_range` ≤ 0: none).
+///
+/// # Errors
+/// A `ValueError` naming the ray for a coordinate that is not finite or a direction of length 0 (or one
+/// whose squared length is beyond float32), and for counts of origins and directions that differ.
+fn cast_map_rays(
+    map: &OccupancyMap<3>,
+    origins: &[f32],
+    directions: &[f32],
+    ignore_unknown: bool,
+    max_range: f64,
+) -> Result<MapCasts, Failure> {
+    let (origins, directions) = (rows::<3, f32>(origins), rows::<3, f32>(directions));
+    let n = match (origins.len(), directions.len()) {
+        (1, n) | (n, 1) => n,
+        (a, b) if a == b => a,
+        (a, b) => {
+            return Err(Failure::Value(format!(
+                "cast_rays: {a} origins and {b} directions: give as many of each, or one origin or \
+                 one direction for all rays"
+            )))
+        }
+    };
+    let nth = |rows: &[[f32; 3]], i: usize| rows[if rows.len() == 1 { 0 } else { i }];
+    let grid = *map.grid();
+    let mut out = MapCasts {
+        hit: Array1::from_elem(n, false),
+        end: Array2::from_elem((n, 3), f64::NAN),
+        key: Array2::from_elem((n, 3), -1),
+        reason: Array1::from_elem(n, OccupancyMapPy::OUTSIDE),
+    };
+    for i in 0..n {
+        let (o, d) = (nth(origins, i), nth(directions, i));
+        if o.iter().any(|c| !c.is_finite()) {
+            return Err(Failure::Value(format!(
+                "cast_rays: the origin of ray {i} has a coordinate that is not finite (as float32)"
+            )));
+        }
+        if d.iter().any(|c| !c.is_finite()) {
+            return Err(Failure::Value(format!(
+                "cast_rays: the direction of ray {i} has a coordinate that is not finite (as float32)"
+            )));
+        }
+        // The squared length as OctoMap's normalized() sums it, in float32.
+        let length_sq: f32 = d.iter().map(|c| c * c).sum();
+        if !(length_sq > 0.0 && length_sq.is_finite()) {
+            return Err(Failure::Value(format!(
+                "cast_rays: the direction of ray {i}, {d:?}, has no length as float32 (zero, or its \
+                 squares under- or overflow)"
+            )));
+        }
+        let (reason, key) = match map.cast_ray(o, d, ignore_unknown, max_range) {
+            CastEnd::Occupied(k) => (OccupancyMapPy::OCCUPIED, k),
+            CastEnd::Unknown(k) => (OccupancyMapPy::UNKNOWN, k),
+            CastEnd::Range(k) => (OccupancyMapPy::BEYOND_RANGE, k),
+            CastEnd::Outside => continue,
+        };
+        out.hit[i] = reason == OccupancyMapPy::OCCUPIED;
+        out.reason[i] = reason;
+        for (a, &k) in key.iter().enumerate() {
+            out.end[[i, a]] = grid.centre(k);
+            out.key[[i, a]] = i64::from(k);
+        }
+    }
+    Ok(out)
+}
+
 /// An occupancy map of dimension 2 or 3 from range scans, with OctoMap's semantics: voxels of side
 /// `resolution` keyed as OctoMap keys them (2**16 a side, voxel key k along an axis covering world
 /// coordinates [(k - 32768) * resolution, (k - 32767) * resolution)), each unknown (never observed), free
@@ -118,6 +198,12 @@ impl OccupancyMapPy {
     /// What `states` says of a voxel with log-odds at or above the occupancy threshold.
     #[classattr]
     const OCCUPIED: u8 = 2;
+    /// What `cast_rays` says of a ray that went beyond its maximum range.
+    #[classattr]
+    const BEYOND_RANGE: u8 = 3;
+    /// What `cast_rays` says of a ray that left the map, or started outside it.
+    #[classattr]
+    const OUTSIDE: u8 = 4;
 
     /// An empty map (every voxel unknown) of dimension `dim` (2 or 3) and voxels of side `resolution`,
     /// with a sensor model given by probabilities (OctoMap's defaults): of a hit, of a miss, the clamps
@@ -225,6 +311,69 @@ impl OccupancyMapPy {
             m.states(rows::<K, f32>(flat)).into_iter().map(state_code).collect()
         }));
         Ok(out.into_pyarray(py))
+    }
+
+    /// Casts rays through a 3-D map as OctoMap's castRay casts them: from the voxel of each origin along
+    /// its direction (world coordinates, converted to float32; `origins` and `directions` are (N, 3)
+    /// arrays, or 3 numbers for one origin or one direction shared by all rays), voxel by voxel until an
+    /// occupied voxel (a hit), an unknown voxel (unless `ignore_unknown`: then rays pass through them),
+    /// the first voxel whose centre is farther than `max_range` from the origin, or the map's edge. A ray
+    /// whose origin is in an occupied voxel hits it.
+    ///
+    /// Returns a `MapRayHits` named tuple: `hit` (N,) bool (the ray ended in an occupied voxel), `end`
+    /// (N, 3) float64 (the world centre of the voxel where it ended; NaN for `OUTSIDE`), `key` (N, 3)
+    /// int64 (that voxel's keys; -1 for `OUTSIDE`) and `reason` (N,) uint8: `OCCUPIED` (a hit), `UNKNOWN`
+    /// (an unknown voxel stopped it), `BEYOND_RANGE` or `OUTSIDE` (it left the map, or its origin is
+    /// outside it).
+    ///
+    /// A coordinate that is not finite, a direction of length 0, a `max_range` that is not a positive
+    /// number, or counts of origins and directions that differ are a ValueError; so is a 2-D map.
+    #[pyo3(signature = (origins, directions, ignore_unknown = false, max_range = None))]
+    fn cast_rays<'py>(
+        &self,
+        py: Python<'py>,
+        origins: &Bound<'py, PyAny>,
+        directions: &Bound<'py, PyAny>,
+        ignore_unknown: bool,
+        max_range: Option<f64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let AnyMap::D3(map) = &self.map else {
+            return Err(Failure::Value(format!(
+                "cast_rays: rays are cast on 3-D maps (OctoMap's castRay); this map has dimension {}",
+                self.dim_of()
+            ))
+            .into());
+        };
+        let range = match max_range {
+            None => -1.0,
+            Some(m) if m > 0.0 => m,
+            Some(m) => {
+                return Err(Failure::Value(format!(
+                    "cast_rays: max_range must be a positive number (or None), not {m}"
+                ))
+                .into())
+            }
+        };
+        let rays = |a: &Bound<'py, PyAny>, what: &str| {
+            let array: PyArrayLikeDyn<'py, f32, AllowTypeChange> = a.extract().map_err(|e| {
+                Failure::Value(format!(
+                    "cast_rays: {what} must be 3 numbers or an (N, 3) array of numbers: {e}"
+                ))
+            })?;
+            let numbers = Numbers::new(array);
+            numbers.rows_of(3, true, &format!("cast_rays: {what}"))?;
+            Ok::<_, Failure>(numbers)
+        };
+        let (o, d) = (rays(origins, "origins")?, rays(directions, "directions")?);
+        let (o, d) = (o.flat(), d.flat());
+        let casts = py.detach(|| cast_map_rays(map, o, d, ignore_unknown, range))?;
+        let hits = py.import("ktree")?.getattr("MapRayHits")?;
+        hits.call1((
+            casts.hit.into_pyarray(py),
+            casts.end.into_pyarray(py),
+            casts.key.into_pyarray(py),
+            casts.reason.into_pyarray(py),
+        ))
     }
 
     /// The keys of the voxels holding `points` (an (N, dim) array of world coordinates, converted to

@@ -1,6 +1,7 @@
 """Occupancy maps (ktree.OccupancyMap) against a naive reference written here in Python: OctoMap's
-insertPointCloud with its key traversal (computeRayKeys) step by step, in float32 and float64 where OctoMap
-computes in each, and the log-odds of each voxel in a dict. Dimensions 2 and 3."""
+insertPointCloud with its key traversal (computeRayKeys) and its castRay step by step, in float32 and
+float64 where OctoMap computes in each, and the log-odds of each voxel in a dict. Dimensions 2 and 3 (ray
+casts: 3)."""
 
 import math
 import sys
@@ -9,6 +10,7 @@ import numpy as np
 import pytest
 
 import ktree
+from test_ktree import run_json
 
 CENTRE = 1 << 15
 F32 = np.float32
@@ -119,6 +121,60 @@ class Reference:
         for k in hits:
             self.update(k, True)
         return len(misses | hits)
+
+    def cast(self, origin, direction, ignore_unknown=False, max_range=None):
+        """OctoMap's castRay (3-D): (reason, key of the voxel where the ray ended or None), the reason as
+        OccupancyMap.cast_rays codes it."""
+        O = ktree.OccupancyMap
+        origin = np.asarray(origin, dtype=np.float32)
+        direction = np.asarray(direction, dtype=np.float32)
+        key = self.keys(origin)
+        if key is None:
+            return O.OUTSIDE, None
+
+        def stops(k):
+            l = self.voxels.get(k)
+            if l is None:
+                return None if ignore_unknown else O.UNKNOWN
+            return O.OCCUPIED if l >= self.occupancy else None
+
+        reason = stops(key)
+        if reason is not None:
+            return reason, key
+        # normalized(): the norm in float64, the division in float32.
+        length = F32(self.norm(direction))
+        d = [F32(c / length) for c in direction]
+        step = [0] * 3
+        t_max = [F64_MAX] * 3
+        t_delta = [F64_MAX] * 3
+        for i in range(3):
+            step[i] = 1 if d[i] > 0 else -1 if d[i] < 0 else 0
+            if step[i] != 0:
+                border = self.centre(key[i]) + step[i] * self.res * 0.5
+                t_max[i] = (border - float(origin[i])) / float(d[i])
+                t_delta[i] = self.res / abs(float(d[i]))
+        key = list(key)
+        while True:
+            if t_max[0] < t_max[1]:
+                axis = 0 if t_max[0] < t_max[2] else 2
+            else:
+                axis = 1 if t_max[1] < t_max[2] else 2
+            if (step[axis] < 0 and key[axis] == 0) or (step[axis] > 0 and key[axis] == 2 * CENTRE - 1):
+                return O.OUTSIDE, None
+            key[axis] += step[axis]
+            t_max[axis] += t_delta[axis]
+            k = tuple(key)
+            if max_range is not None:
+                # The voxel's centre as a float32 point, the squares in float32 summed in float64.
+                sq = 0.0
+                for j in range(3):
+                    e = F32(F32(self.centre(k[j])) - origin[j])
+                    sq += float(F32(e * e))
+                if sq > max_range * max_range:
+                    return O.BEYOND_RANGE, k
+            reason = stops(k)
+            if reason is not None:
+                return reason, k
 
     def state(self, p):
         l = self.voxels.get(self.keys(np.asarray(p, dtype=np.float32)))
@@ -465,3 +521,158 @@ def test_a_history_needs_a_3d_map_made_to_keep_it():
         ktree.OccupancyMap(0.1).history()
     with pytest.raises(ValueError, match="3-D"):
         ktree.OccupancyMap(0.1, dim=2, history=True)
+# --- ray casts (OctoMap's castRay) ---------------------------------------------------------------------
+
+
+def cast_map(seed, resolution):
+    """A 3-D map and its reference after a few random scans, and rays to cast on it: origins and directions
+    with voxel borders, shared axes, zero components and exact diagonals among them (ties in the
+    traversal)."""
+    rng = np.random.default_rng(seed)
+    m = ktree.OccupancyMap(resolution)
+    ref = Reference(resolution, 3)
+    for _ in range(3):
+        points, origin = random_scan(rng, 3, resolution, 60)
+        m.insert(points, origin)
+        ref.insert(points, origin)
+    n = 120
+    origins = rng.uniform(-1.5, 1.5, size=(n, 3))
+    directions = rng.normal(size=(n, 3))
+    for i in range(n):
+        r = rng.random()
+        if r < 0.2:
+            origins[i] = np.round(origins[i] / resolution) * resolution
+        elif r < 0.3:
+            origins[i] = (np.floor(origins[i] / resolution) + 0.5) * resolution
+        r = rng.random()
+        if r < 0.15:
+            directions[i, rng.integers(3)] = 0.0
+        elif r < 0.25:
+            directions[i] = 0.0
+            directions[i, rng.integers(3)] = rng.choice([-1.0, 1.0]) * rng.uniform(0.1, 10)
+        elif r < 0.35:
+            directions[i] = rng.choice([-1.0, 1.0], size=3)
+    return m, ref, origins, directions
+
+
+def check_casts(m, ref, origins, directions, ignore_unknown, max_range):
+    got = m.cast_rays(origins, directions, ignore_unknown=ignore_unknown, max_range=max_range)
+    assert isinstance(got, ktree.MapRayHits) and got._fields == ("hit", "end", "key", "reason")
+    n = len(directions)
+    assert got.hit.dtype == np.bool_ and got.hit.shape == (n,)
+    assert got.end.dtype == np.float64 and got.end.shape == (n, 3)
+    assert got.key.dtype == np.int64 and got.key.shape == (n, 3)
+    assert got.reason.dtype == np.uint8 and got.reason.shape == (n,)
+    origins = np.broadcast_to(origins, (n, 3))
+    reasons = []
+    for i in range(n):
+        reason, key = ref.cast(origins[i], directions[i], ignore_unknown, max_range)
+        reasons.append(reason)
+        assert got.reason[i] == reason, i
+        assert got.hit[i] == (reason == ktree.OccupancyMap.OCCUPIED)
+        if key is None:
+            assert got.key[i].tolist() == [-1, -1, -1]
+            assert np.isnan(got.end[i]).all()
+        else:
+            assert tuple(got.key[i]) == key, i
+            assert got.end[i].tolist() == [ref.centre(k) for k in key]
+    return reasons
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_cast_rays_against_reference(seed):
+    resolution = [0.1, 0.25, 0.5, 0.17][seed % 4]
+    m, ref, origins, directions = cast_map(300 + seed, resolution)
+    seen = set()
+    seen.update(check_casts(m, ref, origins, directions, False, None))
+    seen.update(check_casts(m, ref, origins, directions, False, 1.0))
+    # Through unknown voxels, within a range (a ray to the map's edge is tens of thousands of voxels).
+    seen.update(check_casts(m, ref, origins, directions, True, 2.5))
+    seen.update(check_casts(m, ref, origins, directions.astype(np.float32), True, float(resolution)))
+    O = ktree.OccupancyMap
+    assert {O.OCCUPIED, O.UNKNOWN, O.BEYOND_RANGE} <= seen
+
+
+def test_cast_rays_one_origin_for_all_rays():
+    m, ref, origins, directions = cast_map(7, 0.25)
+    one = m.cast_rays(origins[0], directions, max_range=3.0)
+    each = m.cast_rays(np.repeat(origins[:1], len(directions), axis=0), directions, max_range=3.0)
+    for a, b in zip(one, each):
+        np.testing.assert_array_equal(a, b)
+    check_casts(m, ref, origins[0], directions, True, 3.0)
+    # One direction for all origins, and a single ray.
+    along = m.cast_rays(origins, [1.0, 0.0, 0.0], ignore_unknown=True, max_range=2.0)
+    assert along.reason.shape == (len(origins),)
+    single = m.cast_rays(origins[0], directions[0])
+    assert single.key.shape == (1, 3) and single.reason.shape == (1,)
+    assert m.cast_rays(np.zeros((0, 3)), np.zeros((0, 3))).key.shape == (0, 3)
+
+
+def test_cast_rays_named_cases():
+    O = ktree.OccupancyMap
+    m = O(0.1)
+    # A wall at x = 2.05 seen from the origin's voxel along x; beside it, free voxels, then unknown ones.
+    m.insert(np.array([[2.05, 0.05, 0.05], [2.05, 0.15, 0.05]]), [0.05, 0.05, 0.05])
+    c = CENTRE
+    got = m.cast_rays(
+        [[0.05, 0.05, 0.05], [0.05, 0.05, 0.05], [1.05, 0.05, 0.05], [2.05, 0.05, 0.05], [0.05, 0.05, 0.05]],
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+        max_range=None,
+    )
+    assert got.reason.tolist() == [O.OCCUPIED, O.UNKNOWN, O.UNKNOWN, O.OCCUPIED, O.OCCUPIED]
+    assert got.hit.tolist() == [True, False, False, True, True]
+    assert got.key[0].tolist() == [c + 20, c, c]
+    np.testing.assert_allclose(got.end[0], [2.05, 0.05, 0.05], rtol=0, atol=1e-12)
+    # Along -x from x = 1.05 the free voxels end at the sensor's: the next one is unknown.
+    assert got.key[2].tolist() == [c - 1, c, c]
+    # A range of 0.95: the first voxel whose centre is beyond it, 1 away.
+    short = m.cast_rays([0.05, 0.05, 0.05], [1.0, 0.0, 0.0], max_range=0.95)
+    assert short.reason.tolist() == [O.BEYOND_RANGE] and short.key.tolist() == [[c + 10, c, c]]
+    # Passing through unknown voxels up the y axis to the map's edge; from outside the map.
+    edge = m.cast_rays([[0.05, 0.05, 0.05], [4000.0, 0, 0], [3276.75, 0.05, 0.05]], [0.0, 1.0, 0.0], True)
+    assert edge.reason.tolist() == [O.OUTSIDE, O.OUTSIDE, O.OUTSIDE]
+    assert not edge.hit.any() and (edge.key == -1).all() and np.isnan(edge.end).all()
+    # A ray from the last voxel along x leaves the map at once; unknown voxels stop it otherwise.
+    last = m.cast_rays([3276.75, 0.05, 0.05], [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
+    assert last.reason.tolist() == [O.UNKNOWN, O.UNKNOWN]
+    assert last.key.tolist() == [[2 * c - 1, c, c]] * 2
+
+
+def test_cast_rays_bad_input_is_value_error():
+    m = ktree.OccupancyMap(0.1)
+    m.insert(np.array([[1.0, 0, 0]]), [0, 0, 0])
+    good = np.ones((2, 3))
+    cases = [
+        (dict(origins=np.zeros((2, 2)), directions=good), "origins"),
+        (dict(origins=good, directions=np.zeros((2, 3, 1))), "directions"),
+        (dict(origins=np.zeros(2), directions=good), "origins"),
+        (dict(origins="here", directions=good), "origins"),
+        (dict(origins=np.zeros((3, 3)), directions=good), "3 origins and 2 directions"),
+        (dict(origins=[[0, 0, 0], [np.nan, 0, 0]], directions=good), "origin of ray 1 .*not finite"),
+        (dict(origins=good, directions=[[1, 0, 0], [0, np.inf, 0]]), "direction of ray 1 .*not finite"),
+        (dict(origins=good, directions=[[1, 0, 0], [0, 0, 0]]), "direction of ray 1, .*no length"),
+        (dict(origins=good, directions=[1e-30, 0, 0]), "direction of ray 0, .*no length"),
+        (dict(origins=good, directions=good, max_range=-1.0), "max_range"),
+        (dict(origins=good, directions=good, max_range=0.0), "max_range"),
+        (dict(origins=good, directions=good, max_range=float("nan")), "max_range"),
+    ]
+    for kwargs, message in cases:
+        with pytest.raises(ValueError, match=message):
+            m.cast_rays(**kwargs)
+    with pytest.raises(ValueError, match="dimension 2"):
+        ktree.OccupancyMap(0.1, dim=2).cast_rays([0, 0], [1, 0])
+
+
+def test_cast_rays_agree_with_the_cli(tmp_path):
+    m, ref, origins, directions = cast_map(11, 0.1)
+    m.save(tmp_path / "m.ot")
+    rays = tmp_path / "rays.csv"
+    np.savetxt(rays, np.hstack([origins, directions]).astype(np.float32), delimiter=",", fmt="%.9g")
+    names = {"occupied": 2, "unknown": 0, "range": 3, "outside": 4}
+    for flags, ignore, max_range in [([], False, None), (["--ignore-unknown", "--max-range", "2"], True, 2.0)]:
+        answer = run_json("raycast", tmp_path / "m.ot", "--rays", rays, *flags)
+        got = m.cast_rays(origins, directions, ignore_unknown=ignore, max_range=max_range)
+        assert [names[a["end"]] for a in answer] == got.reason.tolist()
+        assert [a["key"] or [-1, -1, -1] for a in answer] == got.key.tolist()
+        points = np.array([a["point"] or [math.nan] * 3 for a in answer], dtype=np.float64)
+        np.testing.assert_array_equal(points, got.end)

@@ -4,7 +4,8 @@
 //! empty), so every operation of the crate applies to its parts.
 //!
 //! A scan's update ([`ScanUpdate`]) gathers the voxels its rays cross on all threads as sorted Morton keys
-//! and merges them into the map's tree in one pass from the root down.
+//! and merges them into the map's tree in one pass from the root down. Rays may also be integrated one at
+//! a time, as OctoMap's `insertRay` does ([`OccupancyMap::insert_ray`], [`OccupancyMap::insert_rays`]).
 //!
 //! ```
 //! use ktree::map::{OccupancyMap, VoxelState};
@@ -26,6 +27,7 @@ mod history;
 mod leaves;
 mod model;
 mod plane;
+mod rays;
 mod traverse;
 mod update;
 

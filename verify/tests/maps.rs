@@ -1,6 +1,7 @@
 //! Occupancy maps: the key traversal against the geometry of the segment, the map's integration against
 //! a naive reference (a hash map of voxels updated ray by ray), K = 2 and 3, and OctoMap itself on its
-//! own real scan (`scan.dat` of Debian's liboctomap-dev) and on synthetic scans with a maximum range.
+//! own real scan (`scan.dat` of Debian's liboctomap-dev), on synthetic scans with a maximum range, and on
+//! rays inserted one at a time (`insertRay`, its unit test's sphere of rays among them).
 
 use std::collections::{HashMap, HashSet};
 use std::io::Write;
@@ -528,6 +529,152 @@ fn ray_casts_on_a_map_stop_where_octomaps_cast_ray_stops() {
         assert!(
             kinds.len() >= 2,
             "rays of several outcomes ({ignore}, {range})"
+        );
+    }
+}
+
+/// A checker's output split into its `leaf` lines (as one text) and its other lines.
+fn split_leaves(text: &str) -> (String, Vec<&str>) {
+    let (leaves, other): (Vec<&str>, Vec<&str>) =
+        text.lines().partition(|l| l.starts_with("leaf "));
+    (leaves.join("\n"), other)
+}
+
+/// The number after `name` on the line `name N` of a checker's output.
+fn count(lines: &[&str], name: &str) -> u64 {
+    let line = lines
+        .iter()
+        .find_map(|l| l.strip_prefix(name)?.strip_prefix(' '))
+        .unwrap_or_else(|| panic!("the checker printed no {name}"));
+    line.parse().unwrap()
+}
+
+/// octomath's `Vector3::rotate_IP(roll, pitch, yaw)`: turned about y, then z, then x, each step computed
+/// in `f64` from the `f32` coordinates and rounded back.
+fn rotate(p: [f32; 3], roll: f64, pitch: f64, yaw: f64) -> [f32; 3] {
+    let [mut x, mut y, mut z] = p;
+    let (px, pz) = (f64::from(x), f64::from(z));
+    x = (pz * pitch.sin() + px * pitch.cos()) as f32;
+    z = (pz * pitch.cos() - px * pitch.sin()) as f32;
+    let (yx, yy) = (f64::from(x), f64::from(y));
+    x = (yx * yaw.cos() - yy * yaw.sin()) as f32;
+    y = (yx * yaw.sin() + yy * yaw.cos()) as f32;
+    let (ry, rz) = (f64::from(y), f64::from(z));
+    y = (ry * roll.cos() - rz * roll.sin()) as f32;
+    z = (ry * roll.sin() + rz * roll.cos()) as f32;
+    [x, y, z]
+}
+
+/// The ray ends of OctoMap's unit test InsertRay: from the sensor at (0.01, 0.01, 0.02), the point 2 m
+/// away along x ((2.01, 0.01, 0.01) from it) turned by 1° about z 360 times, then by 1° about y, 360
+/// times over: 129 600 rays, the sensor's coordinates added in `f32`.
+fn sphere_ends(origin: [f32; 3]) -> Vec<[f32; 3]> {
+    // octomath's DEG2RAD(1.): 1 · 0.01745329251994329575, the same f64 as this.
+    let degree = 0.017_453_292_519_943_295_f64;
+    let mut on_surface = [2.01f32, 0.01, 0.01];
+    let mut ends = Vec::with_capacity(360 * 360);
+    for _ in 0..360 {
+        for _ in 0..360 {
+            ends.push(std::array::from_fn(|i| origin[i] + on_surface[i]));
+            on_surface = rotate(on_surface, 0.0, 0.0, degree);
+        }
+        on_surface = rotate(on_surface, 0.0, degree, 0.0);
+    }
+    ends
+}
+
+#[test]
+fn octomaps_insert_ray_unit_test_gives_octomaps_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(exe) = octomap_program(dir.path(), "octomap_insert_rays") else {
+        return;
+    };
+    let origin = [0.01f32, 0.01, 0.02];
+    let ends = sphere_ends(origin);
+    let out = Command::new(&exe).arg("sphere").output().unwrap();
+    assert!(out.status.success(), "the checker failed");
+    let text = String::from_utf8(out.stdout).unwrap();
+    let (leaves, lines) = split_leaves(&text);
+    // The same rays as OctoMap's test, to the bit.
+    let theirs_ends: Vec<[f32; 3]> = lines
+        .iter()
+        .filter_map(|l| l.strip_prefix("end "))
+        .map(|l| {
+            let v: Vec<u32> = l
+                .split(' ')
+                .map(|h| u32::from_str_radix(h, 16).unwrap())
+                .collect();
+            [v[0], v[1], v[2]].map(f32::from_bits)
+        })
+        .collect();
+    assert_eq!(theirs_ends.len(), 360 * 360);
+    assert!(theirs_ends
+        .iter()
+        .zip(&ends)
+        .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits)));
+    assert_eq!(count(&lines, "outside"), 0);
+    // OctoMap's test: 50 615 nodes once the map is written as .bt (maximum likelihood, pruned).
+    assert_eq!(count(&lines, "binary_size"), 50_615);
+
+    let mut map = OccupancyMap::<3>::new(0.05).unwrap();
+    assert_eq!(map.insert_rays(origin, &ends, None).unwrap(), 0);
+    let theirs = leaves_tree(&leaves);
+    assert_eq!(differences(map.log_odds(), &theirs), 0);
+    assert_eq!(map.log_odds(), &theirs);
+    let theirs = OccupancyMap::from_log_odds(*map.grid(), *map.model(), theirs).unwrap();
+    assert_eq!(map.occupied(), theirs.occupied());
+    assert_eq!(map.free(), theirs.free());
+    assert_eq!(map.unknown(), theirs.unknown());
+    assert!(map.occupied().voxel_count() > 0 && map.free().voxel_count() > 0);
+    // The same node count in ktree's tree: OctoMap's nodes are the ones that are not empty.
+    let c = max_likelihood(&map).counts();
+    assert_eq!(c.full + c.partial, 50_615);
+    // Ray by ray is not scan by scan: one scan of the same ends updates each voxel once.
+    let mut scan = OccupancyMap::<3>::new(0.05).unwrap();
+    scan.insert(&ends, origin, None).unwrap();
+    assert_ne!(scan.log_odds(), map.log_odds());
+}
+
+#[test]
+fn rays_inserted_one_by_one_give_octomaps_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(exe) = octomap_program(dir.path(), "octomap_insert_rays") else {
+        return;
+    };
+    // The room's scans, each with a point beyond the map, one in the sensor's voxel and one repeated.
+    let mut scans = room_scans();
+    for (points, origin) in &mut scans {
+        points.truncate(1500);
+        points.extend([[5000.0, 1.0, 1.0], *origin, points[0]]);
+    }
+    for (res, range) in [(0.1, None), (0.05, Some(2.5)), (0.2, Some(4.0))] {
+        let mut map = OccupancyMap::<3>::new(res).unwrap();
+        let mut outside = 0;
+        for (i, (points, origin)) in scans.iter().enumerate() {
+            if i == 0 {
+                // The first scan ray by ray, the others at once.
+                for p in points {
+                    outside += usize::from(!map.insert_ray(*origin, *p, range).unwrap());
+                }
+            } else {
+                outside += map.insert_rays(*origin, points, range).unwrap();
+            }
+        }
+        let mut cmd = Command::new(&exe);
+        cmd.arg(res.to_string());
+        if let Some(m) = range {
+            cmd.arg(m.to_string());
+        }
+        let out = run_with_input(&mut cmd, scans_text(&scans));
+        let (leaves, lines) = split_leaves(&out);
+        assert_eq!(outside as u64, count(&lines, "outside"), "at {res} m");
+        // Without a range the rays to the far point leave the map; with one they are cut inside it.
+        assert_eq!(outside, if range.is_none() { 3 } else { 0 });
+        let theirs = leaves_tree(&leaves);
+        assert_eq!(
+            differences(map.log_odds(), &theirs),
+            0,
+            "at {res} m, range {range:?}"
         );
     }
 }
