@@ -7,6 +7,11 @@
 # counts, the sum of the log-odds over voxels). Memory: the map's structure (ktree: the tree's heap bytes;
 # OctoMap: OcTree::memoryUsage) and each process's peak.
 #
+# Then a sequence of 40 synthetic 64-beam LiDAR scans (100 032 points each, ray cast through a room holding
+# the meshes of data/meshes: `maps lidar`) integrated scan by scan by ktree (one thread, all) and by
+# liboctomap (insertPointCloud of each ScanNode), once each at 0.1 m and 0.05 m: each scan's time against
+# the map's size. Last, the history of the walking-person scene (`maps history`).
+#
 # Needs Debian's liboctomap-dev and bzip2, and a C++ compiler.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,9 +42,31 @@ for res in 0.1 0.05; do
   done
   echo "res $res done" >&2
 done
-python3 - "$rows" "$octomap_version" "$load" "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')" "$threads" >"$out.tmp" <<'PY'
+"$ktree_bin" lidar "$scratch/lidar.log" 40
+sequence=$scratch/sequence.txt
+: >"$sequence"
+for res in 0.1 0.05; do
+  {
+    echo "program=ktree-1 res=$res"
+    RAYON_NUM_THREADS=1 "$ktree_bin" sequence "$res" "$scratch/lidar.log"
+    echo "program=ktree-$threads res=$res"
+    RAYON_NUM_THREADS=$threads "$ktree_bin" sequence "$res" "$scratch/lidar.log"
+    echo "program=octomap res=$res"
+    "$peers" sequence "$res" "$scratch/lidar.log" 2>/dev/null
+  } >>"$sequence"
+  echo "sequence at $res done" >&2
+done
+history=$scratch/history.txt
+{
+  "$ktree_bin" history 24 0.1
+  "$ktree_bin" history 24 0.05
+  "$ktree_bin" history 96 0.05
+} >"$history"
+load_end=$(cut -d' ' -f1-3 /proc/loadavg)
+python3 - "$rows" "$octomap_version" "$load" "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')" "$threads" "$sequence" "$history" "$load_end" >"$out.tmp" <<'PY'
+import statistics
 import sys
-rows_path, version, load, cpu, threads = sys.argv[1:]
+rows_path, version, load, cpu, threads, sequence_path, history_path, load_end = sys.argv[1:]
 runs = {}
 current = None
 for line in open(rows_path):
@@ -84,6 +111,72 @@ for res in ["0.1", "0.05"]:
 print()
 print("Both maps have the same occupied and free voxels and the same log-odds (checked here by counts and "
       "the sum of the log-odds over voxels; voxel by voxel in `verify/tests/maps.rs`).")
+
+# The LiDAR sequence: per program and resolution, each scan's seconds and the map's nodes after it.
+seq = {}
+current = None
+for line in open(sequence_path):
+    line = line.strip()
+    if line.startswith("program="):
+        fields = dict(f.split("=") for f in line.split())
+        current = {"scans": []}
+        seq[(fields["res"], fields["program"])] = current
+    elif line.startswith("scan="):
+        fields = dict(f.split("=") for f in line.split())
+        current["scans"].append((float(fields["seconds"]), int(fields["nodes"])))
+    elif "=" in line and current is not None:
+        k, v = line.split("=", 1)
+        current[k] = float(v)
+print()
+print("## A sequence of LiDAR scans")
+print()
+print("40 synthetic 64-beam LiDAR scans (`maps lidar`: 1 563 × 64 rays from 25° below to 15° above the horizon, "
+      "100 032 points each) ray cast exactly through the 2 cm tree of a 16 × 16 × 3 m room holding two copies "
+      "of each mesh of `data/meshes`, the sensor 1.7 m high on a loop of 3.5 m radius; integrated one scan "
+      "after the other (OctoMap: `insertPointCloud` of each `ScanNode` of the `.log`, as its `graph2tree`), "
+      "once each. Each scan's time is shown against the map's size (nodes) after it, over windows of 8 scans "
+      "(median).")
+print()
+for res in ["0.1", "0.05"]:
+    o, k1, kn = (seq[(res, p)] for p in ["octomap", "ktree-1", many])
+    for key in ["occupied", "free", "checksum"]:
+        assert o[key] == k1[key] == kn[key], (res, key, o[key], k1[key], kn[key])
+    print(f"**{res} m**: all 40 scans {o['seconds']:.1f} s by OctoMap, {k1['seconds']:.1f} s by ktree on one thread "
+          f"({o['seconds'] / k1['seconds']:.1f}×), {kn['seconds']:.1f} s on {threads} "
+          f"({o['seconds'] / kn['seconds']:.1f}×); the same map (occupied {int(o['occupied'])}, free "
+          f"{int(o['free'])} voxels, the same sum of log-odds). Map memory: OctoMap {o['map_bytes'] / 1e6:.1f} MB, "
+          f"ktree {k1['map_bytes'] / 1e6:.1f} MB.")
+    print()
+    print("| scans | OctoMap ms a scan | its nodes | ktree 1 thread ms | ktree " + threads + " threads ms | ktree nodes |")
+    print("|---|---|---|---|---|---|")
+    for w in range(0, 40, 8):
+        window = slice(w, w + 8)
+        med = lambda run, i: statistics.median(x[i] for x in run["scans"][window])
+        print(f"| {w + 1}–{w + 8} | {1e3 * med(o, 0):.0f} | {int(med(o, 1))} | {1e3 * med(k1, 0):.0f} | "
+              f"{1e3 * med(kn, 0):.0f} | {int(med(k1, 1))} |")
+    print()
+
+print("## A map's history")
+print()
+print("The walking-person scene (`ktree_verify::scenes::WalkingPerson`: a person walking across a 8 × 6 m room "
+      "in front of a sensor, 360 × 64 rays a scan), integrated step by step and recorded "
+      "(`map::HistoryRecorder`), its 4-D tree built, then the static map and what moved separated "
+      "(`MapHistory::static_map`, `moved`). The history records changes only; a tree of every step's state "
+      "would repeat each wall voxel at every step.")
+print()
+print("| steps | resolution | history nodes | history MB | final map nodes | history / map | static voxels | moved voxels | record s | build s | separate s |")
+print("|---|---|---|---|---|---|---|---|---|---|---|")
+h = {}
+for line in open(history_path):
+    for f in line.split():
+        k, v = f.split("=")
+        h[k] = v
+    if line.startswith("record_seconds"):
+        print(f"| {h['steps']} | {h['res']} m | {h['history_nodes']} | {int(h['history_bytes']) / 1e6:.2f} | "
+              f"{h['map_nodes']} | {int(h['history_nodes']) / int(h['map_nodes']):.2f} | {h['static_voxels']} | "
+              f"{h['moved_voxels']} | {h['record_seconds']} | {h['build_seconds']} | {h['split_seconds']} |")
+print()
+print(f"Load average at the end: {load_end}.")
 PY
 mv "$out.tmp" "$out"
 cat "$out"

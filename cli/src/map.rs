@@ -9,11 +9,14 @@ use std::time::Instant;
 
 use ktree::export::grid_map::write_grid_map;
 use ktree::export::Frame;
+use ktree::io::ktree::v3::{read_valued_ktree_framed, valued_header};
 use ktree::io::scan::{read_scan_directory, read_scans, Pose, Scan, ScanNode};
 use ktree::io::{
     read_bt_map, read_cloud, read_cloud_bytes, read_ot_map, write_bt_map, write_ot_map,
 };
-use ktree::map::{HistoryRecorder, OccupancyMap, SensorModel};
+use ktree::map::{HistoryRecorder, MapGrid, OccupancyMap, SensorModel, MAP_LEVEL};
+use ktree::space::WorldFrame;
+use ktree::tree::Dtype;
 
 use crate::common::error::{CliError, CliResult};
 use crate::common::vector::vector;
@@ -42,7 +45,8 @@ pub struct MapArgs {
     #[arg(long, value_name = "X,Y,Z,ROLL,PITCH,YAW", allow_hyphen_values = true, value_parser = vector::<f64, 6>)]
     pose: Option<[f64; 6]>,
     /// The map: .ot (every log-odds, OctoMap's OcTree), .bt (free and occupied, OctoMap's binary) or
-    /// .ktree (the log-odds as a float32 tree at the map's keys; the resolution is not kept).
+    /// .ktree (the log-odds as a float32 tree at the map's keys, with its resolution and origin as the
+    /// file's world frame).
     #[arg(long)]
     out: PathBuf,
     /// Also write the map's history: a 4-D tree (.ktree, uint8) with time as its fourth axis, one position
@@ -242,15 +246,68 @@ fn write_map(out: &Path, kind: MapKind, map: &OccupancyMap<3>) -> CliResult {
     match kind {
         MapKind::Ot => ktree::fs::write_atomic_with(out, |w| write_ot_map(w, map)),
         MapKind::Bt => ktree::fs::write_atomic_with(out, |w| write_bt_map(w, map)),
-        MapKind::Ktree => ktree::io::ktree::v3::write_valued_ktree_file(out, map.log_odds()),
+        MapKind::Ktree => {
+            let frame = map_frame(map.grid());
+            ktree::io::ktree::v3::write_valued_ktree_file_framed(out, map.log_odds(), Some(&frame))
+        }
     }
     .map_err(CliError::caused)
 }
 
-/// Reads an occupancy map file (`.ot` or `.bt`) with OctoMap's default model.
+/// Where a map's keys are in the world: key 0's lower corner and the resolution.
+fn map_frame(grid: &MapGrid) -> WorldFrame {
+    WorldFrame {
+        voxel_size: grid.resolution(),
+        origin: [grid.corner(); 3],
+    }
+}
+
+/// Whether a file holds an occupancy map: OctoMap's `.ot` and `.bt`, or a `.ktree` of float32 log-odds
+/// in a map's universe (K = 3, level 16) with a world frame.
+pub fn is_map_file(path: &Path) -> bool {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("ot" | "bt") => true,
+        Some("ktree") => {
+            let mut head = [0u8; 16];
+            let read = std::fs::File::open(path)
+                .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head));
+            read.is_ok()
+                && matches!(
+                    valued_header(&head[..], ""),
+                    Ok((3, MAP_LEVEL, Some(Dtype::F32)))
+                )
+                && head[11] & 1 == 1
+        }
+        _ => false,
+    }
+}
+
+/// Reads an occupancy map file (`.ot`, `.bt`, or a `.ktree` of log-odds with its frame) with OctoMap's
+/// default model.
 pub fn read_map(path: &Path) -> CliResult<OccupancyMap<3>> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
     let name = path.display().to_string();
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ktree"))
+    {
+        let (log_odds, frame) =
+            read_valued_ktree_framed::<3, f32>(&bytes, &name).map_err(CliError::caused)?;
+        let not_a_map = || {
+            format!("{name}: not an occupancy map (a .ktree map keeps its resolution and OctoMap's origin as its world frame)")
+        };
+        let frame = frame.ok_or_else(not_a_map)?;
+        let grid = MapGrid::new(frame.voxel_size).map_err(|e| format!("{name}: {e}"))?;
+        if map_frame(&grid) != frame {
+            return Err(not_a_map().into());
+        }
+        return OccupancyMap::from_log_odds(grid, SensorModel::default(), log_odds)
+            .map_err(|e| format!("{name}: {e}").into());
+    }
     let bt = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("bt"));

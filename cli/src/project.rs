@@ -25,7 +25,7 @@ pub struct ProjectArgs {
     #[arg(long, value_parser = parse_axis)]
     axis: usize,
     /// The positions along the axis, LO:HI both included (default: all): voxels for a tree file, world
-    /// coordinates (metres) for an occupancy map (.ot, .bt).
+    /// coordinates (metres) for an occupancy map (.ot, .bt, a map's .ktree).
     #[arg(long, value_name = "LO:HI", allow_hyphen_values = true, value_parser = parse_range)]
     range: Option<(f64, f64)>,
     #[command(flatten)]
@@ -91,9 +91,7 @@ fn parse_range(text: &str) -> Result<(f64, f64), String> {
 
 /// Whether `path` is an occupancy map file (OctoMap's `.ot` and `.bt`).
 pub fn is_map_file(path: &Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("ot") || e.eq_ignore_ascii_case("bt"))
+    crate::map::is_map_file(path)
 }
 
 /// `ktree project`.

@@ -71,8 +71,13 @@ fn map_files_hold_the_librarys_map() {
                 assert_eq!(map.free(), expected.free());
             }
             _ => {
-                let tree = ktree::io::ktree::v3::read_valued_ktree::<3, f32>(&bytes, out).unwrap();
+                let (tree, frame) =
+                    ktree::io::ktree::v3::read_valued_ktree_framed::<3, f32>(&bytes, out).unwrap();
                 assert_eq!(&tree, expected.log_odds());
+                // The map's resolution and OctoMap's origin as the file's world frame.
+                let frame = frame.unwrap();
+                assert_eq!(frame.voxel_size, 0.1);
+                assert_eq!(frame.origin, [-32768.0 * 0.1; 3]);
             }
         }
     }
@@ -137,6 +142,31 @@ fn a_maps_plane_is_a_ros_map_of_its_three_states() {
     assert_eq!(walls_2d.voxel_count(), occupied);
     let yaml = std::fs::read_to_string(dir.path().join("floor.yaml")).unwrap();
     assert!(yaml.contains("resolution: 0.1"), "{yaml}");
+    // The same map kept as a .ktree projects to the same ROS map.
+    run(&[
+        "map",
+        &s("room.xyz"),
+        "--resolution",
+        "0.1",
+        "--sensor-origin",
+        "2.5,1.5,1.2",
+        "--out",
+        &s("room.ktree"),
+    ]);
+    run(&[
+        "project",
+        &s("room.ktree"),
+        "--axis",
+        "z",
+        "--range",
+        "0.2:1.8",
+        "--out",
+        &s("floor_k.png"),
+    ]);
+    let read = |n: &str| std::fs::read(dir.path().join(n)).unwrap();
+    assert_eq!(read("floor_k.png"), read("floor.png"));
+    let yaml_k = String::from_utf8(read("floor_k.yaml")).unwrap();
+    assert_eq!(yaml_k.replace("floor_k", "floor"), yaml);
     assert!(
         yaml.contains(&format!(
             "origin: [{:?}, {:?}, 0.0]",

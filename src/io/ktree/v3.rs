@@ -11,12 +11,14 @@
 //! | 8 | 1 | `K` (1…4) |
 //! | 9 | 1 | `L` (0…[`crate::max_level`]`(K)`) |
 //! | 10 | 1 | the value type, [`Dtype::code`] (1 `uint8`, 2 `uint16`, 3 `uint32`, 4 `int8`, 5 `float32`, 6 `rgb8`) |
-//! | 11 | 5 | reserved, 0 |
-//! | 16 | … | section 0 (the root level), then section `d` right after section `d − 1` |
+//! | 11 | 1 | flags: bit 0 set when a world frame follows the header; the other bits 0 |
+//! | 12 | 4 | reserved, 0 |
+//! | 16 | 32 | only with flag bit 0: the world frame ([`WorldFrame`]): the voxel size, then the origin's x, y and z (`f64` each) |
+//! | 16 or 48 | … | section 0 (the root level), then section `d` right after section `d − 1` |
 //! | S | 32·D | directory: per level `d`, nodes `n_d`, full nodes `f_d`, nodes with children `c_d` (`u64` each), CRC-32 of section `d` (`u32`), reserved `u32` = 0 |
 //! | S + 32·D | 8 | the file's length in bytes (`u64`) |
 //! | S + 32·D + 8 | 4 | `D`, the number of levels (`u32`) |
-//! | S + 32·D + 12 | 4 | CRC-32 of the header (bytes 0…15) and of everything from S up to here |
+//! | S + 32·D + 12 | 4 | CRC-32 of the header (bytes 0…15, and the frame) and of everything from S up to here |
 //!
 //! Section `d` holds `W_d = ⌈n_d / 32⌉` words of 2-bit codes (node `i` in bits `2·(i mod 32)` of word
 //! `i / 32`: `00` empty, `01` full, `10` partial, `11` mixed — every voxel valued, not all alike; unused bits
@@ -46,7 +48,7 @@ use super::v2::layout::{
     samples_of, u32_at, u64_at, words_of, ENTRY_BYTES, HEADER_BYTES, TAIL_BYTES,
 };
 use super::{KtreeFileError, KtreeFileErrorKind, MAGIC};
-use crate::space::{max_level, Universe, MAX_K};
+use crate::space::{max_level, Universe, WorldFrame, MAX_K};
 use crate::tree::valued::ValueStorage;
 use crate::tree::words::{children_mask, full_mask};
 use crate::tree::{AnyTree, AnyValuedTree, Dtype, KTree, PackedStates, Value};
@@ -55,6 +57,9 @@ pub use super::v3_mapped::MappedValuedTree;
 
 /// The format version of valued files.
 pub const VERSION: u16 = 3;
+
+/// The bytes of a world frame after the header: the voxel size and three origin coordinates.
+const FRAME_BYTES: usize = 32;
 
 /// Words between two rank samples.
 const WORDS_PER_SAMPLE: usize = 64;
@@ -75,20 +80,54 @@ fn section_bytes(nodes: u64, full: u64, value_bytes: u64) -> Option<u64> {
 /// # Errors
 /// Any I/O error.
 pub fn write_valued_ktree<const K: usize, V: Value>(
+    out: impl Write,
+    tree: &KTree<K, V>,
+) -> std::io::Result<()> {
+    write_valued_ktree_framed(out, tree, None)
+}
+
+/// Writes a valued tree as a version 3 `.ktree` file with where its voxels are in the world (`frame`, kept
+/// after the header; `None`: none). A tree without values is written as version 2, without a frame.
+///
+/// ```
+/// use ktree::io::ktree::v3::{read_valued_ktree_framed, write_valued_ktree_framed};
+/// use ktree::space::WorldFrame;
+/// use ktree::KTree;
+/// let tree = KTree::<3, f32>::from_dense_values(1, &[Some(0.5); 8]).unwrap();
+/// let frame = WorldFrame { voxel_size: 0.05, origin: [-1.0, 2.0, 0.0] };
+/// let mut bytes = Vec::new();
+/// write_valued_ktree_framed(&mut bytes, &tree, Some(&frame)).unwrap();
+/// assert_eq!(read_valued_ktree_framed::<3, f32>(&bytes, "mem").unwrap(), (tree, Some(frame)));
+/// ```
+///
+/// # Errors
+/// Any I/O error; [`std::io::ErrorKind::InvalidInput`] for a frame whose voxel size is not a positive
+/// number or whose origin is not finite.
+pub fn write_valued_ktree_framed<const K: usize, V: Value>(
     mut out: impl Write,
     tree: &KTree<K, V>,
+    frame: Option<&WorldFrame>,
 ) -> std::io::Result<()> {
     let Some(dtype) = V::DTYPE else {
         return super::write_ktree(out, &tree.shape());
     };
-    let mut header = [0u8; HEADER_BYTES];
-    header[..6].copy_from_slice(MAGIC);
-    header[6..8].copy_from_slice(&VERSION.to_le_bytes());
-    header[8] = K as u8;
-    header[9] = tree.level() as u8;
-    header[10] = dtype.code();
+    if let Some(f) = frame {
+        if let Err(e) = check_frame(f) {
+            return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, e));
+        }
+    }
+    let mut header = Vec::with_capacity(HEADER_BYTES + FRAME_BYTES);
+    header.extend_from_slice(MAGIC);
+    header.extend_from_slice(&VERSION.to_le_bytes());
+    header.extend_from_slice(&[K as u8, tree.level() as u8, dtype.code()]);
+    header.extend_from_slice(&[u8::from(frame.is_some()), 0, 0, 0, 0]);
+    if let Some(f) = frame {
+        for x in [f.voxel_size, f.origin[0], f.origin[1], f.origin[2]] {
+            header.extend_from_slice(&x.to_le_bytes());
+        }
+    }
     out.write_all(&header)?;
-    let mut length = HEADER_BYTES as u64;
+    let mut length = header.len() as u64;
     let mut directory = Vec::with_capacity(tree.depth_count() * ENTRY_BYTES + TAIL_BYTES);
     let mut section = Vec::new();
     for depth in 0..tree.depth_count() {
@@ -138,6 +177,32 @@ pub fn write_valued_ktree<const K: usize, V: Value>(
     hasher.update(&directory);
     directory.extend_from_slice(&hasher.finalize().to_le_bytes());
     out.write_all(&directory)
+}
+
+/// Why a world frame cannot be kept: a voxel size that is not a positive number, an origin not finite.
+fn check_frame(f: &WorldFrame) -> Result<(), String> {
+    if !(f.voxel_size.is_finite() && f.voxel_size > 0.0) {
+        return Err(format!(
+            "a frame's voxel size {} is not a positive number",
+            f.voxel_size
+        ));
+    }
+    if f.origin.iter().any(|c| !c.is_finite()) {
+        return Err(format!("a frame's origin {:?} is not finite", f.origin));
+    }
+    Ok(())
+}
+
+/// Writes a valued tree's `.ktree` file with its world frame atomically ([`write_valued_ktree_framed`]).
+///
+/// # Errors
+/// A [`FileOpError`](crate::fs::FileOpError) naming the path, its source the I/O error.
+pub fn write_valued_ktree_file_framed<const K: usize, V: Value>(
+    path: &Path,
+    tree: &KTree<K, V>,
+    frame: Option<&WorldFrame>,
+) -> Result<(), crate::fs::FileOpError> {
+    crate::fs::write_atomic_with(path, |w| write_valued_ktree_framed(w, tree, frame))
 }
 
 /// Writes a valued tree's `.ktree` file atomically (a temporary file, then renamed).
@@ -199,11 +264,25 @@ pub fn read_valued_ktree<const K: usize, V: Value>(
     bytes: &[u8],
     file: &str,
 ) -> Result<KTree<K, V>, KtreeFileError> {
+    read_valued_ktree_framed(bytes, file).map(|(tree, _)| tree)
+}
+
+/// Reads a `.ktree` file's bytes as [`read_valued_ktree`] does, with the world frame the file keeps
+/// (`None` when it keeps none; version 1 and 2 files keep none).
+///
+/// # Errors
+/// As [`read_valued_ktree`]; a frame whose voxel size is not a positive number or whose origin is not
+/// finite.
+pub fn read_valued_ktree_framed<const K: usize, V: Value>(
+    bytes: &[u8],
+    file: &str,
+) -> Result<(KTree<K, V>, Option<WorldFrame>), KtreeFileError> {
     match check_valued::<K, V>(bytes, file, true)? {
-        Checked::Binary(tree) => Ok(tree),
-        Checked::Valued { tree, .. } => {
-            Ok(tree.expect("the levels were kept: check_valued built the tree"))
-        }
+        Checked::Binary(tree) => Ok((tree, None)),
+        Checked::Valued { tree, frame, .. } => Ok((
+            tree.expect("the levels were kept: check_valued built the tree"),
+            frame,
+        )),
     }
 }
 
@@ -230,6 +309,7 @@ pub(crate) enum Checked<const K: usize, V: Value> {
         universe: Universe<K>,
         levels: Vec<ValuedLevel>,
         tree: Option<KTree<K, V>>,
+        frame: Option<WorldFrame>,
     },
 }
 
@@ -281,14 +361,21 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
             KtreeFileErrorKind::Header(format!("L = {level} exceeds {} for K = {k}", max_level(k))),
         ));
     }
-    if bytes[11..HEADER_BYTES].iter().any(|&b| b != 0) {
+    if bytes[11] > 1 {
         return Err(fail(
             11,
+            KtreeFileErrorKind::Header(format!("flags {:#04x}: only bit 0 is known", bytes[11])),
+        ));
+    }
+    if bytes[12..HEADER_BYTES].iter().any(|&b| b != 0) {
+        return Err(fail(
+            12,
             KtreeFileErrorKind::Header("reserved bytes are not 0".into()),
         ));
     }
+    let sections_at = HEADER_BYTES + if bytes[11] == 1 { FRAME_BYTES } else { 0 };
     let len = bytes.len() as u64;
-    let minimum = (HEADER_BYTES + ENTRY_BYTES + TAIL_BYTES) as u64;
+    let minimum = (sections_at + ENTRY_BYTES + TAIL_BYTES) as u64;
     if len < minimum {
         return Err(fail(
             len,
@@ -325,7 +412,7 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
     let directory_at = tail_at - directory_bytes as usize;
     let stored = u32_at(bytes, bytes.len() - 4);
     let mut hasher = crc32fast::Hasher::new();
-    hasher.update(&bytes[..HEADER_BYTES]);
+    hasher.update(&bytes[..sections_at]);
     hasher.update(&bytes[directory_at..bytes.len() - 4]);
     let computed = hasher.finalize();
     if stored != computed {
@@ -334,11 +421,21 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
             KtreeFileErrorKind::Checksum { stored, computed },
         ));
     }
+    let frame = (sections_at > HEADER_BYTES).then(|| {
+        let at = |i: usize| f64::from_bits(u64_at(bytes, HEADER_BYTES + 8 * i));
+        WorldFrame {
+            voxel_size: at(0),
+            origin: [at(1), at(2), at(3)],
+        }
+    });
+    if let Some(Err(e)) = frame.as_ref().map(check_frame) {
+        return Err(fail(16, KtreeFileErrorKind::Header(e)));
+    }
     let value_bytes = dtype.bytes();
     let mut levels = Vec::with_capacity(if keep { depth as usize } else { 0 });
     let mut values: Vec<Vec<V>> = Vec::with_capacity(if keep { depth as usize } else { 0 });
     let mut found = Vec::with_capacity(depth as usize);
-    let mut offset = HEADER_BYTES as u64;
+    let mut offset = sections_at as u64;
     let mut above_children: Option<u64> = None;
     for d in 0..depth as usize {
         let entry_at = directory_at + d * ENTRY_BYTES;
@@ -478,6 +575,7 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
             universe,
             levels: found,
             tree: None,
+            frame,
         });
     }
     let tree = KTree::from_valued_levels(universe, levels, values);
@@ -487,6 +585,7 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
         universe,
         levels: found,
         tree: Some(tree),
+        frame,
     })
 }
 
@@ -588,5 +687,46 @@ mod tests {
                 assert!(read_any_ktree(cut, "mem").is_err());
             }
         }
+    }
+
+    #[test]
+    fn a_world_frame_reads_back_and_a_damaged_one_is_refused() {
+        let tree =
+            KTree::<2, u16>::from_dense_values(1, &[Some(7), None, Some(9), Some(7)]).unwrap();
+        let frame = WorldFrame {
+            voxel_size: 0.25,
+            origin: [-3.5, 1e6, 0.0],
+        };
+        let mut bytes = Vec::new();
+        write_valued_ktree_framed(&mut bytes, &tree, Some(&frame)).unwrap();
+        let mut plain = Vec::new();
+        write_valued_ktree(&mut plain, &tree).unwrap();
+        assert_eq!(bytes.len(), plain.len() + FRAME_BYTES);
+        assert_eq!(
+            read_valued_ktree_framed::<2, u16>(&bytes, "mem").unwrap(),
+            (tree.clone(), Some(frame))
+        );
+        assert_eq!(read_valued_ktree::<2, u16>(&bytes, "mem").unwrap(), tree);
+        assert_eq!(
+            read_valued_ktree_framed::<2, u16>(&plain, "mem").unwrap(),
+            (tree.clone(), None)
+        );
+        // A changed frame byte breaks the checksum; an unknown flag is refused by name.
+        let mut damaged = bytes.clone();
+        damaged[20] ^= 1;
+        let e = read_valued_ktree::<2, u16>(&damaged, "mem").unwrap_err();
+        assert!(matches!(e.kind, KtreeFileErrorKind::Checksum { .. }), "{e}");
+        let mut flagged = bytes.clone();
+        flagged[11] = 3;
+        let e = read_valued_ktree::<2, u16>(&flagged, "mem")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("flags") && e.contains("byte 11"), "{e}");
+        // A frame no voxel can have is not written.
+        let bad = WorldFrame {
+            voxel_size: 0.0,
+            ..frame
+        };
+        assert!(write_valued_ktree_framed(&mut Vec::new(), &tree, Some(&bad)).is_err());
     }
 }
