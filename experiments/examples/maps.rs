@@ -6,6 +6,8 @@
 //! room holding the meshes of `data/meshes` (voxelized at 2 cm), written as OctoMap's `.log`;
 //! `maps sequence RES FILE.log` integrates them one after the other and prints each scan's time and the
 //! map's size after it. `maps history STEPS RES` times the history of the walking-person scene.
+//! `maps queries RES FILE N M` integrates the scan, then times the states of N points and M ray casts
+//! (OctoMap's `search` and `castRay`), both drawn by the same generator as `peers queries`.
 
 use std::time::Instant;
 
@@ -143,6 +145,40 @@ fn read_scan(path: &str) -> Vec<[f32; 3]> {
         .collect()
 }
 
+/// The generator both programs draw query points and rays from: 64-bit LCG steps, 53 bits a number in
+/// [0, 1).
+struct Draw(u64);
+
+impl Draw {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// N points in the box of the scan's points, and M ray directions, as float32 (OctoMap's precision).
+fn queries(points: &[[f32; 3]], n: usize, m: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let mut lo = [f64::MAX; 3];
+    let mut hi = [f64::MIN; 3];
+    for p in points {
+        for a in 0..3 {
+            lo[a] = lo[a].min(f64::from(p[a]));
+            hi[a] = hi[a].max(f64::from(p[a]));
+        }
+    }
+    let mut draw = Draw(42);
+    let at: Vec<[f32; 3]> = (0..n)
+        .map(|_| std::array::from_fn(|a| (lo[a] + (hi[a] - lo[a]) * draw.next()) as f32))
+        .collect();
+    let directions = (0..m)
+        .map(|_| std::array::from_fn(|_| (2.0 * draw.next() - 1.0) as f32))
+        .collect();
+    (at, directions)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     match args.get(1).map(String::as_str) {
@@ -191,6 +227,40 @@ fn main() {
                     tree.node_count()
                 );
             }
+        }
+        Some("queries") => {
+            let res: f64 = args[2].parse().expect("resolution");
+            let points = read_scan(&args[3]);
+            let (n, m): (usize, usize) = (args[4].parse().expect("N"), args[5].parse().expect("M"));
+            let mut map = OccupancyMap::<3>::new(res).unwrap();
+            map.insert(&points, [0.0; 3], None).unwrap();
+            let (at, directions) = queries(&points, n, m);
+            let mut best = (f64::MAX, f64::MAX);
+            let (mut counts, mut hits) = ([0usize; 3], 0usize);
+            for _ in 0..3 {
+                let t = Instant::now();
+                let states = map.states(&at);
+                best.0 = best.0.min(t.elapsed().as_secs_f64());
+                counts = [0; 3];
+                for s in states {
+                    counts[s as usize] += 1;
+                }
+                let t = Instant::now();
+                hits = directions
+                    .iter()
+                    .filter(|&&d| {
+                        matches!(
+                            map.cast_ray([0.0; 3], d, false, -1.0),
+                            ktree::map::CastEnd::Occupied(_)
+                        )
+                    })
+                    .count();
+                best.1 = best.1.min(t.elapsed().as_secs_f64());
+            }
+            println!("search_seconds={:.6}", best.0);
+            println!("cast_seconds={:.6}", best.1);
+            println!("unknown={} free={} occupied={}", counts[0], counts[1], counts[2]);
+            println!("hits={hits}");
         }
         Some("lidar") => lidar(&args[2], args[3].parse().expect("scans")),
         Some("sequence") => {

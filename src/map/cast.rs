@@ -43,7 +43,19 @@ impl OccupancyMap<3> {
         let Some(mut key) = grid.keys(origin) else {
             return CastEnd::Outside;
         };
-        let state = |k: [u32; 3]| self.state_of(self.log_odds().value_at(k));
+        // The leaf the ray is in (its cell: the keys' bits above `leaf.0`) and its state: looked up again
+        // only when the ray leaves it.
+        let look = |k: [u32; 3]| {
+            let (log_side, v) = self.log_odds().leaf_at(k).unwrap_or((0, None));
+            (log_side, k.map(|c| c >> log_side), self.state_of(v))
+        };
+        let mut leaf = look(key);
+        let mut state = |k: [u32; 3]| {
+            if k.map(|c| c >> leaf.0) != leaf.1 {
+                leaf = look(k);
+            }
+            leaf.2
+        };
         match state(key) {
             VoxelState::Occupied => return CastEnd::Occupied(key),
             VoxelState::Unknown if !ignore_unknown => return CastEnd::Unknown(key),

@@ -439,6 +439,29 @@ impl<const K: usize, V: Value> KTree<K, V> {
 
     /// The value of voxel `point`: `None` where it is empty or outside the universe.
     pub fn value_at(&self, point: [u32; K]) -> Option<V> {
+        self.leaf_at(point).and_then(|(_, v)| v)
+    }
+
+    /// The leaf holding voxel `point` — the log of its side and its value (`None`: empty) — or `None`
+    /// outside the universe. Every voxel of the leaf's cell (`point` with its lowest `log_side` bits
+    /// cleared on each axis) has that value, so a walk through neighbouring voxels looks again only
+    /// once it leaves the cell.
+    ///
+    /// ```
+    /// use ktree::KTree;
+    /// // A quadtree of level 2: the first quadrant holds 3, voxel (2, 0) holds 5.
+    /// let tree = KTree::<2, u8>::from_dense_values(2, &[
+    ///     Some(3), Some(3), Some(5), None,
+    ///     Some(3), Some(3), None, None,
+    ///     None, None, None, None,
+    ///     None, None, None, None,
+    /// ]).unwrap();
+    /// assert_eq!(tree.leaf_at([1, 1]), Some((1, Some(3))));
+    /// assert_eq!(tree.leaf_at([2, 0]), Some((0, Some(5))));
+    /// assert_eq!(tree.leaf_at([3, 3]), Some((1, None)));
+    /// assert_eq!(tree.leaf_at([4, 0]), None);
+    /// ```
+    pub fn leaf_at(&self, point: [u32; K]) -> Option<(u32, Option<V>)> {
         if self.universe.check_point(point).is_err() {
             return None;
         }
@@ -452,7 +475,10 @@ impl<const K: usize, V: Value> KTree<K, V> {
             depth += 1;
             code = (self.levels[depth].block_codes(index - child, K) >> (2 * child)) & 3;
         }
-        (code == 1).then(|| infallible(self.value(depth, index)))
+        Some((
+            log_side,
+            (code == 1).then(|| infallible(self.value(depth, index))),
+        ))
     }
 
     /// The leaves with their values (`None`: empty), in Morton order.

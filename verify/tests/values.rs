@@ -1,5 +1,6 @@
 //! Valued trees against the dense array of values they were made from, K = 1 … 4 and every value type: the
-//! tree is well formed and minimal, gives back every voxel's value (point by point and densely), its leaves
+//! tree is well formed and minimal, gives back every voxel's value (point by point, with the leaf holding
+//! it, and densely), its leaves
 //! cover the universe, and its shape is the binary tree of the voxels that hold a value.
 
 use ktree::tree::valued::ValueLeaves;
@@ -21,7 +22,21 @@ fn check<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseError
         );
         let p = o.universe().dense_point(i);
         prop_assert_eq!(tree.value_at(p).map(Value::key), b.map(Value::key));
+        // The leaf holding the voxel: its value there, and the same value on all of its cell.
+        let (log_side, v) = tree.leaf_at(p).unwrap();
+        prop_assert_eq!(v.map(Value::key), b.map(Value::key));
+        let side = 1usize << log_side;
+        let corner = p.map(|c| c >> log_side << log_side);
+        for j in 0..side.pow(K as u32) {
+            let q: [u32; K] =
+                std::array::from_fn(|a| corner[a] + (j / side.pow(a as u32) % side) as u32);
+            prop_assert_eq!(
+                dense[o.universe().dense_index(q)].map(Value::key),
+                b.map(Value::key)
+            );
+        }
     }
+    prop_assert_eq!(tree.leaf_at([1u32 << o.level; K]), None);
     // The leaves tile the universe.
     let volume: u128 = ValueLeaves::new(&tree).map(|l| l.unwrap().0.volume()).sum();
     prop_assert_eq!(volume, o.universe().voxels());
