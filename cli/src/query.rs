@@ -224,10 +224,10 @@ fn answer_map_points(args: &QueryArgs) -> CliResult {
 
 /// A map file and, for an OctoMap `ColorOcTree` `.ot` file, its voxels' colours.
 fn read_map_and_colours(path: &Path) -> CliResult<(OccupancyMap<3>, Option<KTree<3, Rgb>>)> {
-    let bt = path
+    let ot = path
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("bt"));
-    if !bt {
+        .is_some_and(|e| e.eq_ignore_ascii_case("ot"));
+    if ot {
         let bytes =
             std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
         let name = path.display().to_string();
