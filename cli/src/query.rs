@@ -1,5 +1,5 @@
 //! `ktree query FILE --points P [--distance] [--nearest] [--json]` (on a map file: each point unknown, free
-//! or occupied) and
+//! or occupied, and its voxel's colour in a `ColorOcTree` `.ot`) and
 //! `ktree raycast FILE --rays R [--max-t T] [--json]` (on a map file: OctoMap's castRay,
 //! `--ignore-unknown`, `--max-range`): point queries, nearest full voxels and ray casts
 //! on a tree file. A version 2 file is read through its memory map (so a tree larger than memory is
@@ -9,9 +9,11 @@ use crate::common::error::{CliError, CliResult};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use ktree::io::FileTree;
+use ktree::io::{read_color_ot_map, FileTree, GridFileErrorKind};
+use ktree::map::{OccupancyMap, SensorModel};
 use ktree::query::{self, Query, RayCast, RayHit};
-use ktree::with_tree;
+use ktree::value::Rgb;
+use ktree::{with_tree, KTree};
 
 use crate::common::error::read_error;
 
@@ -33,7 +35,8 @@ pub struct QueryArgs {
     #[arg(long)]
     nearest: bool,
     /// Print a JSON array of objects (`point`, `inside`, and `distance`, `nearest` when asked; for a map
-    /// `point` and `state`).
+    /// `point` and `state`, and `colour` for an OctoMap `ColorOcTree` .ot: `[r, g, b]`, or null where the
+    /// voxel has none).
     #[arg(long)]
     json: bool,
 }
@@ -166,7 +169,8 @@ pub fn run_query(args: QueryArgs) -> CliResult {
 }
 
 /// `ktree query` of an occupancy map (`.ot`, `.bt`): the state (unknown, free or occupied) of the voxel
-/// holding each point, the points in world coordinates (three numbers a line).
+/// holding each point, the points in world coordinates (three numbers a line); with `--json`, also the
+/// voxel's colour for a `ColorOcTree` `.ot`.
 fn answer_map_points(args: &QueryArgs) -> CliResult {
     if args.distance || args.nearest {
         return Err(format!(
@@ -175,7 +179,7 @@ fn answer_map_points(args: &QueryArgs) -> CliResult {
         )
         .into());
     }
-    let map = crate::map::read_map(&args.tree)?;
+    let (map, colours) = read_map_and_colours(&args.tree)?;
     let table = table::read::<f64>(&args.points, 3)?;
     let pts: Vec<[f32; 3]> = table
         .rows
@@ -183,6 +187,13 @@ fn answer_map_points(args: &QueryArgs) -> CliResult {
         .map(|r| [r[0] as f32, r[1] as f32, r[2] as f32])
         .collect();
     let states = map.states(&pts);
+    let colours = colours.map(|c| {
+        let keys: Vec<[u32; 3]> = pts
+            .iter()
+            .map(|&p| map.grid().keys(p).unwrap_or([u32::MAX; 3]))
+            .collect();
+        c.values_at(&keys)
+    });
     let name = |s: ktree::map::VoxelState| match s {
         ktree::map::VoxelState::Unknown => "unknown",
         ktree::map::VoxelState::Free => "free",
@@ -196,7 +207,10 @@ fn answer_map_points(args: &QueryArgs) -> CliResult {
     for (i, (row, state)) in table.rows.iter().zip(&states).enumerate() {
         if args.json {
             let sep = if i == 0 { "\n" } else { ",\n" };
-            let o = serde_json::json!({"point": row[..3].to_vec(), "state": name(*state)});
+            let mut o = serde_json::json!({"point": row[..3].to_vec(), "state": name(*state)});
+            if let Some(colours) = &colours {
+                o["colour"] = serde_json::json!(colours[i]);
+            }
             write!(w, "{sep}{o}").map_err(io)?;
         } else {
             writeln!(w, "{} {} {} {}", row[0], row[1], row[2], name(*state)).map_err(io)?;
@@ -206,6 +220,25 @@ fn answer_map_points(args: &QueryArgs) -> CliResult {
         writeln!(w, "{}]", if states.is_empty() { "" } else { "\n" }).map_err(io)?;
     }
     w.flush().map_err(io)
+}
+
+/// A map file and, for an OctoMap `ColorOcTree` `.ot` file, its voxels' colours.
+fn read_map_and_colours(path: &Path) -> CliResult<(OccupancyMap<3>, Option<KTree<3, Rgb>>)> {
+    let ot = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ot"));
+    if ot {
+        let bytes =
+            std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        let name = path.display().to_string();
+        match read_color_ot_map(&bytes, &name, SensorModel::default()) {
+            Ok((map, colours)) => return Ok((map, Some(colours))),
+            // Another tree type (an `OcTree`): read as a map without colours.
+            Err(e) if matches!(e.kind, GridFileErrorKind::Unsupported(_)) => {}
+            Err(e) => return Err(CliError::caused(e)),
+        }
+    }
+    Ok((crate::map::read_map(path)?, None))
 }
 
 /// The rays of a table, each of `2K` numbers, checked.

@@ -469,3 +469,57 @@ fn a_maps_history_and_static_map_are_written_beside_it() {
     assert!(!ok);
     assert!(err.contains("a history is written as .ktree"), "{err}");
 }
+
+#[test]
+fn queries_of_a_colour_map_report_each_voxels_colour_in_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let mut map = OccupancyMap::<3>::new(0.1).unwrap();
+    map.insert(&walls(), [2.5, 1.5, 1.2], None).unwrap();
+    // The occupied voxels of the wall y = 0 red, the others of the map uncoloured.
+    let probes = [
+        [3.0f32, 0.0, 1.05],
+        [3.0, 4.0, 1.05],
+        [2.5, 1.5, 1.2],
+        [-20.0, 5.0, 1.0],
+    ];
+    let wall = ktree::rays::ValueRuns::from_runs(
+        16,
+        (32708u32..32838).map(|x| (ktree::Ray::new([x, 32768, 32700], 32850), [200u8, 10, 10])),
+    )
+    .unwrap();
+    let colours = KTree::from_value_runs(&wall).mask(&map.occupied());
+    assert_eq!(
+        colours.value_at(map.grid().keys(probes[0]).unwrap()),
+        Some([200, 10, 10])
+    );
+    let mut bytes = Vec::new();
+    ktree::io::write_color_ot_map(&mut bytes, &map, &colours).unwrap();
+    std::fs::write(s("room.ot"), bytes).unwrap();
+    write_xyz(&dir.path().join("p.txt"), &probes);
+    let json = run(&["query", &s("room.ot"), "--points", &s("p.txt"), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let got: Vec<(&str, serde_json::Value)> = (0..4)
+        .map(|i| (v[i]["state"].as_str().unwrap(), v[i]["colour"].clone()))
+        .collect();
+    let null = serde_json::Value::Null;
+    assert_eq!(
+        got,
+        [
+            ("occupied", serde_json::json!([200, 10, 10])),
+            ("occupied", null.clone()),
+            ("free", null.clone()),
+            ("unknown", null)
+        ]
+    );
+    // Text output, and a plain OcTree's JSON, are as they were: no colour.
+    let text = run(&["query", &s("room.ot"), "--points", &s("p.txt")]);
+    assert_eq!(text.lines().next().unwrap().split(' ').count(), 4);
+    let mut plain = Vec::new();
+    ktree::io::write_ot_map(&mut plain, &map).unwrap();
+    std::fs::write(s("plain.ot"), plain).unwrap();
+    let json = run(&["query", &s("plain.ot"), "--points", &s("p.txt"), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v[0]["state"], "occupied");
+    assert!(v[0].get("colour").is_none(), "{json}");
+}

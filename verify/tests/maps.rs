@@ -14,6 +14,9 @@ use ktree::KTree;
 use ktree_verify::tools;
 use proptest::prelude::*;
 
+#[path = "maps/colours.rs"]
+mod colours;
+
 /// The smallest and largest world coordinates of voxel `key` along an axis.
 fn bounds(grid: &MapGrid, key: u32) -> (f64, f64) {
     let lo = grid.corner() + f64::from(key) * grid.resolution();

@@ -33,6 +33,9 @@ pub use grid::{GridFileError, GridFileErrorKind, GridMeta, GridPlacement, Placed
 #[cfg(feature = "volume")]
 pub use nifti::{write_nifti_file, NiftiWriteError};
 pub use octomap::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
-pub use octomap_map::{read_bt_map, read_ot_map, write_bt_map, write_ot_map, OT_HEADER};
+pub use octomap_map::{
+    read_bt_map, read_color_ot_map, read_ot_map, write_bt_map, write_color_ot_map, write_ot_map,
+    OT_HEADER,
+};
 pub use vdb::{read_vdb, write_vdb};
 pub use vdb_level_set::write_vdb_level_set;
