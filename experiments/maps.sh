@@ -42,6 +42,18 @@ for res in 0.1 0.05; do
   done
   echo "res $res done" >&2
 done
+queries=$scratch/queries.txt
+: >"$queries"
+for res in 0.1 0.05; do
+  for round in 1 2 3; do
+    {
+      echo "program=ktree res=$res"
+      RAYON_NUM_THREADS=1 "$ktree_bin" queries "$res" "$scratch/scan.dat" 1000000 20000
+      echo "program=octomap res=$res"
+      "$peers" queries "$res" "$scratch/scan.dat" 1000000 20000
+    } >>"$queries"
+  done
+done
 "$ktree_bin" lidar "$scratch/lidar.log" 40
 sequence=$scratch/sequence.txt
 : >"$sequence"
@@ -63,10 +75,10 @@ history=$scratch/history.txt
   "$ktree_bin" history 96 0.05
 } >"$history"
 load_end=$(cut -d' ' -f1-3 /proc/loadavg)
-python3 - "$rows" "$octomap_version" "$load" "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')" "$threads" "$sequence" "$history" "$load_end" >"$out.tmp" <<'PY'
+python3 - "$rows" "$octomap_version" "$load" "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')" "$threads" "$sequence" "$history" "$load_end" "$queries" >"$out.tmp" <<'PY'
 import statistics
 import sys
-rows_path, version, load, cpu, threads, sequence_path, history_path, load_end = sys.argv[1:]
+rows_path, version, load, cpu, threads, sequence_path, history_path, load_end, queries_path = sys.argv[1:]
 runs = {}
 current = None
 for line in open(rows_path):
@@ -111,6 +123,39 @@ for res in ["0.1", "0.05"]:
 print()
 print("Both maps have the same occupied and free voxels and the same log-odds (checked here by counts and "
       "the sum of the log-odds over voxels; voxel by voxel in `verify/tests/maps.rs`).")
+
+# Queries and ray casts on the map of the scan.
+q = {}
+current = None
+for line in open(queries_path):
+    fields = dict(f.split("=") for f in line.split())
+    if "program" in fields:
+        current = q.setdefault((fields["res"], fields["program"]), [])
+        current.append({})
+    else:
+        current[-1].update(fields)
+print()
+print("## Questions of a map")
+print()
+print("The map of the scan above, asked the state of 1 000 000 points drawn uniformly in the box of the scan's "
+      "points (OctoMap: `search` and `isNodeOccupied` of each; ktree: `OccupancyMap::states`, one thread), and "
+      "20 000 ray casts from the sensor in uniformly drawn directions (`castRay` with unknown voxels stopping "
+      "rays; ktree: `OccupancyMap::cast_ray`). The same draws on both sides (one generator); best of 3 in "
+      "each process, 3 rounds alternating, best kept. Both give the same counts.")
+print()
+print("| resolution | OctoMap search s | ktree s | faster | OctoMap castRay s | ktree s | faster | unknown / free / occupied | hits |")
+print("|---|---|---|---|---|---|---|---|---|")
+for res in ["0.1", "0.05"]:
+    k, o = q[(res, "ktree")], q[(res, "octomap")]
+    for key in ["unknown", "free", "occupied", "hits"]:
+        assert len({r[key] for r in k + o}) == 1, (res, key)
+    ks = min(float(r["search_seconds"]) for r in k)
+    os_ = min(float(r["search_seconds"]) for r in o)
+    kc = min(float(r["cast_seconds"]) for r in k)
+    oc = min(float(r["cast_seconds"]) for r in o)
+    r0 = k[0]
+    print(f"| {res} m | {os_:.3f} | {ks:.3f} | {os_ / ks:.2f}× | {oc:.4f} | {kc:.4f} | {oc / kc:.2f}× | "
+          f"{r0['unknown']} / {r0['free']} / {r0['occupied']} | {r0['hits']} |")
 
 # The LiDAR sequence: per program and resolution, each scan's seconds and the map's nodes after it.
 seq = {}
