@@ -145,9 +145,13 @@ class Tree:
         voxel_size: float,
         origin: Optional[Tuple[float, float, float]] = None,
         level: Optional[int] = None,
+        values: Optional[npt.ArrayLike] = None,
+        reduce: Literal["mean", "max", "min", "mode", "count"] = "mean",
     ) -> Tree:
         """The octree of the voxels holding points of an (n, 3) array: voxel floor((p - origin) / voxel_size),
-        origin default the points' minimum corner, level default the smallest holding every voxel."""
+        origin default the points' minimum corner, level default the smallest holding every voxel. With
+        `values` ((n,) numbers or (n, 3) uint8 colours) each voxel holds its points' values reduced by
+        `reduce` ("mean", "max", "min", "mode"); "count" gives each voxel its number of points (uint32)."""
     @staticmethod
     def from_volume(
         path: _Path,

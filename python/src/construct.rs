@@ -7,6 +7,7 @@ use std::ffi::CString;
 use std::path::PathBuf;
 
 use ktree::io::ReadOptions;
+use ktree::solid::cloud::CloudVoxelizer;
 use ktree::solid::mesh::{MeshTransform, Placement, TriangleMesh};
 use ktree::solid::volume::Select;
 use ktree::solid::SolidError;
@@ -162,31 +163,54 @@ impl Tree {
     /// `floor((p - origin) / voxel_size)` (as numpy computes it), `origin` defaults to the points' minimum
     /// corner and `level` to the smallest that holds every voxel; with `level` given, points outside the
     /// universe are a `ValueError`.
+    ///
+    /// With `values` (one per point: an (n,) array of numbers, or an (n, 3) uint8 array of colours) the
+    /// tree holds a value in each voxel, reduced from its points' values by `reduce`: "mean" (integers
+    /// rounded, halves up), "max", "min", "mode" (the most frequent, the smallest of equally frequent), or
+    /// "count" (the number of points, uint32; `values` may then be None). The value type follows
+    /// `from_dense`: float arrays give float32, integer arrays the smallest integer type holding them.
     #[staticmethod]
-    #[pyo3(signature = (points, voxel_size, origin = None, level = None))]
+    #[pyo3(signature = (points, voxel_size, origin = None, level = None, values = None, reduce = "mean"))]
+    #[allow(clippy::too_many_arguments)]
     fn from_points(
         py: Python<'_>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
         voxel_size: f64,
         origin: Option<[f64; 3]>,
         level: Option<u32>,
+        values: Option<&Bound<'_, PyAny>>,
+        reduce: &str,
     ) -> PyResult<Self> {
         let numbers = Numbers::new(points);
         numbers.rows_of(3, false, "points")?;
         let points = rows::<3, _>(numbers.flat());
-        let tree = py.detach(|| KTree::from_points(points, voxel_size, origin, level));
-        let hint = match &tree {
-            Err(SolidError::PointsOutside { .. }) => {
+        let hint = |e: &SolidError| match e {
+            SolidError::PointsOutside { .. } => {
                 ": use a larger level or voxel_size, or another origin"
             }
-            Err(SolidError::PointBelowOrigin { .. }) => {
+            SolidError::PointBelowOrigin { .. } => {
                 ": give another origin (or none: the points' minimum corner)"
             }
             _ => "",
         };
-        Ok(Tree::wrap(
-            tree.map_err(|e| Failure::Value(format!("{e}{hint}")))?,
-        ))
+        if values.is_some() || reduce != "mean" {
+            let mut voxelizer = CloudVoxelizer::new(voxel_size)
+                .map_err(|e| Failure::Value(format!("from_points: {e}")))?;
+            if let Some(o) = origin {
+                voxelizer = voxelizer.origin(o);
+            }
+            if let Some(l) = level {
+                voxelizer = voxelizer.level(l);
+            }
+            let tree =
+                crate::point_values::tree_of_point_values(py, points, &voxelizer, values, reduce)?;
+            return Ok(Self::valued(tree, 0.0));
+        }
+        let tree = py.detach(|| KTree::from_points(points, voxel_size, origin, level));
+        Ok(Tree::wrap(tree.map_err(|e| {
+            let h = hint(&e);
+            Failure::Value(format!("{e}{h}"))
+        })?))
     }
 
     /// The octree of a volume file (a .json sidecar or its .raw, .nii, .nii.gz): samples with value

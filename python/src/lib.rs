@@ -58,6 +58,7 @@ mod failure;
 mod files;
 mod geometry;
 mod map;
+mod point_values;
 mod query;
 mod rays;
 mod shape;

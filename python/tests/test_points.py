@@ -56,3 +56,64 @@ def test_from_points_errors():
         ktree.Tree.from_points(p, 0.0)
     with pytest.raises(ValueError, match=r"\(n, 3\)"):
         ktree.Tree.from_points(np.zeros((4, 2)), 1.0)
+
+
+def groups(points, s, origin):
+    """The voxel keys of the points (unique rows) and, for each point, the index of its voxel."""
+    keys = np.floor((points - origin) / s).astype(np.int64)
+    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+    return unique, inverse.reshape(-1)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_from_points_with_values_reduces_each_voxels_points_as_numpy(seed):
+    rng = np.random.default_rng(seed)
+    n = 600
+    points = rng.uniform(0.0, 6.0, size=(n, 3))
+    s = 1.0
+    keys, of = groups(points, s, points.min(axis=0))
+    members = [of == g for g in range(len(keys))]
+    floats = rng.normal(size=n)
+    for reduce, fn in [("max", np.max), ("min", np.min), ("mean", np.mean)]:
+        t = ktree.Tree.from_points(points, s, values=floats, reduce=reduce)
+        assert t.dtype == "float32" and t.voxel_count == len(keys)
+        want = np.array([fn(floats[m]) for m in members]).astype(np.float32)
+        if reduce == "mean":  # summed in another order than numpy's pairwise sum
+            np.testing.assert_allclose(t.values(keys), want, rtol=1e-6)
+        else:
+            np.testing.assert_array_equal(t.values(keys), want)
+    labels = rng.integers(0, 5, size=n).astype(np.uint8)
+    t = ktree.Tree.from_points(points, s, values=labels, reduce="mode")
+    assert t.dtype == "uint8"
+    # np.argmax takes the first of equal counts: the smallest label, as ktree does.
+    want = np.array([np.argmax(np.bincount(labels[m], minlength=5)) for m in members])
+    np.testing.assert_array_equal(t.values(keys), want)
+    wide = labels.astype(np.int64) * 1000
+    t = ktree.Tree.from_points(points, s, values=wide, reduce="mean")
+    assert t.dtype == "uint16"
+    want = np.floor(np.array([wide[m].mean() for m in members]) + 0.5)
+    np.testing.assert_array_equal(t.values(keys), want)
+    colours = rng.integers(0, 256, size=(n, 3)).astype(np.uint8)
+    t = ktree.Tree.from_points(points, s, values=colours)
+    assert t.dtype == "rgb8"
+    want = np.floor(np.array([colours[m].mean(axis=0) for m in members]) + 0.5)
+    np.testing.assert_array_equal(t.values(keys), want)
+    t = ktree.Tree.from_points(points, s, reduce="count")
+    assert t.dtype == "uint32"
+    np.testing.assert_array_equal(t.values(keys), np.bincount(of))
+    # The voxels are those of the points without values.
+    assert t.shape() == ktree.Tree.from_points(points, s)
+
+
+def test_from_points_with_bad_values_is_an_error():
+    p = np.array([[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="reduce"):
+        ktree.Tree.from_points(p, 1.0, values=[1.0, 2.0], reduce="median")
+    with pytest.raises(ValueError, match="shape"):
+        ktree.Tree.from_points(p, 1.0, values=[1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match="NaN"):
+        ktree.Tree.from_points(p, 1.0, values=[1.0, np.nan])
+    with pytest.raises(ValueError, match="needs values"):
+        ktree.Tree.from_points(p, 1.0, reduce="max")
+    with pytest.raises(ValueError, match="colours"):
+        ktree.Tree.from_points(p, 1.0, values=np.zeros((2, 3), np.uint8), reduce="max")
