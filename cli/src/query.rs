@@ -1,5 +1,6 @@
-//! `ktree query FILE --points P [--distance] [--nearest] [--json]` (on a map file: each point unknown, free
-//! or occupied, and its voxel's colour in a `ColorOcTree` `.ot`) and
+//! `ktree query FILE --points P [--distance] [--nearest] [--json]` (on a tree with values: each point's
+//! value too; on a map file: each point unknown, free or occupied, and its voxel's colour in a
+//! `ColorOcTree` `.ot`) and
 //! `ktree raycast FILE --rays R [--max-t T] [--json]` (on a map file: OctoMap's castRay,
 //! `--ignore-unknown`, `--max-range`): point queries, nearest full voxels and ray casts
 //! on a tree file. A version 2 file is read through its memory map (so a tree larger than memory is
@@ -12,8 +13,10 @@ use std::path::{Path, PathBuf};
 use ktree::io::{read_color_ot_map, FileTree, GridFileErrorKind};
 use ktree::map::{OccupancyMap, SensorModel};
 use ktree::query::{self, Query, RayCast, RayHit};
+use ktree::tree::AnyValuedTree;
 use ktree::value::Rgb;
-use ktree::{with_tree, KTree};
+use ktree::value::{Dtype, Value};
+use ktree::{with_tree, with_valued, KTree};
 
 use crate::common::error::read_error;
 
@@ -34,7 +37,8 @@ pub struct QueryArgs {
     /// Also print the nearest full voxel.
     #[arg(long)]
     nearest: bool,
-    /// Print a JSON array of objects (`point`, `inside`, and `distance`, `nearest` when asked; for a map
+    /// Print a JSON array of objects (`point`, `inside`, and `distance`, `nearest` when asked, `value` for
+    /// a tree with values: a number, `[r, g, b]`, or null where the voxel is empty; for a map
     /// `point` and `state`, and `colour` for an OctoMap `ColorOcTree` .ot: `[r, g, b]`, or null where the
     /// voxel has none).
     #[arg(long)]
@@ -84,8 +88,37 @@ fn points<const K: usize>(t: &table::Table<i64>) -> Vec<[i64; K]> {
         .collect()
 }
 
-/// Answers the point queries on `tree` and prints them.
-fn answer_points<const K: usize, T: Query<K>>(tree: &T, args: &QueryArgs) -> CliResult {
+/// The values of a valued tree at voxels (`K` coordinates each, the tree's own `K`), as JSON (null where
+/// empty).
+fn values_at<const K: usize>(tree: &AnyValuedTree, voxels: &[[u32; K]]) -> Vec<serde_json::Value> {
+    fn json<V: Value>(v: V) -> serde_json::Value {
+        let text = v.text();
+        let parsed = if V::DTYPE == Some(Dtype::Rgb) {
+            serde_json::from_str(&format!("[{text}]"))
+        } else {
+            serde_json::from_str(&text)
+        };
+        // A float without a JSON number (an infinity) as its text.
+        parsed.unwrap_or(serde_json::Value::String(text))
+    }
+    with_valued!(tree, t => {
+        let points: Vec<_> = voxels
+            .iter()
+            .map(|p| std::array::from_fn(|a| p.get(a).copied().unwrap_or(u32::MAX)))
+            .collect();
+        t.values_at(&points)
+            .into_iter()
+            .map(|v| v.map_or(serde_json::Value::Null, json))
+            .collect()
+    })
+}
+
+/// Answers the point queries on `tree` (with its values' tree if it has values) and prints them.
+fn answer_points<const K: usize, T: Query<K>>(
+    tree: &T,
+    args: &QueryArgs,
+    valued: Option<&AnyValuedTree>,
+) -> CliResult {
     let table = table::read::<i64>(&args.points, K)?;
     let pts = points::<K>(&table);
     // Points beyond the u32 range are outside every universe.
@@ -94,6 +127,7 @@ fn answer_points<const K: usize, T: Query<K>>(tree: &T, args: &QueryArgs) -> Cli
         .map(|p| p.map(|v| u32::try_from(v).unwrap_or(u32::MAX)))
         .collect();
     let inside = tree.contains_many(&voxels).map_err(read_error)?;
+    let values = valued.map(|v| values_at(v, &voxels));
     let near = if args.distance || args.nearest {
         query::nearest_many_signed(tree, &pts).map_err(read_error)?
     } else {
@@ -123,6 +157,9 @@ fn answer_points<const K: usize, T: Query<K>>(tree: &T, args: &QueryArgs) -> Cli
                     serde_json::json!(n.map(|n| n.voxel.to_vec())),
                 );
             }
+            if let Some(values) = &values {
+                o.insert("value".into(), values[i].clone());
+            }
             let sep = if i == 0 { "\n" } else { ",\n" };
             write!(w, "{sep}{}", serde_json::Value::Object(o)).map_err(io)?;
             continue;
@@ -135,6 +172,9 @@ fn answer_points<const K: usize, T: Query<K>>(tree: &T, args: &QueryArgs) -> Cli
             if inside[i] { "inside" } else { "outside" }
         )
         .map_err(io)?;
+        if let Some(v) = values.as_ref().map(|v| &v[i]).filter(|v| !v.is_null()) {
+            write!(w, " value {v}").map_err(io)?;
+        }
         if args.distance {
             match n {
                 Some(n) => write!(w, " distance {}", n.distance()),
@@ -165,7 +205,12 @@ pub fn run_query(args: QueryArgs) -> CliResult {
     if crate::project::is_map_file(&args.tree) {
         return answer_map_points(&args);
     }
-    with_tree!(&open(&args.tree)?, t => answer_points(t, &args))
+    if crate::values::is_valued(&args.tree) {
+        let valued = crate::values::read_valued(&args.tree)?;
+        let shape = FileTree::Memory(valued.shape());
+        return with_tree!(&shape, t => answer_points(t, &args, Some(&valued)));
+    }
+    with_tree!(&open(&args.tree)?, t => answer_points(t, &args, None))
 }
 
 /// `ktree query` of an occupancy map (`.ot`, `.bt`): the state (unknown, free or occupied) of the voxel

@@ -45,7 +45,7 @@ pub fn is_valued(path: &Path) -> bool {
 }
 
 /// A valued `.ktree` file's tree, of the dimension and value type its header names.
-fn read_valued(path: &Path) -> Result<AnyValuedTree, String> {
+pub fn read_valued(path: &Path) -> Result<AnyValuedTree, String> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
     match read_any_ktree(&bytes, &name).map_err(|e| chain(&e))? {

@@ -242,7 +242,72 @@ fn values_on_the_command_line_fail_clearly() {
         "{err}"
     );
     // The binary readers name the value type.
-    std::fs::write(p("points.csv"), "0,0,0\n").unwrap();
-    let (ok, _, err) = ktree(&["query", &p("l.ktree"), "--points", &p("points.csv")]);
+    std::fs::write(p("rays.csv"), "0,0,0,1,0,0\n").unwrap();
+    let (ok, _, err) = ktree(&["raycast", &p("l.ktree"), "--rays", &p("rays.csv")]);
     assert!(!ok && err.contains("uint16"), "{err}");
+}
+
+#[test]
+fn queries_of_a_tree_with_values_give_each_points_value() {
+    use ktree::io::ktree::v3::write_valued_ktree_file;
+    use ktree::KTree;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    // Labels 0..5 in a 8 × 8 × 8 universe (0 empty), colours in a 4 × 4 quadtree.
+    let dense: Vec<Option<u16>> = (0..512u16)
+        .map(|i| Some(i * 7 % 5).filter(|&v| v > 0))
+        .collect();
+    let labels = KTree::<3, u16>::from_dense_values(3, &dense).unwrap();
+    write_valued_ktree_file(Path::new(&p("labels.ktree")), &labels).unwrap();
+    let colours: Vec<Option<[u8; 3]>> = (0..16u8)
+        .map(|i| (i % 3 != 0).then_some([i, 2 * i, 255]))
+        .collect();
+    let painted = KTree::<2, [u8; 3]>::from_dense_values(2, &colours).unwrap();
+    write_valued_ktree_file(Path::new(&p("colours.ktree")), &painted).unwrap();
+    let points: Vec<[u32; 3]> = (0..40u32).map(|i| [i % 9, i * 3 % 8, i * 5 % 10]).collect();
+    let text: String = points
+        .iter()
+        .map(|q| format!("{},{},{}\n", q[0], q[1], q[2]))
+        .collect();
+    std::fs::write(p("points.csv"), text).unwrap();
+    let out = run(&[
+        "query",
+        &p("labels.ktree"),
+        "--points",
+        &p("points.csv"),
+        "--json",
+    ]);
+    let rows: Vec<serde_json::Value> = serde_json::from_str(&out).unwrap();
+    assert_eq!(rows.len(), points.len());
+    for (row, q) in rows.iter().zip(&points) {
+        let want = labels.value_at(*q);
+        assert_eq!(row["value"], serde_json::json!(want), "{q:?}");
+        assert_eq!(row["inside"], serde_json::json!(want.is_some()), "{q:?}");
+    }
+    // The text lines end with the value where there is one.
+    let out = run(&["query", &p("labels.ktree"), "--points", &p("points.csv")]);
+    for (line, q) in out.lines().zip(&points) {
+        match labels.value_at(*q) {
+            Some(v) => assert!(line.ends_with(&format!("inside value {v}")), "{line}"),
+            None => assert!(line.ends_with("outside"), "{line}"),
+        }
+    }
+    std::fs::write(p("cells.csv"), "1,0\n2,0\n3,0\n").unwrap();
+    let out = run(&[
+        "query",
+        &p("colours.ktree"),
+        "--points",
+        &p("cells.csv"),
+        "--json",
+    ]);
+    let rows: Vec<serde_json::Value> = serde_json::from_str(&out).unwrap();
+    let values: Vec<_> = rows.iter().map(|r| r["value"].clone()).collect();
+    assert_eq!(
+        values,
+        [
+            serde_json::json!([1, 2, 255]),
+            serde_json::json!([2, 4, 255]),
+            serde_json::Value::Null
+        ]
+    );
 }
