@@ -103,8 +103,9 @@ impl HistoryRecorder {
         self.steps.len()
     }
 
-    /// The history of the steps recorded: one 4-D tree built from the top down, a cell a leaf where every
-    /// step in its span of time has one state all over its 3-D part.
+    /// The history of the steps recorded: one 4-D tree of their changes built from the top down, a cell
+    /// empty where no step in its span of time changes its 3-D part, a leaf where every step in the span
+    /// has one state all over it.
     pub fn finish(&self) -> MapHistory {
         MapHistory {
             grid: self.grid,
