@@ -46,6 +46,30 @@ use crate::tree::top_down::{build_top_down, Decision};
 use crate::tree::TreeError;
 use crate::KTree;
 
+/// Checks rays before they change a map: every end (`end`, with `{i}` for its index) and the origin
+/// (`start`) finite, the maximum range a distance.
+fn check_rays<const K: usize>(
+    ends: &[[f32; K]],
+    origin: [f32; K],
+    max_range: Option<f64>,
+    end: &str,
+    start: &str,
+) -> Result<(), String> {
+    if let Some(i) = ends.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        let end = end.replace("{i}", &i.to_string());
+        return Err(format!("{end} has a coordinate that is not finite"));
+    }
+    if origin.iter().any(|c| !c.is_finite()) {
+        return Err(format!("{start} has a coordinate that is not finite"));
+    }
+    if let Some(m) = max_range.filter(|m| m.is_nan() || *m < 0.0) {
+        return Err(format!(
+            "the maximum range {m} is not a distance (0 or more)"
+        ));
+    }
+    Ok(())
+}
+
 /// What a map knows of a voxel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum VoxelState {
@@ -147,19 +171,13 @@ impl<const K: usize> OccupancyMap<K> {
         origin: [f32; K],
         max_range: Option<f64>,
     ) -> Result<ScanUpdate, String> {
-        if let Some(i) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(format!(
-                "point {i} of the scan has a coordinate that is not finite"
-            ));
-        }
-        if origin.iter().any(|c| !c.is_finite()) {
-            return Err("the sensor origin has a coordinate that is not finite".into());
-        }
-        if let Some(m) = max_range.filter(|m| m.is_nan() || *m < 0.0) {
-            return Err(format!(
-                "the maximum range {m} is not a distance (0 or more)"
-            ));
-        }
+        check_rays(
+            points,
+            origin,
+            max_range,
+            "point {i} of the scan",
+            "the sensor origin",
+        )?;
         let update = ScanUpdate::compute(&self.grid, points, origin, max_range);
         self.log_odds = apply(&self.log_odds, &update.voxels, &self.model);
         Ok(update)

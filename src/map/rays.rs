@@ -66,19 +66,13 @@ impl<const K: usize> OccupancyMap<K> {
         ends: &[[f32; K]],
         max_range: Option<f64>,
     ) -> Result<usize, String> {
-        if let Some(i) = ends.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(format!(
-                "the end of ray {i} has a coordinate that is not finite"
-            ));
-        }
-        if origin.iter().any(|c| !c.is_finite()) {
-            return Err("the rays' origin has a coordinate that is not finite".into());
-        }
-        if let Some(m) = max_range.filter(|m| m.is_nan() || *m < 0.0) {
-            return Err(format!(
-                "the maximum range {m} is not a distance (0 or more)"
-            ));
-        }
+        super::check_rays(
+            ends,
+            origin,
+            max_range,
+            "the end of ray {i}",
+            "the rays' origin",
+        )?;
         let grid = *self.grid();
         let model = *self.model();
         let tree = &self.log_odds;

@@ -34,13 +34,13 @@
 
 use std::ops::Range;
 
+use super::values::Failure;
 use super::OpsError;
 use crate::space::{Cell, Universe};
 use crate::tree::cursor::{try_walk, Visitor, Walk};
 use crate::tree::storage::TreeStorage;
 use crate::tree::top_down::{build_top_down, Decision, InputNode};
 use crate::tree::valued::ValueState;
-use crate::tree::TreeError;
 use crate::tree::{DimensionMismatch, KTree, NodeRef, NodeState};
 
 /// The `J = K − 1`-dimensional tree of the voxels of `tree` at `position` along `axis`.
@@ -173,15 +173,6 @@ pub fn extrude<const J: usize, const K: usize, T: TreeStorage<J>>(
         level,
         max: crate::max_level(K),
     })?;
-    enum Failure<E> {
-        Read(E),
-        Tree(TreeError),
-    }
-    impl<E> From<TreeError> for Failure<E> {
-        fn from(e: TreeError) -> Self {
-            Failure::Tree(e)
-        }
-    }
     let (lo, hi) = (u64::from(range.start), u64::from(range.end));
     // The child of a K-cell without its bit along `axis` is the child of the J-cell it stands on.
     let low_bits = (1usize << axis) - 1;
@@ -205,11 +196,8 @@ pub fn extrude<const J: usize, const K: usize, T: TreeStorage<J>>(
             node.binary_child(tree, lower).map_err(Failure::Read)
         },
     );
-    built.map_err(|e| match e {
-        Failure::Read(e) => OpsError::storage(e),
-        // Its level was checked, it splits no voxel and holds no value.
-        Failure::Tree(e) => unreachable!("an extrusion is a valid tree: {e}"),
-    })
+    // Its level was checked, it splits no voxel and holds no value: only a read can fail.
+    built.map_err(|e| OpsError::storage(e.into_read()))
 }
 
 /// Joins every complete block of `2^J` sibling cells into their parent, repeatedly. `cells` must be

@@ -136,7 +136,7 @@ pub enum MapError<E> {
 
 /// The builder's error inside an operation: a read of an input or the tree's.
 #[derive(Debug)]
-enum Failure<E> {
+pub(crate) enum Failure<E> {
     Read(E),
     Tree(TreeError),
 }
@@ -149,7 +149,7 @@ impl<E> From<TreeError> for Failure<E> {
 
 impl<E> Failure<E> {
     /// The read error of an operation whose tree cannot be refused (its values are its input's).
-    fn into_read(self) -> E {
+    pub(crate) fn into_read(self) -> E {
         match self {
             Failure::Read(e) => e,
             Failure::Tree(e) => unreachable!("a tree of input values or none is valid: {e}"),
