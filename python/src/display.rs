@@ -125,7 +125,7 @@ pub(crate) fn view_direction(view: &Bound<'_, PyAny>) -> PyResult<View> {
         return Ok(name
             .to_str()?
             .parse()
-            .map_err(|e: display::ViewError| Failure::Value(e.to_string()))?);
+            .map_err(|e: display::ParseViewError| Failure::Value(e.to_string()))?);
     }
     let v: [f64; 3] = view.extract().map_err(|_| {
         Failure::Value("a view is a name or three numbers (x, y, z) towards the viewer".into())

@@ -54,5 +54,5 @@ pub use painter::render_back_to_front;
 #[cfg(feature = "png")]
 pub use raster::render_png;
 pub use raster::{render, render_with_progress, Paint, RenderOptions, RenderStats, Rendered};
-pub use view::{View, ViewError, NAMED_VIEWS};
+pub use view::{ParseViewError, View, NAMED_VIEWS};
 pub use zbuffer::render_zbuffer;

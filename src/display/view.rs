@@ -35,7 +35,7 @@ pub const NAMED_VIEWS: [(&str, [f64; 3]); 7] = [
 
 /// Why a text is not a view.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum ViewError {
+pub enum ParseViewError {
     /// Neither a name nor three numbers.
     #[error("view '{0}' must be iso, top, bottom, front, back, left, right or X,Y,Z")]
     Unknown(String),
@@ -48,14 +48,14 @@ impl View {
     /// The view towards the eye along `direction`.
     ///
     /// # Errors
-    /// [`ViewError::Degenerate`] for a zero or non-finite direction.
-    pub fn new(direction: [f64; 3]) -> Result<Self, ViewError> {
+    /// [`ParseViewError::Degenerate`] for a zero or non-finite direction.
+    pub fn new(direction: [f64; 3]) -> Result<Self, ParseViewError> {
         if direction.iter().all(|x| x.is_finite()) && direction.iter().any(|&x| x != 0.0) {
             Ok(Self {
                 toward_eye: direction,
             })
         } else {
-            Err(ViewError::Degenerate(format!(
+            Err(ParseViewError::Degenerate(format!(
                 "{},{},{}",
                 direction[0], direction[1], direction[2]
             )))
@@ -78,9 +78,9 @@ impl Default for View {
 }
 
 impl FromStr for View {
-    type Err = ViewError;
+    type Err = ParseViewError;
 
-    fn from_str(text: &str) -> Result<Self, ViewError> {
+    fn from_str(text: &str) -> Result<Self, ParseViewError> {
         let name = text.trim();
         if let Some((_, direction)) = NAMED_VIEWS.iter().find(|(n, _)| *n == name) {
             return Ok(Self {
@@ -91,11 +91,11 @@ impl FromStr for View {
             .split(',')
             .map(|x| x.trim().parse::<f64>())
             .collect::<Result<_, _>>()
-            .map_err(|_| ViewError::Unknown(text.to_string()))?;
+            .map_err(|_| ParseViewError::Unknown(text.to_string()))?;
         let [x, y, z] = numbers[..] else {
-            return Err(ViewError::Unknown(text.to_string()));
+            return Err(ParseViewError::Unknown(text.to_string()));
         };
-        Self::new([x, y, z]).map_err(|_| ViewError::Degenerate(text.to_string()))
+        Self::new([x, y, z]).map_err(|_| ParseViewError::Degenerate(text.to_string()))
     }
 }
 

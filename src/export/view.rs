@@ -102,7 +102,7 @@ pub struct Page {
 /// Why a view could not be made.
 #[derive(Debug, Error)]
 #[non_exhaustive]
-pub enum ViewError {
+pub enum ViewPageError {
     /// Bintrees have no 3-D view.
     #[error("a bintree (K = 1) has no 3-D view; view needs K = 2, 3 or 4")]
     Bintree,
@@ -195,21 +195,21 @@ fn pack<const K: usize>(lod: &Lod<K>, level: u32) -> (String, Vec<u8>) {
 /// The page showing `tree` (see the [module docs](self)).
 ///
 /// # Errors
-/// [`ViewError::Bintree`] for K = 1, [`ViewError::ZeroBudget`], [`ViewError::BadTimeAxis`] for a 4-D
-/// tree, [`ViewError::Read`] from the storage.
+/// [`ViewPageError::Bintree`] for K = 1, [`ViewPageError::ZeroBudget`], [`ViewPageError::BadTimeAxis`] for a 4-D
+/// tree, [`ViewPageError::Read`] from the storage.
 pub fn view_page<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     options: &ViewOptions,
-) -> Result<Page, ViewError> {
+) -> Result<Page, ViewPageError> {
     if K == 1 {
-        return Err(ViewError::Bintree);
+        return Err(ViewPageError::Bintree);
     }
     if options.budget == 0 {
-        return Err(ViewError::ZeroBudget);
+        return Err(ViewPageError::ZeroBudget);
     }
     let time = if K == 4 {
         if options.time_axis >= K {
-            return Err(ViewError::BadTimeAxis {
+            return Err(ViewPageError::BadTimeAxis {
                 axis: options.time_axis,
                 k: K,
             });
@@ -225,7 +225,7 @@ pub fn view_page<const K: usize, T: TreeStorage<K>>(
     };
     let level = tree.level();
     let lod =
-        select_boxes(tree, options.budget, &axes).map_err(|e| ViewError::Read(Box::new(e)))?;
+        select_boxes(tree, options.budget, &axes).map_err(|e| ViewPageError::Read(Box::new(e)))?;
     let (groups, bytes) = pack(&lod, level);
     let camera = options.camera.unwrap_or_else(|| {
         if K == 2 { "top" } else { "iso" }
@@ -263,14 +263,14 @@ pub fn view_page<const K: usize, T: TreeStorage<K>>(
 /// Writes [`view_page`] of `tree` to `path` atomically.
 ///
 /// # Errors
-/// As [`view_page`]; [`ViewError::Write`] from the file system.
+/// As [`view_page`]; [`ViewPageError::Write`] from the file system.
 pub fn write_view<const K: usize, T: TreeStorage<K>>(
     path: &Path,
     tree: &T,
     options: &ViewOptions,
-) -> Result<Page, ViewError> {
+) -> Result<Page, ViewPageError> {
     let page = view_page(tree, options)?;
-    write_atomic(path, page.html.as_bytes()).map_err(ViewError::Write)?;
+    write_atomic(path, page.html.as_bytes()).map_err(ViewPageError::Write)?;
     Ok(page)
 }
 
@@ -314,7 +314,7 @@ mod tests {
         let bin = KTree::<1>::full(2).unwrap();
         assert!(matches!(
             view_page(&bin, &ViewOptions::default()),
-            Err(ViewError::Bintree)
+            Err(ViewPageError::Bintree)
         ));
         let t4 = KTree::<4>::full(2).unwrap();
         let bad = ViewOptions {
@@ -323,7 +323,7 @@ mod tests {
         };
         assert!(matches!(
             view_page(&t4, &bad),
-            Err(ViewError::BadTimeAxis { axis: 4, k: 4 })
+            Err(ViewPageError::BadTimeAxis { axis: 4, k: 4 })
         ));
     }
 }

@@ -36,7 +36,7 @@ pub use boxes::{bounding_box, count, crop, VoxelBox};
 pub use dense::{dense_window, dense_window_into, window_voxels, DenseError, DenseOrder};
 pub use nearest::{distance, nearest, nearest_many, nearest_many_signed, nearest_signed, Nearest};
 pub use points::{contains, contains_many, contains_many_signed, PointCursor};
-pub use ray::{cast_ray, cast_rays, Face, RayCast, RayError, RayHit};
+pub use ray::{cast_ray, cast_rays, CastError, Face, RayCast, RayHit};
 pub use stats::{stats, TreeStats};
 pub use values::{first_values, values_at};
 
@@ -239,13 +239,13 @@ impl<const K: usize> KTree<K> {
     /// ```
     ///
     /// # Errors
-    /// [`RayError`] for an infinite or NaN coordinate or a NaN or negative `max_t`.
+    /// [`CastError`] for an infinite or NaN coordinate or a NaN or negative `max_t`.
     pub fn cast_ray(
         &self,
         origin: [f64; K],
         direction: [f64; K],
         max_t: f64,
-    ) -> Result<Option<RayHit<K>>, RayError> {
+    ) -> Result<Option<RayHit<K>>, CastError> {
         let ray = RayCast::new(origin, direction, max_t)?;
         Ok(infallible(cast_ray(self, &ray)))
     }

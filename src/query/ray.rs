@@ -33,7 +33,7 @@ use crate::tree::NodeState;
 /// Why a ray cannot be cast.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
-pub enum RayError {
+pub enum CastError {
     /// A coordinate of the origin or the direction is infinite or NaN: give finite numbers.
     #[error("the ray's {part} has {value} on axis {axis}: coordinates must be finite")]
     NotFinite {
@@ -73,12 +73,12 @@ impl<const K: usize> RayCast<K> {
     /// The ray from `origin` along `direction`, up to the parameter `max_t`.
     ///
     /// # Errors
-    /// [`RayError::NotFinite`] for an infinite or NaN coordinate, [`RayError::MaxT`] for a NaN or
+    /// [`CastError::NotFinite`] for an infinite or NaN coordinate, [`CastError::MaxT`] for a NaN or
     /// negative `max_t`.
-    pub fn new(origin: [f64; K], direction: [f64; K], max_t: f64) -> Result<Self, RayError> {
+    pub fn new(origin: [f64; K], direction: [f64; K], max_t: f64) -> Result<Self, CastError> {
         for (part, v) in [("origin", &origin), ("direction", &direction)] {
             if let Some(axis) = v.iter().position(|x| !x.is_finite()) {
-                return Err(RayError::NotFinite {
+                return Err(CastError::NotFinite {
                     part,
                     axis,
                     value: v[axis],
@@ -86,7 +86,7 @@ impl<const K: usize> RayCast<K> {
             }
         }
         if max_t.is_nan() || max_t < 0.0 {
-            return Err(RayError::MaxT { value: max_t });
+            return Err(CastError::MaxT { value: max_t });
         }
         Ok(Self {
             origin,
