@@ -22,6 +22,7 @@ mod triangles;
 use std::collections::HashMap;
 
 use crate::radix;
+use crate::rays::stretches;
 use crate::tree::storage::TreeStorage;
 
 use super::section::{section, Pieces, Slab};
@@ -416,35 +417,14 @@ impl Sweep {
 }
 
 /// The stretches along a line where exactly one of two sets of runs is full, in order, as `(z0, z1,
-/// whether it is the first)`.
+/// whether it is the first)`: the one merge's [`stretches`] where the memberships differ.
 fn xor_runs(first: &[(u32, u32)], second: &[(u32, u32)], out: &mut Vec<(u32, u32, bool)>) {
     out.clear();
-    let end_at = |runs: &[(u32, u32)], k: usize| {
-        runs.get(k / 2)
-            .map_or(u32::MAX, |r| if k.is_multiple_of(2) { r.0 } else { r.1 })
-    };
-    let (mut i, mut j) = (0, 0);
-    let (mut in_first, mut in_second) = (false, false);
-    let mut from = 0;
-    loop {
-        let (zi, zj) = (end_at(first, i), end_at(second, j));
-        let z = zi.min(zj);
-        if z == u32::MAX {
-            break;
-        }
-        if in_first != in_second && z > from {
-            out.push((from, z, in_first));
-        }
-        if zi == z {
-            in_first = !in_first;
-            i += 1;
-        }
-        if zj == z {
-            in_second = !in_second;
-            j += 1;
-        }
-        from = z;
-    }
+    out.extend(
+        stretches(first, second)
+            .filter(|s| s.first != s.second)
+            .map(|s| (s.z1, s.z2, s.first)),
+    );
 }
 
 /// A row's intervals `(upper, lo, hi)` by `(upper, lo)` from the stretches of [`xor_runs`] (`upper`: the
