@@ -2,6 +2,7 @@
 //! file and a byte offset or a line) with the format's own kind of problem.
 
 use std::fmt;
+use std::path::{Path, PathBuf};
 
 /// A place in an input: a byte offset (binary formats), a 1-based line (text formats), or the whole file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -25,14 +26,14 @@ pub enum Place {
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct Location {
     /// The file, or a name for the input.
-    pub file: String,
+    pub file: PathBuf,
     /// The place in it.
     pub place: Place,
 }
 
 impl Location {
     /// A place in a file.
-    pub fn new(file: impl Into<String>, place: Place) -> Self {
+    pub fn new(file: impl Into<PathBuf>, place: Place) -> Self {
         Self {
             file: file.into(),
             place,
@@ -43,9 +44,9 @@ impl Location {
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.place {
-            Place::Whole => write!(f, "{}", self.file),
-            Place::Byte(offset) => write!(f, "{}: byte {offset}", self.file),
-            Place::Line(line) => write!(f, "{}:{line}", self.file),
+            Place::Whole => write!(f, "{}", self.file.display()),
+            Place::Byte(offset) => write!(f, "{}: byte {offset}", self.file.display()),
+            Place::Line(line) => write!(f, "{}:{line}", self.file.display()),
         }
     }
 }
@@ -76,7 +77,7 @@ pub struct FileError<Kind> {
 
 impl<Kind> FileError<Kind> {
     /// A problem at a byte offset of `file`.
-    pub fn at_byte(file: impl Into<String>, offset: u64, kind: Kind) -> Self {
+    pub fn at_byte(file: impl Into<PathBuf>, offset: u64, kind: Kind) -> Self {
         Self {
             location: Location::new(file, Place::Byte(offset)),
             kind,
@@ -84,7 +85,7 @@ impl<Kind> FileError<Kind> {
     }
 
     /// A problem on a 1-based line of `file` (line 0: the whole file).
-    pub fn at_line(file: impl Into<String>, line: usize, kind: Kind) -> Self {
+    pub fn at_line(file: impl Into<PathBuf>, line: usize, kind: Kind) -> Self {
         let place = if line == 0 {
             Place::Whole
         } else {
@@ -97,7 +98,7 @@ impl<Kind> FileError<Kind> {
     }
 
     /// The file (or the name of the input).
-    pub fn file(&self) -> &str {
+    pub fn file(&self) -> &Path {
         &self.location.file
     }
 
