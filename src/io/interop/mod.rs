@@ -18,15 +18,12 @@
 //! that reading it gives back the tree it was written from.
 
 mod binvox;
-mod blosc;
 mod grid;
 #[cfg(feature = "volume")]
 mod nifti;
 mod octomap;
 mod octomap_map;
 mod vdb;
-mod vdb_level_set;
-mod vdb_values;
 
 pub use binvox::{read_binvox, write_binvox, BINVOX_MAX_DIM};
 pub use grid::{GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree};
@@ -37,5 +34,4 @@ pub use octomap_map::{
     read_bt_map, read_color_ot_map, read_ot_map, write_bt_map, write_color_ot_map, write_ot_map,
     OT_HEADER,
 };
-pub use vdb::{read_vdb, write_vdb};
-pub use vdb_level_set::write_vdb_level_set;
+pub use vdb::{read_vdb, write_vdb, write_vdb_level_set};

@@ -13,7 +13,7 @@
 //! without byte shuffle. Every size is checked against the frame before it is used, and the output is
 //! only ever the size the caller expects.
 
-use super::grid::GridFileErrorKind;
+use crate::io::interop::grid::GridFileErrorKind;
 
 /// The header's length.
 const HEADER: usize = 16;

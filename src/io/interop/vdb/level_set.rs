@@ -18,12 +18,14 @@
 use std::collections::{BTreeMap, HashSet};
 use std::io::Write;
 
-use super::grid::{GridBoxes, GridFileError};
-use super::vdb::{
-    add_leaf, check_root_counts, corner_of, origin_of, push_box, put_grid_head, put_str, put_u32,
-    root_origin, slot, FILE_VERSION, FLOAT_TREE, LEAF_WORDS, LOWER_WORDS, MAGIC, UPPER_WORDS,
+use super::read::{add_leaf, check_root_counts, push_box, root_origin};
+use super::values::{ones, Reader, ValueCoding, ValueKind};
+use super::write::{put_grid_head, put_str, put_u32};
+use super::{
+    corner_of, origin_of, slot, FILE_VERSION, FLOAT_TREE, LEAF_WORDS, LOWER_WORDS, MAGIC,
+    UPPER_WORDS,
 };
-use super::vdb_values::{ones, Reader, ValueCoding, ValueKind};
+use crate::io::interop::grid::{GridBoxes, GridFileError};
 use crate::tree::{KTree, NodeState};
 
 /// Most root tiles (4096³ blocks wholly inside) written.

@@ -14,7 +14,7 @@
 use std::borrow::Cow;
 
 use super::blosc;
-use super::grid::{GridFileError, GridFileErrorKind};
+use crate::io::interop::grid::{GridFileError, GridFileErrorKind};
 
 const COMPRESS_ZIP: u32 = 0x1;
 const COMPRESS_ACTIVE_MASK: u32 = 0x2;
