@@ -31,20 +31,27 @@
 //! assert_eq!(tree.to_dense_values().unwrap(), [Some(3), Some(3), None, Some(7)]);
 //! assert_eq!(tree.shape(), KTree::<1>::from_dense(2, &[true, true, false, true]).unwrap());
 //! ```
+//!
+//! # Modules
+//! [`walk`]: reading a valued tree — the storage trait over trees in memory and files read in place, its
+//! depth-first walk and its leaves, and the tree read as its shape's leaves ([`LeavesOfValues`]);
+//! [`ValueAssembler`]: a valued tree collected from a depth-first traversal; the dense reference builder.
 
-use std::convert::Infallible;
+mod assemble;
+mod dense;
+pub mod walk;
 
-use smallvec::SmallVec;
+pub use assemble::ValueAssembler;
+pub(crate) use dense::for_each_voxel;
+pub use walk::{try_walk_values, LeavesOfValues, ValueLeaves, ValueStorage, ValueVisitor};
 
-use super::cursor::Walk;
-use super::error::StorageError;
 use super::ktree::{KTree, TreeId};
 use super::sink::{LevelSink, MemorySink};
 use super::states::{FullRank, NodeState, PackedStates};
 use super::storage::infallible;
 use super::words::{children_mask, full_mask, unused_mask, LOW_BITS};
 use super::TreeError;
-use crate::space::{Cell, DimCheck, SpaceError, Universe, DENSE_LIMIT};
+use crate::space::{Cell, SpaceError, Universe, DENSE_LIMIT};
 use crate::value::{Value, ValueError};
 
 /// The values of a level's full nodes, in level order, and the rank over the level's full nodes that finds
@@ -115,285 +122,6 @@ pub struct ValueNode<const K: usize, V> {
     /// The node's state, with the value of a full node.
     pub state: ValueState<V>,
 }
-
-/// A valued tree stored in level order, read one block of siblings at a time, reads failing like those of
-/// [`TreeStorage`](super::storage::TreeStorage): a valued tree in memory ([`KTree`] with a value type,
-/// [`Infallible`] reads) or a valued `.ktree` file read in place. A binary tree is one with `Value = ()`.
-pub trait ValueStorage<const K: usize> {
-    /// What a voxel holds.
-    type Value: Value;
-    /// Why a read failed ([`Infallible`] in memory).
-    type Error: std::error::Error + Into<StorageError> + Send + Sync + 'static;
-
-    /// The universe.
-    fn universe(&self) -> Universe<K>;
-
-    /// The number of stored levels.
-    fn depth_count(&self) -> usize;
-
-    /// The root's 2-bit code (`00`, `01`, `10` or `11`).
-    ///
-    /// # Errors
-    /// The storage's read error.
-    fn root_code(&self) -> Result<u32, Self::Error>;
-
-    /// The 2-bit codes of the `2^K` siblings of level `depth` from `first` (a multiple of `2^K`), the first in
-    /// the low bits.
-    ///
-    /// # Errors
-    /// The storage's read error.
-    fn codes(&self, depth: usize, first: usize) -> Result<u32, Self::Error>;
-
-    /// The index in level `depth + 1` of the first child of node `index` of level `depth`, a node with
-    /// children (partial or mixed).
-    ///
-    /// # Errors
-    /// The storage's read error.
-    fn children(&self, depth: usize, index: usize) -> Result<usize, Self::Error>;
-
-    /// The value of the full node `index` of level `depth`.
-    ///
-    /// # Errors
-    /// The storage's read error.
-    fn value(&self, depth: usize, index: usize) -> Result<Self::Value, Self::Error>;
-
-    /// The universe level `L`.
-    fn level(&self) -> u32 {
-        self.universe().level()
-    }
-
-    /// The state of a node of level `depth`, index `index`, whose code is `code`.
-    ///
-    /// # Errors
-    /// The storage's read error.
-    #[inline]
-    fn decode(
-        &self,
-        depth: usize,
-        index: usize,
-        code: u32,
-    ) -> Result<ValueState<Self::Value>, Self::Error> {
-        Ok(match code & 3 {
-            0 => ValueState::Empty,
-            1 => ValueState::Full(self.value(depth, index)?),
-            2 => ValueState::Partial,
-            _ => ValueState::Mixed,
-        })
-    }
-
-    /// The root node.
-    ///
-    /// # Errors
-    /// The storage's read error.
-    fn root(&self) -> Result<ValueNode<K, Self::Value>, Self::Error> {
-        Ok(ValueNode {
-            index: 0,
-            cell: self.universe().root(),
-            state: self.decode(0, 0, self.root_code()?)?,
-        })
-    }
-}
-
-impl<const K: usize, V: Value> ValueStorage<K> for KTree<K, V> {
-    type Value = V;
-    type Error = Infallible;
-
-    #[inline]
-    fn universe(&self) -> Universe<K> {
-        self.universe
-    }
-
-    #[inline]
-    fn depth_count(&self) -> usize {
-        self.levels.len()
-    }
-
-    #[inline]
-    fn root_code(&self) -> Result<u32, Infallible> {
-        Ok((self.levels[0].words()[0] & 3) as u32)
-    }
-
-    #[inline(always)]
-    fn codes(&self, depth: usize, first: usize) -> Result<u32, Infallible> {
-        Ok(self.levels[depth].block_codes(first, K))
-    }
-
-    #[inline(always)]
-    fn children(&self, depth: usize, index: usize) -> Result<usize, Infallible> {
-        Ok(self.levels[depth].partial_rank(index) << K)
-    }
-
-    #[inline]
-    fn value(&self, depth: usize, index: usize) -> Result<V, Infallible> {
-        if !V::STORED {
-            return Ok(V::read_le(&[]));
-        }
-        let level = &self.values[depth];
-        Ok(level.values[level.rank.rank(&self.levels[depth], index)])
-    }
-}
-
-/// A walk of a valued tree: sees each node before its children.
-pub trait ValueVisitor<const K: usize, V> {
-    /// Sees a node; says whether to visit its children, skip them, or stop.
-    fn visit(&mut self, node: &ValueNode<K, V>) -> Walk;
-
-    /// Called after the children of a node have all been visited (not when they were skipped).
-    #[inline]
-    fn leave(&mut self, _node: &ValueNode<K, V>) {}
-}
-
-/// Walks a valued tree depth first from the root, children in code (Morton) order. `Ok(true)` if the
-/// visitor stopped the walk.
-///
-/// # Errors
-/// The storage's first read error.
-pub fn try_walk_values<const K: usize, T: ValueStorage<K>, W: ValueVisitor<K, T::Value>>(
-    tree: &T,
-    visitor: &mut W,
-) -> Result<bool, T::Error> {
-    let mut stack: SmallVec<[(ValueNode<K, T::Value>, bool); 64]> = SmallVec::new();
-    stack.push((tree.root()?, false));
-    while let Some((node, leaving)) = stack.pop() {
-        if leaving {
-            visitor.leave(&node);
-            continue;
-        }
-        match visitor.visit(&node) {
-            Walk::Stop => return Ok(true),
-            Walk::Skip => continue,
-            Walk::Descend if !node.state.has_children() => continue,
-            Walk::Descend => {}
-        }
-        let depth = node.cell.level as usize;
-        let first = tree.children(depth, node.index)?;
-        let codes = tree.codes(depth + 1, first)?;
-        stack.push((node, true));
-        for code in (0..1usize << K).rev() {
-            let index = first + code;
-            stack.push((
-                ValueNode {
-                    index,
-                    cell: node.cell.child(code),
-                    state: tree.decode(depth + 1, index, codes >> (2 * code))?,
-                },
-                false,
-            ));
-        }
-    }
-    Ok(false)
-}
-
-/// The leaves of a valued tree, in Morton order: each leaf's cell and value (`None` for an empty leaf),
-/// or the storage's read error (after which the iterator ends).
-#[derive(Debug, Clone)]
-pub struct ValueLeaves<'a, const K: usize, T: ValueStorage<K>> {
-    tree: &'a T,
-    stack: Vec<ValueNode<K, T::Value>>,
-    fresh: bool,
-}
-
-impl<'a, const K: usize, T: ValueStorage<K>> ValueLeaves<'a, K, T> {
-    /// The leaves of `tree`.
-    pub fn new(tree: &'a T) -> Self {
-        Self {
-            tree,
-            stack: Vec::new(),
-            fresh: true,
-        }
-    }
-}
-
-impl<const K: usize, T: ValueStorage<K>> Iterator for ValueLeaves<'_, K, T> {
-    type Item = Result<(Cell<K>, Option<T::Value>), T::Error>;
-
-    fn next(&mut self) -> Option<Self::Item> {
-        if std::mem::take(&mut self.fresh) {
-            match self.tree.root() {
-                Ok(root) => self.stack.push(root),
-                Err(e) => return Some(Err(e)),
-            }
-        }
-        while let Some(node) = self.stack.pop() {
-            match node.state {
-                ValueState::Empty => return Some(Ok((node.cell, None))),
-                ValueState::Full(v) => return Some(Ok((node.cell, Some(v)))),
-                ValueState::Partial | ValueState::Mixed => {}
-            }
-            let depth = node.cell.level as usize;
-            let read = self.tree.children(depth, node.index).and_then(|first| {
-                let codes = self.tree.codes(depth + 1, first)?;
-                for code in (0..1usize << K).rev() {
-                    let index = first + code;
-                    self.stack.push(ValueNode {
-                        index,
-                        cell: node.cell.child(code),
-                        state: self.tree.decode(depth + 1, index, codes >> (2 * code))?,
-                    });
-                }
-                Ok(())
-            });
-            if let Err(e) = read {
-                self.stack.clear();
-                return Some(Err(e));
-            }
-        }
-        None
-    }
-}
-
-/// Collects a valued tree from its nodes in depth-first order (children in code order): each node is
-/// appended to its level, each full node's value to its level's column. The caller guarantees a complete
-/// traversal of a minimal tree.
-#[derive(Debug, Clone)]
-pub struct ValueAssembler<const K: usize, V> {
-    universe: Universe<K>,
-    levels: Vec<PackedStates>,
-    values: Vec<Vec<V>>,
-}
-
-impl<const K: usize, V: Value> ValueAssembler<K, V> {
-    /// An assembler for a universe of level `level`.
-    ///
-    /// # Errors
-    /// [`SpaceError::LevelTooLarge`] for a level beyond [`crate::max_level`].
-    pub fn new(level: u32) -> Result<Self, SpaceError> {
-        let () = DimCheck::<K>::OK;
-        Ok(Self {
-            universe: Universe::new(level)?,
-            levels: Vec::new(),
-            values: Vec::new(),
-        })
-    }
-
-    /// Appends the next node of the traversal, at `depth`.
-    pub fn push(&mut self, depth: usize, state: ValueState<V>) {
-        while self.levels.len() <= depth {
-            self.levels.push(PackedStates::new());
-            self.values.push(Vec::new());
-        }
-        let code = match state {
-            ValueState::Empty => 0,
-            ValueState::Full(v) => {
-                self.values[depth].push(v);
-                1
-            }
-            ValueState::Partial => 2,
-            ValueState::Mixed => 3,
-        };
-        self.levels[depth].push_code(code);
-    }
-
-    /// The tree (the caller guarantees the traversal was complete and minimal).
-    pub fn finish(self) -> KTree<K, V> {
-        let mut levels = self.levels;
-        for level in &mut levels {
-            level.finish();
-        }
-        KTree::from_valued_levels(self.universe, levels, self.values)
-    }
-}
-
 impl<const K: usize, V: Value> KTree<K, V> {
     /// Assembles a tree from its levels and their full nodes' values. The caller guarantees the structure
     /// (see [`KTree::check`]).
@@ -434,7 +162,7 @@ impl<const K: usize, V: Value> KTree<K, V> {
     /// [`DENSE_LIMIT`](crate::space::DENSE_LIMIT) or an array of another length than `U^K`;
     /// [`TreeError::Value`] for a value no voxel may hold (a NaN).
     pub fn from_dense_values(level: u32, dense: &[Option<V>]) -> Result<Self, TreeError> {
-        crate::tree::valued::reference_pyramid::<K, V>(level, dense)
+        dense::reference_pyramid::<K, V>(level, dense)
     }
 
     /// The value of voxel `point`: `None` where it is empty or outside the universe.
@@ -640,90 +368,6 @@ impl<const K: usize, V: Value> KTree<K, V> {
     }
 }
 
-/// Calls `f` with the dense index of every voxel of `cell`.
-pub(crate) fn for_each_voxel<const K: usize>(
-    universe: &Universe<K>,
-    cell: &Cell<K>,
-    mut f: impl FnMut(usize),
-) {
-    let side = cell.side() as u32;
-    let mut offset = [0u32; K];
-    loop {
-        let p: [u32; K] = std::array::from_fn(|a| cell.origin[a] + offset[a]);
-        f(universe.dense_index(p));
-        let mut axis = 0;
-        loop {
-            if axis == K {
-                return;
-            }
-            offset[axis] += 1;
-            if offset[axis] < side {
-                break;
-            }
-            offset[axis] = 0;
-            axis += 1;
-        }
-    }
-}
-
-/// The reference builder of a valued tree: a dense bottom-up pyramid of node states, then a depth-first
-/// walk from the root. Simple enough to trust; `O(U^K)`.
-pub(crate) fn reference_pyramid<const K: usize, V: Value>(
-    level: u32,
-    dense: &[Option<V>],
-) -> Result<KTree<K, V>, TreeError> {
-    let universe = Universe::<K>::new(level)?;
-    let len = universe.dense_len(DENSE_LIMIT)?;
-    if dense.len() != len {
-        return Err(TreeError::Space(SpaceError::TooLargeForDense {
-            voxels: dense.len() as u128,
-            limit: len as u128,
-        }));
-    }
-    if let Some(e) = dense.iter().flatten().find_map(|v| v.check().err()) {
-        return Err(TreeError::Value(e));
-    }
-    let bottom: Vec<ValueState<V>> = dense
-        .iter()
-        .map(|v| v.map_or(ValueState::Empty, ValueState::Full))
-        .collect();
-    let mut pyramid = vec![bottom];
-    for depth in (0..level).rev() {
-        let fine = pyramid.last().expect("the voxel level");
-        let (fine_u, coarse_u) = (Universe::<K>::new(depth + 1)?, Universe::<K>::new(depth)?);
-        let coarse = (0..fine.len() >> K)
-            .map(|i| {
-                let p = coarse_u.dense_point(i);
-                let kids: Vec<ValueState<V>> = (0..1usize << K)
-                    .map(|code| {
-                        let q = std::array::from_fn(|a| 2 * p[a] + (code >> a & 1) as u32);
-                        fine[fine_u.dense_index(q)]
-                    })
-                    .collect();
-                combine(&kids)
-            })
-            .collect();
-        pyramid.push(coarse);
-    }
-    pyramid.reverse();
-    let mut out = ValueAssembler::<K, V>::new(level)?;
-    let mut stack = vec![(0u32, [0u32; K])];
-    while let Some((depth, p)) = stack.pop() {
-        let u = Universe::<K>::new(depth)?;
-        let state = pyramid[depth as usize][u.dense_index(p)];
-        out.push(depth as usize, state);
-        if state.has_children() {
-            for code in (0..1usize << K).rev() {
-                stack.push((
-                    depth + 1,
-                    std::array::from_fn(|a| 2 * p[a] + (code >> a & 1) as u32),
-                ));
-            }
-        }
-    }
-    Ok(out.finish())
-}
-
 /// The state of a node from its children's: the one rule of minimality.
 ///
 /// ```
@@ -762,64 +406,5 @@ pub fn combine<V: Value>(kids: &[ValueState<V>]) -> ValueState<V> {
 impl From<ValueError> for TreeError {
     fn from(e: ValueError) -> Self {
         TreeError::Value(e)
-    }
-}
-
-/// A valued tree read as a tree without values of the same nodes — a mixed node (`11`) reads as a node
-/// with children (`10`) — so every walk, picture and query of a [`TreeStorage`](super::storage::TreeStorage)
-/// sees each full leaf of the valued tree as one full leaf: the leaves where one value holds. The tree it
-/// shows is the valued tree's [shape](KTree::shape), not reduced where a mixed node stands.
-///
-/// ```
-/// use ktree::tree::valued::LeavesOfValues;
-/// use ktree::tree::cursor::TryLeaves;
-/// use ktree::KTree;
-/// let t = KTree::<1, u8>::from_dense_values(1, &[Some(1), Some(2)]).unwrap(); // a mixed root
-/// let leaves: Vec<_> = TryLeaves::new(&LeavesOfValues(&t)).collect::<Result<_, _>>().unwrap();
-/// assert_eq!(leaves.len(), 2); // the shape alone has one full leaf
-/// ```
-#[derive(Debug, Clone, Copy)]
-pub struct LeavesOfValues<'a, const K: usize, V: Value>(pub &'a KTree<K, V>);
-
-/// Each mixed code (`11`) of `codes` turned into `10`.
-#[inline]
-fn mixed_as_partial(codes: u32) -> u32 {
-    let mixed = codes & (codes >> 1) & 0x5555_5555;
-    codes & !mixed
-}
-
-impl<const K: usize, V: Value> super::storage::TreeStorage<K> for LeavesOfValues<'_, K, V> {
-    type Error = Infallible;
-
-    fn universe(&self) -> Universe<K> {
-        self.0.universe
-    }
-
-    fn depth_count(&self) -> usize {
-        self.0.levels.len()
-    }
-
-    fn level_len(&self, depth: usize) -> usize {
-        self.0.levels[depth].len()
-    }
-
-    fn counts_per_level(&self) -> Vec<super::LevelCounts> {
-        self.0.counts_per_level()
-    }
-
-    fn root_state(&self) -> Result<NodeState, Infallible> {
-        Ok(NodeState::from_bits(mixed_as_partial(infallible(
-            self.0.root_code(),
-        ))))
-    }
-
-    #[inline(always)]
-    fn partial_rank(&self, depth: usize, index: usize) -> Result<usize, Infallible> {
-        Ok(self.0.levels[depth].partial_rank(index))
-    }
-
-    #[inline(always)]
-    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, Infallible> {
-        Ok(mixed_as_partial(self.0.levels[depth].block_codes(first, K)))
     }
 }
