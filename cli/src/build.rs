@@ -36,7 +36,7 @@ pub fn run(args: Args) -> CliResult {
 }
 
 /// Stacks rays read whole straight into the output; returns the summary (empty on ranks other than 0).
-fn build_rays<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<String, String> {
+fn build_rays<const K: usize>(rays: &RaySet<K>, args: &Args) -> CliResult<String> {
     let what = format!("the rays of {}", args.rays.display());
     let held = (what.as_str(), crate::common::memory::ray_bytes(rays));
     let built = TreeOutput::new(&args.out.out, &args.build).write(rays, Some(held))?;
@@ -47,7 +47,7 @@ fn build_rays<const K: usize>(rays: &RaySet<K>, args: &Args) -> Result<String, S
 
 /// Stacks a ray file read slab by slab straight into the output (across the MPI ranks of the run, if
 /// several, each reading its slabs' lines); returns the summary (empty on ranks other than 0).
-fn build_source<const K: usize>(source: &RaysFileSource<K>, args: &Args) -> Result<String, String> {
+fn build_source<const K: usize>(source: &RaysFileSource<K>, args: &Args) -> CliResult<String> {
     let what = format!("the index of {}", args.rays.display());
     let held = (what.as_str(), source.heap_bytes());
     let built = TreeOutput::new(&args.out.out, &args.build).write(source, Some(held))?;

@@ -207,7 +207,7 @@ pub fn run(a: Args) -> CliResult {
                 .into())
             }
         }
-        .map_err(|e| format!("{}: {}", a.input.display(), crate::common::error::chain(&e)))?
+        .map_err(|e| CliError::in_file(&a.input, e))?
         .placed(&frame);
         let written = write_surface(&a.output, &mesh).map_err(CliError::caused)?;
         outln!(

@@ -11,7 +11,7 @@ use ktree::space::WorldFrame;
 use ktree::value::{Dtype, Value};
 use ktree::KTree;
 
-use crate::common::error::{chain, CliError, CliResult};
+use crate::common::error::{cannot_read, CliError, CliResult};
 use crate::outln;
 
 /// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz` or `.ktree`), placed by `frame`.
@@ -42,8 +42,7 @@ pub fn convert_valued(input: &Path, output: &Path, frame: &WorldFrame) -> CliRes
             return write_octree::<V>(input, output, frame);
         }
         // Any other K: a .ktree to a .ktree is a checked copy.
-        let bytes = std::fs::read(input)
-            .map_err(|e| format!("{}: cannot read: {e}", input.display()))?;
+        let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
         ktree::fs::write_atomic(output, &bytes).map_err(CliError::caused)?;
         outln!("{}: copied (K = {k}, {})", output.display(), dtype.name());
         Ok(())
@@ -52,8 +51,8 @@ pub fn convert_valued(input: &Path, output: &Path, frame: &WorldFrame) -> CliRes
 
 fn write_octree<V: Value>(input: &Path, output: &Path, frame: &WorldFrame) -> CliResult {
     let name = input.display().to_string();
-    let bytes = std::fs::read(input).map_err(|e| format!("{name}: cannot read: {e}"))?;
-    let tree = read_valued_ktree::<3, V>(&bytes, &name).map_err(|e| chain(&e))?;
+    let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
+    let tree = read_valued_ktree::<3, V>(&bytes, &name).map_err(CliError::caused)?;
     if output.extension().is_some_and(|e| e == "ktree") {
         write_valued_ktree_file(output, &tree).map_err(CliError::caused)?;
     } else {
@@ -82,7 +81,7 @@ pub fn voxelize_window(
     let level = level.unwrap_or_else(|| fitting_level(&volume, offset));
     let runs = volume
         .to_window_runs(level, offset, window.0, window.1)
-        .map_err(|e| format!("{}: {e}", input.display()))?;
+        .map_err(|e| CliError::in_file(input, e))?;
     let tree = KTree::from_value_runs(&runs);
     write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
     outln!(

@@ -55,6 +55,6 @@ pub fn run(args: DistanceArgs) -> CliResult {
     };
     let mut bytes = Vec::new();
     write_vdb_level_set(&mut bytes, &tree, args.band, args.voxel_size)
-        .map_err(|e| format!("{}: {e}", args.out.display()))?;
+        .map_err(|e| CliError::in_file(&args.out, e))?;
     ktree::fs::write_atomic(&args.out, &bytes).map_err(CliError::caused)
 }

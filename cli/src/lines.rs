@@ -1,7 +1,7 @@
 //! `ktree lines FILE.ktree [--view VIEW] [--out drawing.svg]`: a line drawing of an octree with hidden
 //! lines removed (Veenstra & Ahuja), as SVG (vector) or PNG (by the output's extension).
 
-use crate::common::error::{chain, CliError, CliResult};
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::PathBuf;
@@ -118,6 +118,6 @@ fn draw<T: TreeStorage<3>>(
     toward: [f64; 3],
     method: HiddenLineMethod,
     tick: &mut dyn FnMut(u64, u64),
-) -> Result<LineDrawing, String> {
-    line_drawing_with_progress(tree, toward, method, tick).map_err(|e| chain(&e))
+) -> CliResult<LineDrawing> {
+    line_drawing_with_progress(tree, toward, method, tick).map_err(CliError::caused)
 }

@@ -18,7 +18,7 @@ use ktree::map::{HistoryRecorder, MapGrid, OccupancyMap, SensorModel, MAP_LEVEL}
 use ktree::space::WorldFrame;
 use ktree::tree::Dtype;
 
-use crate::common::error::{CliError, CliResult};
+use crate::common::error::{cannot_read, CliError, CliResult};
 use crate::common::vector::vector;
 use crate::outln;
 
@@ -83,8 +83,7 @@ fn read_points(path: &Path) -> CliResult<Vec<[f32; 3]>> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("dat"));
     let cloud = if dat {
-        let bytes =
-            std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        let bytes = std::fs::read(path).map_err(|e| cannot_read(path, e))?;
         read_cloud_bytes(&bytes, "xyz", path)
     } else {
         read_cloud(path)
@@ -289,7 +288,7 @@ pub fn is_map_file(path: &Path) -> bool {
 /// Reads an occupancy map file (`.ot`, `.bt`, or a `.ktree` of log-odds with its frame) with OctoMap's
 /// default model.
 pub fn read_map(path: &Path) -> CliResult<OccupancyMap<3>> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let bytes = std::fs::read(path).map_err(|e| cannot_read(path, e))?;
     let name = path.display().to_string();
     if path
         .extension()

@@ -68,7 +68,7 @@ fn check_budget(args: &Args) -> CliResult {
     let mut files = 0u64;
     for input in &args.inputs {
         files += std::fs::metadata(input)
-            .map_err(|e| format!("{}: {e}", input.display()))?
+            .map_err(|e| CliError::in_file(input, e))?
             .len();
     }
     let names: Vec<String> = args

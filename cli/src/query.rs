@@ -6,7 +6,7 @@
 //! on a tree file. A version 2 file is read through its memory map (so a tree larger than memory is
 //! queried without being loaded); others are loaded.
 
-use crate::common::error::{CliError, CliResult};
+use crate::common::error::{cannot_read, CliError, CliResult};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -273,8 +273,7 @@ fn read_map_and_colours(path: &Path) -> CliResult<(OccupancyMap<3>, Option<KTree
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("ot"));
     if ot {
-        let bytes =
-            std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        let bytes = std::fs::read(path).map_err(|e| cannot_read(path, e))?;
         let name = path.display().to_string();
         match read_color_ot_map(&bytes, &name, SensorModel::default()) {
             Ok((map, colours)) => return Ok((map, Some(colours))),
@@ -287,7 +286,7 @@ fn read_map_and_colours(path: &Path) -> CliResult<(OccupancyMap<3>, Option<KTree
 }
 
 /// The rays of a table, each of `2K` numbers, checked.
-fn rays<const K: usize>(t: &table::Table<f64>, max_t: f64) -> Result<Vec<RayCast<K>>, String> {
+fn rays<const K: usize>(t: &table::Table<f64>, max_t: f64) -> CliResult<Vec<RayCast<K>>> {
     t.rows
         .iter()
         .enumerate()
@@ -297,7 +296,7 @@ fn rays<const K: usize>(t: &table::Table<f64>, max_t: f64) -> Result<Vec<RayCast
                 std::array::from_fn(|a| r[K + a]),
                 max_t,
             )
-            .map_err(|e| format!("{}: {e}", t.place(i)))
+            .map_err(|e| CliError::about(t.place(i), e))
         })
         .collect()
 }

@@ -74,11 +74,12 @@ fn numbers(v: Vec<Rational>, n: usize, what: &str) -> Result<Vec<Rational>, Stri
     Ok(v)
 }
 
-fn one(text: &Option<String>, what: &str) -> Result<Rational, String> {
+/// The number of `--what`, required.
+fn one(text: &Option<String>, what: &str) -> CliResult<Rational> {
     text.as_deref()
         .ok_or_else(|| format!("--{what} is required for this solid"))?
         .parse()
-        .map_err(|e| format!("--{what}: {e}"))
+        .map_err(|e| CliError::about(format!("--{what}"), e))
 }
 
 fn arr<const K: usize>(
@@ -91,7 +92,7 @@ fn arr<const K: usize>(
         .transpose()
 }
 
-fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
+fn solid<const K: usize>(a: &Args) -> CliResult<Solid<K>> {
     let frame = if a.unit_cube {
         Frame::UnitCube
     } else {
@@ -103,26 +104,25 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
         Rational::int(1 << a.level.saturating_sub(1).min(62))
     };
     let centre = arr::<K>(&a.center, "center")?.unwrap_or([middle; K]);
-    let e = |e: ktree::solid::SolidError| e.to_string();
     let q = match a.solid.as_str() {
-        "ball" => Quadric::ball(centre, one(&a.radius, "radius")?, frame).map_err(e)?,
+        "ball" => Quadric::ball(centre, one(&a.radius, "radius")?, frame).map_err(CliError::caused)?,
         "ellipsoid" => {
             let radii = arr::<K>(&a.radii, "radii")?.ok_or("--radii is required for an ellipsoid")?;
-            Quadric::ellipsoid(centre, radii, frame).map_err(e)?
+            Quadric::ellipsoid(centre, radii, frame).map_err(CliError::caused)?
         }
         "paraboloid" => Quadric::paraboloid(centre, one(&a.radius, "radius")?, one(&a.height, "height")?, frame)
-            .map_err(e)?,
-        "cylinder" => Quadric::cylinder(a.axis, centre, one(&a.radius, "radius")?, frame).map_err(e)?,
+            .map_err(CliError::caused)?,
+        "cylinder" => Quadric::cylinder(a.axis, centre, one(&a.radius, "radius")?, frame).map_err(CliError::caused)?,
         "cone" => Quadric::cone(a.axis, centre, one(&a.radius, "radius")?, one(&a.height, "height")?, frame)
-            .map_err(e)?,
+            .map_err(CliError::caused)?,
         "half-space" => {
             let n = arr::<K>(&a.normal, "normal")?.ok_or("--normal is required for a half-space")?;
-            Quadric::half_space(n, one(&a.offset, "offset")?, frame).map_err(e)?
+            Quadric::half_space(n, one(&a.offset, "offset")?, frame).map_err(CliError::caused)?
         }
         "box" => {
             let lo = arr::<K>(&a.lo, "lo")?.ok_or("--lo is required for a box")?;
             let hi = arr::<K>(&a.hi, "hi")?.ok_or("--hi is required for a box")?;
-            return BoxSolid::new(lo, hi, frame).map(Solid::Box).map_err(e);
+            return BoxSolid::new(lo, hi, frame).map(Solid::Box).map_err(CliError::caused);
         }
         "quadric" => {
             let text = a.quadric.as_deref().ok_or("--quadric MATRIX is required for --solid quadric")?;
@@ -133,12 +133,13 @@ fn solid<const K: usize>(a: &Args) -> Result<Solid<K>, String> {
                     numbers(row.0, K + 1, "quadric")
                 })
                 .collect::<Result<_, _>>()?;
-            Quadric::from_rational_matrix(&rows, frame).map_err(e)?
+            Quadric::from_rational_matrix(&rows, frame).map_err(CliError::caused)?
         }
         other => {
             return Err(format!(
                 "unknown solid '{other}': choose ball, ellipsoid, paraboloid, cylinder, cone, half-space, box or quadric"
-            ))
+            )
+            .into())
         }
     };
     Ok(Solid::Quadric(q))

@@ -2,7 +2,7 @@
 //! hidden-surface image of an octree; a quadtree is drawn as a picture of its cells, a 4-D tree as a strip
 //! of time slices.
 
-use crate::common::error::{read_error, CliError, CliResult};
+use crate::common::error::{cannot_read, read_error, CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -213,9 +213,9 @@ fn render_valued<V: ktree::value::Value>(
     tick: &mut dyn FnMut(u64, u64),
 ) -> CliResult {
     let name = args.file.display().to_string();
-    let bytes = std::fs::read(&args.file).map_err(|e| format!("{name}: cannot read: {e}"))?;
-    let tree = ktree::io::ktree::v3::read_valued_ktree::<3, V>(&bytes, &name)
-        .map_err(|e| crate::common::error::chain(&e))?;
+    let bytes = std::fs::read(&args.file).map_err(|e| cannot_read(&args.file, e))?;
+    let tree =
+        ktree::io::ktree::v3::read_valued_ktree::<3, V>(&bytes, &name).map_err(CliError::caused)?;
     let of_value = ktree::display::palette::value_colours(&tree);
     let paint = |cell: &Cell<3>| {
         colour.unwrap_or_else(|| tree.value_at(cell.origin()).map_or([0; 3], &of_value))

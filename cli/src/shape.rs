@@ -3,7 +3,7 @@
 //! of a tree file (a version 2 `.ktree` read in place through its memory map, any other format read into
 //! memory); and the measures (`surface_area`, `euler_number`) that `stats` and `mass` report.
 
-use crate::common::error::{chain, read_error, CliError, CliResult};
+use crate::common::error::{read_error, CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -17,8 +17,8 @@ use serde::Serialize;
 use crate::common::tree_file::write;
 
 /// Opens a tree file: a version 2 `.ktree` through its memory map, any other format read into memory.
-fn open(path: &Path) -> Result<FileTree, String> {
-    FileTree::open(path, &ReadOptions::default()).map_err(|e| chain(&e))
+fn open(path: &Path) -> CliResult<FileTree> {
+    FileTree::open(path, &ReadOptions::default()).map_err(CliError::caused)
 }
 
 /// Arguments of `ktree morph`.
@@ -47,7 +47,7 @@ fn morph<const K: usize, T: TreeStorage<K> + Sync>(t: &T, args: &MorphArgs) -> C
         "open" => shape::opening(t, r, e),
         _ => shape::closing(t, r, e),
     }
-    .map_err(|err| format!("{}: {err}", args.tree.display()))?;
+    .map_err(|err| CliError::in_file(&args.tree, err))?;
     write(&args.out.out, &out)
 }
 
@@ -87,8 +87,8 @@ struct ComponentsReport {
 fn components<const K: usize, T: TreeStorage<K>>(
     t: &T,
     args: &ComponentsArgs,
-) -> Result<ComponentsReport, String> {
-    let name = |err: ktree::shape::ShapeError| format!("{}: {err}", args.tree.display());
+) -> CliResult<ComponentsReport> {
+    let name = |err| CliError::in_file(&args.tree, err);
     let Some(dir) = &args.out_dir else {
         let sizes = shape::component_sizes(t, args.connectivity).map_err(name)?;
         return Ok(ComponentsReport {
@@ -100,7 +100,7 @@ fn components<const K: usize, T: TreeStorage<K>>(
     };
     let parts = shape::components(t, args.connectivity).map_err(name)?;
     std::fs::create_dir_all(dir).map_err(|e| {
-        chain(&ktree::fs::FileOpError::new(
+        CliError::caused(ktree::fs::FileOpError::new(
             ktree::fs::FileOp::CreateFolder,
             dir,
             e,
@@ -109,7 +109,7 @@ fn components<const K: usize, T: TreeStorage<K>>(
     let mut files = Vec::new();
     for (i, part) in parts.iter().enumerate() {
         let path = dir.join(format!("component-{}.ktree", i + 1));
-        crate::common::tree_file::write_tree(&path, &part.tree).map_err(|e| chain(&e))?;
+        crate::common::tree_file::write_tree(&path, &part.tree).map_err(CliError::caused)?;
         files.push(path);
     }
     Ok(ComponentsReport {
@@ -163,15 +163,15 @@ pub struct Measures {
 /// share of the pieces gathered), with room to spare.
 const BYTES_PER_RUN: u128 = 48;
 
-fn measures_of<const K: usize, T: TreeStorage<K>>(t: &T, budget: u64) -> Result<Measures, String> {
+fn measures_of<const K: usize, T: TreeStorage<K>>(t: &T, budget: u64) -> CliResult<Measures> {
     // The surface area walks the nodes alone; the Euler number holds the runs, counted first.
-    let surface_area = shape::surface_area(t).map_err(|e| read_error(e).to_string())?;
-    let fits = || -> Result<bool, String> {
-        let runs = shape::run_count(t).map_err(|e| read_error(e).to_string())?;
+    let surface_area = shape::surface_area(t).map_err(read_error)?;
+    let fits = || -> CliResult<bool> {
+        let runs = shape::run_count(t).map_err(read_error)?;
         Ok(runs.saturating_mul(BYTES_PER_RUN) <= u128::from(budget))
     };
     let (euler_number, euler_skipped) = if matches!(K, 2 | 3) && fits()? {
-        let e = shape::euler_number(t, K).map_err(|e| chain(&e))?;
+        let e = shape::euler_number(t, K).map_err(CliError::caused)?;
         (Some(e), false)
     } else {
         (None, matches!(K, 2 | 3))
@@ -185,22 +185,22 @@ fn measures_of<const K: usize, T: TreeStorage<K>>(t: &T, budget: u64) -> Result<
 
 /// The measures of a tree file (read in place or in memory): the surface area, and the Euler number
 /// when the tree's runs fit the memory budget.
-pub fn measures(tree: &FileTree) -> Result<Measures, String> {
+pub fn measures(tree: &FileTree) -> CliResult<Measures> {
     let budget = crate::common::memory::default_budget();
     with_tree!(tree, t => measures_of(t, budget))
 }
 
 /// [`measures`] of a tree in memory.
-pub fn measures_in_memory(tree: &AnyTree) -> Result<Measures, String> {
+pub fn measures_in_memory(tree: &AnyTree) -> CliResult<Measures> {
     let budget = crate::common::memory::default_budget();
     ktree::with_dim!(tree, AnyTree, t => measures_of(t, budget))
 }
 
 /// The measures of a tree file if it is small next to the memory budget (at most 1/16 of it), `None` for
 /// a larger file, which `mass` then reports without them (they take a pass over the whole tree).
-pub fn measures_of_file(path: &Path) -> Result<Option<Measures>, String> {
+pub fn measures_of_file(path: &Path) -> CliResult<Option<Measures>> {
     let size = std::fs::metadata(path)
-        .map_err(|e| format!("{}: {e}", path.display()))?
+        .map_err(|e| CliError::in_file(path, e))?
         .len();
     if size > crate::common::memory::default_budget() / 16 {
         return Ok(None);

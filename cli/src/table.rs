@@ -6,6 +6,8 @@
 use std::io::Read;
 use std::path::Path;
 
+use crate::common::error::{CliError, CliResult};
+
 /// Rows of `C` numbers, and where each came from.
 pub struct Table<T> {
     /// The rows, each of the expected number of columns.
@@ -65,7 +67,7 @@ impl Number for f64 {
 }
 
 /// Reads a table of `columns` numbers a row from `path` (`-`: standard input).
-pub fn read<T: Number>(path: &Path, columns: usize) -> Result<Table<T>, String> {
+pub fn read<T: Number>(path: &Path, columns: usize) -> CliResult<Table<T>> {
     let stdin = path.as_os_str() == "-";
     let name = if stdin {
         "standard input".to_string()
@@ -78,15 +80,16 @@ pub fn read<T: Number>(path: &Path, columns: usize) -> Result<Table<T>, String> 
     } else {
         std::fs::File::open(path).and_then(|mut f| f.read_to_end(&mut bytes).map(|_| ()))
     };
-    read.map_err(|e| format!("cannot read {name}: {e}"))?;
+    read.map_err(|e| CliError::about(format!("cannot read {name}"), e))?;
     let npy_name = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
-    if bytes.starts_with(MAGIC) || npy_name {
+    let table = if bytes.starts_with(MAGIC) || npy_name {
         read_npy(&bytes, name, columns)
     } else {
         read_text(&bytes, name, columns)
-    }
+    };
+    Ok(table?)
 }
 
 fn read_text<T: Number>(bytes: &[u8], name: String, columns: usize) -> Result<Table<T>, String> {

@@ -6,7 +6,7 @@
 //! the exact integer operations (rational overlays, child reordering, translation overlays). Otherwise all
 //! steps are concatenated into one affine matrix applied in a single overlay pass (Meagher's M6).
 
-use crate::common::error::{chain, CliResult};
+use crate::common::error::{CliError, CliResult};
 use std::path::PathBuf;
 
 use ktree::ops::{self, Affine, AxisMap, Projective};
@@ -88,7 +88,7 @@ fn rational(text: &str) -> Option<(u32, u32)> {
     }
 }
 
-fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, String> {
+fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> CliResult<KTree<K>> {
     let level = tree.level();
     let translate = match &args.translate {
         Some(List(v)) => {
@@ -96,7 +96,8 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
                 return Err(format!(
                     "--translate needs {K} numbers for a K = {K} tree, got {}",
                     v.len()
-                ));
+                )
+                .into());
             }
             Some(v.clone())
         }
@@ -117,7 +118,7 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
                     .map_err(|_| format!("--scale: '{s}' is not P/Q or a number"))?,
             };
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("--scale must be positive, got {s}"));
+                return Err(format!("--scale must be positive, got {s}").into());
             }
             Some(v)
         }
@@ -129,7 +130,7 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
             Ok(a) => (Some(a), None),
             Err(_) => (
                 None,
-                Some(Projective::<K>::from_homogeneous(v).map_err(|e| chain(&e))?),
+                Some(Projective::<K>::from_homogeneous(v).map_err(CliError::caused)?),
             ),
         },
         None => (None, None),
@@ -144,11 +145,11 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     if exact {
         let mut t = tree.clone();
         if let Some(Some((p, q))) = scale_ratio {
-            t = ops::scale(&t, p, q).map_err(|e| chain(&e))?;
+            t = ops::scale(&t, p, q).map_err(CliError::caused)?;
         }
         for &(from, to, deg) in &rotate {
             let turns = ((deg / 90.0) as i64).rem_euclid(4);
-            let q = AxisMap::<K>::quarter_turn(from, to).map_err(|e| chain(&e))?;
+            let q = AxisMap::<K>::quarter_turn(from, to).map_err(CliError::caused)?;
             for _ in 0..turns {
                 t = infallible(ops::rotate_axes(&t, &q));
             }
@@ -166,7 +167,7 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     let centre = Affine::<K>::universe_centre(level);
     for &(from, to, deg) in &rotate {
         m = Affine::rotation_about(from, to, deg, centre)
-            .map_err(|e| chain(&e))?
+            .map_err(CliError::caused)?
             .after(&m);
     }
     if let Some(v) = &translate {
@@ -177,9 +178,9 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> Result<KTree<K>, Strin
     }
     if let Some(p) = projective {
         let all = p.after(&Projective::from_affine(&m));
-        return ops::transform_projective(tree, &all).map_err(|e| chain(&e));
+        return ops::transform_projective(tree, &all).map_err(CliError::caused);
     }
-    ops::transform(tree, &m).map_err(|e| chain(&e))
+    ops::transform(tree, &m).map_err(CliError::caused)
 }
 
 /// Applies the transforms and writes the result.
@@ -193,7 +194,7 @@ pub fn run(args: Args) -> CliResult {
     }
     let tree = read(&args.input)?;
     ktree::with_dim!(&tree, AnyTree, t => {
-        let out = apply(t, &args).map_err(|e| format!("{}: {e}", args.input.display()))?;
+        let out = apply(t, &args).map_err(|e| e.within(args.input.display()))?;
         write(&args.out.out, &out)
     })
 }

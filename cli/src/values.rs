@@ -16,11 +16,11 @@ use ktree::solid::volume::Volume;
 use ktree::value::{Dtype, Value};
 use ktree::{with_valued, AnyValuedTree, KTree};
 
-use crate::common::error::{chain, CliError, CliResult};
+use crate::common::error::{cannot_read, CliError, CliResult};
 use crate::outln;
 
 /// The dimension and value type of a `.ktree` file (`None`: no values).
-pub fn file_dtype(path: &Path) -> Result<(usize, Option<Dtype>), String> {
+pub fn file_dtype(path: &Path) -> CliResult<(usize, Option<Dtype>)> {
     let mut head = [0u8; 16];
     let read = std::fs::File::open(path).and_then(|mut f| {
         use std::io::Read;
@@ -33,9 +33,9 @@ pub fn file_dtype(path: &Path) -> Result<(usize, Option<Dtype>), String> {
         }
         Ok(n)
     });
-    let n = read.map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let n = read.map_err(|e| cannot_read(path, e))?;
     let (k, _, dtype) =
-        valued_header(&head[..n], &path.display().to_string()).map_err(|e| chain(&e))?;
+        valued_header(&head[..n], &path.display().to_string()).map_err(CliError::caused)?;
     Ok((k, dtype))
 }
 
@@ -45,14 +45,15 @@ pub fn is_valued(path: &Path) -> bool {
 }
 
 /// A valued `.ktree` file's tree, of the dimension and value type its header names.
-pub fn read_valued(path: &Path) -> Result<AnyValuedTree, String> {
+pub fn read_valued(path: &Path) -> CliResult<AnyValuedTree> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
-    match read_any_ktree(&bytes, &name).map_err(|e| chain(&e))? {
+    let bytes = std::fs::read(path).map_err(|e| cannot_read(path, e))?;
+    match read_any_ktree(&bytes, &name).map_err(CliError::caused)? {
         AnyKtree::Valued(tree) => Ok(tree),
         AnyKtree::Binary(_) => Err(format!(
             "{name}: the tree holds no values (this takes a tree made with values, e.g. voxelize --labels)"
-        )),
+        )
+        .into()),
     }
 }
 
@@ -67,7 +68,7 @@ pub fn voxelize_labels(
     let volume = Volume::read(input).map_err(CliError::caused)?;
     let smallest = volume
         .label_dtype()
-        .map_err(|e| format!("{}: {e}", input.display()))?;
+        .map_err(|e| CliError::in_file(input, e))?;
     let dtype = match dtype {
         None => smallest,
         Some(name) => match Dtype::parse(name) {
@@ -87,7 +88,7 @@ pub fn voxelize_labels(
     ) -> CliResult {
         let runs = volume
             .to_label_runs::<V>(level, offset)
-            .map_err(|e| format!("{}: {e}", input.display()))?;
+            .map_err(|e| CliError::in_file(input, e))?;
         let tree = KTree::from_value_runs(&runs);
         write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
         let labels = tree.value_stats().len();
@@ -294,12 +295,12 @@ pub struct ValuedStats {
 }
 
 /// The statistics of a valued `.ktree` file.
-pub fn valued_stats(path: &Path) -> Result<ValuedStats, String> {
+pub fn valued_stats(path: &Path) -> CliResult<ValuedStats> {
     let tree = read_valued(path)?;
     with_valued!(&tree, t => stats_of(t))
 }
 
-fn stats_of<const K: usize, V: Value>(tree: &KTree<K, V>) -> Result<ValuedStats, String> {
+fn stats_of<const K: usize, V: Value>(tree: &KTree<K, V>) -> CliResult<ValuedStats> {
     let shape = tree.shape();
     let Ok(mut s) = stats(&shape, None);
     // The file's own nodes (mixed nodes counted with the partial ones: both have children).

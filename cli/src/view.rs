@@ -1,7 +1,7 @@
 //! `ktree view FILE [--out view.html] [--budget N] [--camera VIEW] [--time-axis A] [--open]`: an
 //! interactive 3-D view of a tree in one self-contained HTML page (see `ktree::export::view`).
 
-use crate::common::error::{chain, CliError, CliResult};
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -84,8 +84,8 @@ fn page_of<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     out: &Path,
     options: &ViewOptions,
-) -> Result<Page, String> {
-    write_view(out, tree, options).map_err(|e| chain(&e))
+) -> CliResult<Page> {
+    write_view(out, tree, options).map_err(CliError::caused)
 }
 
 /// A new page's path in the temporary folder, named after the input.

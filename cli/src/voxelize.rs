@@ -6,7 +6,7 @@
 //! with `--value rgb|intensity|class|count [--reduce mean|max]`, a tree whose voxels hold a value reduced
 //! from their points' (a `.ktree` output).
 
-use crate::common::error::{CliError, CliResult};
+use crate::common::error::{chain, CliError, CliResult};
 use crate::outln;
 
 use std::collections::BTreeMap;
@@ -160,7 +160,7 @@ fn run_cloud(a: &Args) -> CliResult {
         .voxel_size
         .ok_or_else(|| format!("{}: a point cloud needs --voxel-size S", a.input.display()))?;
     let mut v = CloudVoxelizer::new(size)
-        .map_err(|e| format!("--voxel-size: {e}"))?
+        .map_err(|e| CliError::about("--voxel-size", e))?
         .min_points(a.min_points)
         .crop(a.crop);
     if a.crop && a.level.is_none() {
@@ -223,7 +223,7 @@ fn run_cloud(a: &Args) -> CliResult {
 }
 
 /// A voxelizer's error on the cloud `input`, with a hint of the flags that avoid it.
-pub(crate) fn cloud_error(input: &Path, e: ktree::solid::SolidError) -> String {
+pub(crate) fn cloud_error(input: &Path, e: ktree::solid::SolidError) -> CliError {
     use ktree::solid::SolidError;
     let hint = match e {
         SolidError::PointsOutside { .. } => {
@@ -232,9 +232,9 @@ pub(crate) fn cloud_error(input: &Path, e: ktree::solid::SolidError) -> String {
         SolidError::PointBelowOrigin { .. } => {
             ": give --level and --crop to drop such points, or another --origin"
         }
-        _ => "",
+        _ => return CliError::in_file(input, e),
     };
-    format!("{}: {e}{hint}", input.display())
+    CliError::Failed(format!("{}: {}{hint}", input.display(), chain(&e)))
 }
 
 /// Prints the transform `--fit` chose and warns about a mesh that is not closed (`root`: this process
@@ -255,7 +255,7 @@ fn remarks(input: &Path, fitted: Option<&str>, open_edges: usize, root: bool) ->
 
 /// Stacks the source straight into the output, out of core, in the budget less what the source holds;
 /// returns the summary (the one [`write_output`] prints for a tree).
-fn build_out_of_core(source: &VoxelSource, a: &Args) -> Result<String, String> {
+fn build_out_of_core(source: &VoxelSource, a: &Args) -> CliResult<String> {
     let what = match source {
         VoxelSource::Mesh(_) => format!("the placed triangles of {}", a.input.display()),
         VoxelSource::Volume(_) => format!("the samples of {}", a.input.display()),

@@ -37,14 +37,14 @@ impl BudgetArgs {
     }
 
     /// Checks that `what` (taking `bytes` in memory) fits in the budget; returns what is left.
-    pub fn left_after(&self, what: &str, bytes: u64) -> Result<u64, String> {
+    pub fn left_after(&self, what: &str, bytes: u64) -> crate::common::error::CliResult<u64> {
         let budget = self.budget();
         budget.checked_sub(bytes).ok_or_else(|| {
-            format!(
+            crate::common::error::CliError::Failed(format!(
                 "{what} take {} in memory, more than the budget of {} (--max-memory)",
                 size_text(bytes),
                 size_text(budget)
-            )
+            ))
         })
     }
 }

@@ -8,7 +8,7 @@
 //! with the `mpi` feature, in a run of several ranks, the same step is taken by every rank together
 //! ([`crate::distributed`]). [`write_output`] writes rays as text or as a tree, by the output's extension.
 
-use crate::common::error::{chain, CliResult};
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -59,12 +59,12 @@ impl<'a> TreeOutput<'a> {
     /// it (`None` on the other ranks, which print nothing).
     ///
     /// # Errors
-    /// A message: what is held does not fit in the budget, or the build failed (naming the output).
+    /// What is held does not fit in the budget, or the build failed (naming the output).
     pub fn write<const K: usize, S>(
         &self,
         source: &S,
         held: Option<(&str, u64)>,
-    ) -> Result<Option<Built>, String>
+    ) -> CliResult<Option<Built>>
     where
         S: RaySource<K>,
         S::Error: std::error::Error + Send + Sync + 'static,
@@ -95,7 +95,7 @@ impl<'a> TreeOutput<'a> {
         source: &S,
         path: &Path,
         budget: u64,
-    ) -> Result<Option<OutOfCoreReport>, String>
+    ) -> CliResult<Option<OutOfCoreReport>>
     where
         S: RaySource<K>,
         S::Error: std::error::Error + Send + Sync + 'static,
@@ -165,24 +165,24 @@ impl Built {
     }
 }
 
-/// The message of a failed out-of-core build of `out`; `held` bytes were set apart from the budget before
-/// the build (message buffers) and are added back to the budgets it names.
+/// The error of a failed out-of-core build of `out`, naming it once; `held` bytes were set apart from the
+/// budget before the build (message buffers) and are added back to the budgets it names.
 pub fn describe<E: std::error::Error + Send + Sync + 'static>(
     out: &Path,
     e: BuildError<E>,
     held: u64,
-) -> String {
+) -> CliError {
     match e {
-        BuildError::BudgetTooSmall { budget, needed } => format!(
+        BuildError::BudgetTooSmall { budget, needed } => CliError::Failed(format!(
             "{}: {} (--max-memory)",
             out.display(),
             BuildError::<E>::BudgetTooSmall {
                 budget: budget.saturating_add(held),
                 needed: needed.saturating_add(held),
             }
-        ),
-        BuildError::Files(output @ SpillError::Output { .. }) => chain(&output),
-        other => format!("{}: {}", out.display(), chain(&other)),
+        )),
+        BuildError::Files(output @ SpillError::Output { .. }) => CliError::caused(output),
+        other => CliError::in_file(out, other),
     }
 }
 
@@ -193,7 +193,7 @@ pub fn write_output<const K: usize>(
     rays: &RaySet<K>,
     out: &Path,
     build: &BuildArgs,
-) -> Result<String, String> {
+) -> CliResult<String> {
     if is_tree_file(out) {
         let held = ("the rays", crate::common::memory::ray_bytes(rays));
         let built = TreeOutput::new(out, build).write(rays, Some(held))?;
@@ -204,7 +204,7 @@ pub fn write_output<const K: usize>(
     if !crate::distributed::ranks().is_root() {
         return Ok(String::new());
     }
-    write_rays_file(out, rays).map_err(|e| chain(&e))?;
+    write_rays_file(out, rays).map_err(CliError::caused)?;
     Ok(format!(
         "{}: K = {K}, L = {}, {} rays, {} voxels",
         out.display(),

@@ -1,7 +1,7 @@
 //! Trees in and out of the commands: reading `.ktree` files, writing them in the format version asked for
 //! (`--format-version`, default 2), and the one-line summary of a tree written.
 
-use crate::common::error::{chain, CliError, CliResult};
+use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::Path;
@@ -55,8 +55,8 @@ pub fn write_tree<const K: usize>(
 /// the same whatever the version: out of core, in the memory budget.
 pub fn as_version_1<R>(
     out: &Path,
-    build: impl FnOnce(&Path) -> Result<Option<R>, String>,
-) -> Result<Option<R>, String> {
+    build: impl FnOnce(&Path) -> CliResult<Option<R>>,
+) -> CliResult<Option<R>> {
     let name = out
         .file_name()
         .map_or_else(|| "tree".into(), |n| n.to_string_lossy());
@@ -65,9 +65,9 @@ pub fn as_version_1<R>(
     if built.is_some() {
         // This process wrote the version 2 file (the other ranks of an MPI run return `None` and leave it).
         let written = KtreeView::open(&v2)
-            .map_err(|e| chain(&e))
+            .map_err(CliError::caused)
             .and_then(|view| {
-                write_atomic_with(out, |w| write_ktree_v1_view(w, &view)).map_err(|e| chain(&e))
+                write_atomic_with(out, |w| write_ktree_v1_view(w, &view)).map_err(CliError::caused)
             });
         let _ = std::fs::remove_file(&v2);
         written?;
@@ -76,8 +76,8 @@ pub fn as_version_1<R>(
 }
 
 /// Reads a tree file, with the path in any error.
-pub fn read(path: &Path) -> Result<AnyTree, String> {
-    read_ktree_file(path).map_err(|e| chain(&e))
+pub fn read(path: &Path) -> CliResult<AnyTree> {
+    read_ktree_file(path).map_err(CliError::caused)
 }
 
 /// Writes a tree file and prints a one-line summary.
@@ -101,7 +101,7 @@ pub fn print_summary(path: &Path, k: usize, level: u32, counts: &[LevelCounts]) 
     Ok(())
 }
 
-/// The message for two input trees that cannot be combined.
-pub fn pair_error(a: &Path, b: &Path, e: ops::OpsError) -> String {
-    format!("{} and {}: {e}", a.display(), b.display())
+/// The error of two input trees that cannot be combined, naming both.
+pub fn pair_error(a: &Path, b: &Path, e: ops::OpsError) -> CliError {
+    CliError::about(format!("{} and {}", a.display(), b.display()), e)
 }

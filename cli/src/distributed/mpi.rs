@@ -9,6 +9,7 @@ use mpi::traits::*;
 use rayon::prelude::*;
 
 use super::{Ranks, STOPPED};
+use crate::common::error::{CliError, CliResult};
 use crate::common::output::{describe, TreeOutput};
 use ktree::rays::RaySource;
 use ktree::stacking::{balanced_parts, OutOfCoreReport};
@@ -64,13 +65,13 @@ fn chunk_words(budget: u64, size: usize) -> usize {
 }
 
 /// The ranks agree whether one failed: `Ok` if none did; else this rank's error, or [`STOPPED`].
-fn agree<T>(w: &SimpleCommunicator, outcome: Result<T, String>) -> Result<T, String> {
+fn agree<T>(w: &SimpleCommunicator, outcome: CliResult<T>) -> CliResult<T> {
     let failed = u64::from(outcome.is_err());
     let mut any = 0u64;
     w.all_reduce_into(&failed, &mut any, SystemOperation::sum());
     match outcome {
         Err(e) => Err(e),
-        Ok(_) if any > 0 => Err(STOPPED.to_string()),
+        Ok(_) if any > 0 => Err(CliError::Failed(STOPPED.to_string())),
         ok => ok,
     }
 }
@@ -80,13 +81,13 @@ fn agree<T>(w: &SimpleCommunicator, outcome: Result<T, String>) -> Result<T, Str
 /// from this thread only; the pool stacks): `Some(report)` on rank 0, `None` on the other ranks.
 ///
 /// # Errors
-/// A message naming the output if the build fails on this rank; [`STOPPED`] if it failed on another.
+/// The error naming the output if the build fails on this rank; [`STOPPED`] if it failed on another.
 pub fn build_across_ranks<const K: usize, S>(
     tree: &TreeOutput<'_>,
     source: &S,
     out: &Path,
     budget: u64,
-) -> Result<Option<OutOfCoreReport>, String>
+) -> CliResult<Option<OutOfCoreReport>>
 where
     S: RaySource<K>,
     S::Error: std::error::Error + Send + Sync + 'static,
@@ -110,7 +111,7 @@ fn run<const K: usize, S>(
     out: &Path,
     pool: &rayon::ThreadPool,
     budget: u64,
-) -> Result<Option<OutOfCoreReport>, String>
+) -> CliResult<Option<OutOfCoreReport>>
 where
     S: RaySource<K>,
     S::Error: std::error::Error + Send + Sync + 'static,
@@ -136,7 +137,7 @@ where
                 .map(|(i, &b0)| builder.slab_cost(b0).map(|c| (i, c)))
                 .collect::<Result<Vec<_>, _>>()
         })
-        .map_err(|e| format!("{}: {}", out.display(), crate::common::error::chain(&e)));
+        .map_err(|e| CliError::in_file(out, e));
     let measured = agree(w, measured)?;
     for (i, c) in measured {
         costs[i] = c;
@@ -170,13 +171,8 @@ where
         drop(part);
         agree(
             w,
-            streamed.map_err(|e| {
-                format!(
-                    "{}: sending the levels: {}",
-                    out.display(),
-                    crate::common::error::chain(&e)
-                )
-            }),
+            streamed
+                .map_err(|e| CliError::about(format!("{}: sending the levels", out.display()), e)),
         )?;
         root.gather_into(&crate::common::memory::peak_rss_bytes().unwrap_or(0));
         return Ok(None);
@@ -190,9 +186,7 @@ where
         moved += 8 * words.len() as u64;
         match part.add_part(&words) {
             Ok(total) => streams.push(Stream::new(from, total)),
-            Err(e) if added.is_ok() => {
-                added = Err(format!("rank {r}: {}", crate::common::error::chain(&e)))
-            }
+            Err(e) if added.is_ok() => added = Err(CliError::about(format!("rank {r}"), e)),
             Err(_) => {}
         }
     }
