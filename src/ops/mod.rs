@@ -68,7 +68,7 @@ pub use fixed::{transform_fixed, transform_fixed_into, FixedAffine};
 pub use interference::{collision, first_contact, interferes, overlap_cells, Collision};
 pub use mass::{mass_progressive, mass_properties, LevelBounds, MassProperties, ProgressiveMass};
 pub use perspective::{transform_projective, transform_projective_into, Projective};
-pub use project::{extrude, project, slice};
+pub use project::{extrude, project, slice, slice_values};
 pub use rotate::{rotate_axes, rotate_axes_into, AxisMap};
 pub use scale::{grow, grow_into, scale, scale_into, zoom, zoom_into};
 pub use separation::min_separation;

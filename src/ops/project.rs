@@ -40,7 +40,7 @@ use crate::space::{Cell, Universe};
 use crate::tree::cursor::{try_walk, Visitor, Walk};
 use crate::tree::storage::TreeStorage;
 use crate::tree::top_down::{build_top_down, Decision, InputNode};
-use crate::tree::valued::ValueState;
+use crate::tree::valued::{ValueState, ValueStorage};
 use crate::tree::{DimensionMismatch, KTree, NodeRef, NodeState};
 
 /// The `J = K − 1`-dimensional tree of the voxels of `tree` at `position` along `axis`.
@@ -63,6 +63,75 @@ pub fn slice<const K: usize, const J: usize, T: TreeStorage<K>>(
         });
     }
     project(tree, axis, position..position + 1)
+}
+
+/// The `J = K − 1`-dimensional valued tree of the voxels of a valued `tree` at `position` along `axis`,
+/// each with its value: a label volume's section, a 4-D history's state at one step.
+///
+/// ```
+/// use ktree::ops::slice_values;
+/// use ktree::KTree;
+/// // A 2 × 2 quadtree of labels: 1 2 in row y = 0, 3 and empty in row y = 1.
+/// let tree = KTree::<2, u8>::from_dense_values(1, &[Some(1), Some(2), Some(3), None]).unwrap();
+/// let row: KTree<1, u8> = slice_values(&tree, 1, 1).unwrap();
+/// assert_eq!(row.to_dense_values().unwrap(), [Some(3), None]);
+/// let column: KTree<1, u8> = slice_values(&tree, 0, 0).unwrap();
+/// assert_eq!(column.to_dense_values().unwrap(), [Some(1), Some(3)]);
+/// ```
+///
+/// # Errors
+/// As [`slice`].
+pub fn slice_values<const K: usize, const J: usize, T: ValueStorage<K>>(
+    tree: &T,
+    axis: usize,
+    position: u32,
+) -> Result<KTree<J, T::Value>, OpsError> {
+    if J + 1 != K {
+        return Err(OpsError::DimensionMismatch(DimensionMismatch {
+            expected: K - 1,
+            found: J,
+        }));
+    }
+    if axis >= K {
+        return Err(OpsError::BadAxis { axis, k: K });
+    }
+    let level = tree.level();
+    let side = tree.universe().side();
+    if u64::from(position) >= side {
+        return Err(OpsError::SliceOutside {
+            axis,
+            position,
+            side,
+        });
+    }
+    Universe::<J>::new(level).map_err(|_| OpsError::LevelTooLarge {
+        k: J,
+        level,
+        max: crate::max_level(J),
+    })?;
+    // A J-cell of side 2^s stands on the K-node of the same side whose cell holds it at `position`; its
+    // child `code` stands on the K-child whose bit along `axis` is the position's bit s − 1.
+    let low_bits = (1usize << axis) - 1;
+    let root = InputNode::root(tree).map_err(OpsError::storage)?;
+    let built = build_top_down::<J, T::Value, _, Failure<T::Error>>(
+        level,
+        (root, level),
+        |_: &Cell<J>, (node, _): &(InputNode<T::Value>, u32)| {
+            Ok(match node.state {
+                ValueState::Empty => Decision::Leaf(None),
+                ValueState::Full(v) => Decision::Leaf(Some(v)),
+                ValueState::Partial | ValueState::Mixed => Decision::Split,
+            })
+        },
+        |(node, log_side), code| {
+            let bit = ((position >> (log_side - 1)) & 1) as usize;
+            let upper = (code & low_bits) | (bit << axis) | ((code >> axis) << (axis + 1));
+            let child = node.child(tree, upper).map_err(Failure::Read)?;
+            Ok((child, log_side - 1))
+        },
+    );
+    // Its level was checked and the input's values are its own: only a read can fail.
+    built.map_err(|e| OpsError::storage(e.into_read()))
 }
 
 /// The `J = K − 1`-dimensional tree of the positions (the other axes' coordinates) where `tree` has a

@@ -2,10 +2,13 @@
 //! projection along each axis over random ranges is the "any full voxel in the range" of the dense array,
 //! the slice its row at one position; the trees are reduced; a mapped file gives the same trees. The
 //! extrusion (`ops::extrude`) of a J-tree along a new axis over a range is the dense array held there, and
-//! projects back to the tree.
+//! projects back to the tree. The slice of a valued tree (`ops::slice_values`) is the dense array's row of
+//! values, and its shape the slice of the tree's shape.
 
-use ktree::ops::{extrude, project, slice};
+use ktree::ops::{extrude, project, slice, slice_values};
+use ktree::tree::{Rgb, Value};
 use ktree::KTree;
+use ktree_verify::labels::{painted_at, Painted, Palette};
 use ktree_verify::objects::{obj_at, Obj};
 use proptest::prelude::*;
 
@@ -74,8 +77,63 @@ fn check_extrude<const J: usize, const K: usize>(
     Ok(())
 }
 
+fn check_slice_values<const K: usize, const J: usize, V: Palette>(
+    o: &Painted<K>,
+    axis: usize,
+    at: u32,
+) -> Result<(), TestCaseError> {
+    let dense = o.dense::<V>();
+    let tree = KTree::<K, V>::from_dense_values(o.level, &dense).unwrap();
+    let u = o.universe();
+    let axis = axis % K;
+    let at = at % u.side() as u32;
+    let got: KTree<J, V> = slice_values(&tree, axis, at).unwrap();
+    got.assert_well_formed();
+    let plane = ktree::space::Universe::<J>::new(o.level).unwrap();
+    let want: Vec<Option<V>> = (0..plane.voxels() as usize)
+        .map(|i| {
+            let q = plane.dense_point(i);
+            let p: [u32; K] = std::array::from_fn(|a| match a.cmp(&axis) {
+                std::cmp::Ordering::Less => q[a],
+                std::cmp::Ordering::Equal => at,
+                std::cmp::Ordering::Greater => q[a - 1],
+            });
+            dense[u.dense_index(p)]
+        })
+        .collect();
+    let back = got.to_dense_values().unwrap();
+    prop_assert_eq!(
+        back.iter().map(|v| v.map(Value::key)).collect::<Vec<_>>(),
+        want.iter().map(|v| v.map(Value::key)).collect::<Vec<_>>()
+    );
+    // Minimal, so equal to the tree built from the row itself; its shape is the shape's slice.
+    prop_assert_eq!(
+        &got,
+        &KTree::<J, V>::from_dense_values(o.level, &want).unwrap()
+    );
+    prop_assert_eq!(
+        got.shape(),
+        slice::<K, J, _>(&tree.shape(), axis, at).unwrap()
+    );
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ktree_verify::config(64))]
+    #[test]
+    fn slice_values_k2(o in (0u32..=5).prop_flat_map(painted_at::<2>), axis in 0usize..2, at in 0u32..64) {
+        check_slice_values::<2, 1, u8>(&o, axis, at)?;
+        check_slice_values::<2, 1, f32>(&o, axis, at)?;
+    }
+    #[test]
+    fn slice_values_k3(o in (0u32..=4).prop_flat_map(painted_at::<3>), axis in 0usize..3, at in 0u32..16) {
+        check_slice_values::<3, 2, u16>(&o, axis, at)?;
+        check_slice_values::<3, 2, Rgb>(&o, axis, at)?;
+    }
+    #[test]
+    fn slice_values_k4(o in (0u32..=3).prop_flat_map(painted_at::<4>), axis in 0usize..4, at in 0u32..8) {
+        check_slice_values::<4, 3, i8>(&o, axis, at)?;
+    }
     #[test]
     fn extrude_k1_to_k2(o in (0u32..=5).prop_flat_map(obj_at::<1>), axis in 0usize..2, lo in 0u32..64, len in 0u32..40) {
         check_extrude::<1, 2>(&o, axis, lo, len)?;
