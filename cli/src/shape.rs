@@ -18,7 +18,7 @@ use crate::common::tree_file::write;
 
 /// Opens a tree file: a version 2 `.ktree` through its memory map, any other format read into memory.
 fn open(path: &Path) -> Result<FileTree, String> {
-    FileTree::open(path, &ReadOptions::default()).map_err(|e| chain(&e))
+    ktree::input::open_tree(path, &ReadOptions::default()).map_err(|e| chain(&e))
 }
 
 /// Arguments of `ktree morph`.
