@@ -30,6 +30,8 @@
 //!   read; version 3 for valued trees), the ray text, binvox, OctoMap `.bt`, OpenVDB `.vdb`, point clouds and meshes in — and the spill
 //!   files of trees larger than memory (one level a file), which the out-of-core builder and the streamed
 //!   Booleans both write.
+//! * [`input`]: any input file as a tree — tree files read by [`io`], meshes and volumes voxelized by
+//!   [`solid`] on the way in ([`input::read_tree`], [`input::voxelize`], slab by slab [`input::voxel_source`]).
 //! * [`fs`]: atomic writes and spill folders, below everything that writes.
 //! * [`ops`]: Meagher's operations — Booleans, translation, scaling, rotations, affine maps, interference,
 //!   mass properties, complexity — on trees in memory and on mapped files, the trees they make written
@@ -49,10 +51,12 @@
 //! # Layers
 //! Each layer imports only those below it:
 //! ```text
+//!  input              any input file as a tree: tree files read by io, meshes and volumes voxelized by
+//!                     solid (read_tree, read_tree_placed, open_tree; voxelize, voxel_source)
 //!  io/                files by format (and OctoMap's map files, scans in: io::scan): .ktree (v1 read, v2 written and mapped, v3 with values), interop
 //!                     grids, ray text, point clouds and meshes in (into solid/'s PointCloud and TriangleMesh);
-//!                     read_tree / write_tree by extension (meshes and volumes voxelized on the way in,
-//!                     meshes written through export/); spill files, one level a file, and the level
+//!                     read_tree / write_tree of tree files by extension (meshes written through export/,
+//!                     volumes as NIfTI); spill files, one level a file, and the level
 //!                     sink over them; the out-of-core builder's files (Builder::to_file); the Booleans
 //!                     of files larger than memory (ops' merge, mapped inputs, spilled output)
 //!  export/            boundaries as meshes and outlines, and their files (over display's neighbours);
@@ -97,6 +101,7 @@ mod dim;
 pub mod display;
 pub mod export;
 pub mod fs;
+pub mod input;
 pub mod io;
 pub mod map;
 pub mod ops;

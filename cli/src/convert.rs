@@ -10,9 +10,10 @@ use std::path::{Path, PathBuf};
 use ktree::export::surface::smooth_mesh;
 use ktree::export::vtk::{write_time_slices, write_vtk_file};
 use ktree::export::{write_mesh_of, write_surface, ExportError, Frame};
+use ktree::input::read_tree_placed;
 use ktree::io::{
-    ktree_file_version, read_tree_placed, write_tree, AnyMappedTree, FileTree, Format, ReadOptions,
-    WriteOptions, VERSION,
+    ktree_file_version, write_tree, AnyMappedTree, FileTree, Format, ReadOptions, WriteOptions,
+    VERSION,
 };
 use ktree::solid::mesh::MeshTransform;
 use ktree::tree::storage::TreeStorage;

@@ -59,8 +59,8 @@ pub fn run(args: Args) -> CliResult {
         return Err("--stroke must be a positive number".into());
     }
     // A version 2 file is drawn from its memory map, whatever its size.
-    let file =
-        FileTree::open(&args.file, &ktree::io::ReadOptions::default()).map_err(CliError::caused)?;
+    let file = ktree::input::open_tree(&args.file, &ktree::io::ReadOptions::default())
+        .map_err(CliError::caused)?;
     let out = args
         .out
         .clone()

@@ -132,7 +132,7 @@ pub fn run_slice(a: SliceArgs) -> CliResult {
 }
 
 fn open(path: &Path) -> CliResult<FileTree> {
-    FileTree::open(path, &ReadOptions::default()).map_err(CliError::caused)
+    ktree::input::open_tree(path, &ReadOptions::default()).map_err(CliError::caused)
 }
 
 fn run(

@@ -72,7 +72,7 @@ pub struct RaycastArgs {
 
 /// The tree of a file: mapped (version 2) or loaded; the queries run on either.
 fn open(path: &Path) -> CliResult<FileTree> {
-    FileTree::open(path, &ktree::io::ReadOptions::default()).map_err(CliError::caused)
+    ktree::input::open_tree(path, &ktree::io::ReadOptions::default()).map_err(CliError::caused)
 }
 
 /// Standard output, buffered; writes end the command quietly on a closed pipe.

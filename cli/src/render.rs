@@ -132,8 +132,8 @@ pub fn run(args: Args) -> CliResult {
         .into());
     }
     // A version 2 file is drawn from its memory map, whatever its size.
-    let file =
-        FileTree::open(&args.file, &ktree::io::ReadOptions::default()).map_err(CliError::caused)?;
+    let file = ktree::input::open_tree(&args.file, &ktree::io::ReadOptions::default())
+        .map_err(CliError::caused)?;
     match &file {
         FileTree::Memory(AnyTree::K3(t)) => render_octree(
             t,

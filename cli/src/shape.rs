@@ -18,7 +18,7 @@ use crate::common::tree_file::write;
 
 /// Opens a tree file: a version 2 `.ktree` through its memory map, any other format read into memory.
 fn open(path: &Path) -> CliResult<FileTree> {
-    FileTree::open(path, &ReadOptions::default()).map_err(CliError::caused)
+    ktree::input::open_tree(path, &ReadOptions::default()).map_err(CliError::caused)
 }
 
 /// Arguments of `ktree morph`.

@@ -13,7 +13,7 @@ use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::{read_rays_file, FileTree};
+use ktree::io::read_rays_file;
 use ktree::query::{stats, TreeStats};
 use ktree::with_tree;
 
@@ -53,7 +53,7 @@ pub fn run(args: Args) -> CliResult {
     // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
     let (stats, measures) = match (&args.tree, &args.rays) {
         (Some(path), None) => {
-            let file = FileTree::open(path, &ktree::io::ReadOptions::default())
+            let file = ktree::input::open_tree(path, &ktree::io::ReadOptions::default())
                 .map_err(CliError::caused)?;
             let stats = with_tree!(&file, t => stats(t, None).map_err(read_error))?;
             let measures = if args.measures {

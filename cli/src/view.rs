@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 
 use ktree::display::View;
 use ktree::export::view::{write_view, Page, ViewOptions, DEFAULT_BUDGET};
-use ktree::io::FileTree;
 use ktree::tree::cursor::TreeStorage;
 use ktree::with_tree;
 
@@ -57,8 +56,8 @@ pub fn run(args: Args) -> CliResult {
             .map_or_else(|| "ktree".into(), |n| n.to_string_lossy().into_owned()),
     };
     // A version 2 file is read through its memory map, whatever its size.
-    let file =
-        FileTree::open(&args.file, &ktree::io::ReadOptions::default()).map_err(CliError::caused)?;
+    let file = ktree::input::open_tree(&args.file, &ktree::io::ReadOptions::default())
+        .map_err(CliError::caused)?;
     let page = with_tree!(&file, t => page_of(t, &out, &options))?;
     outln!(
         "wrote {} ({} boxes{}, {} bytes)",

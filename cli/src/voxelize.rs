@@ -14,7 +14,8 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
-use ktree::io::{voxel_source, voxelize, Format, ReadOptions, VoxelSource};
+use ktree::input::{voxel_source, voxelize, VoxelSource};
+use ktree::io::{Format, ReadOptions};
 use ktree::rays::{RaySource, SlabRuns};
 use ktree::solid::mesh::MeshTransform;
 use ktree::Universe;

@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use common::{data_dir, ktree, run_openvdb, tools};
-use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions};
+use ktree::input::read_tree;
+use ktree::io::{write_tree, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
 use ktree::stacking::paper::stack;
 use ktree::AnyTree;

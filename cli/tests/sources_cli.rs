@@ -7,7 +7,8 @@ mod common;
 use std::path::Path;
 
 use common::ktree;
-use ktree::io::{read_rays_file, voxelize, write_ktree, ReadOptions};
+use ktree::input::voxelize;
+use ktree::io::{read_rays_file, write_ktree, ReadOptions};
 use ktree::solid::mesh::MeshTransform;
 use ktree::solid::volume::Select;
 use ktree::stacking::paper::stack;

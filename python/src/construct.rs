@@ -1,7 +1,7 @@
 //! Trees made from Python's inputs, each by one call of the library: a dense array (`from_dense`), the
 //! empty and the full universe, runs (`from_rays`), a mesh file or mesh arrays (`from_mesh`,
 //! `from_mesh_arrays`: the slab-wise builder `KTree::from_mesh`, placed as the library places meshes),
-//! points (`from_points`) and a volume file (`from_volume`, read as `ktree::io::read_tree` reads volumes).
+//! points (`from_points`) and a volume file (`from_volume`, read as `ktree::input::read_tree` reads volumes).
 
 use std::ffi::CString;
 use std::path::PathBuf;

@@ -1,5 +1,5 @@
-//! Tree files in and out through the library's dispatch by extension (`ktree::io::read_tree` and
-//! `ktree::io::write_tree` with their default options): `.ktree`, `.rays`, binvox, OctoMap `.bt` and OpenVDB
+//! Tree files in and out through the library's dispatch by extension (`ktree::input::read_tree`, which
+//! voxelizes meshes and volumes, and `ktree::io::write_tree`, with their default options): `.ktree`, `.rays`, binvox, OctoMap `.bt` and OpenVDB
 //! `.vdb`, meshes (voxelized when read; the tree's boundary when written, with `.glb` and `.svg`), VTK
 //! files (`.vtu`, `.htg`) as outputs and volumes as inputs; the `.ktree` bytes of a tree, and pickling
 //! through them. Errors of the file system become `OSError`, the others `ValueError`; an `OSError` is of
@@ -116,5 +116,5 @@ type Rebuild<'py> = (Bound<'py, PyAny>, (Bound<'py, PyBytes>, f64));
 
 /// Reads a tree from a file of any format the library reads, chosen by extension, with `options`.
 pub(crate) fn read_tree_with(path: &Path, options: &ReadOptions) -> Result<AnyTree, Failure> {
-    ktree::io::read_tree(path, options).map_err(|e| Failure::of_error(&e, path))
+    ktree::input::read_tree(path, options).map_err(|e| Failure::of_error(&e, path))
 }

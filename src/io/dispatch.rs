@@ -1,7 +1,8 @@
 //! Reading and writing a tree in any format, chosen by the file's extension: `.ktree`, `.rays` (the ray
-//! text), `.binvox`, `.bt` (OctoMap), `.vdb` (OpenVDB); meshes (`.obj`, `.stl`, `.ply`) read by voxelizing
-//! them and written as the tree's boundary ([`crate::export`]), with `.glb` and `.svg` as outputs only;
-//! volumes (`.json` + raw, `.nii`, `.nii.gz`) as inputs only.
+//! text), `.binvox`, `.bt` (OctoMap), `.vdb` (OpenVDB) read and written; meshes (`.obj`, `.stl`, `.ply`)
+//! written as the tree's boundary ([`crate::export`]), with `.glb`, `.svg` and VTK as outputs only; volumes
+//! written as NIfTI. Meshes and volumes are read by voxelizing them, which [`crate::input`] does above
+//! both the files and the solids: [`read_tree`] here refuses them.
 //!
 //! Grid formats index voxels by integers: ktree voxel = grid index + offset (see [`GridPlacement`]).
 //! binvox, `.bt` and `.vdb` hold octrees only.
@@ -17,7 +18,6 @@ use super::interop::{
 use super::ktree::{read_ktree_file, write_ktree_file, KtreeFileError};
 use super::rays::{read_rays_file, write_rays_file, RaysTextError};
 use crate::fs::write_atomic_with;
-use crate::rays::RaySet;
 use crate::solid::SolidError;
 use crate::tree::{AnyTree, DimensionMismatch, KTree};
 
@@ -35,7 +35,8 @@ pub enum Format {
     OctomapBt,
     /// `.vdb`: an OpenVDB grid.
     Vdb,
-    /// `.obj`, `.stl`, `.ply`: a triangle mesh (voxelized when read; the tree's boundary when written).
+    /// `.obj`, `.stl`, `.ply`: a triangle mesh (voxelized when read, by [`crate::input`]; the tree's
+    /// boundary when written).
     Mesh,
     /// `.glb`: a glTF binary mesh of the tree's boundary (output only).
     Glb,
@@ -45,7 +46,8 @@ pub enum Format {
     Vtu,
     /// `.htg`: a VTK hyper tree grid, for ParaView (output only).
     Htg,
-    /// `.json` (+ raw samples), `.raw`, `.nii`, `.nii.gz`: a volume (input; NIfTI also output).
+    /// `.json` (+ raw samples), `.raw`, `.nii`, `.nii.gz`: a volume (voxelized when read, by
+    /// [`crate::input`]; NIfTI also written).
     Volume,
 }
 
@@ -80,7 +82,8 @@ impl Format {
     }
 }
 
-/// How to read a file. Every field has a default that suits a file holding the whole object.
+/// How to read a file. Every field has a default that suits a file holding the whole object. The mesh and
+/// volume fields are those of [`crate::input`], which voxelizes them.
 #[derive(Debug, Clone, Default)]
 pub struct ReadOptions {
     /// The universe level. Grids and volumes: default the smallest level that holds the grid. Meshes:
@@ -112,7 +115,8 @@ pub struct WriteOptions {
     pub meta: Option<GridMeta>,
 }
 
-/// A tree read by [`read_tree_placed`], with what the reader chose or noticed.
+/// A tree read by [`read_tree_placed`] (or [`crate::input::read_tree_placed`]), with what the reader chose
+/// or noticed.
 #[derive(Debug, Clone)]
 pub struct ReadTree {
     /// The object.
@@ -142,8 +146,8 @@ pub enum IoError {
     #[cfg(any(feature = "cloud", feature = "mesh"))]
     #[error(transparent)]
     Geometry(#[from] super::GeometryFileError),
-    /// A mesh or volume that could not be parsed or voxelized (one that cannot be read is
-    /// [`IoError::Read`]).
+    /// A mesh or volume that could not be parsed or voxelized by [`crate::input`] (one that cannot be read
+    /// is [`IoError::Read`]).
     #[error("{}", with_file(.file, .error))]
     Solid {
         /// The file.
@@ -188,14 +192,14 @@ fn with_file(file: &Path, e: &SolidError) -> String {
     }
 }
 
-fn usage(path: &Path, message: impl Into<String>) -> IoError {
+pub(crate) fn usage(path: &Path, message: impl Into<String>) -> IoError {
     IoError::Usage {
         file: path.to_path_buf(),
         message: message.into(),
     }
 }
 
-fn format_of(path: &Path) -> Result<Format, IoError> {
+pub(crate) fn format_of(path: &Path) -> Result<Format, IoError> {
     Format::of(path).ok_or_else(|| {
         usage(
             path,
@@ -205,7 +209,8 @@ fn format_of(path: &Path) -> Result<Format, IoError> {
     })
 }
 
-/// Reads a tree from a file of any format, chosen by extension.
+/// Reads a tree from a tree file of any format, chosen by extension: `.ktree`, `.rays`, `.binvox`, `.bt`,
+/// `.vdb`. Meshes and volumes are voxelized by [`crate::input::read_tree`], which reads every input.
 ///
 /// ```
 /// use ktree::io::{read_tree, write_tree, ReadOptions, WriteOptions};
@@ -217,10 +222,15 @@ fn format_of(path: &Path) -> Result<Format, IoError> {
 ///     write_tree(&path, &tree, &WriteOptions::default()).unwrap();
 ///     assert_eq!(read_tree(&path, &ReadOptions::default()).unwrap(), tree, "{name}");
 /// }
+/// // A mesh is voxelized by `ktree::input::read_tree`, not read here.
+/// let mesh = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/meshes/fandisk.obj");
+/// let options = ReadOptions { level: Some(5), ..ReadOptions::default() };
+/// assert!(matches!(read_tree(&mesh, &options), Err(ktree::io::IoError::Usage { .. })));
 /// ```
 ///
 /// # Errors
-/// [`IoError`]: the format's own error naming the file and the line or byte, or [`IoError::Usage`].
+/// [`IoError`]: the format's own error naming the file and the line or byte, or [`IoError::Usage`] (an
+/// output-only format, a mesh or a volume, an unknown extension).
 pub fn read_tree(path: &Path, options: &ReadOptions) -> Result<AnyTree, IoError> {
     read_tree_placed(path, options).map(|r| r.tree)
 }
@@ -273,299 +283,12 @@ pub fn read_tree_placed(path: &Path, options: &ReadOptions) -> Result<ReadTree, 
             options.offset,
             options.level,
         )?)),
-        Format::Mesh | Format::Volume => {
-            let v = voxelize(path, options)?;
-            let mut remarks = Vec::new();
-            if let Some(t) = &v.fitted {
-                remarks.push(format!("the mesh was fitted with the transform {t}"));
-            }
-            if v.open_edges > 0 {
-                remarks.push(format!(
-                    "the mesh is not closed ({} edges not shared by exactly two triangles); inside is \
-                     decided by the winding along each column, so some columns may leak or lose runs",
-                    v.open_edges
-                ));
-            }
-            Ok(ReadTree {
-                remarks,
-                ..plain(AnyTree::K3(crate::KTree::from_rays(&v.rays)))
-            })
-        }
-    }
-}
-
-/// A mesh or a volume as rays, with what was chosen or noticed on the way.
-#[derive(Debug, Clone)]
-pub struct Voxelized {
-    /// The voxels inside.
-    pub rays: RaySet<3>,
-    /// Meshes placed by fitting: the transform chosen, as `s,tx,ty,tz`.
-    pub fitted: Option<String>,
-    /// Meshes: edges not shared by exactly two triangles (0 for a closed mesh).
-    pub open_edges: usize,
-}
-
-/// Voxelizes a mesh or a volume file into rays ([`Format::Mesh`], [`Format::Volume`]): a mesh needs
-/// [`ReadOptions::level`], a volume [`ReadOptions::select`]; the volume's sample `(i, j, k)` goes to voxel
-/// `offset + (i, j, k)`.
-///
-/// # Errors
-/// [`IoError::Solid`] from reading or voxelizing, [`IoError::Usage`] for another format or a missing option.
-pub fn voxelize(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
-    match format_of(path)? {
-        Format::Mesh => voxelize_mesh(path, options),
-        Format::Volume => voxelize_volume(path, options),
-        _ => Err(usage(path, "not a mesh or a volume")),
-    }
-}
-
-/// A missing or unreadable input is said as such (an I/O error) before any option is asked for.
-#[cfg(feature = "volume")]
-fn readable(path: &Path) -> Result<(), SolidError> {
-    std::fs::File::open(path)
-        .map(drop)
-        .map_err(|source| SolidError::Io {
-            path: path.to_path_buf(),
-            source,
-        })
-}
-
-#[cfg(any(feature = "mesh", feature = "volume"))]
-fn solid_error(path: &Path) -> impl Fn(SolidError) -> IoError + '_ {
-    move |error| match error {
-        SolidError::Io { path, source } => IoError::Read(crate::fs::FileOpError::new(
-            crate::fs::FileOp::Read,
-            &path,
-            source,
+        Format::Mesh | Format::Volume => Err(usage(
+            path,
+            "meshes and volumes are voxelized when read: read them with ktree::input::read_tree (a mesh \
+             needs a level, a volume a threshold or a label)",
         )),
-        error => IoError::Solid {
-            file: path.to_path_buf(),
-            error,
-        },
     }
-}
-
-/// A mesh or a volume producing its rays slab by slab ([`MeshSource`](crate::solid::mesh::MeshSource),
-/// [`VolumeSource`](crate::solid::volume::VolumeSource)), for building its tree out of core without
-/// holding the whole ray set; the runs are those of [`voxelize`] with the same options.
-#[cfg(any(feature = "mesh", feature = "volume"))]
-#[derive(Debug, Clone)]
-pub enum VoxelSource {
-    /// A placed mesh.
-    #[cfg(feature = "mesh")]
-    Mesh(crate::solid::mesh::MeshSource),
-    /// A volume with its selection and offset.
-    #[cfg(feature = "volume")]
-    Volume(crate::solid::volume::VolumeSource),
-}
-
-#[cfg(any(feature = "mesh", feature = "volume"))]
-impl VoxelSource {
-    /// The bytes the source holds (see `heap_bytes` of each source).
-    pub fn heap_bytes(&self) -> u64 {
-        match self {
-            #[cfg(feature = "mesh")]
-            Self::Mesh(m) => m.heap_bytes(),
-            #[cfg(feature = "volume")]
-            Self::Volume(v) => v.heap_bytes(),
-        }
-    }
-}
-
-#[cfg(any(feature = "mesh", feature = "volume"))]
-impl crate::rays::RaySource<3> for VoxelSource {
-    type Error = std::convert::Infallible;
-
-    fn universe(&self) -> crate::Universe<3> {
-        match self {
-            #[cfg(feature = "mesh")]
-            Self::Mesh(m) => m.universe(),
-            #[cfg(feature = "volume")]
-            Self::Volume(v) => v.universe(),
-        }
-    }
-
-    fn slab(
-        &self,
-        x: std::ops::Range<u32>,
-    ) -> Result<crate::rays::SlabRuns<'_>, std::convert::Infallible> {
-        match self {
-            #[cfg(feature = "mesh")]
-            Self::Mesh(m) => m.slab(x),
-            #[cfg(feature = "volume")]
-            Self::Volume(v) => v.slab(x),
-        }
-    }
-
-    fn occupied_slabs(&self, m: u32) -> Vec<u32> {
-        match self {
-            #[cfg(feature = "mesh")]
-            Self::Mesh(s) => s.occupied_slabs(m),
-            #[cfg(feature = "volume")]
-            Self::Volume(v) => v.occupied_slabs(m),
-        }
-    }
-}
-
-/// A mesh or a volume as a [`VoxelSource`], with what was chosen or noticed on the way.
-#[cfg(any(feature = "mesh", feature = "volume"))]
-#[derive(Debug, Clone)]
-pub struct VoxelizedSource {
-    /// The source of the voxels inside.
-    pub source: VoxelSource,
-    /// Meshes placed by fitting: the transform chosen, as `s,tx,ty,tz`.
-    pub fitted: Option<String>,
-    /// Meshes: edges not shared by exactly two triangles (0 for a closed mesh).
-    pub open_edges: usize,
-}
-
-/// Like [`voxelize`], producing the rays slab by slab: reads the mesh or volume, checks the options and
-/// the placement, and returns a source whose slabs hold the runs [`voxelize`] returns.
-///
-/// ```
-/// use ktree::io::{voxel_source, voxelize, ReadOptions};
-/// use ktree::stacking::{paper::stack, Builder};
-/// use std::path::Path;
-/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/meshes/fandisk.obj");
-/// let options = ReadOptions { level: Some(5), ..ReadOptions::default() };
-/// let slabs = voxel_source(&path, &options).unwrap();
-/// let whole = voxelize(&path, &options).unwrap();
-/// assert_eq!((&slabs.fitted, slabs.open_edges), (&whole.fitted, whole.open_edges));
-/// assert_eq!(Builder::new(&slabs.source).split_depth(2).build().unwrap(), stack(&whole.rays));
-/// ```
-///
-/// # Errors
-/// As [`voxelize`].
-#[cfg(any(feature = "mesh", feature = "volume"))]
-pub fn voxel_source(path: &Path, options: &ReadOptions) -> Result<VoxelizedSource, IoError> {
-    let solid = solid_error(path);
-    match format_of(path)? {
-        #[cfg(feature = "mesh")]
-        Format::Mesh => {
-            let (mesh, level, placement, fitted) = mesh_input(path, options)?;
-            let source =
-                crate::solid::mesh::MeshSource::new(&mesh, level, &placement).map_err(&solid)?;
-            Ok(VoxelizedSource {
-                source: VoxelSource::Mesh(source),
-                fitted,
-                open_edges: mesh.open_edges(),
-            })
-        }
-        #[cfg(feature = "volume")]
-        Format::Volume => {
-            let (volume, level, offset, select) = volume_input(path, options)?;
-            let source = crate::solid::volume::VolumeSource::new(volume, level, offset, select)
-                .map_err(&solid)?;
-            Ok(VoxelizedSource {
-                source: VoxelSource::Volume(source),
-                fitted: None,
-                open_edges: 0,
-            })
-        }
-        #[cfg(not(feature = "mesh"))]
-        Format::Mesh => Err(usage(path, "meshes are read with the `mesh` feature")),
-        #[cfg(not(feature = "volume"))]
-        Format::Volume => Err(usage(path, "volumes are read with the `volume` feature")),
-        _ => Err(usage(path, "not a mesh or a volume")),
-    }
-}
-
-/// The mesh of a file with its level and placement (and the placement as text when it was fitted).
-#[cfg(feature = "mesh")]
-fn mesh_input(
-    path: &Path,
-    options: &ReadOptions,
-) -> Result<
-    (
-        crate::solid::mesh::TriangleMesh,
-        u32,
-        crate::solid::mesh::MeshTransform,
-        Option<String>,
-    ),
-    IoError,
-> {
-    use crate::solid::mesh::MeshTransform;
-    let solid = solid_error(path);
-    std::fs::File::open(path).map_err(|e| super::geometry_file::io_error(path, e))?;
-    let level = options
-        .level
-        .ok_or_else(|| usage(path, "a mesh needs a universe level"))?;
-    let mesh = super::read_mesh(path)?;
-    let (placement, fitted) = match options.mesh_placement {
-        Some(p) => (p, None),
-        None => {
-            let p = MeshTransform::fit(&mesh, level).map_err(&solid)?;
-            (p, Some(p.to_arg()))
-        }
-    };
-    Ok((mesh, level, placement, fitted))
-}
-
-#[cfg(feature = "mesh")]
-fn voxelize_mesh(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
-    let (mesh, level, placement, fitted) = mesh_input(path, options)?;
-    let r = mesh.to_rays(level, &placement).map_err(solid_error(path))?;
-    Ok(Voxelized {
-        rays: r.rays,
-        fitted,
-        open_edges: r.open_edges,
-    })
-}
-
-#[cfg(not(feature = "mesh"))]
-fn voxelize_mesh(path: &Path, _: &ReadOptions) -> Result<Voxelized, IoError> {
-    Err(usage(path, "meshes are read with the `mesh` feature"))
-}
-
-/// The volume of a file with its level, offset and selection.
-#[cfg(feature = "volume")]
-fn volume_input(
-    path: &Path,
-    options: &ReadOptions,
-) -> Result<
-    (
-        crate::solid::volume::Volume,
-        u32,
-        [u32; 3],
-        crate::solid::volume::Select,
-    ),
-    IoError,
-> {
-    use crate::solid::volume::Volume;
-    let solid = solid_error(path);
-    readable(path).map_err(&solid)?;
-    let select = options
-        .select
-        .ok_or_else(|| usage(path, "a volume needs a threshold or a label"))?;
-    let offset = options.offset.unwrap_or([0; 3]);
-    let Ok(offset) = offset
-        .map(u32::try_from)
-        .into_iter()
-        .collect::<Result<Vec<u32>, _>>()
-    else {
-        return Err(usage(path, "a volume's offset must be non-negative"));
-    };
-    let v = Volume::read(path).map_err(&solid)?;
-    let level = options.level.unwrap_or_else(|| v.fitting_level());
-    Ok((v, level, [offset[0], offset[1], offset[2]], select))
-}
-
-#[cfg(feature = "volume")]
-fn voxelize_volume(path: &Path, options: &ReadOptions) -> Result<Voxelized, IoError> {
-    let (v, level, offset, select) = volume_input(path, options)?;
-    let rays = v
-        .to_rays(level, offset, select)
-        .map_err(solid_error(path))?;
-    Ok(Voxelized {
-        rays,
-        fitted: None,
-        open_edges: 0,
-    })
-}
-
-#[cfg(not(feature = "volume"))]
-fn voxelize_volume(path: &Path, _: &ReadOptions) -> Result<Voxelized, IoError> {
-    Err(usage(path, "volumes are read with the `volume` feature"))
 }
 
 /// Writes a tree to a file of the format its extension names, atomically ([`crate::fs::write_atomic`]).

@@ -38,7 +38,8 @@ pub enum FileTree {
 
 impl FileTree {
     /// The tree of the file `path`: a `.ktree` of the current version mapped in place (checked when
-    /// opened), any other format read by [`read_tree`] with `options`.
+    /// opened), any other tree file read by [`read_tree`] with `options` (meshes and volumes, which are
+    /// voxelized: [`crate::input::open_tree`]).
     ///
     /// # Errors
     /// As [`read_tree`].

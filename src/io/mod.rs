@@ -9,8 +9,8 @@
 //!   meshes (OBJ, STL, PLY) in ([`read_cloud`], [`read_mesh`]), one PLY reader for both;
 //! * [`scan`](mod@scan): range scans for occupancy maps — OctoMap's scan graphs and logs, lists of point
 //!   files with their poses ([`read_scans`]);
-//! * [`read_tree`] and [`write_tree`] choose among all of them (and meshes and volumes as inputs) by the
-//!   file's extension.
+//! * [`read_tree`] and [`write_tree`] choose among all of them by the file's extension (meshes and NIfTI
+//!   volumes written; meshes and volumes are read by voxelizing them, in [`crate::input`]).
 //!
 //! Every output is written atomically ([`crate::fs`]).
 //!
@@ -32,7 +32,7 @@ pub mod cloud;
 mod dispatch;
 mod file_tree;
 #[cfg(any(feature = "cloud", feature = "mesh"))]
-mod geometry_file;
+pub(crate) mod geometry_file;
 pub mod interop;
 pub mod ktree;
 mod location;
@@ -62,12 +62,10 @@ pub use scan::{
     ScanNode,
 };
 
+pub(crate) use dispatch::{format_of, usage};
 pub use dispatch::{
-    read_tree, read_tree_placed, voxelize, write_tree, Format, IoError, ReadOptions, ReadTree,
-    Voxelized, WriteOptions,
+    read_tree, read_tree_placed, write_tree, Format, IoError, ReadOptions, ReadTree, WriteOptions,
 };
-#[cfg(any(feature = "mesh", feature = "volume"))]
-pub use dispatch::{voxel_source, VoxelSource, VoxelizedSource};
 pub use file_tree::FileTree;
 pub use interop::{
     read_binvox, read_bt, read_bt_map, read_color_ot_map, read_ot_map, read_vdb, write_binvox,

@@ -19,6 +19,7 @@ const LAYERS: &[&[&str]] = &[
     &["display"],
     &["export"],
     &["io"],
+    &["input"],
 ];
 
 /// Imports that go up today, each `(from, to)`: the list may only shrink (an entry no longer found fails
@@ -104,6 +105,16 @@ fn named_modules(code: &str) -> BTreeSet<String> {
     found
 }
 
+/// The modules that the code of module `top`, of layer `from`, names in its own layer or above (a root
+/// item — a re-exported type, `max_level`, … — belongs to no module and is passed over).
+fn not_below(from: usize, top: &str, code: &str) -> Vec<String> {
+    named_modules(code)
+        .iter()
+        .map(|name| owner(name).to_string())
+        .filter(|m| m != top && layer(m).is_some_and(|to| to >= from))
+        .collect()
+}
+
 #[test]
 fn modules_import_only_downward() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../src");
@@ -132,14 +143,7 @@ fn modules_import_only_downward() {
             )
         });
         let text = std::fs::read_to_string(file).unwrap();
-        for name in named_modules(&code(&text)) {
-            let to_module = owner(&name).to_string();
-            let Some(to) = layer(&to_module) else {
-                continue; // a root item (a re-exported type, `max_level`, …): no module
-            };
-            if to_module == top || to < from {
-                continue;
-            }
+        for to_module in not_below(from, &top, &code(&text)) {
             if KNOWN.contains(&(top.as_str(), to_module.as_str())) {
                 seen_known.insert((top.clone(), to_module.clone()));
                 continue;
@@ -165,4 +169,18 @@ fn the_scan_finds_grouped_and_plain_imports_but_not_macro_paths() {
     let found =
         named_modules("use crate::{io::X, tree};\nlet a = crate::ops::f();\n$crate::shape::g");
     assert_eq!(found.into_iter().collect::<Vec<_>>(), ["io", "ops", "tree"]);
+}
+
+#[test]
+fn io_may_not_import_input() {
+    // io reads and writes files only: `input`, which voxelizes meshes and volumes on the way in, is above
+    // it (and above solid), so io naming it is an upward import.
+    let io = layer("io").unwrap();
+    let input = layer("input").unwrap();
+    assert!(io < input && layer("solid").unwrap() < input);
+    let upward = "use crate::input::voxelize;\nuse crate::solid::mesh::TriangleMesh;";
+    assert_eq!(not_below(io, "io", &code(upward)), ["input"]);
+    let downward =
+        "use crate::io::{self, FileTree};\nlet m = crate::solid::mesh::MeshSource::new();";
+    assert!(not_below(input, "input", &code(downward)).is_empty());
 }

@@ -9,7 +9,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use ktree::io::{read_tree, voxelize, write_ktree_file, write_tree, ReadOptions, WriteOptions};
+use ktree::input::{read_tree, voxelize};
+use ktree::io::{write_ktree_file, write_tree, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
 use ktree::solid::volume::Select;
 use ktree::stacking::paper::stack;

@@ -10,9 +10,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use ktree::fs::write_atomic_with;
+use ktree::input::{voxel_source, voxelize};
 use ktree::io::{
-    open_rays_file, read_rays_file, voxel_source, voxelize, write_rays_source, AnyRaysFileSource,
-    RaysFile, ReadOptions,
+    open_rays_file, read_rays_file, write_rays_source, AnyRaysFileSource, RaysFile, ReadOptions,
 };
 use ktree::rays::RaySource;
 use ktree::solid::volume::Select;
