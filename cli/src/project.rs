@@ -1,15 +1,18 @@
 //! `ktree project FILE --axis A [--range LO:HI] --out OUT` and `ktree slice FILE --axis A --at C --out
 //! OUT`: a K-tree seen in K − 1 dimensions — the union of its slices along an axis over a range of
 //! positions, or one slice. The output is any tree file; a quadtree (from an octree) may also be written as
-//! a `.png` occupancy grid with its `.yaml` (ROS's map_server: occupied black, free white).
+//! a `.png` occupancy grid with its `.yaml` (ROS's map_server: occupied black, free white). The slice of a
+//! tree with values (a version 3 `.ktree`) keeps each voxel's value and is written as a `.ktree`.
 
 use std::path::{Path, PathBuf};
 
 use ktree::export::grid_map::write_grid_map;
 use ktree::export::Frame;
+use ktree::io::ktree::v3::write_valued_ktree_file;
 use ktree::io::{AnyMappedTree, FileTree, ReadOptions};
-use ktree::ops::project;
+use ktree::ops::{project, slice_values};
 use ktree::tree::storage::TreeStorage;
+use ktree::value::Value;
 use ktree::{AnyTree, KTree};
 
 use crate::common::error::{CliError, CliResult};
@@ -117,6 +120,9 @@ pub fn run_project(a: ProjectArgs) -> CliResult {
 
 /// `ktree slice`.
 pub fn run_slice(a: SliceArgs) -> CliResult {
+    if crate::values::is_valued(&a.input) {
+        return slice_valued(&a);
+    }
     let file = open(&a.input)?;
     let side = 1u64 << file.level();
     if u64::from(a.at) >= side {
@@ -129,6 +135,57 @@ pub fn run_slice(a: SliceArgs) -> CliResult {
         .into());
     }
     run(&a.input, a.axis, a.at..a.at + 1, &a.out, "slice")
+}
+
+/// The slice of a tree with values, each voxel with its value, to a `.ktree`.
+fn slice_valued(a: &SliceArgs) -> CliResult {
+    if a.out.out.extension().is_none_or(|e| e != "ktree") {
+        return Err(format!(
+            "{}: the slice of a tree with values is written as a .ktree",
+            a.out.out.display()
+        )
+        .into());
+    }
+    let tree = crate::values::read_valued(&a.input)?;
+    let (k, dtype) = (tree.k(), tree.dtype());
+    if k == 1 {
+        return Err(format!(
+            "{}: a bintree (K = 1) has no slice of fewer dimensions",
+            a.input.display()
+        )
+        .into());
+    }
+    if a.axis >= k {
+        return Err(format!(
+            "{}: axis {} is not below K = {k}",
+            a.input.display(),
+            a.axis
+        )
+        .into());
+    }
+    fn down<const K: usize, const J: usize, V: Value>(
+        tree: &KTree<K, V>,
+        a: &SliceArgs,
+    ) -> CliResult<(u128, u64)> {
+        let lower: KTree<J, V> = slice_values(tree, a.axis, a.at).map_err(CliError::caused)?;
+        write_valued_ktree_file(&a.out.out, &lower).map_err(CliError::caused)?;
+        Ok((lower.voxel_count(), lower.node_count()))
+    }
+    // J = K − 1 (a bintree, K = 1, was refused above: its J stands at 1 only to name a type).
+    let (voxels, nodes) = ktree::with_valued!(k, dtype, KK, V => {
+        let t = tree.as_typed::<KK, V>().ok_or("the tree is of its own dimension and type")?;
+        down::<KK, { if KK > 1 { KK - 1 } else { 1 } }, V>(t, a)?
+    }, else return Err(format!("{}: no slice of K = {k} {} trees", a.input.display(), dtype.name()).into()));
+    outln!(
+        "{}: slice along axis {} at {}: K = {}, L = {}, {} values, {voxels} voxels, {nodes} nodes",
+        a.out.out.display(),
+        a.axis,
+        a.at,
+        k - 1,
+        tree.level(),
+        dtype.name()
+    );
+    Ok(())
 }
 
 fn open(path: &Path) -> CliResult<FileTree> {

@@ -146,3 +146,53 @@ fn bad_axes_and_positions_are_errors() {
     assert!(!ok && err.contains("9:3"), "{err}");
     assert!(!dir.path().join("o.ktree").exists());
 }
+
+#[test]
+fn the_slice_of_a_tree_with_values_keeps_each_voxels_value() {
+    use ktree::io::ktree::v3::{read_valued_ktree, write_valued_ktree_file};
+    use ktree::ops::slice_values;
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    // Labels 1 … 5 in slabs along z, some voxels empty: an 8³ label volume.
+    let dense: Vec<Option<u16>> = (0..512u32)
+        .map(|i| {
+            let (x, z) = (i % 8, i / 64);
+            (x != 3).then_some(1 + (z as u16) % 5)
+        })
+        .collect();
+    let labels = KTree::<3, u16>::from_dense_values(3, &dense).unwrap();
+    write_valued_ktree_file(dir.path().join("labels.ktree").as_path(), &labels).unwrap();
+    for (axis, name, at) in [(0, "x", 5u32), (2, "z", 6), (1, "1", 0)] {
+        let out = s(&format!("s{axis}.ktree"));
+        let said = run(&[
+            "slice",
+            &s("labels.ktree"),
+            "--axis",
+            name,
+            "--at",
+            &at.to_string(),
+            "--out",
+            &out,
+        ]);
+        assert!(said.contains("uint16"), "{said}");
+        let bytes = std::fs::read(&out).unwrap();
+        let got: KTree<2, u16> = read_valued_ktree(&bytes, &out).unwrap();
+        assert_eq!(got, slice_values::<3, 2, _>(&labels, axis, at).unwrap());
+        assert!(got.voxel_count() > 0);
+    }
+    // Values do not go to a picture.
+    let (ok, _, err) = ktree(&[
+        "slice",
+        &s("labels.ktree"),
+        "--axis",
+        "z",
+        "--at",
+        "1",
+        "--out",
+        &s("s.png"),
+    ]);
+    assert!(
+        !ok && err.contains(".ktree") && err.lines().count() == 1,
+        "{err}"
+    );
+}
