@@ -183,17 +183,23 @@ impl GridPlacement {
     }
 }
 
-/// The most nodes the octree of a grid file of `file_len` bytes may have: 2^20, plus 2^7 a byte. A box
-/// that the placement leaves unaligned (a large cell at an offset that is not a multiple of its side)
-/// costs nodes in proportion to its surface, so a file of a few bytes could otherwise ask for billions.
-/// Aligned, no format here makes more than about 20 nodes a byte (a `.vdb` checkerboard of 8³ tiles:
-/// about 2; of voxels in leaves: about 10; a `.bt` inner node's 2 bytes: at most 8 children), so the
-/// bound only stops misplaced files. [`place_boxes`] counts the nodes before it makes any, so a file
-/// refused costs the count alone (building to the bound, as the first readers did, let a 46 KB `.vdb`
-/// take 0.9 s).
+/// The most nodes the octree of a grid file of `file_len` bytes may have: 2^20, plus 2^5 a byte
+/// ([`NODES_A_BYTE`]). A box that the placement leaves unaligned (a large cell at an offset that is not a
+/// multiple of its side) costs nodes in proportion to its surface, so a file of a few bytes could otherwise
+/// ask for billions. Aligned, no format here makes more than about 20 nodes a byte (a `.vdb` checkerboard
+/// of 8³ tiles: about 2; of voxels in leaves: about 10; a `.bt` inner node's 2 bytes: at most 8 children;
+/// the real files of the tests: at most 2.3), so the bound only stops misplaced files. [`place_boxes`]
+/// counts the nodes before it makes any, so a file refused costs the count alone. The allowance a byte is
+/// what bounds a reader's work on any input: at 2^7 a byte, a 46 KB `.vdb` could still ask for 7 million
+/// nodes (0.19 s in the fuzz build); at 2^5, for 2.5 million.
 pub(crate) fn max_grid_nodes(file_len: usize) -> u64 {
-    (1 << 20) + ((file_len as u64) << 7)
+    BASE_NODES + (file_len as u64) * NODES_A_BYTE
 }
+
+/// The nodes any grid file may have, however short ([`max_grid_nodes`]).
+const BASE_NODES: u64 = 1 << 20;
+/// The nodes a grid file may have for each of its bytes ([`max_grid_nodes`]).
+const NODES_A_BYTE: u64 = 1 << 5;
 
 /// The octree of a grid's boxes placed in a universe, of at most `max_nodes` nodes (else an error, found
 /// before any node is made). The boxes are disjoint (every grid format here describes each voxel once), so
@@ -215,7 +221,8 @@ pub(crate) fn place_boxes(
     let too_many = || {
         format!(
             "at offset {:?} in a level-{} universe the grid's octree has more than {max_nodes} nodes \
-             (2^20 + 2^7 a byte of the file): choose an offset that is a multiple of the grid's cell sides",
+             ({BASE_NODES} + {NODES_A_BYTE} a byte of the file): choose an offset that is a multiple of \
+             the grid's cell sides",
             placement.offset, placement.level
         )
     };
