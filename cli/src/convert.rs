@@ -1,6 +1,6 @@
 //! `ktree convert IN OUT`: any format to any format, chosen by extension (`.ktree`, `.rays`, `.binvox`, `.bt`,
 //! `.vdb`; meshes voxelized as inputs and the tree's boundary as outputs, `.glb` and `.svg` outputs only;
-//! volumes as inputs, NIfTI also as outputs; trees with values to NIfTI or `.ktree`).
+//! volumes as inputs, NIfTI also as outputs; trees with values to NIfTI, VTK (`.vtu`, `.htg`) or `.ktree`).
 
 use crate::common::error::{CliError, CliResult};
 use crate::outln;
@@ -76,11 +76,11 @@ pub fn run(a: Args) -> CliResult {
         if let Some(v) = a.voxel_size.filter(|v| !(v.is_finite() && *v > 0.0)) {
             return Err(format!("--voxel-size {v}: expected a positive number").into());
         }
-        let frame = Frame {
-            voxel_size: a.voxel_size.unwrap_or(1.0),
-            origin: a.origin.unwrap_or([0.0; 3]),
+        let placement = crate::convert_values::Placement {
+            voxel_size: a.voxel_size,
+            origin: a.origin,
         };
-        return crate::convert_values::convert_valued(&a.input, &a.output, &frame);
+        return crate::convert_values::convert_valued(&a.input, &a.output, placement);
     }
     let options = ReadOptions {
         level: a.level,

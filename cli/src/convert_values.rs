@@ -1,10 +1,12 @@
 //! `ktree convert` of a tree with values (a version 3 `.ktree`) and `ktree voxelize VOLUME --window LO:HI`:
-//! the values go to a NIfTI volume (`.nii`, `.nii.gz`: labels, densities or colours as its samples) or to
-//! another `.ktree`; a volume's window of intensities comes in as `float32` values.
+//! the values go to a NIfTI volume (`.nii`, `.nii.gz`: labels, densities or colours as its samples), to VTK
+//! files for ParaView (`.vtu`, `.htg`: the values as the cell data `value`) or to another `.ktree`; a
+//! volume's window of intensities comes in as `float32` values.
 
 use std::path::Path;
 
-use ktree::io::ktree::v3::{read_valued_ktree, write_valued_ktree_file};
+use ktree::export::vtk::write_values_vtk_file;
+use ktree::io::ktree::v3::{read_valued_ktree, read_valued_ktree_framed, write_valued_ktree_file};
 use ktree::io::write_nifti_file;
 use ktree::solid::volume::Volume;
 use ktree::space::WorldFrame;
@@ -14,16 +16,52 @@ use ktree::KTree;
 use crate::common::error::{cannot_read, CliError, CliResult};
 use crate::outln;
 
-/// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz` or `.ktree`), placed by `frame`.
-pub fn convert_valued(input: &Path, output: &Path, frame: &WorldFrame) -> CliResult {
+/// Where `--voxel-size` and `--origin` place the output: given, or (VTK files) the input's world frame,
+/// else voxels of 1 from 0.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Placement {
+    /// `--voxel-size`.
+    pub voxel_size: Option<f64>,
+    /// `--origin`: the world position of ktree voxel 0.
+    pub origin: Option<[f64; 3]>,
+}
+
+impl Placement {
+    /// The frame given, the rest from `kept` (a file's world frame), else voxels of 1 from 0.
+    fn frame(self, kept: Option<WorldFrame>) -> WorldFrame {
+        let kept = kept.unwrap_or_default();
+        WorldFrame {
+            voxel_size: self.voxel_size.unwrap_or(kept.voxel_size),
+            origin: self.origin.unwrap_or(kept.origin),
+        }
+    }
+}
+
+/// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz`, `.vtu`, `.htg` or `.ktree`),
+/// placed by `placement` (VTK files: the rest as the input's world frame places it).
+pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliResult {
     let (k, dtype) = crate::values::file_dtype(input)?;
     let dtype = dtype.ok_or_else(|| format!("{}: the tree holds no values", input.display()))?;
     let name = output.to_string_lossy();
     let nifti = name.ends_with(".nii") || name.ends_with(".nii.gz");
     let ktree = name.ends_with(".ktree");
+    let vtk = name.ends_with(".vtu") || name.ends_with(".htg");
+    if vtk {
+        if k != 2 && k != 3 {
+            return Err(format!(
+                "{}: VTK files hold quadtrees and octrees (K = 2, 3); {} has K = {k}",
+                output.display(),
+                input.display()
+            )
+            .into());
+        }
+        return ktree::with_valued!(k, dtype, KK, V => write_vtk::<KK, V>(input, output, placement),
+            else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
+    }
+    let frame = &placement.frame(None);
     if !(nifti || ktree) {
         return Err(format!(
-            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz) or .ktree",
+            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz), VTK (.vtu, .htg) or .ktree",
             output.display(),
             dtype.name()
         )
@@ -47,6 +85,27 @@ pub fn convert_valued(input: &Path, output: &Path, frame: &WorldFrame) -> CliRes
         outln!("{}: copied (K = {k}, {})", output.display(), dtype.name());
         Ok(())
     }, else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()))
+}
+
+/// The valued tree of `input` as a VTK file, `value` its cell data.
+fn write_vtk<const K: usize, V: Value>(
+    input: &Path,
+    output: &Path,
+    placement: Placement,
+) -> CliResult {
+    let name = input.display().to_string();
+    let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
+    let (tree, kept) = read_valued_ktree_framed::<K, V>(&bytes, &name).map_err(CliError::caused)?;
+    write_values_vtk_file(output, &tree, &placement.frame(kept)).map_err(CliError::caused)?;
+    outln!(
+        "{}: K = {K}, L = {}, {} values as cell data, {} nodes, {} voxels",
+        output.display(),
+        tree.level(),
+        V::DTYPE.map_or("", Dtype::name),
+        tree.node_count(),
+        tree.voxel_count()
+    );
+    Ok(())
 }
 
 fn write_octree<V: Value>(input: &Path, output: &Path, frame: &WorldFrame) -> CliResult {

@@ -311,3 +311,46 @@ fn queries_of_a_tree_with_values_give_each_points_value() {
         ]
     );
 }
+
+#[test]
+fn a_tree_with_values_converts_to_vtk_files_whose_cell_data_holds_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    let (shape, values) = labels();
+    let json = write_volume(dir.path(), shape, &values);
+    run(&[
+        "voxelize",
+        json.to_str().unwrap(),
+        "--labels",
+        "--out",
+        &p("l.ktree"),
+    ]);
+    // The labels (0 … 300) as UInt16 cell data, the active scalars; the voxels placed by the flags.
+    let out = run(&["convert", &p("l.ktree"), &p("l.vtu"), "--voxel-size", "0.5"]);
+    assert!(out.contains("uint16"), "{out}");
+    let vtu = std::fs::read(p("l.vtu")).unwrap();
+    let text = String::from_utf8_lossy(&vtu);
+    assert!(text.contains(r#"<CellData Scalars="value">"#), "{text}");
+    assert!(text.contains(r#"<DataArray type="UInt16" Name="value""#));
+    assert!(text.contains(r#"Name="level""#) && text.contains(r#"Name="side""#));
+    run(&["convert", &p("l.ktree"), &p("l.htg"), "--origin", "1,2,3"]);
+    let htg = std::fs::read_to_string(p("l.htg")).unwrap();
+    assert!(htg.contains(r#"<CellData Scalars="value">"#));
+    assert!(htg.contains(r#"<DataArray type="UInt16" Name="value""#));
+    assert!(htg.contains(r#"RangeMin="1""#));
+    // Every label of the volume is a value of the hyper tree grid's vertices.
+    let (_, numbers) = htg.split_once(r#"Name="value""#).unwrap();
+    let numbers = &numbers[numbers.find('>').unwrap() + 1..numbers.find('<').unwrap()];
+    let found: std::collections::BTreeSet<u16> = numbers
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let labels: std::collections::BTreeSet<u16> = values.iter().copied().collect();
+    assert_eq!(found, labels); // 0 at the vertices without a value, and the background's voxels
+                               // Another extension names every output a tree with values converts to.
+    let (ok, _, err) = ktree(&["convert", &p("l.ktree"), &p("l.ply")]);
+    assert!(
+        !ok && err.contains(".vtu") && err.contains(".htg") && err.contains(".nii"),
+        "{err}"
+    );
+}

@@ -1,6 +1,9 @@
 """Meshes and VTK files out, checked by other libraries: trimesh (watertight, consistently wound, the volume
 and the Euler number of the voxels) and VTK (the .vtu and .htg files read back with their cell counts,
-bounds and volume)."""
+bounds and volume; for trees with values, the cell data `value` — its VTK type, its components and each
+cell's value against the numpy array the tree was made of)."""
+
+import subprocess
 
 import numpy as np
 import pytest
@@ -144,3 +147,111 @@ def test_to_mesh_smooth_is_watertight_near_the_voxels_volume():
     assert abs(m.volume - t.voxel_count) < 0.01 * t.voxel_count
     exact = trimesh.Trimesh(*t.to_mesh(), process=False)
     assert m.volume != exact.volume
+
+
+# --- trees with values: the cell data `value` -------------------------------------------------------------
+
+VTK_TYPES = {"uint8": vtk.VTK_UNSIGNED_CHAR, "uint16": vtk.VTK_UNSIGNED_SHORT, "int8": vtk.VTK_SIGNED_CHAR,
+             "float32": vtk.VTK_FLOAT, "rgb8": vtk.VTK_UNSIGNED_CHAR}
+
+
+def convert(src, out):
+    from test_ktree import cli
+
+    subprocess.run([cli(), "convert", str(src), str(out)], check=True, capture_output=True, text=True)
+
+
+def check_cells_hold(data, dense, k, components):
+    """Each cell of `data` (voxels of side 1 from 0) covers voxels of `dense` that all hold its `value`, and
+    the cells cover every voxel with a value: the cell's centre and extent give the voxels."""
+    values = vtk_to_numpy(data.GetCellData().GetArray("value"))
+    if components == 1:
+        values = values.reshape(-1, 1)
+    covered = np.zeros(dense.shape[:k], bool)
+    for c in range(data.GetNumberOfCells()):
+        b = np.array(data.GetCell(c).GetBounds()).reshape(3, 2)[:k]
+        box = tuple(slice(int(round(lo)), int(round(hi))) for lo, hi in b)
+        centre = tuple(int((lo + hi) / 2) for lo, hi in b)
+        want = dense[centre].reshape(-1)
+        np.testing.assert_array_equal(values[c], want)
+        region = dense[box].reshape(-1, components)
+        assert (region == want).all(), (c, box)
+        assert not covered[box].any()
+        covered[box] = True
+    np.testing.assert_array_equal(covered, (dense != 0).reshape(dense.shape[:k] + (-1,)).any(axis=-1))
+
+
+def read_value_files(tmp_path, src, k, dtype, components, dense):
+    for ext in ["vtu", "htg"]:
+        path = tmp_path / f"v.{ext}"
+        convert(src, path)
+        if ext == "htg":
+            r = vtk.vtkXMLHyperTreeGridReader()
+            r.SetFileName(str(path))
+            r.Update()
+            grid = r.GetOutput()
+            raw = grid.GetCellData().GetArray("value")
+            assert raw.GetDataType() == VTK_TYPES[dtype] and raw.GetNumberOfComponents() == components
+            assert raw.GetNumberOfTuples() == grid.GetNumberOfCells()
+        data, _ = read_vtk(path)
+        array = data.GetCellData().GetArray("value")
+        assert array is not None, ext
+        assert array.GetDataType() == VTK_TYPES[dtype], ext
+        assert array.GetNumberOfComponents() == components, ext
+        if ext == "vtu":
+            # The active scalars (VTK's hyper tree grid reader does not read CellData's Scalars).
+            assert data.GetCellData().GetScalars().GetName() == "value"
+        check_cells_hold(data, dense, k, components)
+        if ext == "htg" and dtype == "float32":
+            # A vertex without a value (one with children, or an empty leaf) holds NaN.
+            nan = np.isnan(vtk_to_numpy(raw)).sum()
+            assert nan == grid.GetNumberOfCells() - data.GetNumberOfCells()
+
+
+@pytest.mark.parametrize("k", [2, 3])
+@pytest.mark.parametrize("dtype", ["uint8", "uint16", "int8", "float32"])
+def test_vtk_reads_the_values_of_a_tree_with_values(tmp_path, k, dtype):
+    rng = np.random.default_rng(10 * k + len(dtype))
+    level = 4 if k == 2 else 3
+    a = rng.integers(0, 4, size=(2**level,) * k)
+    # Blocks of one value, so that leaves of several voxels are cells too.
+    a[(slice(0, 2**level // 2),) * k] = 2
+    a = a.astype(dtype)
+    if dtype == "float32":
+        a = a * np.float32(0.1)
+        a[(1,) * k] = np.float32(-2.5e-7)
+        a[(2,) * k] = np.inf
+        # The last vertex of the .htg (the last voxel, empty, in a block with a value) holds NaN.
+        a[(-1,) * k] = 0
+        a[(-2,) + (-1,) * (k - 1)] = np.float32(0.3)
+    elif dtype == "int8":
+        a[(1,) * k] = -128
+    src = tmp_path / "v.ktree"
+    ktree.Tree.from_dense(a).save(src)
+    read_value_files(tmp_path, src, k, dtype, 1, a)
+
+
+def test_vtk_reads_the_colours_of_a_point_cloud(tmp_path):
+    from test_ktree import cli
+
+    rng = np.random.default_rng(7)
+    side = 8
+    colours = rng.integers(1, 3, size=(side, side, side, 3)).astype(np.uint8) * 120
+    colours[rng.random((side,) * 3) < 0.5] = 0  # no point: an empty voxel
+    colours[:4, :4, :4] = [10, 20, 30]
+    points = np.argwhere(colours.any(axis=-1))
+    lines = [f"{x + 0.5} {y + 0.5} {z + 0.5} {' '.join(map(str, colours[x, y, z]))}" for x, y, z in points]
+    ply = tmp_path / "c.ply"
+    ply.write_text(
+        "ply\nformat ascii 1.0\n"
+        f"element vertex {len(lines)}\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n" + "\n".join(lines) + "\n"
+    )
+    src = tmp_path / "c.ktree"
+    subprocess.run(
+        [cli(), "voxelize", str(ply), "--voxel-size", "1", "--origin", "0,0,0", "--level", "3",
+         "--value", "rgb", "--out", str(src)],
+        check=True, capture_output=True, text=True,
+    )
+    read_value_files(tmp_path, src, 3, "rgb8", 3, colours)

@@ -7,6 +7,14 @@
 //! Both carry the cell data `level` (the leaf's depth in the tree, 0 at the root) and `side` (the leaf's
 //! edge in world units). Arrays are raw little-endian binary in the appended section (header UInt64).
 //!
+//! A valued tree ([`write_values_vtu`], [`write_values_htg`], [`write_values_vtk_file`]; K = 2, 3) is
+//! written the same way, with one more cell data array, `value`, the active scalars
+//! (`<CellData Scalars="value">`, which ParaView colours by): `UInt8`, `UInt16`, `UInt32`, `Int8` or
+//! `Float32` by the value type, three `UInt8` components for colours (shown as they are with ParaView's
+//! *Map Scalars* off). The `.vtu` has a cell per leaf where one value holds, with that value; the `.htg`
+//! gives each vertex a value: a full leaf its own, a vertex with children (partial or mixed) and a masked
+//! (empty) leaf NaN for `float32` and 0 for the other types.
+//!
 //! ```
 //! use ktree::export::{vtk::write_vtu, Frame};
 //! let tree = ktree::KTree::<3>::full(1).unwrap();
@@ -24,9 +32,12 @@ use super::{ExportError, Frame};
 use crate::display::slices::slice_4d;
 use crate::display::DisplayError;
 use crate::fs::write_atomic_with;
+use crate::space::Cell;
 use crate::tree::cursor::{try_walk, TryLeaves, Visitor, Walk};
 use crate::tree::storage::TreeStorage;
-use crate::tree::{NodeRef, NodeState, StorageError};
+use crate::tree::valued::{try_walk_values, ValueLeaves, ValueNode, ValueStorage, ValueVisitor};
+use crate::tree::{NodeRef, NodeState, StorageError, ValueState};
+use crate::value::{Dtype, Value};
 
 /// One array of the appended section.
 struct Array {
@@ -95,7 +106,89 @@ pub fn write_vtu<const K: usize, T: TreeStorage<K>>(
     frame: &Frame,
 ) -> io::Result<()> {
     check_dimension::<K>(".vtu")?;
-    Grid::of(tree, frame).map_err(read_error)?.write(w)
+    Grid::of(full_leaves(tree), frame)
+        .map_err(read_error)?
+        .write(w)
+}
+
+/// The leaves of a tree without values as [`Grid::of`] and [`Depths`] take them: a full leaf holds `()`.
+fn full_leaves<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+) -> impl Iterator<Item = Result<(Cell<K>, Option<()>), T::Error>> + '_ {
+    TryLeaves::new(tree)
+        .map(|leaf| leaf.map(|(cell, state)| (cell, (state == NodeState::Full).then_some(()))))
+}
+
+/// A valued tree's full leaves as an unstructured grid, as [`write_vtu`] writes a tree without values
+/// (the leaves where one value holds: a mixed node's parts are cells of their own), with the cell data
+/// `value`: each cell's value, the active scalars.
+///
+/// ```
+/// use ktree::export::{vtk::write_values_vtu, Frame};
+/// let tree = ktree::KTree::<2, u8>::from_dense_values(1, &[Some(3), Some(3), None, Some(7)]).unwrap();
+/// let mut bytes = Vec::new();
+/// write_values_vtu(&mut bytes, &tree, &Frame::default()).unwrap();
+/// let text = String::from_utf8_lossy(&bytes);
+/// assert!(text.contains(r#"NumberOfCells="3""#));
+/// assert!(text.contains(r#"<DataArray type="UInt8" Name="value""#));
+/// ```
+///
+/// # Errors
+/// As [`write_vtu`].
+pub fn write_values_vtu<const K: usize, T: ValueStorage<K>>(
+    w: &mut dyn Write,
+    tree: &T,
+    frame: &Frame,
+) -> io::Result<()> {
+    check_dimension::<K>(".vtu")?;
+    Grid::of(ValueLeaves::new(tree), frame)
+        .map_err(read_error)?
+        .write(w)
+}
+
+/// The VTK type of a value's components and their number: `UInt8`, `UInt16`, `UInt32`, `Int8`,
+/// `Float32`; three `UInt8` for a colour.
+fn vtk_type(dtype: Dtype) -> (&'static str, usize) {
+    match dtype {
+        Dtype::U8 => ("UInt8", 1),
+        Dtype::U16 => ("UInt16", 1),
+        Dtype::U32 => ("UInt32", 1),
+        Dtype::I8 => ("Int8", 1),
+        Dtype::F32 => ("Float32", 1),
+        Dtype::Rgb => ("UInt8", 3),
+    }
+}
+
+/// The value a hyper tree grid gives a vertex without one (a node with children, an empty leaf): NaN
+/// for `float32`, else 0 (black for colours), as little-endian bytes.
+fn no_value(dtype: Dtype) -> Vec<u8> {
+    if dtype == Dtype::F32 {
+        f32::NAN.to_le_bytes().to_vec()
+    } else {
+        vec![0; dtype.bytes()]
+    }
+}
+
+/// The components of a value's little-endian `bytes` as ASCII, space-separated.
+fn ascii_value(dtype: Dtype, bytes: &[u8]) -> String {
+    match dtype {
+        Dtype::U8 | Dtype::Rgb => bytes
+            .iter()
+            .map(u8::to_string)
+            .collect::<Vec<_>>()
+            .join(" "),
+        Dtype::I8 => (bytes[0] as i8).to_string(),
+        Dtype::U16 => u16::from_le_bytes([bytes[0], bytes[1]]).to_string(),
+        Dtype::U32 => u32::from_le_bytes(bytes.try_into().expect("4 bytes")).to_string(),
+        Dtype::F32 => {
+            let x = f32::from_le_bytes(bytes.try_into().expect("4 bytes"));
+            if x.is_nan() {
+                "nan".into()
+            } else {
+                format!("{x:e}")
+            }
+        }
+    }
 }
 
 /// The arrays of a `.vtu` file, read from the tree.
@@ -107,12 +200,19 @@ struct Grid {
     types: Array,
     level: Array,
     side: Array,
+    /// The leaves' values, for a tree with values.
+    value: Option<Array>,
     cells: u64,
 }
 
 impl Grid {
-    /// The full leaves of `tree` as cells (see [`write_vtu`]).
-    fn of<const K: usize, T: TreeStorage<K>>(tree: &T, frame: &Frame) -> Result<Self, T::Error> {
+    /// The cells of the full leaves among `leaves` (a leaf's cell and its value, `None` for an empty leaf;
+    /// `Some(())` for a full leaf of a tree without values), in the order given; with values, the cell
+    /// data `value` too (see [`write_vtu`] and [`write_values_vtu`]).
+    fn of<const K: usize, V: Value, E>(
+        leaves: impl Iterator<Item = Result<(Cell<K>, Option<V>), E>>,
+        frame: &Frame,
+    ) -> Result<Self, E> {
         let corners = 1usize << K;
         let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
         let mut grid = Grid {
@@ -123,12 +223,19 @@ impl Grid {
             types: Array::new("types", "UInt8", 1),
             level: Array::new("level", "Int32", 1),
             side: Array::new("side", "Float64", 1),
+            value: V::DTYPE.map(|d| {
+                let (kind, components) = vtk_type(d);
+                Array::new("value", kind, components)
+            }),
             cells: 0,
         };
-        for leaf in TryLeaves::new(tree) {
-            let (cell, state) = leaf?;
-            if state != NodeState::Full {
+        for leaf in leaves {
+            let (cell, value) = leaf?;
+            let Some(value) = value else {
                 continue;
+            };
+            if let Some(values) = &mut grid.value {
+                value.write_le(&mut values.bytes);
             }
             let s = cell.side() as u32;
             for o in 0..corners {
@@ -174,7 +281,7 @@ impl Grid {
 
     /// The `.vtu` file.
     fn write(&self, w: &mut dyn Write) -> io::Result<()> {
-        let order = [
+        let mut order = vec![
             &self.level,
             &self.side,
             &self.points,
@@ -182,6 +289,7 @@ impl Grid {
             &self.offsets,
             &self.types,
         ];
+        order.extend(&self.value);
         let at = offsets(&order);
         writeln!(
             w,
@@ -190,12 +298,21 @@ impl Grid {
              <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
             self.point_count, self.cells
         )?;
+        let scalars = if self.value.is_some() {
+            "value"
+        } else {
+            "level"
+        };
         writeln!(
             w,
-            "   <CellData Scalars=\"level\">\n    {}\n    {}\n   </CellData>",
+            "   <CellData Scalars=\"{scalars}\">\n    {}\n    {}",
             self.level.tag(at[0]),
             self.side.tag(at[1])
         )?;
+        if let Some(value) = &self.value {
+            writeln!(w, "    {}", value.tag(at[6]))?;
+        }
+        writeln!(w, "   </CellData>")?;
         writeln!(
             w,
             "   <Points>\n    {}\n   </Points>",
@@ -230,21 +347,40 @@ fn read_error(e: impl Into<StorageError>) -> io::Error {
 }
 
 /// The nodes of a tree breadth first, as VTK's hyper tree descriptor wants them: per depth, each node's
-/// state in level order.
-struct Depths<const K: usize> {
-    /// Per depth: (state, level) of each node, in order.
-    nodes: Vec<Vec<(NodeState, u32)>>,
+/// state in level order — [`NodeState::Partial`] for a node with children (a valued tree's mixed node
+/// too) — and its value (`None` unless it is a full leaf; `Some(())` in a tree without values).
+struct Depths<const K: usize, V> {
+    nodes: Vec<Vec<(NodeState, Option<V>)>>,
 }
 
-impl<const K: usize> Visitor<K> for Depths<K> {
+impl<const K: usize, V> Depths<K, V> {
+    fn push(&mut self, depth: usize, state: NodeState, value: Option<V>) {
+        if self.nodes.len() <= depth {
+            self.nodes.resize_with(depth + 1, Vec::new);
+        }
+        self.nodes[depth].push((state, value));
+    }
+}
+
+impl<const K: usize> Visitor<K> for Depths<K, ()> {
     const LEAVES: bool = false;
     const ORIGINS: bool = false;
     fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-        let d = node.cell().level as usize;
-        if self.nodes.len() <= d {
-            self.nodes.resize_with(d + 1, Vec::new);
-        }
-        self.nodes[d].push((node.state(), d as u32));
+        let state = node.state();
+        let value = (state == NodeState::Full).then_some(());
+        self.push(node.cell().level as usize, state, value);
+        Walk::Descend
+    }
+}
+
+impl<const K: usize, V: Value> ValueVisitor<K, V> for Depths<K, V> {
+    fn visit(&mut self, node: &ValueNode<K, V>) -> Walk {
+        let (state, value) = match node.state {
+            ValueState::Empty => (NodeState::Empty, None),
+            ValueState::Full(v) => (NodeState::Full, Some(v)),
+            ValueState::Partial | ValueState::Mixed => (NodeState::Partial, None),
+        };
+        self.push(node.cell.level as usize, state, value);
         Walk::Descend
     }
 }
@@ -281,19 +417,60 @@ pub fn write_htg<const K: usize, T: TreeStorage<K>>(
         .write(w, tree.level(), frame)
 }
 
-impl<const K: usize> Depths<K> {
+/// A valued tree as a hyper tree grid, as [`write_htg`] writes a tree without values — refined where a
+/// node has children (partial or mixed), the empty leaves masked — with the cell data `value` on every
+/// vertex: a full leaf's value; NaN (`float32`) or 0 (the other types; black for colours) at a vertex
+/// with children and at a masked (empty) leaf, which ParaView does not draw.
+///
+/// ```
+/// use ktree::export::{vtk::write_values_htg, Frame};
+/// let tree = ktree::KTree::<2, f32>::from_dense_values(1, &[Some(0.5), None, None, Some(2.0)]).unwrap();
+/// let mut bytes = Vec::new();
+/// write_values_htg(&mut bytes, &tree, &Frame::default()).unwrap();
+/// let text = String::from_utf8_lossy(&bytes);
+/// assert!(text.contains(r#"Name="value" NumberOfTuples="5" format="ascii">nan 5e-1 nan nan 2e0 <"#));
+/// ```
+///
+/// # Errors
+/// As [`write_vtu`].
+pub fn write_values_htg<const K: usize, T: ValueStorage<K>>(
+    w: &mut dyn Write,
+    tree: &T,
+    frame: &Frame,
+) -> io::Result<()> {
+    check_dimension::<K>(".htg")?;
+    Depths::of_values(tree)
+        .map_err(read_error)?
+        .write(w, tree.level(), frame)
+}
+
+impl<const K: usize> Depths<K, ()> {
     /// The nodes of `tree`, read before anything is written. Level order is breadth first: each depth's
     /// nodes in index order, which a depth-first walk meets in the same order.
     fn of<T: TreeStorage<K>>(tree: &T) -> Result<Self, T::Error> {
-        let mut depths = Depths::<K> { nodes: Vec::new() };
+        let mut depths = Depths { nodes: Vec::new() };
         try_walk(tree, &mut depths)?;
+        Ok(depths)
+    }
+}
+
+impl<const K: usize, V: Value> Depths<K, V> {
+    /// The nodes of a valued tree, as [`Depths::of`].
+    fn of_values<T: ValueStorage<K, Value = V>>(tree: &T) -> Result<Self, T::Error> {
+        let mut depths = Depths { nodes: Vec::new() };
+        try_walk_values(tree, &mut depths)?;
         Ok(depths)
     }
 
     /// The `.htg` file of a tree of universe level `top` whose nodes these are.
     fn write(&self, w: &mut dyn Write, top: u32, frame: &Frame) -> io::Result<()> {
         let depths = self;
-        let all: Vec<(NodeState, u32)> = depths.nodes.iter().flatten().copied().collect();
+        let all: Vec<(NodeState, u32)> = depths
+            .nodes
+            .iter()
+            .enumerate()
+            .flat_map(|(d, nodes)| nodes.iter().map(move |(s, _)| (*s, d as u32)))
+            .collect();
         let u = (1u64 << top) as f64 * frame.voxel_size;
         // The descriptor: one bit per node of every depth but the last, refined or not.
         let inner = depths.nodes.len().saturating_sub(1);
@@ -380,7 +557,8 @@ impl<const K: usize> Depths<K> {
             &depths.nodes.len().to_string(),
         )?;
         array(w, "Bit", "Mask", all.len(), &bits(&mask, all.len()))?;
-        writeln!(w, "  </Trees>\n  <CellData>")?;
+        let scalars = if V::STORED { " Scalars=\"value\"" } else { "" };
+        writeln!(w, "  </Trees>\n  <CellData{scalars}>")?;
         let levels: Vec<String> = all.iter().map(|(_, d)| d.to_string()).collect();
         let sides: Vec<String> = all
             .iter()
@@ -388,6 +566,38 @@ impl<const K: usize> Depths<K> {
             .collect();
         array(w, "Int32", "level", all.len(), &levels.join(" "))?;
         array(w, "Float64", "side", all.len(), &sides.join(" "))?;
+        if let Some(dtype) = V::DTYPE {
+            let (kind, components) = vtk_type(dtype);
+            let none = no_value(dtype);
+            let mut bytes = Vec::new();
+            let values: Vec<String> = depths
+                .nodes
+                .iter()
+                .flatten()
+                .map(|(_, value)| match value {
+                    Some(v) => {
+                        bytes.clear();
+                        v.write_le(&mut bytes);
+                        ascii_value(dtype, &bytes)
+                    }
+                    None => ascii_value(dtype, &none),
+                })
+                .collect();
+            // A space after the last number: VTK's ASCII reader fails on a `nan` or `inf` that ends the
+            // text.
+            writeln!(
+                w,
+                "   <DataArray type=\"{kind}\" Name=\"value\"{} NumberOfTuples=\"{}\" \
+                 format=\"ascii\">{} </DataArray>",
+                if components > 1 {
+                    format!(" NumberOfComponents=\"{components}\"")
+                } else {
+                    String::new()
+                },
+                all.len(),
+                values.join(" ")
+            )?;
+        }
         writeln!(w, "  </CellData>\n </HyperTreeGrid>\n</VTKFile>")
     }
 }
@@ -411,6 +621,54 @@ pub fn write_vtk_file<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     frame: &Frame,
 ) -> Result<(), ExportError> {
+    let htg = vtk_file_kind::<K>(path)?;
+    let storage = |e: T::Error| ExportError::Storage(e.into());
+    if htg {
+        let depths = Depths::of(tree).map_err(storage)?;
+        write_atomic_with(path, |w| depths.write(w, tree.level(), frame))
+    } else {
+        let grid = Grid::of(full_leaves(tree), frame).map_err(storage)?;
+        write_atomic_with(path, |w| grid.write(w))
+    }
+    .map_err(ExportError::Write)
+}
+
+/// Writes the valued tree `tree` to `path` as the VTK file its extension names, atomically: `.vtu`
+/// ([`write_values_vtu`]) or `.htg` ([`write_values_htg`]), placed by `frame`; the values are the cell
+/// data `value`. The tree (any storage) is read before the file is opened.
+///
+/// ```
+/// use ktree::export::{vtk::write_values_vtk_file, Frame};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("colours.vtu");
+/// let tree = ktree::KTree::<3, ktree::value::Rgb>::from_dense_values(0, &[Some([255, 0, 0])]).unwrap();
+/// write_values_vtk_file(&path, &tree, &Frame::default()).unwrap();
+/// let text = String::from_utf8_lossy(&std::fs::read(&path).unwrap()).into_owned();
+/// assert!(text.contains(r#"<DataArray type="UInt8" Name="value" NumberOfComponents="3""#));
+/// ```
+///
+/// # Errors
+/// As [`write_vtk_file`].
+pub fn write_values_vtk_file<const K: usize, T: ValueStorage<K>>(
+    path: &Path,
+    tree: &T,
+    frame: &Frame,
+) -> Result<(), ExportError> {
+    let htg = vtk_file_kind::<K>(path)?;
+    let storage = |e: T::Error| ExportError::Storage(e.into());
+    if htg {
+        let depths = Depths::of_values(tree).map_err(storage)?;
+        write_atomic_with(path, |w| depths.write(w, tree.level(), frame))
+    } else {
+        let grid = Grid::of(ValueLeaves::new(tree), frame).map_err(storage)?;
+        write_atomic_with(path, |w| grid.write(w))
+    }
+    .map_err(ExportError::Write)
+}
+
+/// Whether `path` names a `.htg` file (else a `.vtu` one); [`ExportError::Usage`] for another extension
+/// or a dimension VTK's files do not hold.
+fn vtk_file_kind<const K: usize>(path: &Path) -> Result<bool, ExportError> {
     let usage = |message: String| ExportError::Usage {
         file: path.to_path_buf(),
         message,
@@ -428,15 +686,7 @@ pub fn write_vtk_file<const K: usize, T: TreeStorage<K>>(
             "VTK files are written for quadtrees and octrees (K = 2, 3); this tree has K = {K}"
         )));
     }
-    let storage = |e: T::Error| ExportError::Storage(e.into());
-    if ext == "htg" {
-        let depths = Depths::of(tree).map_err(storage)?;
-        write_atomic_with(path, |w| depths.write(w, tree.level(), frame))
-    } else {
-        let grid = Grid::of(tree, frame).map_err(storage)?;
-        write_atomic_with(path, |w| grid.write(w))
-    }
-    .map_err(ExportError::Write)
+    Ok(ext == "htg")
 }
 
 /// A 4-D tree as a time series for ParaView: the octree of each slice along `time_axis` (the other axes

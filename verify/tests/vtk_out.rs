@@ -1,9 +1,11 @@
 //! VTK files read back: the `.vtu` unstructured grid (a cell per full leaf: count, bounds, volume, and the
 //! voxels its cells cover are the tree's) and the `.htg` hyper tree grid (its descriptor and mask decoded
-//! breadth first give back the tree's voxels), for random quadtrees and octrees.
+//! breadth first give back the tree's voxels), for random quadtrees and octrees; for random valued trees
+//! (`u8`, `u16`, `u32`, `i8`, `f32`, colours) the cell data `value` gives back every voxel's value.
 
-use ktree::export::vtk::{write_htg, write_vtu};
+use ktree::export::vtk::{write_htg, write_values_htg, write_values_vtu, write_vtu};
 use ktree::export::Frame;
+use ktree::value::{Dtype, Rgb, Value};
 use ktree::KTree;
 use proptest::prelude::*;
 
@@ -61,6 +63,14 @@ const FRAME: Frame = Frame {
 
 /// Reads a `.vtu` of a K-tree of `level` back into a dense array, checking its cells on the way.
 fn vtu_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
+    vtu_cells::<K>(bytes, level)
+        .iter()
+        .map(Option::is_some)
+        .collect()
+}
+
+/// The cell of a `.vtu` of a K-tree of `level` that covers each voxel (a dense array), checking the cells.
+fn vtu_cells<const K: usize>(bytes: &[u8], level: u32) -> Vec<Option<usize>> {
     let text = String::from_utf8_lossy(bytes);
     let piece = &text[text.find("<Piece").unwrap()..];
     let cells: usize = attr(piece, "NumberOfCells").parse().unwrap();
@@ -82,7 +92,7 @@ fn vtu_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
     );
     assert_eq!(conn.len(), cells * corners);
     let u = 1usize << level;
-    let mut dense = vec![false; u.pow(K as u32)];
+    let mut dense = vec![None; u.pow(K as u32)];
     for c in 0..cells {
         assert_eq!(offsets[c], ((c + 1) * corners) as i64);
         assert_eq!(types[c], if K == 3 { 11 } else { 8 });
@@ -117,8 +127,8 @@ fn vtu_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
             for a in (0..K).rev() {
                 index = index * u + v0[a] + (i / s.pow(a as u32)) % s;
             }
-            assert!(!dense[index], "cells overlap");
-            dense[index] = true;
+            assert!(dense[index].is_none(), "cells overlap");
+            dense[index] = Some(c);
         }
     }
     dense
@@ -126,6 +136,16 @@ fn vtu_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
 
 /// Reads a `.htg` of a K-tree of `level` back into a dense array.
 fn htg_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
+    htg_vertices::<K>(bytes, level)
+        .0
+        .iter()
+        .map(Option::is_some)
+        .collect()
+}
+
+/// The unmasked leaf vertex of a `.htg` of a K-tree of `level` that covers each voxel (a dense array), and
+/// whether each vertex is a leaf.
+fn htg_vertices<const K: usize>(bytes: &[u8], level: u32) -> (Vec<Option<usize>>, Vec<bool>) {
     let text = String::from_utf8_lossy(bytes);
     let bits = |name: &str| -> Vec<bool> {
         data_array(&text, name)
@@ -157,7 +177,8 @@ fn htg_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
     assert_eq!(levels.len(), mask.len());
     // Breadth first: each refined node's children follow at the next depth, in order.
     let u = 1usize << level;
-    let mut dense = vec![false; u.pow(K as u32)];
+    let mut dense = vec![None; u.pow(K as u32)];
+    let mut leaf = vec![false; mask.len()];
     let mut current: Vec<([usize; 3], usize)> = vec![([0; 3], u)];
     let mut index = 0;
     for (depth, &n) in per_depth.iter().enumerate() {
@@ -174,13 +195,16 @@ fn htg_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
                     }
                     next.push((o, s / 2));
                 }
-            } else if !mask[index] {
-                for i in 0..s.pow(K as u32) {
-                    let mut at = 0;
-                    for a in (0..K).rev() {
-                        at = at * u + origin[a] + (i / s.pow(a as u32)) % s;
+            } else {
+                leaf[index] = true;
+                if !mask[index] {
+                    for i in 0..s.pow(K as u32) {
+                        let mut at = 0;
+                        for a in (0..K).rev() {
+                            at = at * u + origin[a] + (i / s.pow(a as u32)) % s;
+                        }
+                        dense[at] = Some(index);
                     }
-                    dense[at] = true;
                 }
             }
             index += 1;
@@ -188,7 +212,7 @@ fn htg_voxels<const K: usize>(bytes: &[u8], level: u32) -> Vec<bool> {
         current = next;
     }
     assert!(current.is_empty());
-    dense
+    (dense, leaf)
 }
 
 fn dense_of<const K: usize>(tree: &KTree<K>) -> Vec<bool> {
@@ -258,8 +282,199 @@ fn the_empty_and_the_full_universe() {
     assert!(write_htg(&mut out, &KTree::<4>::full(1).unwrap(), &FRAME).is_err());
 }
 
+/// Random values of a type: a few distinct ones, so that full nodes merge.
+trait Sample: Value {
+    fn sample(r: u64) -> Self;
+}
+
+impl Sample for u8 {
+    fn sample(r: u64) -> Self {
+        (r % 4) as u8 * 85
+    }
+}
+
+impl Sample for u16 {
+    fn sample(r: u64) -> Self {
+        (r % 3) as u16 * 30_000
+    }
+}
+
+impl Sample for u32 {
+    fn sample(r: u64) -> Self {
+        (r % 3) as u32 * 2_000_000_000
+    }
+}
+
+impl Sample for i8 {
+    fn sample(r: u64) -> Self {
+        [-128, -1, 0, 127][(r % 4) as usize]
+    }
+}
+
+impl Sample for f32 {
+    fn sample(r: u64) -> Self {
+        [0.0, -0.0, 0.1, -3.5e-20, 1.0e30, f32::INFINITY][(r % 6) as usize]
+    }
+}
+
+impl Sample for Rgb {
+    fn sample(r: u64) -> Self {
+        [[255, 0, 0], [0, 128, 255], [1, 2, 3]][(r % 3) as usize]
+    }
+}
+
+/// A random dense array of a K-tree of `level`: `density` tenths of the voxels hold a value.
+fn random_values<const K: usize, V: Sample>(level: u32, seed: u64, density: u64) -> Vec<Option<V>> {
+    let n = 1usize << (K as u32 * level);
+    let mut state = seed | 1;
+    (0..n)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % 10 < density).then(|| V::sample(state / 10))
+        })
+        .collect()
+}
+
+/// The VTK type and component count `value` must have.
+fn vtk_type(dtype: Dtype) -> (&'static str, usize) {
+    match dtype {
+        Dtype::U8 => ("UInt8", 1),
+        Dtype::U16 => ("UInt16", 1),
+        Dtype::U32 => ("UInt32", 1),
+        Dtype::I8 => ("Int8", 1),
+        Dtype::F32 => ("Float32", 1),
+        Dtype::Rgb => ("UInt8", 3),
+    }
+}
+
+/// Checks the `value` tag's type and components.
+fn check_value_tag<V: Value>(text: &str) {
+    let (tag, _) = data_array(text, "value");
+    let (kind, components) = vtk_type(V::DTYPE.unwrap());
+    assert_eq!(attr(tag, "type"), kind);
+    if components > 1 {
+        assert_eq!(attr(tag, "NumberOfComponents"), components.to_string());
+    } else {
+        assert!(!tag.contains("NumberOfComponents") || attr(tag, "NumberOfComponents") == "1");
+    }
+    assert!(text.contains("<CellData Scalars=\"value\">"));
+}
+
+/// A value of the `.htg`'s ASCII components, as the little-endian bytes the value type reads.
+fn htg_value<V: Value>(components: &[&str]) -> V {
+    let mut bytes = Vec::new();
+    for c in components {
+        match V::DTYPE.unwrap() {
+            Dtype::U8 | Dtype::Rgb => bytes.push(c.parse::<u8>().unwrap()),
+            Dtype::I8 => bytes.extend(c.parse::<i8>().unwrap().to_le_bytes()),
+            Dtype::U16 => bytes.extend(c.parse::<u16>().unwrap().to_le_bytes()),
+            Dtype::U32 => bytes.extend(c.parse::<u32>().unwrap().to_le_bytes()),
+            Dtype::F32 => bytes.extend(c.parse::<f32>().unwrap().to_le_bytes()),
+        }
+    }
+    V::read_le(&bytes)
+}
+
+/// Writes a valued tree of `dense` as `.vtu` and `.htg`, reads each voxel's value back from the cell data
+/// `value` and compares it (bit for bit) with `dense`; the `.htg`'s vertices without a value (with
+/// children, or masked) hold NaN (`float32`) or 0.
+fn check_values<const K: usize, V: Value>(level: u32, dense: &[Option<V>]) {
+    let tree = KTree::<K, V>::from_dense_values(level, dense).unwrap();
+    let same = |a: Option<V>, b: Option<V>| a.map(Value::key) == b.map(Value::key);
+    let size = V::DTYPE.unwrap().bytes();
+    // .vtu: each voxel's cell, the cell's value.
+    let mut vtu = Vec::new();
+    write_values_vtu(&mut vtu, &tree, &FRAME).unwrap();
+    let text = String::from_utf8_lossy(&vtu);
+    check_value_tag::<V>(&text);
+    let values: Vec<V> = appended(&vtu, &text, "value")
+        .chunks_exact(size)
+        .map(V::read_le)
+        .collect();
+    let cells = vtu_cells::<K>(&vtu, level);
+    assert_eq!(
+        values.len(),
+        attr(&text, "NumberOfCells").parse::<usize>().unwrap()
+    );
+    for (i, (cell, want)) in cells.iter().zip(dense).enumerate() {
+        assert!(same(cell.map(|c| values[c]), *want), "vtu voxel {i}");
+    }
+    // .htg: each voxel's leaf vertex, the vertex's value.
+    let mut htg = Vec::new();
+    write_values_htg(&mut htg, &tree, &FRAME).unwrap();
+    let text = String::from_utf8_lossy(&htg);
+    check_value_tag::<V>(&text);
+    let (tag, numbers) = data_array(&text, "value");
+    let components = vtk_type(V::DTYPE.unwrap()).1;
+    let tokens: Vec<&str> = numbers.split_whitespace().collect();
+    let values: Vec<V> = tokens
+        .chunks_exact(components)
+        .map(htg_value::<V>)
+        .collect();
+    let (vertices, leaf) = htg_vertices::<K>(&htg, level);
+    assert_eq!(values.len(), leaf.len());
+    assert_eq!(attr(tag, "NumberOfTuples"), leaf.len().to_string());
+    for (i, (vertex, want)) in vertices.iter().zip(dense).enumerate() {
+        assert!(same(vertex.map(|v| values[v]), *want), "htg voxel {i}");
+    }
+    let mut covering = vec![false; leaf.len()];
+    for v in vertices.iter().flatten() {
+        covering[*v] = true;
+    }
+    let none = V::read_le(&if V::DTYPE == Some(Dtype::F32) {
+        f32::NAN.to_le_bytes().to_vec()
+    } else {
+        vec![0; size]
+    });
+    for (v, value) in values.iter().enumerate() {
+        if !covering[v] {
+            assert!(same(Some(*value), Some(none)), "vertex {v} without a value");
+        }
+    }
+}
+
+#[test]
+fn values_of_every_type_read_back() {
+    fn all<const K: usize>(level: u32, seed: u64) {
+        check_values::<K, u8>(level, &random_values::<K, u8>(level, seed, 7));
+        check_values::<K, u16>(level, &random_values::<K, u16>(level, seed, 7));
+        check_values::<K, u32>(level, &random_values::<K, u32>(level, seed, 7));
+        check_values::<K, i8>(level, &random_values::<K, i8>(level, seed, 7));
+        check_values::<K, f32>(level, &random_values::<K, f32>(level, seed, 7));
+        check_values::<K, Rgb>(level, &random_values::<K, Rgb>(level, seed, 7));
+    }
+    for seed in 1..4 {
+        all::<2>(3, seed);
+        all::<3>(2, seed);
+    }
+    // One value everywhere, none at all, a single voxel.
+    check_values::<3, f32>(2, &[Some(0.25); 64]);
+    check_values::<2, Rgb>(2, &[None; 16]);
+    check_values::<3, u8>(0, &[Some(9)]);
+    let mut out = Vec::new();
+    let line = KTree::<1, u8>::from_dense_values(1, &[Some(1), None]).unwrap();
+    assert!(write_values_vtu(&mut out, &line, &FRAME).is_err());
+    assert!(write_values_htg(&mut out, &line, &FRAME).is_err());
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn random_valued_octrees_read_back(level in 0u32..=3, seed in any::<u64>(), density in 0u64..=10) {
+        check_values::<3, u8>(level, &random_values::<3, u8>(level, seed, density));
+        check_values::<3, f32>(level, &random_values::<3, f32>(level, seed, density));
+        check_values::<3, Rgb>(level, &random_values::<3, Rgb>(level, seed, density));
+    }
+
+    #[test]
+    fn random_valued_quadtrees_read_back(level in 0u32..=4, seed in any::<u64>(), density in 0u64..=10) {
+        check_values::<2, u8>(level, &random_values::<2, u8>(level, seed, density));
+        check_values::<2, f32>(level, &random_values::<2, f32>(level, seed, density));
+        check_values::<2, Rgb>(level, &random_values::<2, Rgb>(level, seed, density));
+    }
 
     #[test]
     fn random_octrees_read_back(level in 1u32..=3, seed in any::<u64>(), density in 0u64..=10) {
