@@ -80,7 +80,7 @@ pub fn slice<const K: usize, const J: usize, T: TreeStorage<K>>(
 /// ```
 ///
 /// # Errors
-/// As [`slice`].
+/// As [`slice()`].
 pub fn slice_values<const K: usize, const J: usize, T: ValueStorage<K>>(
     tree: &T,
     axis: usize,
