@@ -80,6 +80,9 @@ pub fn run(a: Args) -> CliResult {
             voxel_size: a.voxel_size,
             origin: a.origin,
         };
+        if let Some(axis) = a.time_axis {
+            return crate::convert_values::time_series(&a.input, &a.output, axis, placement);
+        }
         return crate::convert_values::convert_valued(&a.input, &a.output, placement);
     }
     let options = ReadOptions {

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use ktree::export::vtk::write_values_vtk_file;
+use ktree::export::vtk::{write_values_time_slices, write_values_vtk_file};
 use ktree::io::ktree::v3::{read_valued_ktree, read_valued_ktree_framed, write_valued_ktree_file};
 use ktree::io::write_nifti_file;
 use ktree::solid::volume::Volume;
@@ -85,6 +85,35 @@ pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliR
         outln!("{}: copied (K = {k}, {})", output.display(), dtype.name());
         Ok(())
     }, else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()))
+}
+
+/// The 4-D valued tree of `input` as a time series of VTK files along `axis` (`.pvd` with `.vtu` slices,
+/// or `.vtu` or `.htg` slices alone), `value` their cell data.
+pub fn time_series(input: &Path, output: &Path, axis: usize, placement: Placement) -> CliResult {
+    let (k, dtype) = crate::values::file_dtype(input)?;
+    let dtype = dtype.ok_or_else(|| format!("{}: the tree holds no values", input.display()))?;
+    if k != 4 {
+        return Err(format!(
+            "{}: --time-axis slices 4-D trees; this tree has K = {k}",
+            input.display()
+        )
+        .into());
+    }
+    let name = input.display().to_string();
+    let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
+    let files = ktree::with_valued!(4, dtype, KK, V => {
+        let (tree, kept) =
+            read_valued_ktree_framed::<4, V>(&bytes, &name).map_err(CliError::caused)?;
+        write_values_time_slices(output, &tree, axis, &placement.frame(kept))
+            .map_err(CliError::caused)?
+    }, else return Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
+    outln!(
+        "{}: K = 4, {} values, slices along axis {axis} ({} files)",
+        output.display(),
+        dtype.name(),
+        files.len()
+    );
+    Ok(())
 }
 
 /// The valued tree of `input` as a VTK file, `value` its cell data.

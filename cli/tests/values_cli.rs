@@ -354,3 +354,33 @@ fn a_tree_with_values_converts_to_vtk_files_whose_cell_data_holds_them() {
         "{err}"
     );
 }
+
+#[test]
+fn a_4d_tree_with_values_converts_to_a_time_series() {
+    use ktree::io::ktree::v3::write_valued_ktree_file;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    // Label t + 1 on the half x < 2 at each time t of a 4⁴ universe.
+    let dense: Vec<Option<u8>> = (0..256u32)
+        .map(|i| (i % 4 < 2).then_some(1 + (i / 64) as u8))
+        .collect();
+    let tree = ktree::KTree::<4, u8>::from_dense_values(2, &dense).unwrap();
+    write_valued_ktree_file(Path::new(&p("h.ktree")), &tree).unwrap();
+    let out = run(&["convert", &p("h.ktree"), &p("h.pvd"), "--time-axis", "3"]);
+    assert!(out.contains("5 files"), "{out}");
+    let pvd = std::fs::read_to_string(p("h.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 4);
+    for t in 0..4 {
+        let text = String::from_utf8_lossy(&std::fs::read(p(&format!("h_{t:04}.vtu"))).unwrap())
+            .into_owned();
+        assert!(text.contains("<CellData Scalars=\"value\">"), "{text}");
+    }
+    // Not a 4-D tree: a clear error.
+    let three = ktree::KTree::<3, u8>::from_dense_values(1, &[Some(1); 8]).unwrap();
+    write_valued_ktree_file(Path::new(&p("t.ktree")), &three).unwrap();
+    let (ok, _, err) = ktree(&["convert", &p("t.ktree"), &p("t.pvd"), "--time-axis", "0"]);
+    assert!(
+        !ok && err.contains("4-D") && err.lines().count() == 1,
+        "{err}"
+    );
+}

@@ -1,8 +1,8 @@
 //! VTK XML files for ParaView: an unstructured grid (`.vtu`) of one voxel (octrees) or pixel (quadtrees)
 //! cell per full leaf, and a hyper tree grid (`.htg`), the form VTK keeps a tree in.
 //!
-//! A 4-D tree goes out as a time series of its 3-D slices ([`write_time_slices`]), with a `.pvd`
-//! collection for ParaView's time controls.
+//! A 4-D tree goes out as a time series of its 3-D slices ([`write_time_slices`], with values
+//! [`write_values_time_slices`]), with a `.pvd` collection for ParaView's time controls.
 //!
 //! Both carry the cell data `level` (the leaf's depth in the tree, 0 at the root) and `side` (the leaf's
 //! edge in world units). Arrays are raw little-endian binary in the appended section (header UInt64).
@@ -713,6 +713,81 @@ pub fn write_time_slices<T: TreeStorage<4>>(
     time_axis: usize,
     frame: &Frame,
 ) -> Result<Vec<PathBuf>, ExportError> {
+    let side = tree.universe().side();
+    write_time_series(path, side, time_axis, |file, t, htg| {
+        let slice = slice_4d(tree, time_axis, t).map_err(|e| match e {
+            DisplayError::Storage(e) => ExportError::Storage(e),
+            e => ExportError::Usage {
+                file: path.to_path_buf(),
+                message: e.to_string(),
+            },
+        })?;
+        write_atomic_with(file, |w| {
+            if htg {
+                write_htg(w, &slice, frame)
+            } else {
+                write_vtu(w, &slice, frame)
+            }
+        })
+        .map_err(ExportError::Write)
+    })
+}
+
+/// A 4-D tree with values as a time series for ParaView, as [`write_time_slices`] writes a tree without:
+/// each slice along `time_axis` ([`crate::ops::slice_values`]) an octree with its `value` cell data
+/// ([`write_values_vtu`], [`write_values_htg`]).
+///
+/// ```
+/// use ktree::export::{vtk::write_values_time_slices, Frame};
+/// use ktree::KTree;
+/// // Two time steps of a 2⁴ universe: label 1 at t = 0, label 2 at t = 1, over the whole space.
+/// let dense: Vec<Option<u8>> = (0..16).map(|i| Some(1 + (i / 8) as u8)).collect();
+/// let tree = KTree::<4, u8>::from_dense_values(1, &dense).unwrap();
+/// let dir = tempfile::tempdir().unwrap();
+/// let files = write_values_time_slices(&dir.path().join("run.pvd"), &tree, 3, &Frame::default()).unwrap();
+/// assert_eq!(files.len(), 3);
+/// let second = std::fs::read(&files[1]).unwrap(); // XML with raw binary arrays appended
+/// assert!(String::from_utf8_lossy(&second).contains(r#"Name="value""#));
+/// ```
+///
+/// # Errors
+/// As [`write_time_slices`].
+pub fn write_values_time_slices<T: ValueStorage<4>>(
+    path: &Path,
+    tree: &T,
+    time_axis: usize,
+    frame: &Frame,
+) -> Result<Vec<PathBuf>, ExportError> {
+    let side = tree.universe().side();
+    write_time_series(path, side, time_axis, |file, t, htg| {
+        let slice =
+            crate::ops::slice_values::<4, 3, T>(tree, time_axis, t).map_err(|e| match e {
+                crate::ops::OpsError::Storage(e) => ExportError::Storage(e),
+                e => ExportError::Usage {
+                    file: path.to_path_buf(),
+                    message: e.to_string(),
+                },
+            })?;
+        write_atomic_with(file, |w| {
+            if htg {
+                write_values_htg(w, &slice, frame)
+            } else {
+                write_values_vtu(w, &slice, frame)
+            }
+        })
+        .map_err(ExportError::Write)
+    })
+}
+
+/// The time series of a 4-D tree of side `side`: `write_slice(file, t, htg)` writes the slice at `t` to
+/// `file` (a `.htg` if `htg`, else a `.vtu`); the files are named and the `.pvd` collection written as
+/// [`write_time_slices`] says.
+fn write_time_series(
+    path: &Path,
+    side: u64,
+    time_axis: usize,
+    mut write_slice: impl FnMut(&Path, u32, bool) -> Result<(), ExportError>,
+) -> Result<Vec<PathBuf>, ExportError> {
     let usage = |message: String| ExportError::Usage {
         file: path.to_path_buf(),
         message,
@@ -741,25 +816,13 @@ pub fn write_time_slices<T: TreeStorage<4>>(
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let dir = path.parent().unwrap_or(Path::new(""));
-    let side = tree.universe().side();
     let digits = side.saturating_sub(1).to_string().len().max(4);
     let mut written = Vec::new();
     let mut entries = String::new();
     for t in 0..side as u32 {
-        let slice = slice_4d(tree, time_axis, t).map_err(|e| match e {
-            DisplayError::Storage(e) => ExportError::Storage(e),
-            e => usage(e.to_string()),
-        })?;
         let name = format!("{stem}_{t:0digits$}.{slice_ext}");
         let file = dir.join(&name);
-        write_atomic_with(&file, |w| {
-            if slice_ext == "htg" {
-                write_htg(w, &slice, frame)
-            } else {
-                write_vtu(w, &slice, frame)
-            }
-        })
-        .map_err(ExportError::Write)?;
+        write_slice(&file, t, slice_ext == "htg")?;
         entries.push_str(&format!(
             "  <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{}\"/>\n",
             xml_escape(&name)

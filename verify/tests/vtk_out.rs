@@ -3,7 +3,9 @@
 //! breadth first give back the tree's voxels), for random quadtrees and octrees; for random valued trees
 //! (`u8`, `u16`, `u32`, `i8`, `f32`, colours) the cell data `value` gives back every voxel's value.
 
-use ktree::export::vtk::{write_htg, write_values_htg, write_values_vtu, write_vtu};
+use ktree::export::vtk::{
+    write_htg, write_values_htg, write_values_time_slices, write_values_vtu, write_vtu,
+};
 use ktree::export::Frame;
 use ktree::value::{Dtype, Rgb, Value};
 use ktree::KTree;
@@ -431,6 +433,58 @@ fn check_values<const K: usize, V: Value>(level: u32, dense: &[Option<V>]) {
     for (v, value) in values.iter().enumerate() {
         if !covering[v] {
             assert!(same(Some(*value), Some(none)), "vertex {v} without a value");
+        }
+    }
+}
+
+/// A 4-D valued tree as a time series: along every axis, the `.vtu` of slice `t` gives each voxel of the
+/// dense array at `t` its value, and the `.pvd` lists the slices in order.
+#[test]
+fn a_4d_tree_with_values_goes_out_slice_by_slice() {
+    let level = 2;
+    let dense = random_values::<4, u16>(level, 11, 6);
+    let tree = KTree::<4, u16>::from_dense_values(level, &dense).unwrap();
+    let side = 1u32 << level;
+    let dir = tempfile::tempdir().unwrap();
+    for axis in 0..4 {
+        let pvd = dir.path().join(format!("run{axis}.pvd"));
+        let files = write_values_time_slices(&pvd, &tree, axis, &FRAME).unwrap();
+        assert_eq!(files.len(), side as usize + 1);
+        let collection = std::fs::read_to_string(&pvd).unwrap();
+        for t in 0..side {
+            let bytes = std::fs::read(&files[t as usize]).unwrap();
+            let text = String::from_utf8_lossy(&bytes);
+            check_value_tag::<u16>(&text);
+            let name = files[t as usize].file_name().unwrap().to_str().unwrap();
+            assert!(collection.contains(&format!(
+                "timestep=\"{t}\" group=\"\" part=\"0\" file=\"{name}\""
+            )));
+            let values: Vec<u16> = appended(&bytes, &text, "value")
+                .chunks_exact(2)
+                .map(u16::read_le)
+                .collect();
+            let cells = vtu_cells::<3>(&bytes, level);
+            for (i, cell) in cells.iter().enumerate() {
+                let q = [
+                    i as u32 % side,
+                    i as u32 / side % side,
+                    i as u32 / side / side,
+                ];
+                let p: [u32; 4] = std::array::from_fn(|a| match a.cmp(&axis) {
+                    std::cmp::Ordering::Less => q[a],
+                    std::cmp::Ordering::Equal => t,
+                    std::cmp::Ordering::Greater => q[a - 1],
+                });
+                let at = p
+                    .iter()
+                    .rev()
+                    .fold(0usize, |n, &c| n * side as usize + c as usize);
+                assert_eq!(
+                    cell.map(|c| values[c]),
+                    dense[at],
+                    "axis {axis}, t {t}, voxel {i}"
+                );
+            }
         }
     }
 }
