@@ -29,14 +29,14 @@ use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use super::{ExportError, Frame};
-use crate::display::slices::slice_4d;
-use crate::display::DisplayError;
 use crate::fs::write_atomic_with;
 use crate::space::Cell;
-use crate::tree::cursor::{try_walk, TryLeaves, Visitor, Walk};
+use crate::tree::cursor::Walk;
 use crate::tree::storage::TreeStorage;
-use crate::tree::valued::{try_walk_values, ValueLeaves, ValueNode, ValueStorage, ValueVisitor};
-use crate::tree::{NodeRef, NodeState, StorageError, ValueState};
+use crate::tree::valued::{
+    try_walk_values, BinaryValues, ValueLeaves, ValueNode, ValueStorage, ValueVisitor,
+};
+use crate::tree::{NodeState, StorageError, ValueState};
 use crate::value::{Dtype, Value};
 
 /// One array of the appended section.
@@ -105,18 +105,7 @@ pub fn write_vtu<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     frame: &Frame,
 ) -> io::Result<()> {
-    check_dimension::<K>(".vtu")?;
-    Grid::of(full_leaves(tree), frame)
-        .map_err(read_error)?
-        .write(w)
-}
-
-/// The leaves of a tree without values as [`Grid::of`] and [`Depths`] take them: a full leaf holds `()`.
-fn full_leaves<const K: usize, T: TreeStorage<K>>(
-    tree: &T,
-) -> impl Iterator<Item = Result<(Cell<K>, Option<()>), T::Error>> + '_ {
-    TryLeaves::new(tree)
-        .map(|leaf| leaf.map(|(cell, state)| (cell, (state == NodeState::Full).then_some(()))))
+    write_values_vtu(w, &BinaryValues(tree), frame)
 }
 
 /// A valued tree's full leaves as an unstructured grid, as [`write_vtu`] writes a tree without values
@@ -362,17 +351,6 @@ impl<const K: usize, V> Depths<K, V> {
     }
 }
 
-impl<const K: usize> Visitor<K> for Depths<K, ()> {
-    const LEAVES: bool = false;
-    const ORIGINS: bool = false;
-    fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-        let state = node.state();
-        let value = (state == NodeState::Full).then_some(());
-        self.push(node.cell().level as usize, state, value);
-        Walk::Descend
-    }
-}
-
 impl<const K: usize, V: Value> ValueVisitor<K, V> for Depths<K, V> {
     fn visit(&mut self, node: &ValueNode<K, V>) -> Walk {
         let (state, value) = match node.state {
@@ -411,10 +389,7 @@ pub fn write_htg<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     frame: &Frame,
 ) -> io::Result<()> {
-    check_dimension::<K>(".htg")?;
-    Depths::of(tree)
-        .map_err(read_error)?
-        .write(w, tree.level(), frame)
+    write_values_htg(w, &BinaryValues(tree), frame)
 }
 
 /// A valued tree as a hyper tree grid, as [`write_htg`] writes a tree without values — refined where a
@@ -444,18 +419,10 @@ pub fn write_values_htg<const K: usize, T: ValueStorage<K>>(
         .write(w, tree.level(), frame)
 }
 
-impl<const K: usize> Depths<K, ()> {
-    /// The nodes of `tree`, read before anything is written. Level order is breadth first: each depth's
-    /// nodes in index order, which a depth-first walk meets in the same order.
-    fn of<T: TreeStorage<K>>(tree: &T) -> Result<Self, T::Error> {
-        let mut depths = Depths { nodes: Vec::new() };
-        try_walk(tree, &mut depths)?;
-        Ok(depths)
-    }
-}
-
 impl<const K: usize, V: Value> Depths<K, V> {
-    /// The nodes of a valued tree, as [`Depths::of`].
+    /// The nodes of a valued tree (a binary one through [`BinaryValues`]), read before anything is
+    /// written. Level order is breadth first: each depth's nodes in index order, which a depth-first
+    /// walk meets in the same order.
     fn of_values<T: ValueStorage<K, Value = V>>(tree: &T) -> Result<Self, T::Error> {
         let mut depths = Depths { nodes: Vec::new() };
         try_walk_values(tree, &mut depths)?;
@@ -621,16 +588,7 @@ pub fn write_vtk_file<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     frame: &Frame,
 ) -> Result<(), ExportError> {
-    let htg = vtk_file_kind::<K>(path)?;
-    let storage = |e: T::Error| ExportError::Storage(e.into());
-    if htg {
-        let depths = Depths::of(tree).map_err(storage)?;
-        write_atomic_with(path, |w| depths.write(w, tree.level(), frame))
-    } else {
-        let grid = Grid::of(full_leaves(tree), frame).map_err(storage)?;
-        write_atomic_with(path, |w| grid.write(w))
-    }
-    .map_err(ExportError::Write)
+    write_values_vtk_file(path, &BinaryValues(tree), frame)
 }
 
 /// Writes the valued tree `tree` to `path` as the VTK file its extension names, atomically: `.vtu`
@@ -713,24 +671,7 @@ pub fn write_time_slices<T: TreeStorage<4>>(
     time_axis: usize,
     frame: &Frame,
 ) -> Result<Vec<PathBuf>, ExportError> {
-    let side = tree.universe().side();
-    write_time_series(path, side, time_axis, |file, t, htg| {
-        let slice = slice_4d(tree, time_axis, t).map_err(|e| match e {
-            DisplayError::Storage(e) => ExportError::Storage(e),
-            e => ExportError::Usage {
-                file: path.to_path_buf(),
-                message: e.to_string(),
-            },
-        })?;
-        write_atomic_with(file, |w| {
-            if htg {
-                write_htg(w, &slice, frame)
-            } else {
-                write_vtu(w, &slice, frame)
-            }
-        })
-        .map_err(ExportError::Write)
-    })
+    write_values_time_slices(path, &BinaryValues(tree), time_axis, frame)
 }
 
 /// A 4-D tree with values as a time series for ParaView, as [`write_time_slices`] writes a tree without:

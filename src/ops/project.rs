@@ -54,14 +54,7 @@ pub fn slice<const K: usize, const J: usize, T: TreeStorage<K>>(
     axis: usize,
     position: u32,
 ) -> Result<KTree<J>, OpsError> {
-    let side = tree.universe().side();
-    if axis < K && u64::from(position) >= side {
-        return Err(OpsError::SliceOutside {
-            axis,
-            position,
-            side,
-        });
-    }
+    check_inside(axis, position, tree.universe())?;
     project(tree, axis, position..position + 1)
 }
 
@@ -86,29 +79,9 @@ pub fn slice_values<const K: usize, const J: usize, T: ValueStorage<K>>(
     axis: usize,
     position: u32,
 ) -> Result<KTree<J, T::Value>, OpsError> {
-    if J + 1 != K {
-        return Err(OpsError::DimensionMismatch(DimensionMismatch {
-            expected: K - 1,
-            found: J,
-        }));
-    }
-    if axis >= K {
-        return Err(OpsError::BadAxis { axis, k: K });
-    }
     let level = tree.level();
-    let side = tree.universe().side();
-    if u64::from(position) >= side {
-        return Err(OpsError::SliceOutside {
-            axis,
-            position,
-            side,
-        });
-    }
-    Universe::<J>::new(level).map_err(|_| OpsError::LevelTooLarge {
-        k: J,
-        level,
-        max: crate::max_level(J),
-    })?;
+    check_inside(axis, position, tree.universe())?;
+    down::<K, J>(axis, level)?;
     // A J-cell of side 2^s stands on the K-node of the same side whose cell holds it at `position`; its
     // child `code` stands on the K-child whose bit along `axis` is the position's bit s − 1.
     let low_bits = (1usize << axis) - 1;
@@ -146,20 +119,7 @@ pub fn project<const K: usize, const J: usize, T: TreeStorage<K>>(
     axis: usize,
     range: Range<u32>,
 ) -> Result<KTree<J>, OpsError> {
-    if J + 1 != K {
-        return Err(OpsError::DimensionMismatch(DimensionMismatch {
-            expected: K - 1,
-            found: J,
-        }));
-    }
-    if axis >= K {
-        return Err(OpsError::BadAxis { axis, k: K });
-    }
-    let universe = Universe::<J>::new(tree.level()).map_err(|_| OpsError::LevelTooLarge {
-        k: J,
-        level: tree.level(),
-        max: crate::max_level(J),
-    })?;
+    let universe = down::<K, J>(axis, tree.level())?;
     struct Range1<const K: usize> {
         axis: usize,
         lo: u64,
@@ -212,6 +172,45 @@ pub fn project<const K: usize, const J: usize, T: TreeStorage<K>>(
         outer.push(c);
     }
     Ok(KTree::from_sorted_cells(universe, &maximal(outer)))
+}
+
+/// The universe of level `level` in `J` dimensions, for a `K`-tree seen along `axis`.
+///
+/// # Errors
+/// [`OpsError::DimensionMismatch`] unless `J + 1 = K`; [`OpsError::BadAxis`] for an axis not below `K`;
+/// [`OpsError::LevelTooLarge`] for a level `J` dimensions cannot have.
+fn down<const K: usize, const J: usize>(axis: usize, level: u32) -> Result<Universe<J>, OpsError> {
+    if J + 1 != K {
+        return Err(OpsError::DimensionMismatch(DimensionMismatch {
+            expected: K - 1,
+            found: J,
+        }));
+    }
+    if axis >= K {
+        return Err(OpsError::BadAxis { axis, k: K });
+    }
+    Universe::<J>::new(level).map_err(|_| OpsError::LevelTooLarge {
+        k: J,
+        level,
+        max: crate::max_level(J),
+    })
+}
+
+/// [`OpsError::SliceOutside`] for a `position` along `axis` (when below `K`) outside `universe`.
+fn check_inside<const K: usize>(
+    axis: usize,
+    position: u32,
+    universe: Universe<K>,
+) -> Result<(), OpsError> {
+    let side = universe.side();
+    if axis < K && u64::from(position) >= side {
+        return Err(OpsError::SliceOutside {
+            axis,
+            position,
+            side,
+        });
+    }
+    Ok(())
 }
 
 /// The `K = J + 1`-dimensional tree of the voxels whose coordinate along `axis` lies in `range` (clipped

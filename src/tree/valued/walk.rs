@@ -10,7 +10,7 @@ use crate::tree::cursor::Walk;
 use crate::tree::error::StorageError;
 use crate::tree::ktree::KTree;
 use crate::tree::states::NodeState;
-use crate::tree::storage::infallible;
+use crate::tree::storage::{infallible, TreeStorage};
 use crate::value::Value;
 
 /// A valued tree stored in level order, read one block of siblings at a time, reads failing like those of
@@ -127,6 +127,52 @@ impl<const K: usize, V: Value> ValueStorage<K> for KTree<K, V> {
         }
         let level = &self.values[depth];
         Ok(level.values[level.rank.rank(&self.levels[depth], index)])
+    }
+}
+
+/// A binary tree read as a valued tree whose full voxels hold `()`: what lets one valued code path serve
+/// binary trees in memory and mapped `.ktree` files alike.
+///
+/// ```
+/// use ktree::tree::valued::{BinaryValues, ValueStorage};
+/// use ktree::KTree;
+/// let tree = KTree::<2>::from_dense(1, &[true, false, true, true]).unwrap();
+/// let seen = BinaryValues(&tree);
+/// assert_eq!(seen.value(1, 0), Ok(()));
+/// assert_eq!(seen.codes(1, 0), Ok(0b01_01_00_01));
+/// ```
+#[derive(Debug, Clone, Copy)]
+pub struct BinaryValues<'a, T>(pub &'a T);
+
+impl<const K: usize, T: TreeStorage<K>> ValueStorage<K> for BinaryValues<'_, T> {
+    type Value = ();
+    type Error = T::Error;
+
+    fn universe(&self) -> Universe<K> {
+        self.0.universe()
+    }
+
+    fn depth_count(&self) -> usize {
+        self.0.depth_count()
+    }
+
+    fn root_code(&self) -> Result<u32, T::Error> {
+        Ok(self.0.root_state()? as u32)
+    }
+
+    #[inline(always)]
+    fn codes(&self, depth: usize, first: usize) -> Result<u32, T::Error> {
+        self.0.block_codes(depth, first)
+    }
+
+    #[inline(always)]
+    fn children(&self, depth: usize, index: usize) -> Result<usize, T::Error> {
+        self.0.first_child(depth, index)
+    }
+
+    #[inline]
+    fn value(&self, _depth: usize, _index: usize) -> Result<(), T::Error> {
+        Ok(())
     }
 }
 
