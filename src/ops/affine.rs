@@ -31,11 +31,12 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::output::Memory;
-use super::overlay::{resample_into, Preimage};
+use super::overlay::{resample_into, resample_values, Preimage};
 use super::OpsError;
 use crate::space::Universe;
 use crate::tree::sink::LevelSink;
 use crate::tree::storage::TreeStorage;
+use crate::tree::valued::ValueStorage;
 use crate::tree::KTree;
 
 /// An affine map `x ↦ A·x + b` of continuous coordinates (voxel units, origin at the universe's corner).
@@ -258,6 +259,27 @@ pub fn transform<const K: usize, T: TreeStorage<K>>(
     let map = Inverse::of(m, tree.universe())?;
     resample_into::<K, _, _, _, T::Error>(tree, &map, Memory::new(tree.universe()))
         .map_err(OpsError::storage)
+}
+
+/// [`transform`] of a valued tree: target voxel `q` takes the value of source voxel
+/// `m⁻¹`-[`Affine::source_voxel`]`(q)` — a label volume turned or sheared, each voxel keeping its label
+/// (nearest-neighbour resampling: values are never blended).
+///
+/// ```
+/// use ktree::{KTree, ops::{transform_values, Affine}};
+/// let a = KTree::<2, u8>::from_dense_values(1, &[Some(1), Some(2), None, None]).unwrap();
+/// let m = Affine::rotation_about(0, 1, 180.0, Affine::<2>::universe_centre(1)).unwrap();
+/// assert_eq!(transform_values(&a, &m).unwrap().to_dense_values().unwrap(), [None, None, Some(2), Some(1)]);
+/// ```
+///
+/// # Errors
+/// As [`transform`].
+pub fn transform_values<const K: usize, T: ValueStorage<K>>(
+    tree: &T,
+    m: &Affine<K>,
+) -> Result<KTree<K, T::Value>, OpsError> {
+    let map = Inverse::of(m, tree.universe())?;
+    resample_values(tree, &map).map_err(OpsError::storage)
 }
 
 /// [`transform`] written to `sink`.

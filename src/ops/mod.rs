@@ -55,7 +55,7 @@ mod separation;
 mod translate;
 pub mod values;
 
-pub use affine::{transform, transform_into, Affine};
+pub use affine::{transform, transform_into, transform_values, Affine};
 pub use boolean::{
     boolean, boolean_into, complement, complement_into, difference, intersection,
     symmetric_difference, union, BoolOp,
@@ -67,9 +67,11 @@ pub use error::OpsError;
 pub use fixed::{transform_fixed, transform_fixed_into, FixedAffine};
 pub use interference::{collision, first_contact, interferes, overlap_cells, Collision};
 pub use mass::{mass_progressive, mass_properties, LevelBounds, MassProperties, ProgressiveMass};
-pub use perspective::{transform_projective, transform_projective_into, Projective};
+pub use perspective::{
+    transform_projective, transform_projective_into, transform_projective_values, Projective,
+};
 pub use project::{extrude, project, slice, slice_values};
-pub use rotate::{rotate_axes, rotate_axes_into, AxisMap};
-pub use scale::{grow, grow_into, scale, scale_into, zoom, zoom_into};
+pub use rotate::{rotate_axes, rotate_axes_into, rotate_values, AxisMap};
+pub use scale::{grow, grow_into, scale, scale_into, scale_values, zoom, zoom_into};
 pub use separation::min_separation;
 pub use translate::{fine_shift, translate, translate_fine, translate_fine_into, translate_into};

@@ -32,12 +32,18 @@
 //! assert_eq!(resample(&a, &ShiftOne).unwrap().to_dense().unwrap(), [false, true, true, false]);
 //! ```
 
+use std::rc::Rc;
+
 use super::output::{collapse, leaf, Memory};
+use super::values::Failure;
 use crate::space::Cell;
 use crate::tree::locate::PointCursor;
 use crate::tree::sink::LevelSink;
 use crate::tree::storage::TreeStorage;
+use crate::tree::top_down::{build_top_down, Decision, InputNode};
+use crate::tree::valued::{ValueState, ValueStorage};
 use crate::tree::{KTree, NodeRef, NodeState};
+use crate::value::Value;
 
 /// How target voxels map back into the source universe.
 pub trait Preimage<const K: usize> {
@@ -304,4 +310,200 @@ where
     let root_ctx = map.root();
     let state = engine.node::<E>(universe.root(), root_ctx, 0..1)?;
     Ok(engine.out.finish(state)?)
+}
+
+/// A source node of a valued overlay: its cell and where it stands in the source.
+#[derive(Clone, Copy)]
+struct ValueEntry<const K: usize, V> {
+    cell: Cell<K>,
+    node: InputNode<V>,
+}
+
+/// A target cell of a valued resampling: the source nodes meeting its preimage box (refined until no
+/// larger than the box, as the binary engine's overlay) and what the cell is.
+struct ValueOverlay<const K: usize, V> {
+    cell: Cell<K>,
+    entries: Vec<ValueEntry<K, V>>,
+    decision: Decision<V>,
+}
+
+/// What the leaves of an overlay hold so far: nothing seen, one state (`None`: empty) or more than one.
+enum Seen<V> {
+    Nothing,
+    One(Option<V>),
+    Several,
+}
+
+impl<V: Value> Seen<V> {
+    fn add(&mut self, value: Option<V>) {
+        *self = match std::mem::replace(self, Seen::Several) {
+            Seen::Nothing => Seen::One(value),
+            Seen::One(v) if same(v, value) => Seen::One(v),
+            _ => Seen::Several,
+        }
+    }
+}
+
+fn same<V: Value>(a: Option<V>, b: Option<V>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => a.same(b),
+        _ => false,
+    }
+}
+
+impl<const K: usize, V: Value> ValueOverlay<K, V> {
+    /// The overlay of target `cell` from its parent's `entries` (for the root, the source's root).
+    fn of<T: ValueStorage<K, Value = V>, P: Preimage<K>>(
+        src: &T,
+        map: &P,
+        cell: Cell<K>,
+        parent: &[ValueEntry<K, V>],
+    ) -> Result<Self, T::Error> {
+        let side = src.universe().side() as i64;
+        let leaf = |decision| {
+            Ok(Self {
+                cell,
+                entries: Vec::new(),
+                decision,
+            })
+        };
+        if cell.log_side == 0 {
+            let p = map.voxel(cell.origin);
+            if p.iter().any(|&c| c < 0 || c >= side) {
+                return leaf(Decision::Leaf(None));
+            }
+            let p = p.map(|c| c as u32);
+            let start = match parent.iter().find(|e| e.cell.contains(p)) {
+                Some(e) => *e,
+                None => ValueEntry {
+                    cell: src.universe().root(),
+                    node: InputNode::root(src)?,
+                },
+            };
+            return leaf(Decision::Leaf(value_of(src, start, p)?));
+        }
+        let mut bx = map.cell_box(cell.origin, cell.side());
+        let mut seen = Seen::Nothing;
+        for b in bx.iter_mut() {
+            if b.0 < 0 || b.1 >= side {
+                seen.add(None); // part of the preimage is in the void
+            }
+            b.0 = b.0.max(0);
+            b.1 = b.1.min(side - 1);
+            if b.0 > b.1 {
+                return leaf(Decision::Leaf(None));
+            }
+        }
+        let extent = bx.iter().map(|b| b.1 - b.0 + 1).max().unwrap_or(1);
+        let mut entries = Vec::new();
+        let mut partial = false;
+        let mut stack: Vec<ValueEntry<K, V>> = parent
+            .iter()
+            .filter(|e| meets(&e.cell, &bx))
+            .copied()
+            .collect();
+        while let Some(e) = stack.pop() {
+            match e.node.state {
+                ValueState::Empty => seen.add(None),
+                ValueState::Full(v) => seen.add(Some(v)),
+                ValueState::Partial | ValueState::Mixed if e.cell.side() as i64 <= extent => {
+                    partial = true;
+                }
+                ValueState::Partial | ValueState::Mixed => {
+                    for code in 0..1usize << K {
+                        let child = e.cell.child(code);
+                        if meets(&child, &bx) {
+                            stack.push(ValueEntry {
+                                cell: child,
+                                node: e.node.child(src, code)?,
+                            });
+                        }
+                    }
+                    continue;
+                }
+            }
+            entries.push(e);
+        }
+        let decision = match seen {
+            Seen::One(value) if !partial => Decision::Leaf(value),
+            Seen::Nothing if !partial => Decision::Leaf(None),
+            _ => Decision::Split,
+        };
+        Ok(Self {
+            cell,
+            entries,
+            decision,
+        })
+    }
+}
+
+/// The value of source voxel `p`, looked up from `start`, a node whose cell holds it.
+fn value_of<const K: usize, T: ValueStorage<K>>(
+    src: &T,
+    start: ValueEntry<K, T::Value>,
+    p: [u32; K],
+) -> Result<Option<T::Value>, T::Error> {
+    let ValueEntry { mut cell, mut node } = start;
+    while node.state.has_children() {
+        let half = 1u32 << (cell.log_side - 1);
+        let code = (0..K).fold(0, |code, a| {
+            code | usize::from(p[a] - cell.origin[a] >= half) << a
+        });
+        node = node.child(src, code)?;
+        cell = cell.child(code);
+    }
+    Ok(match node.state {
+        ValueState::Full(v) => Some(v),
+        _ => None,
+    })
+}
+
+/// [`resample`] of a valued tree: target voxel `q` takes the value of source voxel `map.voxel(q)`
+/// (empty outside the universe). A target cell whose preimage box meets source leaves of one value (or
+/// only empty ones) is a leaf; the output is minimal.
+///
+/// ```
+/// use ktree::ops::overlay::{resample_values, Preimage};
+/// use ktree::KTree;
+/// /// Target voxel q comes from source voxel q − 1 along the one axis: a shift by one.
+/// struct ShiftOne;
+/// impl Preimage<1> for ShiftOne {
+///     fn voxel(&self, q: [u32; 1]) -> [i64; 1] {
+///         [i64::from(q[0]) - 1]
+///     }
+///     fn cell_box(&self, origin: [u32; 1], side: u64) -> [(i64, i64); 1] {
+///         let lo = i64::from(origin[0]) - 1;
+///         [(lo, lo + side as i64 - 1)]
+///     }
+/// }
+/// let a = KTree::<1, u8>::from_dense_values(2, &[Some(4), Some(7), None, None]).unwrap();
+/// let shifted = resample_values(&a, &ShiftOne).unwrap();
+/// assert_eq!(shifted.to_dense_values().unwrap(), [None, Some(4), Some(7), None]);
+/// ```
+///
+/// # Errors
+/// The storage's read error (none for a [`KTree`]).
+pub fn resample_values<const K: usize, T: ValueStorage<K>, P: Preimage<K>>(
+    src: &T,
+    map: &P,
+) -> Result<KTree<K, T::Value>, T::Error> {
+    let universe = src.universe();
+    let root = ValueEntry {
+        cell: universe.root(),
+        node: InputNode::root(src)?,
+    };
+    let overlay = ValueOverlay::of(src, map, universe.root(), &[root])?;
+    build_top_down::<K, T::Value, _, Failure<T::Error>>(
+        universe.level(),
+        Rc::new(overlay),
+        |_, overlay| Ok(overlay.decision),
+        |overlay, code| {
+            let cell = overlay.cell.child(code);
+            ValueOverlay::of(src, map, cell, &overlay.entries)
+                .map(Rc::new)
+                .map_err(Failure::Read)
+        },
+    )
+    .map_err(Failure::into_read)
 }

@@ -13,11 +13,12 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::output::Memory;
-use super::overlay::{resample_into, Preimage};
+use super::overlay::{resample_into, resample_values, Preimage};
 use super::OpsError;
 use crate::space::Universe;
 use crate::tree::sink::LevelSink;
 use crate::tree::storage::TreeStorage;
+use crate::tree::valued::ValueStorage;
 use crate::tree::KTree;
 
 /// A projective map of a `K`-dimensional universe, as a homogeneous `(K+1)×(K+1)` matrix acting on column
@@ -226,6 +227,19 @@ pub fn transform_projective<const K: usize, T: TreeStorage<K>>(
     let map = Inverse::of(m, tree.universe())?;
     resample_into::<K, _, _, _, T::Error>(tree, &map, Memory::new(tree.universe()))
         .map_err(OpsError::storage)
+}
+
+/// [`transform_projective`] of a valued tree: each target voxel takes the value of the source voxel its
+/// centre maps back into.
+///
+/// # Errors
+/// As [`transform_projective`].
+pub fn transform_projective_values<const K: usize, T: ValueStorage<K>>(
+    tree: &T,
+    m: &Projective<K>,
+) -> Result<KTree<K, T::Value>, OpsError> {
+    let map = Inverse::of(m, tree.universe())?;
+    resample_values(tree, &map).map_err(OpsError::storage)
 }
 
 /// [`transform_projective`] written to `sink`.

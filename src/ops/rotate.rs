@@ -7,9 +7,12 @@
 //! universe's centre. On a tree it is a fixed permutation of the `2^K` child codes applied at every node.
 
 use super::output::Memory;
+use super::values::Failure;
 use super::OpsError;
 use crate::tree::sink::LevelSink;
 use crate::tree::storage::TreeStorage;
+use crate::tree::top_down::{build_top_down, Decision, InputNode};
+use crate::tree::valued::{ValueState, ValueStorage};
 use crate::tree::{KTree, NodeState};
 
 /// An element of the hyperoctahedral group in `K` dimensions: a signed permutation of the axes.
@@ -202,6 +205,39 @@ pub fn rotate_axes<const K: usize, T: TreeStorage<K>>(
     map: &AxisMap<K>,
 ) -> Result<KTree<K>, T::Error> {
     rotate_axes_into(tree, map, Memory::new(tree.universe()))
+}
+
+/// [`rotate_axes`] of a valued tree: each voxel keeps its value. The output has the input's node counts
+/// per level.
+///
+/// ```
+/// use ktree::{KTree, ops::{rotate_values, AxisMap}};
+/// // Voxel (1, 0) holds 7; a quarter turn x → y moves it to (1, 1).
+/// let a = KTree::<2, u8>::from_dense_values(1, &[Some(2), Some(7), None, None]).unwrap();
+/// let r = rotate_values(&a, &AxisMap::quarter_turn(0, 1).unwrap()).unwrap();
+/// assert_eq!(r.to_dense_values().unwrap(), [None, Some(2), None, Some(7)]);
+/// ```
+///
+/// # Errors
+/// The storage's read error (none for a [`KTree`]).
+pub fn rotate_values<const K: usize, T: ValueStorage<K>>(
+    tree: &T,
+    map: &AxisMap<K>,
+) -> Result<KTree<K, T::Value>, T::Error> {
+    let table = map.child_table();
+    build_top_down::<K, T::Value, _, Failure<T::Error>>(
+        tree.level(),
+        InputNode::root(tree)?,
+        |_, node| {
+            Ok(match node.state {
+                ValueState::Empty => Decision::Leaf(None),
+                ValueState::Full(v) => Decision::Leaf(Some(v)),
+                ValueState::Partial | ValueState::Mixed => Decision::Split,
+            })
+        },
+        |node, code| node.child(tree, table[code]).map_err(Failure::Read),
+    )
+    .map_err(Failure::into_read)
 }
 
 /// [`rotate_axes`] written to `sink`. The output is walked depth first in its own child order, so its

@@ -3,12 +3,13 @@
 //! [`TreeStorage`] and writes through any [`LevelSink`] (the `*_into` forms).
 
 use super::output::{copy_into, Memory};
-use super::overlay::{resample_into, Preimage};
+use super::overlay::{resample_into, resample_values, Preimage};
 use super::OpsError;
 use crate::space::{max_level, Universe};
 use crate::tree::locate::locate;
 use crate::tree::sink::{copy_subtree_to, LevelSink};
 use crate::tree::storage::TreeStorage;
+use crate::tree::valued::ValueStorage;
 use crate::tree::{KTree, NodeState};
 
 fn check_path<const K: usize>(path: &[usize], level: u32) -> Result<(), OpsError> {
@@ -241,6 +242,26 @@ pub fn scale<const K: usize, T: TreeStorage<K>>(
     let ratio = Ratio::<K>::new(num, den)?;
     scale_checked::<K, _, _, T::Error>(tree, ratio, Memory::new(tree.universe()))
         .map_err(OpsError::storage)
+}
+
+/// [`scale`] of a valued tree: target voxel `q` takes the value of the source voxel containing
+/// `(q + ½)·den/num`.
+///
+/// ```
+/// use ktree::{KTree, ops::scale_values};
+/// let a = KTree::<1, u8>::from_dense_values(2, &[Some(3), Some(5), None, None]).unwrap();
+/// assert_eq!(scale_values(&a, 2, 1).unwrap().to_dense_values().unwrap(), [Some(3), Some(3), Some(5), Some(5)]);
+/// ```
+///
+/// # Errors
+/// As [`scale`].
+pub fn scale_values<const K: usize, T: ValueStorage<K>>(
+    tree: &T,
+    num: u32,
+    den: u32,
+) -> Result<KTree<K, T::Value>, OpsError> {
+    let ratio = Ratio::<K>::new(num, den)?;
+    resample_values(tree, &ratio).map_err(OpsError::storage)
 }
 
 /// [`scale`] written to `sink`.

@@ -6,6 +6,7 @@
 use std::collections::{BTreeMap, HashMap};
 
 use ktree::ops::values::Rule;
+use ktree::ops::{self, Affine, AxisMap};
 use ktree::tree::{Rgb, Value};
 use ktree::{KTree, Universe};
 use ktree_verify::labels::{painted_at, Painted, Palette};
@@ -160,6 +161,38 @@ fn check<const K: usize, V: Palette>(a: &Painted<K>, b: &Painted<K>) -> Result<(
     }
     same(&ta.translate_values(t), &tree_of::<K, V>(level, &moved))?;
 
+    // Quarter turns and reflections, rational scales and an affine turn carry every voxel's value.
+    let maps = AxisMap::<K>::all();
+    let map = maps[(level as usize * 7 + da.len()) % maps.len()];
+    let mut turned = vec![None; da.len()];
+    for (i, v) in da.iter().enumerate() {
+        turned[u.dense_index(map.map_point(u.dense_point(i), u.side() as u32))] = *v;
+    }
+    same(
+        &ops::rotate_values(&ta, &map).unwrap(),
+        &tree_of::<K, V>(level, &turned),
+    )?;
+    for (num, den) in [(3u32, 2u32), (1, 2), (2, 1)] {
+        let back =
+            |q: u32| ((2 * i64::from(q) + 1) * i64::from(den)).div_euclid(2 * i64::from(num));
+        let want = resampled(&da, u, |q| q.map(back));
+        same(
+            &ops::scale_values(&ta, num, den).unwrap(),
+            &tree_of::<K, V>(level, &want),
+        )?;
+    }
+    let centre = Affine::<K>::universe_centre(level);
+    let m = if K >= 2 {
+        Affine::rotation_about(0, 1, 30.0, centre).unwrap()
+    } else {
+        Affine::scaling_about(0.75, centre)
+    };
+    let inverse = m.inverse().unwrap();
+    let want = resampled(&da, u, |q| inverse.source_voxel(q));
+    let got = ops::transform_values(&ta, &m).unwrap();
+    same(&got, &tree_of::<K, V>(level, &want))?;
+    prop_assert_eq!(got.shape(), ops::transform(&ta.shape(), &m).unwrap());
+
     // Per-value statistics against a count over the dense array.
     let mut want: BTreeMap<V::Key, Measured<K>> = BTreeMap::new();
     for (i, v) in da.iter().enumerate() {
@@ -208,6 +241,25 @@ fn check<const K: usize, V: Palette>(a: &Painted<K>, b: &Painted<K>) -> Result<(
         prop_assert_eq!(s.surface_area, faces);
     }
     Ok(())
+}
+
+/// The dense array whose voxel `q` holds the value of voxel `source(q)` of `dense` (empty outside).
+fn resampled<const K: usize, V: Value>(
+    dense: &[Option<V>],
+    u: Universe<K>,
+    source: impl Fn([u32; K]) -> [i64; K],
+) -> Vec<Option<V>> {
+    let side = u.side() as i64;
+    (0..dense.len())
+        .map(|i| {
+            let p = source(u.dense_point(i));
+            if p.iter().all(|&c| (0..side).contains(&c)) {
+                dense[u.dense_index(p.map(|c| c as u32))]
+            } else {
+                None
+            }
+        })
+        .collect()
 }
 
 fn pair<const K: usize>() -> impl Strategy<Value = (Painted<K>, Painted<K>)> {
