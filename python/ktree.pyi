@@ -111,11 +111,17 @@ class Tree:
     works on its shape (the voxels with a value) and returns trees without values."""
 
     @staticmethod
-    def from_dense(array: npt.ArrayLike, level: Optional[int] = None, background: float = 0.0) -> Tree:
+    def from_dense(
+        array: npt.ArrayLike,
+        level: Optional[int] = None,
+        background: float = 0.0,
+        dtype: Optional[str] = None,
+    ) -> Tree:
         """The tree of an array indexed [x, y, z, ...] (K = ndim), placed at the origin of a universe of
         level `level` (default: the smallest holding the longest axis). A boolean array gives a tree without
         values; a numeric one a tree with values (uint8, uint16, uint32, int8, float32; other integers the
-        smallest of these holding them, float64 float32) where voxels equal to `background` are empty."""
+        smallest of these holding them, float64 float32) where voxels equal to `background` are empty.
+        `dtype` names the value type instead; "rgb" takes the last axis as 3 colour channels (K = ndim - 1)."""
     @staticmethod
     def empty(k: int, level: int) -> Tree:
         """The empty tree."""

@@ -1,5 +1,6 @@
 //! `ktree transform A [--scale S] [--rotate R] [--translate T] [--matrix M] --out B`: geometric transforms
-//! of a `.ktree` file, applied in the order scale, rotate, translate, matrix.
+//! of a tree file, applied in the order scale, rotate, translate, matrix; a `.ktree` with values keeps each
+//! voxel's value (nearest-neighbour: values are never blended) and is written as a `.ktree`.
 //!
 //! When every step is exact — a rational scale `p/q` (about the universe's origin corner), rotations by
 //! multiples of 90° (about the universe's centre) and an integer translation, no matrix — the steps run as
@@ -9,12 +10,12 @@
 use crate::common::error::{CliError, CliResult};
 use std::path::PathBuf;
 
-use ktree::ops::{self, Affine, AxisMap, Projective};
-use ktree::tree::storage::infallible;
-use ktree::KTree;
+use ktree::io::ktree::v3::write_valued_ktree_file;
+use ktree::ops::{Affine, AxisMap, Geometry, Projective};
 
 use crate::common::tree_file::{read, write};
 use crate::common::vector::{list, List};
+use crate::outln;
 
 /// Arguments of `ktree transform`.
 #[derive(Debug, clap::Args)]
@@ -88,8 +89,12 @@ fn rational(text: &str) -> Option<(u32, u32)> {
     }
 }
 
-fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> CliResult<KTree<K>> {
-    let level = tree.level();
+/// The transforms of `args` applied to `tree` (binary or valued) of level `level`.
+fn apply<const K: usize, T: Geometry<K> + Clone>(
+    tree: &T,
+    level: u32,
+    args: &Args,
+) -> CliResult<T> {
     let translate = match &args.translate {
         Some(List(v)) => {
             if v.len() != K {
@@ -145,17 +150,17 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> CliResult<KTree<K>> {
     if exact {
         let mut t = tree.clone();
         if let Some(Some((p, q))) = scale_ratio {
-            t = ops::scale(&t, p, q).map_err(CliError::caused)?;
+            t = t.scaled(p, q).map_err(CliError::caused)?;
         }
         for &(from, to, deg) in &rotate {
             let turns = ((deg / 90.0) as i64).rem_euclid(4);
             let q = AxisMap::<K>::quarter_turn(from, to).map_err(CliError::caused)?;
             for _ in 0..turns {
-                t = infallible(ops::rotate_axes(&t, &q));
+                t = t.rotated(&q);
             }
         }
         if let Some(v) = &translate {
-            t = infallible(ops::translate(&t, std::array::from_fn(|i| v[i] as i64)));
+            t = t.translated(std::array::from_fn(|i| v[i] as i64));
         }
         return Ok(t);
     }
@@ -178,9 +183,9 @@ fn apply<const K: usize>(tree: &KTree<K>, args: &Args) -> CliResult<KTree<K>> {
     }
     if let Some(p) = projective {
         let all = p.after(&Projective::from_affine(&m));
-        return ops::transform_projective(tree, &all).map_err(CliError::caused);
+        return tree.projective(&all).map_err(CliError::caused);
     }
-    ops::transform(tree, &m).map_err(CliError::caused)
+    tree.affine(&m).map_err(CliError::caused)
 }
 
 /// Applies the transforms and writes the result.
@@ -192,9 +197,39 @@ pub fn run(args: Args) -> CliResult {
     {
         return Err("give at least one of --translate, --rotate, --scale, --matrix".into());
     }
+    if crate::values::is_valued(&args.input) {
+        return run_valued(&args);
+    }
     let tree = read(&args.input)?;
     ktree::with_dim!(&tree, AnyTree, t => {
-        let out = apply(t, &args).map_err(|e| e.within(args.input.display()))?;
+        let out = apply(t, t.level(), &args).map_err(|e| e.within(args.input.display()))?;
         write(&args.out.out, &out)
     })
+}
+
+/// The transforms of a tree with values, each voxel keeping its value, to a `.ktree`.
+fn run_valued(args: &Args) -> CliResult {
+    let out = &args.out.out;
+    if out.extension().is_none_or(|e| e != "ktree") {
+        return Err(format!(
+            "{}: a tree with values is written as a .ktree",
+            out.display()
+        )
+        .into());
+    }
+    let tree = crate::values::read_valued(&args.input)?;
+    let (k, dtype) = (tree.k(), tree.dtype());
+    let (voxels, nodes) = ktree::with_valued!(k, dtype, KK, V => {
+        let t = tree.as_typed::<KK, V>().ok_or("the tree is of its own dimension and type")?;
+        let moved = apply(t, t.level(), args).map_err(|e| e.within(args.input.display()))?;
+        write_valued_ktree_file(out, &moved).map_err(CliError::caused)?;
+        (moved.voxel_count(), moved.node_count())
+    }, else return Err(format!("{}: no transform of K = {k} {} trees", args.input.display(), dtype.name()).into()));
+    outln!(
+        "{}: K = {k}, L = {}, {} values, {voxels} voxels, {nodes} nodes",
+        out.display(),
+        tree.level(),
+        dtype.name()
+    );
+    Ok(())
 }

@@ -384,3 +384,67 @@ fn a_4d_tree_with_values_converts_to_a_time_series() {
         "{err}"
     );
 }
+
+#[test]
+fn a_tree_with_values_transforms_each_voxel_keeping_its_value() {
+    use ktree::io::ktree::v3::{read_valued_ktree, write_valued_ktree_file};
+    use ktree::ops::{transform, Affine};
+    use ktree::KTree;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let dense: Vec<Option<u16>> = (0..512u16)
+        .map(|i| Some(i * 7 % 5 + (i / 64) * 10).filter(|&v| v % 5 > 0))
+        .collect();
+    let labels = KTree::<3, u16>::from_dense_values(3, &dense).unwrap();
+    write_valued_ktree_file(Path::new(&p("labels.ktree")), &labels).unwrap();
+    let read = |name: &str| {
+        let bytes = std::fs::read(p(name)).unwrap();
+        read_valued_ktree::<3, u16>(&bytes, name).unwrap()
+    };
+    // Exact: a quarter turn about z, x → y, then one voxel along x: (x, y, z) → (8 − y, x, z).
+    run(&[
+        "transform",
+        &p("labels.ktree"),
+        "--rotate",
+        "z:90",
+        "--translate",
+        "1,0,0",
+        "--out",
+        &p("turned.ktree"),
+    ]);
+    let turned = read("turned.ktree");
+    for (i, v) in dense.iter().enumerate() {
+        let (x, y, z) = (i as u32 % 8, i as u32 / 8 % 8, i as u32 / 64);
+        let to = [8 - y, x, z];
+        if to[0] < 8 {
+            assert_eq!(turned.value_at(to), *v, "{x} {y} {z}");
+        }
+    }
+    assert_eq!(turned.voxel_count(), turned.shape().voxel_count());
+    // One affine pass: the voxels are those of the shape's transform, each with a value it had.
+    run(&[
+        "transform",
+        &p("labels.ktree"),
+        "--rotate",
+        "z:30",
+        "--out",
+        &p("tilted.ktree"),
+    ]);
+    let tilted = read("tilted.ktree");
+    let m = Affine::rotation_about(0, 1, 30.0, Affine::<3>::universe_centre(3)).unwrap();
+    assert_eq!(tilted.shape(), transform(&labels.shape(), &m).unwrap());
+    let had: std::collections::BTreeSet<u16> = dense.iter().flatten().copied().collect();
+    assert!(tilted
+        .value_leaves()
+        .all(|(_, v)| v.is_none_or(|v| had.contains(&v))));
+    // Values go to a .ktree only.
+    let (ok, _, err) = ktree(&[
+        "transform",
+        &p("labels.ktree"),
+        "--scale",
+        "2",
+        "--out",
+        &p("big.binvox"),
+    ]);
+    assert!(!ok && err.contains("is written as a .ktree"), "{err}");
+}

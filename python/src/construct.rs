@@ -12,6 +12,7 @@ use ktree::solid::mesh::{MeshTransform, Placement, TriangleMesh};
 use ktree::solid::volume::Select;
 use ktree::solid::SolidError;
 use ktree::space::{Universe, DENSE_LIMIT};
+use ktree::value::Dtype;
 use ktree::{AnyTree, KTree};
 use numpy::ndarray::ArrayViewD;
 use numpy::{AllowTypeChange, PyArrayLike2, PyArrayLikeDyn};
@@ -30,13 +31,17 @@ impl Tree {
     /// values where the voxels equal to `background` are empty: uint8, uint16, uint32, int8 and float32
     /// are kept; other integer types become the smallest of uint8, int8, uint16, uint32 that holds their
     /// values (a ValueError if none does); float64 and float16 become float32. A NaN is a ValueError.
+    /// `dtype` names the value type instead ("uint8", "uint16", "uint32", "int8", "float32", or "rgb":
+    /// colours, the array's last axis their 3 channels of 0..255, K = `array.ndim - 1`, the background
+    /// the grey (b, b, b)).
     #[staticmethod]
-    #[pyo3(signature = (array, level = None, background = 0.0))]
+    #[pyo3(signature = (array, level = None, background = 0.0, dtype = None))]
     fn from_dense(
         py: Python<'_>,
         array: &Bound<'_, PyAny>,
         level: Option<u32>,
         background: f64,
+        dtype: Option<&str>,
     ) -> PyResult<Self> {
         let array = py.import("numpy")?.call_method1("asarray", (array,))?;
         let name: String = array.getattr("dtype")?.getattr("name")?.extract()?;
@@ -49,10 +54,37 @@ impl Tree {
             (0.0, 0.0)
         };
         let shape: Vec<usize> = array.getattr("shape")?.extract()?;
-        let level = level.unwrap_or_else(|| level_for(shape.iter().copied().max().unwrap_or(1)));
-        if let Some(dtype) = crate::values::dtype_for(&name, lo, hi)? {
-            let tree =
-                crate::values::tree_of_array(py, &array, shape.len(), dtype, level, background)?;
+        let dtype = match dtype {
+            None => crate::values::dtype_for(&name, lo, hi)?,
+            Some(given) => Some(Dtype::parse(given).ok_or_else(|| {
+                Failure::Value(format!(
+                    "from_dense: dtype {given:?}: one of uint8, uint16, uint32, int8, float32, rgb was expected"
+                ))
+            })?),
+        };
+        // A colour array's last axis holds the channels.
+        let k = match dtype {
+            Some(Dtype::Rgb)
+                if !(0.0..=255.0).contains(&lo) || hi > 255.0 || !name.contains("int") =>
+            {
+                return Err(Failure::Value(format!(
+                    "from_dense: colours are integers of 0..255, got dtype {name} ({lo} to {hi})"
+                ))
+                .into())
+            }
+            Some(Dtype::Rgb) if shape.last() == Some(&3) => shape.len() - 1,
+            Some(Dtype::Rgb) => {
+                return Err(Failure::Value(format!(
+                    "from_dense: colours need a last axis of 3 channels, got shape {shape:?}"
+                ))
+                .into())
+            }
+            _ => shape.len(),
+        };
+        let level =
+            level.unwrap_or_else(|| level_for(shape[..k].iter().copied().max().unwrap_or(1)));
+        if let Some(dtype) = dtype {
+            let tree = crate::values::tree_of_array(py, &array, k, dtype, level, background)?;
             return Ok(Self::valued(tree, background));
         }
         let array: PyArrayLikeDyn<'_, bool, AllowTypeChange> = array.extract()?;

@@ -1,10 +1,10 @@
 //! Geometric transforms of a tree of any `K`: exact integer operations where the parameters allow (integer
 //! translations, quarter turns, rational scales), one affine (or projective) overlay pass otherwise: the
-//! methods `translate`, `rotate`, `scale` and `affine`.
+//! methods `translate`, `rotate`, `scale` and `affine`. A tree with values keeps each voxel's value (the
+//! value of the voxel its centre maps back into: values are never blended).
 
-use ktree::ops::{self, Affine, AxisMap, Projective};
-use ktree::tree::storage::infallible;
-use ktree::{with_dim, AnyTree, KTree};
+use ktree::ops::{Affine, AxisMap, Geometry, Projective};
+use ktree::{with_dim, with_valued, AnyTree, AnyValuedTree};
 use numpy::{AllowTypeChange, PyArrayLike2};
 use pyo3::prelude::*;
 use pyo3::types::PyString;
@@ -17,10 +17,7 @@ impl Tree {
     /// Translated by `offset` (K numbers): exactly by whole voxels when all are integers (voxels leaving the
     /// universe are lost), by an affine pass otherwise.
     fn translate(&self, py: Python<'_>, offset: Vec<f64>) -> PyResult<Self> {
-        let out = py.detach(
-            || with_dim!(&self.inner, AnyTree, t => translate(t, &offset).map(AnyTree::from)),
-        )?;
-        Ok(Self::binary(out))
+        self.transformed(py, &Step::Translate(offset))
     }
 
     /// Rotated by `degrees` about the universe's centre, in the plane of `axes` = (i, j) (turning axis i
@@ -37,8 +34,7 @@ impl Tree {
             Some(a) => rotation_plane(self.inner.k(), &a)?,
             None => (0, 1),
         };
-        let out = py.detach(|| with_dim!(&self.inner, AnyTree, t => rotate(t, degrees, from, to).map(AnyTree::from)))?;
-        Ok(Self::binary(out))
+        self.transformed(py, &Step::Rotate(degrees, from, to))
     }
 
     /// Scaled by `factor` about the universe's origin corner: an int or a `fractions.Fraction` p/q is exact
@@ -61,9 +57,7 @@ impl Tree {
                 }
             }
         };
-        let out = py
-            .detach(|| with_dim!(&self.inner, AnyTree, t => scale(t, factor).map(AnyTree::from)))?;
-        Ok(Self::binary(out))
+        self.transformed(py, &Step::Scale(factor))
     }
 
     /// Mapped by a homogeneous (K + 1) x (K + 1) matrix acting on column vectors [x; 1], in one overlay
@@ -83,10 +77,55 @@ impl Tree {
             ))
             .into());
         }
-        let out = py.detach(
-            || with_dim!(&self.inner, AnyTree, t => self::matrix(t, &m).map(AnyTree::from)),
-        )?;
-        Ok(Self::binary(out))
+        self.transformed(py, &Step::Matrix(m))
+    }
+}
+
+impl Tree {
+    /// This tree moved by `step`: a tree with values keeps each voxel's value.
+    fn transformed(&self, py: Python<'_>, step: &Step) -> PyResult<Self> {
+        Ok(match &self.values {
+            Some(values) => {
+                let out = py.detach(
+                    || with_valued!(values, t => step.apply(t, t.level()).map(AnyValuedTree::from)),
+                )?;
+                self.with_values(out)
+            }
+            None => {
+                let out = py.detach(
+                    || with_dim!(&self.inner, AnyTree, t => step.apply(t, t.level()).map(AnyTree::from)),
+                )?;
+                Self::binary(out)
+            }
+        })
+    }
+}
+
+/// One transform asked of a tree of any `K`, with or without values.
+enum Step {
+    /// By `K` numbers.
+    Translate(Vec<f64>),
+    /// By degrees in the plane of two axes.
+    Rotate(f64, usize, usize),
+    /// By a factor about the origin corner.
+    Scale(Factor),
+    /// By a homogeneous matrix, row-major.
+    Matrix(Vec<f64>),
+}
+
+impl Step {
+    /// The step applied to `tree`, of level `level`.
+    fn apply<const K: usize, T: Geometry<K> + Clone>(
+        &self,
+        tree: &T,
+        level: u32,
+    ) -> Result<T, Failure> {
+        match self {
+            Step::Translate(t) => translate(tree, t),
+            Step::Rotate(degrees, from, to) => rotate(tree, level, *degrees, *from, *to),
+            Step::Scale(factor) => scale(tree, *factor),
+            Step::Matrix(m) => matrix(tree, m),
+        }
     }
 }
 
@@ -119,7 +158,7 @@ pub(crate) enum Factor {
 
 /// Translated by `t` (K numbers): exactly when all are whole numbers (voxels leaving the universe are
 /// dropped), by an affine pass otherwise.
-pub(crate) fn translate<const K: usize>(tree: &KTree<K>, t: &[f64]) -> Result<KTree<K>, Failure> {
+fn translate<const K: usize, T: Geometry<K>>(tree: &T, t: &[f64]) -> Result<T, Failure> {
     let t: [f64; K] = t.try_into().map_err(|_| {
         Failure::Value(format!(
             "a translation of a K = {K} tree needs {K} numbers, got {}",
@@ -130,19 +169,20 @@ pub(crate) fn translate<const K: usize>(tree: &KTree<K>, t: &[f64]) -> Result<KT
         return Err(Failure::Value(format!("translation {t:?} is not finite")));
     }
     if t.iter().all(|v| v.fract() == 0.0 && v.abs() < 9.0e15) {
-        return Ok(infallible(ops::translate(tree, t.map(|v| v as i64))));
+        return Ok(tree.translated(t.map(|v| v as i64)));
     }
-    Ok(ops::transform(tree, &Affine::translation(t))?)
+    Ok(tree.affine(&Affine::translation(t))?)
 }
 
 /// Rotated by `degrees` in the plane of axes `from` → `to`, about the universe's centre: by reordering
 /// children for multiples of 90°, by an affine pass otherwise.
-pub(crate) fn rotate<const K: usize>(
-    tree: &KTree<K>,
+fn rotate<const K: usize, T: Geometry<K> + Clone>(
+    tree: &T,
+    level: u32,
     degrees: f64,
     from: usize,
     to: usize,
-) -> Result<KTree<K>, Failure> {
+) -> Result<T, Failure> {
     if !degrees.is_finite() {
         return Err(Failure::Value(format!("angle {degrees} is not finite")));
     }
@@ -151,21 +191,21 @@ pub(crate) fn rotate<const K: usize>(
         let turns = ((degrees / 90.0) % 4.0) as i64;
         let mut out = tree.clone();
         for _ in 0..turns.rem_euclid(4) {
-            out = infallible(ops::rotate_axes(&out, &quarter));
+            out = out.rotated(&quarter);
         }
         return Ok(out);
     }
-    let centre = Affine::<K>::universe_centre(tree.level());
+    let centre = Affine::<K>::universe_centre(level);
     let m = Affine::rotation_about(from, to, degrees, centre)?;
-    Ok(ops::transform(tree, &m)?)
+    Ok(tree.affine(&m)?)
 }
 
 /// Scaled by `factor` about the universe's origin corner.
-pub(crate) fn scale<const K: usize>(tree: &KTree<K>, factor: Factor) -> Result<KTree<K>, Failure> {
+fn scale<const K: usize, T: Geometry<K>>(tree: &T, factor: Factor) -> Result<T, Failure> {
     match factor {
-        Factor::Ratio(p, q) => Ok(ops::scale(tree, p, q)?),
+        Factor::Ratio(p, q) => Ok(tree.scaled(p, q)?),
         Factor::Real(s) if s.is_finite() && s > 0.0 => {
-            Ok(ops::transform(tree, &Affine::scaling_about(s, [0.0; K]))?)
+            Ok(tree.affine(&Affine::scaling_about(s, [0.0; K]))?)
         }
         Factor::Real(s) => Err(Failure::Value(format!(
             "the scale factor must be a positive number, got {s}"
@@ -175,12 +215,12 @@ pub(crate) fn scale<const K: usize>(tree: &KTree<K>, factor: Factor) -> Result<K
 
 /// Mapped by a homogeneous `(K + 1) × (K + 1)` matrix (row-major, acting on column vectors `[x; 1]`):
 /// affine when the last row is `0 … 0 1`, projective otherwise.
-pub(crate) fn matrix<const K: usize>(tree: &KTree<K>, m: &[f64]) -> Result<KTree<K>, Failure> {
+fn matrix<const K: usize, T: Geometry<K>>(tree: &T, m: &[f64]) -> Result<T, Failure> {
     match Affine::<K>::from_homogeneous(m) {
-        Ok(a) => Ok(ops::transform(tree, &a)?),
+        Ok(a) => Ok(tree.affine(&a)?),
         Err(_) => {
             let p = Projective::<K>::from_homogeneous(m)?;
-            Ok(ops::transform_projective(tree, &p)?)
+            Ok(tree.projective(&p)?)
         }
     }
 }

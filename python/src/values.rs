@@ -171,19 +171,34 @@ pub(crate) fn from_dense<const K: usize, V: Scalar>(
         ))
     })?;
     let view = array.as_array();
+    let channels = V::CHANNELS;
+    let shape = if channels > 1 {
+        &view.shape()[..K] // the caller checked the last axis
+    } else {
+        view.shape()
+    };
     let universe = Universe::<K>::new(level)?;
     let len = universe.dense_len(DENSE_LIMIT)?;
     let side = universe.side() as usize;
-    if let Some(n) = view.shape().iter().find(|&&n| n > side) {
+    if let Some(n) = shape.iter().find(|&&n| n > side) {
         return Err(Failure::Value(format!(
-            "an array of shape {:?} does not fit a level-{level} universe of side {side} ({n} > {side})",
-            view.shape()
+            "an array of shape {shape:?} does not fit a level-{level} universe of side {side} ({n} > {side})"
         )));
     }
     let mut dense = vec![background; len];
-    for (index, v) in view.indexed_iter() {
+    // The values in C order (the last axis fastest), `channels` numbers each.
+    let numbers: Vec<V::Elem> = view.iter().copied().collect();
+    let mut index = vec![0usize; K];
+    for value in numbers.chunks_exact(channels) {
         let flat = (0..K).rev().fold(0, |acc, a| acc * side + index[a]);
-        dense[flat] = V::of_elems(std::slice::from_ref(v));
+        dense[flat] = V::of_elems(value);
+        for a in (0..K).rev() {
+            index[a] += 1;
+            if index[a] < shape[a] {
+                break;
+            }
+            index[a] = 0;
+        }
     }
     py.detach(|| {
         let runs = ValueRuns::<K, V>::from_dense_background(level, &dense, background)
@@ -509,7 +524,12 @@ pub(crate) fn tree_of_array(
     level: u32,
     background: f64,
 ) -> PyResult<AnyValuedTree> {
-    let array = array.call_method1("astype", (dtype.name(),))?;
+    let elements = if dtype == Dtype::Rgb {
+        "uint8"
+    } else {
+        dtype.name()
+    };
+    let array = array.call_method1("astype", (elements,))?;
     with_valued!(k, dtype, K, V => {
         let typed: PyArrayLikeDyn<'_, <V as Scalar>::Elem, AllowTypeChange> = array.extract()?;
         Ok(from_dense::<K, V>(py, typed, level, background)?)

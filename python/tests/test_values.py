@@ -129,3 +129,55 @@ def test_equality_pickle_bytes_and_files(tmp_path):
     assert ktree.Tree.load(path) == t
     with pytest.raises(ValueError, match=".ktree"):
         t.save(tmp_path / "labels.binvox")
+
+
+@pytest.mark.parametrize("k", [2, 3, 4])
+@pytest.mark.parametrize("dtype", ["uint16", "float32"])
+def test_transforms_keep_each_voxels_value(k, dtype):
+    rng = np.random.default_rng(300 + k)
+    side = 4 if k == 4 else 8
+    a = random_labels(rng, k, dtype, side)
+    a = np.pad(a, [(0, side - n) for n in a.shape])  # the whole universe, so numpy sees what ktree does
+    t = ktree.Tree.from_dense(a)
+    whole = lambda u: u.to_dense((0,) * k, a.shape)  # noqa: E731
+    for turns in range(-1, 4):
+        turned = t.rotate(90 * turns, (0, k - 1))
+        assert turned.dtype == dtype
+        np.testing.assert_array_equal(whole(turned), np.rot90(a, turns, axes=(0, k - 1)))
+    offset = [1, -2] + [0] * (k - 2)
+    moved = np.zeros_like(a)
+    moved[1:, : side - 2] = a[:-1, 2:]
+    np.testing.assert_array_equal(whole(t.translate(offset)), moved)
+    doubled = a
+    for axis in range(k):
+        doubled = doubled.repeat(2, axis=axis)
+    np.testing.assert_array_equal(whole(t.scale(2)), doubled[(slice(0, side),) * k])
+    # Any angle: the voxels are those of the shape turned, each holding a value the tree had.
+    tilted = t.rotate(30, (0, 1))
+    assert tilted.shape() == t.shape().rotate(30, (0, 1))
+    kept = whole(tilted)
+    assert set(np.unique(kept)) <= set(np.unique(a)) | {0}
+
+
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_colours_from_dense_keep_their_channels(k):
+    rng = np.random.default_rng(400 + k)
+    shape = tuple(int(n) for n in rng.integers(1, 7, size=k))
+    palette = np.array([[0, 0, 0], [255, 0, 0], [10, 200, 30]], dtype=np.uint8)
+    a = palette[rng.integers(0, 3, size=shape)]
+    t = ktree.Tree.from_dense(a, dtype="rgb")
+    assert t.dtype == "rgb8" and t.k == k
+    assert t.voxel_count == int(np.count_nonzero(a.any(axis=-1)))
+    np.testing.assert_array_equal(t.to_dense((0,) * k, shape), a)
+    points = np.argwhere(np.ones(shape, bool))
+    np.testing.assert_array_equal(t.values(points), a[tuple(points.T)])
+    # A grey background; the dtype named for a label array.
+    grey = ktree.Tree.from_dense(a, dtype="rgb", background=255)
+    assert grey.voxel_count == int(np.count_nonzero((a != 255).any(axis=-1)))
+    assert ktree.Tree.from_dense(np.arange(8).reshape(2, 4), dtype="uint16").dtype == "uint16"
+    with pytest.raises(ValueError, match="3 channels"):
+        ktree.Tree.from_dense(np.zeros((4, 4), np.uint8), dtype="rgb")
+    with pytest.raises(ValueError, match="0..255"):
+        ktree.Tree.from_dense(np.full((2, 3), 300), dtype="rgb")
+    with pytest.raises(ValueError, match="dtype"):
+        ktree.Tree.from_dense(a, dtype="complex")

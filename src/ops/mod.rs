@@ -22,6 +22,7 @@
 //! | arbitrary rotation, any affine map (M5, M6) | [`transform`] with an [`Affine`] | overlay engine, voxel-exact | output-sensitive |
 //! | the same with integer additions and shifts only (M5, M8) | [`transform_fixed`] | overlay engine, fixed-point cell images updated incrementally | output-sensitive |
 //! | perspective deformation (M6) | [`transform_projective`] with a [`Projective`] map, e.g. [`Projective::perspective`] | overlay engine, voxel-exact | output-sensitive |
+//! | the same on a valued tree, each voxel keeping its value | [`rotate_values`], [`scale_values`], [`transform_values`], [`transform_projective_values`], `KTree::translate_values`; [`Geometry`] names each transform once for binary and valued trees | child reordering; the overlay engine over values ([`overlay::resample_values`]) | as above |
 //! | interference (M14) | [`interferes`], [`overlap_cells`], [`first_contact`], [`min_separation`] | simultaneous traversal, early exit; branch and bound | at most linear |
 //! | mass (M10) | [`mass_properties`], [`mass_progressive`] | exact integer moment sums; level-by-level bounds | linear; stops early |
 //! | complexity (M9) | [`complexity`], [`over_translations`], [`over_placements`], [`over_maps`], [`normalise_to_origin`] | node counts | one operation per placement |
@@ -42,6 +43,7 @@ mod boolean;
 mod complexity;
 mod error;
 mod fixed;
+mod geometry;
 mod interference;
 mod mass;
 mod operators;
@@ -65,6 +67,7 @@ pub use complexity::{
 };
 pub use error::OpsError;
 pub use fixed::{transform_fixed, transform_fixed_into, FixedAffine};
+pub use geometry::Geometry;
 pub use interference::{collision, first_contact, interferes, overlap_cells, Collision};
 pub use mass::{mass_progressive, mass_properties, LevelBounds, MassProperties, ProgressiveMass};
 pub use perspective::{
