@@ -193,7 +193,8 @@ fn a_damaged_valued_file_is_an_error_at_a_byte_never_a_panic() {
 }
 
 /// Building from valued runs: the runs of the dense array (maximal stretches of equal values), and the same
-/// voxels as one run each (touching runs of one value), give the tree of the dense array.
+/// voxels as one run each (touching runs of one value), give the tree of the dense array, built on one
+/// thread or apart below any split depth.
 fn from_runs<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseError> {
     use ktree::rays::ValueRuns;
     use ktree::Ray;
@@ -215,6 +216,18 @@ fn from_runs<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseE
     let got = KTree::from_value_runs(&single);
     got.assert_well_formed();
     prop_assert!(got == want);
+    // Built apart below every split depth, on one thread and on two: the same tree.
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        for split in 0..=o.level + 1 {
+            let got = pool.install(|| KTree::from_value_runs_split(&single, split));
+            got.assert_well_formed();
+            prop_assert!(got == want, "split {split}, {threads} threads");
+        }
+    }
     // A dense array of plain values with a background: the palette's first value is empty there.
     let background = V::PALETTE[0];
     let plain: Vec<V> = dense.iter().map(|v| v.unwrap_or(background)).collect();
