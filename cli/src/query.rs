@@ -3,13 +3,15 @@
 //! `ColorOcTree` `.ot`) and
 //! `ktree raycast FILE --rays R [--max-t T] [--json]` (on a map file: OctoMap's castRay,
 //! `--ignore-unknown`, `--max-range`): point queries, nearest full voxels and ray casts
-//! on a tree file. A version 2 file is read through its memory map (so a tree larger than memory is
-//! queried without being loaded); others are loaded.
+//! on a tree file. A version 2 file, and a version 3 file with values queried for its values, is read
+//! through its memory map (so a tree larger than memory is queried without being loaded); others are
+//! loaded.
 
 use crate::common::error::{cannot_read, CliError, CliResult};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+use ktree::io::ktree::v3::MappedValuedTree;
 use ktree::io::{read_color_ot_map, FileTree, GridFileErrorKind};
 use ktree::map::{OccupancyMap, SensorModel};
 use ktree::query::{self, Query, RayCast, RayHit};
@@ -88,19 +90,21 @@ fn points<const K: usize>(t: &table::Table<i64>) -> Vec<[i64; K]> {
         .collect()
 }
 
+/// A value as JSON: a number, `[r, g, b]` for a colour, a float without a JSON number (an infinity) as
+/// its text.
+fn value_json<V: Value>(v: V) -> serde_json::Value {
+    let text = v.text();
+    let parsed = if V::DTYPE == Some(Dtype::Rgb) {
+        serde_json::from_str(&format!("[{text}]"))
+    } else {
+        serde_json::from_str(&text)
+    };
+    parsed.unwrap_or(serde_json::Value::String(text))
+}
+
 /// The values of a valued tree at voxels (`K` coordinates each, the tree's own `K`), as JSON (null where
 /// empty).
 fn values_at<const K: usize>(tree: &AnyValuedTree, voxels: &[[u32; K]]) -> Vec<serde_json::Value> {
-    fn json<V: Value>(v: V) -> serde_json::Value {
-        let text = v.text();
-        let parsed = if V::DTYPE == Some(Dtype::Rgb) {
-            serde_json::from_str(&format!("[{text}]"))
-        } else {
-            serde_json::from_str(&text)
-        };
-        // A float without a JSON number (an infinity) as its text.
-        parsed.unwrap_or(serde_json::Value::String(text))
-    }
     with_valued!(tree, t => {
         let points: Vec<_> = voxels
             .iter()
@@ -108,9 +112,32 @@ fn values_at<const K: usize>(tree: &AnyValuedTree, voxels: &[[u32; K]]) -> Vec<s
             .collect();
         t.values_at(&points)
             .into_iter()
-            .map(|v| v.map_or(serde_json::Value::Null, json))
+            .map(|v| v.map_or(serde_json::Value::Null, value_json))
             .collect()
     })
+}
+
+/// The points of `args` as voxels (points beyond the `u32` range are outside every universe).
+fn voxels_of<const K: usize>(pts: &[[i64; K]]) -> Vec<[u32; K]> {
+    pts.iter()
+        .map(|p| p.map(|v| u32::try_from(v).unwrap_or(u32::MAX)))
+        .collect()
+}
+
+/// Answers the point queries of a `.ktree` file with values read in place (its memory map): each point's
+/// value, and inside where it has one.
+fn answer_mapped_values(args: &QueryArgs, k: usize, dtype: Dtype) -> CliResult {
+    with_valued!(k, dtype, KK, V => {
+        let tree = MappedValuedTree::<KK, V>::open(&args.tree).map_err(CliError::caused)?;
+        let pts = points::<KK>(&table::read::<i64>(&args.points, KK)?);
+        let values = query::values_at(&tree, &voxels_of(&pts)).map_err(CliError::caused)?;
+        let inside: Vec<bool> = values.iter().map(Option::is_some).collect();
+        let values: Vec<serde_json::Value> = values
+            .into_iter()
+            .map(|v| v.map_or(serde_json::Value::Null, value_json))
+            .collect();
+        print_points(&pts, &inside, Some(&values), &[], args)
+    }, else Err(format!("{}: K = {k} is not 1 to 4", args.tree.display()).into()))
 }
 
 /// Answers the point queries on `tree` (with its values' tree if it has values) and prints them.
@@ -121,11 +148,7 @@ fn answer_points<const K: usize, T: Query<K>>(
 ) -> CliResult {
     let table = table::read::<i64>(&args.points, K)?;
     let pts = points::<K>(&table);
-    // Points beyond the u32 range are outside every universe.
-    let voxels: Vec<[u32; K]> = pts
-        .iter()
-        .map(|p| p.map(|v| u32::try_from(v).unwrap_or(u32::MAX)))
-        .collect();
+    let voxels = voxels_of(&pts);
     let inside = tree.contains_many(&voxels).map_err(read_error)?;
     let values = valued.map(|v| values_at(v, &voxels));
     let near = if args.distance || args.nearest {
@@ -133,6 +156,18 @@ fn answer_points<const K: usize, T: Query<K>>(
     } else {
         Vec::new()
     };
+    print_points(&pts, &inside, values.as_deref(), &near, args)
+}
+
+/// Prints the answers to the point queries: each point, whether it is inside, its value (a tree with
+/// values), and its distance and nearest voxel when asked (`near`).
+fn print_points<const K: usize>(
+    pts: &[[i64; K]],
+    inside: &[bool],
+    values: Option<&[serde_json::Value]>,
+    near: &[Option<query::Nearest<K>>],
+    args: &QueryArgs,
+) -> CliResult {
     let mut w = out();
     let io = crate::common::error::CliError::from_output;
     if args.json {
@@ -157,7 +192,7 @@ fn answer_points<const K: usize, T: Query<K>>(
                     serde_json::json!(n.map(|n| n.voxel.to_vec())),
                 );
             }
-            if let Some(values) = &values {
+            if let Some(values) = values {
                 o.insert("value".into(), values[i].clone());
             }
             let sep = if i == 0 { "\n" } else { ",\n" };
@@ -172,7 +207,7 @@ fn answer_points<const K: usize, T: Query<K>>(
             if inside[i] { "inside" } else { "outside" }
         )
         .map_err(io)?;
-        if let Some(v) = values.as_ref().map(|v| &v[i]).filter(|v| !v.is_null()) {
+        if let Some(v) = values.map(|v| &v[i]).filter(|v| !v.is_null()) {
             write!(w, " value {v}").map_err(io)?;
         }
         if args.distance {
@@ -206,6 +241,11 @@ pub fn run_query(args: QueryArgs) -> CliResult {
         return answer_map_points(&args);
     }
     if crate::values::is_valued(&args.tree) {
+        let (k, dtype) = crate::values::file_dtype(&args.tree)?;
+        // Values alone are read in place; distances need the shape's tree in memory.
+        if let (Some(dtype), false) = (dtype, args.distance || args.nearest) {
+            return answer_mapped_values(&args, k, dtype);
+        }
         let valued = crate::values::read_valued(&args.tree)?;
         let shape = FileTree::Memory(valued.shape());
         return with_tree!(&shape, t => answer_points(t, &args, Some(&valued)));

@@ -249,6 +249,7 @@ fn values_on_the_command_line_fail_clearly() {
 
 #[test]
 fn queries_of_a_tree_with_values_give_each_points_value() {
+    // Values alone are read from the file in place; with distances, the tree is loaded.
     use ktree::io::ktree::v3::write_valued_ktree_file;
     use ktree::KTree;
     let dir = tempfile::tempdir().unwrap();
@@ -290,6 +291,23 @@ fn queries_of_a_tree_with_values_give_each_points_value() {
         match labels.value_at(*q) {
             Some(v) => assert!(line.ends_with(&format!("inside value {v}")), "{line}"),
             None => assert!(line.ends_with("outside"), "{line}"),
+        }
+    }
+    // With distances the shape is read too: the same values, 0 inside.
+    let out = run(&[
+        "query",
+        &p("labels.ktree"),
+        "--points",
+        &p("points.csv"),
+        "--distance",
+        "--json",
+    ]);
+    let rows: Vec<serde_json::Value> = serde_json::from_str(&out).unwrap();
+    for (row, q) in rows.iter().zip(&points) {
+        let want = labels.value_at(*q);
+        assert_eq!(row["value"], serde_json::json!(want), "{q:?}");
+        if want.is_some() {
+            assert_eq!(row["distance"], serde_json::json!(0.0), "{q:?}");
         }
     }
     std::fs::write(p("cells.csv"), "1,0\n2,0\n3,0\n").unwrap();
