@@ -78,6 +78,33 @@ pub trait ValueStorage<const K: usize> {
         })
     }
 
+    /// The leaf holding voxel `point` — the log of its side and its value (`None`: empty) — or `None`
+    /// outside the universe, on any storage ([`KTree::leaf_at`] in memory).
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn try_leaf_at(&self, point: [u32; K]) -> Result<Option<(u32, Option<Self::Value>)>, Self::Error> {
+        if self.universe().check_point(point).is_err() {
+            return Ok(None);
+        }
+        let (mut depth, mut index) = (0usize, 0usize);
+        let mut code = self.root_code()?;
+        let mut log_side = self.level();
+        while code >= 2 {
+            log_side -= 1;
+            let child = (0..K).fold(0, |c, a| c | ((point[a] >> log_side & 1) as usize) << a);
+            index = self.children(depth, index)? + child;
+            depth += 1;
+            code = (self.codes(depth, index - child)? >> (2 * child)) & 3;
+        }
+        let value = if code == 1 {
+            Some(self.value(depth, index)?)
+        } else {
+            None
+        };
+        Ok(Some((log_side, value)))
+    }
+
     /// The root node.
     ///
     /// # Errors
