@@ -104,18 +104,29 @@ pub fn write_value_ply<V: Value>(
     mesh: &ValueMesh<V>,
     colour: &dyn Fn(V) -> [u8; 3],
 ) -> io::Result<()> {
-    let mut properties = String::from("property uchar red\nproperty uchar green\nproperty uchar blue\n");
+    let mut properties =
+        String::from("property uchar red\nproperty uchar green\nproperty uchar blue\n");
     if V::DTYPE == Some(Dtype::Rgb) {
-        properties += "property uchar red_back\nproperty uchar green_back\nproperty uchar blue_back\n";
+        properties +=
+            "property uchar red_back\nproperty uchar green_back\nproperty uchar blue_back\n";
     } else {
         let (ty, name) = (
             ply_type(V::DTYPE),
-            if V::DTYPE == Some(Dtype::F32) { "value" } else { "label" },
+            if V::DTYPE == Some(Dtype::F32) {
+                "value"
+            } else {
+                "label"
+            },
         );
         properties += &format!("property {ty} {name}\nproperty {ty} {name}_back\n");
     }
     properties += "property uchar back_empty\n";
-    ply_header(w, mesh.vertex_count(), mesh.faces_once().count(), &properties)?;
+    ply_header(
+        w,
+        mesh.vertex_count(),
+        mesh.faces_once().count(),
+        &properties,
+    )?;
     let mut bases = Vec::with_capacity(mesh.surfaces.len());
     let mut base = 0u32;
     for s in &mesh.surfaces {
@@ -287,11 +298,11 @@ fn linear(c: u8) -> f64 {
     }
 }
 
+/// A mesh of a `.glb`, with a name and a colour for its material when given.
+type GlbPart<'a> = (&'a SurfaceMesh, Option<(String, [u8; 3])>);
+
 /// A `.glb` of one mesh and node per part, each with a name and a material of that colour when given.
-fn write_glb_parts(
-    w: &mut dyn Write,
-    parts: &[(&SurfaceMesh, Option<(String, [u8; 3])>)],
-) -> io::Result<()> {
+fn write_glb_parts(w: &mut dyn Write, parts: &[GlbPart<'_>]) -> io::Result<()> {
     let too_big = || {
         io::Error::new(
             io::ErrorKind::InvalidInput,

@@ -303,30 +303,30 @@ pub fn write_value_surface<V: Value>(
         write_atomic_with(path, |w| fill(w)).map_err(ExportError::Write)
     };
     let all = mesh.surfaces.iter().map(|s| s.mesh.triangles.len()).sum();
-    let elements = match MeshFormat::of(path) {
-        Some(MeshFormat::Ply) => {
-            write(path, &|w| files::write_value_ply(w, mesh, &colour))?;
-            mesh.faces_once().count()
-        }
-        Some(MeshFormat::Obj) => {
-            let mtl = path.with_extension("mtl");
-            write(&mtl, &|w| files::write_value_mtl(w, mesh, &colour))?;
-            let name = mtl.file_name().map(|n| n.to_string_lossy().into_owned());
-            write(path, &|w| files::write_value_obj(w, mesh, name.as_deref()))?;
-            all
-        }
-        Some(MeshFormat::Glb) => {
-            write(path, &|w| files::write_value_glb(w, mesh, &colour))?;
-            all
-        }
-        _ => {
-            return Err(ExportError::Usage {
+    let elements =
+        match MeshFormat::of(path) {
+            Some(MeshFormat::Ply) => {
+                write(path, &|w| files::write_value_ply(w, mesh, &colour))?;
+                mesh.faces_once().count()
+            }
+            Some(MeshFormat::Obj) => {
+                let mtl = path.with_extension("mtl");
+                write(&mtl, &|w| files::write_value_mtl(w, mesh, &colour))?;
+                let name = mtl.file_name().map(|n| n.to_string_lossy().into_owned());
+                write(path, &|w| files::write_value_obj(w, mesh, name.as_deref()))?;
+                all
+            }
+            Some(MeshFormat::Glb) => {
+                write(path, &|w| files::write_value_glb(w, mesh, &colour))?;
+                all
+            }
+            _ => return Err(ExportError::Usage {
                 file: path.to_path_buf(),
-                message: "the surfaces of values are written with their colours as .ply, .obj or .glb"
-                    .into(),
-            })
-        }
-    };
+                message:
+                    "the surfaces of values are written with their colours as .ply, .obj or .glb"
+                        .into(),
+            }),
+        };
     Ok(Written {
         vertices: mesh.vertex_count(),
         elements,

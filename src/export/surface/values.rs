@@ -141,8 +141,8 @@ pub fn try_value_boundary_mesh<T: ValueStorage<3>>(
             },
             None => {
                 let mesh = infallible(sweep::sweep(&voxels, Merge::None));
-                let behind = behind_each(tree, &mesh)?
-                    .expect("a unit face has one voxel behind it");
+                let behind =
+                    behind_each(tree, &mesh)?.expect("a unit face has one voxel behind it");
                 ValueSurface {
                     value,
                     mesh,
@@ -194,9 +194,11 @@ fn behind<T: ValueStorage<3>>(
         return Ok(Some(None));
     }
     let span = |d: usize| {
-        let (lo, hi) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
-            (lo.min(q[d]), hi.max(q[d]))
-        });
+        let (lo, hi) = p
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
+                (lo.min(q[d]), hi.max(q[d]))
+            });
         (lo.floor() as u32, hi.ceil() as u32)
     };
     let ((b0, b1), (c0, c1)) = (span(b), span(c));
@@ -282,13 +284,25 @@ mod tests {
         out
     }
 
+    /// A triangle's normal (twice its area long) and its area.
+    fn normal(p: [[f64; 3]; 3]) -> ([f64; 3], f64) {
+        let u: [f64; 3] = std::array::from_fn(|a| p[1][a] - p[0][a]);
+        let w: [f64; 3] = std::array::from_fn(|a| p[2][a] - p[0][a]);
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        (n, (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0)
+    }
+
     fn check(level: u32, dense: &[Option<u8>]) {
         let side = 1i64 << level;
         let tree = KTree::<3, u8>::from_dense_values(level, dense).unwrap();
         let mesh = value_boundary_mesh(&tree);
         let mut areas: HashMap<(u8, Option<u8>), f64> = HashMap::new();
         let mut once: HashMap<(u8, Option<u8>), f64> = HashMap::new();
-        for (k, s) in mesh.surfaces.iter().enumerate() {
+        for s in &mesh.surfaces {
             assert_eq!(s.behind.len(), s.mesh.triangles.len());
             let voxels = dense.iter().filter(|v| **v == Some(s.value)).count();
             assert_eq!(s.mesh.volume(), voxels as f64, "the volume of {}", s.value);
@@ -303,45 +317,32 @@ mod tests {
             assert!(edges.values().all(|&n| n == 0), "{} is closed", s.value);
             for (t, tri) in s.mesh.triangles.iter().enumerate() {
                 let p = tri.map(|i| s.mesh.vertices[i as usize]);
-                let u: [f64; 3] = std::array::from_fn(|a| p[1][a] - p[0][a]);
-                let w: [f64; 3] = std::array::from_fn(|a| p[2][a] - p[0][a]);
-                let n = [
-                    u[1] * w[2] - u[2] * w[1],
-                    u[2] * w[0] - u[0] * w[2],
-                    u[0] * w[1] - u[1] * w[0],
-                ];
-                let area = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0;
+                let (n, area) = normal(p);
                 *areas.entry((s.value, s.behind[t])).or_insert(0.0) += area;
                 // Points inside the triangle: the value on its inner side, `behind` on its outer side.
                 for weights in [[0.31, 0.33, 0.36], [0.6, 0.2, 0.2], [0.15, 0.7, 0.15]] {
-                    let c: [f64; 3] = std::array::from_fn(|a| {
-                        (0..3).map(|i| weights[i] * p[i][a]).sum::<f64>()
-                    });
+                    let c: [f64; 3] =
+                        std::array::from_fn(|a| (0..3).map(|i| weights[i] * p[i][a]).sum::<f64>());
                     let voxel = |sign: f64| {
-                        std::array::from_fn(|a| (c[a] + sign * 0.25 * n[a] / n[a].abs().max(1.0)).floor() as i64)
+                        std::array::from_fn(|a| {
+                            (c[a] + sign * 0.25 * n[a] / n[a].abs().max(1.0)).floor() as i64
+                        })
                     };
                     assert_eq!(at(dense, side, voxel(-1.0)), Some(s.value));
                     assert_eq!(at(dense, side, voxel(1.0)), s.behind[t]);
                 }
             }
-            let _ = k;
         }
         for (k, t) in mesh.faces_once() {
             let s = &mesh.surfaces[k];
-            let p = s.mesh.triangles[t].map(|i| s.mesh.vertices[i as usize]);
-            let u: [f64; 3] = std::array::from_fn(|a| p[1][a] - p[0][a]);
-            let w: [f64; 3] = std::array::from_fn(|a| p[2][a] - p[0][a]);
-            let n = [
-                u[1] * w[2] - u[2] * w[1],
-                u[2] * w[0] - u[0] * w[2],
-                u[0] * w[1] - u[1] * w[0],
-            ];
-            let area = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0;
+            let (_, area) = normal(s.mesh.triangles[t].map(|i| s.mesh.vertices[i as usize]));
             *once.entry((s.value, s.behind[t])).or_insert(0.0) += area;
         }
         let reference = reference(dense, side);
         let close = |a: &HashMap<_, f64>, b: &HashMap<_, f64>| {
-            a.len() == b.len() && a.iter().all(|(k, v)| b.get(k).is_some_and(|w| (v - w).abs() < 1e-9))
+            a.len() == b.len()
+                && a.iter()
+                    .all(|(k, v)| b.get(k).is_some_and(|w| (v - w).abs() < 1e-9))
         };
         assert!(close(&areas, &reference), "{areas:?} against {reference:?}");
         // Once: against nothing, or from the smaller value's side.
@@ -375,6 +376,9 @@ mod tests {
         }
         check(3, &dense);
         let mesh = value_boundary_mesh(&KTree::<3, u8>::from_dense_values(3, &dense).unwrap());
-        assert!(mesh.surfaces.iter().all(|s| s.merged && s.mesh.triangles.len() == 12));
+        assert!(mesh
+            .surfaces
+            .iter()
+            .all(|s| s.merged && s.mesh.triangles.len() == 12));
     }
 }

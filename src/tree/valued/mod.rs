@@ -43,7 +43,9 @@ pub mod walk;
 
 pub use assemble::ValueAssembler;
 pub(crate) use dense::for_each_voxel;
-pub use walk::{try_walk_values, LeavesOfValues, ValueLeaves, ValueStorage, ValueVisitor};
+pub use walk::{
+    try_walk_values, LeafValue, LeavesOfValues, ValueLeaves, ValueStorage, ValueVisitor,
+};
 
 use super::ktree::{KTree, TreeId};
 use super::sink::{LevelSink, MemorySink};

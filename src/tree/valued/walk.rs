@@ -13,6 +13,9 @@ use crate::tree::states::NodeState;
 use crate::tree::storage::infallible;
 use crate::value::Value;
 
+/// A leaf met by a look-up: the log of its side and its value (`None`: empty).
+pub type LeafValue<V> = (u32, Option<V>);
+
 /// A valued tree stored in level order, read one block of siblings at a time, reads failing like those of
 /// [`TreeStorage`](crate::tree::storage::TreeStorage): a valued tree in memory ([`KTree`] with a value type,
 /// [`Infallible`] reads) or a valued `.ktree` file read in place. A binary tree is one with `Value = ()`.
@@ -83,7 +86,7 @@ pub trait ValueStorage<const K: usize> {
     ///
     /// # Errors
     /// The storage's read error.
-    fn try_leaf_at(&self, point: [u32; K]) -> Result<Option<(u32, Option<Self::Value>)>, Self::Error> {
+    fn try_leaf_at(&self, point: [u32; K]) -> Result<Option<LeafValue<Self::Value>>, Self::Error> {
         if self.universe().check_point(point).is_err() {
             return Ok(None);
         }
