@@ -176,6 +176,16 @@ pub fn write_obj(w: &mut dyn Write, mesh: &SurfaceMesh) -> io::Result<()> {
 /// with all of its triangles, so each group is a closed surface (a face between two values is in both
 /// groups, oriented outward from each); `mtllib mtl` first when given (see [`write_value_mtl`]).
 ///
+/// ```
+/// use ktree::export::{files::write_value_obj, surface::value_boundary_mesh};
+/// let mesh = value_boundary_mesh(&ktree::KTree::<3, u16>::from_dense_values(1, &[Some(7); 8]).unwrap());
+/// let mut bytes = Vec::new();
+/// write_value_obj(&mut bytes, &mesh, Some("cube.mtl")).unwrap();
+/// let text = String::from_utf8(bytes).unwrap();
+/// assert!(text.contains("mtllib cube.mtl\n") && text.contains("g label_7\nusemtl label_7\n"));
+/// assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 12);
+/// ```
+///
 /// # Errors
 /// The writer's.
 pub fn write_value_obj<V: Value>(
@@ -204,6 +214,14 @@ pub fn write_value_obj<V: Value>(
 
 /// The materials of [`write_value_obj`]'s groups: per value `newmtl` of its name and `Kd`, its colour by
 /// `colour` (0 to 1 per channel).
+///
+/// ```
+/// use ktree::export::{files::write_value_mtl, surface::value_boundary_mesh};
+/// let mesh = value_boundary_mesh(&ktree::KTree::<3, u8>::from_dense_values(1, &[Some(2); 8]).unwrap());
+/// let mut bytes = Vec::new();
+/// write_value_mtl(&mut bytes, &mesh, &|_| [255, 0, 0]).unwrap();
+/// assert!(String::from_utf8(bytes).unwrap().contains("newmtl label_2\nKd 1 0 0\n"));
+/// ```
 ///
 /// # Errors
 /// The writer's.
@@ -272,6 +290,15 @@ pub fn write_glb(w: &mut dyn Write, mesh: &SurfaceMesh) -> io::Result<()> {
 /// mesh and node of its name ([`ValueSurface::name`](super::surface::ValueSurface::name)), all of its
 /// triangles (a closed surface: a face between two values is in both) and a material whose
 /// `baseColorFactor` is its colour by `colour` (sRGB, given as glTF's linear factors).
+///
+/// ```
+/// use ktree::export::{files::write_value_glb, surface::value_boundary_mesh};
+/// let mesh = value_boundary_mesh(&ktree::KTree::<3, u8>::from_dense_values(1, &[Some(1); 8]).unwrap());
+/// let mut bytes = Vec::new();
+/// write_value_glb(&mut bytes, &mesh, &|_| [255, 255, 255]).unwrap();
+/// assert!(bytes.starts_with(b"glTF"));
+/// assert!(String::from_utf8_lossy(&bytes).contains(r#""baseColorFactor":[1,1,1,1]"#));
+/// ```
 ///
 /// # Errors
 /// As [`write_glb`].

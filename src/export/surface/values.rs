@@ -114,6 +114,15 @@ pub fn value_boundary_mesh<V: Value>(tree: &KTree<3, V>) -> ValueMesh<V> {
 
 /// [`value_boundary_mesh`] over any valued storage.
 ///
+/// ```
+/// use ktree::export::surface::{try_value_boundary_mesh, value_boundary_mesh};
+/// let tree = ktree::KTree::<3, f32>::from_dense_values(1, &[Some(0.5); 8]).unwrap();
+/// let mesh = try_value_boundary_mesh(&tree).unwrap();
+/// assert_eq!(mesh, value_boundary_mesh(&tree));
+/// assert_eq!(mesh.surfaces[0].name(), "value_0.5");
+/// assert!(mesh.surfaces[0].merged); // the cube's six squares, nothing behind them
+/// ```
+///
 /// # Errors
 /// The storage's read error.
 ///

@@ -84,6 +84,12 @@ pub trait ValueStorage<const K: usize> {
     /// The leaf holding voxel `point` — the log of its side and its value (`None`: empty) — or `None`
     /// outside the universe, on any storage ([`KTree::leaf_at`] in memory).
     ///
+    /// ```
+    /// use ktree::tree::valued::ValueStorage;
+    /// let tree = ktree::KTree::<3, u8>::from_dense_values(1, &[Some(4); 8]).unwrap();
+    /// assert_eq!(tree.try_leaf_at([1, 0, 1]), Ok(Some((1, Some(4)))));
+    /// ```
+    ///
     /// # Errors
     /// The storage's read error.
     fn try_leaf_at(&self, point: [u32; K]) -> Result<Option<LeafValue<Self::Value>>, Self::Error> {
