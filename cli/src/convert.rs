@@ -1,6 +1,7 @@
 //! `ktree convert IN OUT`: any format to any format, chosen by extension (`.ktree`, `.rays`, `.binvox`, `.bt`,
 //! `.vdb`; meshes voxelized as inputs and the tree's boundary as outputs, `.glb` and `.svg` outputs only;
-//! volumes as inputs, NIfTI also as outputs; trees with values to NIfTI, VTK (`.vtu`, `.htg`) or `.ktree`).
+//! volumes as inputs, NIfTI also as outputs; trees with values to NIfTI, VTK (`.vtu`, `.htg`), the surfaces
+//! of their values with colours (`.ply`, `.obj`, `.glb`) or `.ktree`).
 
 use crate::common::error::{CliError, CliResult};
 use crate::outln;
@@ -28,7 +29,8 @@ pub struct Args {
     /// .nii, .nii.gz).
     input: PathBuf,
     /// The output: .ktree, .rays, .binvox, .bt, .vdb, the tree's boundary as a mesh (.ply, .obj, .stl,
-    /// .glb; a quadtree's outline as .ply edges, .obj lines or .svg), or VTK for ParaView (.vtu: a cell per
+    /// .glb; a quadtree's outline as .ply edges, .obj lines or .svg; an octree with values as the surface
+    /// of each value with its colour, .ply, .obj with a .mtl, .glb), or VTK for ParaView (.vtu: a cell per
     /// full leaf; .htg: a hyper tree grid).
     output: PathBuf,
     /// Universe level (grids, volumes: default the smallest that holds the input; meshes: required).

@@ -1,11 +1,13 @@
 //! `ktree convert` of a tree with values (a version 3 `.ktree`) and `ktree voxelize VOLUME --window LO:HI`:
 //! the values go to a NIfTI volume (`.nii`, `.nii.gz`: labels, densities or colours as its samples), to VTK
-//! files for ParaView (`.vtu`, `.htg`: the values as the cell data `value`) or to another `.ktree`; a
-//! volume's window of intensities comes in as `float32` values.
+//! files for ParaView (`.vtu`, `.htg`: the values as the cell data `value`), to the surfaces of its values
+//! with their colours (`.ply`, `.obj`, `.glb`) or to another `.ktree`; a volume's window of intensities comes in as `float32` values.
 
 use std::path::Path;
 
+use ktree::export::surface::value_boundary_mesh;
 use ktree::export::vtk::{write_values_time_slices, write_values_vtk_file};
+use ktree::export::{write_value_surface, MeshFormat};
 use ktree::io::ktree::v3::{read_valued_ktree, read_valued_ktree_framed, write_valued_ktree_file};
 use ktree::io::write_nifti_file;
 use ktree::solid::volume::Volume;
@@ -46,6 +48,22 @@ pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliR
     let nifti = name.ends_with(".nii") || name.ends_with(".nii.gz");
     let ktree = name.ends_with(".ktree");
     let vtk = name.ends_with(".vtu") || name.ends_with(".htg");
+    let mesh = matches!(
+        MeshFormat::of(output),
+        Some(MeshFormat::Ply | MeshFormat::Obj | MeshFormat::Glb)
+    );
+    if mesh {
+        if k != 3 {
+            return Err(format!(
+                "{}: the surfaces of values are made for octrees (K = 3); {} has K = {k}",
+                output.display(),
+                input.display()
+            )
+            .into());
+        }
+        return ktree::with_valued!(3, dtype, KK, V => write_value_mesh::<V>(input, output, placement),
+            else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
+    }
     if vtk {
         if k != 2 && k != 3 {
             return Err(format!(
@@ -61,7 +79,8 @@ pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliR
     let frame = &placement.frame(None);
     if !(nifti || ktree) {
         return Err(format!(
-            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz), VTK (.vtu, .htg) or .ktree",
+            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz), VTK (.vtu, .htg), the surfaces \
+             of its values with their colours (.ply, .obj, .glb) or .ktree",
             output.display(),
             dtype.name()
         )
@@ -133,6 +152,25 @@ fn write_vtk<const K: usize, V: Value>(
         V::DTYPE.map_or("", Dtype::name),
         tree.node_count(),
         tree.voxel_count()
+    );
+    Ok(())
+}
+
+/// The surface of each value of the octree in `input` with its colour (`.ply`, `.obj` with its `.mtl`,
+/// `.glb`), placed as the VTK files are.
+fn write_value_mesh<V: Value>(input: &Path, output: &Path, placement: Placement) -> CliResult {
+    let name = input.display().to_string();
+    let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
+    let (tree, kept) = read_valued_ktree_framed::<3, V>(&bytes, &name).map_err(CliError::caused)?;
+    let mesh = value_boundary_mesh(&tree).placed(&placement.frame(kept));
+    let written = write_value_surface(output, &mesh).map_err(CliError::caused)?;
+    outln!(
+        "{}: the surfaces of {} {} values, {} vertices, {} triangles",
+        output.display(),
+        mesh.surfaces.len(),
+        V::DTYPE.map_or("", Dtype::name),
+        written.vertices,
+        written.elements
     );
     Ok(())
 }

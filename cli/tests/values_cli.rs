@@ -50,6 +50,20 @@ fn write_volume(dir: &Path, shape: [usize; 3], values: &[u16]) -> std::path::Pat
     json
 }
 
+/// The tree of `ktree voxelize --labels` of the volume, `labels.ktree` in `dir`.
+fn label_tree(dir: &Path, shape: [usize; 3], values: &[u16]) -> std::path::PathBuf {
+    let json = write_volume(dir, shape, values);
+    let labels = dir.join("labels.ktree");
+    run(&[
+        "voxelize",
+        json.to_str().unwrap(),
+        "--labels",
+        "--out",
+        labels.to_str().unwrap(),
+    ]);
+    labels
+}
+
 /// Voxels, box `[lo, hi)` and the sums of the centres of one label, counted on the samples.
 type Measured = (u64, [usize; 3], [usize; 3], [f64; 3]);
 
@@ -58,16 +72,9 @@ type Measured = (u64, [usize; 3], [usize; 3], [f64; 3]);
 fn a_label_volume_becomes_one_tree_whose_values_select_and_measure_as_the_samples() {
     let dir = tempfile::tempdir().unwrap();
     let (shape, values) = labels();
-    let json = write_volume(dir.path(), shape, &values);
-    let labels = dir.path().join("labels.ktree");
+    let labels = label_tree(dir.path(), shape, &values);
+    let json = dir.path().join("labels.json");
     let p = |name: &str| dir.path().join(name).display().to_string();
-    run(&[
-        "voxelize",
-        json.to_str().unwrap(),
-        "--labels",
-        "--out",
-        labels.to_str().unwrap(),
-    ]);
 
     // Per-value statistics against the samples.
     let stats: serde_json::Value =
@@ -366,7 +373,7 @@ fn a_tree_with_values_converts_to_vtk_files_whose_cell_data_holds_them() {
     let labels: std::collections::BTreeSet<u16> = values.iter().copied().collect();
     assert_eq!(found, labels); // 0 at the vertices without a value, and the background's voxels
                                // Another extension names every output a tree with values converts to.
-    let (ok, _, err) = ktree(&["convert", &p("l.ktree"), &p("l.ply")]);
+    let (ok, _, err) = ktree(&["convert", &p("l.ktree"), &p("l.stl")]);
     assert!(
         !ok && err.contains(".vtu") && err.contains(".htg") && err.contains(".nii"),
         "{err}"
@@ -465,4 +472,174 @@ fn a_tree_with_values_transforms_each_voxel_keeping_its_value() {
         &p("big.binvox"),
     ]);
     assert!(!ok && err.contains("is written as a .ktree"), "{err}");
+}
+
+/// A binary little-endian PLY of `ktree convert` of `uint16` labels: its vertices and, per face, its
+/// corners, colour, `label`, `label_back` and `back_empty`.
+#[allow(clippy::type_complexity)] // The file's own columns.
+fn read_label_ply(bytes: &[u8]) -> (Vec<[f32; 3]>, Vec<([u32; 3], [u8; 3], u16, Option<u16>)>) {
+    let end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    let header = std::str::from_utf8(&bytes[..end]).unwrap();
+    let count = |element: &str| -> usize {
+        let line = header.lines().find(|l| l.starts_with(element)).unwrap();
+        line.rsplit(' ').next().unwrap().parse().unwrap()
+    };
+    assert!(header.contains(
+        "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty ushort label\n\
+         property ushort label_back\nproperty uchar back_empty\nend_header"
+    ));
+    let (nv, nf) = (count("element vertex"), count("element face"));
+    let mut at = end;
+    let mut take = |n: usize| {
+        at += n;
+        &bytes[at - n..at]
+    };
+    let vertices = (0..nv)
+        .map(|_| std::array::from_fn(|_| f32::from_le_bytes(take(4).try_into().unwrap())))
+        .collect();
+    let faces = (0..nf)
+        .map(|_| {
+            assert_eq!(take(1), [3]);
+            let t = std::array::from_fn(|_| i32::from_le_bytes(take(4).try_into().unwrap()) as u32);
+            let colour = take(3).try_into().unwrap();
+            let label = u16::from_le_bytes(take(2).try_into().unwrap());
+            let back = u16::from_le_bytes(take(2).try_into().unwrap());
+            let empty = take(1)[0] == 1;
+            (t, colour, label, (!empty).then_some(back))
+        })
+        .collect();
+    assert_eq!(at, bytes.len());
+    (vertices, faces)
+}
+
+#[test]
+fn a_label_volume_becomes_the_surfaces_of_its_labels_with_their_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let (shape, values) = labels();
+    let labels = label_tree(dir.path(), shape, &values);
+    let label = |p: [i64; 3]| -> Option<u16> {
+        let inside = (0..3).all(|a| (0..shape[a] as i64).contains(&p[a]));
+        let v = inside
+            .then(|| values[p[0] as usize + shape[0] * (p[1] as usize + shape[1] * p[2] as usize)]);
+        v.filter(|&v| v != 0)
+    };
+    // The faces between a voxel of each label and its neighbour, counted on the samples.
+    let mut faces: BTreeMap<(u16, Option<u16>), f64> = BTreeMap::new();
+    let mut voxels: BTreeMap<u16, f64> = BTreeMap::new();
+    for z in 0..shape[2] as i64 {
+        for y in 0..shape[1] as i64 {
+            for x in 0..shape[0] as i64 {
+                let Some(v) = label([x, y, z]) else { continue };
+                *voxels.entry(v).or_default() += 1.0;
+                for a in 0..3 {
+                    for step in [-1, 1] {
+                        let mut q = [x, y, z];
+                        q[a] += step;
+                        let w = label(q);
+                        if w != Some(v) && w.is_none_or(|w| v < w) {
+                            *faces.entry((v, w)).or_default() += 1.0;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    let ply = dir.path().join("labels.ply");
+    let out = run(&[
+        "convert",
+        labels.to_str().unwrap(),
+        ply.to_str().unwrap(),
+        "--voxel-size",
+        "0.5",
+        "--origin",
+        "1,2,3",
+    ]);
+    assert!(out.contains("the surfaces of 4 uint16 values"), "{out}");
+    let (vertices, ply_faces) = read_label_ply(&std::fs::read(&ply).unwrap());
+    let mut areas: BTreeMap<(u16, Option<u16>), f64> = BTreeMap::new();
+    let mut volumes: BTreeMap<u16, f64> = BTreeMap::new();
+    for (t, colour, v, back) in &ply_faces {
+        assert_eq!(
+            *colour,
+            ktree::display::palette::label_colour(u64::from(*v))
+        );
+        let [a, b, c] = t.map(|i| vertices[i as usize].map(f64::from));
+        let (u, w) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        );
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        // Areas in voxels (0.5 a side); volumes from each label's faces with their sides.
+        *areas.entry((*v, *back)).or_default() +=
+            (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0 / 0.25;
+        let signed = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]))
+            / 6.0;
+        *volumes.entry(*v).or_default() += signed;
+        if let Some(w) = back {
+            *volumes.entry(*w).or_default() -= signed;
+        }
+    }
+    assert_eq!(areas.len(), faces.len());
+    for (key, n) in &faces {
+        assert!(
+            (areas[key] - n).abs() < 1e-6,
+            "{key:?}: {} against {n}",
+            areas[key]
+        );
+    }
+    for (v, n) in &voxels {
+        assert!(
+            (volumes[v] - n * 0.125).abs() < 1e-6,
+            "label {v}: {} against {n}",
+            volumes[v]
+        );
+    }
+    // The first vertex is where --origin and --voxel-size place it.
+    assert!(vertices
+        .iter()
+        .all(|p| (0..3).all(|a| p[a] >= [1.0, 2.0, 3.0][a])));
+
+    // OBJ: a group and a material per label, the colours in the .mtl beside it.
+    let obj = dir.path().join("labels.obj");
+    run(&["convert", labels.to_str().unwrap(), obj.to_str().unwrap()]);
+    let text = std::fs::read_to_string(&obj).unwrap();
+    assert!(text.contains("mtllib labels.mtl\n"));
+    let mtl = std::fs::read_to_string(dir.path().join("labels.mtl")).unwrap();
+    for v in voxels.keys() {
+        assert!(text.contains(&format!("g label_{v}\nusemtl label_{v}\n")));
+        let [r, g, b] =
+            ktree::display::palette::label_colour(u64::from(*v)).map(|c| f64::from(c) / 255.0);
+        assert!(
+            mtl.contains(&format!("newmtl label_{v}\nKd {r} {g} {b}\n")),
+            "{mtl}"
+        );
+    }
+
+    // glTF: a mesh and a material per label.
+    let glb = dir.path().join("labels.glb");
+    run(&["convert", labels.to_str().unwrap(), glb.to_str().unwrap()]);
+    let bytes = std::fs::read(&glb).unwrap();
+    assert_eq!(&bytes[..4], b"glTF");
+    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let gltf: serde_json::Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
+    assert_eq!(gltf["materials"].as_array().unwrap().len(), 4);
+    assert_eq!(gltf["meshes"][0]["name"], "label_1");
+
+    // STL holds no colours.
+    let (ok, _, err) = ktree(&[
+        "convert",
+        labels.to_str().unwrap(),
+        dir.path().join("l.stl").to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains(".ply, .obj"), "{err}");
 }

@@ -232,26 +232,12 @@ def test_vtk_reads_the_values_of_a_tree_with_values(tmp_path, k, dtype):
 
 
 def test_vtk_reads_the_colours_of_a_point_cloud(tmp_path):
-    from test_ktree import cli
+    from test_ktree import rgb_tree
 
     rng = np.random.default_rng(7)
     side = 8
     colours = rng.integers(1, 3, size=(side, side, side, 3)).astype(np.uint8) * 120
     colours[rng.random((side,) * 3) < 0.5] = 0  # no point: an empty voxel
     colours[:4, :4, :4] = [10, 20, 30]
-    points = np.argwhere(colours.any(axis=-1))
-    lines = [f"{x + 0.5} {y + 0.5} {z + 0.5} {' '.join(map(str, colours[x, y, z]))}" for x, y, z in points]
-    ply = tmp_path / "c.ply"
-    ply.write_text(
-        "ply\nformat ascii 1.0\n"
-        f"element vertex {len(lines)}\n"
-        "property float x\nproperty float y\nproperty float z\n"
-        "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n" + "\n".join(lines) + "\n"
-    )
-    src = tmp_path / "c.ktree"
-    subprocess.run(
-        [cli(), "voxelize", str(ply), "--voxel-size", "1", "--origin", "0,0,0", "--level", "3",
-         "--value", "rgb", "--out", str(src)],
-        check=True, capture_output=True, text=True,
-    )
+    src = rgb_tree(tmp_path, colours)
     read_value_files(tmp_path, src, 3, "rgb8", 3, colours)

@@ -557,6 +557,27 @@ def cli():
     return found
 
 
+def rgb_tree(tmp_path, colours):
+    """A tree of colours at level 3 made by `ktree voxelize --value rgb` of a point in each voxel of `colours`
+    (a (8, 8, 8, 3) uint8 array, black: no point), written to `tmp_path / "c.ktree"`."""
+    points = np.argwhere(colours.any(axis=-1))
+    lines = [f"{x + 0.5} {y + 0.5} {z + 0.5} {' '.join(map(str, colours[x, y, z]))}" for x, y, z in points]
+    ply = tmp_path / "c.ply"
+    ply.write_text(
+        "ply\nformat ascii 1.0\n"
+        f"element vertex {len(lines)}\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n" + "\n".join(lines) + "\n"
+    )
+    src = tmp_path / "c.ktree"
+    subprocess.run(
+        [cli(), "voxelize", str(ply), "--voxel-size", "1", "--origin", "0,0,0", "--level", "3",
+         "--value", "rgb", "--out", str(src)],
+        check=True, capture_output=True, text=True,
+    )
+    return src
+
+
 def run_json(*args):
     binary = cli()
     out = subprocess.run([binary, *map(str, args), "--json"], check=True, capture_output=True, text=True)

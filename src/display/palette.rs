@@ -50,16 +50,41 @@ pub fn ramp(t: f64) -> [u8; 3] {
 /// The colouring of `tree`'s values: labels (integer types) by [`label_colour`], floats by [`ramp`] from
 /// the tree's smallest value to its largest, colours as they are.
 pub fn value_colours<V: Value>(tree: &KTree<3, V>) -> impl Fn(V) -> [u8; 3] {
-    let number = |v: V| -> f64 { v.text().parse().unwrap_or(0.0) };
-    let (lo, hi) = if V::DTYPE == Some(Dtype::F32) {
-        tree.value_leaves()
-            .filter_map(|(_, v)| v)
+    colouring(range(tree.value_leaves().filter_map(|(_, v)| v)))
+}
+
+/// The colouring of [`value_colours`] for the values `values` (floats ramp from their smallest to their
+/// largest): the colours of a tree's values from any list of them.
+///
+/// ```
+/// use ktree::display::palette::{colours_of_values, label_colour, ramp};
+/// assert_eq!(colours_of_values([7u16])(7), label_colour(7));
+/// assert_eq!(colours_of_values([1.0f32, 3.0])(2.0), ramp(0.5));
+/// ```
+pub fn colours_of_values<V: Value>(values: impl IntoIterator<Item = V>) -> impl Fn(V) -> [u8; 3] {
+    colouring(range(values))
+}
+
+/// A value as a number.
+fn number<V: Value>(v: V) -> f64 {
+    v.text().parse().unwrap_or(0.0)
+}
+
+/// The smallest and largest of float values (other types: 0 and 1, unused).
+fn range<V: Value>(values: impl IntoIterator<Item = V>) -> (f64, f64) {
+    if V::DTYPE == Some(Dtype::F32) {
+        values
+            .into_iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
                 (lo.min(number(v)), hi.max(number(v)))
             })
     } else {
         (0.0, 1.0)
-    };
+    }
+}
+
+/// The colouring of [`value_colours`], floats ramping from `lo` to `hi`.
+fn colouring<V: Value>((lo, hi): (f64, f64)) -> impl Fn(V) -> [u8; 3] {
     move |v: V| match V::DTYPE {
         Some(Dtype::Rgb) => {
             let mut bytes = Vec::with_capacity(3);

@@ -25,10 +25,12 @@ use std::path::Path;
 
 use thiserror::Error;
 
+use crate::display::palette::colours_of_values;
 use crate::fs::write_atomic_with;
 use crate::space::Universe;
 use crate::tree::storage::TreeStorage;
 use crate::tree::{AnyTree, LevelCounts, NodeState, StorageError};
+use crate::value::Value;
 
 /// Where voxels are in the world for an export: ktree voxel `v` is at `origin + voxel_size · v` (the
 /// universe's corner at `origin`; quadtrees use the first two coordinates). The crate's one world frame,
@@ -267,6 +269,67 @@ pub fn write_surface(path: &Path, mesh: &surface::SurfaceMesh) -> Result<Written
     Ok(Written {
         vertices: mesh.vertices.len(),
         elements: mesh.triangles.len(),
+    })
+}
+
+/// Writes the surfaces of a tree's values (already placed in the world) to `path` with their colours,
+/// atomically, by its extension: `.ply` with every face once and its values and colour as face
+/// properties ([`files::write_value_ply`]), `.obj` with a group per value and its materials in a `.mtl`
+/// beside it ([`files::write_value_obj`]), `.glb` with a mesh and material per value
+/// ([`files::write_value_glb`]). Labels are coloured by
+/// [`label_colour`](crate::display::palette::label_colour), floats along
+/// [`ramp`](crate::display::palette::ramp) from the smallest value to the largest, colours as they are.
+///
+/// ```
+/// use ktree::export::{surface::value_boundary_mesh, write_value_surface, Frame};
+/// let dir = tempfile::tempdir().unwrap();
+/// let mut dense = [None; 8];
+/// (dense[0], dense[1]) = (Some(1u8), Some(2));
+/// let tree = ktree::KTree::<3, u8>::from_dense_values(1, &dense).unwrap();
+/// let mesh = value_boundary_mesh(&tree).placed(&Frame::default());
+/// let written = write_value_surface(&dir.path().join("labels.obj"), &mesh).unwrap();
+/// assert_eq!(written.elements, 24); // two cubes, each closed in its group
+/// assert!(dir.path().join("labels.mtl").exists());
+/// ```
+///
+/// # Errors
+/// [`ExportError::Usage`] for another extension; [`ExportError::Write`] from the file system.
+pub fn write_value_surface<V: Value>(
+    path: &Path,
+    mesh: &surface::ValueMesh<V>,
+) -> Result<Written, ExportError> {
+    let colour = colours_of_values(mesh.surfaces.iter().map(|s| s.value));
+    let write = |path: &Path, fill: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
+        write_atomic_with(path, |w| fill(w)).map_err(ExportError::Write)
+    };
+    let all = mesh.surfaces.iter().map(|s| s.mesh.triangles.len()).sum();
+    let elements =
+        match MeshFormat::of(path) {
+            Some(MeshFormat::Ply) => {
+                write(path, &|w| files::write_value_ply(w, mesh, &colour))?;
+                mesh.faces_once().count()
+            }
+            Some(MeshFormat::Obj) => {
+                let mtl = path.with_extension("mtl");
+                write(&mtl, &|w| files::write_value_mtl(w, mesh, &colour))?;
+                let name = mtl.file_name().map(|n| n.to_string_lossy().into_owned());
+                write(path, &|w| files::write_value_obj(w, mesh, name.as_deref()))?;
+                all
+            }
+            Some(MeshFormat::Glb) => {
+                write(path, &|w| files::write_value_glb(w, mesh, &colour))?;
+                all
+            }
+            _ => return Err(ExportError::Usage {
+                file: path.to_path_buf(),
+                message:
+                    "the surfaces of values are written with their colours as .ply, .obj or .glb"
+                        .into(),
+            }),
+        };
+    Ok(Written {
+        vertices: mesh.vertex_count(),
+        elements,
     })
 }
 

@@ -53,6 +53,9 @@
 
 mod section;
 mod sweep;
+mod values;
+
+pub use values::{try_value_boundary_mesh, value_boundary_mesh, ValueMesh, ValueSurface};
 
 use std::convert::Infallible;
 use std::sync::OnceLock;

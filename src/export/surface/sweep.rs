@@ -33,7 +33,8 @@ use points::Point;
 /// The boundary of `tree` as a closed, outward-oriented triangle mesh, its planes merged as `merge` says.
 pub(super) fn sweep<T: TreeStorage<3>>(tree: &T, merge: Merge) -> Result<SurfaceMesh, T::Error> {
     let mut sweep = Sweep::new(tree.level(), merge);
-    for_each_section(tree, |x, _, below, slab| {
+    // Unit faces: a step at every x, so that rectangles across the sweep are one voxel long.
+    for_each_section(tree, merge == Merge::None, |x, _, below, slab| {
         if !(below.bands.is_empty() && slab.bands.is_empty()) {
             sweep.step(x, below, slab);
         }
@@ -52,7 +53,7 @@ pub(super) fn unit_faces<T: TreeStorage<3>>(tree: &T) -> Result<u128, T::Error> 
     let mut xor = Vec::new();
     let mut faces = 0u128;
     let length = |runs: &[(u32, u32)]| runs.iter().map(|r| u128::from(r.1 - r.0)).sum::<u128>();
-    for_each_section(tree, |x, next, below, slab| {
+    for_each_section(tree, false, |x, next, below, slab| {
         // The plane x = X.
         for (y, end, lower, upper) in Pieces::new(below, slab) {
             xor_runs(lower, upper, &mut xor);
@@ -81,9 +82,10 @@ pub(super) fn unit_faces<T: TreeStorage<3>>(tree: &T) -> Result<u128, T::Error> 
 
 /// Calls `step(x, next, below, slab)` at each `x` where the cross-section of `tree` changes, in order, and
 /// at the universe's side (`slab` empty there): `slab` is the section from `x` up to `next`, `below` the
-/// one before `x`.
+/// one before `x`. At every `x` when `unit`.
 fn for_each_section<T: TreeStorage<3>>(
     tree: &T,
+    unit: bool,
     mut step: impl FnMut(u32, u32, &Slab, &Slab),
 ) -> Result<(), T::Error> {
     let side = 1u32 << tree.level();
@@ -91,7 +93,12 @@ fn for_each_section<T: TreeStorage<3>>(
     let mut x = 0;
     loop {
         let next = if x < side {
-            section(tree, x, &mut slab)?.min(side)
+            let next = section(tree, x, &mut slab)?.min(side);
+            if unit {
+                next.min(x + 1)
+            } else {
+                next
+            }
         } else {
             slab.clear();
             side

@@ -44,7 +44,8 @@ pub mod walk;
 pub use assemble::ValueAssembler;
 pub(crate) use dense::for_each_voxel;
 pub use walk::{
-    try_walk_values, BinaryValues, LeavesOfValues, ValueLeaves, ValueStorage, ValueVisitor,
+    try_walk_values, BinaryValues, LeafValue, LeavesOfValues, ValueLeaves, ValueStorage,
+    ValueVisitor,
 };
 
 use super::ktree::{KTree, TreeId};
@@ -192,23 +193,7 @@ impl<const K: usize, V: Value> KTree<K, V> {
     /// assert_eq!(tree.leaf_at([4, 0]), None);
     /// ```
     pub fn leaf_at(&self, point: [u32; K]) -> Option<(u32, Option<V>)> {
-        if self.universe.check_point(point).is_err() {
-            return None;
-        }
-        let (mut depth, mut index) = (0usize, 0usize);
-        let mut code = infallible(self.root_code());
-        let mut log_side = self.level();
-        while code >= 2 {
-            log_side -= 1;
-            let child = (0..K).fold(0, |c, a| c | ((point[a] >> log_side & 1) as usize) << a);
-            index = infallible(self.children(depth, index)) + child;
-            depth += 1;
-            code = (self.levels[depth].block_codes(index - child, K) >> (2 * child)) & 3;
-        }
-        Some((
-            log_side,
-            (code == 1).then(|| infallible(self.value(depth, index))),
-        ))
+        infallible(self.try_leaf_at(point))
     }
 
     /// The leaves with their values (`None`: empty), in Morton order.

@@ -13,6 +13,9 @@ use crate::tree::states::NodeState;
 use crate::tree::storage::{infallible, TreeStorage};
 use crate::value::Value;
 
+/// A leaf met by a look-up: the log of its side and its value (`None`: empty).
+pub type LeafValue<V> = (u32, Option<V>);
+
 /// A valued tree stored in level order, read one block of siblings at a time, reads failing like those of
 /// [`TreeStorage`](crate::tree::storage::TreeStorage): a valued tree in memory ([`KTree`] with a value type,
 /// [`Infallible`] reads) or a valued `.ktree` file read in place. A binary tree is one with `Value = ()`.
@@ -76,6 +79,39 @@ pub trait ValueStorage<const K: usize> {
             2 => ValueState::Partial,
             _ => ValueState::Mixed,
         })
+    }
+
+    /// The leaf holding voxel `point` — the log of its side and its value (`None`: empty) — or `None`
+    /// outside the universe, on any storage ([`KTree::leaf_at`] in memory).
+    ///
+    /// ```
+    /// use ktree::tree::valued::ValueStorage;
+    /// let tree = ktree::KTree::<3, u8>::from_dense_values(1, &[Some(4); 8]).unwrap();
+    /// assert_eq!(tree.try_leaf_at([1, 0, 1]), Ok(Some((1, Some(4)))));
+    /// ```
+    ///
+    /// # Errors
+    /// The storage's read error.
+    fn try_leaf_at(&self, point: [u32; K]) -> Result<Option<LeafValue<Self::Value>>, Self::Error> {
+        if self.universe().check_point(point).is_err() {
+            return Ok(None);
+        }
+        let (mut depth, mut index) = (0usize, 0usize);
+        let mut code = self.root_code()?;
+        let mut log_side = self.level();
+        while code >= 2 {
+            log_side -= 1;
+            let child = (0..K).fold(0, |c, a| c | ((point[a] >> log_side & 1) as usize) << a);
+            index = self.children(depth, index)? + child;
+            depth += 1;
+            code = (self.codes(depth, index - child)? >> (2 * child)) & 3;
+        }
+        let value = if code == 1 {
+            Some(self.value(depth, index)?)
+        } else {
+            None
+        };
+        Ok(Some((log_side, value)))
     }
 
     /// The root node.

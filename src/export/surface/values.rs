@@ -1,0 +1,393 @@
+//! The boundary of each value of an octree with values: one closed, outward-oriented surface per value,
+//! each triangle with the value behind it.
+//!
+//! A value's surface is the boundary mesh of the voxels holding it, made by the sweep of
+//! [`boundary_mesh`](super::boundary_mesh), so it is closed, crack-free and 2-manifold as that one is. Its
+//! rectangles stay merged when each triangle then has one value (or nothing) behind it; otherwise the
+//! value's surface is made of unit faces, each with its own value behind. A face between two values is
+//! in both values' surfaces, oriented outward from each; [`ValueMesh::faces_once`] gives it once.
+
+use std::collections::BTreeMap;
+
+use crate::ops::values::select_where;
+use crate::tree::storage::infallible;
+use crate::tree::valued::{ValueLeaves, ValueStorage};
+use crate::value::{Dtype, Value};
+use crate::KTree;
+
+use super::{others, sweep, Frame, Merge, SurfaceMesh};
+
+/// The surface of one value: closed and outward-oriented around the voxels holding it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValueSurface<V> {
+    /// The value inside.
+    pub value: V,
+    /// The surface, in voxel coordinates until [`ValueMesh::placed`].
+    pub mesh: SurfaceMesh,
+    /// For each triangle, the value on its outer side (`None`: nothing).
+    pub behind: Vec<Option<V>>,
+    /// Whether its rectangles are merged (else every unit face is its own square).
+    pub merged: bool,
+}
+
+impl<V: Value> ValueSurface<V> {
+    /// A name for the value's part of a file: `label_3` (integers), `value_0.25` (floats), `rgb_255_0_0`
+    /// (colours).
+    pub fn name(&self) -> String {
+        match V::DTYPE {
+            Some(Dtype::F32) => format!("value_{}", self.value.text()),
+            Some(Dtype::Rgb) => format!("rgb_{}", self.value.text().replace(',', "_")),
+            _ => format!("label_{}", self.value.text()),
+        }
+    }
+}
+
+/// The surfaces of every value of a tree, by increasing value ([`Value::key`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValueMesh<V> {
+    /// One surface per value.
+    pub surfaces: Vec<ValueSurface<V>>,
+}
+
+impl<V: Value> ValueMesh<V> {
+    /// The surfaces in world units (see [`SurfaceMesh::placed`]).
+    pub fn placed(&self, frame: &Frame) -> Self {
+        ValueMesh {
+            surfaces: self
+                .surfaces
+                .iter()
+                .map(|s| ValueSurface {
+                    mesh: s.mesh.placed(frame),
+                    ..s.clone()
+                })
+                .collect(),
+        }
+    }
+
+    /// Every face once, as `(surface, triangle)` indices: a face against nothing from its value's
+    /// surface, a face between two values from the surface of the smaller one (oriented outward from it).
+    pub fn faces_once(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.surfaces.iter().enumerate().flat_map(|(k, s)| {
+            s.behind
+                .iter()
+                .enumerate()
+                .filter(|(_, b)| b.is_none_or(|b| s.value.key() < b.key()))
+                .map(move |(t, _)| (k, t))
+        })
+    }
+
+    /// The vertices of all the surfaces.
+    pub fn vertex_count(&self) -> usize {
+        self.surfaces.iter().map(|s| s.mesh.vertices.len()).sum()
+    }
+}
+
+/// The boundary of each value of `tree`: per value, the closed, outward-oriented surface of the voxels
+/// holding it, each triangle with the value behind it (see the module's documentation). In voxel
+/// coordinates. (Any valued storage: [`try_value_boundary_mesh`].)
+///
+/// ```
+/// use ktree::export::surface::value_boundary_mesh;
+/// use ktree::KTree;
+/// // Voxel (0, 0, 0) holds 1, voxel (1, 0, 0) holds 2.
+/// let mut dense = [None; 8];
+/// (dense[0], dense[1]) = (Some(1u8), Some(2));
+/// let mesh = value_boundary_mesh(&KTree::<3, u8>::from_dense_values(1, &dense).unwrap());
+/// let one = &mesh.surfaces[0];
+/// assert_eq!((one.value, one.mesh.volume(), one.mesh.triangles.len()), (1, 1.0, 12));
+/// // The square at x = 1 has 2 behind it; the rest of the cube has nothing.
+/// assert_eq!(one.behind.iter().filter(|b| **b == Some(2)).count(), 2);
+/// // Each cube's 10 triangles against nothing and the 2 between them, once.
+/// assert_eq!(mesh.faces_once().count(), 22);
+/// ```
+///
+/// # Performance
+/// One sweep of [`boundary_mesh`](super::boundary_mesh) per value over the voxels holding it, and a
+/// look-up of the leaves behind each triangle; a value whose merged triangles have several values
+/// behind one of them is swept again face by face.
+///
+/// # Panics
+/// As [`boundary_mesh`](super::boundary_mesh).
+pub fn value_boundary_mesh<V: Value>(tree: &KTree<3, V>) -> ValueMesh<V> {
+    infallible(try_value_boundary_mesh(tree))
+}
+
+/// [`value_boundary_mesh`] over any valued storage.
+///
+/// ```
+/// use ktree::export::surface::{try_value_boundary_mesh, value_boundary_mesh};
+/// let tree = ktree::KTree::<3, f32>::from_dense_values(1, &[Some(0.5); 8]).unwrap();
+/// let mesh = try_value_boundary_mesh(&tree).unwrap();
+/// assert_eq!(mesh, value_boundary_mesh(&tree));
+/// assert_eq!(mesh.surfaces[0].name(), "value_0.5");
+/// assert!(mesh.surfaces[0].merged); // the cube's six squares, nothing behind them
+/// ```
+///
+/// # Errors
+/// The storage's read error.
+///
+/// # Panics
+/// As [`boundary_mesh`](super::boundary_mesh).
+pub fn try_value_boundary_mesh<T: ValueStorage<3>>(
+    tree: &T,
+) -> Result<ValueMesh<T::Value>, T::Error> {
+    let mut values = BTreeMap::new();
+    for leaf in ValueLeaves::new(tree) {
+        if let (_, Some(v)) = leaf? {
+            values.entry(v.key()).or_insert(v);
+        }
+    }
+    let mut surfaces = Vec::with_capacity(values.len());
+    for value in values.into_values() {
+        let voxels = select_where(tree, |v| v.same(value))?;
+        let mesh = infallible(sweep::sweep(&voxels, Merge::Rectangles));
+        let surface = match behind_each(tree, &mesh)? {
+            Some(behind) => ValueSurface {
+                value,
+                mesh,
+                behind,
+                merged: true,
+            },
+            None => {
+                let mesh = infallible(sweep::sweep(&voxels, Merge::None));
+                let behind =
+                    behind_each(tree, &mesh)?.expect("a unit face has one voxel behind it");
+                ValueSurface {
+                    value,
+                    mesh,
+                    behind,
+                    merged: false,
+                }
+            }
+        };
+        surfaces.push(surface);
+    }
+    Ok(ValueMesh { surfaces })
+}
+
+/// The value behind each triangle of `mesh`, or `None` if some triangle has several.
+#[allow(clippy::type_complexity)] // A read that may fail of a list that may not exist.
+fn behind_each<T: ValueStorage<3>>(
+    tree: &T,
+    mesh: &SurfaceMesh,
+) -> Result<Option<Vec<Option<T::Value>>>, T::Error> {
+    let mut out = Vec::with_capacity(mesh.triangles.len());
+    for t in &mesh.triangles {
+        match behind(tree, t.map(|i| mesh.vertices[i as usize]))? {
+            Some(b) => out.push(b),
+            None => return Ok(None),
+        }
+    }
+    Ok(Some(out))
+}
+
+/// The value behind the triangle `p` (in a plane of the lattice, counter-clockwise seen from outside):
+/// `Some(None)` when nothing is, `None` when the voxels behind its bounding box do not all hold one value.
+fn behind<T: ValueStorage<3>>(
+    tree: &T,
+    p: [[f64; 3]; 3],
+) -> Result<Option<Option<T::Value>>, T::Error> {
+    let a = (0..3)
+        .find(|&a| p[0][a] == p[1][a] && p[1][a] == p[2][a])
+        .expect("a boundary triangle lies in a plane of the lattice");
+    let (b, c) = others(a);
+    let (u, w) = (
+        [p[1][b] - p[0][b], p[1][c] - p[0][c]],
+        [p[2][b] - p[0][b], p[2][c] - p[0][c]],
+    );
+    // The normal's component along a: (u × w)_a, as (b, c, a) is cyclic.
+    let outward = u[0] * w[1] - u[1] * w[0] > 0.0;
+    let coord = p[0][a] as i64;
+    let layer = if outward { coord } else { coord - 1 };
+    if layer < 0 || layer >= 1i64 << tree.level() {
+        return Ok(Some(None));
+    }
+    let span = |d: usize| {
+        let (lo, hi) = p
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
+                (lo.min(q[d]), hi.max(q[d]))
+            });
+        (lo.floor() as u32, hi.ceil() as u32)
+    };
+    let ((b0, b1), (c0, c1)) = (span(b), span(c));
+    let mut found: Option<Option<T::Value>> = None;
+    for cv in c0..c1 {
+        let mut bv = b0;
+        while bv < b1 {
+            let mut point = [0u32; 3];
+            (point[a], point[b], point[c]) = (layer as u32, bv, cv);
+            let (log_side, v) = tree
+                .try_leaf_at(point)?
+                .expect("the voxels behind a boundary face are in the universe");
+            match found {
+                None => found = Some(v),
+                Some(f) if f.map(Value::key) != v.map(Value::key) => return Ok(None),
+                Some(_) => {}
+            }
+            // The leaf's cell ends where bit log_side of b next turns over.
+            bv = ((bv >> log_side) + 1) << log_side;
+        }
+    }
+    Ok(found)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::collections::HashMap;
+
+    /// Random labels 1 to 3 (or nothing) in aligned blocks of every size, at `level`.
+    fn labels(level: u32) -> impl Strategy<Value = Vec<Option<u8>>> {
+        let side = 1usize << level;
+        let block = (0..level, any::<[u16; 3]>(), prop::option::of(1u8..4));
+        prop::collection::vec(block, 1..12).prop_map(move |blocks| {
+            let mut dense = vec![None; side * side * side];
+            for (log, at, value) in blocks {
+                let at = at.map(|c| ((c as usize % side) >> log) << log);
+                for z in at[2]..at[2] + (1 << log) {
+                    for y in at[1]..at[1] + (1 << log) {
+                        for x in at[0]..at[0] + (1 << log) {
+                            dense[x + side * (y + side * z)] = value;
+                        }
+                    }
+                }
+            }
+            dense
+        })
+    }
+
+    /// The value of voxel `p` of `dense` (nothing outside the universe).
+    fn at(dense: &[Option<u8>], side: i64, p: [i64; 3]) -> Option<u8> {
+        if p.iter().all(|c| (0..side).contains(c)) {
+            dense[(p[0] + side * (p[1] + side * p[2])) as usize]
+        } else {
+            None
+        }
+    }
+
+    /// The unit faces between a voxel of value `v` and its neighbour holding `w`, by `(v, w)`, counted on
+    /// the dense array.
+    fn reference(dense: &[Option<u8>], side: i64) -> HashMap<(u8, Option<u8>), f64> {
+        let mut out = HashMap::new();
+        for z in 0..side {
+            for y in 0..side {
+                for x in 0..side {
+                    let Some(v) = at(dense, side, [x, y, z]) else {
+                        continue;
+                    };
+                    for a in 0..3 {
+                        for step in [-1, 1] {
+                            let mut q = [x, y, z];
+                            q[a] += step;
+                            let w = at(dense, side, q);
+                            if w != Some(v) {
+                                *out.entry((v, w)).or_insert(0.0) += 1.0;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// A triangle's normal (twice its area long) and its area.
+    fn normal(p: [[f64; 3]; 3]) -> ([f64; 3], f64) {
+        let u: [f64; 3] = std::array::from_fn(|a| p[1][a] - p[0][a]);
+        let w: [f64; 3] = std::array::from_fn(|a| p[2][a] - p[0][a]);
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        (n, (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0)
+    }
+
+    fn check(level: u32, dense: &[Option<u8>]) {
+        let side = 1i64 << level;
+        let tree = KTree::<3, u8>::from_dense_values(level, dense).unwrap();
+        let mesh = value_boundary_mesh(&tree);
+        let mut areas: HashMap<(u8, Option<u8>), f64> = HashMap::new();
+        let mut once: HashMap<(u8, Option<u8>), f64> = HashMap::new();
+        for s in &mesh.surfaces {
+            assert_eq!(s.behind.len(), s.mesh.triangles.len());
+            let voxels = dense.iter().filter(|v| **v == Some(s.value)).count();
+            assert_eq!(s.mesh.volume(), voxels as f64, "the volume of {}", s.value);
+            // Closed: every directed edge is met once each way.
+            let mut edges: HashMap<(u32, u32), i32> = HashMap::new();
+            for t in &s.mesh.triangles {
+                for i in 0..3 {
+                    let (p, q) = (t[i], t[(i + 1) % 3]);
+                    *edges.entry((p.min(q), p.max(q))).or_insert(0) += if p < q { 1 } else { -1 };
+                }
+            }
+            assert!(edges.values().all(|&n| n == 0), "{} is closed", s.value);
+            for (t, tri) in s.mesh.triangles.iter().enumerate() {
+                let p = tri.map(|i| s.mesh.vertices[i as usize]);
+                let (n, area) = normal(p);
+                *areas.entry((s.value, s.behind[t])).or_insert(0.0) += area;
+                // Points inside the triangle: the value on its inner side, `behind` on its outer side.
+                for weights in [[0.31, 0.33, 0.36], [0.6, 0.2, 0.2], [0.15, 0.7, 0.15]] {
+                    let c: [f64; 3] =
+                        std::array::from_fn(|a| (0..3).map(|i| weights[i] * p[i][a]).sum::<f64>());
+                    let voxel = |sign: f64| {
+                        std::array::from_fn(|a| {
+                            (c[a] + sign * 0.25 * n[a] / n[a].abs().max(1.0)).floor() as i64
+                        })
+                    };
+                    assert_eq!(at(dense, side, voxel(-1.0)), Some(s.value));
+                    assert_eq!(at(dense, side, voxel(1.0)), s.behind[t]);
+                }
+            }
+        }
+        for (k, t) in mesh.faces_once() {
+            let s = &mesh.surfaces[k];
+            let (_, area) = normal(s.mesh.triangles[t].map(|i| s.mesh.vertices[i as usize]));
+            *once.entry((s.value, s.behind[t])).or_insert(0.0) += area;
+        }
+        let reference = reference(dense, side);
+        let close = |a: &HashMap<_, f64>, b: &HashMap<_, f64>| {
+            a.len() == b.len()
+                && a.iter()
+                    .all(|(k, v)| b.get(k).is_some_and(|w| (v - w).abs() < 1e-9))
+        };
+        assert!(close(&areas, &reference), "{areas:?} against {reference:?}");
+        // Once: against nothing, or from the smaller value's side.
+        let expected: HashMap<_, f64> = reference
+            .into_iter()
+            .filter(|((v, w), _)| w.is_none_or(|w| *v < w))
+            .collect();
+        assert!(close(&once, &expected), "{once:?} against {expected:?}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn each_value_is_closed_and_its_faces_are_those_of_the_voxels(dense in labels(3)) {
+            check(3, &dense);
+        }
+    }
+
+    #[test]
+    fn a_value_alone_in_space_keeps_its_rectangles() {
+        // Two blocks of 2 × 2 × 2 apart: six squares each, merged.
+        let side = 8;
+        let mut dense = vec![None; side * side * side];
+        for z in 0..2 {
+            for y in 0..2 {
+                for x in 0..2 {
+                    dense[x + side * (y + side * z)] = Some(1u8);
+                    dense[x + 4 + side * (y + side * (z + 4))] = Some(2);
+                }
+            }
+        }
+        check(3, &dense);
+        let mesh = value_boundary_mesh(&KTree::<3, u8>::from_dense_values(3, &dense).unwrap());
+        assert!(mesh
+            .surfaces
+            .iter()
+            .all(|s| s.merged && s.mesh.triangles.len() == 12));
+    }
+}
