@@ -27,11 +27,15 @@ mod level_set;
 mod read;
 #[cfg(test)]
 mod tests;
+mod typed;
 mod values;
 mod write;
 
 pub use level_set::write_vdb_level_set;
 pub use read::read_vdb;
+pub use typed::{
+    read_vdb_values, vdb_holds_values, write_any_valued_vdb, write_vdb_values, PlacedValues,
+};
 pub use write::write_vdb;
 
 const MAGIC: i64 = 0x5644_4220;
@@ -40,6 +44,10 @@ const BOOL_TREE: &str = "Tree_bool_5_4_3";
 const MASK_TREE: &str = "Tree_mask_5_4_3";
 const FLOAT_TREE: &str = "Tree_float_5_4_3";
 const DOUBLE_TREE: &str = "Tree_double_5_4_3";
+const INT32_TREE: &str = "Tree_int32_5_4_3";
+const INT64_TREE: &str = "Tree_int64_5_4_3";
+const VEC3S_TREE: &str = "Tree_vec3s_5_4_3";
+const VEC3D_TREE: &str = "Tree_vec3d_5_4_3";
 /// Appended to a grid's type name when its values are saved as half floats.
 const HALF_FLOAT_SUFFIX: &str = "_HalfFloat";
 /// Grid metadata written by ktree: the universe level and the offset, read back as defaults.
