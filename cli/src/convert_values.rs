@@ -1,13 +1,14 @@
 //! `ktree convert` of a tree with values (a version 3 `.ktree`) and `ktree voxelize VOLUME --window LO:HI`:
-//! the values go to a NIfTI volume (`.nii`, `.nii.gz`: labels, densities or colours as its samples), to VTK
-//! files for ParaView (`.vtu`, `.htg`: the values as the cell data `value`) or to another `.ktree`; a
-//! volume's window of intensities comes in as `float32` values.
+//! the values go to a NIfTI volume (`.nii`, `.nii.gz`: labels, densities or colours as its samples), to an
+//! OpenVDB typed grid (`.vdb`: `Int32Grid`, `FloatGrid`, `Vec3SGrid`), to VTK files for ParaView (`.vtu`,
+//! `.htg`: the values as the cell data `value`) or to another `.ktree`; an OpenVDB typed grid comes in as a
+//! valued `.ktree`; a volume's window of intensities comes in as `float32` values.
 
 use std::path::Path;
 
 use ktree::export::vtk::{write_values_time_slices, write_values_vtk_file};
 use ktree::io::ktree::v3::{read_valued_ktree, read_valued_ktree_framed, write_valued_ktree_file};
-use ktree::io::write_nifti_file;
+use ktree::io::{read_vdb_values, write_nifti_file, write_vdb_values};
 use ktree::solid::volume::Volume;
 use ktree::space::WorldFrame;
 use ktree::value::{Dtype, Value};
@@ -37,7 +38,7 @@ impl Placement {
     }
 }
 
-/// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz`, `.vtu`, `.htg` or `.ktree`),
+/// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz`, `.vdb`, `.vtu`, `.htg` or `.ktree`),
 /// placed by `placement` (VTK files: the rest as the input's world frame places it).
 pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliResult {
     let (k, dtype) = crate::values::file_dtype(input)?;
@@ -45,6 +46,7 @@ pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliR
     let name = output.to_string_lossy();
     let nifti = name.ends_with(".nii") || name.ends_with(".nii.gz");
     let ktree = name.ends_with(".ktree");
+    let vdb = name.ends_with(".vdb");
     let vtk = name.ends_with(".vtu") || name.ends_with(".htg");
     if vtk {
         if k != 2 && k != 3 {
@@ -59,17 +61,18 @@ pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliR
             else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
     }
     let frame = &placement.frame(None);
-    if !(nifti || ktree) {
+    if !(nifti || ktree || vdb) {
         return Err(format!(
-            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz), VTK (.vtu, .htg) or .ktree",
+            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz), OpenVDB (.vdb), VTK (.vtu, .htg) \
+             or .ktree",
             output.display(),
             dtype.name()
         )
         .into());
     }
-    if nifti && k != 3 {
+    if (nifti || vdb) && k != 3 {
         return Err(format!(
-            "{}: NIfTI volumes hold octrees (K = 3); {} has K = {k}",
+            "{}: NIfTI volumes and OpenVDB grids hold octrees (K = 3); {} has K = {k}",
             output.display(),
             input.display()
         )
@@ -143,6 +146,9 @@ fn write_octree<V: Value>(input: &Path, output: &Path, frame: &WorldFrame) -> Cl
     let tree = read_valued_ktree::<3, V>(&bytes, &name).map_err(CliError::caused)?;
     if output.extension().is_some_and(|e| e == "ktree") {
         write_valued_ktree_file(output, &tree).map_err(CliError::caused)?;
+    } else if output.extension().is_some_and(|e| e == "vdb") {
+        ktree::fs::write_atomic_with(output, |w| write_vdb_values(w, &tree, [0; 3], frame))
+            .map_err(CliError::caused)?;
     } else {
         write_nifti_file(output, &tree, frame).map_err(CliError::caused)?;
     }
@@ -153,6 +159,32 @@ fn write_octree<V: Value>(input: &Path, output: &Path, frame: &WorldFrame) -> Cl
         V::DTYPE.map_or("", Dtype::name),
         tree.node_count(),
         tree.voxel_count()
+    );
+    Ok(())
+}
+
+/// `ktree convert IN.vdb OUT.ktree` of a grid with values (not a `BoolGrid`, `MaskGrid` or level set):
+/// a valued `.ktree` of its active voxels, placed by `level` and `offset` (ktree voxel = grid index +
+/// offset; by default those the file was written with, else the smallest universe from 0).
+pub fn vdb_to_valued(
+    input: &Path,
+    output: &Path,
+    level: Option<u32>,
+    offset: Option<[i64; 3]>,
+) -> CliResult {
+    let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
+    let read = read_vdb_values(&bytes, &input.display().to_string(), offset, level)
+        .map_err(CliError::caused)?;
+    ktree::with_valued!(&read.tree, t => write_valued_ktree_file(output, t))
+        .map_err(CliError::caused)?;
+    let tree = &read.tree;
+    outln!(
+        "{}: K = 3, L = {}, {} values, {} voxels (grid index + {:?} = ktree voxel)",
+        output.display(),
+        tree.level(),
+        tree.dtype().name(),
+        ktree::with_valued!(tree, t => t.voxel_count()),
+        read.placement.offset
     );
     Ok(())
 }

@@ -422,11 +422,7 @@ mod tests {
 
     /// A level-`level` tree of blocks (aligned cubes of side `2^s`) and voxels, each of a value of
     /// `palette`, later ones over earlier ones.
-    fn blocks<V: Value>(
-        level: u32,
-        palette: &[V],
-        picks: &[(u32, [u32; 3], usize)],
-    ) -> KTree<3, V> {
+    fn blocks<V: Value>(level: u32, palette: &[V], picks: &[Pick]) -> KTree<3, V> {
         let side = 1usize << level;
         let mut dense = vec![None; side * side * side];
         for &(s, p, v) in picks {
@@ -468,7 +464,11 @@ mod tests {
         bytes
     }
 
-    fn picks() -> impl Strategy<Value = (u32, Vec<(u32, [u32; 3], usize)>, [i64; 3])> {
+    /// A block or voxel of [`blocks`]: the log of its side, a corner, which value of the palette.
+    type Pick = (u32, [u32; 3], usize);
+
+    /// A level, blocks, and the offset to write at.
+    fn picks() -> impl Strategy<Value = (u32, Vec<Pick>, [i64; 3])> {
         (
             0u32..=5,
             prop::collection::vec((0u32..=5, any::<[u32; 3]>(), 0usize..8), 0..12),
