@@ -349,7 +349,18 @@ fn build<V: Value>(
 /// `u8`, `u16`, `u32` holding them all when none is negative, else as `i8`; floats as `f32`; vectors as
 /// [`Rgb`](crate::value::Rgb) (components rounded). Placed by `offset` and `level` as [`read_vdb`](super::read_vdb) places a
 /// grid (ktree's metadata used when none is given); values stored raw or compressed as OpenVDB writes them.
-/// See [`write_vdb_values`] for an example.
+///
+/// ```
+/// use ktree::io::{read_vdb_values, vdb_holds_values, write_vdb_values, GridMeta};
+/// use ktree::{value::Dtype, KTree};
+/// let tree = KTree::<3, u32>::from_dense_values(1, &[Some(5), None, None, None, None, None, None, Some(9)]).unwrap();
+/// let mut bytes = Vec::new();
+/// write_vdb_values(&mut bytes, &tree, [-1, 0, 0], &GridMeta::default()).unwrap();
+/// assert!(vdb_holds_values(&bytes, "labels.vdb").unwrap());
+/// let read = read_vdb_values(&bytes, "labels.vdb", None, None).unwrap();
+/// assert_eq!(read.tree.dtype(), Dtype::U8); // the smallest type holding 5 and 9
+/// assert_eq!(read.placement.offset, [-1, 0, 0]);
+/// ```
 ///
 /// # Errors
 /// [`GridFileError`] naming the byte offset: as [`read_vdb`](super::read_vdb); no grid with values (a
