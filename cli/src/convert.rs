@@ -1,7 +1,8 @@
 //! `ktree convert IN OUT`: any format to any format, chosen by extension (`.ktree`, `.rays`, `.binvox`, `.bt`,
 //! `.vdb`; meshes voxelized as inputs and the tree's boundary as outputs, `.glb` and `.svg` outputs only;
-//! volumes as inputs, NIfTI also as outputs; trees with values to NIfTI, VTK (`.vtu`, `.htg`), the surfaces
-//! of their values with colours (`.ply`, `.obj`, `.glb`) or `.ktree`).
+//! volumes as inputs, NIfTI also as outputs; trees with values to NIfTI, OpenVDB, VTK (`.vtu`, `.htg`), the
+//! surfaces of their values with colours (`.ply`, `.obj`, `.glb`) or `.ktree`, and an OpenVDB grid with
+//! values to a valued `.ktree`).
 
 use crate::common::error::{CliError, CliResult};
 use crate::outln;
@@ -86,6 +87,12 @@ pub fn run(a: Args) -> CliResult {
             return crate::convert_values::time_series(&a.input, &a.output, axis, placement);
         }
         return crate::convert_values::convert_valued(&a.input, &a.output, placement);
+    }
+    if Format::of(&a.input) == Some(Format::Vdb)
+        && Format::of(&a.output) == Some(Format::Ktree)
+        && vdb_with_values(&a.input)
+    {
+        return crate::convert_values::vdb_to_valued(&a.input, &a.output, a.level, a.offset);
     }
     let options = ReadOptions {
         level: a.level,
@@ -254,6 +261,14 @@ pub fn run(a: Args) -> CliResult {
         c.nodes(),
     );
     Ok(())
+}
+
+/// Whether `path` is an OpenVDB file whose first grid read holds values (a file that cannot be read says
+/// no: the reader of every format then reports it).
+fn vdb_with_values(path: &Path) -> bool {
+    std::fs::read(path).is_ok_and(|b| {
+        ktree::io::vdb_holds_values(&b, &path.display().to_string()).unwrap_or(false)
+    })
 }
 
 /// Writes the tree's boundary (a mesh or an outline) or a VTK file, by the output's extension.

@@ -1,25 +1,31 @@
 //! `ktree convert` of a tree with values (a version 3 `.ktree`) and `ktree voxelize VOLUME --window LO:HI`:
-//! the values go to a NIfTI volume (`.nii`, `.nii.gz`: labels, densities or colours as its samples), to VTK
-//! files for ParaView (`.vtu`, `.htg`: the values as the cell data `value`), to the surfaces of its values
-//! with their colours (`.ply`, `.obj`, `.glb`) or to another `.ktree`; a volume's window of intensities comes in as `float32` values.
+//! the values go to a NIfTI volume (`.nii`, `.nii.gz`: labels, densities or colours as its samples), to an
+//! OpenVDB typed grid (`.vdb`: `Int32Grid`, `FloatGrid`, `Vec3SGrid`), to VTK files for ParaView (`.vtu`,
+//! `.htg`: the values as the cell data `value`), to the surfaces of its values with their colours (`.ply`,
+//! `.obj`, `.glb`) or to another `.ktree`, each placed by the file's world frame unless `--voxel-size` or
+//! `--origin` say otherwise; an OpenVDB typed grid comes in as a valued `.ktree`; a volume's window of
+//! intensities comes in as `float32` values.
 
 use std::path::Path;
 
 use ktree::export::surface::value_boundary_mesh;
 use ktree::export::vtk::{write_values_time_slices, write_values_vtk_file};
 use ktree::export::{write_value_surface, MeshFormat};
-use ktree::io::ktree::v3::{read_valued_ktree, read_valued_ktree_framed, write_valued_ktree_file};
-use ktree::io::write_nifti_file;
+use ktree::io::ktree::v3::{
+    read_valued_ktree_framed, write_valued_ktree_file, write_valued_ktree_file_framed,
+};
+use ktree::io::{read_vdb_values, write_nifti_file, write_vdb_values};
 use ktree::solid::volume::Volume;
 use ktree::space::WorldFrame;
+use ktree::tree::AnyValuedTree;
 use ktree::value::{Dtype, Value};
 use ktree::KTree;
 
 use crate::common::error::{cannot_read, CliError, CliResult};
 use crate::outln;
 
-/// Where `--voxel-size` and `--origin` place the output: given, or (VTK files) the input's world frame,
-/// else voxels of 1 from 0.
+/// Where `--voxel-size` and `--origin` place the output: given, or the input's world frame, else voxels of
+/// 1 from 0.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Placement {
     /// `--voxel-size`.
@@ -39,71 +45,149 @@ impl Placement {
     }
 }
 
-/// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz`, `.vtu`, `.htg` or `.ktree`),
-/// placed by `placement` (VTK files: the rest as the input's world frame places it).
+/// What a tree with values is written as, by the output's extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Output {
+    /// `.nii`, `.nii.gz` (octrees).
+    Nifti,
+    /// `.vdb`: an OpenVDB typed grid (octrees).
+    Vdb,
+    /// `.vtu`, `.htg` (quadtrees and octrees).
+    Vtk,
+    /// `.ply`, `.obj`, `.glb`: the surface of each value with its colour (octrees).
+    Mesh,
+    /// `.ktree` (any K).
+    Ktree,
+}
+
+impl Output {
+    fn of(output: &Path) -> Option<Self> {
+        let name = output.to_string_lossy();
+        let ends = |e: &str| name.ends_with(e);
+        Some(if ends(".nii") || ends(".nii.gz") {
+            Output::Nifti
+        } else if ends(".vdb") {
+            Output::Vdb
+        } else if ends(".vtu") || ends(".htg") {
+            Output::Vtk
+        } else if ends(".ktree") {
+            Output::Ktree
+        } else if matches!(
+            MeshFormat::of(output),
+            Some(MeshFormat::Ply | MeshFormat::Obj | MeshFormat::Glb)
+        ) {
+            Output::Mesh
+        } else {
+            return None;
+        })
+    }
+
+    /// Whether the output holds trees of `k` dimensions; else what it holds.
+    fn holds(self, k: usize) -> Result<(), &'static str> {
+        match self {
+            Output::Ktree => Ok(()),
+            Output::Vtk if k == 2 || k == 3 => Ok(()),
+            Output::Vtk => Err("VTK files hold quadtrees and octrees (K = 2, 3)"),
+            _ if k == 3 => Ok(()),
+            Output::Nifti => Err("NIfTI volumes hold octrees (K = 3)"),
+            Output::Vdb => Err("OpenVDB grids hold octrees (K = 3)"),
+            Output::Mesh => Err("the surfaces of values are made for octrees (K = 3)"),
+        }
+    }
+}
+
+/// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz`, `.vdb`, `.vtu`, `.htg`, `.ply`,
+/// `.obj`, `.glb` or `.ktree`), placed by `placement`, the rest as the input's world frame places it.
 pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliResult {
     let (k, dtype) = crate::values::file_dtype(input)?;
     let dtype = dtype.ok_or_else(|| format!("{}: the tree holds no values", input.display()))?;
-    let name = output.to_string_lossy();
-    let nifti = name.ends_with(".nii") || name.ends_with(".nii.gz");
-    let ktree = name.ends_with(".ktree");
-    let vtk = name.ends_with(".vtu") || name.ends_with(".htg");
-    let mesh = matches!(
-        MeshFormat::of(output),
-        Some(MeshFormat::Ply | MeshFormat::Obj | MeshFormat::Glb)
-    );
-    if mesh {
-        if k != 3 {
-            return Err(format!(
-                "{}: the surfaces of values are made for octrees (K = 3); {} has K = {k}",
-                output.display(),
-                input.display()
-            )
-            .into());
-        }
-        return ktree::with_valued!(3, dtype, KK, V => write_value_mesh::<V>(input, output, placement),
-            else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
-    }
-    if vtk {
-        if k != 2 && k != 3 {
-            return Err(format!(
-                "{}: VTK files hold quadtrees and octrees (K = 2, 3); {} has K = {k}",
-                output.display(),
-                input.display()
-            )
-            .into());
-        }
-        return ktree::with_valued!(k, dtype, KK, V => write_vtk::<KK, V>(input, output, placement),
-            else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
-    }
-    let frame = &placement.frame(None);
-    if !(nifti || ktree) {
+    let Some(format) = Output::of(output) else {
         return Err(format!(
-            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz), VTK (.vtu, .htg), the surfaces \
-             of its values with their colours (.ply, .obj, .glb) or .ktree",
+            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz), OpenVDB (.vdb), VTK (.vtu, \
+             .htg), the surfaces of its values with their colours (.ply, .obj, .glb) or .ktree",
             output.display(),
             dtype.name()
         )
         .into());
-    }
-    if nifti && k != 3 {
-        return Err(format!(
-            "{}: NIfTI volumes hold octrees (K = 3); {} has K = {k}",
+    };
+    format.holds(k).map_err(|holds| {
+        format!(
+            "{}: {holds}; {} has K = {k}",
             output.display(),
             input.display()
         )
-        .into());
-    }
-    ktree::with_valued!(k, dtype, KK, V => {
-        if KK == 3 {
-            return write_octree::<V>(input, output, frame);
+    })?;
+    ktree::with_valued!(k, dtype, KK, V => write_valued::<KK, V>(input, output, format, placement),
+        else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()))
+}
+
+/// The valued tree of a `.ktree` file and the world frame it keeps.
+pub fn read_framed<const K: usize, V: Value>(
+    input: &Path,
+) -> CliResult<(KTree<K, V>, Option<WorldFrame>)> {
+    let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
+    read_valued_ktree_framed::<K, V>(&bytes, &input.display().to_string()).map_err(CliError::caused)
+}
+
+/// Writes the valued tree of `input` to `output` as `format` (which holds `K` dimensions).
+fn write_valued<const K: usize, V: Value>(
+    input: &Path,
+    output: &Path,
+    format: Output,
+    placement: Placement,
+) -> CliResult {
+    let (tree, kept) = read_framed::<K, V>(input)?;
+    let frame = placement.frame(kept);
+    let tree = AnyValuedTree::from(tree);
+    let typed = tree
+        .as_typed::<K, V>()
+        .ok_or("the tree is of its own dimension and type")?;
+    let octree = || {
+        tree.as_typed::<3, V>()
+            .ok_or("the formats of octrees were checked to get K = 3")
+    };
+    let mut what = "values";
+    match format {
+        Output::Ktree => {
+            // The frame is kept, or given; a tree without one stays without.
+            let given = placement.voxel_size.is_some() || placement.origin.is_some();
+            let keep = (kept.is_some() || given).then_some(frame);
+            write_valued_ktree_file_framed(output, typed, keep.as_ref())
+                .map_err(CliError::caused)?
         }
-        // Any other K: a .ktree to a .ktree is a checked copy.
-        let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
-        ktree::fs::write_atomic(output, &bytes).map_err(CliError::caused)?;
-        outln!("{}: copied (K = {k}, {})", output.display(), dtype.name());
-        Ok(())
-    }, else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()))
+        Output::Vtk => {
+            write_values_vtk_file(output, typed, &frame).map_err(CliError::caused)?;
+            what = "values as cell data";
+        }
+        Output::Nifti => write_nifti_file(output, octree()?, &frame).map_err(CliError::caused)?,
+        Output::Vdb => {
+            let octree = octree()?;
+            ktree::fs::write_atomic_with(output, |w| write_vdb_values(w, octree, [0; 3], &frame))
+                .map_err(CliError::caused)?
+        }
+        Output::Mesh => {
+            let mesh = value_boundary_mesh(octree()?).placed(&frame);
+            let written = write_value_surface(output, &mesh).map_err(CliError::caused)?;
+            outln!(
+                "{}: the surfaces of {} {} values, {} vertices, {} triangles",
+                output.display(),
+                mesh.surfaces.len(),
+                V::DTYPE.map_or("", Dtype::name),
+                written.vertices,
+                written.elements
+            );
+            return Ok(());
+        }
+    }
+    outln!(
+        "{}: K = {K}, L = {}, {} {what}, {} nodes, {} voxels",
+        output.display(),
+        typed.level(),
+        V::DTYPE.map_or("", Dtype::name),
+        typed.node_count(),
+        typed.voxel_count()
+    );
+    Ok(())
 }
 
 /// The 4-D valued tree of `input` as a time series of VTK files along `axis` (`.pvd` with `.vtu` slices,
@@ -118,11 +202,8 @@ pub fn time_series(input: &Path, output: &Path, axis: usize, placement: Placemen
         )
         .into());
     }
-    let name = input.display().to_string();
-    let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
     let files = ktree::with_valued!(4, dtype, KK, V => {
-        let (tree, kept) =
-            read_valued_ktree_framed::<4, V>(&bytes, &name).map_err(CliError::caused)?;
+        let (tree, kept) = read_framed::<4, V>(input)?;
         write_values_time_slices(output, &tree, axis, &placement.frame(kept))
             .map_err(CliError::caused)?
     }, else return Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
@@ -135,62 +216,30 @@ pub fn time_series(input: &Path, output: &Path, axis: usize, placement: Placemen
     Ok(())
 }
 
-/// The valued tree of `input` as a VTK file, `value` its cell data.
-fn write_vtk<const K: usize, V: Value>(
+/// `ktree convert IN.vdb OUT.ktree` of a grid with values (not a `BoolGrid`, `MaskGrid` or level set):
+/// a valued `.ktree` of its active voxels and the grid's world frame, placed by `level` and `offset` (ktree voxel = grid index +
+/// offset; by default those the file was written with, else the smallest universe from 0).
+pub fn vdb_to_valued(
     input: &Path,
     output: &Path,
-    placement: Placement,
+    level: Option<u32>,
+    offset: Option<[i64; 3]>,
 ) -> CliResult {
-    let name = input.display().to_string();
     let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
-    let (tree, kept) = read_valued_ktree_framed::<K, V>(&bytes, &name).map_err(CliError::caused)?;
-    write_values_vtk_file(output, &tree, &placement.frame(kept)).map_err(CliError::caused)?;
+    let read = read_vdb_values(&bytes, &input.display().to_string(), offset, level)
+        .map_err(CliError::caused)?;
+    // The grid's world placement, counted from ktree voxel 0.
+    let frame = read.meta.counted_from(read.placement.offset.map(|o| -o));
+    ktree::with_valued!(&read.tree, t => write_valued_ktree_file_framed(output, t, Some(&frame)))
+        .map_err(CliError::caused)?;
+    let tree = &read.tree;
     outln!(
-        "{}: K = {K}, L = {}, {} values as cell data, {} nodes, {} voxels",
+        "{}: K = 3, L = {}, {} values, {} voxels (grid index + {:?} = ktree voxel)",
         output.display(),
         tree.level(),
-        V::DTYPE.map_or("", Dtype::name),
-        tree.node_count(),
-        tree.voxel_count()
-    );
-    Ok(())
-}
-
-/// The surface of each value of the octree in `input` with its colour (`.ply`, `.obj` with its `.mtl`,
-/// `.glb`), placed as the VTK files are.
-fn write_value_mesh<V: Value>(input: &Path, output: &Path, placement: Placement) -> CliResult {
-    let name = input.display().to_string();
-    let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
-    let (tree, kept) = read_valued_ktree_framed::<3, V>(&bytes, &name).map_err(CliError::caused)?;
-    let mesh = value_boundary_mesh(&tree).placed(&placement.frame(kept));
-    let written = write_value_surface(output, &mesh).map_err(CliError::caused)?;
-    outln!(
-        "{}: the surfaces of {} {} values, {} vertices, {} triangles",
-        output.display(),
-        mesh.surfaces.len(),
-        V::DTYPE.map_or("", Dtype::name),
-        written.vertices,
-        written.elements
-    );
-    Ok(())
-}
-
-fn write_octree<V: Value>(input: &Path, output: &Path, frame: &WorldFrame) -> CliResult {
-    let name = input.display().to_string();
-    let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
-    let tree = read_valued_ktree::<3, V>(&bytes, &name).map_err(CliError::caused)?;
-    if output.extension().is_some_and(|e| e == "ktree") {
-        write_valued_ktree_file(output, &tree).map_err(CliError::caused)?;
-    } else {
-        write_nifti_file(output, &tree, frame).map_err(CliError::caused)?;
-    }
-    outln!(
-        "{}: K = 3, L = {}, {} values, {} nodes, {} voxels",
-        output.display(),
-        tree.level(),
-        V::DTYPE.map_or("", Dtype::name),
-        tree.node_count(),
-        tree.voxel_count()
+        tree.dtype().name(),
+        ktree::with_valued!(tree, t => t.voxel_count()),
+        read.placement.offset
     );
     Ok(())
 }

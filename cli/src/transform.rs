@@ -10,7 +10,7 @@
 use crate::common::error::{CliError, CliResult};
 use std::path::PathBuf;
 
-use ktree::io::ktree::v3::write_valued_ktree_file;
+use ktree::io::ktree::v3::write_valued_ktree_file_framed;
 use ktree::ops::{Affine, AxisMap, Geometry, Projective};
 
 use crate::common::tree_file::{read, write};
@@ -217,18 +217,19 @@ fn run_valued(args: &Args) -> CliResult {
         )
         .into());
     }
-    let tree = crate::values::read_valued(&args.input)?;
-    let (k, dtype) = (tree.k(), tree.dtype());
-    let (voxels, nodes) = ktree::with_valued!(k, dtype, KK, V => {
-        let t = tree.as_typed::<KK, V>().ok_or("the tree is of its own dimension and type")?;
-        let moved = apply(t, t.level(), args).map_err(|e| e.within(args.input.display()))?;
-        write_valued_ktree_file(out, &moved).map_err(CliError::caused)?;
-        (moved.voxel_count(), moved.node_count())
+    let (k, dtype) = crate::values::file_dtype(&args.input)?;
+    let dtype =
+        dtype.ok_or_else(|| format!("{}: the tree holds no values", args.input.display()))?;
+    let (level, voxels, nodes) = ktree::with_valued!(k, dtype, KK, V => {
+        // The voxels move in the universe; the universe keeps its place in the world.
+        let (t, frame) = crate::convert_values::read_framed::<KK, V>(&args.input)?;
+        let moved = apply(&t, t.level(), args).map_err(|e| e.within(args.input.display()))?;
+        write_valued_ktree_file_framed(out, &moved, frame.as_ref()).map_err(CliError::caused)?;
+        (moved.level(), moved.voxel_count(), moved.node_count())
     }, else return Err(format!("{}: no transform of K = {k} {} trees", args.input.display(), dtype.name()).into()));
     outln!(
-        "{}: K = {k}, L = {}, {} values, {voxels} voxels, {nodes} nodes",
+        "{}: K = {k}, L = {level}, {} values, {voxels} voxels, {nodes} nodes",
         out.display(),
-        tree.level(),
         dtype.name()
     );
     Ok(())

@@ -11,9 +11,11 @@ use std::process::{Command, Stdio};
 
 use common::{data_dir, ktree, run_openvdb, tools};
 use ktree::input::read_tree;
+use ktree::io::ktree::v3::{read_valued_ktree_file, write_valued_ktree_file};
 use ktree::io::{write_tree, ReadOptions, WriteOptions};
 use ktree::rays::ball_rays;
 use ktree::stacking::paper::stack;
+use ktree::value::{Rgb, Value};
 use ktree::AnyTree;
 use ktree::{KTree, NodeState};
 
@@ -335,5 +337,169 @@ fn a_vdb_written_by_openvdb_reads_into_ktree_with_the_same_voxels() {
             AnyTree::K3(tree.clone()),
             "{name}"
         );
+    }
+}
+
+/// Valued octrees of the value types OpenVDB's Python module holds as grids (`FloatGrid`, `Vec3SGrid`),
+/// in a level-4 universe: an 8³ block of one value (a tile of a 16³ node) and single voxels of other values,
+/// none 0 (OpenVDB's `copyFromArray` leaves the background's voxels inactive).
+fn valued_objects() -> (KTree<3, f32>, KTree<3, Rgb>) {
+    let mut floats = vec![None; 4096];
+    let mut colours = vec![None; 4096];
+    for x in 0..16 {
+        for y in 0..16 {
+            for z in 0..16 {
+                let i = x + 16 * (y + 16 * z);
+                if x >= 8 && y >= 8 && z >= 8 {
+                    floats[i] = Some(2.5);
+                    colours[i] = Some([200, 10, 3]);
+                } else if (x * 7 + y * 3 + z) % 5 == 0 {
+                    floats[i] = Some(x as f32 * 0.25 - y as f32 - 0.375);
+                    colours[i] = Some([x as u8 * 16, y as u8 * 16 + 1, 255]);
+                }
+            }
+        }
+    }
+    (
+        KTree::from_dense_values(4, &floats).unwrap(),
+        KTree::from_dense_values(4, &colours).unwrap(),
+    )
+}
+
+/// A valued tree's voxels and their values as text (`x y z value`, colours `r,g,b`), sorted.
+fn voxel_values<V: Value>(tree: &KTree<3, V>) -> Vec<String> {
+    let mut out = Vec::new();
+    let dense = tree.to_dense_values().unwrap();
+    for (i, v) in dense.iter().enumerate() {
+        if let Some(v) = v {
+            out.push(format!(
+                "{} {} {} {}",
+                i % 16,
+                i / 16 % 16,
+                i / 256,
+                v.text()
+            ));
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Writes `tree` with `ktree convert` as a `.vdb` and has OpenVDB list every active value (tiles spread
+/// into their voxels): they must be the tree's voxels and values, and a tile must be among them.
+fn check_typed_grid_in_openvdb<V: Value>(
+    python: &tools::PythonOpenVdb,
+    dir: &Path,
+    tree: &KTree<3, V>,
+    grid: &str,
+) {
+    let name = V::DTYPE.unwrap().name();
+    let input = dir.join(format!("{name}.ktree"));
+    let output = dir.join(format!("{name}.vdb"));
+    write_valued_ktree_file(&input, tree).unwrap();
+    let (ok, _, err) = ktree(&["convert", input.to_str().unwrap(), output.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let script = format!(
+        "g = vdb.read({:?}, 'ktree')\nprint(type(g).__name__, g.gridClass, g.activeVoxelCount())\n\
+         for t in g.iterOnValues():\n    v = t['value']\n    v = ','.join(str(round(c)) for c in v) \
+         if isinstance(v, tuple) else '%g' % v\n    (x0, y0, z0), (x1, y1, z1) = t['min'], t['max']\n    \
+         for x in range(x0, x1 + 1):\n        for y in range(y0, y1 + 1):\n            \
+         for z in range(z0, z1 + 1):\n                print(x, y, z, v, int(t['count'] > 1))",
+        output.display().to_string()
+    );
+    let out = run_openvdb(python, &script);
+    let mut lines = out.lines();
+    let head: Vec<&str> = lines.next().unwrap().split_whitespace().collect();
+    assert_eq!(head[0], grid, "{out}");
+    assert_ne!(head[1], "GRID_LEVEL_SET");
+    assert_eq!(head[2], tree.voxel_count().to_string());
+    let mut seen = Vec::new();
+    let mut tiles = 0;
+    for line in lines {
+        let (voxel, tile) = line.rsplit_once(' ').unwrap();
+        tiles += usize::from(tile == "1");
+        seen.push(voxel.to_string());
+    }
+    seen.sort();
+    assert_eq!(seen, voxel_values(tree), "{name}");
+    assert_eq!(tiles, 512, "{name}: the 8³ block is one tile");
+}
+
+#[test]
+fn valued_trees_written_as_typed_vdb_grids_open_in_openvdb_with_every_value() {
+    let Some(python) = tools::require_python_openvdb() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (floats, colours) = valued_objects();
+    check_typed_grid_in_openvdb(&python, dir.path(), &floats, "FloatGrid");
+    check_typed_grid_in_openvdb(&python, dir.path(), &colours, "Vec3SGrid");
+}
+
+#[test]
+fn typed_grids_written_by_openvdb_convert_to_valued_ktree_files_value_for_value() {
+    let Some(python) = tools::require_python_openvdb() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (floats, colours) = valued_objects();
+    // The dense arrays (x slowest, as numpy's C order and OpenVDB's x, y, z) copied into grids at index
+    // −8, pruned into tiles, written with OpenVDB's default compression.
+    let arrays = |values: Vec<String>| {
+        values
+            .into_iter()
+            .map(|l| {
+                let w: Vec<&str> = l.split(' ').collect();
+                format!("a[{}, {}, {}] = ({})", w[0], w[1], w[2], w[3])
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    for (name, grid, shape, set, want) in [
+        (
+            "float32",
+            "FloatGrid",
+            "(16, 16, 16)",
+            arrays(voxel_values(&floats)),
+            voxel_values(&floats),
+        ),
+        (
+            "rgb8",
+            "Vec3SGrid",
+            "(16, 16, 16, 3)",
+            arrays(voxel_values(&colours)),
+            voxel_values(&colours),
+        ),
+    ] {
+        let path = dir.path().join(format!("{name}_openvdb.vdb"));
+        let script = format!(
+            "import numpy as np\na = np.zeros({shape}, dtype=np.float32)\n{set}\ng = vdb.{grid}()\n\
+             g.name = 'g'\ng.copyFromArray(a, ijk=(-8, -8, -8))\ng.prune(g.zeroValue)\nvdb.write({:?}, grids=[g])\n\
+             print(g.activeVoxelCount(), sum(t['count'] > 1 for t in g.iterOnValues()))",
+            path.display().to_string()
+        );
+        let out = run_openvdb(&python, &script);
+        let counts: Vec<&str> = out.split_whitespace().collect();
+        assert_eq!(counts[0], want.len().to_string(), "{name}");
+        assert_eq!(counts[1], "1", "{name}: the 8³ block is one tile");
+        let output = dir.path().join(format!("{name}.ktree"));
+        let (ok, _, err) = ktree(&[
+            "convert",
+            path.to_str().unwrap(),
+            output.to_str().unwrap(),
+            "--offset",
+            "8,8,8",
+            "--level",
+            "4",
+        ]);
+        assert!(ok, "{err}");
+        let got = match name {
+            "float32" => voxel_values(&read_valued_ktree_file::<3, f32>(&output).unwrap()),
+            _ => voxel_values(&read_valued_ktree_file::<3, Rgb>(&output).unwrap()),
+        };
+        assert_eq!(got, want, "{name}");
+        // The command-line statistics read the grid's shape.
+        let (ok, out, err) = ktree(&["stats", path.to_str().unwrap()]);
+        assert!(ok && out.contains(&want.len().to_string()), "{out}{err}");
     }
 }

@@ -643,3 +643,46 @@ fn a_label_volume_becomes_the_surfaces_of_its_labels_with_their_colours() {
     ]);
     assert!(!ok && err.contains(".ply, .obj"), "{err}");
 }
+
+#[test]
+fn a_tree_with_values_keeps_its_world_frame_through_every_conversion() {
+    use ktree::io::ktree::v3::{read_valued_ktree_framed, write_valued_ktree_file_framed};
+    use ktree::space::WorldFrame;
+    use ktree::KTree;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let dense: Vec<Option<u8>> = (0..64u8).map(|i| (i % 3 != 0).then_some(i % 4)).collect();
+    let labels = KTree::<3, u8>::from_dense_values(2, &dense).unwrap();
+    let frame = WorldFrame {
+        voxel_size: 0.5,
+        origin: [1.0, -2.0, 3.0],
+    };
+    write_valued_ktree_file_framed(Path::new(&p("a.ktree")), &labels, Some(&frame)).unwrap();
+    let framed = |name: &str| {
+        let bytes = std::fs::read(p(name)).unwrap();
+        read_valued_ktree_framed::<3, u8>(&bytes, name).unwrap()
+    };
+    // .ktree to .ktree, and through OpenVDB and back: the same voxels, values and frame.
+    run(&["convert", &p("a.ktree"), &p("b.ktree")]);
+    assert_eq!(framed("b.ktree"), (labels.clone(), Some(frame)));
+    run(&["convert", &p("a.ktree"), &p("a.vdb")]);
+    run(&["convert", &p("a.vdb"), &p("c.ktree")]);
+    let (back, kept) = framed("c.ktree");
+    assert_eq!(back.to_dense_values().unwrap(), dense);
+    let kept = kept.expect("a frame");
+    assert_eq!(kept.voxel_size, 0.5);
+    for a in 0..3 {
+        assert!((kept.origin[a] - frame.origin[a]).abs() < 1e-9, "{kept:?}");
+    }
+    // NIfTI: the voxel size is pixdim[1..=3] (bytes 80..92 of the header).
+    run(&["convert", &p("a.ktree"), &p("a.nii")]);
+    let nii = std::fs::read(p("a.nii")).unwrap();
+    for a in 0..3 {
+        let at = 80 + 4 * a;
+        let size = f32::from_le_bytes(nii[at..at + 4].try_into().unwrap());
+        assert_eq!(size, 0.5);
+    }
+    // --voxel-size overrides the frame.
+    run(&["convert", &p("a.ktree"), &p("d.ktree"), "--voxel-size", "2"]);
+    assert_eq!(framed("d.ktree").1.unwrap().voxel_size, 2.0);
+}

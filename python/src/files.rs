@@ -20,9 +20,21 @@ use crate::Tree;
 #[pymethods]
 impl Tree {
     /// Reads a tree file; the format is chosen by the extension. A `.ktree` file with values (version 3)
-    /// gives a tree with values (background 0).
+    /// or an OpenVDB grid with values (`Int32Grid`, `FloatGrid`, `Vec3SGrid`, …) gives a tree with values
+    /// (background 0).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        if path.extension().is_some_and(|e| e == "vdb") {
+            let name = path.display().to_string();
+            let bytes = std::fs::read(&path).map_err(|e| Failure::of_error(&e, &path))?;
+            if ktree::io::vdb_holds_values(&bytes, &name).unwrap_or(false) {
+                let read = py.detach(|| {
+                    ktree::io::read_vdb_values(&bytes, &name, None, None)
+                        .map_err(|e| Failure::of_error(&e, &path))
+                })?;
+                return Ok(Self::valued(read.tree, 0.0));
+            }
+        }
         if path.extension().is_some_and(|e| e == "ktree") && file_holds_values(&path) {
             let tree = py.detach(|| {
                 let name = path.display().to_string();
@@ -36,13 +48,23 @@ impl Tree {
     }
 
     /// Writes the tree (atomically: a temporary file renamed); the format is chosen by the extension. A
-    /// tree with values is written only as `.ktree` (version 3; other formats would drop the values: save
-    /// `tree.shape()` for them).
+    /// tree with values is written only as `.ktree` (version 3) or, an octree, as an OpenVDB typed grid
+    /// (`.vdb`: `Int32Grid`, `FloatGrid` or `Vec3SGrid`); other formats would drop the values: save
+    /// `tree.shape()` for them.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         if let Some(values) = &self.values {
+            if path.extension().is_some_and(|e| e == "vdb") {
+                let meta = ktree::io::GridMeta::default();
+                return Ok(py.detach(|| {
+                    ktree::fs::write_atomic_with(&path, |w| {
+                        ktree::io::write_any_valued_vdb(w, values, [0; 3], &meta)
+                    })
+                    .map_err(|e| Failure::of_error(&e, &path))
+                })?);
+            }
             if path.extension().is_none_or(|e| e != "ktree") {
                 return Err(Failure::Value(format!(
-                    "{}: a tree with values is saved as .ktree (save tree.shape() for other formats)",
+                    "{}: a tree with values is saved as .ktree or .vdb (save tree.shape() for other formats)",
                     path.display()
                 ))
                 .into());

@@ -34,4 +34,7 @@ pub use octomap_map::{
     read_bt_map, read_color_ot_map, read_ot_map, write_bt_map, write_color_ot_map, write_ot_map,
     OT_HEADER,
 };
-pub use vdb::{read_vdb, write_vdb, write_vdb_level_set};
+pub use vdb::{
+    read_vdb, read_vdb_values, vdb_holds_values, write_any_valued_vdb, write_vdb,
+    write_vdb_level_set, write_vdb_values, PlacedValues,
+};

@@ -350,7 +350,7 @@ pub(super) fn read_interior(
     coding: &ValueCoding,
 ) -> Result<GridBoxes, GridFileError> {
     let kind = coding.kind;
-    let background = r.value(kind, "background")?;
+    let background = r.scalar(kind, "background")?;
     let iso = match kind {
         ValueKind::F64 => (background - 1e-15).min(0.0),
         _ => f64::from((background as f32 - 1e-8).min(0.0)),
@@ -362,7 +362,7 @@ pub(super) fn read_interior(
     let mut seen = HashSet::new();
     for _ in 0..tiles {
         let o = root_origin(r, &mut seen, "root tile origin")?;
-        let value = r.value(kind, "tile value")?;
+        let value = r.scalar(kind, "tile value")?;
         r.take(1, "tile state")?;
         if value < iso {
             push_box(&mut boxes, r, o, [4096; 3])?;
@@ -375,7 +375,12 @@ pub(super) fn read_interior(
         let child_mask = r.mask(UPPER_WORDS)?;
         let value_mask = r.mask(UPPER_WORDS)?;
         let inside = r
-            .values(coding, UPPER_WORDS * 64, &value_mask, background)?
+            .values(
+                coding,
+                UPPER_WORDS * 64,
+                &value_mask,
+                [background, 0.0, 0.0],
+            )?
             .below(&value_mask, iso);
         for n in ones(&and_not(&inside, &child_mask)) {
             push_box(&mut boxes, r, corner_of(o, n, 5, 7), [128; 3])?;
@@ -385,7 +390,12 @@ pub(super) fn read_interior(
             let lower_children = r.mask(LOWER_WORDS)?;
             let lower_values = r.mask(LOWER_WORDS)?;
             let inside = r
-                .values(coding, LOWER_WORDS * 64, &lower_values, background)?
+                .values(
+                    coding,
+                    LOWER_WORDS * 64,
+                    &lower_values,
+                    [background, 0.0, 0.0],
+                )?
                 .below(&lower_values, iso);
             for m in ones(&and_not(&inside, &lower_children)) {
                 push_box(&mut boxes, r, corner_of(lo, m, 4, 3), [8; 3])?;
@@ -400,7 +410,7 @@ pub(super) fn read_interior(
         // topology's.
         r.take(8 * LEAF_WORDS, "leaf value mask")?;
         let inside = r
-            .values(coding, LEAF_WORDS * 64, mask, background)?
+            .values(coding, LEAF_WORDS * 64, mask, [background, 0.0, 0.0])?
             .below(mask, iso);
         add_leaf(&mut boxes, r, *lo, &inside)?;
     }
@@ -489,7 +499,7 @@ mod tests {
     }
 
     #[test]
-    fn a_fog_volume_is_refused_naming_its_class() {
+    fn a_fog_volume_reads_as_its_active_voxels_with_their_values() {
         let tree = KTree::from_rays(&ball_rays::<3>(4, [8, 8, 8], 10).unwrap());
         let mut bytes = Vec::new();
         write_vdb_level_set(&mut bytes, &tree, 2.0, 1.0).unwrap();
@@ -501,8 +511,16 @@ mod tests {
             &bytes[at + 9..],
         ]
         .concat();
-        let e = read_vdb(&fog, "fog.vdb", None, None).unwrap_err();
-        assert!(e.to_string().contains("\"fog volume\""), "{e}");
-        assert_eq!(e.offset(), Some(at as u64 - 4), "{e}");
+        let band = tree.narrow_band(2.0).unwrap();
+        let shape = read_vdb(&fog, "fog.vdb", None, None).unwrap().tree;
+        assert_eq!(shape.voxel_count(), band.len() as u128);
+        let values = crate::io::read_vdb_values(&fog, "fog.vdb", None, None).unwrap();
+        let crate::AnyValuedTree::K3F32(values) = values.tree else {
+            panic!("a FloatGrid reads as float32")
+        };
+        for (v, d) in band.iter() {
+            assert!(shape.contains(v));
+            assert_eq!(values.value_at(v), Some(d as f32));
+        }
     }
 }

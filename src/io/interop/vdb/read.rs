@@ -4,22 +4,20 @@
 use std::collections::HashSet;
 
 use super::level_set::read_interior;
-use super::values::{ones, Reader, ValueCoding, ValueKind};
+use super::values::{ones, Reader, Sample, ValueCoding, ValueKind};
 use super::*;
 use crate::io::interop::grid::{
     max_grid_nodes, place_boxes, GridBoxes, GridFileError, GridFileErrorKind, GridMeta,
     GridPlacement, IndexBox, PlacedTree, MAX_GRID_RUNS,
 };
 
-/// The grid types read, from a descriptor's type name (`_HalfFloat` marks a grid saved with half floats).
+/// A grid type read, from a descriptor's type name (`_HalfFloat` marks a grid saved with half floats).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum GridType {
-    /// `BoolGrid`: its active voxels.
-    Bool,
-    /// `MaskGrid`: its active voxels.
-    Mask,
-    /// `FloatGrid` or `DoubleGrid` of class level set: its interior.
-    Real { kind: ValueKind, half: bool },
+pub(super) struct GridType {
+    pub kind: ValueKind,
+    pub half: bool,
+    /// A `MaskGrid` (bool topology, no values in its leaves).
+    pub mask: bool,
 }
 
 impl GridType {
@@ -28,56 +26,57 @@ impl GridType {
             Some(base) => (base, true),
             None => (name, false),
         };
-        Some(match base {
-            BOOL_TREE => Self::Bool,
-            MASK_TREE => Self::Mask,
-            FLOAT_TREE => Self::Real {
-                kind: ValueKind::F32,
-                half,
-            },
-            DOUBLE_TREE => Self::Real {
-                kind: ValueKind::F64,
-                half,
-            },
+        let (kind, mask) = match base {
+            BOOL_TREE => (ValueKind::Bool, false),
+            MASK_TREE => (ValueKind::Bool, true),
+            FLOAT_TREE => (ValueKind::F32, false),
+            DOUBLE_TREE => (ValueKind::F64, false),
+            INT32_TREE => (ValueKind::I32, false),
+            INT64_TREE => (ValueKind::I64, false),
+            VEC3S_TREE => (ValueKind::Vec3S, false),
+            VEC3D_TREE => (ValueKind::Vec3D, false),
             _ => return None,
-        })
+        };
+        (!half || kind.is_float()).then_some(Self { kind, half, mask })
     }
 
-    fn name(self) -> &'static str {
-        match self {
-            Self::Bool => "BoolGrid",
-            Self::Mask => "MaskGrid",
-            Self::Real {
-                kind: ValueKind::F64,
-                ..
-            } => "DoubleGrid",
-            Self::Real { .. } => "FloatGrid",
+    pub fn name(self) -> &'static str {
+        match self.kind {
+            ValueKind::Bool if self.mask => "MaskGrid",
+            ValueKind::Bool => "BoolGrid",
+            ValueKind::F32 => "FloatGrid",
+            ValueKind::F64 => "DoubleGrid",
+            ValueKind::I32 => "Int32Grid",
+            ValueKind::I64 => "Int64Grid",
+            ValueKind::Vec3S => "Vec3SGrid",
+            ValueKind::Vec3D => "Vec3DGrid",
         }
     }
 
+    /// Whether a grid of this type and class is a level set (read as its interior).
+    pub fn is_level_set(self, class: Option<&str>) -> bool {
+        matches!(self.kind, ValueKind::F32 | ValueKind::F64) && class == Some("level set")
+    }
+
     /// How its node values are stored, under the file's compression flags.
-    fn coding(self, compression: u32) -> ValueCoding {
-        let (kind, half) = match self {
-            Self::Bool | Self::Mask => (ValueKind::Bool, false),
-            Self::Real { kind, half } => (kind, half),
-        };
+    pub fn coding(self, compression: u32) -> ValueCoding {
         ValueCoding {
             compression,
-            kind,
-            half,
+            kind: self.kind,
+            half: self.half,
         }
     }
 }
 
 /// What a grid's header (compression flags, metadata, transform) says.
-struct GridHeader {
-    compression: u32,
+pub(super) struct GridHeader {
+    pub compression: u32,
     /// ktree's own metadata: the universe level and offset a file was written with.
-    level: Option<u32>,
-    offset: Option<[i64; 3]>,
+    pub level: Option<u32>,
+    pub offset: Option<[i64; 3]>,
     /// The grid class (`class` metadata), and where its value is.
-    class: Option<(String, usize)>,
-    meta: GridMeta,
+    pub class: Option<(String, usize)>,
+    pub meta: GridMeta,
 }
 
 impl Reader<'_> {
@@ -273,92 +272,157 @@ pub(super) fn check_root_counts(
     Ok(())
 }
 
-/// The active voxels of a `BoolGrid` or `MaskGrid`'s tree (from its background on), as boxes. The node
-/// values are decoded (and so checked) but play no part.
-fn read_active(
+/// What a walk over a grid's active voxels ([`walk_active`]) meets, in the file's order.
+pub(super) trait ActiveVisitor {
+    /// Whether the walk decodes the values (else only the topology is read, and the leaf buffers of a
+    /// grid with values are left unread).
+    const VALUES: bool;
+
+    /// An active tile: the cube of side `side` at `origin`, its value (0 without [`Self::VALUES`]) stored
+    /// at byte `at`.
+    fn tile(
+        &mut self,
+        r: &Reader,
+        origin: [i64; 3],
+        side: u64,
+        value: Sample,
+        at: usize,
+    ) -> Result<(), GridFileError>;
+
+    /// The active voxels (`mask`) of the leaf at `origin`, and (with [`Self::VALUES`]) its 512 values,
+    /// whose buffer starts at byte `at`.
+    fn leaf(
+        &mut self,
+        r: &Reader,
+        origin: [i64; 3],
+        mask: &[u64],
+        values: &[Sample],
+        at: usize,
+    ) -> Result<(), GridFileError>;
+}
+
+/// The active voxels and tiles of a grid's tree (from its background on), shown to `visitor`. Values are
+/// decoded (and so checked) node by node as the file stores them.
+pub(super) fn walk_active<V: ActiveVisitor>(
     r: &mut Reader,
+    grid: GridType,
     coding: &ValueCoding,
-    is_bool: bool,
-) -> Result<GridBoxes, GridFileError> {
-    r.take(1, "background")?;
+    visitor: &mut V,
+) -> Result<(), GridFileError> {
+    let kind = coding.kind;
+    let background = r.value(kind, "background")?;
     let tiles = r.u32("root tile count")? as usize;
     let children = r.u32("root child count")? as usize;
-    check_root_counts(r, tiles, 14, children)?;
-    let mut boxes = GridBoxes::default();
+    check_root_counts(r, tiles, 12 + kind.size() + 1, children)?;
     let mut seen = HashSet::new();
     for _ in 0..tiles {
         let o = root_origin(r, &mut seen, "root tile origin")?;
-        r.take(1, "tile value")?;
+        let at = r.at;
+        let value = r.value(kind, "tile value")?;
         if r.take(1, "tile state")?[0] != 0 {
-            push_box(&mut boxes, r, o, [4096; 3])?;
+            visitor.tile(r, o, 4096, value, at)?;
         }
     }
-    let mut leaves = 0usize;
+    // An internal node's active tiles: the values that are active and not children.
+    let tiles_of = |r: &mut Reader,
+                    visitor: &mut V,
+                    count: usize,
+                    children: &[u64],
+                    lo: [i64; 3],
+                    (log_dim, child_log): (u32, u32)|
+     -> Result<(), GridFileError> {
+        let active = r.mask(count / 64)?;
+        let at = r.at;
+        let node = r.values(coding, count, &active, background)?;
+        let mut values = Vec::new();
+        if V::VALUES {
+            node.each(&active, |_, v| values.push(v));
+        }
+        for n in ones(&active) {
+            if children[n / 64] >> (n % 64) & 1 == 0 {
+                let value = values.get(n).copied().unwrap_or_default();
+                visitor.tile(
+                    r,
+                    corner_of(lo, n, log_dim, child_log),
+                    1 << child_log,
+                    value,
+                    at,
+                )?;
+            }
+        }
+        Ok(())
+    };
+    let mut leaves: Vec<([i64; 3], Vec<u64>)> = Vec::new();
     for _ in 0..children {
         let o = root_origin(r, &mut seen, "root child origin")?;
         let child_mask = r.mask(UPPER_WORDS)?;
-        let value_mask = r.mask(UPPER_WORDS)?;
-        r.values(coding, UPPER_WORDS * 64, &value_mask, 0.0)?;
-        for n in ones(&value_mask) {
-            if child_mask[n / 64] >> (n % 64) & 1 == 0 {
-                push_box(&mut boxes, r, corner_of(o, n, 5, 7), [128; 3])?;
-            }
-        }
+        tiles_of(r, visitor, UPPER_WORDS * 64, &child_mask, o, (5, 7))?;
         for n in ones(&child_mask) {
             let lo = corner_of(o, n, 5, 7);
             let lower_children = r.mask(LOWER_WORDS)?;
-            let lower_values = r.mask(LOWER_WORDS)?;
-            r.values(coding, LOWER_WORDS * 64, &lower_values, 0.0)?;
-            for m in ones(&lower_values) {
-                if lower_children[m / 64] >> (m % 64) & 1 == 0 {
-                    push_box(&mut boxes, r, corner_of(lo, m, 4, 3), [8; 3])?;
-                }
-            }
+            tiles_of(r, visitor, LOWER_WORDS * 64, &lower_children, lo, (4, 3))?;
             for m in ones(&lower_children) {
-                leaves += 1;
-                let leaf = r.mask(LEAF_WORDS)?;
-                add_leaf(&mut boxes, r, corner_of(lo, m, 4, 3), &leaf)?;
+                leaves.push((corner_of(lo, m, 4, 3), r.mask(LEAF_WORDS)?));
             }
         }
     }
-    if is_bool {
-        // Each bool leaf's buffer: its value mask, origin and values again.
-        for _ in 0..leaves {
+    for (lo, mask) in &leaves {
+        let at = r.at;
+        let mut values = Vec::new();
+        if kind == ValueKind::Bool && !grid.mask {
+            // A bool leaf's buffer: its value mask, origin and values again.
             r.take(2 * 8 * LEAF_WORDS + 12, "leaf buffer")?;
+        } else if V::VALUES {
+            // The buffer's copy of the value mask: OpenVDB reading a file seeks past it and keeps the
+            // topology's.
+            r.take(8 * LEAF_WORDS, "leaf value mask")?;
+            let node = r.values(coding, LEAF_WORDS * 64, mask, background)?;
+            node.each(mask, |_, v| values.push(v));
         }
+        visitor.leaf(r, *lo, mask, &values, at)?;
     }
-    Ok(boxes)
+    Ok(())
 }
 
-/// Reads an OpenVDB file's first `BoolGrid` or `MaskGrid` — its active voxels — or level set (a
-/// `FloatGrid` or `DoubleGrid` of class `level set`) — its interior, every voxel and tile whose value is
-/// below zero, active or not (see [`crate::io::interop`]'s notes on level sets) — into an octree, placed by
-/// `offset` and `level` (see [`GridPlacement::choose`]; the region chosen for is the one read). A file
-/// written by ktree carries its level and offset as grid metadata (`ktree_level`, `ktree_offset`), used
-/// when the caller gives none. Values may be stored raw or compressed as OpenVDB writes them: active-mask
-/// compression, zlib, Blosc (LZ4), half floats.
-///
-/// ```
-/// use ktree::io::{read_vdb, write_vdb_level_set};
-/// use ktree::{rays::ball_rays, KTree};
-/// let ball = KTree::from_rays(&ball_rays::<3>(5, [16, 16, 16], 24).unwrap());
-/// let mut sdf = Vec::new();
-/// write_vdb_level_set(&mut sdf, &ball, 3.0, 0.5).unwrap();
-/// assert_eq!(read_vdb(&sdf, "sdf.vdb", None, None).unwrap().tree, ball);
-/// ```
-///
-/// # Errors
-/// [`GridFileError`] naming the byte offset: not a `.vdb` file, a format version before 222, no grid of a
-/// type read, a `FloatGrid` or `DoubleGrid` of another class than level set (a fog volume, say; when no
-/// other grid is read), a transform other than a scale and translation, sizes beyond the file, compressed
-/// data that does not decode to its size, a Blosc codec other than LZ4, or voxels outside the universe
-/// asked for.
-pub fn read_vdb(
-    bytes: &[u8],
-    file: &str,
-    offset: Option<[i64; 3]>,
-    level: Option<u32>,
-) -> Result<PlacedTree, GridFileError> {
+/// The active voxels of a grid, as boxes.
+#[derive(Default)]
+struct ActiveBoxes(GridBoxes);
+
+impl ActiveVisitor for ActiveBoxes {
+    const VALUES: bool = false;
+
+    fn tile(
+        &mut self,
+        r: &Reader,
+        origin: [i64; 3],
+        side: u64,
+        _: Sample,
+        _: usize,
+    ) -> Result<(), GridFileError> {
+        push_box(&mut self.0, r, origin, [side; 3])
+    }
+
+    fn leaf(
+        &mut self,
+        r: &Reader,
+        origin: [i64; 3],
+        mask: &[u64],
+        _: &[Sample],
+        _: usize,
+    ) -> Result<(), GridFileError> {
+        add_leaf(&mut self.0, r, origin, mask)
+    }
+}
+
+/// The header of a file and the first grid of a type that `wanted` takes (given the type and its class),
+/// the reader left at the grid's tree (its buffer count). A grid passed over is named in the error when no
+/// grid is taken, with `why` (a sentence on what is read).
+pub(super) fn find_grid<'a>(
+    bytes: &'a [u8],
+    file: &'a str,
+    wanted: impl Fn(GridType, Option<&str>) -> bool,
+    why: &str,
+) -> Result<(Reader<'a>, GridType, GridHeader), GridFileError> {
     let mut r = Reader { bytes, at: 0, file };
     if r.i64("magic")? != MAGIC {
         r.at = 0;
@@ -406,14 +470,13 @@ pub fn read_vdb(
             // descriptors pointing at one long header again and again would otherwise take quadratic time.
             header_bytes += r.at.saturating_sub(usize::try_from(header_at).unwrap_or(0));
             let class = head.class.as_ref().map(|(c, _)| c.as_str());
-            if matches!(grid, GridType::Real { .. }) && class != Some("level set") {
+            if !wanted(grid, class) {
                 refused.get_or_insert_with(|| {
                     let at = head.class.as_ref().map_or(after_descriptor, |(_, at)| *at);
                     r.fail_at(
                         at,
                         GridFileErrorKind::Unsupported(format!(
-                            "a {} of class {:?}: of a FloatGrid or DoubleGrid only a level set's \
-                             interior (values below 0) is read",
+                            "a {} of class {:?}: {why}",
                             grid.name(),
                             shortened(class.unwrap_or("unknown"))
                         )),
@@ -445,23 +508,65 @@ pub fn read_vdb(
     }
     let Some((grid, head)) = found else {
         return Err(refused.unwrap_or_else(|| {
-            r.fail(GridFileErrorKind::Unsupported(
-                "no BoolGrid, MaskGrid or level set (FloatGrid, DoubleGrid) in the file".into(),
-            ))
+            r.fail(GridFileErrorKind::Unsupported(format!(
+                "no grid of a type read in the file: {why}"
+            )))
         }));
     };
-    let level = level.or(head.level);
-    let offset = offset.or(head.offset);
     if r.i32("buffer count")? != 1 {
         r.at -= 4;
         return Err(r.fail(GridFileErrorKind::Unsupported(
             "more than one buffer".into(),
         )));
     }
+    Ok((r, grid, head))
+}
+
+/// Reads an OpenVDB file's first `BoolGrid` or `MaskGrid` — its active voxels — or level set (a
+/// `FloatGrid` or `DoubleGrid` of class `level set`) — its interior, every voxel and tile whose value is
+/// below zero, active or not (see [`crate::io::interop`]'s notes on level sets) — into an octree, placed by
+/// `offset` and `level` (see [`GridPlacement::choose`]; the region chosen for is the one read). A file
+/// written by ktree carries its level and offset as grid metadata (`ktree_level`, `ktree_offset`), used
+/// when the caller gives none. Values may be stored raw or compressed as OpenVDB writes them: active-mask
+/// compression, zlib, Blosc (LZ4), half floats.
+///
+/// ```
+/// use ktree::io::{read_vdb, write_vdb_level_set};
+/// use ktree::{rays::ball_rays, KTree};
+/// let ball = KTree::from_rays(&ball_rays::<3>(5, [16, 16, 16], 24).unwrap());
+/// let mut sdf = Vec::new();
+/// write_vdb_level_set(&mut sdf, &ball, 3.0, 0.5).unwrap();
+/// assert_eq!(read_vdb(&sdf, "sdf.vdb", None, None).unwrap().tree, ball);
+/// ```
+///
+/// # Errors
+/// [`GridFileError`] naming the byte offset: not a `.vdb` file, a format version before 222, no grid of a
+/// type read, a `FloatGrid` or `DoubleGrid` of another class than level set (a fog volume, say; when no
+/// other grid is read), a transform other than a scale and translation, sizes beyond the file, compressed
+/// data that does not decode to its size, a Blosc codec other than LZ4, or voxels outside the universe
+/// asked for.
+pub fn read_vdb(
+    bytes: &[u8],
+    file: &str,
+    offset: Option<[i64; 3]>,
+    level: Option<u32>,
+) -> Result<PlacedTree, GridFileError> {
+    let (mut r, grid, head) = find_grid(
+        bytes,
+        file,
+        |_, _| true,
+        "BoolGrid, MaskGrid, Int32Grid, Int64Grid, FloatGrid, DoubleGrid, Vec3SGrid and Vec3DGrid are read",
+    )?;
+    let level = level.or(head.level);
+    let offset = offset.or(head.offset);
     let coding = grid.coding(head.compression);
-    let boxes = match grid {
-        GridType::Bool | GridType::Mask => read_active(&mut r, &coding, grid == GridType::Bool)?,
-        GridType::Real { .. } => read_interior(&mut r, &coding)?,
+    let class = head.class.as_ref().map(|(c, _)| c.as_str());
+    let boxes = if grid.is_level_set(class) {
+        read_interior(&mut r, &coding)?
+    } else {
+        let mut active = ActiveBoxes::default();
+        walk_active(&mut r, grid, &coding, &mut active)?;
+        active.0
     };
     let placement = GridPlacement::choose(boxes.known, offset, level)
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;

@@ -58,7 +58,7 @@ fn a_grid_end_before_its_descriptor_is_refused_at_the_first_descriptor() {
     let mut b = file_head();
     b.extend_from_slice(&100_000i32.to_le_bytes());
     let descriptor_at = b.len() as i64;
-    for s in ["g", "Tree_vec3s_5_4_3", ""] {
+    for s in ["g", "Tree_vec3i_5_4_3", ""] {
         put_str(&mut b, s);
     }
     let end_field_at = b.len() + 16;
@@ -71,10 +71,10 @@ fn a_grid_end_before_its_descriptor_is_refused_at_the_first_descriptor() {
 }
 
 #[test]
-fn fog_volumes_are_passed_over_and_refused_by_their_class() {
+fn level_sets_are_passed_over_by_the_value_reader_and_named_by_their_class() {
     // A header, then 3000 descriptors of FloatGrids, each followed by a byte and pointing at one header
-    // of 2000 metadata entries and class "fog volume": the scan stops reading that header again once
-    // twice the file's length has been read, and says why the file is refused.
+    // of 2000 metadata entries and class "level set": reading values, the scan stops reading that header
+    // again once twice the file's length has been read, and says why the file is refused.
     let mut b = file_head();
     let count = 3000;
     b.extend_from_slice(&(count as i32).to_le_bytes());
@@ -105,14 +105,14 @@ fn fog_volumes_are_passed_over_and_refused_by_their_class() {
         put_u32(&mut b, 0);
     }
     let class_at = b.len() + 4 + 5 + 4 + 6;
-    for s in ["class", "string", "fog volume"] {
+    for s in ["class", "string", "level set"] {
         put_str(&mut b, s);
     }
     put_str(&mut b, "TranslationMap");
     b.extend_from_slice(&[0; 24]);
-    let e = read_vdb(&b, "fog", None, None).unwrap_err();
+    let e = read_vdb_values(&b, "sdf", None, None).unwrap_err();
     assert!(
-        matches!(&e.kind, GridFileErrorKind::Unsupported(m) if m.contains("\"fog volume\"")),
+        matches!(&e.kind, GridFileErrorKind::Unsupported(m) if m.contains("\"level set\"")),
         "{e}"
     );
     assert_eq!(e.offset(), Some(class_at as u64), "{e}");

@@ -89,9 +89,14 @@ impl<'a> Reader<'a> {
     }
 
     /// One value of the grid's type at full precision (a background, a tile, an inactive value).
-    pub fn value(&mut self, kind: ValueKind, what: &str) -> Result<f64, GridFileError> {
+    pub fn value(&mut self, kind: ValueKind, what: &str) -> Result<Sample, GridFileError> {
         let b = self.take(kind.size(), what)?;
         Ok(kind.decode(b, false))
+    }
+
+    /// One scalar value (a level set's background or tile): a vector's first component.
+    pub fn scalar(&mut self, kind: ValueKind, what: &str) -> Result<f64, GridFileError> {
+        self.value(kind, what).map(|v| v[0])
     }
 
     /// `n` bytes of a value buffer: raw, or the chunk the compression flags say.
@@ -137,7 +142,7 @@ impl<'a> Reader<'a> {
         coding: &ValueCoding,
         count: usize,
         active: &[u64],
-        background: f64,
+        background: Sample,
     ) -> Result<NodeValues<'a>, GridFileError> {
         let kind = coding.kind;
         let flag_at = self.at;
@@ -173,7 +178,11 @@ impl<'a> Reader<'a> {
         } else {
             count
         };
-        let size = if coding.half { 2 } else { kind.size() };
+        let size = if coding.half {
+            2 * kind.components()
+        } else {
+            kind.size()
+        };
         let stored = if coding.half && stored == 0 {
             Cow::Borrowed(&[][..])
         } else {
@@ -204,14 +213,14 @@ pub(super) struct NodeValues<'a> {
     /// Whether only the active values are stored.
     masked: bool,
     /// The inactive values where the selection mask's bit is off and on.
-    inactive: [f64; 2],
+    inactive: [Sample; 2],
     selection: Option<&'a [u8]>,
 }
 
 impl NodeValues<'_> {
     /// Calls `f(n, value)` for each value `n` of the node in order; `active` is the value mask the
     /// values were read with.
-    pub fn each(&self, active: &[u64], mut f: impl FnMut(usize, f64)) {
+    pub fn each(&self, active: &[u64], mut f: impl FnMut(usize, Sample)) {
         let mut stored = self
             .stored
             .chunks_exact(self.size)
@@ -231,7 +240,7 @@ impl NodeValues<'_> {
     pub fn below(&self, active: &[u64], threshold: f64) -> Vec<u64> {
         let mut mask = vec![0u64; self.count.div_ceil(64)];
         self.each(active, |n, v| {
-            if v < threshold {
+            if v[0] < threshold {
                 mask[n / 64] |= 1 << (n % 64);
             }
         });
@@ -255,6 +264,10 @@ fn inflate(chunk: &[u8], n: usize) -> Result<Vec<u8>, String> {
     Ok(out)
 }
 
+/// One value of a grid: its components (a scalar is the first, the others 0), each exact for every type read
+/// (`int64` beyond 2^53 rounded).
+pub(super) type Sample = [f64; 3];
+
 /// A grid's value type, as stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum ValueKind {
@@ -264,34 +277,65 @@ pub(super) enum ValueKind {
     F32,
     /// `double`.
     F64,
+    /// `int32`.
+    I32,
+    /// `int64`.
+    I64,
+    /// `vec3s`: three floats.
+    Vec3S,
+    /// `vec3d`: three doubles.
+    Vec3D,
 }
 
 impl ValueKind {
-    /// Bytes of one value at full precision.
-    pub fn size(self) -> usize {
+    /// Components of a value.
+    pub fn components(self) -> usize {
         match self {
-            Self::Bool => 1,
-            Self::F32 => 4,
-            Self::F64 => 8,
+            Self::Vec3S | Self::Vec3D => 3,
+            _ => 1,
         }
     }
 
-    fn decode(self, b: &[u8], half: bool) -> f64 {
-        if half && self != Self::Bool {
-            return half::f16::from_le_bytes([b[0], b[1]]).to_f64();
+    /// Bytes of one value at full precision.
+    pub fn size(self) -> usize {
+        self.components()
+            * match self {
+                Self::Bool => 1,
+                Self::F32 | Self::I32 | Self::Vec3S => 4,
+                Self::F64 | Self::I64 | Self::Vec3D => 8,
+            }
+    }
+
+    /// Whether its values are floating point (and so may be stored as half floats).
+    pub fn is_float(self) -> bool {
+        matches!(self, Self::F32 | Self::F64 | Self::Vec3S | Self::Vec3D)
+    }
+
+    fn decode(self, b: &[u8], half: bool) -> Sample {
+        let mut v = [0.0; 3];
+        let size = if half && self.is_float() {
+            2
+        } else {
+            self.size() / self.components()
+        };
+        for (c, b) in v.iter_mut().zip(b.chunks_exact(size)) {
+            *c = match (self, size) {
+                (Self::Bool, _) => f64::from(u8::from(b[0] != 0)),
+                (_, 2) => half::f16::from_le_bytes([b[0], b[1]]).to_f64(),
+                (Self::I32, _) => f64::from(i32::from_le_bytes(b.try_into().expect("4 bytes"))),
+                (Self::I64, _) => i64::from_le_bytes(b.try_into().expect("8 bytes")) as f64,
+                (_, 4) => f64::from(f32::from_le_bytes(b.try_into().expect("4 bytes"))),
+                _ => f64::from_le_bytes(b.try_into().expect("8 bytes")),
+            };
         }
-        match self {
-            Self::Bool => f64::from(u8::from(b[0] != 0)),
-            Self::F32 => f64::from(f32::from_le_bytes(b.try_into().expect("4 bytes"))),
-            Self::F64 => f64::from_le_bytes(b.try_into().expect("8 bytes")),
-        }
+        v
     }
 
     /// OpenVDB's `math::negative` of a value (a bool is its own negative).
-    fn negative(self, v: f64) -> f64 {
+    fn negative(self, v: Sample) -> Sample {
         match self {
             Self::Bool => v,
-            _ => -v,
+            _ => v.map(|c| -c),
         }
     }
 }
@@ -338,11 +382,11 @@ mod tests {
         active: &[u64],
         background: f64,
     ) -> Result<Vec<f64>, GridFileError> {
-        let node = reader(bytes).values(coding, count, active, background)?;
+        let node = reader(bytes).values(coding, count, active, [background, 0.0, 0.0])?;
         let mut all = Vec::new();
         node.each(active, |n, v| {
             assert_eq!(n, all.len());
-            all.push(v);
+            all.push(v[0]);
         });
         Ok(all)
     }

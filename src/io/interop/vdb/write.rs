@@ -8,65 +8,83 @@ use super::*;
 use crate::io::interop::grid::GridMeta;
 use crate::tree::{KTree, NodeState};
 
-/// A 16³ internal node: 8³ tiles that are fully active, and leaves (8³ bit masks) by slot.
-#[derive(Default)]
-struct Lower {
-    tiles: Vec<bool>,
-    leaves: BTreeMap<u32, [u64; LEAF_WORDS]>,
+/// A node of OpenVDB's tree: which of its `n` tiles (or voxels, in a leaf) are active, all `n` values of
+/// `width` bytes each (0 where inactive), and its children by slot.
+struct Node<C> {
+    active: Vec<u64>,
+    values: Vec<u8>,
+    children: BTreeMap<u32, C>,
 }
 
-/// A 32³ internal node: 128³ tiles that are fully active, and lower nodes by slot.
-#[derive(Default)]
-struct Upper {
-    tiles: Vec<bool>,
-    lowers: BTreeMap<u32, Lower>,
-}
-
-/// The grid of a tree in OpenVDB's node structure, voxels at index = ktree voxel − `offset`.
-fn build_nodes(tree: &KTree<3>, offset: [i64; 3]) -> BTreeMap<[i64; 3], Upper> {
-    let mut root: BTreeMap<[i64; 3], Upper> = BTreeMap::new();
-    tree.for_each_leaf(|cell, state| {
-        if state != NodeState::Full {
-            return;
+impl<C> Node<C> {
+    fn new(words: usize, width: usize) -> Self {
+        Self {
+            active: vec![0; words],
+            values: vec![0; words * 64 * width],
+            children: BTreeMap::new(),
         }
-        let side = cell.side() as i64;
-        let lo: [i64; 3] = std::array::from_fn(|a| i64::from(cell.origin[a]) - offset[a]);
-        add_box(&mut root, lo, side);
-    });
-    root
+    }
+
+    fn set(&mut self, n: usize, value: &[u8]) {
+        self.active[n / 64] |= 1 << (n % 64);
+        self.values[n * value.len()..(n + 1) * value.len()].copy_from_slice(value);
+    }
 }
 
-/// Marks the cube `[lo, lo + side)³` active, as tiles where whole nodes are covered.
-fn add_box(root: &mut BTreeMap<[i64; 3], Upper>, lo: [i64; 3], side: i64) {
-    // Split the cube into the blocks of side `step` it covers: 128 (upper tiles), 8 (lower tiles), 1.
-    let covers = |step: i64| lo.iter().all(|&c| c % step == 0) && side % step == 0;
-    let step = [128, 8, 1].into_iter().find(|&s| covers(s)).unwrap_or(1);
-    let n = side / step;
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
-                let p = [lo[0] + i * step, lo[1] + j * step, lo[2] + k * step];
-                let upper = root.entry(origin_of(p, 12)).or_default();
-                if upper.tiles.is_empty() {
-                    upper.tiles = vec![false; UPPER_WORDS * 64];
+type Leaf = Node<()>;
+type Lower = Node<Leaf>;
+type Upper = Node<Lower>;
+
+/// A grid in OpenVDB's node structure (root → 32³ → 16³ → 8³ leaves), built from cubes of one value each
+/// (`width` bytes as the grid stores it): whole nodes covered become active tiles.
+pub(super) struct GridNodes {
+    width: usize,
+    root: BTreeMap<[i64; 3], Upper>,
+}
+
+impl GridNodes {
+    pub fn new(width: usize) -> Self {
+        Self {
+            width,
+            root: BTreeMap::new(),
+        }
+    }
+
+    /// Makes the cube `[lo, lo + side)³` active with `value`, as tiles where whole nodes are covered.
+    pub fn add_cube(&mut self, lo: [i64; 3], side: i64, value: &[u8]) {
+        // Split the cube into the blocks of side `step` it covers: 128 (upper tiles), 8 (lower tiles), 1.
+        let covers = |step: i64| lo.iter().all(|&c| c % step == 0) && side % step == 0;
+        let step = [128, 8, 1].into_iter().find(|&s| covers(s)).unwrap_or(1);
+        let n = side / step;
+        let width = self.width;
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let p = [lo[0] + i * step, lo[1] + j * step, lo[2] + k * step];
+                    let upper = self
+                        .root
+                        .entry(origin_of(p, 12))
+                        .or_insert_with(|| Node::new(UPPER_WORDS, width));
+                    let us = slot(p, 5, 7);
+                    if step == 128 {
+                        upper.set(us as usize, value);
+                        continue;
+                    }
+                    let lower = upper
+                        .children
+                        .entry(us)
+                        .or_insert_with(|| Node::new(LOWER_WORDS, width));
+                    let ls = slot(p, 4, 3);
+                    if step == 8 {
+                        lower.set(ls as usize, value);
+                        continue;
+                    }
+                    let leaf = lower
+                        .children
+                        .entry(ls)
+                        .or_insert_with(|| Node::new(LEAF_WORDS, width));
+                    leaf.set(slot(p, 3, 0) as usize, value);
                 }
-                let us = slot(p, 5, 7);
-                if step == 128 {
-                    upper.tiles[us as usize] = true;
-                    continue;
-                }
-                let lower = upper.lowers.entry(us).or_default();
-                if lower.tiles.is_empty() {
-                    lower.tiles = vec![false; LOWER_WORDS * 64];
-                }
-                let ls = slot(p, 4, 3);
-                if step == 8 {
-                    lower.tiles[ls as usize] = true;
-                    continue;
-                }
-                let leaf = lower.leaves.entry(ls).or_insert([0; LEAF_WORDS]);
-                let n = slot(p, 3, 0) as usize;
-                leaf[n / 64] |= 1 << (n % 64);
             }
         }
     }
@@ -120,16 +138,135 @@ pub(super) fn put_grid_head(
     (positions_at, grid_at)
 }
 
-fn put_mask(out: &mut Vec<u8>, bits: impl Iterator<Item = bool>, words: usize) {
-    let mut w = vec![0u64; words];
-    for (n, on) in bits.enumerate() {
-        if on {
-            w[n / 64] |= 1 << (n % 64);
+fn put_words(out: &mut Vec<u8>, words: &[u64]) {
+    for w in words {
+        out.extend_from_slice(&w.to_le_bytes());
+    }
+}
+
+/// The mask of a node's children.
+fn child_mask<C>(node: &Node<C>, words: usize) -> Vec<u64> {
+    let mut mask = vec![0u64; words];
+    for &n in node.children.keys() {
+        mask[n as usize / 64] |= 1 << (n % 64);
+    }
+    mask
+}
+
+/// Checks that a universe of `level` at `offset` fits OpenVDB's 32-bit indices and the voxel size is a
+/// positive number.
+pub(super) fn check_placement(
+    level: u32,
+    offset: [i64; 3],
+    meta: &GridMeta,
+) -> std::io::Result<()> {
+    let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, m);
+    let side = 1i64 << level;
+    for a in 0..3 {
+        if i32::try_from(offset[a]).is_err() || side - offset[a] > i64::from(i32::MAX) {
+            return Err(invalid(format!(
+                "offset {offset:?} puts indices outside OpenVDB's 32-bit range"
+            )));
         }
     }
-    for x in w {
-        out.extend_from_slice(&x.to_le_bytes());
+    let s = meta.voxel_size;
+    if !(s > 0.0 && s.is_finite()) {
+        return Err(invalid(format!("voxel size {s} is not a positive number")));
     }
+    Ok(())
+}
+
+/// Writes a file of one grid named `ktree` of tree type `tree_type` holding `nodes`, uncompressed, with
+/// ktree's metadata (`level`, `offset`) and the transform of `meta`; background 0. A `BoolGrid`'s leaves
+/// store their values as bits, the others' as `6` (all values follow) and the 512 values.
+pub(super) fn write_grid(
+    mut w: impl Write,
+    nodes: &GridNodes,
+    tree_type: &str,
+    level: u32,
+    offset: [i64; 3],
+    meta: &GridMeta,
+) -> std::io::Result<()> {
+    let mut out = Vec::new();
+    out.extend_from_slice(&MAGIC.to_le_bytes());
+    put_u32(&mut out, FILE_VERSION);
+    put_u32(&mut out, 10);
+    put_u32(&mut out, 0);
+    out.push(1); // the grid descriptors carry offsets
+    let uuid_at = out.len();
+    out.extend_from_slice(&[b'0'; 36]); // filled in below from the grid's bytes
+    let (positions_at, grid_at) = put_grid_head(&mut out, tree_type, "unknown", level, offset);
+    put_str(&mut out, "UniformScaleTranslateMap");
+    let s = meta.voxel_size;
+    let centre = meta.origin.map(|o| o + s / 2.0);
+    for v in [
+        centre,
+        [s; 3],
+        [s; 3],
+        [1.0 / s; 3],
+        [1.0 / (s * s); 3],
+        [0.5 / s; 3],
+    ] {
+        for x in v {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    // Topology: the root, then each internal node's masks and values, each leaf's value mask.
+    put_u32(&mut out, 1); // buffer count
+    out.extend(std::iter::repeat_n(0u8, nodes.width)); // background: 0
+    put_u32(&mut out, 0); // root tiles
+    put_u32(&mut out, nodes.root.len() as u32);
+    for (origin, upper) in &nodes.root {
+        for c in origin {
+            out.extend_from_slice(&(*c as i32).to_le_bytes());
+        }
+        put_words(&mut out, &child_mask(upper, UPPER_WORDS));
+        put_words(&mut out, &upper.active);
+        out.push(6); // all values follow, uncompressed
+        out.extend_from_slice(&upper.values);
+        for lower in upper.children.values() {
+            put_words(&mut out, &child_mask(lower, LOWER_WORDS));
+            put_words(&mut out, &lower.active);
+            out.push(6);
+            out.extend_from_slice(&lower.values);
+            for leaf in lower.children.values() {
+                put_words(&mut out, &leaf.active);
+            }
+        }
+    }
+    // Buffers: each leaf's value mask, then its origin and values as bits (bool) or its values.
+    let block_at = out.len();
+    for (origin, upper) in &nodes.root {
+        for (&us, lower) in &upper.children {
+            for (&ls, leaf) in &lower.children {
+                put_words(&mut out, &leaf.active);
+                if tree_type == BOOL_TREE {
+                    let leaf_origin =
+                        corner_of(corner_of(*origin, us as usize, 5, 7), ls as usize, 4, 3);
+                    for c in leaf_origin {
+                        out.extend_from_slice(&(c as i32).to_le_bytes());
+                    }
+                    put_words(&mut out, &leaf.active);
+                } else {
+                    out.push(6);
+                    out.extend_from_slice(&leaf.values);
+                }
+            }
+        }
+    }
+    let end_at = out.len();
+    for (i, p) in [grid_at, block_at, end_at].into_iter().enumerate() {
+        out[positions_at + 8 * i..positions_at + 8 * i + 8]
+            .copy_from_slice(&(p as i64).to_le_bytes());
+    }
+    let crc = crc32fast::hash(&out[grid_at..]);
+    let uuid = format!(
+        "{crc:08x}-0000-4000-8000-{:012x}",
+        (end_at - grid_at) as u64 & 0xFFFF_FFFF_FFFF
+    );
+    out[uuid_at..uuid_at + 36].copy_from_slice(uuid.as_bytes());
+    w.write_all(&out)?;
+    w.flush()
 }
 
 /// Writes an octree as an OpenVDB file with one `BoolGrid` named `ktree`: OpenVDB index = ktree voxel −
@@ -148,113 +285,18 @@ fn put_mask(out: &mut Vec<u8>, bits: impl Iterator<Item = bool>, words: usize) {
 /// Any I/O error; [`std::io::ErrorKind::InvalidInput`] if an index falls outside OpenVDB's 32-bit range or
 /// the voxel size is not positive.
 pub fn write_vdb(
-    mut w: impl Write,
+    w: impl Write,
     tree: &KTree<3>,
     offset: [i64; 3],
     meta: &GridMeta,
 ) -> std::io::Result<()> {
-    let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, m);
-    let side = 1i64 << tree.level();
-    for a in 0..3 {
-        if i32::try_from(offset[a]).is_err() || side - offset[a] > i64::from(i32::MAX) {
-            return Err(invalid(format!(
-                "offset {offset:?} puts indices outside OpenVDB's 32-bit range"
-            )));
+    check_placement(tree.level(), offset, meta)?;
+    let mut nodes = GridNodes::new(1);
+    tree.for_each_leaf(|cell, state| {
+        if state == NodeState::Full {
+            let lo = std::array::from_fn(|a| i64::from(cell.origin[a]) - offset[a]);
+            nodes.add_cube(lo, cell.side() as i64, &[1]);
         }
-    }
-    let s = meta.voxel_size;
-    if !(s > 0.0 && s.is_finite()) {
-        return Err(invalid(format!("voxel size {s} is not a positive number")));
-    }
-    let root = build_nodes(tree, offset);
-    let mut out = Vec::new();
-    out.extend_from_slice(&MAGIC.to_le_bytes());
-    put_u32(&mut out, FILE_VERSION);
-    put_u32(&mut out, 10);
-    put_u32(&mut out, 0);
-    out.push(1); // the grid descriptors carry offsets
-    let crc = crc32fast::hash(
-        &tree
-            .level_states(tree.depth_count() - 1)
-            .words()
-            .iter()
-            .flat_map(|w| w.to_le_bytes())
-            .collect::<Vec<u8>>(),
-    );
-    let uuid = format!("{crc:08x}-0000-4000-8000-{:012x}", tree.node_count());
-    out.extend_from_slice(uuid.as_bytes());
-    let (positions_at, grid_at) =
-        put_grid_head(&mut out, BOOL_TREE, "unknown", tree.level(), offset);
-    put_str(&mut out, "UniformScaleTranslateMap");
-    let centre = meta.origin.map(|o| o + s / 2.0);
-    for v in [
-        centre,
-        [s; 3],
-        [s; 3],
-        [1.0 / s; 3],
-        [1.0 / (s * s); 3],
-        [0.5 / s; 3],
-    ] {
-        for x in v {
-            out.extend_from_slice(&x.to_le_bytes());
-        }
-    }
-    // Topology.
-    put_u32(&mut out, 1); // buffer count
-    out.push(0); // background: false
-    put_u32(&mut out, 0); // root tiles
-    put_u32(&mut out, root.len() as u32);
-    for (origin, upper) in &root {
-        for c in origin {
-            out.extend_from_slice(&(*c as i32).to_le_bytes());
-        }
-        put_mask(
-            &mut out,
-            (0..UPPER_WORDS * 64).map(|n| upper.lowers.contains_key(&(n as u32))),
-            UPPER_WORDS,
-        );
-        put_mask(&mut out, upper.tiles.iter().copied(), UPPER_WORDS);
-        out.push(6); // all values follow, uncompressed
-        out.extend(upper.tiles.iter().map(|&t| u8::from(t)));
-        for lower in upper.lowers.values() {
-            put_mask(
-                &mut out,
-                (0..LOWER_WORDS * 64).map(|n| lower.leaves.contains_key(&(n as u32))),
-                LOWER_WORDS,
-            );
-            put_mask(&mut out, lower.tiles.iter().copied(), LOWER_WORDS);
-            out.push(6);
-            out.extend(lower.tiles.iter().map(|&t| u8::from(t)));
-            for leaf in lower.leaves.values() {
-                for x in leaf {
-                    out.extend_from_slice(&x.to_le_bytes());
-                }
-            }
-        }
-    }
-    let block_at = out.len();
-    for (origin, upper) in &root {
-        for (&us, lower) in &upper.lowers {
-            for (&ls, leaf) in &lower.leaves {
-                for x in leaf {
-                    out.extend_from_slice(&x.to_le_bytes());
-                }
-                let leaf_origin =
-                    corner_of(corner_of(*origin, us as usize, 5, 7), ls as usize, 4, 3);
-                for c in leaf_origin {
-                    out.extend_from_slice(&(c as i32).to_le_bytes());
-                }
-                for x in leaf {
-                    out.extend_from_slice(&x.to_le_bytes());
-                }
-            }
-        }
-    }
-    let end_at = out.len();
-    for (i, p) in [grid_at, block_at, end_at].into_iter().enumerate() {
-        out[positions_at + 8 * i..positions_at + 8 * i + 8]
-            .copy_from_slice(&(p as i64).to_le_bytes());
-    }
-    w.write_all(&out)?;
-    w.flush()
+    });
+    write_grid(w, &nodes, BOOL_TREE, tree.level(), offset, meta)
 }
