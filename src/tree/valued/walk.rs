@@ -17,7 +17,7 @@ use crate::value::Value;
 pub type LeafValue<V> = (u32, Option<V>);
 
 /// A valued tree stored in level order, read one block of siblings at a time, reads failing like those of
-/// [`TreeStorage`](crate::tree::storage::TreeStorage): a valued tree in memory ([`KTree`] with a value type,
+/// [`TreeStorage`]: a valued tree in memory ([`KTree`] with a value type,
 /// [`Infallible`] reads) or a valued `.ktree` file read in place. A binary tree is one with `Value = ()`.
 pub trait ValueStorage<const K: usize> {
     /// What a voxel holds.
@@ -322,7 +322,7 @@ impl<const K: usize, T: ValueStorage<K>> Iterator for ValueLeaves<'_, K, T> {
 }
 
 /// A valued tree read as a tree without values of the same nodes — a mixed node (`11`) reads as a node
-/// with children (`10`) — so every walk, picture and query of a [`TreeStorage`](crate::tree::storage::TreeStorage)
+/// with children (`10`) — so every walk, picture and query of a [`TreeStorage`]
 /// sees each full leaf of the valued tree as one full leaf: the leaves where one value holds. The tree it
 /// shows is the valued tree's [shape](KTree::shape), not reduced where a mixed node stands.
 ///
@@ -344,7 +344,7 @@ fn mixed_as_partial(codes: u32) -> u32 {
     codes & !mixed
 }
 
-impl<const K: usize, V: Value> crate::tree::storage::TreeStorage<K> for LeavesOfValues<'_, K, V> {
+impl<const K: usize, V: Value> TreeStorage<K> for LeavesOfValues<'_, K, V> {
     type Error = Infallible;
 
     fn universe(&self) -> Universe<K> {
