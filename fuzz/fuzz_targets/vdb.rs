@@ -1,4 +1,5 @@
-//! The OpenVDB `.vdb` reader on arbitrary bytes: it never panics, and whatever it accepts is a well-formed tree.
+//! The OpenVDB `.vdb` readers on arbitrary bytes: they never panic, and whatever they accept is a
+//! well-formed tree (the binary reader's voxels, the typed reader's values).
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
@@ -8,5 +9,8 @@ fuzz_target!(|data: &[u8]| {
             .tree
             .check()
             .expect("a tree from a reader is well formed");
+    }
+    if let Ok(placed) = ktree::io::read_vdb_values(data, "fuzz", None, None) {
+        ktree::with_valued!(&placed.tree, t => t.assert_well_formed());
     }
 });
