@@ -30,10 +30,17 @@ use crate::value::Value;
 use crate::KTree;
 
 impl<const K: usize, V: Value> KTree<K, V> {
-    /// The minimal valued tree of `runs`, on the threads of the current rayon pool: the subtrees of cells
-    /// of about 2^18 voxels built apart ([`default_split_depth`], see [`KTree::from_value_runs_split`]).
+    /// The minimal valued tree of `runs`, on the threads of the current rayon pool: with more than one,
+    /// the subtrees of cells of about 2^18 voxels built apart ([`default_split_depth`], see
+    /// [`KTree::from_value_runs_split`]); with one, in a single depth-first pass (joining the subtrees'
+    /// levels costs about a tenth more there).
     pub fn from_value_runs(runs: &ValueRuns<K, V>) -> KTree<K, V> {
-        Self::from_value_runs_split(runs, default_split_depth(K, runs.universe().level()))
+        let split = if rayon::current_num_threads() > 1 {
+            default_split_depth(K, runs.universe().level())
+        } else {
+            0
+        };
+        Self::from_value_runs_split(runs, split)
     }
 
     /// [`KTree::from_value_runs`] on the threads of the current rayon pool: the subtrees of the cells of
