@@ -88,8 +88,9 @@ pub fn run(a: Args) -> CliResult {
         }
         return crate::convert_values::convert_valued(&a.input, &a.output, placement);
     }
+    // A typed grid keeps its values in every output that holds them; the others get its shape.
     if Format::of(&a.input) == Some(Format::Vdb)
-        && Format::of(&a.output) == Some(Format::Ktree)
+        && ktree::io::keeps_values(&a.output)
         && vdb_with_values(&a.input)
     {
         return crate::convert_values::vdb_to_valued(&a.input, &a.output, a.level, a.offset);

@@ -8,17 +8,13 @@
 
 use std::path::Path;
 
-use ktree::export::surface::value_boundary_mesh;
-use ktree::export::vtk::{write_values_time_slices, write_values_vtk_file};
-use ktree::export::{write_value_surface, MeshFormat};
-use ktree::io::ktree::v3::{
-    read_valued_ktree_framed, write_valued_ktree_file, write_valued_ktree_file_framed,
-};
-use ktree::io::{read_vdb_values, write_nifti_file, write_vdb_values};
+use ktree::export::vtk::write_values_time_slices;
+use ktree::io::ktree::v3::{read_valued_ktree_framed, write_valued_ktree_file};
+use ktree::io::{read_vdb_values, write_valued_tree, WriteOptions, WrittenValues};
 use ktree::solid::volume::Volume;
 use ktree::space::WorldFrame;
 use ktree::tree::AnyValuedTree;
-use ktree::value::{Dtype, Value};
+use ktree::value::Value;
 use ktree::KTree;
 
 use crate::common::error::{cannot_read, CliError, CliResult};
@@ -45,80 +41,20 @@ impl Placement {
     }
 }
 
-/// What a tree with values is written as, by the output's extension.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Output {
-    /// `.nii`, `.nii.gz` (octrees).
-    Nifti,
-    /// `.vdb`: an OpenVDB typed grid (octrees).
-    Vdb,
-    /// `.vtu`, `.htg` (quadtrees and octrees).
-    Vtk,
-    /// `.ply`, `.obj`, `.glb`: the surface of each value with its colour (octrees).
-    Mesh,
-    /// `.ktree` (any K).
-    Ktree,
-}
-
-impl Output {
-    fn of(output: &Path) -> Option<Self> {
-        let name = output.to_string_lossy();
-        let ends = |e: &str| name.ends_with(e);
-        Some(if ends(".nii") || ends(".nii.gz") {
-            Output::Nifti
-        } else if ends(".vdb") {
-            Output::Vdb
-        } else if ends(".vtu") || ends(".htg") {
-            Output::Vtk
-        } else if ends(".ktree") {
-            Output::Ktree
-        } else if matches!(
-            MeshFormat::of(output),
-            Some(MeshFormat::Ply | MeshFormat::Obj | MeshFormat::Glb)
-        ) {
-            Output::Mesh
-        } else {
-            return None;
-        })
-    }
-
-    /// Whether the output holds trees of `k` dimensions; else what it holds.
-    fn holds(self, k: usize) -> Result<(), &'static str> {
-        match self {
-            Output::Ktree => Ok(()),
-            Output::Vtk if k == 2 || k == 3 => Ok(()),
-            Output::Vtk => Err("VTK files hold quadtrees and octrees (K = 2, 3)"),
-            _ if k == 3 => Ok(()),
-            Output::Nifti => Err("NIfTI volumes hold octrees (K = 3)"),
-            Output::Vdb => Err("OpenVDB grids hold octrees (K = 3)"),
-            Output::Mesh => Err("the surfaces of values are made for octrees (K = 3)"),
-        }
-    }
-}
-
 /// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz`, `.vdb`, `.vtu`, `.htg`, `.ply`,
-/// `.obj`, `.glb` or `.ktree`), placed by `placement`, the rest as the input's world frame places it.
+/// `.obj`, `.glb` or `.ktree`: see [`write_valued_tree`]), placed by `placement`, the rest as the input's
+/// world frame places it.
 pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliResult {
     let (k, dtype) = crate::values::file_dtype(input)?;
     let dtype = dtype.ok_or_else(|| format!("{}: the tree holds no values", input.display()))?;
-    let Some(format) = Output::of(output) else {
-        return Err(format!(
-            "{}: a tree with values ({}) converts to NIfTI (.nii, .nii.gz), OpenVDB (.vdb), VTK (.vtu, \
-             .htg), the surfaces of its values with their colours (.ply, .obj, .glb) or .ktree",
-            output.display(),
-            dtype.name()
-        )
-        .into());
-    };
-    format.holds(k).map_err(|holds| {
-        format!(
-            "{}: {holds}; {} has K = {k}",
-            output.display(),
-            input.display()
-        )
-    })?;
-    ktree::with_valued!(k, dtype, KK, V => write_valued::<KK, V>(input, output, format, placement),
-        else Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()))
+    let (tree, kept) = ktree::with_valued!(k, dtype, KK, V => {
+        let (tree, kept) = read_framed::<KK, V>(input)?;
+        (AnyValuedTree::from(tree), kept)
+    }, else return Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
+    // The frame is kept, or given; a tree without one stays without (in a `.ktree`).
+    let given = placement.voxel_size.is_some() || placement.origin.is_some();
+    let frame = (kept.is_some() || given).then(|| placement.frame(kept));
+    write_and_report(output, &tree, frame)
 }
 
 /// The valued tree of a `.ktree` file and the world frame it keeps.
@@ -129,64 +65,30 @@ pub fn read_framed<const K: usize, V: Value>(
     read_valued_ktree_framed::<K, V>(&bytes, &input.display().to_string()).map_err(CliError::caused)
 }
 
-/// Writes the valued tree of `input` to `output` as `format` (which holds `K` dimensions).
-fn write_valued<const K: usize, V: Value>(
-    input: &Path,
-    output: &Path,
-    format: Output,
-    placement: Placement,
-) -> CliResult {
-    let (tree, kept) = read_framed::<K, V>(input)?;
-    let frame = placement.frame(kept);
-    let tree = AnyValuedTree::from(tree);
-    let typed = tree
-        .as_typed::<K, V>()
-        .ok_or("the tree is of its own dimension and type")?;
-    let octree = || {
-        tree.as_typed::<3, V>()
-            .ok_or("the formats of octrees were checked to get K = 3")
+/// Writes `tree` to `output` (ktree voxel 0 at `frame`'s origin) and says what was written.
+fn write_and_report(output: &Path, tree: &AnyValuedTree, frame: Option<WorldFrame>) -> CliResult {
+    let options = WriteOptions {
+        offset: [0; 3],
+        meta: frame,
     };
-    let mut what = "values";
-    match format {
-        Output::Ktree => {
-            // The frame is kept, or given; a tree without one stays without.
-            let given = placement.voxel_size.is_some() || placement.origin.is_some();
-            let keep = (kept.is_some() || given).then_some(frame);
-            write_valued_ktree_file_framed(output, typed, keep.as_ref())
-                .map_err(CliError::caused)?
-        }
-        Output::Vtk => {
-            write_values_vtk_file(output, typed, &frame).map_err(CliError::caused)?;
-            what = "values as cell data";
-        }
-        Output::Nifti => write_nifti_file(output, octree()?, &frame).map_err(CliError::caused)?,
-        Output::Vdb => {
-            let octree = octree()?;
-            ktree::fs::write_atomic_with(output, |w| write_vdb_values(w, octree, [0; 3], &frame))
-                .map_err(CliError::caused)?
-        }
-        Output::Mesh => {
-            let mesh = value_boundary_mesh(octree()?).placed(&frame);
-            let written = write_value_surface(output, &mesh).map_err(CliError::caused)?;
-            outln!(
-                "{}: the surfaces of {} {} values, {} vertices, {} triangles",
-                output.display(),
-                mesh.surfaces.len(),
-                V::DTYPE.map_or("", Dtype::name),
-                written.vertices,
-                written.elements
-            );
-            return Ok(());
-        }
+    let written = write_valued_tree(output, tree, &options).map_err(CliError::caused)?;
+    let dtype = tree.dtype().name();
+    match written {
+        WrittenValues::Surfaces { surfaces, written } => outln!(
+            "{}: the surfaces of {surfaces} {dtype} values, {} vertices, {} triangles",
+            output.display(),
+            written.vertices,
+            written.elements
+        ),
+        WrittenValues::Voxels => outln!(
+            "{}: K = {}, L = {}, {dtype} values, {} nodes, {} voxels",
+            output.display(),
+            tree.k(),
+            tree.level(),
+            ktree::with_valued!(tree, t => t.node_count()),
+            ktree::with_valued!(tree, t => t.voxel_count())
+        ),
     }
-    outln!(
-        "{}: K = {K}, L = {}, {} {what}, {} nodes, {} voxels",
-        output.display(),
-        typed.level(),
-        V::DTYPE.map_or("", Dtype::name),
-        typed.node_count(),
-        typed.voxel_count()
-    );
     Ok(())
 }
 
@@ -216,9 +118,10 @@ pub fn time_series(input: &Path, output: &Path, axis: usize, placement: Placemen
     Ok(())
 }
 
-/// `ktree convert IN.vdb OUT.ktree` of a grid with values (not a `BoolGrid`, `MaskGrid` or level set):
-/// a valued `.ktree` of its active voxels and the grid's world frame, placed by `level` and `offset` (ktree voxel = grid index +
-/// offset; by default those the file was written with, else the smallest universe from 0).
+/// `ktree convert IN.vdb OUT` of a grid with values (not a `BoolGrid`, `MaskGrid` or level set): its
+/// active voxels, placed by `level` and `offset` (ktree voxel = grid index + offset; by default those the
+/// file was written with, else the smallest universe from 0), written with the grid's world frame to any
+/// output that keeps values (see [`write_valued_tree`]).
 pub fn vdb_to_valued(
     input: &Path,
     output: &Path,
@@ -228,20 +131,14 @@ pub fn vdb_to_valued(
     let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
     let read = read_vdb_values(&bytes, &input.display().to_string(), offset, level)
         .map_err(CliError::caused)?;
-    // The grid's world placement, counted from ktree voxel 0.
-    let frame = read.meta.counted_from(read.placement.offset.map(|o| -o));
-    ktree::with_valued!(&read.tree, t => write_valued_ktree_file_framed(output, t, Some(&frame)))
-        .map_err(CliError::caused)?;
-    let tree = &read.tree;
     outln!(
-        "{}: K = 3, L = {}, {} values, {} voxels (grid index + {:?} = ktree voxel)",
-        output.display(),
-        tree.level(),
-        tree.dtype().name(),
-        ktree::with_valued!(tree, t => t.voxel_count()),
+        "{}: grid index + {:?} = ktree voxel",
+        input.display(),
         read.placement.offset
     );
-    Ok(())
+    // The grid's world placement, counted from ktree voxel 0.
+    let frame = read.meta.counted_from(read.placement.offset.map(|o| -o));
+    write_and_report(output, &read.tree, Some(frame))
 }
 
 /// `ktree voxelize VOLUME --window LO:HI`: the samples from `lo` to `hi` kept as `float32` values.

@@ -682,6 +682,18 @@ fn a_tree_with_values_keeps_its_world_frame_through_every_conversion() {
         let size = f32::from_le_bytes(nii[at..at + 4].try_into().unwrap());
         assert_eq!(size, 0.5);
     }
+    // The typed grid goes to NIfTI, VTK and meshes directly: the same files as from the .ktree.
+    for out in ["nii", "vtu", "htg", "ply"] {
+        let (direct, through) = (p(&format!("vdb.{out}")), p(&format!("ktree.{out}")));
+        run(&["convert", &p("a.vdb"), &direct]);
+        run(&["convert", &p("a.ktree"), &through]);
+        let same = std::fs::read(&direct).unwrap() == std::fs::read(&through).unwrap();
+        assert!(same, "{out}: the grid's file differs from the tree's");
+    }
+    // Formats that would drop the values write the shape of the grid's active voxels.
+    run(&["convert", &p("a.vdb"), &p("shape.binvox")]);
+    let (ok, _, err) = ktree(&["convert", &p("a.ktree"), &p("a.bt")]);
+    assert!(!ok && err.contains("hold no values"), "{err}");
     // --voxel-size overrides the frame.
     run(&["convert", &p("a.ktree"), &p("d.ktree"), "--voxel-size", "2"]);
     assert_eq!(framed("d.ktree").1.unwrap().voxel_size, 2.0);

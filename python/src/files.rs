@@ -48,35 +48,17 @@ impl Tree {
     }
 
     /// Writes the tree (atomically: a temporary file renamed); the format is chosen by the extension. A
-    /// tree with values is written only as `.ktree` (version 3) or, an octree, as an OpenVDB typed grid
-    /// (`.vdb`: `Int32Grid`, `FloatGrid` or `Vec3SGrid`); other formats would drop the values: save
-    /// `tree.shape()` for them.
+    /// tree with values keeps them in `.ktree` (version 3), OpenVDB typed grids (`.vdb`), NIfTI (`.nii`,
+    /// `.nii.gz`), VTK cell data (`.vtu`, `.htg`) and the coloured surfaces of its values (`.ply`, `.obj`,
+    /// `.glb`); other formats would drop the values: save `tree.shape()` for them.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        if let Some(values) = &self.values {
-            if path.extension().is_some_and(|e| e == "vdb") {
-                let meta = ktree::io::GridMeta::default();
-                return Ok(py.detach(|| {
-                    ktree::fs::write_atomic_with(&path, |w| {
-                        ktree::io::write_any_valued_vdb(w, values, [0; 3], &meta)
-                    })
-                    .map_err(|e| Failure::of_error(&e, &path))
-                })?);
-            }
-            if path.extension().is_none_or(|e| e != "ktree") {
-                return Err(Failure::Value(format!(
-                    "{}: a tree with values is saved as .ktree or .vdb (save tree.shape() for other formats)",
-                    path.display()
-                ))
-                .into());
-            }
-            return Ok(py.detach(|| {
-                ktree::fs::write_atomic_with(&path, |w| write_any_valued_ktree(w, values))
-                    .map_err(|e| Failure::of_error(&e, &path))
-            })?);
-        }
+        let options = WriteOptions::default();
         Ok(py.detach(|| {
-            ktree::io::write_tree(&path, &self.inner, &WriteOptions::default())
-                .map_err(|e| Failure::of_error(&e, &path))
+            match &self.values {
+                Some(values) => ktree::io::write_valued_tree(&path, values, &options).map(drop),
+                None => ktree::io::write_tree(&path, &self.inner, &options),
+            }
+            .map_err(|e| Failure::of_error(&e, &path))
         })?)
     }
 

@@ -43,6 +43,17 @@ def missing(needed, install):
     pytest.skip(message)
 
 
+def python_importing(module, extra=()):
+    """An interpreter that imports `module` and numpy — those named in `extra`, this one, `python3` on the
+    PATH or `/usr/bin/python3` (Debian's packages of OpenVDB and nibabel are for the system's) — or None."""
+    found = [*extra, sys.executable, shutil.which("python3"), "/usr/bin/python3"]
+    for python in filter(None, found):
+        probe = subprocess.run([python, "-c", f"import {module}, numpy"], capture_output=True)
+        if probe.returncode == 0:
+            return python
+    return None
+
+
 def whole(t):
     """The tree's whole universe as a dense array (to_dense's default is the bounding box)."""
     return t.to_dense((0,) * t.k, (t.side,) * t.k)

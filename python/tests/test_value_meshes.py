@@ -61,16 +61,22 @@ def values_of(a):
 
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize("ext", ["obj", "glb"])
-def test_each_label_is_a_watertight_group_of_its_volume_and_colour(tmp_path, seed, ext):
+@pytest.mark.parametrize("by", ["convert", "save"])
+def test_each_label_is_a_watertight_group_of_its_volume_and_colour(tmp_path, seed, ext, by):
     a = labels(np.random.default_rng(seed))
-    out = convert(tmp_path, a, f"labels.{ext}")
+    if by == "convert":
+        out, voxel = convert(tmp_path, a, f"labels.{ext}"), VOXEL
+    else:
+        # Tree.save: voxels of side 1 from the origin.
+        out, voxel = tmp_path / f"saved.{ext}", 1.0
+        ktree.Tree.from_dense(a).save(out)
     scene = trimesh.load(out, process=False)
     values, counts = values_of(a)
     assert sorted(scene.geometry) == sorted(f"label_{v}" for v in values)
     for v, n in zip(values, counts):
         m = scene.geometry[f"label_{v}"]
         assert m.is_watertight and m.is_winding_consistent
-        assert m.volume == pytest.approx(n * VOXEL**3)
+        assert m.volume == pytest.approx(n * voxel**3)
         material = m.visual.material
         if ext == "obj":
             colour = np.asarray(material.diffuse)[:3]

@@ -1,6 +1,7 @@
 """Trees with values against numpy and scipy.ndimage, K = 1..4, every dtype."""
 
 import pickle
+import subprocess
 
 import numpy as np
 import pytest
@@ -129,6 +130,37 @@ def test_equality_pickle_bytes_and_files(tmp_path):
     assert ktree.Tree.load(path) == t
     with pytest.raises(ValueError, match=".ktree"):
         t.save(tmp_path / "labels.binvox")
+
+
+@pytest.mark.parametrize("dtype", ["uint8", "uint16", "int8", "float32"])
+def test_saved_nifti_holds_every_value_for_nibabel(tmp_path, dtype):
+    from test_ktree import missing, python_importing
+
+    python = python_importing("nibabel")
+    if python is None:
+        missing("nibabel", "install Debian's python3-nibabel")
+    rng = np.random.default_rng(len(dtype))
+    a = random_labels(rng, 3, dtype)
+    a[0, 0, 0] = 3  # the bounding box starts at the origin
+    t = ktree.Tree.from_dense(a)
+    path = tmp_path / "labels.nii.gz"
+    t.save(path)
+    read = subprocess.run(
+        [python, "-c", "import sys, numpy as np, nibabel as nib\n"
+         "img = nib.load(sys.argv[1])\n"
+         "np.save(sys.argv[2], np.asanyarray(img.dataobj))\n"
+         "print(*map(float, img.header.get_zooms()[:3]))", str(path), str(tmp_path / "read.npy")],
+        capture_output=True, text=True,
+    )
+    assert read.returncode == 0, read.stderr
+    got = np.load(tmp_path / "read.npy")
+    # The universe's voxels, unit voxels from the origin (Tree.save writes no other frame).
+    want = t.to_dense((0, 0, 0), (t.side,) * 3)
+    np.testing.assert_array_equal(got, want)
+    assert got.dtype == want.dtype
+    assert read.stdout.split() == ["1.0"] * 3
+    with pytest.raises(ValueError, match="hold no values"):
+        t.save(tmp_path / "labels.bt")
 
 
 @pytest.mark.parametrize("k", [2, 3, 4])

@@ -5,25 +5,21 @@ the interpreter that imports it — `$KTREE_PYTHON_OPENVDB`, this one, `python3`
 when KTREE_REQUIRE_TOOLS is set to anything but empty or 0 (see `test_ktree.missing`)."""
 
 import os
-import shutil
 import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import ktree
-from test_ktree import missing
+from test_ktree import missing, python_importing
 
 
 def openvdb_python():
     """The interpreter that imports OpenVDB's module, and the module's name; None when there is none."""
-    found = [os.environ.get("KTREE_PYTHON_OPENVDB"), sys.executable, shutil.which("python3"), "/usr/bin/python3"]
-    for python in filter(None, found):
-        for module in ("pyopenvdb", "openvdb"):
-            probe = subprocess.run([python, "-c", f"import {module}, numpy"], capture_output=True)
-            if probe.returncode == 0:
-                return python, module
+    for module in ("pyopenvdb", "openvdb"):
+        python = python_importing(module, [os.environ.get("KTREE_PYTHON_OPENVDB")])
+        if python is not None:
+            return python, module
     return None
 
 

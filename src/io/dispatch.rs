@@ -397,7 +397,7 @@ fn write_typed<const K: usize>(
 
 /// Whether `path` names a NIfTI file (`.nii`, `.nii.gz`).
 #[cfg(feature = "volume")]
-fn is_nifti(path: &Path) -> bool {
+pub(crate) fn is_nifti(path: &Path) -> bool {
     let name = path.to_string_lossy();
     name.ends_with(".nii") || name.ends_with(".nii.gz")
 }
@@ -448,7 +448,7 @@ fn whole_voxels(meta: &GridMeta) -> Option<[i64; 3]> {
 }
 
 /// An export's error as a file error of `path`.
-fn export_error(path: &Path, e: crate::export::ExportError) -> IoError {
+pub(crate) fn export_error(path: &Path, e: crate::export::ExportError) -> IoError {
     use crate::export::ExportError;
     match e {
         ExportError::Write(e) => IoError::Write(e),

@@ -11,6 +11,7 @@
 //!   files with their poses ([`read_scans`]);
 //! * [`read_tree`] and [`write_tree`] choose among all of them by the file's extension (meshes and NIfTI
 //!   volumes written; meshes and volumes are read by voxelizing them, in [`crate::input`]).
+//! * [`write_valued_tree`] writes a tree with values to the formats that keep them.
 //!
 //! Every output is written atomically ([`crate::fs`]).
 //!
@@ -49,6 +50,7 @@ mod scalar;
 #[cfg(feature = "cloud")]
 pub mod scan;
 pub(crate) mod spill;
+mod write_values;
 
 #[cfg(feature = "cloud")]
 pub use cloud::{is_cloud_file, read_cloud, read_cloud_bytes, CLOUD_FORMATS};
@@ -89,3 +91,4 @@ pub use rays::{
     open_rays_file, read_rays, read_rays_file, write_rays, write_rays_file, write_rays_source,
     AnyRaysFileSource, RaysFile, RaysFileSource, RaysTextError, RaysTextErrorKind,
 };
+pub use write_values::{keeps_values, write_valued_tree, WrittenValues};
