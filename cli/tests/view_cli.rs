@@ -576,6 +576,12 @@ fn bad_input_is_a_one_line_error_and_the_default_page_is_temporary() {
     std::fs::remove_file(written).unwrap();
 }
 
+/// Whether `px` is a shade of `base`: every channel `base`'s times one factor (to rounding).
+fn is_shade(px: [u8; 3], base: [u8; 3]) -> bool {
+    let f = f64::from(px[0].max(px[1]).max(px[2])) / f64::from(base[0].max(base[1]).max(base[2]));
+    (0..3).all(|c| (f64::from(px[c]) - f64::from(base[c]) * f).abs() <= 3.0)
+}
+
 /// The values of the legend's entries in the page's DOM (`data-value` of `#legend .entry`).
 fn legend_of(browser: &Path, page: &Path, hash: &str) -> Vec<String> {
     let url = format!("file://{}{hash}", page.display());
@@ -632,7 +638,28 @@ fn pages_of_trees_with_values_are_coloured_by_value_with_a_legend() {
     )
     .unwrap();
     write_ktree_file(&p("shape.ktree"), &many.shape()).unwrap();
-    for name in ["labels2d", "many", "floats", "shape"] {
+    // A 4-D ball of label 1 in the first half of time and 2 in the second; a tree of colours.
+    let moving: Vec<Option<u8>> = (0..1usize << 16)
+        .map(|i| {
+            let [x, y, z, t] = [0, 4, 8, 12].map(|s| ((i >> s) & 15) as f64 + 0.5);
+            let inside = (x - 8.0).powi(2) + (y - 8.0).powi(2) + (z - 8.0).powi(2) <= 30.0;
+            inside.then_some(if t < 8.0 { 1 } else { 2 })
+        })
+        .collect();
+    write_valued_ktree_file(
+        &p("moving.ktree"),
+        &KTree::<4, u8>::from_dense_values(4, &moving).unwrap(),
+    )
+    .unwrap();
+    let colours: Vec<Option<ktree::tree::Rgb>> = (0..64u8)
+        .map(|i| (i % 2 == 0).then_some([4 * i, 255 - 4 * i, 90]))
+        .collect();
+    write_valued_ktree_file(
+        &p("colours.ktree"),
+        &KTree::<3, ktree::tree::Rgb>::from_dense_values(2, &colours).unwrap(),
+    )
+    .unwrap();
+    for name in ["labels2d", "many", "floats", "shape", "moving", "colours"] {
         let (ok, out, err) = ktree(&[
             "view",
             &s(&p(&format!("{name}.ktree"))),
@@ -690,6 +717,34 @@ fn pages_of_trees_with_values_are_coloured_by_value_with_a_legend() {
     let (status, errors) = page_status(&browser, &p("floats.html"), "");
     assert_eq!(get(&status, "errors"), "0", "{errors}");
     assert_eq!(get(&status, "legend"), "ramp 0.5 2.5");
+    let (status, errors) = page_status(&browser, &p("colours.html"), "");
+    assert_eq!(get(&status, "errors"), "0", "{errors}");
+    assert_eq!(get(&status, "legend"), "stored");
+    // A 4-D tree: the slice at time 12 shows label 2 only, in its colour.
+    let (status, errors) = page_status(&browser, &p("moving.html"), "#time=12");
+    assert_eq!(get(&status, "errors"), "0", "{errors}");
+    assert_eq!(get(&status, "colour"), "value");
+    assert_eq!(get(&status, "legend"), "1,2");
+    assert!(get(&status, "painted").parse::<u64>().unwrap() > 100);
+    let shot = p("moving.png");
+    run_chromium(
+        &browser,
+        &format!("file://{}#bare&time=12", p("moving.html").display()),
+        &[
+            "--window-size=320,240",
+            &format!("--screenshot={}", shot.display()),
+        ],
+    );
+    let image = image::open(&shot).unwrap().to_rgb8();
+    let drawn: Vec<[u8; 3]> = image
+        .pixels()
+        .map(|px| px.0)
+        .filter(|&px| px != [255, 255, 255])
+        .collect();
+    assert!(drawn.len() > 1000, "{} pixels drawn", drawn.len());
+    for px in drawn {
+        assert!(is_shade(px, label_colour(2)), "{px:?} at time 12");
+    }
     // The colour menu: another colouring from the URL, and the selftest switches away from by value.
     let (status, _) = page_status(&browser, &p("many.html"), "#colour=depth");
     assert_eq!(get(&status, "colour"), "depth");
@@ -724,12 +779,9 @@ fn pages_of_trees_with_values_are_coloured_by_value_with_a_legend() {
         if px == [255, 255, 255] {
             continue;
         }
-        let shade_of = labels.iter().position(|&l| {
-            let base = label_colour(u64::from(l));
-            let f = f64::from(px[0].max(px[1]).max(px[2]))
-                / f64::from(base[0].max(base[1]).max(base[2]));
-            (0..3).all(|c| (f64::from(px[c]) - f64::from(base[c]) * f).abs() <= 3.0)
-        });
+        let shade_of = labels
+            .iter()
+            .position(|&l| is_shade(px, label_colour(u64::from(l))));
         let Some(i) = shade_of else {
             panic!("{px:?} is the shade of no label's colour");
         };
