@@ -1,6 +1,6 @@
 //! `ktree render FILE.ktree [--camera VIEW] [--perspective FOV] [--size WxH] [--out img.png]`: a
 //! hidden-surface image of an octree; a quadtree is drawn as a picture of its cells, a 4-D tree as a strip
-//! of time slices.
+//! of time slices; a tree with values (K = 2, 3 or 4) in its values' colours.
 
 use crate::common::error::{cannot_read, read_error, CliError, CliResult};
 use crate::outln;
@@ -19,13 +19,15 @@ use ktree::display::{
 use ktree::io::{read_rays_file, AnyMappedTree, FileTree};
 use ktree::space::Cell;
 use ktree::tree::storage::TreeStorage;
-use ktree::{AnyRaySet, AnyTree};
+use ktree::tree::valued::BinaryValues;
+use ktree::{AnyRaySet, AnyTree, KTree};
 
 /// Arguments of `ktree render`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// A `.ktree` file, version 2 read in place, or any format `ktree convert` reads (K = 3:
-    /// hidden-surface image; K = 2: picture of the cells; K = 4: strip of slices).
+    /// hidden-surface image; K = 2: picture of the cells; K = 4: strip of slices; a tree with values in
+    /// its values' colours).
     file: PathBuf,
     /// Where the camera looks from: iso, top, bottom, front, back, left, right, or a direction X,Y,Z from
     /// the object towards the eye. The camera frames the object.
@@ -112,17 +114,23 @@ pub fn run(args: Args) -> CliResult {
     let colour = parse_colour(args.colour.as_deref())?;
     if crate::values::is_valued(&args.file) {
         let (k, dtype) = crate::values::file_dtype(&args.file)?;
-        if k != 3 {
-            return Err(format!(
-                "{}: pictures of trees with values are of octrees (K = 3); this one has K = {k}",
+        let dtype = dtype.ok_or("a valued file has a value type")?;
+        return match k {
+            2 => ktree::with_valued!(2, dtype, KK, V => {
+                render_valued_quadtree::<V>(&args, &out, w.min(h), colour)
+            }, else unreachable!("every value type has an arm")),
+            3 => ktree::with_valued!(3, dtype, KK, V => {
+                render_valued::<V>(&args, &out, w, h, colour, bar.as_ref(), &mut tick)
+            }, else unreachable!("every value type has an arm")),
+            4 => ktree::with_valued!(4, dtype, KK, V => {
+                render_valued_strip::<V>(&args, &out, h, colour)
+            }, else unreachable!("every value type has an arm")),
+            _ => Err(format!(
+                "{}: a bintree (K = {k}) has no picture; render needs K = 2, 3 or 4",
                 args.file.display()
             )
-            .into());
-        }
-        let dtype = dtype.ok_or("a valued file has a value type")?;
-        return ktree::with_valued!(3, dtype, KK, V => {
-            render_valued::<V>(&args, &out, w, h, colour, bar.as_ref(), &mut tick)
-        }, else unreachable!("every value type has an arm"));
+            .into()),
+        };
     }
     if args.colour.as_deref() == Some("value") {
         return Err(format!(
@@ -153,19 +161,28 @@ pub fn run(args: Args) -> CliResult {
             bar.as_ref(),
             &mut tick,
         ),
-        FileTree::Memory(AnyTree::K2(t)) => render_quadtree(t, &out, w.min(h)),
-        FileTree::Mapped(AnyMappedTree::K2(t)) => render_quadtree(t, &out, w.min(h)),
-        FileTree::Memory(AnyTree::K4(t)) => render_strip(t, &args, &out, h),
-        FileTree::Mapped(AnyMappedTree::K4(t)) => render_strip(t, &args, &out, h),
+        FileTree::Memory(AnyTree::K2(t)) => render_quadtree(t, &out, w.min(h), colour),
+        FileTree::Mapped(AnyMappedTree::K2(t)) => render_quadtree(t, &out, w.min(h), colour),
+        FileTree::Memory(AnyTree::K4(t)) => render_strip(t, &args, &out, h, colour),
+        FileTree::Mapped(AnyMappedTree::K4(t)) => render_strip(t, &args, &out, h, colour),
         FileTree::Memory(AnyTree::K1(_)) | FileTree::Mapped(AnyMappedTree::K1(_)) => {
             Err("a bintree (K = 1) has no picture; render needs K = 2, 3 or 4".into())
         }
     }
 }
 
-/// Draws a quadtree's cells, `size` pixels square, to the PNG `out`.
-fn render_quadtree<T: TreeStorage<2>>(tree: &T, out: &Path, size: u32) -> CliResult {
-    let canvas = plane::quadtree_canvas(tree, size).map_err(CliError::caused)?;
+/// Draws a quadtree's cells, `size` pixels square, to the PNG `out` (full cells in `colour` if given).
+fn render_quadtree<T: TreeStorage<2>>(
+    tree: &T,
+    out: &Path,
+    size: u32,
+    colour: Option<[u8; 3]>,
+) -> CliResult {
+    let canvas = match colour {
+        None => plane::quadtree_canvas(tree, size),
+        Some(c) => plane::values_canvas(&BinaryValues(tree), size, |()| c),
+    }
+    .map_err(CliError::caused)?;
     canvas.write_png(out).map_err(CliError::caused)?;
     // Every leaf is full or empty: the counts say how many there are, without a walk.
     let counts = tree.counts();
@@ -177,11 +194,77 @@ fn render_quadtree<T: TreeStorage<2>>(tree: &T, out: &Path, size: u32) -> CliRes
     Ok(())
 }
 
+/// Draws a quadtree with values, `size` pixels square, each leaf in its value's colour (or `colour`), to
+/// the PNG `out`.
+fn render_valued_quadtree<V: ktree::value::Value>(
+    args: &Args,
+    out: &Path,
+    size: u32,
+    colour: Option<[u8; 3]>,
+) -> CliResult {
+    let tree = read_valued::<2, V>(&args.file)?;
+    let of_value = ktree::display::palette::value_colours(&tree);
+    let canvas = plane::values_canvas(&tree, size, |v| colour.unwrap_or_else(|| of_value(v)))
+        .map_err(CliError::caused)?;
+    canvas.write_png(out).map_err(CliError::caused)?;
+    let leaves = tree.value_leaves().count();
+    let values = tree.value_leaves().filter(|(_, v)| v.is_some()).count();
+    outln!(
+        "wrote {} (quadtree with values, {leaves} leaves, {values} of them holding a value)",
+        out.display()
+    );
+    Ok(())
+}
+
+/// A valued `.ktree` file's tree of dimension `K` and value type `V` (as its header says).
+fn read_valued<const K: usize, V: ktree::value::Value>(file: &Path) -> CliResult<KTree<K, V>> {
+    let bytes = std::fs::read(file).map_err(|e| cannot_read(file, e))?;
+    ktree::io::ktree::v3::read_valued_ktree::<K, V>(&bytes, &file.display().to_string())
+        .map_err(CliError::caused)
+}
+
+/// Draws a strip of a 4-D tree with values, each leaf in its value's colour (or `colour`).
+fn render_valued_strip<V: ktree::value::Value>(
+    args: &Args,
+    out: &Path,
+    size: u32,
+    colour: Option<[u8; 3]>,
+) -> CliResult {
+    let tree = read_valued::<4, V>(&args.file)?;
+    let of_value = ktree::display::palette::value_colours(&tree);
+    let strip = slices::time_strip_values(&tree, args.time_axis, args.frames, size, |v| {
+        colour.unwrap_or_else(|| of_value(v))
+    })
+    .map_err(CliError::caused)?;
+    write_strip(strip, args, out)
+}
+
 /// Draws a strip of a 4-D tree's slices, frames `size` pixels square, to the PNG `out` (and each frame
-/// to the frames' folder if asked).
-fn render_strip<T: TreeStorage<4>>(tree: &T, args: &Args, out: &Path, size: u32) -> CliResult {
-    let (strip, frames) =
-        slices::time_strip(tree, args.time_axis, args.frames, size).map_err(CliError::caused)?;
+/// to the frames' folder if asked), in `colour` if given.
+fn render_strip<T: TreeStorage<4>>(
+    tree: &T,
+    args: &Args,
+    out: &Path,
+    size: u32,
+    colour: Option<[u8; 3]>,
+) -> CliResult {
+    let strip = match colour {
+        None => slices::time_strip(tree, args.time_axis, args.frames, size),
+        Some(c) => slices::time_strip_values(
+            &BinaryValues(tree),
+            args.time_axis,
+            args.frames,
+            size,
+            |()| c,
+        ),
+    }
+    .map_err(CliError::caused)?;
+    write_strip(strip, args, out)
+}
+
+/// Writes a strip to the PNG `out` (and each frame to the frames' folder if asked).
+fn write_strip(strip: slices::Strip, args: &Args, out: &Path) -> CliResult {
+    let (strip, frames) = strip;
     strip.write_png(out).map_err(CliError::caused)?;
     if let Some(dir) = &args.frames_dir {
         for (i, (_, frame)) in frames.iter().enumerate() {
@@ -201,7 +284,6 @@ fn render_strip<T: TreeStorage<4>>(tree: &T, args: &Args, out: &Path, size: u32)
     Ok(())
 }
 
-/// Renders an octree, in memory or memory-mapped, to the PNG `out` (and the depth image if asked).
 /// Draws an octree with values, each leaf in its value's colour (or `colour`).
 fn render_valued<V: ktree::value::Value>(
     args: &Args,
@@ -212,10 +294,7 @@ fn render_valued<V: ktree::value::Value>(
     bar: Option<&ProgressBar>,
     tick: &mut dyn FnMut(u64, u64),
 ) -> CliResult {
-    let name = args.file.display().to_string();
-    let bytes = std::fs::read(&args.file).map_err(|e| cannot_read(&args.file, e))?;
-    let tree =
-        ktree::io::ktree::v3::read_valued_ktree::<3, V>(&bytes, &name).map_err(CliError::caused)?;
+    let tree = read_valued::<3, V>(&args.file)?;
     let of_value = ktree::display::palette::value_colours(&tree);
     let paint = |cell: &Cell<3>| {
         colour.unwrap_or_else(|| tree.value_at(cell.origin()).map_or([0; 3], &of_value))
@@ -232,6 +311,7 @@ fn render_valued<V: ktree::value::Value>(
     )
 }
 
+/// Renders an octree, in memory or memory-mapped, to the PNG `out` (and the depth image if asked).
 fn render_octree<T: TreeStorage<3>>(
     tree: &T,
     args: &Args,

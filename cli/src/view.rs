@@ -1,5 +1,6 @@
 //! `ktree view FILE [--out view.html] [--budget N] [--camera VIEW] [--time-axis A] [--open]`: an
-//! interactive 3-D view of a tree in one self-contained HTML page (see `ktree::export::view`).
+//! interactive 3-D view of a tree in one self-contained HTML page (see `ktree::export::view`); a tree with
+//! values is coloured by value, with a legend.
 
 use crate::common::error::{CliError, CliResult};
 use crate::outln;
@@ -7,7 +8,7 @@ use crate::outln;
 use std::path::{Path, PathBuf};
 
 use ktree::display::View;
-use ktree::export::view::{write_view, Page, ViewOptions, DEFAULT_BUDGET};
+use ktree::export::view::{write_values_view, write_view, Page, ViewOptions, DEFAULT_BUDGET};
 use ktree::tree::cursor::TreeStorage;
 use ktree::with_tree;
 
@@ -15,7 +16,7 @@ use ktree::with_tree;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The tree: a `.ktree` file or any format `ktree convert` reads (K = 2: flat squares; K = 3: boxes;
-    /// K = 4: a slider over the time axis).
+    /// K = 4: a slider over the time axis; a tree with values: coloured by value, with a legend).
     file: PathBuf,
     /// The page to write (default: a new file in the temporary folder, its path printed).
     #[arg(long)]
@@ -55,10 +56,22 @@ pub fn run(args: Args) -> CliResult {
             .file_name()
             .map_or_else(|| "ktree".into(), |n| n.to_string_lossy().into_owned()),
     };
+    if crate::values::is_valued(&args.file) {
+        let tree = crate::values::read_valued(&args.file)?;
+        let page = ktree::with_valued!(&tree, t => {
+            write_values_view(&out, t, &options).map_err(CliError::caused)
+        })?;
+        return report(&args, &out, &page);
+    }
     // A version 2 file is read through its memory map, whatever its size.
     let file = ktree::input::open_tree(&args.file, &ktree::io::ReadOptions::default())
         .map_err(CliError::caused)?;
     let page = with_tree!(&file, t => page_of(t, &out, &options))?;
+    report(&args, &out, &page)
+}
+
+/// Says what was written, and opens it if asked.
+fn report(args: &Args, out: &Path, page: &Page) -> CliResult {
     outln!(
         "wrote {} ({} boxes{}, {} bytes)",
         out.display(),
@@ -74,7 +87,7 @@ pub fn run(args: Args) -> CliResult {
         page.html.len()
     );
     if args.open {
-        open(&out)?;
+        open(out)?;
     }
     Ok(())
 }

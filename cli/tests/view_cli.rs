@@ -575,3 +575,222 @@ fn bad_input_is_a_one_line_error_and_the_default_page_is_temporary() {
         .contains("ktree-header"));
     std::fs::remove_file(written).unwrap();
 }
+
+/// Whether `px` is a shade of `base`: every channel `base`'s times one factor (to rounding).
+fn is_shade(px: [u8; 3], base: [u8; 3]) -> bool {
+    let f = f64::from(px[0].max(px[1]).max(px[2])) / f64::from(base[0].max(base[1]).max(base[2]));
+    (0..3).all(|c| (f64::from(px[c]) - f64::from(base[c]) * f).abs() <= 3.0)
+}
+
+/// The values of the legend's entries in the page's DOM (`data-value` of `#legend .entry`).
+fn legend_of(browser: &Path, page: &Path, hash: &str) -> Vec<String> {
+    let url = format!("file://{}{hash}", page.display());
+    let dom = run_chromium(browser, &url, &["--window-size=320,240", "--dump-dom"]);
+    dom.split("class=\"entry\" data-value=\"")
+        .skip(1)
+        .map(|rest| rest.split('"').next().unwrap().to_string())
+        .collect()
+}
+
+/// Pages of trees with values: coloured by value (the page's status says `colour=value`, the first
+/// colouring), their legend lists the tree's labels (the 32 that fill the most voxels, and how many more
+/// there are), a float tree's legend is the ramp from its smallest to its largest value; the colour menu
+/// still switches (selftest); in a screenshot of a quadtree with values every drawn pixel is a shade of one
+/// label's palette colour and each label's squares show its colour as the page shades a face seen from
+/// above. Pages of trees without values keep their colourings.
+#[test]
+fn pages_of_trees_with_values_are_coloured_by_value_with_a_legend() {
+    use ktree::display::palette::label_colour;
+    use ktree::io::ktree::v3::write_valued_ktree_file;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    // A quadtree: 16 × 16 voxels in 4 × 4 blocks of labels 3, 10, 17, 24 (by block column) and 50 (the
+    // top row of blocks), the top right block empty.
+    let labels2: Vec<Option<u8>> = (0..256u32)
+        .map(|i| {
+            let (bx, by) = (i % 16 / 4, i / 16 / 4);
+            match (bx, by) {
+                (3, 3) => None,
+                (_, 3) => Some(50),
+                _ => Some(3 + 7 * bx as u8),
+            }
+        })
+        .collect();
+    let quad = KTree::<2, u8>::from_dense_values(4, &labels2).unwrap();
+    write_valued_ktree_file(&p("labels2d.ktree"), &quad).unwrap();
+    // An octree of 40 labels in slabs one voxel thick across x: labels 1 … 32 where y < 24 (768 voxels
+    // each), 33 … 40 where y ≥ 24 and x < 8 (256 each): the legend keeps the 32 that fill the most voxels.
+    let labels3: Vec<Option<u16>> = (0..32u32.pow(3))
+        .map(|i| {
+            let (x, y) = (i % 32, i / 32 % 32);
+            let label = x as u16 + 1 + if y >= 24 { 32 } else { 0 };
+            (label <= 40).then_some(label)
+        })
+        .collect();
+    let many = KTree::<3, u16>::from_dense_values(5, &labels3).unwrap();
+    write_valued_ktree_file(&p("many.ktree"), &many).unwrap();
+    let floats: Vec<Option<f32>> = (0..64u32)
+        .map(|i| (i % 3 != 0).then_some(0.5 + (i % 5) as f32 / 2.0))
+        .collect();
+    write_valued_ktree_file(
+        &p("floats.ktree"),
+        &KTree::<3, f32>::from_dense_values(2, &floats).unwrap(),
+    )
+    .unwrap();
+    write_ktree_file(&p("shape.ktree"), &many.shape()).unwrap();
+    // A 4-D ball of label 1 in the first half of time and 2 in the second; a tree of colours.
+    let moving: Vec<Option<u8>> = (0..1usize << 16)
+        .map(|i| {
+            let [x, y, z, t] = [0, 4, 8, 12].map(|s| ((i >> s) & 15) as f64 + 0.5);
+            let inside = (x - 8.0).powi(2) + (y - 8.0).powi(2) + (z - 8.0).powi(2) <= 30.0;
+            inside.then_some(if t < 8.0 { 1 } else { 2 })
+        })
+        .collect();
+    write_valued_ktree_file(
+        &p("moving.ktree"),
+        &KTree::<4, u8>::from_dense_values(4, &moving).unwrap(),
+    )
+    .unwrap();
+    let colours: Vec<Option<ktree::tree::Rgb>> = (0..64u8)
+        .map(|i| (i % 2 == 0).then_some([4 * i, 255 - 4 * i, 90]))
+        .collect();
+    write_valued_ktree_file(
+        &p("colours.ktree"),
+        &KTree::<3, ktree::tree::Rgb>::from_dense_values(2, &colours).unwrap(),
+    )
+    .unwrap();
+    for name in ["labels2d", "many", "floats", "shape", "moving", "colours"] {
+        let (ok, out, err) = ktree(&[
+            "view",
+            &s(&p(&format!("{name}.ktree"))),
+            "--out",
+            &s(&p(&format!("{name}.html"))),
+        ]);
+        assert!(ok, "{name}: {err}");
+        assert!(out.contains("boxes"), "{out}");
+    }
+    // The header carries the legend whether or not a browser is there.
+    let legend = &header_of(&p("labels2d.html"))["values"]["legend"];
+    assert_eq!(legend["kind"], "labels");
+    let entries: Vec<u64> = legend["entries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e[0].as_u64().unwrap())
+        .collect();
+    assert_eq!(entries, [3, 10, 17, 24, 50]);
+    assert_eq!(
+        header_of(&p("shape.html"))["values"],
+        serde_json::Value::Null
+    );
+    let Some(browser) = chromium() else {
+        return;
+    };
+    // The labels of the quadtree: its distinct values, from the dense array.
+    let mut distinct: Vec<String> = labels2.iter().flatten().map(u8::to_string).collect();
+    distinct.sort_by_key(|v| v.parse::<u32>().unwrap());
+    distinct.dedup();
+    let (status, errors) = page_status(&browser, &p("labels2d.html"), "");
+    assert_eq!(get(&status, "errors"), "0", "{errors}");
+    assert_eq!(get(&status, "colour"), "value");
+    assert_eq!(get(&status, "legend"), distinct.join(","));
+    assert_eq!(get(&status, "legend_more"), "0");
+    assert_eq!(legend_of(&browser, &p("labels2d.html"), ""), distinct);
+    // Forty labels: the 32 that fill the most voxels, counted from the dense array, and 8 more.
+    let mut voxels = std::collections::BTreeMap::<u16, u32>::new();
+    for v in labels3.iter().flatten() {
+        *voxels.entry(*v).or_default() += 1;
+    }
+    let mut by_count: Vec<(u16, u32)> = voxels.into_iter().collect();
+    by_count.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let mut top: Vec<u16> = by_count.iter().take(32).map(|e| e.0).collect();
+    top.sort_unstable();
+    let top: Vec<String> = top.iter().map(u16::to_string).collect();
+    let (status, errors) = page_status(&browser, &p("many.html"), "");
+    assert_eq!(get(&status, "errors"), "0", "{errors}");
+    assert_eq!(get(&status, "colour"), "value");
+    assert_eq!(get(&status, "legend"), top.join(","));
+    assert_eq!(
+        get(&status, "legend_more"),
+        (by_count.len() - 32).to_string()
+    );
+    let (status, errors) = page_status(&browser, &p("floats.html"), "");
+    assert_eq!(get(&status, "errors"), "0", "{errors}");
+    assert_eq!(get(&status, "legend"), "ramp 0.5 2.5");
+    let (status, errors) = page_status(&browser, &p("colours.html"), "");
+    assert_eq!(get(&status, "errors"), "0", "{errors}");
+    assert_eq!(get(&status, "legend"), "stored");
+    // A 4-D tree: the slice at time 12 shows label 2 only, in its colour.
+    let (status, errors) = page_status(&browser, &p("moving.html"), "#time=12");
+    assert_eq!(get(&status, "errors"), "0", "{errors}");
+    assert_eq!(get(&status, "colour"), "value");
+    assert_eq!(get(&status, "legend"), "1,2");
+    assert!(get(&status, "painted").parse::<u64>().unwrap() > 100);
+    let shot = p("moving.png");
+    run_chromium(
+        &browser,
+        &format!("file://{}#bare&time=12", p("moving.html").display()),
+        &[
+            "--window-size=320,240",
+            &format!("--screenshot={}", shot.display()),
+        ],
+    );
+    let image = image::open(&shot).unwrap().to_rgb8();
+    let drawn: Vec<[u8; 3]> = image
+        .pixels()
+        .map(|px| px.0)
+        .filter(|&px| px != [255, 255, 255])
+        .collect();
+    assert!(drawn.len() > 1000, "{} pixels drawn", drawn.len());
+    for px in drawn {
+        assert!(is_shade(px, label_colour(2)), "{px:?} at time 12");
+    }
+    // The colour menu: another colouring from the URL, and the selftest switches away from by value.
+    let (status, _) = page_status(&browser, &p("many.html"), "#colour=depth");
+    assert_eq!(get(&status, "colour"), "depth");
+    let (status, errors) = page_status(&browser, &p("many.html"), "#selftest");
+    assert_eq!(get(&status, "errors"), "0", "{errors}");
+    assert_eq!(get(&status, "selftest_colour"), "1", "{status:?}");
+    // Without values: by normal as before, whatever the URL asks; no legend.
+    for hash in ["", "#colour=value"] {
+        let (status, errors) = page_status(&browser, &p("shape.html"), hash);
+        assert_eq!(get(&status, "errors"), "0", "{errors}");
+        assert_eq!(get(&status, "colour"), "normal", "{hash}");
+        assert!(!status.iter().any(|(k, _)| k == "legend"));
+    }
+    // The quadtree's picture: seen from above, a face's colour is its label's palette colour times the
+    // page's shading of an upward face, 0.72 + 0.28 · (light · z) with the light 1, 0.6, 0.3 on the
+    // camera's forward (reversed), up and right axes: 0.72 + 0.28 / √1.45; outlines are darker shades.
+    let shot = p("labels2d.png");
+    run_chromium(
+        &browser,
+        &format!("file://{}#bare", p("labels2d.html").display()),
+        &[
+            "--window-size=320,240",
+            &format!("--screenshot={}", shot.display()),
+        ],
+    );
+    let image = image::open(&shot).unwrap().to_rgb8();
+    let k = 0.72 + 0.28 / 1.45f64.sqrt();
+    let labels: Vec<u8> = distinct.iter().map(|v| v.parse().unwrap()).collect();
+    let mut faces = vec![0u32; labels.len()];
+    for px in image.pixels() {
+        let px = px.0;
+        if px == [255, 255, 255] {
+            continue;
+        }
+        let shade_of = labels
+            .iter()
+            .position(|&l| is_shade(px, label_colour(u64::from(l))));
+        let Some(i) = shade_of else {
+            panic!("{px:?} is the shade of no label's colour");
+        };
+        let base = label_colour(u64::from(labels[i]));
+        if (0..3).all(|c| (f64::from(px[c]) - f64::from(base[c]) * k).abs() <= 2.0) {
+            faces[i] += 1;
+        }
+    }
+    for (label, n) in labels.iter().zip(&faces) {
+        assert!(*n > 200, "label {label}: {n} pixels of its face colour");
+    }
+}

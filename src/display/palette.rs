@@ -47,9 +47,9 @@ pub fn ramp(t: f64) -> [u8; 3] {
     std::array::from_fn(|c| (STOPS[i][c] + f * (STOPS[i + 1][c] - STOPS[i][c])).round() as u8)
 }
 
-/// The colouring of `tree`'s values: labels (integer types) by [`label_colour`], floats by [`ramp`] from
-/// the tree's smallest value to its largest, colours as they are.
-pub fn value_colours<V: Value>(tree: &KTree<3, V>) -> impl Fn(V) -> [u8; 3] {
+/// The colouring of `tree`'s values (any `K`): labels (integer types) by [`label_colour`], floats by
+/// [`ramp`] from the tree's smallest value to its largest, colours as they are.
+pub fn value_colours<const K: usize, V: Value>(tree: &KTree<K, V>) -> impl Fn(V) -> [u8; 3] {
     colouring(range(tree.value_leaves().filter_map(|(_, v)| v)))
 }
 
@@ -63,6 +63,82 @@ pub fn value_colours<V: Value>(tree: &KTree<3, V>) -> impl Fn(V) -> [u8; 3] {
 /// ```
 pub fn colours_of_values<V: Value>(values: impl IntoIterator<Item = V>) -> impl Fn(V) -> [u8; 3] {
     colouring(range(values))
+}
+
+/// The number of labels a [`Legend`] lists at most (the most frequent).
+pub const LEGEND_LABELS: usize = 32;
+
+/// What the colours of a tree's values mean, for a legend beside its picture.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Legend<V> {
+    /// Labels (integer types): the [`LEGEND_LABELS`] values that fill the most voxels, in increasing order,
+    /// each with its colour and its number of voxels, and how many other values the tree holds.
+    Labels {
+        /// Value, colour, voxels.
+        entries: Vec<(V, [u8; 3], u128)>,
+        /// Values left out.
+        more: usize,
+    },
+    /// Floats: the [`ramp`] from `min` (at 0) to `max` (at 1); `None` for a tree without values.
+    Ramp {
+        /// The smallest and largest value.
+        range: Option<(V, V)>,
+    },
+    /// Colours ([`Rgb`](crate::value::Rgb)) drawn as they are stored.
+    AsStored,
+}
+
+/// The legend of `tree`'s colours ([`value_colours`]).
+///
+/// ```
+/// use ktree::display::palette::{label_colour, value_legend, Legend};
+/// use ktree::KTree;
+/// let t = KTree::<2, u8>::from_dense_values(1, &[Some(4), Some(4), None, Some(9)]).unwrap();
+/// let Legend::Labels { entries, more } = value_legend(&t) else { panic!() };
+/// assert_eq!(entries, [(4, label_colour(4), 2), (9, label_colour(9), 1)]);
+/// assert_eq!(more, 0);
+/// ```
+pub fn value_legend<const K: usize, V: Value>(tree: &KTree<K, V>) -> Legend<V> {
+    match V::DTYPE {
+        Some(Dtype::Rgb) => Legend::AsStored,
+        Some(Dtype::F32) => Legend::Ramp {
+            range: tree
+                .value_leaves()
+                .filter_map(|(_, v)| v)
+                .fold(None, |range, v| match range {
+                    None => Some((v, v)),
+                    Some((lo, hi)) => Some((
+                        if number(v) < number(lo) { v } else { lo },
+                        if number(v) > number(hi) { v } else { hi },
+                    )),
+                }),
+        },
+        _ => {
+            let mut voxels: std::collections::BTreeMap<i64, (V, u128)> = Default::default();
+            for (cell, v) in tree.value_leaves() {
+                let Some(v) = v else { continue };
+                let n = 1u128
+                    .checked_shl(cell.log_side() * K as u32)
+                    .unwrap_or(u128::MAX);
+                let entry = voxels.entry(number(v) as i64).or_insert((v, 0));
+                entry.1 = entry.1.saturating_add(n);
+            }
+            let mut entries: Vec<(V, u128)> = voxels.into_values().collect();
+            let more = entries.len().saturating_sub(LEGEND_LABELS);
+            // The most frequent (ties: the smaller value), then shown in increasing order.
+            entries.sort_by(|a, b| b.1.cmp(&a.1).then(number(a.0).total_cmp(&number(b.0))));
+            entries.truncate(LEGEND_LABELS);
+            entries.sort_by(|a, b| number(a.0).total_cmp(&number(b.0)));
+            let colour = colouring::<V>((0.0, 1.0));
+            Legend::Labels {
+                entries: entries
+                    .into_iter()
+                    .map(|(v, n)| (v, colour(v), n))
+                    .collect(),
+                more,
+            }
+        }
+    }
 }
 
 /// A value as a number.

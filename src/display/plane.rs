@@ -1,4 +1,5 @@
-//! 2-D quadtrees as pictures: full cells filled, every leaf's boundary drawn, so the decomposition shows.
+//! 2-D quadtrees as pictures: full cells filled (in their values' colours for a tree with values), every
+//! leaf's boundary drawn, so the decomposition shows.
 //!
 //! ```
 //! use ktree::{display::plane::quadtree_svg, rays::ball_rays, stacking::paper::stack};
@@ -14,6 +15,7 @@ use super::error::DisplayError;
 use super::png::Canvas;
 use crate::tree::cursor::TryLeaves;
 use crate::tree::storage::{infallible, TreeStorage};
+use crate::tree::valued::{BinaryValues, ValueLeaves, ValueStorage};
 use crate::tree::NodeState;
 
 /// Colours of a quadtree picture.
@@ -23,7 +25,7 @@ const GRID: [u8; 3] = [150, 150, 150];
 
 /// A `size × size` raster picture of a quadtree: axis 0 to the right, axis 1 up; full leaves filled,
 /// leaf boundaries drawn in grey (boundaries of cells smaller than 3 pixels are left out so that fine
-/// detail stays readable).
+/// detail stays readable). The picture of [`values_canvas`] in one colour.
 ///
 /// ```
 /// use ktree::{stacking::paper::stack, rays::ball_rays, display::plane::quadtree_canvas};
@@ -36,18 +38,46 @@ const GRID: [u8; 3] = [150, 150, 150];
 /// [`DisplayError::BadSize`] for a zero or too large size; [`DisplayError::Storage`] if a read of the tree
 /// fails.
 pub fn quadtree_canvas<T: TreeStorage<2>>(tree: &T, size: u32) -> Result<Canvas, DisplayError> {
+    values_canvas(&BinaryValues(tree), size, |()| FILL)
+}
+
+/// A `size × size` raster picture of a quadtree with values: each full leaf filled with `colour` of its
+/// value, empty leaves left white, leaf boundaries drawn as in [`quadtree_canvas`] (a binary tree is the
+/// case of one colour, through [`BinaryValues`]).
+///
+/// ```
+/// use ktree::display::{palette::value_colours, plane::values_canvas};
+/// use ktree::KTree;
+/// // Labels 1 and 2 on the left half, nothing on the right.
+/// let t = KTree::<2, u8>::from_dense_values(1, &[Some(1), None, Some(2), None]).unwrap();
+/// let colour = value_colours(&t);
+/// let canvas = values_canvas(&t, 4, &colour).unwrap();
+/// let pixel = |x: usize, y: usize| &canvas.rgb[3 * (4 * y + x)..3 * (4 * y + x) + 3];
+/// assert_eq!(pixel(0, 3), colour(1)); // axis 1 points up: voxel (0, 0) is at the bottom left
+/// assert_eq!(pixel(0, 0), colour(2));
+/// assert_eq!(pixel(3, 0), [255, 255, 255]);
+/// ```
+///
+/// # Errors
+/// [`DisplayError::BadSize`] for a zero or too large size; [`DisplayError::Storage`] if a read of the tree
+/// fails.
+pub fn values_canvas<T: ValueStorage<2>>(
+    tree: &T,
+    size: u32,
+    colour: impl Fn(T::Value) -> [u8; 3],
+) -> Result<Canvas, DisplayError> {
     let mut canvas = Canvas::new(size, size, EMPTY)?;
     let scale = f64::from(size) / tree.universe().side() as f64;
     let px = |v: f64| (v * scale).round() as i64;
     let h = i64::from(size);
     let mut outlines = Vec::new();
-    for leaf in TryLeaves::new(tree) {
-        let (cell, state) = leaf.map_err(|e| DisplayError::Storage(e.into()))?;
+    for leaf in ValueLeaves::new(tree) {
+        let (cell, value) = leaf.map_err(|e| DisplayError::Storage(e.into()))?;
         let (x0, y0) = (f64::from(cell.origin[0]), f64::from(cell.origin[1]));
         let s = cell.side() as f64;
         let (a, b, c, d) = (px(x0), h - px(y0 + s), px(x0 + s), h - px(y0));
-        if state == NodeState::Full {
-            canvas.fill_rect(a, b, c, d, FILL);
+        if let Some(v) = value {
+            canvas.fill_rect(a, b, c, d, colour(v));
         }
         if s * scale >= 3.0 {
             outlines.push((a, b, c, d));

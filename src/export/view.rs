@@ -6,12 +6,13 @@
 //! `Content-Security-Policy` of `default-src 'none'` forbids every request (a fetch would be a console
 //! error). Octrees are drawn as shaded boxes, quadtrees as flat squares, 4-D trees as the 3-D slice at a
 //! time chosen with a slider. The mouse orbits (left button), pans (right button or shift) and zooms
-//! (wheel); sliders clip along each axis; a toggle colours by face normal or by depth in the tree. The
-//! first camera is the one `ktree render --camera NAME` takes (the same orthographic projection and
-//! framing): it is framed here, on the boxes of the page, and given to the page in its header. At any
-//! window size, and again after every change of size, the page shows the smallest rectangle of the
-//! window's shape that holds the boxes with a 5 % margin (the wheel zooms from there). The URL hash sets
-//! the start: `#camera=NAME` another camera, `colour=depth` or `colour=normal`, `time=T` the slice of a
+//! (wheel); sliders clip along each axis; a toggle colours by face normal or by depth in the tree, and a
+//! tree with values by value, with a legend ([`view_values_page`]). The first camera is the one
+//! `ktree render --camera NAME` takes (the same orthographic projection and framing): it is framed here,
+//! on the boxes of the page, and given to the page in its header. At any window size, and again after
+//! every change of size, the page shows the smallest rectangle of the window's shape that holds the boxes
+//! with a 5 % margin (the wheel zooms from there). The URL hash sets the start: `#camera=NAME` another
+//! camera, `colour=depth`, `colour=normal` or `colour=value`, `time=T` the slice of a
 //! 4-D tree, `bare` no controls (the key `h` hides and shows them). `selftest`
 //! drives every control after the first frame with DOM events (drags with both buttons, the wheel, a clip
 //! slider, the camera and colour menus, the time slider) and records in the page's status, for each, whether
@@ -48,10 +49,14 @@ use std::path::Path;
 
 use thiserror::Error;
 
+use crate::display::palette::{ramp, value_colours, value_legend, Legend};
 use crate::display::{View, NAMED_VIEWS};
 use crate::fs::write_atomic;
 use crate::space::Cell;
 use crate::tree::cursor::TreeStorage;
+use crate::tree::valued::LeavesOfValues;
+use crate::value::Value;
+use crate::KTree;
 use camera::PageCamera;
 
 pub use lod::{select_boxes, select_boxes_of, Lod};
@@ -156,11 +161,16 @@ fn escape(text: &str) -> String {
 }
 
 /// The boxes packed in groups of one kind (0 full, 1 coarse) and depth: per box its `K` coordinates in
-/// units of the cell's side, little-endian, 2 bytes each for depths up to 16, else 4. Returns the
-/// groups' JSON and the bytes.
-fn pack<const K: usize>(lod: &Lod<K>, level: u32) -> (String, Vec<u8>) {
+/// units of the cell's side, little-endian, 2 bytes each for depths up to 16, else 4; then, with `colour`,
+/// 3 bytes R, G, B per box in the same order (coarse boxes grey). Returns the groups' JSON and the bytes.
+fn pack<const K: usize>(
+    lod: &Lod<K>,
+    level: u32,
+    colour: Option<&BoxColour<'_, K>>,
+) -> (String, Vec<u8>) {
     let mut groups = String::from("[");
     let mut bytes = Vec::new();
+    let mut colours = Vec::new();
     for (kind, cells) in [(0, &lod.full), (1, &lod.coarse)] {
         for depth in 0..=level {
             let at: Vec<&Cell<K>> = cells.iter().filter(|c| c.level() == depth).collect();
@@ -185,11 +195,28 @@ fn pack<const K: usize>(lod: &Lod<K>, level: u32) -> (String, Vec<u8>) {
                         bytes.extend_from_slice(&unit.to_le_bytes());
                     }
                 }
+                if let Some(colour) = colour {
+                    colours.extend(if kind == 0 { colour(c) } else { COARSE });
+                }
             }
         }
     }
     groups.push(']');
+    bytes.extend(colours);
     (groups, bytes)
+}
+
+/// The colour of a full box.
+type BoxColour<'a, const K: usize> = dyn Fn(&Cell<K>) -> [u8; 3] + 'a;
+
+/// The colour of a coarse box of a tree with values (its voxels' values differ).
+const COARSE: [u8; 3] = [160, 160, 160];
+
+/// The colours of a tree with values on its page: each full box's colour, and the header's `values`
+/// entry (value type and legend).
+struct PageValues<'a, const K: usize> {
+    colour: &'a BoxColour<'a, K>,
+    json: String,
 }
 
 /// The page showing `tree` (see the [module docs](self)).
@@ -200,6 +227,78 @@ fn pack<const K: usize>(lod: &Lod<K>, level: u32) -> (String, Vec<u8>) {
 pub fn view_page<const K: usize, T: TreeStorage<K>>(
     tree: &T,
     options: &ViewOptions,
+) -> Result<Page, ViewPageError> {
+    page(tree, options, None)
+}
+
+/// The page showing a tree with values: its boxes coloured by value as `ktree render` colours them
+/// ([`value_colours`]; the colour menu's `by value`, the first colouring, `#colour=value` in the URL),
+/// with a legend ([`value_legend`]: the labels and their colours, the ramp from the smallest to the
+/// largest float, or a note that colours are drawn as stored). Each box is a leaf of one value
+/// ([`LeavesOfValues`]); the boxes the budget leaves coarse are grey.
+///
+/// ```
+/// use ktree::export::view::{view_values_page, ViewOptions};
+/// use ktree::KTree;
+/// let t = KTree::<2, u8>::from_dense_values(1, &[Some(3), None, Some(5), Some(5)]).unwrap();
+/// let page = view_values_page(&t, &ViewOptions::default()).unwrap();
+/// assert_eq!(page.boxes, 3);
+/// assert!(page.html.contains("\"legend\":{\"kind\":\"labels\""));
+/// ```
+///
+/// # Errors
+/// As [`view_page`].
+pub fn view_values_page<const K: usize, V: Value>(
+    tree: &KTree<K, V>,
+    options: &ViewOptions,
+) -> Result<Page, ViewPageError> {
+    let of_value = value_colours(tree);
+    let colour = |cell: &Cell<K>| tree.value_at(cell.origin()).map_or(COARSE, &of_value);
+    let number = |v: V| {
+        let x: f64 = v.text().parse().unwrap_or(f64::NAN);
+        if x.is_finite() {
+            x.to_string()
+        } else {
+            "null".into()
+        }
+    };
+    let rgb = |c: [u8; 3]| format!("[{},{},{}]", c[0], c[1], c[2]);
+    let legend = match value_legend(tree) {
+        Legend::Labels { entries, more } => {
+            let entries: Vec<String> = entries
+                .iter()
+                .map(|(v, c, n)| format!("[{},{},{n}]", number(*v), rgb(*c)))
+                .collect();
+            format!(
+                "{{\"kind\":\"labels\",\"entries\":[{}],\"more\":{more}}}",
+                entries.join(",")
+            )
+        }
+        Legend::Ramp { range } => {
+            let stops: Vec<String> = (0..=4).map(|i| rgb(ramp(f64::from(i) / 4.0))).collect();
+            let (lo, hi) = range.map_or(("null".into(), "null".into()), |(lo, hi)| {
+                (number(lo), number(hi))
+            });
+            format!(
+                "{{\"kind\":\"ramp\",\"min\":{lo},\"max\":{hi},\"stops\":[{}]}}",
+                stops.join(",")
+            )
+        }
+        Legend::AsStored => "{\"kind\":\"stored\"}".into(),
+    };
+    let dtype = V::DTYPE.map_or("none", |d| d.name());
+    let values = PageValues {
+        colour: &colour,
+        json: format!("{{\"dtype\":\"{dtype}\",\"legend\":{legend}}}"),
+    };
+    page(&LeavesOfValues(tree), options, Some(values))
+}
+
+/// The page of `tree`, its boxes coloured by `values` if given.
+fn page<const K: usize, T: TreeStorage<K>>(
+    tree: &T,
+    options: &ViewOptions,
+    values: Option<PageValues<'_, K>>,
 ) -> Result<Page, ViewPageError> {
     if K == 1 {
         return Err(ViewPageError::Bintree);
@@ -226,7 +325,7 @@ pub fn view_page<const K: usize, T: TreeStorage<K>>(
     let level = tree.level();
     let lod =
         select_boxes(tree, options.budget, &axes).map_err(|e| ViewPageError::Read(Box::new(e)))?;
-    let (groups, bytes) = pack(&lod, level);
+    let (groups, bytes) = pack(&lod, level, values.as_ref().map(|v| v.colour));
     let camera = options.camera.unwrap_or_else(|| {
         if K == 2 { "top" } else { "iso" }
             .parse()
@@ -238,7 +337,7 @@ pub fn view_page<const K: usize, T: TreeStorage<K>>(
         .map(|(name, d)| format!("\"{name}\":{}", v(*d)))
         .collect();
     let header = format!(
-        "{{\"k\":{K},\"level\":{level},\"time_axis\":{},\"budget\":{},\"complete\":{},\"full\":{},\"coarse\":{},\"camera\":{},\"frame\":{},\"views\":{{{}}},\"groups\":{groups}}}",
+        "{{\"k\":{K},\"level\":{level},\"time_axis\":{},\"budget\":{},\"complete\":{},\"full\":{},\"coarse\":{},\"camera\":{},\"frame\":{},\"views\":{{{}}},\"values\":{},\"groups\":{groups}}}",
         time.map_or("null".into(), |t| t.to_string()),
         options.budget,
         lod.complete,
@@ -247,6 +346,7 @@ pub fn view_page<const K: usize, T: TreeStorage<K>>(
         v(camera.toward_eye()),
         PageCamera::framing(&lod, level, time, camera.toward_eye()).json(),
         views.join(","),
+        values.as_ref().map_or("null", |v| v.json.as_str()),
     );
     let html = TEMPLATE
         .replace("{{TITLE}}", &escape(&options.title))
@@ -274,10 +374,23 @@ pub fn write_view<const K: usize, T: TreeStorage<K>>(
     Ok(page)
 }
 
+/// Writes [`view_values_page`] of `tree` to `path` atomically.
+///
+/// # Errors
+/// As [`view_values_page`]; [`ViewPageError::Write`] from the file system.
+pub fn write_values_view<const K: usize, V: Value>(
+    path: &Path,
+    tree: &KTree<K, V>,
+    options: &ViewOptions,
+) -> Result<Page, ViewPageError> {
+    let page = view_values_page(tree, options)?;
+    write_atomic(path, page.html.as_bytes()).map_err(ViewPageError::Write)?;
+    Ok(page)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::KTree;
 
     #[test]
     fn base64_matches_the_rfc_vectors() {
