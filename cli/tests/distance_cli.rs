@@ -111,33 +111,14 @@ fn pyopenvdb_reads_the_level_set_with_the_band_values() {
 /// # Panics
 /// If it does not build with both there.
 fn level_set_check(dir: &Path) -> Option<PathBuf> {
-    let compiler = tools::require(&["g++"], "install g++")?;
-    if !tools::require_file(
-        Path::new("/usr/include/openvdb/openvdb.h"),
-        "install Debian's libopenvdb-dev (OpenVDB's headers and library)",
-    ) {
-        return None;
-    }
-    static BUILT: OnceLock<PathBuf> = OnceLock::new();
-    let built = BUILT.get_or_init(|| {
-        let exe = dir.join("vdb_level_set_check");
-        let src =
-            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/interop/vdb_level_set_check.cpp");
-        let built = Command::new(compiler)
-            .args(["-std=c++17", "-O1", "-o"])
-            .arg(&exe)
-            .arg(&src)
-            .args(["-lopenvdb", "-ltbb", "-lImath"])
-            .output()
-            .unwrap();
-        assert!(
-            built.status.success(),
-            "vdb_level_set_check does not build: {}",
-            String::from_utf8_lossy(&built.stderr)
-        );
-        exe
-    });
-    Some(built.clone())
+    static BUILT: OnceLock<Option<PathBuf>> = OnceLock::new();
+    BUILT
+        .get_or_init(|| {
+            let src = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/interop/vdb_level_set_check.cpp");
+            tools::build_openvdb_program(dir, &src)
+        })
+        .clone()
 }
 
 #[test]

@@ -1,6 +1,8 @@
 //! Interoperability checked against the real tools, not against our own reading of their formats: OctoMap
 //! (Debian `octomap-tools`, `liboctomap-dev`, and `octomap_check.cpp` here built against it with `g++`) for
-//! `.bt` and binvox, OpenVDB's Python module (Debian `python3-openvdb`) for `.vdb`. A test whose tool is
+//! `.bt` and binvox, OpenVDB's Python module (Debian `python3-openvdb`) for `.vdb`, and OpenVDB's C++
+//! library (`libopenvdb-dev`, `vdb_values_check.cpp` here) for `Int32Grid`s, which the Python module cannot
+//! read. A test whose tool is
 //! missing prints a visible `SKIPPED:` line and passes, or fails under `KTREE_REQUIRE_TOOLS=1`, which
 //! `.ci/run` sets after installing them (`common::tools`).
 
@@ -502,4 +504,115 @@ fn typed_grids_written_by_openvdb_convert_to_valued_ktree_files_value_for_value(
         let (ok, out, err) = ktree(&["stats", path.to_str().unwrap()]);
         assert!(ok && out.contains(&want.len().to_string()), "{out}{err}");
     }
+}
+
+/// Labels over 16³: an 8³ block of one label (a whole OpenVDB leaf node) and scattered labels from `label`.
+fn label_object<V: Value>(label: impl Fn(usize, usize, usize) -> V) -> KTree<3, V> {
+    let mut dense = vec![None; 4096];
+    for (i, v) in dense.iter_mut().enumerate() {
+        let (x, y, z) = (i % 16, i / 16 % 16, i / 256);
+        if x >= 8 && y >= 8 && z >= 8 {
+            *v = Some(label(1, 1, 1));
+        } else if (x * 5 + y * 3 + z) % 7 == 0 {
+            *v = Some(label(x, y, z));
+        }
+    }
+    KTree::from_dense_values(4, &dense).unwrap()
+}
+
+/// `Int32Grid`s both ways, checked by OpenVDB's C++ library (`tests/interop/vdb_values_check.cpp`): labels
+/// written by `ktree convert` list in OpenVDB as the tree's voxels and values, the block as a tile; labels
+/// written and pruned by OpenVDB convert to the same tree.
+fn check_int32_grids_both_ways<V: Value>(check: &Path, dir: &Path, labels: &KTree<3, V>) {
+    let name = V::DTYPE.unwrap().name();
+    let want = voxel_values(labels);
+    let input = dir.join(format!("{name}.ktree"));
+    let output = dir.join(format!("{name}.vdb"));
+    write_valued_ktree_file(&input, labels).unwrap();
+    let (ok, _, err) = ktree(&["convert", input.to_str().unwrap(), output.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let listed = Command::new(check).arg(&output).output().unwrap();
+    let text = String::from_utf8(listed.stdout).unwrap();
+    assert!(
+        listed.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&listed.stderr)
+    );
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split_whitespace().collect();
+    assert_eq!(head[1], "Tree_int32_5_4_3", "{text}");
+    assert_eq!(head[5], labels.voxel_count().to_string());
+    let (mut got, mut tiles) = (Vec::new(), 0);
+    for line in lines {
+        let (voxel, tile) = line.rsplit_once(' ').unwrap();
+        tiles += usize::from(tile == "1");
+        got.push(voxel.to_string());
+    }
+    got.sort();
+    assert_eq!(got, want, "{name}: OpenVDB's voxels and values");
+    assert_eq!(tiles, 512, "{name}: the 8³ block is one tile");
+
+    // OpenVDB writes the labels at grid index − 8; ktree reads them back at + 8.
+    let voxels = dir.join(format!("{name}_voxels.txt"));
+    let shifted: Vec<String> = want
+        .iter()
+        .map(|l| {
+            let w: Vec<i64> = l.split(' ').map(|n| n.parse().unwrap()).collect();
+            format!("{} {} {} {}", w[0] - 8, w[1] - 8, w[2] - 8, w[3])
+        })
+        .collect();
+    std::fs::write(&voxels, shifted.join("\n")).unwrap();
+    let by_openvdb = dir.join(format!("{name}_openvdb.vdb"));
+    let written = Command::new(check)
+        .arg("--write")
+        .args([&voxels, &by_openvdb])
+        .output()
+        .unwrap();
+    assert!(
+        written.status.success(),
+        "{}",
+        String::from_utf8_lossy(&written.stderr)
+    );
+    let report = String::from_utf8(written.stdout).unwrap();
+    assert_eq!(report.trim(), format!("active {} tiles 1", want.len()));
+    let back = dir.join(format!("{name}_back.ktree"));
+    let (ok, _, err) = ktree(&[
+        "convert",
+        by_openvdb.to_str().unwrap(),
+        back.to_str().unwrap(),
+        "--offset",
+        "8,8,8",
+        "--level",
+        "4",
+    ]);
+    assert!(ok, "{err}");
+    let read = read_valued_ktree_file::<3, V>(&back).unwrap();
+    assert_eq!(&read, labels, "{name}: OpenVDB's grid read back");
+}
+
+#[test]
+fn int32_grids_go_both_ways_between_ktree_and_openvdb_label_for_label() {
+    let dir = tempfile::tempdir().unwrap();
+    let source =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/interop/vdb_values_check.cpp");
+    let Some(check) = tools::build_openvdb_program(dir.path(), &source) else {
+        return;
+    };
+    let wide = |x: usize, y: usize, z: usize| (70_000 + x * 1000 + y * 10 + z) as u32;
+    check_int32_grids_both_ways(
+        &check,
+        dir.path(),
+        &label_object(|x, y, z| (x + y + z) as u8),
+    );
+    check_int32_grids_both_ways(
+        &check,
+        dir.path(),
+        &label_object(|x, y, _| (300 + x * 16 + y) as u16),
+    );
+    check_int32_grids_both_ways(&check, dir.path(), &label_object(wide));
+    check_int32_grids_both_ways(
+        &check,
+        dir.path(),
+        &label_object(|x, y, z| x as i8 - y as i8 - z as i8),
+    );
 }

@@ -82,19 +82,52 @@ pub fn require(names: &[&str], install: &str) -> Option<PathBuf> {
 /// If the program does not build with both there (with the compiler's messages).
 #[track_caller]
 pub fn build_octomap_program(dir: &Path, source: &Path) -> Option<PathBuf> {
+    let headers = "/usr/include/octomap/octomap.h";
+    let install = "install Debian's liboctomap-dev (OctoMap's headers and library)";
+    build_program(
+        dir,
+        source,
+        (headers, install),
+        &["-O2", "-loctomap", "-loctomath"],
+    )
+}
+
+/// Builds the C++ program `source` against the installed OpenVDB (libopenvdb, TBB, Imath) into `dir`,
+/// named as the source's stem; `None` after [`missing`] without `g++` or OpenVDB's headers.
+///
+/// # Panics
+/// If the program does not build with both there (with the compiler's messages).
+#[track_caller]
+pub fn build_openvdb_program(dir: &Path, source: &Path) -> Option<PathBuf> {
+    let headers = "/usr/include/openvdb/openvdb.h";
+    let install = "install Debian's libopenvdb-dev (OpenVDB's headers and library)";
+    build_program(
+        dir,
+        source,
+        (headers, install),
+        &["-O1", "-lopenvdb", "-ltbb", "-lImath"],
+    )
+}
+
+/// Builds `source` with `g++` (C++17) and `flags` (optimisation, libraries) into `dir`, once the
+/// library's `header` exists (else [`missing`] with its `install` advice).
+#[track_caller]
+fn build_program(
+    dir: &Path,
+    source: &Path,
+    (header, install): (&str, &str),
+    flags: &[&str],
+) -> Option<PathBuf> {
     let compiler = require(&["g++"], "install g++")?;
-    if !require_file(
-        Path::new("/usr/include/octomap/octomap.h"),
-        "install Debian's liboctomap-dev (OctoMap's headers and library)",
-    ) {
+    if !require_file(Path::new(header), install) {
         return None;
     }
     let exe = dir.join(source.file_stem().expect("a source file"));
     let built = std::process::Command::new(compiler)
-        .args(["-O2", "-o"])
+        .args(["-std=c++17", "-o"])
         .arg(&exe)
         .arg(source)
-        .args(["-loctomap", "-loctomath"])
+        .args(flags)
         .output()
         .expect("g++ runs");
     assert!(
