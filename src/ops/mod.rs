@@ -17,7 +17,7 @@
 //! | Booleans (M2) | [`boolean`], [`union`], [`intersection`], [`difference`], [`symmetric_difference`], [`complement`] | simultaneous depth-first traversal; complement on packed words | linear in the nodes reached |
 //! | Booleans of files larger than memory | `io::boolean_files`, `io::complement_file` | [`boolean_into`] over memory maps, levels spilled and streamed to a `.ktree` | linear; memory bounded by the depth |
 //! | translation (M3) | [`translate`], [`translate_fine`] | fixed overlay of `2^K` obels per target node | linear in the output nodes |
-//! | scaling (M4) | [`grow`], [`zoom`] (by `2^n` through the root), [`scale`] (rational, overlays) | root levels; overlay engine | `O(n·2^K)` + copy; output-sensitive |
+//! | scaling (M4) | [`grow`], [`zoom`] (by `2^n` through the root; [`grow_values`], [`zoom_values`] with values), [`scale`] (rational, overlays) | root levels; overlay engine | `O(n·2^K)` + copy; output-sensitive |
 //! | rotations, reflections (M5) | [`rotate_axes`] with any [`AxisMap`] (`K!·2^K` of them) | child reordering | linear |
 //! | arbitrary rotation, any affine map (M5, M6) | [`transform`] with an [`Affine`] | overlay engine, voxel-exact | output-sensitive |
 //! | the same with integer additions and shifts only (M5, M8) | [`transform_fixed`] | overlay engine, fixed-point cell images updated incrementally | output-sensitive |
@@ -75,6 +75,8 @@ pub use perspective::{
 };
 pub use project::{extrude, project, slice, slice_values};
 pub use rotate::{rotate_axes, rotate_axes_into, rotate_values, AxisMap};
-pub use scale::{grow, grow_into, scale, scale_into, scale_values, zoom, zoom_into};
+pub use scale::{
+    grow, grow_into, grow_values, scale, scale_into, scale_values, zoom, zoom_into, zoom_values,
+};
 pub use separation::min_separation;
 pub use translate::{fine_shift, translate, translate_fine, translate_fine_into, translate_into};

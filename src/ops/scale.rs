@@ -5,12 +5,16 @@
 use super::output::{copy_into, Memory};
 use super::overlay::{resample_into, resample_values, Preimage};
 use super::OpsError;
-use crate::space::{max_level, Universe};
+use crate::space::{max_level, Cell, Universe};
+use crate::tree::cursor::Walk;
 use crate::tree::locate::locate;
 use crate::tree::sink::{copy_subtree_to, LevelSink};
 use crate::tree::storage::TreeStorage;
-use crate::tree::valued::ValueStorage;
+use crate::tree::valued::{
+    try_walk_values, ValueAssembler, ValueNode, ValueState, ValueStorage, ValueVisitor,
+};
 use crate::tree::{KTree, NodeState};
+use crate::value::Value;
 
 fn check_path<const K: usize>(path: &[usize], level: u32) -> Result<(), OpsError> {
     if path.len() > level as usize || path.iter().any(|&c| c >= 1 << K) {
@@ -180,6 +184,124 @@ where
         false,
     )?;
     Ok(sink.finish(NodeState::Partial)?)
+}
+
+/// [`grow`] of a tree with values: the old universe becomes the cell of the new one reached by `path`,
+/// each voxel keeping its value. The old nodes are copied unchanged, `n` levels deeper.
+///
+/// ```
+/// use ktree::{KTree, ops::{grow_values, zoom_values}};
+/// let a = KTree::<2, u8>::from_dense_values(1, &[Some(1), None, Some(2), Some(2)]).unwrap();
+/// let g = grow_values(&a, &[3]).unwrap(); // into the upper-right quadrant
+/// assert_eq!((g.level(), g.value_at([2, 2]), g.value_at([3, 3])), (2, Some(1), Some(2)));
+/// assert_eq!(zoom_values(&g, &[3]).unwrap(), a);
+/// ```
+///
+/// # Errors
+/// As [`grow`].
+pub fn grow_values<const K: usize, T: ValueStorage<K>>(
+    tree: &T,
+    path: &[usize],
+) -> Result<KTree<K, T::Value>, OpsError> {
+    let universe = grown::<K>(tree.level(), path)?;
+    let mut out = assembler::<K, T::Value>(universe)?;
+    let root = tree.root().map_err(OpsError::storage)?;
+    if path.is_empty() || root.state == ValueState::Empty {
+        // Nothing moves, or nothing to place: the whole universe is the old root's subtree or empty.
+        if path.is_empty() {
+            copy_values_below(tree, &[], 0, &mut out)?;
+        } else {
+            out.push(0, ValueState::Empty);
+        }
+        return Ok(out.finish());
+    }
+    // The new levels: one node with children a level down to the old root, its siblings empty.
+    fn place<const K: usize, T: ValueStorage<K>>(
+        tree: &T,
+        path: &[usize],
+        depth: usize,
+        out: &mut ValueAssembler<K, T::Value>,
+    ) -> Result<(), OpsError> {
+        out.push(depth, ValueState::Partial);
+        for code in 0..1 << K {
+            match path.get(depth) {
+                Some(&c) if c == code && depth + 1 < path.len() => {
+                    place(tree, path, depth + 1, out)?
+                }
+                Some(&c) if c == code => copy_values_below(tree, &[], depth + 1, out)?,
+                _ => out.push(depth + 1, ValueState::Empty),
+            }
+        }
+        Ok(())
+    }
+    place(tree, path, 0, &mut out)?;
+    Ok(out.finish())
+}
+
+/// [`zoom`] of a tree with values: the cell reached by `path` becomes the universe, each voxel keeping its
+/// value; everything outside the cell is dropped. See [`grow_values`].
+///
+/// # Errors
+/// As [`zoom`].
+pub fn zoom_values<const K: usize, T: ValueStorage<K>>(
+    tree: &T,
+    path: &[usize],
+) -> Result<KTree<K, T::Value>, OpsError> {
+    let universe = zoomed::<K>(tree.level(), path)?;
+    let mut out = assembler::<K, T::Value>(universe)?;
+    copy_values_below(tree, path, 0, &mut out)?;
+    Ok(out.finish())
+}
+
+/// An empty assembler for a tree of `universe` (a level [`grown`] or [`zoomed`] checked).
+fn assembler<const K: usize, V: Value>(
+    universe: Universe<K>,
+) -> Result<ValueAssembler<K, V>, OpsError> {
+    let level = universe.level();
+    ValueAssembler::new(level).map_err(|_| OpsError::LevelTooLarge {
+        k: K,
+        level,
+        max: max_level(K),
+    })
+}
+
+/// Appends to `out`, depth first, the subtree of `tree` at the cell reached by `path` (or the leaf
+/// above it that covers it), its root at depth `to`.
+fn copy_values_below<const K: usize, T: ValueStorage<K>>(
+    tree: &T,
+    path: &[usize],
+    to: usize,
+    out: &mut ValueAssembler<K, T::Value>,
+) -> Result<(), OpsError> {
+    struct Copy<'a, const K: usize, V> {
+        /// The cell whose subtree is copied.
+        target: Cell<K>,
+        to: usize,
+        out: &'a mut ValueAssembler<K, V>,
+    }
+    impl<const K: usize, V: Value> ValueVisitor<K, V> for Copy<'_, K, V> {
+        fn visit(&mut self, node: &ValueNode<K, V>) -> Walk {
+            let (depth, n) = (node.cell.level(), self.target.level());
+            if depth <= n && !node.cell.contains(self.target.origin()) {
+                return Walk::Skip; // beside the path to the cell
+            }
+            if depth < n {
+                // Above the cell: a leaf covers the whole cell.
+                if !node.state.has_children() {
+                    self.out.push(self.to, node.state);
+                }
+            } else {
+                self.out.push((depth - n) as usize + self.to, node.state);
+            }
+            Walk::Descend
+        }
+    }
+    let target = path
+        .iter()
+        .fold(tree.universe().root(), |c, &code| c.child(code));
+    let mut copy = Copy { target, to, out };
+    try_walk_values(tree, &mut copy).map_err(OpsError::storage)?;
+    Ok(())
 }
 
 /// The preimage of a uniform scaling by `num / den` about the universe's origin corner.

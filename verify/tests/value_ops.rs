@@ -1,7 +1,7 @@
 //! Operations on valued trees against the same operation on dense arrays of values, K = 1 … 4 and several
 //! value types: select (a value, a range), mask, combine by every rule, overlay, map and relabel, and the
-//! per-value statistics. Every result is well formed and minimal (equal, node for node, to the tree of its
-//! dense reference).
+//! per-value statistics, the transforms, and growing and zooming through the root. Every result is well
+//! formed and minimal (equal, node for node, to the tree of its dense reference).
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -192,6 +192,46 @@ fn check<const K: usize, V: Palette>(a: &Painted<K>, b: &Painted<K>) -> Result<(
     let got = ops::transform_values(&ta, &m).unwrap();
     same(&got, &tree_of::<K, V>(level, &want))?;
     prop_assert_eq!(got.shape(), ops::transform(&ta.shape(), &m).unwrap());
+
+    // Grow and zoom by powers of two through the root: the old universe is the cell of `path`.
+    let path: Vec<usize> = (0..2)
+        .map(|d| (level as usize + 3 * d) % (1 << K))
+        .collect();
+    let corner = |path: &[usize], level: u32| -> [i64; K] {
+        std::array::from_fn(|a| {
+            let bit = |d: usize| (path[d] >> a & 1) as i64;
+            (0..path.len())
+                .map(|d| bit(d) << (level - 1 - d as u32))
+                .sum()
+        })
+    };
+    let grown = Universe::<K>::new(level + 2).unwrap();
+    let at = corner(&path, level + 2);
+    let want: Vec<Option<V>> = (0..grown.side().pow(K as u32) as usize)
+        .map(|i| {
+            let q = grown.dense_point(i);
+            let p: [i64; K] = std::array::from_fn(|a| i64::from(q[a]) - at[a]);
+            let inside = p.iter().all(|&c| (0..u.side() as i64).contains(&c));
+            inside
+                .then(|| da[u.dense_index(p.map(|c| c as u32))])
+                .flatten()
+        })
+        .collect();
+    let g = ops::grow_values(&ta, &path).unwrap();
+    same(&g, &tree_of::<K, V>(level + 2, &want))?;
+    same(&ops::zoom_values(&g, &path).unwrap(), &ta)?;
+    prop_assert_eq!(g.shape(), ops::grow(&ta.shape(), &path).unwrap());
+    let n = (level as usize).min(2);
+    let zoomed = Universe::<K>::new(level - n as u32).unwrap();
+    let at = corner(&path[..n], level);
+    let want = resampled(&da, u, |q| std::array::from_fn(|a| i64::from(q[a]) + at[a]));
+    let want: Vec<Option<V>> = (0..zoomed.side().pow(K as u32) as usize)
+        .map(|i| want[u.dense_index(zoomed.dense_point(i))])
+        .collect();
+    same(
+        &ops::zoom_values(&ta, &path[..n]).unwrap(),
+        &tree_of::<K, V>(level - n as u32, &want),
+    )?;
 
     // Per-value statistics against a count over the dense array.
     let mut want: BTreeMap<V::Key, Measured<K>> = BTreeMap::new();
