@@ -3,7 +3,7 @@
 # a dense label volume (u32 → ktree uint32 / OpenVDB Int32Grid) and a dense float volume (f32 → float32 /
 # FloatGrid), L = 8 and 9, and the values at 10^7 random points; memory of the structures and of the
 # processes; bits a node per value type. The volume: the 3-D Shepp–Logan phantom
-# (experiments/examples/values.rs). ktree: `ValueRuns::from_dense_background` + `KTree::from_value_runs`,
+# (experiments/examples/values.rs). ktree: `KTree::from_dense_background` (straight from the array),
 # `KTree::values_at`. OpenVDB: experiments/values/peers.cpp (`tools::copyFromDense` serial + `prune`, one
 # ValueAccessor), given the array in its own default layout (ZYX) and as the file holds it (XYZ). Best of 3
 # inside each process, the programs alternating over 3 rounds, best kept; ktree also on two threads. Answers
@@ -74,8 +74,9 @@ print("ellipsoids, the table of Kak & Slaney as extended to 3-D by Schabel's `ph
 print("and the rotations about z only: `experiments/examples/values.rs`), as **labels** (the last ellipsoid holding a voxel's")
 print("centre, 1–10, 0 outside; stored as u32) and as a **density** (the sum of the intensities, float32, 0 outside). Both")
 print("programs read the same raw file (x fastest) before the clock starts, and 0 is the background of both.")
-print(f"**ktree**: `ValueRuns::from_dense_background` then `KTree::from_value_runs`, one thread (and two beside: the runs")
-print("are scanned on one thread, the subtrees of cells of 2^18 voxels built on the rayon pool). **OpenVDB**")
+print(f"**ktree**: `KTree::from_dense_background`, straight from the array (its bricks of 16³ voxels read once, a cell whose")
+print("bricks hold one value a leaf, the others built from their children), one thread (and two beside: the bricks read and")
+print("the subtrees of cells of 2^18 voxels built on the rayon pool). **OpenVDB**")
 print(f"(libopenvdb-dev {version}, `experiments/values/peers.cpp`): `tools::copyFromDense` (serial, tolerance 0) into an")
 print("`Int32Grid` / `FloatGrid`, then `tools::prune` (tolerance 0), TBB limited to one thread; it is given the array in its")
 print("default layout (ZYX, z fastest: transposed before the clock starts) and as the file holds it (`LayoutXYZ`); the faster")

@@ -128,17 +128,16 @@ fn build<V: Value>(level: u32, raw: &Path, repeats: usize, as_f64: impl Fn(V) ->
     for _ in 0..repeats {
         drop(tree.take());
         let start = Instant::now();
-        let runs = ValueRuns::<3, V>::from_dense_background(level, &dense, background).unwrap();
-        let scanned = start.elapsed().as_secs_f64();
-        let built = KTree::from_value_runs(&runs);
+        // VALUES_VIA_RUNS=1: through the array's runs (the stacking path), else straight from the array.
+        let built = if std::env::var_os("VALUES_VIA_RUNS").is_some() {
+            let runs = ValueRuns::<3, V>::from_dense_background(level, &dense, background).unwrap();
+            let scanned = start.elapsed().as_secs_f64();
+            eprintln!("scan {scanned:.4} s, {} runs", runs.len());
+            KTree::from_value_runs(&runs)
+        } else {
+            KTree::<3, V>::from_dense_background(level, &dense, background).unwrap()
+        };
         best = best.min(start.elapsed().as_secs_f64());
-        if std::env::var_os("VALUES_SPLIT").is_some() {
-            eprintln!(
-                "scan {scanned:.4} s, {} runs, total {:.4} s",
-                runs.len(),
-                start.elapsed().as_secs_f64()
-            );
-        }
         tree = Some(built);
     }
     let tree = tree.unwrap();

@@ -6,7 +6,6 @@
 use std::collections::HashMap;
 
 use ktree::ops::values::Rule;
-use ktree::rays::ValueRuns;
 use ktree::space::{Universe, DENSE_LIMIT};
 use ktree::value::{Dtype, Rgb, Value};
 use ktree::{with_dim, with_valued, AnyTree, AnyValuedTree, KTree};
@@ -201,9 +200,9 @@ pub(crate) fn from_dense<const K: usize, V: Scalar>(
         }
     }
     py.detach(|| {
-        let runs = ValueRuns::<K, V>::from_dense_background(level, &dense, background)
+        let tree = KTree::<K, V>::from_dense_background(level, &dense, background)
             .map_err(Failure::value)?;
-        Ok(AnyValuedTree::from(KTree::from_value_runs(&runs)))
+        Ok(AnyValuedTree::from(tree))
     })
 }
 

@@ -254,7 +254,10 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
 }
 
 /// The universe's voxel count, checked to be `len` and to fit a dense array.
-fn check_dense_len<const K: usize>(universe: Universe<K>, len: usize) -> Result<usize, RayError> {
+pub(crate) fn check_dense_len<const K: usize>(
+    universe: Universe<K>,
+    len: usize,
+) -> Result<usize, RayError> {
     let want = universe.dense_len(DENSE_LIMIT)?;
     if len != want {
         return Err(RayError::Space(

@@ -97,6 +97,7 @@ mod any;
 mod bitmap;
 mod builder;
 mod cells;
+mod dense_values;
 mod out_of_core;
 pub mod paper;
 mod partition;

@@ -69,7 +69,7 @@ impl<const K: usize, V: Value> KTree<K, V> {
 }
 
 /// A subtree built apart: its root's state and the states of each level below it, in level order.
-type Subtree<V> = (ValueState<V>, Vec<Vec<ValueState<V>>>);
+pub(super) type Subtree<V> = (ValueState<V>, Vec<Vec<ValueState<V>>>);
 
 /// The subtree of `cell` from the pieces inside it: its root's state and the states of each level below
 /// it (in level order), built apart on the rayon pool down to the cells of depth `split`.
@@ -107,12 +107,17 @@ fn subtree<const K: usize, V: Value>(
             )
         })
         .collect();
+    join(kids)
+}
+
+/// The subtree of a cell from those of its `2^K` children, in code order: a leaf if they are alike, else
+/// the children, then each level of their subtrees one after the other.
+pub(super) fn join<V: Value>(kids: Vec<Subtree<V>>) -> Subtree<V> {
     let states: Vec<ValueState<V>> = kids.iter().map(|k| k.0).collect();
     let state = combine(&states);
     if !state.has_children() {
         return (state, Vec::new());
     }
-    // Below the cell: its children, then each level of their subtrees one after the other.
     let mut levels = vec![states];
     for (_, below) in kids {
         for (d, level) in below.into_iter().enumerate() {

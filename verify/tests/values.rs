@@ -240,6 +240,18 @@ fn from_runs<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseE
     let got = KTree::from_value_runs(&runs);
     got.assert_well_formed();
     prop_assert!(got == want);
+    // Straight from the dense array, on one thread and on two.
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let got = pool
+            .install(|| KTree::<K, V>::from_dense_background(o.level, &plain, background))
+            .unwrap();
+        got.assert_well_formed();
+        prop_assert!(got == want, "from the dense array, {threads} threads");
+    }
     Ok(())
 }
 
@@ -271,4 +283,8 @@ fn valued_runs_that_overlap_or_hold_nan_are_errors() {
     assert!(e.to_string().contains("NaN"), "{e}");
     let e = ValueRuns::<1, f32>::from_dense(1, &[None, Some(f32::NAN)]).unwrap_err();
     assert!(e.to_string().contains("NaN"), "{e}");
+    let e = KTree::<2, f32>::from_dense_background(1, &[0.0, 0.0, 2.0, f32::NAN], 0.0).unwrap_err();
+    assert!(e.to_string().contains("NaN"), "{e}");
+    let e = KTree::<2, f32>::from_dense_background(1, &[0.0; 5], 0.0).unwrap_err();
+    assert!(!e.to_string().is_empty());
 }
