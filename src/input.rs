@@ -365,6 +365,8 @@ pub struct MeshLabels {
     pub tree: crate::AnyValuedTree,
     /// Label `i + 1` is `names[i]`: the file, or the group of a single OBJ file.
     pub names: Vec<String>,
+    /// Label `i + 1` is held by `voxels[i]` voxels (0 for a mesh the later ones hide).
+    pub voxels: Vec<u64>,
     /// Where the meshes went: voxel coordinate = `scale · v + translate`.
     pub transform: crate::solid::mesh::MeshTransform,
     /// Placed by fitting: the transform chosen, as `s,tx,ty,tz`.
@@ -399,6 +401,7 @@ pub struct MeshLabels {
 /// std::fs::write(&scene, obj).unwrap();
 /// let labels = voxelize_mesh_labels(&[&scene], &ReadOptions { level: Some(4), ..ReadOptions::default() }).unwrap();
 /// assert_eq!(labels.names, ["left", "right"]);
+/// assert!(labels.voxels.iter().all(|&n| n > 0)); // the voxels of each label
 /// let ktree::AnyValuedTree::K3U8(tree) = labels.tree else { panic!("labels of u8") };
 /// assert_eq!(tree.value_stats().into_keys().collect::<Vec<_>>(), [1, 2]);
 /// // A missing file is named.
@@ -463,23 +466,26 @@ pub fn voxelize_mesh_labels(
     let meshes: Vec<TriangleMesh> = meshes.into_iter().map(|(m, _, _)| m).collect();
     let (transform, fitted) =
         mesh_placement(options, &meshes, level).map_err(solid_error(first))?;
-    let placement = crate::solid::mesh::Placement::Transform(transform);
+    // As `KTree::from_label_meshes` builds them, with the voxels of each label counted on the runs.
     fn build<V: crate::value::Value + TryFrom<u32>>(
         meshes: &[TriangleMesh],
         level: u32,
-        placement: crate::solid::mesh::Placement,
-    ) -> Result<crate::AnyValuedTree, SolidError> {
-        KTree::<3, V>::from_label_meshes(meshes, level, placement).map(crate::AnyValuedTree::from)
+        transform: &crate::solid::mesh::MeshTransform,
+    ) -> Result<(crate::AnyValuedTree, Vec<u64>), SolidError> {
+        let labels = crate::solid::mesh::label_runs::<V>(meshes, level, transform)?;
+        let tree = KTree::from_value_runs(&labels.runs);
+        Ok((crate::AnyValuedTree::from(tree), labels.voxels))
     }
-    let tree = match meshes.len() {
-        0..=255 => build::<u8>(&meshes, level, placement),
-        256..=65535 => build::<u16>(&meshes, level, placement),
-        _ => build::<u32>(&meshes, level, placement),
+    let (tree, voxels) = match meshes.len() {
+        0..=255 => build::<u8>(&meshes, level, &transform),
+        256..=65535 => build::<u16>(&meshes, level, &transform),
+        _ => build::<u32>(&meshes, level, &transform),
     }
     .map_err(solid_error(first))?;
     Ok(MeshLabels {
         tree,
         names,
+        voxels,
         transform,
         fitted,
     })

@@ -219,15 +219,17 @@ fn run_mesh_labels(a: &Args) -> CliResult {
     if let Some(t) = &labels.fitted {
         outln!("--fit chose --transform {t}");
     }
-    for (i, name) in labels.names.iter().enumerate() {
-        outln!("label {}: {name}", i + 1);
+    for (i, (name, voxels)) in labels.names.iter().zip(&labels.voxels).enumerate() {
+        outln!("label {}: {name} ({voxels} voxels)", i + 1);
     }
     let frame = labels.transform.world_frame();
-    let (voxels, nodes, used) = ktree::with_valued!(&labels.tree, t => {
+    let nodes = ktree::with_valued!(&labels.tree, t => {
         ktree::io::ktree::v3::write_valued_ktree_file_framed(&a.out.out, t, frame.as_ref())
             .map_err(CliError::caused)?;
-        (t.voxel_count(), t.node_count(), t.value_stats().len())
+        t.node_count()
     });
+    let voxels: u64 = labels.voxels.iter().sum();
+    let used = labels.voxels.iter().filter(|&&v| v > 0).count();
     outln!(
         "{}: {voxels} voxels labelled with {used} of {} labels ({}), L = {level}, {nodes} nodes",
         a.out.out.display(),

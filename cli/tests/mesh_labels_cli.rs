@@ -131,8 +131,11 @@ fn several_mesh_files_are_one_label_each() {
     ]);
     let stdout = run(&args);
     for (i, (path, _)) in files.iter().enumerate() {
-        let line = format!("label {}: {}", i + 1, path.display());
-        assert!(stdout.lines().any(|l| l == line), "{line} in {stdout}");
+        let line = format!("label {}: {} (", i + 1, path.display());
+        assert!(
+            stdout.lines().any(|l| l.starts_with(&line)),
+            "{line} in {stdout}"
+        );
     }
     let transform = fitted(&stdout);
     let s = stats(&out);
@@ -150,9 +153,21 @@ fn several_mesh_files_are_one_label_each() {
             "{}",
             path.display()
         );
+        let printed = format!("label {}: {} ({want} voxels)", i + 1, path.display());
+        assert!(
+            stdout.lines().any(|l| l == printed),
+            "{printed} in {stdout}"
+        );
         total += want;
     }
     assert_eq!(s["voxels"], total);
+    // The file keeps the placement as its world frame: voxel c's corner is the mesh point (c − t) / s.
+    let bytes = std::fs::read(&out).unwrap();
+    let (_, frame) =
+        ktree::io::ktree::v3::read_valued_ktree_framed::<3, u8>(&bytes, "labels").unwrap();
+    let t = ktree::solid::mesh::MeshTransform::parse(&transform).unwrap();
+    assert_eq!(frame, t.world_frame());
+    assert!(frame.is_some());
     // The same with --transform: the labels do not depend on how the placement was given.
     let again = d.join("again.ktree");
     let mut args = vec!["voxelize"];
@@ -198,8 +213,11 @@ fn one_obj_file_s_groups_are_one_label_each() {
         out.to_str().unwrap(),
     ]);
     for (i, (name, _, _)) in boxes.iter().enumerate() {
-        let line = format!("label {}: {name}", i + 1);
-        assert!(stdout.lines().any(|l| l == line), "{line} in {stdout}");
+        let line = format!("label {}: {name} (", i + 1);
+        assert!(
+            stdout.lines().any(|l| l.starts_with(&line)),
+            "{line} in {stdout}"
+        );
     }
     let transform = fitted(&stdout);
     let s = stats(&out);
@@ -209,6 +227,11 @@ fn one_obj_file_s_groups_are_one_label_each() {
         let want = alone(&d.join(format!("{name}.obj")), &transform, "5", d);
         assert!(want > 0, "{name}");
         assert_eq!(values[&(i + 1).to_string()]["voxels"], want, "{name}");
+        let printed = format!("label {}: {name} ({want} voxels)", i + 1);
+        assert!(
+            stdout.lines().any(|l| l == printed),
+            "{printed} in {stdout}"
+        );
     }
     // Without groups, one label named by the file.
     let single = d.join("base.obj");

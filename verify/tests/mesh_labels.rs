@@ -11,7 +11,7 @@ use std::path::Path;
 
 use ktree::input::voxelize_mesh_labels;
 use ktree::io::ReadOptions;
-use ktree::solid::mesh::{MeshTransform, Placement, TriangleMesh};
+use ktree::solid::mesh::{label_runs, MeshTransform, Placement, TriangleMesh};
 use ktree::{AnyValuedTree, KTree, Universe};
 use proptest::prelude::*;
 
@@ -134,6 +134,17 @@ fn check(meshes: &[TriangleMesh], level: u32, placement: Placement) -> Result<()
         prop_assert_eq!(g, w, "voxel {:?}", u.dense_point(i));
     }
     prop_assert_eq!(tree, KTree::from_dense_values(level, &want).unwrap());
+    // The voxels counted for each label on the runs.
+    let counted = label_runs::<u8>(meshes, level, &transform).unwrap().voxels;
+    for (i, &n) in counted.iter().enumerate() {
+        let label = Some(i as u8 + 1);
+        prop_assert_eq!(
+            n,
+            want.iter().filter(|&&v| v == label).count() as u64,
+            "label {:?}",
+            label
+        );
+    }
     Ok(())
 }
 
@@ -301,6 +312,10 @@ fn an_obj_file_s_groups_are_labels_as_each_group_voxelized_alone() {
             }
         }
         assert_eq!(tree.to_dense_values().unwrap(), want, "level {l}");
+        for (i, &n) in labels.voxels.iter().enumerate() {
+            let label = Some(i as u8 + 1);
+            assert_eq!(n, want.iter().filter(|&&v| v == label).count() as u64);
+        }
     }
     // Faces before the first group are a group of their own; a file without groups is one label.
     let head = format!(

@@ -18,6 +18,8 @@ pub struct LabelRuns<V> {
     /// For each mesh, its edges not shared by exactly two triangles (0 for a closed mesh; see
     /// [`TriangleMesh::open_edges`]).
     pub open_edges: Vec<usize>,
+    /// For each mesh, the voxels that hold its label (0 for a mesh the later ones hide).
+    pub voxels: Vec<u64>,
 }
 
 /// The meshes placed by one `placement` in a universe of level `level`, as runs of labels: mesh `i` is
@@ -40,6 +42,7 @@ pub struct LabelRuns<V> {
 /// let identity = MeshTransform { scale: 1.0, translate: [0.0; 3] };
 /// let labels = label_runs::<u8>(&meshes, 3, &identity).unwrap();
 /// assert_eq!(labels.open_edges, [0, 0]);
+/// assert_eq!(labels.voxels, [64 - 8, 64]);
 /// let tree = KTree::from_value_runs(&labels.runs);
 /// assert_eq!((tree.value_at([0, 0, 0]), tree.value_at([3, 3, 3]), tree.value_at([5, 5, 5])), (Some(1), Some(2), Some(2)));
 /// assert_eq!(tree.value_at([7, 7, 7]), None);
@@ -95,19 +98,42 @@ pub fn label_runs<V: Value + TryFrom<u32>>(
     let mut sweep = Sweep::default();
     for column in all.chunk_by(|a, b| a.0 == b.0) {
         match column {
-            [(key, z1, z2, mesh)] => runs.push(ValueRun {
+            [(key, z1, z2, mesh)] => runs.push(MeshRun {
                 column: *key,
                 z1: *z1,
                 z2: *z2,
-                value: labels[*mesh as usize],
+                mesh: *mesh,
             }),
-            _ => sweep.column(column, &labels, &mut runs),
+            _ => sweep.column(column, &mut runs),
         }
     }
+    let mut voxels = vec![0u64; meshes.len()];
+    for r in &runs {
+        voxels[r.mesh as usize] += u64::from(r.z2 - r.z1);
+    }
+    let runs = runs
+        .into_iter()
+        .map(|r| ValueRun {
+            column: r.column,
+            z1: r.z1,
+            z2: r.z2,
+            value: labels[r.mesh as usize],
+        })
+        .collect();
     Ok(LabelRuns {
         runs: ValueRuns::from_sorted_runs(universe, runs),
         open_edges,
+        voxels,
     })
+}
+
+/// A run of the merged labels: its column's key, `[z1, z2)` and the mesh whose label it holds.
+#[derive(Debug, Clone, Copy)]
+struct MeshRun {
+    column: u64,
+    z1: u32,
+    z2: u32,
+    mesh: u32,
 }
 
 /// The buffers of the sweep along one column, kept from column to column.
@@ -122,12 +148,7 @@ struct Sweep {
 impl Sweep {
     /// Appends the labelled runs of one column (`column`: its meshes' runs, all of one key) to `out`:
     /// between two consecutive ends of runs, the label of the last mesh inside.
-    fn column<V: Value>(
-        &mut self,
-        column: &[(u64, u32, u32, u32)],
-        labels: &[V],
-        out: &mut Vec<ValueRun<V>>,
-    ) {
+    fn column(&mut self, column: &[(u64, u32, u32, u32)], out: &mut Vec<MeshRun>) {
         let key = column[0].0;
         self.events.clear();
         self.inside.clear();
@@ -153,11 +174,11 @@ impl Sweep {
                 continue;
             }
             if let Some((z1, mesh)) = open {
-                out.push(ValueRun {
+                out.push(MeshRun {
                     column: key,
                     z1,
                     z2: z,
-                    value: labels[mesh as usize],
+                    mesh,
                 });
             }
             open = top.map(|m| (z, m));
