@@ -138,6 +138,14 @@ class Tree:
     ) -> Tree:
         """The octree of an OBJ, STL or PLY mesh; `transform` (s, tx, ty, tz) maps v to s*v + t, default: fit."""
     @staticmethod
+    def from_meshes(
+        paths: Sequence[_Path],
+        level: int,
+        transform: Optional[Tuple[float, float, float, float]] = None,
+    ) -> tuple[Tree, list[str]]:
+        """One octree of labels from mesh files placed together: file i is label i + 1 (a single OBJ file:
+        each group/object), the later mesh winning where they overlap; the tree and each label's name."""
+    @staticmethod
     def from_mesh_arrays(
         vertices: npt.ArrayLike,
         faces: npt.ArrayLike,

@@ -7,7 +7,8 @@
 //! [`ReadOptions::mesh_placement`] or fitted into the universe) or a volume (`.json` + raw, `.raw`, `.nii`,
 //! `.nii.gz`; [`ReadOptions::select`] required) voxelized into an octree. [`voxelize`] gives a mesh's or a
 //! volume's rays, [`voxel_source`] the same rays slab by slab, for building out of core; [`open_tree`] maps
-//! a `.ktree` in place and reads anything else into memory. Errors are [`IoError`]s: a mesh or volume that
+//! a `.ktree` in place and reads anything else into memory; [`voxelize_mesh_labels`] voxelizes several
+//! meshes (or the groups of one OBJ file) together into one tree of labels. Errors are [`IoError`]s: a mesh or volume that
 //! cannot be voxelized is [`IoError::Solid`], a missing option [`IoError::Usage`].
 //!
 //! ```
@@ -327,21 +328,167 @@ fn mesh_input(
     ),
     IoError,
 > {
-    use crate::solid::mesh::MeshTransform;
     let solid = solid_error(path);
     std::fs::File::open(path).map_err(|e| crate::io::geometry_file::io_error(path, e))?;
     let level = options
         .level
         .ok_or_else(|| usage(path, "a mesh needs a universe level"))?;
     let mesh = crate::io::read_mesh(path)?;
-    let (placement, fitted) = match options.mesh_placement {
-        Some(p) => (p, None),
-        None => {
-            let p = MeshTransform::fit(&mesh, level).map_err(&solid)?;
-            (p, Some(p.to_arg()))
-        }
-    };
+    let (placement, fitted) =
+        mesh_placement(options, std::slice::from_ref(&mesh), level).map_err(&solid)?;
     Ok((mesh, level, placement, fitted))
+}
+
+/// The placement of `meshes` together: [`ReadOptions::mesh_placement`], or the union of their bounding
+/// boxes fitted into the universe (and then the transform as text).
+#[cfg(feature = "mesh")]
+fn mesh_placement(
+    options: &ReadOptions,
+    meshes: &[crate::solid::mesh::TriangleMesh],
+    level: u32,
+) -> Result<(crate::solid::mesh::MeshTransform, Option<String>), SolidError> {
+    use crate::solid::mesh::Placement;
+    match options.mesh_placement {
+        Some(p) => Ok((p, None)),
+        None => {
+            let p = Placement::Fit.transform_all(meshes, level)?;
+            Ok((p, Some(p.to_arg())))
+        }
+    }
+}
+
+/// Meshes voxelized together as labels ([`voxelize_mesh_labels`]), with the name of each label.
+#[cfg(feature = "mesh")]
+#[derive(Debug, Clone)]
+pub struct MeshLabels {
+    /// An octree of labels: `u8` for up to 255 meshes, `u16` up to 65535, `u32` beyond.
+    pub tree: crate::AnyValuedTree,
+    /// Label `i + 1` is `names[i]`: the file, or the group of a single OBJ file.
+    pub names: Vec<String>,
+    /// Label `i + 1` is held by `voxels[i]` voxels (0 for a mesh the later ones hide).
+    pub voxels: Vec<u64>,
+    /// Where the meshes went: voxel coordinate = `scale · v + translate`.
+    pub transform: crate::solid::mesh::MeshTransform,
+    /// Placed by fitting: the transform chosen, as `s,tx,ty,tz`.
+    pub fitted: Option<String>,
+}
+
+/// Voxelizes mesh files together into one tree of labels ([`KTree::from_label_meshes`]): each file one
+/// label (1, 2, … in the order given), or, for a single `.obj` file, each of its groups and objects one
+/// label, in the order they appear ([`io::read_obj_groups`]; a file without groups is one label). Where
+/// meshes overlap, the later one wins. All share one placement: [`ReadOptions::mesh_placement`], or
+/// their union fitted into the universe; [`ReadOptions::level`] is required. Every mesh must be closed.
+///
+/// ```
+/// use ktree::input::voxelize_mesh_labels;
+/// use ktree::io::ReadOptions;
+/// use std::path::Path;
+/// let dir = tempfile::tempdir().unwrap();
+/// let scene = dir.path().join("scene.obj");
+/// let mut obj = String::new();
+/// for (group, at) in [("left", 0), ("right", 3)] {
+///     obj += &format!("g {group}\n");
+///     for i in 0..8 {
+///         let c = [at + (i & 1), (i >> 1) & 1, (i >> 2) & 1];
+///         obj += &format!("v {} {} {}\n", c[0], c[1], c[2]);
+///     }
+///     let base = if at == 0 { 0 } else { 8 };
+///     for t in [[1, 3, 2], [2, 3, 4], [5, 6, 7], [6, 8, 7], [1, 2, 5], [2, 6, 5],
+///               [3, 7, 4], [4, 7, 8], [1, 5, 3], [3, 5, 7], [2, 4, 6], [4, 8, 6]] {
+///         obj += &format!("f {} {} {}\n", base + t[0], base + t[1], base + t[2]);
+///     }
+/// }
+/// std::fs::write(&scene, obj).unwrap();
+/// let labels = voxelize_mesh_labels(&[&scene], &ReadOptions { level: Some(4), ..ReadOptions::default() }).unwrap();
+/// assert_eq!(labels.names, ["left", "right"]);
+/// assert!(labels.voxels.iter().all(|&n| n > 0)); // the voxels of each label
+/// let ktree::AnyValuedTree::K3U8(tree) = labels.tree else { panic!("labels of u8") };
+/// assert_eq!(tree.value_stats().into_keys().collect::<Vec<_>>(), [1, 2]);
+/// // A missing file is named.
+/// let missing = dir.path().join("missing.stl");
+/// let e = voxelize_mesh_labels(&[&scene, &missing], &ReadOptions { level: Some(4), ..ReadOptions::default() });
+/// assert!(e.unwrap_err().to_string().contains("missing.stl"));
+/// ```
+///
+/// # Errors
+/// [`IoError::Usage`] for no file, a file that is not a mesh, or no level; [`IoError::Read`] and
+/// [`IoError::Geometry`] for a file that cannot be read or parsed; [`IoError::Solid`] naming the file
+/// (and the group) for a mesh that is not closed, or meshes that cannot be placed.
+#[cfg(feature = "mesh")]
+pub fn voxelize_mesh_labels(
+    paths: &[impl AsRef<Path>],
+    options: &ReadOptions,
+) -> Result<MeshLabels, IoError> {
+    use crate::solid::mesh::TriangleMesh;
+    let Some(first) = paths.first().map(AsRef::as_ref) else {
+        return Err(usage(Path::new(""), "no mesh to voxelize as labels"));
+    };
+    // Each mesh with its file and, for the groups of one OBJ file, its group's name.
+    let mut meshes: Vec<(TriangleMesh, &Path, Option<String>)> = Vec::new();
+    for path in paths.iter().map(AsRef::as_ref) {
+        if format_of(path)? != Format::Mesh {
+            return Err(usage(
+                path,
+                "not a mesh: labels are voxelized from meshes (.obj, .stl, .ply)",
+            ));
+        }
+        std::fs::File::open(path).map_err(|e| crate::io::geometry_file::io_error(path, e))?;
+        let obj = crate::io::geometry_file::extension(path) == "obj";
+        if paths.len() == 1 && obj {
+            let groups = io::read_obj_groups(path)?;
+            let named = groups.len() > 1;
+            for (name, mesh) in groups {
+                meshes.push((mesh, path, named.then_some(name)));
+            }
+        } else {
+            meshes.push((io::read_mesh(path)?, path, None));
+        }
+    }
+    for (mesh, path, group) in &meshes {
+        let open = mesh.open_edges();
+        if open > 0 {
+            let what = group
+                .as_ref()
+                .map_or("the mesh".to_string(), |g| format!("group '{g}'"));
+            return Err(solid_error(path)(SolidError::BadParameter(format!(
+                "{what} is not closed ({open} edges not shared by exactly two triangles): \
+                 a label is the inside of a closed mesh"
+            ))));
+        }
+    }
+    let level = options
+        .level
+        .ok_or_else(|| usage(first, "meshes need a universe level"))?;
+    let names = meshes
+        .iter()
+        .map(|(_, path, group)| group.clone().unwrap_or_else(|| path.display().to_string()))
+        .collect();
+    let meshes: Vec<TriangleMesh> = meshes.into_iter().map(|(m, _, _)| m).collect();
+    let (transform, fitted) =
+        mesh_placement(options, &meshes, level).map_err(solid_error(first))?;
+    // As `KTree::from_label_meshes` builds them, with the voxels of each label counted on the runs.
+    fn build<V: crate::value::Value + TryFrom<u32>>(
+        meshes: &[TriangleMesh],
+        level: u32,
+        transform: &crate::solid::mesh::MeshTransform,
+    ) -> Result<(crate::AnyValuedTree, Vec<u64>), SolidError> {
+        let labels = crate::solid::mesh::label_runs::<V>(meshes, level, transform)?;
+        let tree = KTree::from_value_runs(&labels.runs);
+        Ok((crate::AnyValuedTree::from(tree), labels.voxels))
+    }
+    let (tree, voxels) = match meshes.len() {
+        0..=255 => build::<u8>(&meshes, level, &transform),
+        256..=65535 => build::<u16>(&meshes, level, &transform),
+        _ => build::<u32>(&meshes, level, &transform),
+    }
+    .map_err(solid_error(first))?;
+    Ok(MeshLabels {
+        tree,
+        names,
+        voxels,
+        transform,
+        fitted,
+    })
 }
 
 #[cfg(feature = "mesh")]

@@ -29,6 +29,10 @@ pub struct Args {
     /// The input: a mesh (.obj, .stl, .ply), a volume (.json sidecar or its .raw, .nii, .nii.gz) or a point
     /// cloud (.ply without faces, .pcd, .xyz, .csv, .txt, .las, .laz).
     input: PathBuf,
+    /// With --labels: more meshes (.obj, .stl, .ply), voxelized with the first into one tree of labels,
+    /// each file one label in the order given.
+    #[arg(value_name = "MESH")]
+    more: Vec<PathBuf>,
     /// Universe level L (meshes: required; volumes and clouds: default the smallest level that holds them).
     #[arg(long)]
     level: Option<u32>,
@@ -40,7 +44,9 @@ pub struct Args {
     transform: Option<MeshTransform>,
     #[command(flatten)]
     volume: crate::common::args::VolumeArgs,
-    /// Volume: every sample's label kept, 0 the background: a tree with values (a .ktree output).
+    /// Volume: every sample's label kept, 0 the background; meshes: each mesh one label (1, 2, … in the
+    /// order given; one .obj file: each of its groups or objects), the later mesh winning where they
+    /// overlap, placed together by --fit or --transform. A tree with values (a .ktree output).
     #[arg(long, conflicts_with_all = ["threshold", "label"])]
     labels: bool,
     /// Volume: the samples from LO to HI (both included) kept as float32 values, the rest the
@@ -84,6 +90,9 @@ pub struct Args {
 
 /// Voxelizes the input and writes it.
 pub fn run(a: Args) -> CliResult {
+    if !a.more.is_empty() || (a.labels && Format::of(&a.input) == Some(Format::Mesh)) {
+        return run_mesh_labels(&a);
+    }
     // A `.ply` is a cloud or a mesh by its header: a broken one is said as such.
     if ktree::io::is_cloud_file(&a.input).map_err(CliError::caused)? {
         return run_cloud(&a);
@@ -151,6 +160,82 @@ pub fn run(a: Args) -> CliResult {
     let v = voxelize(&a.input, &options).map_err(CliError::caused)?;
     remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
     crate::common::output::print_summary(&write_output(&v.rays, &a.out.out, &a.build)?)?;
+    Ok(())
+}
+
+/// Voxelizes meshes together into one tree of labels, prints each label's name and writes the tree
+/// (with the world frame of the placement when its scale is positive).
+fn run_mesh_labels(a: &Args) -> CliResult {
+    let inputs: Vec<&Path> = std::iter::once(&a.input)
+        .chain(&a.more)
+        .map(PathBuf::as_path)
+        .collect();
+    if !a.labels {
+        return Err(format!(
+            "{}: several inputs are voxelized together only as labels (--labels: each mesh one label)",
+            a.more[0].display()
+        )
+        .into());
+    }
+    if let Some(other) = inputs.iter().find(|p| Format::of(p) != Some(Format::Mesh)) {
+        return Err(format!(
+            "{}: not a mesh: --labels over several inputs takes meshes (.obj, .stl, .ply); a label volume is given alone",
+            other.display()
+        )
+        .into());
+    }
+    if a.voxel_size.is_some() || a.origin.is_some() || a.crop || a.value.is_some() {
+        return Err(format!(
+            "{}: --voxel-size, --origin, --crop and --value are for point clouds, not mesh labels",
+            a.input.display()
+        )
+        .into());
+    }
+    if a.dtype.is_some() {
+        return Err(
+            "--dtype is for label volumes: mesh labels are uint8 up to 255 meshes, uint16 beyond"
+                .into(),
+        );
+    }
+    if !is_tree_file(&a.out.out) {
+        return Err(format!(
+            "--labels writes a tree with values: the output must be a .ktree, not {}",
+            a.out.out.display()
+        )
+        .into());
+    }
+    let level = a.level.ok_or("--level L is required for a mesh")?;
+    let mesh_placement = match (a.transform, a.fit) {
+        (Some(t), _) => Some(t),
+        (None, true) => None,
+        (None, false) => return Err("a mesh needs --fit or --transform s,tx,ty,tz".into()),
+    };
+    let options = ReadOptions {
+        level: Some(level),
+        mesh_placement,
+        ..ReadOptions::default()
+    };
+    let labels = ktree::input::voxelize_mesh_labels(&inputs, &options).map_err(CliError::caused)?;
+    if let Some(t) = &labels.fitted {
+        outln!("--fit chose --transform {t}");
+    }
+    for (i, (name, voxels)) in labels.names.iter().zip(&labels.voxels).enumerate() {
+        outln!("label {}: {name} ({voxels} voxels)", i + 1);
+    }
+    let frame = labels.transform.world_frame();
+    let nodes = ktree::with_valued!(&labels.tree, t => {
+        ktree::io::ktree::v3::write_valued_ktree_file_framed(&a.out.out, t, frame.as_ref())
+            .map_err(CliError::caused)?;
+        t.node_count()
+    });
+    let voxels: u64 = labels.voxels.iter().sum();
+    let used = labels.voxels.iter().filter(|&&v| v > 0).count();
+    outln!(
+        "{}: {voxels} voxels labelled with {used} of {} labels ({}), L = {level}, {nodes} nodes",
+        a.out.out.display(),
+        labels.names.len(),
+        labels.tree.dtype().name(),
+    );
     Ok(())
 }
 

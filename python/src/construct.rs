@@ -1,6 +1,7 @@
 //! Trees made from Python's inputs, each by one call of the library: a dense array (`from_dense`), the
 //! empty and the full universe, runs (`from_rays`), a mesh file or mesh arrays (`from_mesh`,
-//! `from_mesh_arrays`: the slab-wise builder `KTree::from_mesh`, placed as the library places meshes),
+//! `from_mesh_arrays`: the slab-wise builder `KTree::from_mesh`, placed as the library places meshes;
+//! several meshes as one tree of labels, `from_meshes`),
 //! points (`from_points`) and a volume file (`from_volume`, read as `ktree::input::read_tree` reads volumes).
 
 use std::ffi::CString;
@@ -146,6 +147,41 @@ impl Tree {
         let mesh =
             py.detach(|| ktree::io::read_mesh(&path).map_err(|e| Failure::of_error(&e, &path)))?;
         mesh_tree(py, &mesh, level, placement, &path.display().to_string())
+    }
+
+    /// One octree of labels from several mesh files (OBJ, STL, PLY) placed together in a universe of level
+    /// `level`: file i (in the order given) is label i + 1 (uint8 up to 255 meshes, uint16 beyond), or,
+    /// for a single OBJ file, each of its groups/objects in file order; where meshes overlap, the later
+    /// wins. `transform` places every mesh as in `from_mesh`; without it their union is fitted. Every mesh
+    /// must be closed. Returns the tree and the name of each label (`names[i]` is label i + 1).
+    #[staticmethod]
+    #[pyo3(signature = (paths, level, transform = None))]
+    fn from_meshes(
+        py: Python<'_>,
+        paths: Vec<PathBuf>,
+        level: u32,
+        transform: Option<[f64; 4]>,
+    ) -> PyResult<(Self, Vec<String>)> {
+        let mesh_placement = match placement(transform)? {
+            Placement::Transform(t) => Some(t),
+            Placement::Fit => None,
+        };
+        let options = ReadOptions {
+            level: Some(level),
+            mesh_placement,
+            ..ReadOptions::default()
+        };
+        let labels = py.detach(|| {
+            ktree::input::voxelize_mesh_labels(&paths, &options).map_err(|e| {
+                let path = match &e {
+                    ktree::io::IoError::Solid { file, .. }
+                    | ktree::io::IoError::Usage { file, .. } => file.clone(),
+                    _ => PathBuf::new(),
+                };
+                Failure::of_error(&e, &path)
+            })
+        })?;
+        Ok((Self::valued(labels.tree, 0.0), labels.names))
     }
 
     /// The octree of a triangle mesh given as an `(n, 3)` float array of vertices and an `(m, 3)` integer

@@ -57,7 +57,7 @@ pub use cloud::{is_cloud_file, read_cloud, read_cloud_bytes, CLOUD_FORMATS};
 #[cfg(any(feature = "cloud", feature = "mesh"))]
 pub use geometry_file::{GeometryFileError, GeometryFileErrorKind};
 #[cfg(feature = "mesh")]
-pub use mesh::{read_mesh, read_mesh_bytes, MESH_FORMATS};
+pub use mesh::{read_mesh, read_mesh_bytes, read_obj_groups, read_obj_groups_bytes, MESH_FORMATS};
 #[cfg(feature = "cloud")]
 pub use scan::{
     read_scan_directory, read_scan_graph, read_scan_list, read_scan_log, read_scans, Pose, Scan,

@@ -227,6 +227,19 @@ impl<const K: usize, V: Value> ValueRuns<K, V> {
         Ok(Self { universe, runs })
     }
 
+    /// Runs already sorted by column and `z1`, disjoint in each column, of values that pass
+    /// [`Value::check`] (a producer that makes them so, as the mesh labels do).
+    #[cfg_attr(not(feature = "mesh"), allow(dead_code))]
+    pub(crate) fn from_sorted_runs(universe: Universe<K>, runs: Vec<ValueRun<V>>) -> Self {
+        debug_assert!(runs
+            .windows(2)
+            .all(|p| (p[0].column, p[0].z2) <= (p[1].column, p[1].z1)));
+        debug_assert!(runs
+            .iter()
+            .all(|r| r.z1 < r.z2 && u64::from(r.z2) <= universe.side()));
+        Self { universe, runs }
+    }
+
     /// The universe.
     pub fn universe(&self) -> Universe<K> {
         self.universe

@@ -57,3 +57,41 @@ impl KTree<3> {
         }
     }
 }
+
+#[cfg(feature = "mesh")]
+impl<V: crate::value::Value + TryFrom<u32>> KTree<3, V> {
+    /// The tree of labels of several meshes placed together in a universe of level `level`: mesh `i` (in
+    /// the order given) is label `i + 1`, the voxels of no mesh the background; where meshes overlap, the
+    /// later mesh wins. One placement for all: [`Placement::Fit`](crate::solid::mesh::Placement::Fit)
+    /// fits the union of their bounding boxes ([`MeshTransform::fit_all`](crate::solid::mesh::MeshTransform::fit_all)).
+    /// Built from the runs of [`label_runs`](crate::solid::mesh::label_runs), so minimal; a mesh that is
+    /// not closed is voxelized column by column as [`KTree::from_mesh`] does (check
+    /// [`TriangleMesh::open_edges`](crate::solid::mesh::TriangleMesh::open_edges) first to refuse one).
+    ///
+    /// ```
+    /// use ktree::solid::mesh::{Placement, TriangleMesh};
+    /// use ktree::KTree;
+    /// let tetrahedron = |at: f64| TriangleMesh::new(
+    ///     vec![[at, 0.0, 0.0], [at + 1.0, 0.0, 0.0], [at, 1.0, 0.0], [at, 0.0, 1.0]],
+    ///     vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    /// ).unwrap();
+    /// let meshes = [tetrahedron(0.0), tetrahedron(2.0)];
+    /// let tree = KTree::<3, u8>::from_label_meshes(&meshes, 5, Placement::Fit).unwrap();
+    /// let labels: Vec<u8> = tree.value_stats().into_keys().collect();
+    /// assert_eq!(labels, [1, 2]);
+    /// tree.assert_well_formed();
+    /// ```
+    ///
+    /// # Errors
+    /// [`SolidError`]: a bad level, meshes that cannot be fitted or are too large for the universe, no
+    /// mesh, or more meshes than `V` has labels.
+    pub fn from_label_meshes(
+        meshes: &[crate::solid::mesh::TriangleMesh],
+        level: u32,
+        placement: crate::solid::mesh::Placement,
+    ) -> Result<Self, SolidError> {
+        let transform = placement.transform_all(meshes, level)?;
+        let labels = crate::solid::mesh::label_runs(meshes, level, &transform)?;
+        Ok(Self::from_value_runs(&labels.runs))
+    }
+}

@@ -72,3 +72,47 @@ pub fn read_mesh_bytes(
     .map_err(|fault| fault.in_file(file))?;
     TriangleMesh::new(vertices, triangles).map_err(|e| Fault::whole(e.to_string()).in_file(file))
 }
+
+/// Reads an OBJ file's groups (`g`) and objects (`o`) as separate meshes, each with its name, in the order
+/// they first appear: the faces before any `g` or `o` line are the first (named `unnamed_object`) when
+/// there are some; groups of one name are one mesh; a group without triangles is left out. A file without
+/// groups is one mesh.
+///
+/// ```
+/// use ktree::io::read_obj_groups_bytes;
+/// let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\ng base\nf 1 3 2\ng side\nf 1 2 4\nf 1 4 3\ng base\nf 2 3 4\n";
+/// let groups = read_obj_groups_bytes(obj, "mem.obj".as_ref()).unwrap();
+/// let names: Vec<&str> = groups.iter().map(|(n, _)| n.as_str()).collect();
+/// assert_eq!(names, ["base", "side"]);
+/// assert_eq!((groups[0].1.triangles().len(), groups[1].1.triangles().len()), (2, 2));
+/// ```
+///
+/// # Errors
+/// As [`read_mesh`]; a group whose mesh is not valid ([`TriangleMesh::new`]) is named in the message.
+pub fn read_obj_groups(path: &Path) -> Result<Vec<(String, TriangleMesh)>, GeometryFileError> {
+    let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
+    read_obj_groups_bytes(&bytes, path)
+}
+
+/// Parses an OBJ file held in memory into its groups and objects, as [`read_obj_groups`] does; `file`
+/// names the input in errors.
+///
+/// # Errors
+/// As [`read_obj_groups`].
+pub fn read_obj_groups_bytes(
+    bytes: &[u8],
+    file: &Path,
+) -> Result<Vec<(String, TriangleMesh)>, GeometryFileError> {
+    let groups = obj::read_groups(bytes).map_err(|fault| fault.in_file(file))?;
+    if groups.is_empty() {
+        return Err(Fault::whole("no triangle").in_file(file));
+    }
+    groups
+        .into_iter()
+        .map(|(name, (vertices, triangles))| {
+            TriangleMesh::new(vertices, triangles)
+                .map(|mesh| (name.clone(), mesh))
+                .map_err(|e| Fault::whole(format!("group '{name}': {e}")).in_file(file))
+        })
+        .collect()
+}

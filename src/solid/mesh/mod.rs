@@ -28,6 +28,10 @@
 //! **Work:** `O(triangles + rays)` plus a radix sort of the crossings: each triangle visits only the columns
 //! in its bounding box.
 //!
+//! **Labels.** [`label_runs`] voxelizes several meshes in one placement into runs of labels (mesh `i` is
+//! label `i + 1`, the later mesh winning where they overlap), for a valued tree
+//! ([`KTree::from_label_meshes`](crate::KTree::from_label_meshes)).
+//!
 //! **Slab by slab.** [`MeshSource`] gives the same runs one slab of columns at a time, from the triangles
 //! its index lists for the slab, for building trees out of core without holding the whole ray set.
 //!
@@ -43,9 +47,11 @@
 //! assert!(voxels.rays.voxel_count() > 1000);
 //! ```
 
+mod labels;
 mod placement;
 mod voxelize;
 
+pub use labels::{label_runs, LabelRuns};
 pub use placement::{MeshTransform, Placement};
 pub use voxelize::{MeshRays, MeshSource, MAX_LEVEL};
 
