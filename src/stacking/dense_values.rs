@@ -239,7 +239,7 @@ mod tests {
                 let region = (p[0] * 2 / universe.side() as u32) as u16 + 1;
                 if i.wrapping_mul(2_654_435_761) % 97 < 5 {
                     7
-                } else if p[K - 1] % 5 == 0 {
+                } else if p[K - 1].is_multiple_of(5) {
                     0
                 } else {
                     region
