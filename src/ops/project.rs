@@ -40,7 +40,7 @@ use crate::space::{Cell, Universe};
 use crate::tree::cursor::{try_walk, Visitor, Walk};
 use crate::tree::storage::TreeStorage;
 use crate::tree::top_down::{build_top_down, Decision, InputNode};
-use crate::tree::valued::{ValueState, ValueStorage};
+use crate::tree::valued::{BinaryValues, ValueState, ValueStorage};
 use crate::tree::{DimensionMismatch, KTree, NodeRef, NodeState};
 
 /// The `J = K − 1`-dimensional tree of the voxels of `tree` at `position` along `axis`.
@@ -246,7 +246,7 @@ pub fn extrude<const J: usize, const K: usize, T: TreeStorage<J>>(
     let low_bits = (1usize << axis) - 1;
     let built = build_top_down::<K, (), _, Failure<T::Error>>(
         level,
-        InputNode::binary_root(tree).map_err(OpsError::storage)?,
+        InputNode::root(&BinaryValues(tree)).map_err(OpsError::storage)?,
         |cell: &Cell<K>, node: &InputNode<()>| {
             let o = u64::from(cell.origin[axis]);
             let end = o + cell.side();
@@ -261,7 +261,8 @@ pub fn extrude<const J: usize, const K: usize, T: TreeStorage<J>>(
         },
         |node, code| {
             let lower = (code & low_bits) | ((code >> (axis + 1)) << axis);
-            node.binary_child(tree, lower).map_err(Failure::Read)
+            node.child(&BinaryValues(tree), lower)
+                .map_err(Failure::Read)
         },
     );
     // Its level was checked, it splits no voxel and holds no value: only a read can fail.

@@ -24,7 +24,7 @@ use crate::rays::ValueRuns;
 use crate::space::Cell;
 use crate::tree::storage::infallible;
 use crate::tree::top_down::{build_top_down, Decision, InputNode};
-use crate::tree::valued::{ValueState, ValueStorage};
+use crate::tree::valued::{BinaryValues, ValueState, ValueStorage};
 use crate::tree::{TreeError, Value};
 use crate::KTree;
 use crate::Ray;
@@ -223,7 +223,7 @@ impl<const K: usize, V: Value> KTree<K, V> {
             self.level(),
             (
                 infallible(InputNode::root(self)),
-                infallible(InputNode::binary_root(mask)),
+                infallible(InputNode::root(&BinaryValues(mask))),
             ),
             |_, (node, m)| {
                 Ok(match (m.state, leaf(node.state)) {
@@ -235,7 +235,7 @@ impl<const K: usize, V: Value> KTree<K, V> {
             |(node, m), code| {
                 Ok((
                     infallible(node.child(self, code)),
-                    infallible(m.binary_child(mask, code)),
+                    infallible(m.child(&BinaryValues(mask), code)),
                 ))
             },
         );

@@ -37,9 +37,8 @@
 
 use super::ktree::KTree;
 use super::states::PackedStates;
-use super::storage::TreeStorage;
 use super::valued::{combine, ValueState, ValueStorage};
-use super::{NodeState, TreeError};
+use super::TreeError;
 use crate::space::{Cell, Universe};
 use crate::value::Value;
 
@@ -204,48 +203,5 @@ impl<V: Value> InputNode<V> {
             index,
             state: tree.decode(self.depth + 1, index, codes >> (2 * code))?,
         })
-    }
-}
-
-impl InputNode<()> {
-    /// The root of a binary tree on any [`TreeStorage`].
-    ///
-    /// # Errors
-    /// The storage's read error.
-    pub fn binary_root<const K: usize, T: TreeStorage<K>>(tree: &T) -> Result<Self, T::Error> {
-        Ok(Self {
-            depth: 0,
-            index: 0,
-            state: binary_state(tree.root_state()?),
-        })
-    }
-
-    /// The node of child `code` of a binary tree's cell.
-    ///
-    /// # Errors
-    /// The storage's read error.
-    pub fn binary_child<const K: usize, T: TreeStorage<K>>(
-        &self,
-        tree: &T,
-        code: usize,
-    ) -> Result<Self, T::Error> {
-        if !self.state.has_children() {
-            return Ok(*self);
-        }
-        let first = tree.first_child(self.depth, self.index)?;
-        let index = first + code;
-        Ok(Self {
-            depth: self.depth + 1,
-            index,
-            state: binary_state(tree.state(self.depth + 1, index)?),
-        })
-    }
-}
-
-fn binary_state(state: NodeState) -> ValueState<()> {
-    match state {
-        NodeState::Empty => ValueState::Empty,
-        NodeState::Full => ValueState::Full(()),
-        NodeState::Partial => ValueState::Partial,
     }
 }
