@@ -79,8 +79,9 @@ fn write_typed<const K: usize, V: Value>(
         usage(
             path,
             format!(
-                "{what} hold no values: write .ktree, .vdb, .nii, .vtu, .htg, or the surfaces of the \
-                 values as .ply, .obj or .glb (or the tree's shape to this format)"
+                "{what} hold no values: write .ktree, OpenVDB (.vdb), NIfTI (.nii, .nii.gz), VTK (.vtu, \
+                 .htg), or the surfaces of the values as .ply, .obj or .glb (or the tree's shape to this \
+                 format)"
             ),
         )
     };
