@@ -8,23 +8,7 @@ mod common;
 use std::path::Path;
 
 use common::{ktree, run};
-
-/// A box's corners `i` at `(i & 1, i >> 1 & 1, i >> 2 & 1)` and its triangles, counter-clockwise seen
-/// from outside.
-const CUBE: [[u32; 3]; 12] = [
-    [0, 2, 1],
-    [1, 2, 3],
-    [4, 5, 6],
-    [5, 7, 6],
-    [0, 1, 4],
-    [1, 5, 4],
-    [2, 6, 3],
-    [3, 6, 7],
-    [0, 4, 2],
-    [2, 4, 6],
-    [1, 3, 5],
-    [3, 7, 5],
-];
+use ktree_verify::meshes::CUBE;
 
 fn corners(lo: [f64; 3], hi: [f64; 3]) -> Vec<[f64; 3]> {
     (0..8)

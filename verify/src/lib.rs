@@ -8,6 +8,7 @@
 pub mod cases;
 mod config;
 pub mod labels;
+pub mod meshes;
 pub mod objects;
 pub mod scenes;
 pub mod sparse;

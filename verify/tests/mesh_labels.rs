@@ -13,32 +13,8 @@ use ktree::input::voxelize_mesh_labels;
 use ktree::io::ReadOptions;
 use ktree::solid::mesh::{label_runs, MeshTransform, Placement, TriangleMesh};
 use ktree::{AnyValuedTree, KTree, Universe};
+use ktree_verify::meshes::{cube, octahedron, CUBE};
 use proptest::prelude::*;
-
-/// The box [lo, hi], outward oriented.
-fn cube(lo: [f64; 3], hi: [f64; 3]) -> TriangleMesh {
-    let vertices: Vec<[f64; 3]> = (0..8)
-        .map(|i| [0, 1, 2].map(|a| if i >> a & 1 == 1 { hi[a] } else { lo[a] }))
-        .collect();
-    TriangleMesh::new(vertices, CUBE.to_vec()).unwrap()
-}
-
-/// The triangles of a box's corners `i` at `(i & 1, i >> 1 & 1, i >> 2 & 1)`, counter-clockwise seen
-/// from outside.
-const CUBE: [[u32; 3]; 12] = [
-    [0, 2, 1],
-    [1, 2, 3],
-    [4, 5, 6],
-    [5, 7, 6],
-    [0, 1, 4],
-    [1, 5, 4],
-    [2, 6, 3],
-    [3, 6, 7],
-    [0, 4, 2],
-    [2, 4, 6],
-    [1, 3, 5],
-    [3, 7, 5],
-];
 
 /// The tetrahedron of four corners, outward oriented whatever their order (`None` when flat).
 fn tetrahedron(p: [[f64; 3]; 4]) -> Option<TriangleMesh> {
@@ -52,31 +28,6 @@ fn tetrahedron(p: [[f64; 3]; 4]) -> Option<TriangleMesh> {
         return Some(mesh);
     }
     TriangleMesh::new(p.to_vec(), vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]).ok()
-}
-
-/// The octahedron |x − c| + |y − c| + |z − c| ≤ r, outward oriented.
-fn octahedron(c: [f64; 3], r: f64) -> TriangleMesh {
-    let mut vertices = Vec::new();
-    for a in 0..3 {
-        for s in [-1.0, 1.0] {
-            let mut v = c;
-            v[a] += s * r;
-            vertices.push(v);
-        }
-    }
-    let mut triangles = Vec::new();
-    for (x, sx) in [(0u32, -1.0), (1, 1.0)] {
-        for (y, sy) in [(2u32, -1.0), (3, 1.0)] {
-            for (z, sz) in [(4u32, -1.0), (5, 1.0)] {
-                if sx * sy * sz > 0.0 {
-                    triangles.push([x, y, z]);
-                } else {
-                    triangles.push([x, z, y]);
-                }
-            }
-        }
-    }
-    TriangleMesh::new(vertices, triangles).unwrap()
 }
 
 /// The reference: each mesh voxelized alone by the binary voxelizer, painted in order into a dense

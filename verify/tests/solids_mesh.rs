@@ -6,58 +6,12 @@
 use std::path::Path;
 
 use ktree_verify::cases;
+use ktree_verify::meshes::{cube, octahedron};
 
 use ktree::solid::mesh::{MeshTransform, TriangleMesh};
 use ktree::stacking::paper::stack;
 use ktree::{KTree, Universe};
 use proptest::prelude::*;
-
-/// The octahedron |x−c| + |y−c| + |z−c| ≤ r, outward oriented.
-fn octahedron(c: [f64; 3], r: f64) -> TriangleMesh {
-    let mut vertices = Vec::new();
-    for a in 0..3 {
-        for s in [-1.0, 1.0] {
-            let mut v = c;
-            v[a] += s * r;
-            vertices.push(v);
-        }
-    }
-    // Vertices: 0 −x, 1 +x, 2 −y, 3 +y, 4 −z, 5 +z.
-    let mut triangles = Vec::new();
-    for (x, sx) in [(0u32, -1.0), (1, 1.0)] {
-        for (y, sy) in [(2u32, -1.0), (3, 1.0)] {
-            for (z, sz) in [(4u32, -1.0), (5, 1.0)] {
-                // Counter-clockwise seen from outside iff the triple product of (x, y, z) is positive.
-                if sx * sy * sz > 0.0 {
-                    triangles.push([x, y, z]);
-                } else {
-                    triangles.push([x, z, y]);
-                }
-            }
-        }
-    }
-    TriangleMesh::new(vertices, triangles).unwrap()
-}
-
-/// The box [lo, hi]³, outward oriented.
-fn cube(lo: [f64; 3], hi: [f64; 3]) -> TriangleMesh {
-    let vertices: Vec<[f64; 3]> = (0..8)
-        .map(|i| [0, 1, 2].map(|a| if i >> a & 1 == 1 { hi[a] } else { lo[a] }))
-        .collect();
-    let quads = [
-        [0, 2, 3, 1], // z = lo (faces −z)
-        [4, 5, 7, 6], // z = hi
-        [0, 1, 5, 4], // y = lo
-        [2, 6, 7, 3], // y = hi
-        [0, 4, 6, 2], // x = lo
-        [1, 3, 7, 5], // x = hi
-    ];
-    let triangles = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
-    TriangleMesh::new(vertices, triangles).unwrap()
-}
 
 fn rays_dense(mesh: &TriangleMesh, level: u32, p: &MeshTransform) -> Vec<bool> {
     let r = mesh.to_rays(level, p).unwrap();

@@ -14,6 +14,7 @@ use ktree::stacking::{paper::stack, Builder};
 use ktree::AnyRaySet;
 use ktree::{Ray, RaySet};
 use ktree_verify::cases::{self, ray_sets, Case};
+use ktree_verify::meshes::cube;
 use proptest::prelude::*;
 
 /// Every slab of every width has the runs of the whole set, and the occupied slabs hold them all.
@@ -91,26 +92,6 @@ fn soups() -> impl Strategy<Value = TriangleMesh> {
             let triangles = t.iter().map(|t| t.map(|i| i % n)).collect();
             TriangleMesh::new(vertices, triangles).unwrap()
         })
-}
-
-/// The box [lo, hi]³, outward oriented (closed).
-fn cube(lo: [f64; 3], hi: [f64; 3]) -> TriangleMesh {
-    let vertices: Vec<[f64; 3]> = (0..8)
-        .map(|i| [0, 1, 2].map(|a| if i >> a & 1 == 1 { hi[a] } else { lo[a] }))
-        .collect();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let triangles = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
-    TriangleMesh::new(vertices, triangles).unwrap()
 }
 
 fn mesh_agrees(
