@@ -2,7 +2,7 @@
 //! hidden-surface image of an octree; a quadtree is drawn as a picture of its cells, a 4-D tree as a strip
 //! of time slices; a tree with values (K = 2, 3 or 4) in its values' colours.
 
-use crate::common::error::{cannot_read, read_error, CliError, CliResult};
+use crate::common::error::{read_error, CliError, CliResult};
 use crate::outln;
 
 use std::path::{Path, PathBuf};
@@ -20,7 +20,7 @@ use ktree::io::{read_rays_file, AnyMappedTree, FileTree};
 use ktree::space::Cell;
 use ktree::tree::storage::TreeStorage;
 use ktree::tree::valued::BinaryValues;
-use ktree::{AnyRaySet, AnyTree, KTree};
+use ktree::{AnyRaySet, AnyTree};
 
 /// Arguments of `ktree render`.
 #[derive(Debug, clap::Args)]
@@ -202,7 +202,7 @@ fn render_valued_quadtree<V: ktree::value::Value>(
     size: u32,
     colour: Option<[u8; 3]>,
 ) -> CliResult {
-    let tree = read_valued::<2, V>(&args.file)?;
+    let (tree, _) = crate::convert_values::read_framed::<2, V>(&args.file)?;
     let of_value = ktree::display::palette::value_colours(&tree);
     let canvas = plane::values_canvas(&tree, size, |v| colour.unwrap_or_else(|| of_value(v)))
         .map_err(CliError::caused)?;
@@ -216,13 +216,6 @@ fn render_valued_quadtree<V: ktree::value::Value>(
     Ok(())
 }
 
-/// A valued `.ktree` file's tree of dimension `K` and value type `V` (as its header says).
-fn read_valued<const K: usize, V: ktree::value::Value>(file: &Path) -> CliResult<KTree<K, V>> {
-    let bytes = std::fs::read(file).map_err(|e| cannot_read(file, e))?;
-    ktree::io::ktree::v3::read_valued_ktree::<K, V>(&bytes, &file.display().to_string())
-        .map_err(CliError::caused)
-}
-
 /// Draws a strip of a 4-D tree with values, each leaf in its value's colour (or `colour`).
 fn render_valued_strip<V: ktree::value::Value>(
     args: &Args,
@@ -230,7 +223,7 @@ fn render_valued_strip<V: ktree::value::Value>(
     size: u32,
     colour: Option<[u8; 3]>,
 ) -> CliResult {
-    let tree = read_valued::<4, V>(&args.file)?;
+    let (tree, _) = crate::convert_values::read_framed::<4, V>(&args.file)?;
     let of_value = ktree::display::palette::value_colours(&tree);
     let strip = slices::time_strip_values(&tree, args.time_axis, args.frames, size, |v| {
         colour.unwrap_or_else(|| of_value(v))
@@ -294,7 +287,7 @@ fn render_valued<V: ktree::value::Value>(
     bar: Option<&ProgressBar>,
     tick: &mut dyn FnMut(u64, u64),
 ) -> CliResult {
-    let tree = read_valued::<3, V>(&args.file)?;
+    let (tree, _) = crate::convert_values::read_framed::<3, V>(&args.file)?;
     let of_value = ktree::display::palette::value_colours(&tree);
     let paint = |cell: &Cell<3>| {
         colour.unwrap_or_else(|| tree.value_at(cell.origin()).map_or([0; 3], &of_value))
