@@ -38,7 +38,7 @@ pub struct Args {
     #[arg(long)]
     level: Option<u32>,
     /// Grids and volumes: ktree voxel = grid index + offset, as x,y,z (default 0, or what moves negative
-    /// indices to 0).
+    /// indices to 0, rounded up to a multiple of the grid's largest aligned tile or node side).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = vector::<i64, 3>)]
     offset: Option<[i64; 3]>,
     /// Grid output: grid index = ktree voxel − offset, as x,y,z (default: .vdb and .bt keep the input's

@@ -164,9 +164,38 @@ fn a_bt_written_by_octomap_reads_into_ktree_with_the_same_voxels() {
             .write_all(input.as_bytes())
             .unwrap();
         assert!(child.wait().unwrap().success());
-        // The default placement moves the negative indices to 0 and picks the level of the known region.
-        let read = read_tree(&path, &ReadOptions::default()).unwrap();
+        // At the offset written with, the same tree.
+        let options = ReadOptions {
+            level: Some(tree.level()),
+            offset: Some([5, 5, 5]),
+            ..ReadOptions::default()
+        };
+        let read = read_tree(&path, &options).unwrap();
         assert_eq!(read, AnyTree::K3(tree.clone()), "{name}");
+        // The default placement moves the negative indices to at least 0, by a multiple of the side of
+        // OctoMap's largest pruned node (so it stays one node): the same voxels, shifted.
+        let bytes = std::fs::read(&path).unwrap();
+        let placed = ktree::io::read_bt(&bytes, "octomap.bt", None, None, false).unwrap();
+        let [o, oy, oz] = placed.placement.offset;
+        assert!(
+            o >= 5 && [oy, oz] == [o, o],
+            "{name}: {:?}",
+            placed.placement
+        );
+        let shift = (o - 5) as u32;
+        assert_eq!(placed.tree.voxel_count(), tree.voxel_count(), "{name}");
+        for x in 0..side {
+            for y in 0..side {
+                for z in 0..side {
+                    if tree.contains([x, y, z]) {
+                        assert!(
+                            placed.tree.contains([x + shift, y + shift, z + shift]),
+                            "{name}"
+                        );
+                    }
+                }
+            }
+        }
         // Unknown space read as full: the universe of the next level has the rest filled.
         let options = ReadOptions {
             level: Some(tree.level() + 1),
@@ -340,6 +369,60 @@ fn a_vdb_written_by_openvdb_reads_into_ktree_with_the_same_voxels() {
             "{name}"
         );
     }
+}
+
+#[test]
+fn a_vdb_with_tiles_at_negative_indices_reads_by_default_with_its_tiles_aligned() {
+    let Some(python) = tools::require_python_openvdb() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    // A 128³ tile of an internal node at x = −128 and one voxel at x = −131, as OpenVDB writes them.
+    let path = dir.path().join("tiles.vdb");
+    let script = format!(
+        "g = vdb.BoolGrid()\ng.name = 'g'\ng.fill((-128, 0, 0), (-1, 127, 127), True, True)\n\
+         g.getAccessor().setValueOn((-131, 0, 0), True)\nvdb.write({:?}, grids=[g])\n\
+         print(g.activeVoxelCount(), g.leafCount())",
+        path.display().to_string()
+    );
+    let out = run_openvdb(&python, &script);
+    assert_eq!(
+        out.trim(),
+        format!("{} 1", (1u64 << 21) + 1),
+        "one tile, one leaf"
+    );
+    // The default offset is the smallest multiple of the tile's side that makes every index ≥ 0 (256, not
+    // 131): the tile is one node, not a cube cut into nodes along its faces.
+    let placed =
+        ktree::io::read_vdb(&std::fs::read(&path).unwrap(), "tiles.vdb", None, None).unwrap();
+    assert_eq!(placed.placement.offset, [256, 0, 0]);
+    let tree = placed.tree;
+    assert_eq!(tree.voxel_count(), (1 << 21) + 1);
+    for (voxel, inside) in [
+        ([128, 0, 0], true),
+        ([255, 127, 127], true),
+        ([125, 0, 0], true),
+        ([127, 0, 0], false),
+        ([256, 0, 0], false),
+        ([128, 128, 0], false),
+    ] {
+        assert_eq!(tree.contains(voxel), inside, "{voxel:?}");
+    }
+    let shifted = ktree::io::read_vdb(
+        &std::fs::read(&path).unwrap(),
+        "tiles.vdb",
+        Some([131, 0, 0]),
+        None,
+    )
+    .unwrap()
+    .tree;
+    assert_eq!(shifted.voxel_count(), tree.voxel_count());
+    assert!(
+        tree.node_count() * 100 < shifted.node_count(),
+        "{} nodes aligned, {} at offset 131",
+        tree.node_count(),
+        shifted.node_count()
+    );
 }
 
 /// Valued octrees of the value types OpenVDB's Python module holds as grids (`FloatGrid`, `Vec3SGrid`),

@@ -90,7 +90,8 @@ pub struct ReadOptions {
     /// required.
     pub level: Option<u32>,
     /// Grids and volumes: ktree voxel = grid index + `offset`. Default: 0, except that an axis with
-    /// negative indices is shifted so that its smallest index becomes 0 (see [`GridPlacement::choose`]).
+    /// negative indices is shifted so that its smallest index becomes 0, or a little more to keep the grid's
+    /// aligned cells aligned (see [`GridPlacement::choose`]).
     pub offset: Option<[i64; 3]>,
     /// OctoMap: read unknown cells inside the universe as full (default: as empty).
     pub unknown_full: bool,

@@ -121,9 +121,10 @@ fn binvox_with_huge_or_tiny_metadata_reads_back() {
 }
 
 /// `octomap_bt_structured`: a `.bt` file of 90 bytes — a free voxel at key x = 1 and an occupied cube of
-/// side 2^14 — read at the default placement (offset 32767 on x) puts the cube off its alignment, and its
-/// octree would have billions of nodes (the reader ran out of memory). Grid readers now stop at 2^20 +
-/// 2^5 nodes a byte of the file with a placement error; at an aligned offset the file reads.
+/// side 2^14 — read at offset 32767 on x (once the default placement: minus the smallest index) puts the
+/// cube off its alignment, and its octree would have billions of nodes (the reader ran out of memory). Grid
+/// readers stop at 2^20 + 2^5 nodes a byte of the file with a placement error; the default offset is now a
+/// multiple of the largest aligned cell's side (32768 here), where the file reads as one cube.
 #[test]
 fn bt_cube_off_its_alignment_is_a_placement_error_not_unbounded_memory() {
     use ktree::io::{read_bt, GridFileErrorKind, BT_HEADER};
@@ -135,21 +136,32 @@ fn bt_cube_off_its_alignment_is_a_placement_error_not_unbounded_memory() {
     }
     file.extend_from_slice(&[0b01_00, 0]); // depth 15: voxel child 1 (key x = 1) free
     for (level, unknown_full) in [(None, false), (Some(21), true)] {
-        let e = read_bt(&file, "cut.bt", None, level, unknown_full).unwrap_err();
+        let e = read_bt(
+            &file,
+            "cut.bt",
+            Some([32767, 32768, 32768]),
+            level,
+            unknown_full,
+        )
+        .unwrap_err();
         assert!(
             matches!(&e.kind, GridFileErrorKind::GridPlacement(m) if m.contains("nodes")),
             "{e}"
         );
     }
-    let aligned = read_bt(&file, "cut.bt", Some([32768; 3]), Some(16), false).unwrap();
-    assert_eq!(aligned.tree.voxel_count(), 1 << 42);
-    assert!(aligned.tree.node_count() < 1000);
+    for offset in [None, Some([32768; 3])] {
+        let aligned = read_bt(&file, "cut.bt", offset, Some(16), false).unwrap();
+        assert_eq!(aligned.placement.offset[0], 32768);
+        assert_eq!(aligned.tree.voxel_count(), 1 << 42);
+        assert!(aligned.tree.node_count() < 1000);
+    }
 }
 
-/// Found by fuzzing `.vdb`: a 46 KB grid whose root tiles the default placement leaves unaligned. The
-/// reader stopped at its node bound with a placement error, but the bound (then 2^20 + 2^10 nodes a byte)
-/// let it build 48 million nodes first (0.9 s, over libFuzzer's time limit on a loaded machine). The
-/// bound is now 2^20 + 2^5 nodes a byte: the same error, after counting at most 2.5 million nodes.
+/// Found by fuzzing `.vdb`: a 46 KB grid whose root tiles the offset in its metadata (`ktree_offset`, 35
+/// on z) leaves unaligned. The reader stopped at its node bound with a placement error, but the bound (then
+/// 2^20 + 2^10 nodes a byte) let it build 48 million nodes first (0.9 s, over libFuzzer's time limit on a
+/// loaded machine). The bound is now 2^20 + 2^5 nodes a byte: the same error, after counting at most 2.5
+/// million nodes.
 #[test]
 fn a_vdb_with_unaligned_tiles_stops_at_the_node_bound() {
     use ktree::io::{read_vdb, GridFileErrorKind};

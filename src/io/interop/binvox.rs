@@ -162,7 +162,7 @@ pub fn read_binvox(
             )),
         ));
     }
-    let placement = GridPlacement::choose(boxes.known, offset, level)
+    let placement = GridPlacement::choose(boxes.known, boxes.alignment(), offset, level)
         .map_err(|m| fail(0, GridFileErrorKind::GridPlacement(m)))?;
     let tree = place_boxes(&boxes, &placement, max_grid_nodes(bytes.len()))
         .map_err(|m| fail(0, GridFileErrorKind::GridPlacement(m)))?;

@@ -84,6 +84,30 @@ pub(crate) struct GridBoxes {
 }
 
 impl GridBoxes {
+    /// The side of the largest aligned cells among the boxes inside: the largest power of two that divides
+    /// some box's origin on every axis and fits in its sizes (1 if there are no boxes). A default offset that
+    /// is a multiple of it keeps every box as aligned in the universe as it is among the grid's indices, so
+    /// a grid's tiles stay single nodes ([`GridPlacement::choose`]).
+    pub fn alignment(&self) -> u64 {
+        self.inside
+            .iter()
+            .map(|b| {
+                (0..3)
+                    .map(|a| {
+                        let fits = 1u64 << (63 - b.size[a].max(1).leading_zeros());
+                        let divides = match b.origin[a] {
+                            0 => u64::MAX,
+                            o => 1u64 << o.trailing_zeros(),
+                        };
+                        fits.min(divides)
+                    })
+                    .min()
+                    .unwrap_or(1)
+            })
+            .max()
+            .unwrap_or(1)
+    }
+
     pub fn note_known(&mut self, b: IndexBox) {
         let hi = b.hi();
         self.known = Some(match self.known {
@@ -107,24 +131,35 @@ pub struct GridPlacement {
 
 impl GridPlacement {
     /// The placement of a grid whose known region is `known` (half-open bounds of grid indices):
-    /// `offset` if given, else 0 on every axis where no index is negative and `−min` where one is; `level`
-    /// if given, else the smallest level whose universe holds the region (0 for an empty region).
+    /// `offset` if given, else 0 on every axis where no index is negative and, where one is, the smallest
+    /// multiple of `alignment` (a power of two: the side of the grid's largest aligned cells) that makes
+    /// every index at least 0; `level` if given, else the smallest level whose universe holds the region (0 for an empty region).
+    /// A grid's aligned cells (OpenVDB's tiles, OctoMap's pruned nodes) thus stay aligned cells: an offset
+    /// that is not a multiple of a cell's side would cut it into nodes in proportion to its surface.
     ///
     /// ```
     /// use ktree::io::GridPlacement;
-    /// let p = GridPlacement::choose(Some(([-3, 0, 5], [4, 9, 6])), None, None).unwrap();
+    /// let p = GridPlacement::choose(Some(([-3, 0, 5], [4, 9, 6])), 1, None, None).unwrap();
     /// assert_eq!(p, GridPlacement { offset: [3, 0, 0], level: 4 });
+    /// // A grid of 8³ blocks at multiples of 8: the offset is one too.
+    /// let p = GridPlacement::choose(Some(([-3, 0, 5], [4, 9, 6])), 8, None, None).unwrap();
+    /// assert_eq!(p, GridPlacement { offset: [8, 0, 0], level: 4 });
     /// ```
     ///
     /// # Errors
     /// A sentence when the region does not fit (a level beyond [`max_level`]`(3)`).
     pub fn choose(
         known: Option<([i64; 3], [i64; 3])>,
+        alignment: u64,
         offset: Option<[i64; 3]>,
         level: Option<u32>,
     ) -> Result<Self, String> {
+        let step = i64::try_from(alignment.max(1)).unwrap_or(1 << 62);
         let offset = offset.unwrap_or_else(|| match known {
-            Some((lo, _)) => std::array::from_fn(|a| (-lo[a]).max(0)),
+            Some((lo, _)) => std::array::from_fn(|a| {
+                let shift = lo[a].saturating_neg().max(0);
+                (shift / step + i64::from(shift % step != 0)).saturating_mul(step)
+            }),
             None => [0; 3],
         });
         let level = match level {

@@ -133,7 +133,7 @@ pub fn read_bt(
             GridFileErrorKind::Data(format!("{} bytes after the tree", bytes.len() - at)),
         ));
     }
-    let placement = GridPlacement::choose(boxes.known, offset, level)
+    let placement = GridPlacement::choose(boxes.known, boxes.alignment(), offset, level)
         .map_err(|m| fail(0, GridFileErrorKind::GridPlacement(m)))?;
     let tree = place_boxes(&boxes, &placement, max_grid_nodes(bytes.len()))
         .map_err(|m| fail(0, GridFileErrorKind::GridPlacement(m)))?;

@@ -568,7 +568,7 @@ pub fn read_vdb(
         walk_active(&mut r, grid, &coding, &mut active)?;
         active.0
     };
-    let placement = GridPlacement::choose(boxes.known, offset, level)
+    let placement = GridPlacement::choose(boxes.known, boxes.alignment(), offset, level)
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;
     let tree = place_boxes(&boxes, &placement, max_grid_nodes(bytes.len()))
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;

@@ -389,6 +389,7 @@ pub fn read_vdb_values(
     let dtype = choose_dtype(&r, grid.kind, &read.values)?;
     let placement = GridPlacement::choose(
         read.boxes.known,
+        read.boxes.alignment(),
         offset.or(head.offset),
         level.or(head.level),
     )
