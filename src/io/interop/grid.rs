@@ -226,8 +226,13 @@ impl GridPlacement {
 /// the real files of the tests: at most 2.3), so the bound only stops misplaced files. [`place_boxes`]
 /// counts the nodes before it makes any, so a file refused costs the count alone. The allowance a byte is
 /// what bounds a reader's work on any input: at 2^7 a byte, a 46 KB `.vdb` could still ask for 7 million
-/// nodes (0.19 s in the fuzz build); at 2^5, for 2.5 million.
-pub(crate) fn max_grid_nodes(file_len: usize) -> u64 {
+/// nodes (0.19 s in the fuzz build); at 2^5, for 2.5 million. A caller reading untrusted files may set a
+/// smaller bound ([`read_vdb_within`](crate::io::read_vdb_within)).
+///
+/// ```
+/// assert_eq!(ktree::io::max_grid_nodes(1000), (1 << 20) + 32 * 1000);
+/// ```
+pub fn max_grid_nodes(file_len: usize) -> u64 {
     BASE_NODES + (file_len as u64) * NODES_A_BYTE
 }
 

@@ -26,7 +26,9 @@ mod octomap_map;
 mod vdb;
 
 pub use binvox::{read_binvox, write_binvox, BINVOX_MAX_DIM};
-pub use grid::{GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree};
+pub use grid::{
+    max_grid_nodes, GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree,
+};
 #[cfg(feature = "volume")]
 pub use nifti::{write_nifti_file, NiftiWriteError};
 pub use octomap::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
@@ -35,6 +37,6 @@ pub use octomap_map::{
     OT_HEADER,
 };
 pub use vdb::{
-    read_vdb, read_vdb_values, vdb_holds_values, write_any_valued_vdb, write_vdb,
-    write_vdb_level_set, write_vdb_values, PlacedValues,
+    read_vdb, read_vdb_values, read_vdb_values_within, read_vdb_within, vdb_holds_values,
+    write_any_valued_vdb, write_vdb, write_vdb_level_set, write_vdb_values, PlacedValues,
 };

@@ -35,9 +35,10 @@ mod values;
 mod write;
 
 pub use level_set::write_vdb_level_set;
-pub use read::read_vdb;
+pub use read::{read_vdb, read_vdb_within};
 pub use typed::{
-    read_vdb_values, vdb_holds_values, write_any_valued_vdb, write_vdb_values, PlacedValues,
+    read_vdb_values, read_vdb_values_within, vdb_holds_values, write_any_valued_vdb,
+    write_vdb_values, PlacedValues,
 };
 pub use write::write_vdb;
 

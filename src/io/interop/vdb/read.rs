@@ -551,6 +551,33 @@ pub fn read_vdb(
     offset: Option<[i64; 3]>,
     level: Option<u32>,
 ) -> Result<PlacedTree, GridFileError> {
+    read_vdb_within(bytes, file, offset, level, max_grid_nodes(bytes.len()))
+}
+
+/// [`read_vdb`] with the octree bounded to `max_nodes` nodes (instead of [`max_grid_nodes`] of the file's
+/// length): a placement that would make more is refused with a [`GridFileErrorKind::GridPlacement`] error
+/// before any node is made. For a caller that reads untrusted files in bounded time and memory.
+///
+/// ```
+/// use ktree::io::{read_vdb_within, write_vdb, GridFileErrorKind, GridMeta};
+/// use ktree::{rays::ball_rays, KTree};
+/// let ball = KTree::from_rays(&ball_rays::<3>(5, [16, 16, 16], 12).unwrap());
+/// let mut bytes = Vec::new();
+/// write_vdb(&mut bytes, &ball, [0; 3], &GridMeta::default()).unwrap();
+/// assert_eq!(read_vdb_within(&bytes, "ball.vdb", None, None, 10_000).unwrap().tree, ball);
+/// let e = read_vdb_within(&bytes, "ball.vdb", None, None, 100).unwrap_err();
+/// assert!(matches!(e.kind, GridFileErrorKind::GridPlacement(_)));
+/// ```
+///
+/// # Errors
+/// As [`read_vdb`].
+pub fn read_vdb_within(
+    bytes: &[u8],
+    file: &str,
+    offset: Option<[i64; 3]>,
+    level: Option<u32>,
+    max_nodes: u64,
+) -> Result<PlacedTree, GridFileError> {
     let (mut r, grid, head) = find_grid(
         bytes,
         file,
@@ -570,7 +597,7 @@ pub fn read_vdb(
     };
     let placement = GridPlacement::choose(boxes.known, boxes.alignment(), offset, level)
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;
-    let tree = place_boxes(&boxes, &placement, max_grid_nodes(bytes.len()))
+    let tree = place_boxes(&boxes, &placement, max_nodes)
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;
     Ok(PlacedTree {
         tree,

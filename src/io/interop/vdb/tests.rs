@@ -40,6 +40,35 @@ fn round_trip_keeps_the_universe_and_tiles_cover_whole_nodes() {
     assert!(bytes.len() < 8 * 50_000, "{} bytes", bytes.len());
 }
 
+#[test]
+fn a_node_bound_below_the_trees_size_is_refused_and_at_it_the_tree_reads() {
+    let ball = stack(&ball_rays::<3>(5, [16, 16, 15], 11).unwrap());
+    let labels = KTree::<3, u8>::from_dense_values(
+        3,
+        &(0..512u16)
+            .map(|i| (i % 3 != 0).then_some((i % 7 + 1) as u8))
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
+    let (mut binary, mut valued) = (Vec::new(), Vec::new());
+    write_vdb(&mut binary, &ball, [0; 3], &GridMeta::default()).unwrap();
+    write_vdb_values(&mut valued, &labels, [0; 3], &GridMeta::default()).unwrap();
+    let n = ball.node_count();
+    assert_eq!(
+        read_vdb_within(&binary, "b", None, None, n).unwrap().tree,
+        ball
+    );
+    let e = read_vdb_within(&binary, "b", None, None, n - 1).unwrap_err();
+    assert!(
+        matches!(&e.kind, GridFileErrorKind::GridPlacement(m) if m.contains("nodes")),
+        "{e}"
+    );
+    let read = read_vdb_values_within(&valued, "v", None, None, 1 << 12).unwrap();
+    assert_eq!(read.tree, crate::AnyValuedTree::from(labels.clone()));
+    let e = read_vdb_values_within(&valued, "v", None, None, 16).unwrap_err();
+    assert!(e.to_string().contains("more than 16"), "{e}");
+}
+
 /// A file's header up to its grid count: magic, versions, no file metadata.
 fn file_head() -> Vec<u8> {
     let mut b = MAGIC.to_le_bytes().to_vec();

@@ -175,10 +175,8 @@ impl ValueBoxes {
             return Err(r.fail_at(
                 at,
                 GridFileErrorKind::Unsupported(format!(
-                    "more than {} runs of voxels along z ({} a byte of the file and {} more)",
+                    "more than {} runs of voxels along z (the bound on the tree's nodes)",
                     self.max_runs,
-                    max_grid_nodes(1) - max_grid_nodes(0),
-                    max_grid_nodes(0)
                 )),
             ));
         }
@@ -366,12 +364,28 @@ fn build<V: Value>(
 /// [`GridFileError`] naming the byte offset: as [`read_vdb`](super::read_vdb); no grid with values (a
 /// `BoolGrid`, `MaskGrid` or level set is named); a value its type cannot hold (an integer below −128 among
 /// negative ones or beyond `u32`, a NaN, a float beyond `f32`, a vector component outside 0 … 255); more runs
-/// of voxels along z than the node bound of a file of its size (2^20 and 2^5 a byte).
+/// of voxels along z than the node bound of a file of its size ([`max_grid_nodes`]).
 pub fn read_vdb_values(
     bytes: &[u8],
     file: &str,
     offset: Option<[i64; 3]>,
     level: Option<u32>,
+) -> Result<PlacedValues, GridFileError> {
+    read_vdb_values_within(bytes, file, offset, level, max_grid_nodes(bytes.len()))
+}
+
+/// [`read_vdb_values`] with the octree, and the runs of voxels read, bounded to `max_nodes` (instead of
+/// [`max_grid_nodes`] of the file's length), as [`read_vdb_within`](super::read_vdb_within) bounds a grid
+/// without values.
+///
+/// # Errors
+/// As [`read_vdb_values`].
+pub fn read_vdb_values_within(
+    bytes: &[u8],
+    file: &str,
+    offset: Option<[i64; 3]>,
+    level: Option<u32>,
+    max_nodes: u64,
 ) -> Result<PlacedValues, GridFileError> {
     let (mut r, grid, head) = find_grid(
         bytes,
@@ -382,7 +396,7 @@ pub fn read_vdb_values(
     )?;
     let coding = grid.coding(head.compression);
     let mut read = ValueBoxes {
-        max_runs: max_grid_nodes(bytes.len()).min(MAX_GRID_RUNS),
+        max_runs: max_nodes.min(MAX_GRID_RUNS),
         ..ValueBoxes::default()
     };
     walk_active(&mut r, grid, &coding, &mut read)?;
@@ -395,7 +409,7 @@ pub fn read_vdb_values(
     )
     .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;
     // The shape first: it checks that the voxels fit the universe and bounds the tree's nodes.
-    place_boxes(&read.boxes, &placement, max_grid_nodes(bytes.len()))
+    place_boxes(&read.boxes, &placement, max_nodes)
         .map_err(|m| GridFileError::new(file, 0, GridFileErrorKind::GridPlacement(m)))?;
     let tree =
         with_valued!(3, dtype, K, V => build::<V>(&read.boxes, &read.values, dtype, &placement),
