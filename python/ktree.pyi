@@ -424,7 +424,8 @@ class OccupancyMap:
     def log_odds(self) -> Tree:
         """The log-odds of the observed voxels, as a tree with float32 values (unknown voxels empty)."""
     def save(self, path: _Path) -> None:
-        """Writes a 3-D map as OctoMap's .ot (every log-odds) or .bt (free and occupied), atomically."""
+        """Writes a 3-D map as OctoMap's .ot (every log-odds) or .bt (free and occupied), or as a .ktree of
+        its log-odds with its world frame (as `ktree map` writes), atomically."""
     @staticmethod
     def load(
         path: _Path,
@@ -434,7 +435,8 @@ class OccupancyMap:
         clamp_max: float = 0.971,
         occupancy: float = 0.5,
     ) -> OccupancyMap:
-        """Reads a 3-D map from OctoMap's .ot or .bt file, with the sensor model of these probabilities."""
+        """Reads a 3-D map from OctoMap's .ot or .bt file or a .ktree map, with the sensor model of these
+        probabilities."""
     @property
     def resolution(self) -> float:
         """The side of a voxel."""

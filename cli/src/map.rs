@@ -9,13 +9,13 @@ use std::time::Instant;
 
 use ktree::export::grid_map::write_grid_map;
 use ktree::export::Frame;
-use ktree::io::ktree::v3::{read_valued_ktree_framed, valued_header};
+use ktree::io::ktree::read_map_ktree;
+use ktree::io::ktree::v3::valued_header;
 use ktree::io::scan::{read_scan_directory, read_scans, Pose, Scan, ScanNode};
 use ktree::io::{
     read_bt_map, read_cloud, read_cloud_bytes, read_ot_map, write_bt_map, write_ot_map,
 };
-use ktree::map::{HistoryRecorder, MapGrid, OccupancyMap, SensorModel, MAP_LEVEL};
-use ktree::space::WorldFrame;
+use ktree::map::{HistoryRecorder, OccupancyMap, SensorModel, MAP_LEVEL};
 use ktree::tree::Dtype;
 
 use crate::common::error::{cannot_read, CliError, CliResult};
@@ -245,20 +245,9 @@ fn write_map(out: &Path, kind: MapKind, map: &OccupancyMap<3>) -> CliResult {
     match kind {
         MapKind::Ot => ktree::fs::write_atomic_with(out, |w| write_ot_map(w, map)),
         MapKind::Bt => ktree::fs::write_atomic_with(out, |w| write_bt_map(w, map)),
-        MapKind::Ktree => {
-            let frame = map_frame(map.grid());
-            ktree::io::ktree::v3::write_valued_ktree_file_framed(out, map.log_odds(), Some(&frame))
-        }
+        MapKind::Ktree => ktree::io::ktree::write_map_ktree_file(out, map),
     }
     .map_err(CliError::caused)
-}
-
-/// Where a map's keys are in the world: key 0's lower corner and the resolution.
-fn map_frame(grid: &MapGrid) -> WorldFrame {
-    WorldFrame {
-        voxel_size: grid.resolution(),
-        origin: [grid.corner(); 3],
-    }
 }
 
 /// Whether a file holds an occupancy map: OctoMap's `.ot` and `.bt`, or a `.ktree` of float32 log-odds
@@ -294,18 +283,7 @@ pub fn read_map(path: &Path) -> CliResult<OccupancyMap<3>> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("ktree"))
     {
-        let (log_odds, frame) =
-            read_valued_ktree_framed::<3, f32>(&bytes, &name).map_err(CliError::caused)?;
-        let not_a_map = || {
-            format!("{name}: not an occupancy map (a .ktree map keeps its resolution and OctoMap's origin as its world frame)")
-        };
-        let frame = frame.ok_or_else(not_a_map)?;
-        let grid = MapGrid::new(frame.voxel_size).map_err(|e| format!("{name}: {e}"))?;
-        if map_frame(&grid) != frame {
-            return Err(not_a_map().into());
-        }
-        return OccupancyMap::from_log_odds(grid, SensorModel::default(), log_odds)
-            .map_err(|e| format!("{name}: {e}").into());
+        return read_map_ktree(&bytes, &name, SensorModel::default()).map_err(CliError::caused);
     }
     let bt = path
         .extension()

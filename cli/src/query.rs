@@ -12,10 +12,12 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use ktree::io::ktree::v3::MappedValuedTree;
+use ktree::io::ktree::MappedMap;
 use ktree::io::{read_color_ot_map, FileTree, GridFileErrorKind};
-use ktree::map::{OccupancyMap, SensorModel};
+use ktree::map::{MapView, OccupancyMap, SensorModel};
 use ktree::query::{self, Query, RayCast, RayHit};
 use ktree::tree::AnyValuedTree;
+use ktree::tree::ValueStorage;
 use ktree::value::Rgb;
 use ktree::value::{Dtype, Value};
 use ktree::{with_tree, with_valued, KTree};
@@ -264,14 +266,37 @@ fn answer_map_points(args: &QueryArgs) -> CliResult {
         )
         .into());
     }
+    if is_ktree(&args.tree) {
+        let map = MappedMap::open(&args.tree, SensorModel::default()).map_err(CliError::caused)?;
+        return write_map_states(&map.view(), None, args);
+    }
     let (map, colours) = read_map_and_colours(&args.tree)?;
+    write_map_states(&map.view(), colours.as_ref(), args)
+}
+
+/// Whether `path` names a `.ktree` file (a map read in place).
+fn is_ktree(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ktree"))
+}
+
+/// Prints the state of the voxel of each point of `args.points` in `map` (and its colour from `colours`).
+fn write_map_states<S>(
+    map: &MapView<'_, 3, S>,
+    colours: Option<&KTree<3, Rgb>>,
+    args: &QueryArgs,
+) -> CliResult
+where
+    S: ValueStorage<3, Value = f32> + Sync,
+    S::Error: Send,
+{
     let table = table::read::<f64>(&args.points, 3)?;
     let pts: Vec<[f32; 3]> = table
         .rows
         .iter()
         .map(|r| [r[0] as f32, r[1] as f32, r[2] as f32])
         .collect();
-    let states = map.states(&pts);
+    let states = map.states(&pts).map_err(read_error)?;
     let colours = colours.map(|c| {
         let keys: Vec<[u32; 3]> = pts
             .iter()
@@ -404,7 +429,18 @@ pub fn run_raycast(args: RaycastArgs) -> CliResult {
 /// ended — `occupied` (a hit), `unknown`, `range` (beyond --max-range) or `outside` the map — with the
 /// key and the world centre of the voxel where it ended.
 fn answer_map_rays(args: &RaycastArgs) -> CliResult {
-    let map = crate::map::read_map(&args.tree)?;
+    if is_ktree(&args.tree) {
+        let map = MappedMap::open(&args.tree, SensorModel::default()).map_err(CliError::caused)?;
+        return write_map_casts(&map.view(), args);
+    }
+    write_map_casts(&crate::map::read_map(&args.tree)?.view(), args)
+}
+
+/// Prints how each ray of `args.rays` cast on `map` ended.
+fn write_map_casts<S: ValueStorage<3, Value = f32>>(
+    map: &MapView<'_, 3, S>,
+    args: &RaycastArgs,
+) -> CliResult {
     let table = table::read::<f64>(&args.rays, 6)?;
     let range = match args.max_range {
         Some(m) if !(m.is_finite() && m > 0.0) => {
@@ -420,12 +456,14 @@ fn answer_map_rays(args: &RaycastArgs) -> CliResult {
     }
     for (i, r) in table.rows.iter().enumerate() {
         let f = |a: usize| r[a] as f32;
-        let end = map.cast_ray(
-            [f(0), f(1), f(2)],
-            [f(3), f(4), f(5)],
-            args.ignore_unknown,
-            range,
-        );
+        let end = map
+            .cast_ray(
+                [f(0), f(1), f(2)],
+                [f(3), f(4), f(5)],
+                args.ignore_unknown,
+                range,
+            )
+            .map_err(read_error)?;
         let (name, key) = match end {
             ktree::map::CastEnd::Occupied(k) => ("occupied", Some(k)),
             ktree::map::CastEnd::Unknown(k) => ("unknown", Some(k)),

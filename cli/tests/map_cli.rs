@@ -336,6 +336,21 @@ fn queries_of_a_map_answer_unknown_free_or_occupied() {
     assert_eq!(v[2]["point"], serde_json::json!([-20.0, 5.0, 1.0]));
     let (ok, _, err) = ktree(&["query", &s("room.bt"), "--points", &s("p.txt"), "--nearest"]);
     assert!(!ok && err.contains("unknown, free or occupied"), "{err}");
+    // The same map as a .ktree, read in place, answers the same.
+    run(&[
+        "map",
+        &s("room.xyz"),
+        "--resolution",
+        "0.1",
+        "--sensor-origin",
+        "2.5,1.5,1.2",
+        "--out",
+        &s("room.ktree"),
+    ]);
+    assert_eq!(
+        run(&["query", &s("room.ktree"), "--points", &s("p.txt")]),
+        text
+    );
 }
 
 #[test]
@@ -352,6 +367,16 @@ fn ray_casts_on_a_map_report_where_they_end() {
         "2.5,1.5,1.2",
         "--out",
         &s("room.ot"),
+    ]);
+    run(&[
+        "map",
+        &s("room.xyz"),
+        "--resolution",
+        "0.1",
+        "--sensor-origin",
+        "2.5,1.5,1.2",
+        "--out",
+        &s("room.ktree"),
     ]);
     let map = read_ot_map(
         &std::fs::read(s("room.ot")).unwrap(),
@@ -382,6 +407,13 @@ fn ray_casts_on_a_map_report_where_they_end() {
         args.extend(extra.iter().map(|a| a.to_string()));
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let out = run(&args);
+        // The same map as a .ktree, read in place: the same ends.
+        let in_place: Vec<String> = args
+            .iter()
+            .map(|a| a.replace("room.ot", "room.ktree"))
+            .collect();
+        let in_place: Vec<&str> = in_place.iter().map(String::as_str).collect();
+        assert_eq!(run(&in_place), out);
         for (r, line) in rays.iter().zip(out.lines()) {
             let end = map.cast_ray([r[0], r[1], r[2]], [r[3], r[4], r[5]], ignore, range);
             let word = line.split(' ').next().unwrap();

@@ -425,7 +425,8 @@ impl OccupancyMapPy {
     }
 
     /// Writes a 3-D map as OctoMap's `.ot` (every log-odds) or `.bt` (each known voxel free or occupied),
-    /// atomically.
+    /// or as a `.ktree` of its log-odds with its world frame (as `ktree map` writes, read in place by
+    /// `ktree query` and `ktree raycast`), atomically.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let AnyMap::D3(map) = &self.map else {
             return Err(Failure::Value(format!(
@@ -438,31 +439,23 @@ impl OccupancyMapPy {
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
-        let bt = match ext.as_deref() {
-            Some("ot") => false,
-            Some("bt") => true,
-            _ => {
-                return Err(Failure::Value(format!(
-                    "{}: a map is saved as .ot or .bt",
-                    path.display()
-                ))
-                .into())
-            }
-        };
-        Ok(py.detach(|| {
-            ktree::fs::write_atomic_with(&path, |w| {
-                if bt {
-                    write_bt_map(w, map)
-                } else {
-                    write_ot_map(w, map)
-                }
-            })
-            .map_err(|e| Failure::of_error(&e, &path))
+        Ok(py.detach(|| match ext.as_deref() {
+            Some("ot") => ktree::fs::write_atomic_with(&path, |w| write_ot_map(w, map))
+                .map_err(|e| Failure::of_error(&e, &path)),
+            Some("bt") => ktree::fs::write_atomic_with(&path, |w| write_bt_map(w, map))
+                .map_err(|e| Failure::of_error(&e, &path)),
+            Some("ktree") => ktree::io::ktree::write_map_ktree_file(&path, map)
+                .map_err(|e| Failure::of_error(&e, &path)),
+            _ => Err(Failure::Value(format!(
+                "{}: a map is saved as .ot, .bt or .ktree",
+                path.display()
+            ))),
         })?)
     }
 
-    /// Reads a 3-D map from OctoMap's `.ot` or `.bt` file, with a sensor model given by probabilities as
-    /// for the constructor (a `.bt` file's occupied voxels take the upper clamp, its free ones the lower).
+    /// Reads a 3-D map from OctoMap's `.ot` or `.bt` file or a `.ktree` map, with a sensor model given by
+    /// probabilities as for the constructor (a `.bt` file's occupied voxels take the upper clamp, its free
+    /// ones the lower).
     #[staticmethod]
     #[pyo3(signature = (path, prob_hit = 0.7, prob_miss = 0.4, clamp_min = 0.1192, clamp_max = 0.971, occupancy = 0.5))]
     fn load(
@@ -477,18 +470,21 @@ impl OccupancyMapPy {
         let model =
             SensorModel::from_probabilities(prob_hit, prob_miss, clamp_min, clamp_max, occupancy);
         model.check().map_err(Failure::Value)?;
-        let bt = path
+        let ext = path
             .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("bt"));
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
         let map = py.detach(|| {
             let bytes = std::fs::read(&path).map_err(|e| Failure::of_error(&e, &path))?;
             let name = path.display().to_string();
-            if bt {
-                read_bt_map(&bytes, &name, model)
-            } else {
-                read_ot_map(&bytes, &name, model)
+            match ext.as_deref() {
+                Some("bt") => {
+                    read_bt_map(&bytes, &name, model).map_err(|e| Failure::of_error(&e, &path))
+                }
+                Some("ktree") => ktree::io::ktree::read_map_ktree(&bytes, &name, model)
+                    .map_err(|e| Failure::of_error(&e, &path)),
+                _ => read_ot_map(&bytes, &name, model).map_err(|e| Failure::of_error(&e, &path)),
             }
-            .map_err(|e| Failure::of_error(&e, &path))
         })?;
         Ok(Self {
             map: AnyMap::D3(map),

@@ -476,7 +476,15 @@ def test_save_and_load_through_octomaps_files(tmp_path):
     assert ml.free() == m.free()
     probes = rng.uniform(-2.5, 2.5, size=(500, 3))
     assert (ml.states(probes) == m.states(probes)).all()
-    with pytest.raises(ValueError, match=r"\.ot or \.bt"):
+    # A .ktree map keeps every log-odds and the resolution (its world frame).
+    m.save(tmp_path / "m.ktree")
+    mk = ktree.OccupancyMap.load(tmp_path / "m.ktree")
+    assert mk.resolution == 0.1
+    assert mk.log_odds() == m.log_odds()
+    ktree.Tree.full(3, 4).save(tmp_path / "cube.ktree")
+    with pytest.raises(ValueError, match="cube.ktree"):
+        ktree.OccupancyMap.load(tmp_path / "cube.ktree")
+    with pytest.raises(ValueError, match=r"\.ot, \.bt or \.ktree"):
         m.save(tmp_path / "m.png")
     with pytest.raises(ValueError, match="dimension 2"):
         ktree.OccupancyMap(0.1, dim=2).save(tmp_path / "flat.ot")

@@ -2,8 +2,10 @@
 //! voxel (its DDA, its `f32` and `f64` steps), until an occupied voxel (a hit), an unknown one (unless
 //! unknown voxels are passed through), the maximum range or the map's edge.
 
-use super::{OccupancyMap, VoxelState};
+use super::{MapView, OccupancyMap, VoxelState};
 use crate::map::traverse::norm;
+use crate::tree::storage::infallible;
+use crate::tree::ValueStorage;
 
 /// How a ray cast ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -39,26 +41,45 @@ impl OccupancyMap<3> {
         ignore_unknown: bool,
         max_range: f64,
     ) -> CastEnd {
+        infallible(
+            self.view()
+                .cast_ray(origin, direction, ignore_unknown, max_range),
+        )
+    }
+}
+
+impl<S: ValueStorage<3, Value = f32>> MapView<'_, 3, S> {
+    /// [`OccupancyMap::cast_ray`] on the map's log-odds in any storage.
+    ///
+    /// # Errors
+    /// The storage's first read error.
+    pub fn cast_ray(
+        &self,
+        origin: [f32; 3],
+        direction: [f32; 3],
+        ignore_unknown: bool,
+        max_range: f64,
+    ) -> Result<CastEnd, S::Error> {
         let grid = *self.grid();
         let Some(mut key) = grid.keys(origin) else {
-            return CastEnd::Outside;
+            return Ok(CastEnd::Outside);
         };
         // The leaf the ray is in (its cell: the keys' bits above `leaf.0`) and its state: looked up again
         // only when the ray leaves it.
-        let look = |k: [u32; 3]| {
-            let (log_side, v) = self.log_odds().leaf_at(k).unwrap_or((0, None));
-            (log_side, k.map(|c| c >> log_side), self.state_of(v))
+        let look = |k: [u32; 3]| -> Result<_, S::Error> {
+            let (log_side, v) = self.log_odds().try_leaf_at(k)?.unwrap_or((0, None));
+            Ok((log_side, k.map(|c| c >> log_side), self.state_of(v)))
         };
-        let mut leaf = look(key);
-        let mut state = |k: [u32; 3]| {
+        let mut leaf = look(key)?;
+        let mut state = |k: [u32; 3]| -> Result<VoxelState, S::Error> {
             if k.map(|c| c >> leaf.0) != leaf.1 {
-                leaf = look(k);
+                leaf = look(k)?;
             }
-            leaf.2
+            Ok(leaf.2)
         };
-        match state(key) {
-            VoxelState::Occupied => return CastEnd::Occupied(key),
-            VoxelState::Unknown if !ignore_unknown => return CastEnd::Unknown(key),
+        match state(key)? {
+            VoxelState::Occupied => return Ok(CastEnd::Occupied(key)),
+            VoxelState::Unknown if !ignore_unknown => return Ok(CastEnd::Unknown(key)),
             _ => {}
         }
         // OctoMap's normalized(): the norm in f64, the division in f32.
@@ -86,7 +107,7 @@ impl OccupancyMap<3> {
             }
         }
         if step == [0; 3] {
-            return CastEnd::Outside;
+            return Ok(CastEnd::Outside);
         }
         let range_sq = max_range * max_range;
         let last = (1u32 << super::MAP_LEVEL) - 1;
@@ -98,7 +119,7 @@ impl OccupancyMap<3> {
                 }
             }
             if (step[dim] < 0 && key[dim] == 0) || (step[dim] > 0 && key[dim] == last) {
-                return CastEnd::Outside;
+                return Ok(CastEnd::Outside);
             }
             key[dim] = (key[dim] as i32 + step[dim]) as u32;
             t_max[dim] += t_delta[dim];
@@ -110,12 +131,12 @@ impl OccupancyMap<3> {
                     sq += f64::from(e * e);
                 }
                 if sq > range_sq {
-                    return CastEnd::Range(key);
+                    return Ok(CastEnd::Range(key));
                 }
             }
-            match state(key) {
-                VoxelState::Occupied => return CastEnd::Occupied(key),
-                VoxelState::Unknown if !ignore_unknown => return CastEnd::Unknown(key),
+            match state(key)? {
+                VoxelState::Occupied => return Ok(CastEnd::Occupied(key)),
+                VoxelState::Unknown if !ignore_unknown => return Ok(CastEnd::Unknown(key)),
                 _ => {}
             }
         }

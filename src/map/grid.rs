@@ -78,4 +78,27 @@ impl MapGrid {
     pub fn corner(&self) -> f64 {
         -f64::from(CENTRE_KEY) * self.resolution
     }
+
+    /// The map's world frame: voxels of its resolution, key 0 at its [corner](Self::corner) on every
+    /// axis (what a `.ktree` map file keeps).
+    ///
+    /// ```
+    /// use ktree::map::MapGrid;
+    /// let grid = MapGrid::new(0.25).unwrap();
+    /// assert_eq!(grid.world_frame().origin, [-8192.0; 3]);
+    /// assert_eq!(MapGrid::from_world_frame(&grid.world_frame()), Some(grid));
+    /// ```
+    pub fn world_frame(&self) -> crate::space::WorldFrame {
+        crate::space::WorldFrame {
+            voxel_size: self.resolution,
+            origin: [self.corner(); 3],
+        }
+    }
+
+    /// The grid whose world frame is `frame`, or `None` if `frame` is not a map's (its origin is not the
+    /// corner of a map of its voxel size).
+    pub fn from_world_frame(frame: &crate::space::WorldFrame) -> Option<Self> {
+        let grid = Self::new(frame.voxel_size).ok()?;
+        (grid.world_frame() == *frame).then_some(grid)
+    }
 }

@@ -30,6 +30,7 @@ mod plane;
 mod rays;
 mod traverse;
 mod update;
+mod view;
 
 pub use cast::CastEnd;
 pub use grid::{MapGrid, CENTRE_KEY, MAP_LEVEL};
@@ -39,8 +40,8 @@ pub use model::{log_odds, probability, SensorModel};
 pub use plane::MapPlane;
 pub use traverse::{clipped_end, key_ray, visit_key_ray};
 pub use update::{apply, ScanUpdate};
+pub use view::MapView;
 
-use crate::ops::values::select_where;
 use crate::tree::storage::infallible;
 use crate::tree::top_down::{build_top_down, Decision};
 use crate::tree::TreeError;
@@ -185,36 +186,22 @@ impl<const K: usize> OccupancyMap<K> {
 
     /// The state of the voxels holding `points` (world coordinates; outside the map: unknown).
     pub fn states(&self, points: &[[f32; K]]) -> Vec<VoxelState> {
-        let keys: Vec<[u32; K]> = points
-            .iter()
-            .map(|&p| self.grid.keys(p).unwrap_or([u32::MAX; K]))
-            .collect();
-        self.log_odds
-            .values_at(&keys)
-            .into_iter()
-            .map(|v| self.state_of(v))
-            .collect()
+        infallible(self.view().states(points))
     }
 
     /// The state of a voxel of log-odds `l` (`None`: unknown).
     pub fn state_of(&self, l: Option<f32>) -> VoxelState {
-        match l {
-            None => VoxelState::Unknown,
-            Some(l) if self.model.is_occupied(l) => VoxelState::Occupied,
-            Some(_) => VoxelState::Free,
-        }
+        self.view().state_of(l)
     }
 
     /// The occupied voxels, as a binary tree at the map's keys.
     pub fn occupied(&self) -> KTree<K> {
-        let model = self.model;
-        infallible(select_where(&self.log_odds, move |l| model.is_occupied(l)))
+        infallible(self.view().occupied())
     }
 
     /// The free voxels (observed, not occupied).
     pub fn free(&self) -> KTree<K> {
-        let model = self.model;
-        infallible(select_where(&self.log_odds, move |l| !model.is_occupied(l)))
+        infallible(self.view().free())
     }
 
     /// This map with its observed voxels inside `voxels` made free (their log-odds the model's lower
@@ -241,6 +228,6 @@ impl<const K: usize> OccupancyMap<K> {
 
     /// The unknown voxels (never observed).
     pub fn unknown(&self) -> KTree<K> {
-        !&self.log_odds.shape()
+        infallible(self.view().unknown())
     }
 }

@@ -26,12 +26,14 @@ use thiserror::Error;
 
 use crate::tree::{AnyTree, KTree};
 
+mod map_file;
 pub mod streamed;
 pub mod v1;
 pub mod v2;
 pub mod v3;
 mod v3_mapped;
 
+pub use map_file::{read_map_ktree, write_map_ktree_file, MappedMap};
 pub use streamed::{
     boolean_files, boolean_views, complement_file, BooleanFileError, BooleanFileReport,
     ViewOperation,

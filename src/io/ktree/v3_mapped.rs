@@ -22,7 +22,7 @@ use std::sync::Arc;
 use super::v3::{check_valued, Checked, ValuedLevel};
 use crate::io::mmap::FileMap;
 use crate::io::{KtreeFileError, KtreeFileErrorKind};
-use crate::space::Universe;
+use crate::space::{Universe, WorldFrame};
 use crate::tree::valued::ValueStorage;
 use crate::tree::words::{children_mask, full_mask};
 use crate::value::Value;
@@ -44,6 +44,7 @@ pub struct MappedValuedTree<const K: usize, V> {
     universe: Universe<K>,
     levels: Arc<[ValuedLevel]>,
     value_bytes: usize,
+    frame: Option<WorldFrame>,
     values: PhantomData<V>,
 }
 
@@ -83,19 +84,28 @@ impl<const K: usize, V: Value> MappedValuedTree<K, V> {
         };
         match check_valued::<K, V>(map.bytes(), &name, false)? {
             Checked::Valued {
-                universe, levels, ..
+                universe,
+                levels,
+                frame,
+                ..
             } => Ok(Self {
                 map: Arc::new(map),
                 file: name.into(),
                 universe,
                 levels: levels.into(),
                 value_bytes: dtype.bytes(),
+                frame,
                 values: PhantomData,
             }),
             Checked::Binary(_) => {
                 unreachable!("V has a dtype: a binary file fails the dtype check")
             }
         }
+    }
+
+    /// The world frame the file keeps, if any.
+    pub fn frame(&self) -> Option<WorldFrame> {
+        self.frame
     }
 
     /// The error of a read the checked shape does not allow: the file changed after it was opened.
