@@ -35,7 +35,8 @@ class RayHits(NamedTuple):
 
 class MapRayHits(NamedTuple):
     """What OccupancyMap.cast_rays returns: per ray, whether it hit an occupied voxel, the world centre
-    of the voxel where it ended (NaN for OUTSIDE), that voxel's keys (-1 for OUTSIDE) and why it ended:
+    of the voxel where it ended (for OUTSIDE the last voxel in the map, NaN when the origin is outside it),
+    that voxel's keys (-1 where NaN) and why it ended:
     OccupancyMap.OCCUPIED (a hit), UNKNOWN, BEYOND_RANGE or OUTSIDE."""
 
     hit: npt.NDArray[np.bool_]

@@ -427,7 +427,8 @@ pub fn run_raycast(args: RaycastArgs) -> CliResult {
 
 /// `ktree raycast` of an occupancy map: per ray (origin and direction in world coordinates), how it
 /// ended — `occupied` (a hit), `unknown`, `range` (beyond --max-range) or `outside` the map — with the
-/// key and the world centre of the voxel where it ended.
+/// key and the world centre of the voxel where it ended (for `outside`, the last voxel inside the map; none
+/// when the origin is outside it).
 fn answer_map_rays(args: &RaycastArgs) -> CliResult {
     if is_ktree(&args.tree) {
         let map = MappedMap::open(&args.tree, SensorModel::default()).map_err(CliError::caused)?;
@@ -468,7 +469,7 @@ fn write_map_casts<S: ValueStorage<3, Value = f32>>(
             ktree::map::CastEnd::Occupied(k) => ("occupied", Some(k)),
             ktree::map::CastEnd::Unknown(k) => ("unknown", Some(k)),
             ktree::map::CastEnd::Range(k) => ("range", Some(k)),
-            ktree::map::CastEnd::Outside => ("outside", None),
+            ktree::map::CastEnd::Outside(k) => ("outside", k),
         };
         let point = key.map(|k| k.map(|c| map.grid().centre(c)));
         if args.json {

@@ -421,7 +421,7 @@ fn ray_casts_on_a_map_report_where_they_end() {
                 ktree::map::CastEnd::Occupied(_) => "occupied",
                 ktree::map::CastEnd::Unknown(_) => "unknown",
                 ktree::map::CastEnd::Range(_) => "range",
-                ktree::map::CastEnd::Outside => "outside",
+                ktree::map::CastEnd::Outside(_) => "outside",
             };
             assert_eq!(word, want, "{line}");
         }

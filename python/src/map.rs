@@ -150,7 +150,8 @@ fn cast_map_rays(
             CastEnd::Occupied(k) => (OccupancyMapPy::OCCUPIED, k),
             CastEnd::Unknown(k) => (OccupancyMapPy::UNKNOWN, k),
             CastEnd::Range(k) => (OccupancyMapPy::BEYOND_RANGE, k),
-            CastEnd::Outside => continue,
+            CastEnd::Outside(Some(k)) => (OccupancyMapPy::OUTSIDE, k),
+            CastEnd::Outside(None) => continue,
         };
         out.hit[i] = reason == OccupancyMapPy::OCCUPIED;
         out.reason[i] = reason;
@@ -321,8 +322,8 @@ impl OccupancyMapPy {
     /// whose origin is in an occupied voxel hits it.
     ///
     /// Returns a `MapRayHits` named tuple: `hit` (N,) bool (the ray ended in an occupied voxel), `end`
-    /// (N, 3) float64 (the world centre of the voxel where it ended; NaN for `OUTSIDE`), `key` (N, 3)
-    /// int64 (that voxel's keys; -1 for `OUTSIDE`) and `reason` (N,) uint8: `OCCUPIED` (a hit), `UNKNOWN`
+    /// (N, 3) float64 (the world centre of the voxel where it ended — for `OUTSIDE`, the last voxel in
+    /// the map, NaN if the origin is outside it), `key` (N, 3) int64 (that voxel's keys, or -1) and `reason` (N,) uint8: `OCCUPIED` (a hit), `UNKNOWN`
     /// (an unknown voxel stopped it), `BEYOND_RANGE` or `OUTSIDE` (it left the map, or its origin is
     /// outside it).
     ///

@@ -160,7 +160,8 @@ class Reference:
             else:
                 axis = 1 if t_max[1] < t_max[2] else 2
             if (step[axis] < 0 and key[axis] == 0) or (step[axis] > 0 and key[axis] == 2 * CENTRE - 1):
-                return O.OUTSIDE, None
+                # OctoMap's end: the last voxel inside the map.
+                return O.OUTSIDE, tuple(key)
             key[axis] += step[axis]
             t_max[axis] += t_delta[axis]
             k = tuple(key)
@@ -639,7 +640,11 @@ def test_cast_rays_named_cases():
     # Passing through unknown voxels up the y axis to the map's edge; from outside the map.
     edge = m.cast_rays([[0.05, 0.05, 0.05], [4000.0, 0, 0], [3276.75, 0.05, 0.05]], [0.0, 1.0, 0.0], True)
     assert edge.reason.tolist() == [O.OUTSIDE, O.OUTSIDE, O.OUTSIDE]
-    assert not edge.hit.any() and (edge.key == -1).all() and np.isnan(edge.end).all()
+    assert not edge.hit.any()
+    # Where a ray leaves the map its end is the last voxel inside (OctoMap's end); from outside, none.
+    assert edge.key.tolist() == [[c, 2 * c - 1, c], [-1, -1, -1], [2 * c - 1, 2 * c - 1, c]]
+    np.testing.assert_allclose(edge.end[0], [0.05, 3276.75, 0.05], rtol=0, atol=1e-9)
+    assert np.isnan(edge.end[1]).all()
     # A ray from the last voxel along x leaves the map at once; unknown voxels stop it otherwise.
     last = m.cast_rays([3276.75, 0.05, 0.05], [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
     assert last.reason.tolist() == [O.UNKNOWN, O.UNKNOWN]

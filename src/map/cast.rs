@@ -16,8 +16,10 @@ pub enum CastEnd {
     Unknown([u32; 3]),
     /// The ray went beyond the maximum range (the keys of the first voxel beyond it).
     Range([u32; 3]),
-    /// The ray left the map, or its origin is outside it, or its direction is zero.
-    Outside,
+    /// The ray left the map (the keys of the last voxel inside it, where OctoMap's `castRay` puts its
+    /// `end`), or its origin is outside the map or its direction is zero (`None`: OctoMap leaves `end` as
+    /// it was).
+    Outside(Option<[u32; 3]>),
 }
 
 impl OccupancyMap<3> {
@@ -62,7 +64,7 @@ impl<S: ValueStorage<3, Value = f32>> MapView<'_, 3, S> {
     ) -> Result<CastEnd, S::Error> {
         let grid = *self.grid();
         let Some(mut key) = grid.keys(origin) else {
-            return Ok(CastEnd::Outside);
+            return Ok(CastEnd::Outside(None));
         };
         // The leaf the ray is in (its cell: the keys' bits above `leaf.0`) and its state: looked up again
         // only when the ray leaves it.
@@ -107,7 +109,7 @@ impl<S: ValueStorage<3, Value = f32>> MapView<'_, 3, S> {
             }
         }
         if step == [0; 3] {
-            return Ok(CastEnd::Outside);
+            return Ok(CastEnd::Outside(None));
         }
         let range_sq = max_range * max_range;
         let last = (1u32 << super::MAP_LEVEL) - 1;
@@ -119,7 +121,7 @@ impl<S: ValueStorage<3, Value = f32>> MapView<'_, 3, S> {
                 }
             }
             if (step[dim] < 0 && key[dim] == 0) || (step[dim] > 0 && key[dim] == last) {
-                return Ok(CastEnd::Outside);
+                return Ok(CastEnd::Outside(Some(key)));
             }
             key[dim] = (key[dim] as i32 + step[dim]) as u32;
             t_max[dim] += t_delta[dim];

@@ -507,7 +507,9 @@ fn ray_casts_on_a_map_stop_where_octomaps_cast_ray_stops() {
         .iter()
         .map(|(o, d)| format!("{} {} {} {} {} {}\n", o[0], o[1], o[2], d[0], d[1], d[2]))
         .collect();
-    for (ignore, range) in [(false, -1.0), (true, 4.0), (false, 2.0)] {
+    // Passing through unknown voxels with no range, the rays that meet nothing reach the map's bounds,
+    // where OctoMap's end is the last voxel inside.
+    for (ignore, range) in [(false, -1.0), (true, 4.0), (false, 2.0), (true, -1.0)] {
         let mut cmd = Command::new(&files);
         cmd.arg("cast")
             .arg(&ot)
@@ -520,8 +522,10 @@ fn ray_casts_on_a_map_stop_where_octomaps_cast_ray_stops() {
             let end = map.cast_ray(*o, *d, ignore, range);
             let (hit, key) = match end {
                 ktree::map::CastEnd::Occupied(k) => (1, Some(k)),
-                ktree::map::CastEnd::Unknown(k) | ktree::map::CastEnd::Range(k) => (0, Some(k)),
-                ktree::map::CastEnd::Outside => (0, None),
+                ktree::map::CastEnd::Unknown(k)
+                | ktree::map::CastEnd::Range(k)
+                | ktree::map::CastEnd::Outside(Some(k)) => (0, Some(k)),
+                ktree::map::CastEnd::Outside(None) => (0, None),
             };
             kinds.insert(std::mem::discriminant(&end));
             assert_eq!(f[0], hit, "ray {o:?} {d:?}: {end:?}");
@@ -533,6 +537,12 @@ fn ray_casts_on_a_map_stop_where_octomaps_cast_ray_stops() {
             kinds.len() >= 2,
             "rays of several outcomes ({ignore}, {range})"
         );
+        if (ignore, range) == (true, -1.0) {
+            assert!(
+                kinds.contains(&std::mem::discriminant(&ktree::map::CastEnd::Outside(None))),
+                "rays that reach the map's bounds"
+            );
+        }
     }
 }
 
