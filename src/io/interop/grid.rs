@@ -218,13 +218,12 @@ impl GridPlacement {
     }
 }
 
-/// The most nodes the octree of a grid file of `file_len` bytes may have: 2^20, plus 2^5 a byte
-/// ([`NODES_A_BYTE`]). A box that the placement leaves unaligned (a large cell at an offset that is not a
+/// The most nodes the octree of a grid file of `file_len` bytes may have: 2^20, plus 2^5 a byte. A box that the placement leaves unaligned (a large cell at an offset that is not a
 /// multiple of its side) costs nodes in proportion to its surface, so a file of a few bytes could otherwise
 /// ask for billions. Aligned, no format here makes more than about 20 nodes a byte (a `.vdb` checkerboard
 /// of 8³ tiles: about 2; of voxels in leaves: about 10; a `.bt` inner node's 2 bytes: at most 8 children;
-/// the real files of the tests: at most 2.3), so the bound only stops misplaced files. [`place_boxes`]
-/// counts the nodes before it makes any, so a file refused costs the count alone. The allowance a byte is
+/// the real files of the tests: at most 2.3), so the bound only stops misplaced files. The readers count
+/// the nodes before they make any, so a file refused costs the count alone. The allowance a byte is
 /// what bounds a reader's work on any input: at 2^7 a byte, a 46 KB `.vdb` could still ask for 7 million
 /// nodes (0.19 s in the fuzz build); at 2^5, for 2.5 million. A caller reading untrusted files may set a
 /// smaller bound ([`read_vdb_within`](crate::io::read_vdb_within)).
