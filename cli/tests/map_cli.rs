@@ -34,6 +34,21 @@ fn write_xyz(path: &std::path::Path, points: &[[f32; 3]]) {
     std::fs::write(path, text).unwrap();
 }
 
+/// Runs `ktree map room.xyz --resolution 0.1 --sensor-origin 2.5,1.5,1.2 --out OUT` in `dir`.
+fn map_room(dir: &std::path::Path, out: &str) {
+    let s = |n: &str| dir.join(n).to_str().unwrap().to_string();
+    run(&[
+        "map",
+        &s("room.xyz"),
+        "--resolution",
+        "0.1",
+        "--sensor-origin",
+        "2.5,1.5,1.2",
+        "--out",
+        &s(out),
+    ]);
+}
+
 #[test]
 fn map_files_hold_the_librarys_map() {
     let dir = tempfile::tempdir().unwrap();
@@ -88,16 +103,7 @@ fn a_maps_plane_is_a_ros_map_of_its_three_states() {
     let dir = tempfile::tempdir().unwrap();
     let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
     write_xyz(&dir.path().join("room.xyz"), &walls());
-    run(&[
-        "map",
-        &s("room.xyz"),
-        "--resolution",
-        "0.1",
-        "--sensor-origin",
-        "2.5,1.5,1.2",
-        "--out",
-        &s("room.ot"),
-    ]);
+    map_room(dir.path(), "room.ot");
     run(&[
         "project",
         &s("room.ot"),
@@ -143,16 +149,7 @@ fn a_maps_plane_is_a_ros_map_of_its_three_states() {
     let yaml = std::fs::read_to_string(dir.path().join("floor.yaml")).unwrap();
     assert!(yaml.contains("resolution: 0.1"), "{yaml}");
     // The same map kept as a .ktree projects to the same ROS map.
-    run(&[
-        "map",
-        &s("room.xyz"),
-        "--resolution",
-        "0.1",
-        "--sensor-origin",
-        "2.5,1.5,1.2",
-        "--out",
-        &s("room.ktree"),
-    ]);
+    map_room(dir.path(), "room.ktree");
     run(&[
         "project",
         &s("room.ktree"),
@@ -291,16 +288,7 @@ fn queries_of_a_map_answer_unknown_free_or_occupied() {
     let dir = tempfile::tempdir().unwrap();
     let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
     write_xyz(&dir.path().join("room.xyz"), &walls());
-    run(&[
-        "map",
-        &s("room.xyz"),
-        "--resolution",
-        "0.1",
-        "--sensor-origin",
-        "2.5,1.5,1.2",
-        "--out",
-        &s("room.bt"),
-    ]);
+    map_room(dir.path(), "room.bt");
     let probes = [
         [3.0f32, 0.0, 1.05],
         [2.5, 1.5, 1.2],
@@ -337,16 +325,7 @@ fn queries_of_a_map_answer_unknown_free_or_occupied() {
     let (ok, _, err) = ktree(&["query", &s("room.bt"), "--points", &s("p.txt"), "--nearest"]);
     assert!(!ok && err.contains("unknown, free or occupied"), "{err}");
     // The same map as a .ktree, read in place, answers the same.
-    run(&[
-        "map",
-        &s("room.xyz"),
-        "--resolution",
-        "0.1",
-        "--sensor-origin",
-        "2.5,1.5,1.2",
-        "--out",
-        &s("room.ktree"),
-    ]);
+    map_room(dir.path(), "room.ktree");
     assert_eq!(
         run(&["query", &s("room.ktree"), "--points", &s("p.txt")]),
         text
@@ -358,26 +337,8 @@ fn ray_casts_on_a_map_report_where_they_end() {
     let dir = tempfile::tempdir().unwrap();
     let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
     write_xyz(&dir.path().join("room.xyz"), &walls());
-    run(&[
-        "map",
-        &s("room.xyz"),
-        "--resolution",
-        "0.1",
-        "--sensor-origin",
-        "2.5,1.5,1.2",
-        "--out",
-        &s("room.ot"),
-    ]);
-    run(&[
-        "map",
-        &s("room.xyz"),
-        "--resolution",
-        "0.1",
-        "--sensor-origin",
-        "2.5,1.5,1.2",
-        "--out",
-        &s("room.ktree"),
-    ]);
+    map_room(dir.path(), "room.ot");
+    map_room(dir.path(), "room.ktree");
     let map = read_ot_map(
         &std::fs::read(s("room.ot")).unwrap(),
         "room.ot",

@@ -131,13 +131,7 @@ impl<const K: usize> OccupancyMap<K> {
         model: SensorModel,
         log_odds: KTree<K, f32>,
     ) -> Result<Self, String> {
-        model.check()?;
-        if log_odds.level() != MAP_LEVEL {
-            return Err(format!(
-                "a map's tree has level {MAP_LEVEL}, this one {}",
-                log_odds.level()
-            ));
-        }
+        MapView::new(grid, model, &log_odds)?;
         Ok(Self {
             grid,
             model,
