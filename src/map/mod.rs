@@ -3,8 +3,9 @@
 //! [`key_ray`]), built on a valued tree ([`KTree<K, f32>`](crate::KTree) of log-odds; unknown voxels are
 //! empty), so every operation of the crate applies to its parts.
 //!
-//! A scan's update ([`ScanUpdate`]) gathers the voxels its rays cross on all threads as sorted Morton keys
-//! and merges them into the map's tree in one pass from the root down. Rays may also be integrated one at
+//! A scan's update ([`ScanUpdate`]) gathers the voxels its rays cross on all threads as bitmaps of blocks
+//! of voxels, reads them back in Morton order and merges them into the map's tree in one pass from the
+//! root down (the map's unobserved and uniform parts built as the keys come, without search). Rays may also be integrated one at
 //! a time, as OctoMap's `insertRay` does ([`OccupancyMap::insert_ray`], [`OccupancyMap::insert_rays`]).
 //!
 //! ```
@@ -31,6 +32,7 @@ mod rays;
 mod traverse;
 mod update;
 mod view;
+mod voxel_set;
 
 pub use cast::CastEnd;
 pub use grid::{MapGrid, CENTRE_KEY, MAP_LEVEL};
@@ -38,7 +40,7 @@ pub use history::{state_labels, HistoryRecorder, MapHistory, FREE, MAX_STEPS, OC
 pub use leaves::{tree_from_leaves, Leaf};
 pub use model::{log_odds, probability, SensorModel};
 pub use plane::MapPlane;
-pub use traverse::{clipped_end, key_ray, visit_key_ray};
+pub use traverse::{clipped_end, key_ray, visit_key_ray, visit_morton_ray};
 pub use update::{apply, ScanUpdate};
 pub use view::MapView;
 

@@ -3,6 +3,7 @@
 //! `f64` steps so that floating-point ties fall the same way.
 
 use super::grid::MapGrid;
+use crate::space::{morton_decode, morton_encode, spread_bits};
 
 /// The Euclidean length of `v` as OctoMap's `Vector3::norm` computes it: the squares summed in `f32`, the
 /// root taken in `f64`.
@@ -64,57 +65,201 @@ pub fn visit_key_ray<const K: usize>(
     end: [f32; K],
     mut visit: impl FnMut([u32; K]),
 ) -> bool {
+    visit_morton_ray(grid, origin, end, |code| visit(morton_decode(code)))
+}
+
+/// [`visit_key_ray`] handing each voxel's Morton key (of the map's universe) instead of its keys: the
+/// traversal steps the Morton key itself, an axis's bits at a time, so no key is encoded on the way.
+///
+/// ```
+/// use ktree::map::{visit_key_ray, visit_morton_ray, MapGrid};
+/// use ktree::space::morton_encode;
+/// let grid = MapGrid::new(0.1).unwrap();
+/// let (a, b) = ([0.03f32, -0.41, 0.25], [-1.7f32, 0.9, 0.33]);
+/// let (mut keys, mut codes) = (Vec::new(), Vec::new());
+/// visit_key_ray(&grid, a, b, |k| keys.push(morton_encode(k)));
+/// visit_morton_ray(&grid, a, b, |c| codes.push(c));
+/// assert_eq!(codes, keys);
+/// assert_eq!(codes.len(), 31);
+/// ```
+#[inline]
+pub fn visit_morton_ray<const K: usize>(
+    grid: &MapGrid,
+    origin: [f32; K],
+    end: [f32; K],
+    mut visit: impl FnMut(u64),
+) -> bool {
     let (Some(key_origin), Some(key_end)) = (grid.keys(origin), grid.keys(end)) else {
         return false;
     };
     if key_origin == key_end {
         return true;
     }
-    visit(key_origin);
+    let mut code = morton_encode(key_origin);
+    let code_end = morton_encode(key_end);
+    visit(code);
     let mut direction = difference(origin, end);
     let length = norm(direction) as f32;
     for d in &mut direction {
         *d /= length;
     }
     let resolution = grid.resolution();
-    let mut step = [0i32; K];
     let mut t_max = [f64::MAX; K];
     let mut t_delta = [f64::MAX; K];
+    // A step along axis i: the axis's bits of the Morton key (mask[i]) counted up or down by one,
+    // wrapping at 16 bits as OctoMap's 16-bit keys wrap. Counting up fills the other axes' bits with ones
+    // (carry[i] = !mask[i]) so the carry runs through them; counting down clears them (carry[i] = 0).
+    let mut mask = [0u64; K];
+    let mut carry = [0u64; K];
+    let mut add = [0u64; K];
     for i in 0..K {
-        if direction[i] > 0.0 {
-            step[i] = 1;
+        mask[i] = spread_bits::<K>(u32::from(u16::MAX)) << i;
+        let step = if direction[i] > 0.0 {
+            1.0
         } else if direction[i] < 0.0 {
-            step[i] = -1;
-        }
-        if step[i] != 0 {
-            // The voxel's border in the ray's direction; OctoMap rounds the half step to f32.
-            let border = grid.centre(key_origin[i])
-                + f64::from((f64::from(step[i]) * resolution * 0.5) as f32);
-            t_max[i] = (border - f64::from(origin[i])) / f64::from(direction[i]);
-            t_delta[i] = resolution / f64::from(direction[i]).abs();
-        }
+            -1.0
+        } else {
+            continue;
+        };
+        (carry[i], add[i]) = if step > 0.0 {
+            (!mask[i], 1)
+        } else {
+            (0, u64::MAX)
+        };
+        // The voxel's border in the ray's direction; OctoMap rounds the half step to f32.
+        let border = grid.centre(key_origin[i]) + f64::from((step * resolution * 0.5) as f32);
+        t_max[i] = (border - f64::from(origin[i])) / f64::from(direction[i]);
+        t_delta[i] = resolution / f64::from(direction[i]).abs();
     }
-    // OctoMap's keys are 16-bit and wrap; a key stepped past the map's edge wraps the same way.
-    let mut key = key_origin;
-    loop {
-        // The axis of the smallest t_max, ties going to the later axis (OctoMap's comparisons).
-        let mut dim = 0;
-        for i in 1..K {
-            if t_max[i] <= t_max[dim] {
-                dim = i;
-            }
+    // The axis of the smallest t_max, ties going to the later axis (OctoMap's comparisons). Chosen and
+    // stepped without branches, the K times kept in registers: which axis comes next is what the
+    // processor cannot predict.
+    let nearest = |t_max: &[f64; K]| {
+        let (mut dim, mut best) = (0, t_max[0]);
+        for (i, &t) in t_max.iter().enumerate().skip(1) {
+            let nearer = t <= best;
+            dim = std::hint::select_unpredictable(nearer, i, dim);
+            best = std::hint::select_unpredictable(nearer, t, best);
         }
-        key[dim] = (key[dim] as i32 + step[dim]) as u32 & 0xffff;
-        t_max[dim] += t_delta[dim];
-        if key == key_end {
+        (dim, best)
+    };
+    let (mut dim, _) = nearest(&t_max);
+    loop {
+        let stepped = ((code & mask[dim]) | carry[dim]).wrapping_add(add[dim]) & mask[dim];
+        code = stepped | (code & !mask[dim]);
+        for (i, (t, delta)) in t_max.iter_mut().zip(t_delta).enumerate() {
+            *t += std::hint::select_unpredictable(i == dim, delta, 0.0);
+        }
+        if code == code_end {
             break;
         }
+        let reached;
+        (dim, reached) = nearest(&t_max);
         // Past the end point's distance without meeting its voxel (rounding): stop.
-        let reached = t_max.iter().copied().fold(f64::MAX, f64::min);
         if reached > f64::from(length) {
             break;
         }
-        visit(key);
+        visit(code);
     }
     true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The traversal stepping keys one axis at a time, as OctoMap's `computeRayKeys` steps them.
+    fn stepping_keys<const K: usize>(
+        grid: &MapGrid,
+        origin: [f32; K],
+        end: [f32; K],
+    ) -> Option<Vec<[u32; K]>> {
+        let (key_origin, key_end) = (grid.keys(origin)?, grid.keys(end)?);
+        let mut out = Vec::new();
+        if key_origin == key_end {
+            return Some(out);
+        }
+        out.push(key_origin);
+        let mut direction = difference(origin, end);
+        let length = norm(direction) as f32;
+        for d in &mut direction {
+            *d /= length;
+        }
+        let res = grid.resolution();
+        let (mut step, mut t_max, mut t_delta) = ([0i32; K], [f64::MAX; K], [f64::MAX; K]);
+        for i in 0..K {
+            step[i] = if direction[i] > 0.0 {
+                1
+            } else if direction[i] < 0.0 {
+                -1
+            } else {
+                0
+            };
+            if step[i] != 0 {
+                let border =
+                    grid.centre(key_origin[i]) + f64::from((f64::from(step[i]) * res * 0.5) as f32);
+                t_max[i] = (border - f64::from(origin[i])) / f64::from(direction[i]);
+                t_delta[i] = res / f64::from(direction[i]).abs();
+            }
+        }
+        let mut key = key_origin;
+        loop {
+            let mut dim = 0;
+            for i in 1..K {
+                if t_max[i] <= t_max[dim] {
+                    dim = i;
+                }
+            }
+            key[dim] = (key[dim] as i32 + step[dim]) as u32 & 0xffff;
+            t_max[dim] += t_delta[dim];
+            if key == key_end || t_max.iter().copied().fold(f64::MAX, f64::min) > f64::from(length)
+            {
+                break;
+            }
+            out.push(key);
+        }
+        Some(out)
+    }
+
+    fn same_as_stepping_keys<const K: usize>(
+        a: [f32; K],
+        b: [f32; K],
+        res: f64,
+    ) -> Result<(), TestCaseError> {
+        let grid = MapGrid::new(res).unwrap();
+        let mut keys = Vec::new();
+        let inside = key_ray(&grid, a, b, &mut keys);
+        let expected = stepping_keys(&grid, a, b);
+        prop_assert_eq!(inside, expected.is_some());
+        prop_assert_eq!(keys, expected.unwrap_or_default());
+        Ok(())
+    }
+
+    /// Coordinates near the middle of the map and near its edges (where keys are 0 or 65 535).
+    fn coord() -> impl Strategy<Value = f32> {
+        prop_oneof![-20.0f32..20.0, 3270.0f32..3276.8, -3276.8f32..-3270.0]
+    }
+
+    proptest! {
+        #[test]
+        fn morton_steps_are_key_steps_k1(a in [coord()], b in [coord()], res in 0.1f64..0.7) {
+            same_as_stepping_keys(a, b, res)?;
+        }
+
+        #[test]
+        fn morton_steps_are_key_steps_k2(a in [coord(), coord()], b in [coord(), coord()], res in 0.1f64..0.7) {
+            same_as_stepping_keys(a, b, res)?;
+        }
+
+        #[test]
+        fn morton_steps_are_key_steps_k3(a in [coord(), coord(), coord()], b in [coord(), coord(), coord()], res in 0.1f64..0.7) {
+            same_as_stepping_keys(a, b, res)?;
+        }
+
+        #[test]
+        fn morton_steps_are_key_steps_k4(a in [coord(), coord(), coord(), coord()], b in [coord(), coord(), coord(), coord()], res in 0.1f64..0.7) {
+            same_as_stepping_keys(a, b, res)?;
+        }
+    }
 }

@@ -1,13 +1,15 @@
 //! One scan's update of a map: the voxels its points end in (hits) and the voxels its rays cross on the
 //! way (misses), each once, hits winning — OctoMap's `computeUpdate` and `insertPointCloud` with
-//! `discretize = false` — gathered on all threads as Morton keys, deduplicated by sorting, and merged
-//! into the map's tree in one depth-first pass.
+//! `discretize = false` — gathered on all threads: each ray's misses set as bits of the blocks of voxels
+//! it crosses (repeats cost nothing; the blocks, not the voxels, are sorted), the hits sorted, and the
+//! whole merged into the map's tree in one depth-first pass.
 
 use rayon::prelude::*;
 
 use super::grid::MapGrid;
 use super::model::SensorModel;
-use super::traverse::{clipped_end, difference, norm, visit_key_ray};
+use super::traverse::{clipped_end, difference, norm, visit_morton_ray};
+use super::voxel_set::{SortedVoxels, VoxelSet};
 use crate::radix::radix_sort;
 use crate::space::morton_encode;
 use crate::tree::storage::infallible;
@@ -39,43 +41,39 @@ impl ScanUpdate {
         max_range: Option<f64>,
     ) -> Self {
         let bits = K as u32 * super::MAP_LEVEL;
-        let parts: Vec<(Vec<u64>, Vec<u64>, usize)> = points
+        // Each task's misses in a set of its own (repeats cost nothing), its hits in a list.
+        let parts: Vec<(VoxelSet, Vec<u64>, usize)> = points
             .par_chunks(POINTS_A_TASK)
-            .map(|chunk| {
-                let (mut hits, mut misses, mut outside) = (Vec::new(), Vec::new(), 0usize);
-                let mut seen = RepeatFilter::new();
-                for &p in chunk {
-                    let within = max_range.is_none_or(|m| norm(difference(origin, p)) <= m);
-                    let end = match max_range {
-                        Some(m) if !within => clipped_end(origin, p, m),
-                        _ => p,
-                    };
-                    let inside = visit_key_ray(grid, origin, end, |k| {
-                        let key = morton_encode(k);
-                        if seen.is_new(key) {
-                            misses.push(key);
-                        }
-                    });
-                    outside += usize::from(!inside);
-                    if within {
-                        if let Some(k) = grid.keys(p) {
-                            hits.push(morton_encode(k));
+            .fold(
+                || (VoxelSet::new(), Vec::new(), 0usize),
+                |(mut misses, mut hits, mut outside), chunk| {
+                    for &p in chunk {
+                        let within = max_range.is_none_or(|m| norm(difference(origin, p)) <= m);
+                        let end = match max_range {
+                            Some(m) if !within => clipped_end(origin, p, m),
+                            _ => p,
+                        };
+                        let inside = visit_morton_ray(grid, origin, end, |key| misses.insert(key));
+                        outside += usize::from(!inside);
+                        if within {
+                            if let Some(k) = grid.keys(p) {
+                                hits.push(morton_encode(k));
+                            }
                         }
                     }
-                }
-                (hits, misses, outside)
-            })
+                    (misses, hits, outside)
+                },
+            )
             .collect();
         let rays_outside = parts.iter().map(|p| p.2).sum();
-        let (mut hits, mut misses) = (Vec::new(), Vec::new());
-        for (h, m, _) in parts {
+        let mut hits = Vec::new();
+        let mut sets = Vec::with_capacity(parts.len());
+        for (set, h, _) in parts {
             hits.extend(h);
-            misses.extend(m);
+            sets.push(set);
         }
-        let ((), ()) = rayon::join(
-            || sort_dedup(&mut hits, bits),
-            || sort_dedup(&mut misses, bits),
-        );
+        let (misses, ()) =
+            rayon::join(|| SortedVoxels::union(sets), || sort_dedup(&mut hits, bits));
         Self {
             voxels: merge_sorted(&hits, &misses),
             rays_outside,
@@ -89,55 +87,20 @@ fn sort_dedup(keys: &mut Vec<u64>, bits: u32) {
     keys.dedup();
 }
 
-/// A direct-mapped table of recently seen keys: most voxels a ray crosses were crossed by the rays just
-/// before it (they share the sensor), and a key found here is not gathered again. Lossy — a key pushed
-/// out by another is gathered twice — so the sort still removes the remaining repeats.
-struct RepeatFilter {
-    slots: Vec<u64>,
-}
-
-impl RepeatFilter {
-    const BITS: u32 = 14;
-
-    fn new() -> Self {
-        Self {
-            slots: vec![u64::MAX; 1 << Self::BITS],
-        }
-    }
-
-    #[inline]
-    fn is_new(&mut self, key: u64) -> bool {
-        let slot = (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - Self::BITS)) as usize;
-        let fresh = self.slots[slot] != key;
-        self.slots[slot] = key;
-        fresh
-    }
-}
-
-/// The union of two increasing key lists, each key marked whether it is in `hits` (which win).
-fn merge_sorted(hits: &[u64], misses: &[u64]) -> Vec<(u64, bool)> {
+/// The union of the increasing keys `hits` and the set `misses`, each key marked whether it is a hit
+/// (hits win).
+fn merge_sorted(hits: &[u64], misses: &SortedVoxels) -> Vec<(u64, bool)> {
     let mut out = Vec::with_capacity(hits.len() + misses.len());
-    let (mut i, mut j) = (0, 0);
-    while i < hits.len() || j < misses.len() {
-        match (hits.get(i), misses.get(j)) {
-            (Some(&h), Some(&m)) if m < h => {
-                out.push((m, false));
-                j += 1;
-            }
-            (Some(&h), m) => {
-                out.push((h, true));
-                i += 1;
-                if m == Some(&h) {
-                    j += 1;
-                }
-            }
-            (None, Some(&m)) => {
-                out.push((m, false));
-                j += 1;
-            }
-            (None, None) => unreachable!(),
+    let mut hits = hits.iter().copied().peekable();
+    misses.for_each(|m| {
+        while let Some(h) = hits.next_if(|&h| h <= m) {
+            out.push((h, true));
         }
-    }
+        if out.last() != Some(&(m, true)) {
+            out.push((m, false));
+        }
+    });
+    out.extend(hits.map(|h| (h, true)));
     out
 }
 
@@ -190,10 +153,12 @@ impl<const K: usize> Merge<'_, K> {
                 return ValueState::Full(self.model.update(v.unwrap_or(0.0), first));
             }
         }
-        if update.is_empty() {
-            if let Some(v) = leaf {
-                return v.map_or(ValueState::Empty, ValueState::Full);
+        if let Some(v) = leaf {
+            let background = v.map_or(ValueState::Empty, ValueState::Full);
+            if update.is_empty() {
+                return background;
             }
+            return self.leaf(background, v.unwrap_or(0.0), update, base, log_side, depth);
         }
         // Not a leaf of the result: its children, each from the map's child and its part of the update.
         let span = 1u64 << (K as u32 * (log_side - 1));
@@ -216,5 +181,79 @@ impl<const K: usize> Merge<'_, K> {
             self.levels[depth + 1].extend_from_slice(kids);
         }
         state
+    }
+
+    /// [`node`](Self::node) for a leaf of the map (every voxel `background`, of log-odds `before`), in one
+    /// pass over its updates: the cells on the way from one updated voxel to the next are opened and
+    /// closed as the voxels come (their Morton keys are in order), each cell's children settled once, with
+    /// no search. `log_side` ≥ 1.
+    fn leaf(
+        &mut self,
+        background: ValueState<f32>,
+        before: f32,
+        update: &[(u64, bool)],
+        base: u64,
+        log_side: u32,
+        depth: usize,
+    ) -> ValueState<f32> {
+        let k = K as u32;
+        let fanout = 1usize << K;
+        let hit = ValueState::Full(self.model.update(before, true));
+        let miss = ValueState::Full(self.model.update(before, false));
+        let top = log_side as usize;
+        // The open cell at each height r (a side of 2^r; r = top is this leaf's cell): its children and
+        // how many of them are settled.
+        let mut kids = vec![[background; 16]; top + 1];
+        let mut settled = vec![0usize; top + 1];
+        let digit = |key: u64, r: usize| (key >> (k * (r as u32 - 1))) as usize & (fanout - 1);
+        // Settles the rest of the open cell at height r with the background; its state.
+        let close = |levels: &mut [Vec<ValueState<f32>>],
+                     kids: &mut [ValueState<f32>; 16],
+                     from: usize,
+                     r: usize| {
+            kids[from..fanout].fill(background);
+            let state = combine(&kids[..fanout]);
+            if state.has_children() {
+                levels[depth + top - r + 1].extend_from_slice(&kids[..fanout]);
+            }
+            state
+        };
+        let mut previous: Option<u64> = None;
+        for &(key, is_hit) in update {
+            let key = key - base;
+            // The lowest height whose cell holds both this voxel and the one before: the cells below it
+            // on the previous voxel's way are finished.
+            let shared = match previous {
+                None => top,
+                Some(p) => {
+                    let shared = ((64 - (p ^ key).leading_zeros()).div_ceil(k)) as usize;
+                    for r in 1..shared {
+                        let state = close(&mut self.levels, &mut kids[r], settled[r], r);
+                        let d = digit(p, r + 1);
+                        kids[r + 1][d] = state;
+                        settled[r + 1] = d + 1;
+                    }
+                    shared
+                }
+            };
+            for r in (1..=shared).rev() {
+                let from = if r == shared { settled[r] } else { 0 };
+                let d = digit(key, r);
+                kids[r][from..d].fill(background);
+                settled[r] = d;
+            }
+            let d = digit(key, 1);
+            kids[1][d] = if is_hit { hit } else { miss };
+            settled[1] = d + 1;
+            previous = Some(key);
+        }
+        let last = previous.expect("a leaf's update is not empty");
+        for r in 1..top {
+            let state = close(&mut self.levels, &mut kids[r], settled[r], r);
+            let d = digit(last, r + 1);
+            kids[r + 1][d] = state;
+            settled[r + 1] = d + 1;
+        }
+        close(&mut self.levels, &mut kids[top], settled[top], top)
     }
 }
