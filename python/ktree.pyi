@@ -400,6 +400,12 @@ class OccupancyMap:
         """Integrates a scan: (N, dim) world points (as float32) seen from `origin`, rays cut at
         `max_range` (a point beyond it is no hit), as OctoMap's insertPointCloud. Returns the number of
         voxels updated."""
+    def set_colours(self, points: npt.ArrayLike, colours: npt.ArrayLike) -> int:
+        """Colours the observed voxels holding (N, 3) world points with (N, 3) uint8 colours, each voxel
+        the mean of its points' colours (points in unknown voxels colour nothing), as OctoMap's
+        ColorOcTree; kept by save to .ot and load. Returns the number of voxels coloured."""
+    def colours(self) -> Optional[Tree]:
+        """The voxels' colours as a tree with rgb values at the map's keys, or None for a map given none."""
     def states(self, points: npt.ArrayLike) -> npt.NDArray[np.uint8]:
         """The states (UNKNOWN, FREE, OCCUPIED) of the voxels holding (N, dim) world points."""
     def cast_rays(
@@ -425,8 +431,9 @@ class OccupancyMap:
     def log_odds(self) -> Tree:
         """The log-odds of the observed voxels, as a tree with float32 values (unknown voxels empty)."""
     def save(self, path: _Path) -> None:
-        """Writes a 3-D map as OctoMap's .ot (every log-odds) or .bt (free and occupied), or as a .ktree of
-        its log-odds with its world frame (as `ktree map` writes), atomically."""
+        """Writes a 3-D map as OctoMap's .ot (every log-odds; a ColorOcTree with its colours if it has
+        some) or .bt (free and occupied), or as a .ktree of its log-odds with its world frame (as `ktree
+        map` writes), atomically."""
     @staticmethod
     def load(
         path: _Path,

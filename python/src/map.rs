@@ -6,13 +6,16 @@
 
 use std::path::PathBuf;
 
-use ktree::io::{read_bt_map, read_ot_map, write_bt_map, write_ot_map};
+use ktree::io::{
+    read_bt_map, read_ot_map_with_colours, write_bt_map, write_color_ot_map, write_ot_map,
+};
 use ktree::map::{
     probability, CastEnd, HistoryRecorder, MapHistory, OccupancyMap, SensorModel, VoxelState,
 };
-use ktree::{AnyTree, AnyValuedTree};
+use ktree::value::Rgb;
+use ktree::{AnyTree, AnyValuedTree, KTree};
 use numpy::ndarray::{Array1, Array2};
-use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLikeDyn};
+use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike2, PyArrayLikeDyn};
 use pyo3::prelude::*;
 
 use crate::arrays::{rows, Numbers};
@@ -179,6 +182,8 @@ pub(crate) struct OccupancyMapPy {
     map: AnyMap,
     /// The steps recorded, for a map made with `history=True`.
     recorder: Option<HistoryRecorder>,
+    /// The voxels' colours, for a 3-D map given some (`set_colours`, or read from a `ColorOcTree`).
+    colours: Option<KTree<3, Rgb>>,
 }
 
 impl OccupancyMapPy {
@@ -248,7 +253,11 @@ impl OccupancyMapPy {
                 .into())
             }
         };
-        Ok(Self { map, recorder })
+        Ok(Self {
+            map,
+            recorder,
+            colours: None,
+        })
     }
 
     /// Integrates one scan: `points` an (N, dim) array of world coordinates (float64 and other numbers
@@ -297,6 +306,69 @@ impl OccupancyMapPy {
         Ok(MapHistoryPy {
             history: py.detach(|| recorder.finish()),
         })
+    }
+
+    /// Colours the observed voxels holding `points` (an (N, 3) array of world coordinates, converted to
+    /// float32) with `colours` (an (N, 3) uint8 array of red, green, blue): each voxel the mean of its
+    /// points' colours (rounded), replacing the colour it had. Points in unknown voxels or outside the map
+    /// colour nothing, as OctoMap's ColorOcTree colours only the nodes it has. The colours are kept by
+    /// `save` to `.ot` (a ColorOcTree; white is its "no colour") and read back by `load`. Returns the
+    /// number of voxels coloured. 3-D maps only.
+    fn set_colours(
+        &mut self,
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        colours: &Bound<'_, PyAny>,
+    ) -> PyResult<u64> {
+        let AnyMap::D3(map) = &self.map else {
+            return Err(Failure::Value(
+                "set_colours: colours are kept for 3-D maps (OctoMap's ColorOcTree)".into(),
+            )
+            .into());
+        };
+        let numbers = points_of(points, 3, "set_colours: points")?;
+        let array: PyArrayLike2<'_, u8, AllowTypeChange> = colours.extract().map_err(|e| {
+            Failure::Value(format!(
+                "set_colours: colours must be an (N, 3) array of uint8: {e}"
+            ))
+        })?;
+        let array = array.as_array();
+        if array.ncols() != 3 {
+            return Err(Failure::Value(format!(
+                "set_colours: colours must be (N, 3), got {:?}",
+                array.shape()
+            ))
+            .into());
+        }
+        let rgb: Vec<Rgb> = array
+            .rows()
+            .into_iter()
+            .map(|r| [r[0], r[1], r[2]])
+            .collect();
+        let flat = numbers.flat();
+        let (colours, coloured) = py.detach(|| -> Result<_, Failure> {
+            let new = map
+                .colours_of_points(rows::<3, f32>(flat), &rgb)
+                .map_err(|e| Failure::Value(format!("set_colours: {e}")))?;
+            let coloured = new.voxel_count() as u64;
+            let all = match &self.colours {
+                Some(old) => old
+                    .overlay(&new)
+                    .map_err(|e| Failure::Value(format!("set_colours: {e}")))?,
+                None => new,
+            };
+            Ok((all, coloured))
+        })?;
+        self.colours = Some(colours);
+        Ok(coloured)
+    }
+
+    /// The voxels' colours as a 3-D tree with rgb values at the map's keys (a level-16 universe, as
+    /// `occupied()`), or None for a map given none.
+    fn colours(&self) -> Option<Tree> {
+        self.colours
+            .as_ref()
+            .map(|c| Tree::valued(AnyValuedTree::from(c.clone()), 0.0))
     }
 
     /// The state of the voxels holding `points` (an (N, dim) array of world coordinates, converted to
@@ -425,8 +497,8 @@ impl OccupancyMapPy {
         Tree::valued(values, 0.0)
     }
 
-    /// Writes a 3-D map as OctoMap's `.ot` (every log-odds) or `.bt` (each known voxel free or occupied),
-    /// or as a `.ktree` of its log-odds with its world frame (as `ktree map` writes, read in place by
+    /// Writes a 3-D map as OctoMap's `.ot` (every log-odds; a ColorOcTree with the map's colours if it
+    /// has some) or `.bt` (each known voxel free or occupied), or as a `.ktree` of its log-odds with its world frame (as `ktree map` writes, read in place by
     /// `ktree query` and `ktree raycast`), atomically.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let AnyMap::D3(map) = &self.map else {
@@ -441,8 +513,11 @@ impl OccupancyMapPy {
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         Ok(py.detach(|| match ext.as_deref() {
-            Some("ot") => ktree::fs::write_atomic_with(&path, |w| write_ot_map(w, map))
-                .map_err(|e| Failure::of_error(&e, &path)),
+            Some("ot") => ktree::fs::write_atomic_with(&path, |w| match &self.colours {
+                Some(colours) => write_color_ot_map(w, map, colours),
+                None => write_ot_map(w, map),
+            })
+            .map_err(|e| Failure::of_error(&e, &path)),
             Some("bt") => ktree::fs::write_atomic_with(&path, |w| write_bt_map(w, map))
                 .map_err(|e| Failure::of_error(&e, &path)),
             Some("ktree") => ktree::io::ktree::write_map_ktree_file(&path, map)
@@ -456,7 +531,7 @@ impl OccupancyMapPy {
 
     /// Reads a 3-D map from OctoMap's `.ot` or `.bt` file or a `.ktree` map, with a sensor model given by
     /// probabilities as for the constructor (a `.bt` file's occupied voxels take the upper clamp, its free
-    /// ones the lower).
+    /// ones the lower). A ColorOcTree's colours are kept (`colours()`).
     #[staticmethod]
     #[pyo3(signature = (path, prob_hit = 0.7, prob_miss = 0.4, clamp_min = 0.1192, clamp_max = 0.971, occupancy = 0.5))]
     fn load(
@@ -475,21 +550,24 @@ impl OccupancyMapPy {
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
-        let map = py.detach(|| {
+        let (map, colours) = py.detach(|| {
             let bytes = std::fs::read(&path).map_err(|e| Failure::of_error(&e, &path))?;
             let name = path.display().to_string();
             match ext.as_deref() {
-                Some("bt") => {
-                    read_bt_map(&bytes, &name, model).map_err(|e| Failure::of_error(&e, &path))
-                }
-                Some("ktree") => ktree::io::ktree::read_map_ktree(&bytes, &name, model)
+                Some("bt") => read_bt_map(&bytes, &name, model)
+                    .map(|m| (m, None))
                     .map_err(|e| Failure::of_error(&e, &path)),
-                _ => read_ot_map(&bytes, &name, model).map_err(|e| Failure::of_error(&e, &path)),
+                Some("ktree") => ktree::io::ktree::read_map_ktree(&bytes, &name, model)
+                    .map(|m| (m, None))
+                    .map_err(|e| Failure::of_error(&e, &path)),
+                _ => read_ot_map_with_colours(&bytes, &name, model)
+                    .map_err(|e| Failure::of_error(&e, &path)),
             }
         })?;
         Ok(Self {
             map: AnyMap::D3(map),
             recorder: None,
+            colours,
         })
     }
 

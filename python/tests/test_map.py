@@ -496,6 +496,49 @@ def test_save_and_load_through_octomaps_files(tmp_path):
         ktree.OccupancyMap.load(tmp_path / "missing.ot")
 
 
+def test_colours_are_means_of_points_and_kept_by_colour_octree_files(tmp_path):
+    rng = np.random.default_rng(9)
+    points = rng.uniform(-1.5, 1.5, size=(400, 3)).astype(np.float32)
+    colours = rng.integers(0, 255, size=(400, 3), dtype=np.uint8)
+    m = ktree.OccupancyMap(0.2)
+    assert m.colours() is None
+    m.insert(points, [0.05, 0.05, 0.05])
+    # A point in an unknown voxel colours nothing.
+    far = np.array([[50.0, 50.0, 50.0]], dtype=np.float32)
+    assert m.states(far)[0] == ktree.OccupancyMap.UNKNOWN
+    count = m.set_colours(np.vstack([points, far]), np.vstack([colours, [[1, 2, 3]]]).astype(np.uint8))
+    groups = {}
+    for key, colour in zip(map(tuple, m.keys(points)), colours):
+        groups.setdefault(key, []).append(colour.astype(np.int64))
+    assert count == len(groups)
+    tree = m.colours()
+    assert tree.dtype == "rgb8" and tree.voxel_count == len(groups)
+    keys = np.array(list(groups), dtype=np.int64)
+    # The mean of each channel, rounded half up.
+    expected = np.array([np.floor(np.mean(g, axis=0) + 0.5) for g in groups.values()], dtype=np.uint8)
+    assert (tree.values(keys) == expected).all()
+    # A second colouring replaces the colours of the voxels it colours and keeps the others'.
+    m.set_colours(points[:1], np.array([[7, 8, 9]], dtype=np.uint8))
+    again = m.colours().values(keys)
+    first = tuple(m.keys(points[:1])[0])
+    for key, colour, before in zip(map(tuple, keys), again, expected):
+        assert tuple(colour) == ((7, 8, 9) if key == first else tuple(before))
+    # Saved as a ColorOcTree and read back with the same log-odds and colours; an OcTree has none.
+    m.save(tmp_path / "coloured.ot")
+    back = ktree.OccupancyMap.load(tmp_path / "coloured.ot")
+    assert back.log_odds() == m.log_odds()
+    assert back.colours() == m.colours()
+    assert b"id ColorOcTree" in (tmp_path / "coloured.ot").read_bytes()[:200]
+    plain = ktree.OccupancyMap(0.2)
+    plain.insert(points, [0.05, 0.05, 0.05])
+    plain.save(tmp_path / "plain.ot")
+    assert ktree.OccupancyMap.load(tmp_path / "plain.ot").colours() is None
+    with pytest.raises(ValueError, match="a colour for each point"):
+        m.set_colours(points, colours[:10])
+    with pytest.raises(ValueError, match="3-D maps"):
+        ktree.OccupancyMap(0.2, dim=2).set_colours(points[:, :2], colours)
+
+
 def test_a_history_gives_each_steps_states_and_separates_what_moved(tmp_path):
     m = ktree.OccupancyMap(0.1, history=True)
     origin = [0.05, 0.05, 0.05]

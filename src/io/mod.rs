@@ -70,11 +70,12 @@ pub use dispatch::{
 };
 pub use file_tree::FileTree;
 pub use interop::{
-    max_grid_nodes, read_binvox, read_bt, read_bt_map, read_color_ot_map, read_ot_map, read_vdb,
-    read_vdb_values, read_vdb_values_within, read_vdb_within, vdb_holds_values,
-    write_any_valued_vdb, write_binvox, write_bt, write_bt_map, write_color_ot_map, write_ot_map,
-    write_vdb, write_vdb_level_set, write_vdb_values, GridFileError, GridFileErrorKind, GridMeta,
-    GridPlacement, PlacedTree, PlacedValues, BINVOX_MAX_DIM, BT_DEPTH, BT_HEADER, OT_HEADER,
+    max_grid_nodes, read_binvox, read_bt, read_bt_map, read_color_ot_map, read_ot_map,
+    read_ot_map_with_colours, read_vdb, read_vdb_values, read_vdb_values_within, read_vdb_within,
+    vdb_holds_values, write_any_valued_vdb, write_binvox, write_bt, write_bt_map,
+    write_color_ot_map, write_ot_map, write_vdb, write_vdb_level_set, write_vdb_values,
+    GridFileError, GridFileErrorKind, GridMeta, GridPlacement, PlacedTree, PlacedValues,
+    BINVOX_MAX_DIM, BT_DEPTH, BT_HEADER, OT_HEADER,
 };
 #[cfg(feature = "volume")]
 pub use interop::{write_nifti_file, NiftiWriteError};

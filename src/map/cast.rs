@@ -113,18 +113,28 @@ impl<S: ValueStorage<3, Value = f32>> MapView<'_, 3, S> {
         }
         let range_sq = max_range * max_range;
         let last = (1u32 << super::MAP_LEVEL) - 1;
+        // The key at which a step along each axis would leave the map (none for an axis not stepped).
+        let edge = step.map(|s| match s {
+            -1 => 0,
+            1 => last,
+            _ => u32::MAX,
+        });
         loop {
-            let mut dim = 0;
-            for i in 1..3 {
-                if t_max[i] <= t_max[dim] {
-                    dim = i;
-                }
+            // The axis of the smallest t_max, ties going to the later axis, chosen and stepped without
+            // branches (which axis comes next is what the processor cannot predict).
+            let (mut dim, mut best) = (0, t_max[0]);
+            for (i, &t) in t_max.iter().enumerate().skip(1) {
+                let nearer = t <= best;
+                dim = std::hint::select_unpredictable(nearer, i, dim);
+                best = std::hint::select_unpredictable(nearer, t, best);
             }
-            if (step[dim] < 0 && key[dim] == 0) || (step[dim] > 0 && key[dim] == last) {
+            if key[dim] == edge[dim] {
                 return Ok(CastEnd::Outside(Some(key)));
             }
-            key[dim] = (key[dim] as i32 + step[dim]) as u32;
-            t_max[dim] += t_delta[dim];
+            key[dim] = key[dim].wrapping_add_signed(step[dim]);
+            for (i, (t, delta)) in t_max.iter_mut().zip(t_delta).enumerate() {
+                *t += std::hint::select_unpredictable(i == dim, delta, 0.0);
+            }
             if max_range > 0.0 {
                 // OctoMap: the voxel's centre as a float point, its squared distance summed in f64.
                 let mut sq = 0.0f64;

@@ -23,6 +23,7 @@
 //! ```
 
 mod cast;
+mod colours;
 mod grid;
 mod history;
 mod leaves;

@@ -33,8 +33,8 @@ pub use grid::{
 pub use nifti::{write_nifti_file, NiftiWriteError};
 pub use octomap::{read_bt, write_bt, BT_DEPTH, BT_HEADER};
 pub use octomap_map::{
-    read_bt_map, read_color_ot_map, read_ot_map, write_bt_map, write_color_ot_map, write_ot_map,
-    OT_HEADER,
+    read_bt_map, read_color_ot_map, read_ot_map, read_ot_map_with_colours, write_bt_map,
+    write_color_ot_map, write_ot_map, OT_HEADER,
 };
 pub use vdb::{
     read_vdb, read_vdb_values, read_vdb_values_within, read_vdb_within, vdb_holds_values,

@@ -61,13 +61,40 @@ pub fn read_color_ot_map(
     file: &str,
     model: SensorModel,
 ) -> Result<(OccupancyMap<3>, KTree<3, Rgb>), GridFileError> {
-    let mut nodes = read_ot_nodes(bytes, file, &["ColorOcTree"], true)?;
+    let nodes = read_ot_nodes(bytes, file, &["ColorOcTree"], true)?;
+    let (map, colours) = finish_with_colours(file, nodes, model)?;
+    Ok((map, colours.expect("a ColorOcTree read with its colours")))
+}
+
+/// Reads an OctoMap `.ot` file's bytes of either tree type into a map with the sensor model `model`, and
+/// the colours of its leaves if it is a `ColorOcTree` (as [`read_color_ot_map`]; `None` for an `OcTree`).
+///
+/// # Errors
+/// As [`read_ot_map`].
+pub fn read_ot_map_with_colours(
+    bytes: &[u8],
+    file: &str,
+    model: SensorModel,
+) -> Result<(OccupancyMap<3>, Option<KTree<3, Rgb>>), GridFileError> {
+    let nodes = read_ot_nodes(bytes, file, &["OcTree", "ColorOcTree"], true)?;
+    finish_with_colours(file, nodes, model)
+}
+
+/// The map of nodes read and, if they were read with colours, the colour tree.
+fn finish_with_colours(
+    file: &str,
+    nodes: OtNodes,
+    model: SensorModel,
+) -> Result<(OccupancyMap<3>, Option<KTree<3, Rgb>>), GridFileError> {
     let map = finish(file, nodes.counts, nodes.res, model, nodes.leaves)?;
-    nodes.colours.sort_unstable_by_key(|l| l.0);
-    let colours = tree_from_leaves::<3, Rgb>(MAP_LEVEL, &nodes.colours).map_err(|e| {
+    let Some(mut colours) = nodes.colours else {
+        return Ok((map, None));
+    };
+    colours.sort_unstable_by_key(|l| l.0);
+    let colours = tree_from_leaves::<3, Rgb>(MAP_LEVEL, &colours).map_err(|e| {
         GridFileError::new(file, nodes.counts.2, GridFileErrorKind::Data(e.to_string()))
     })?;
-    Ok((map, colours))
+    Ok((map, Some(colours)))
 }
 
 /// OctoMap's colour of a node with no colour set (`ColorOcTreeNode::isColorSet`): white.
@@ -80,7 +107,8 @@ struct OtNodes {
     /// Nodes read, nodes the header says, the byte after the last node read, the file's length.
     counts: (u64, u64, usize, usize),
     leaves: Vec<Leaf<f32>>,
-    colours: Vec<Leaf<Rgb>>,
+    /// The leaves' colours, for a `ColorOcTree` read with them.
+    colours: Option<Vec<Leaf<Rgb>>>,
 }
 
 /// Reads the header and the nodes of an `.ot` file whose tree type is one of `ids`: the one reader of
@@ -168,7 +196,7 @@ fn read_ot_nodes(
         res,
         counts: (nodes, size, at, bytes.len()),
         leaves,
-        colours,
+        colours: (keep_colours && coloured).then_some(colours),
     })
 }
 
