@@ -364,7 +364,15 @@ class MapHistory:
     def dynamic(self) -> Tree:
         """Where and when voxels that are free at some step became occupied, as a 4-D tree."""
     def save(self, path: _Path) -> None:
-        """Writes the 4-D tree as a .ktree file (uint8), atomically."""
+        """Writes the history as a .ktree file (the 4-D tree, the map's resolution and the number of
+        steps; as `ktree map --history` writes), atomically."""
+    @staticmethod
+    def load(path: _Path) -> MapHistory:
+        """Reads a history saved by save or written by `ktree map --history`."""
+    @property
+    def resolution(self) -> float:
+        """The side of the maps' voxels."""
+    def __eq__(self, other: object, /) -> bool: ...
 
 @final
 class OccupancyMap:

@@ -186,8 +186,7 @@ pub fn run_map(a: MapArgs) -> CliResult {
         let history = recorder.finish();
         let moved = history.moved();
         if let Some(path) = &a.history {
-            ktree::io::ktree::v3::write_valued_ktree_file(path, history.tree())
-                .map_err(CliError::caused)?;
+            ktree::io::ktree::write_history_ktree_file(path, &history).map_err(CliError::caused)?;
             outln!(
                 "{}: the history of {} steps as a 4-D tree of {} nodes (the map: {} nodes)",
                 path.display(),

@@ -403,7 +403,7 @@ fn ray_casts_on_a_map_report_where_they_end() {
 
 #[test]
 fn a_maps_history_and_static_map_are_written_beside_it() {
-    use ktree::map::{state_labels, HistoryRecorder, MapHistory};
+    use ktree::map::{state_labels, HistoryRecorder};
     let dir = tempfile::tempdir().unwrap();
     let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
     std::fs::create_dir(dir.path().join("scans")).unwrap();
@@ -437,11 +437,11 @@ fn a_maps_history_and_static_map_are_written_beside_it() {
     ]);
     assert!(text.contains("the history of 5 steps"), "{text}");
     let history = recorder.finish();
-    let file =
-        ktree::io::ktree::v3::read_valued_ktree_file::<4, u8>(&dir.path().join("history.ktree"))
-            .unwrap();
-    let read = MapHistory::from_tree(*expected.grid(), file, Some(5)).unwrap();
+    // The file keeps the map's grid and the 5 steps.
+    let bytes = std::fs::read(dir.path().join("history.ktree")).unwrap();
+    let read = ktree::io::ktree::read_history_ktree(&bytes, "history.ktree").unwrap();
     assert_eq!(read, history);
+    assert_eq!((read.steps(), read.grid()), (5, expected.grid()));
     assert_eq!(read.at(4).unwrap(), state_labels(&expected));
     let bytes = std::fs::read(s("static.bt")).unwrap();
     let still = read_bt_map(&bytes, "static.bt", SensorModel::default()).unwrap();

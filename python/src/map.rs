@@ -650,12 +650,34 @@ impl MapHistoryPy {
         Tree::binary(AnyTree::from(py.detach(|| self.history.dynamic())))
     }
 
-    /// Writes the 4-D tree as a `.ktree` file (uint8), atomically.
+    /// Writes the history as a `.ktree` file (the 4-D tree, uint8, with the map's resolution as its world
+    /// frame and the number of steps; as `ktree map --history` writes), atomically.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         Ok(py.detach(|| {
-            ktree::io::ktree::v3::write_valued_ktree_file(&path, self.history.tree())
+            ktree::io::ktree::write_history_ktree_file(&path, &self.history)
                 .map_err(|e| Failure::of_error(&e, &path))
         })?)
+    }
+
+    /// Reads a history saved by `save` or written by `ktree map --history`.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let history = py.detach(|| {
+            let bytes = std::fs::read(&path).map_err(|e| Failure::of_error(&e, &path))?;
+            ktree::io::ktree::read_history_ktree(&bytes, &path.display().to_string())
+                .map_err(|e| Failure::of_error(&e, &path))
+        })?;
+        Ok(Self { history })
+    }
+
+    /// The side of the maps' voxels.
+    #[getter]
+    fn resolution(&self) -> f64 {
+        self.history.grid().resolution()
+    }
+
+    fn __eq__(&self, other: PyRef<'_, Self>) -> bool {
+        self.history == other.history
     }
 
     fn __repr__(&self) -> String {

@@ -564,6 +564,13 @@ def test_a_history_gives_each_steps_states_and_separates_what_moved(tmp_path):
     assert h.dynamic().k == 4 and h.tree.k == 4
     h.save(tmp_path / "history.ktree")
     assert ktree.Tree.load(tmp_path / "history.ktree") == h.tree
+    # Read back with its steps (nothing changed after step 1, yet all 6 are kept) and resolution.
+    back = ktree.MapHistory.load(tmp_path / "history.ktree")
+    assert back == h and back.steps == 6 and back.resolution == 0.1
+    assert back.at(5) == h.at(5)
+    m.save(tmp_path / "map.ktree")
+    with pytest.raises(ValueError, match="map.ktree"):
+        ktree.MapHistory.load(tmp_path / "map.ktree")
     with pytest.raises(ValueError, match="step 6"):
         h.at(6)
 

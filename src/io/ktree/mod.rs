@@ -26,14 +26,18 @@ use thiserror::Error;
 
 use crate::tree::{AnyTree, KTree};
 
+mod history_file;
 mod map_file;
+pub mod notes;
 pub mod streamed;
 pub mod v1;
 pub mod v2;
 pub mod v3;
 mod v3_mapped;
 
+pub use history_file::{read_history_ktree, write_history_ktree_file, STEPS_NOTE};
 pub use map_file::{read_map_ktree, write_map_ktree_file, MappedMap};
+pub use notes::Notes;
 pub use streamed::{
     boolean_files, boolean_views, complement_file, BooleanFileError, BooleanFileReport,
     ViewOperation,

@@ -11,14 +11,15 @@
 //! | 8 | 1 | `K` (1…4) |
 //! | 9 | 1 | `L` (0…[`crate::max_level`]`(K)`) |
 //! | 10 | 1 | the value type, [`Dtype::code`] (1 `uint8`, 2 `uint16`, 3 `uint32`, 4 `int8`, 5 `float32`, 6 `rgb8`) |
-//! | 11 | 1 | flags: bit 0 set when a world frame follows the header; the other bits 0 |
+//! | 11 | 1 | flags: bit 0 set when a world frame follows the header, bit 1 when notes follow it; the other bits 0 |
 //! | 12 | 4 | reserved, 0 |
 //! | 16 | 32 | only with flag bit 0: the world frame ([`WorldFrame`]): the voxel size, then the origin's x, y and z (`f64` each) |
-//! | 16 or 48 | … | section 0 (the root level), then section `d` right after section `d − 1` |
+//! | 16 or 48 | 8 + N, padded to 8 | only with flag bit 1: the notes ([`Notes`]): their length `N` (`u64`), then `N` bytes of `name=text` lines |
+//! | after them | … | section 0 (the root level), then section `d` right after section `d − 1` |
 //! | S | 32·D | directory: per level `d`, nodes `n_d`, full nodes `f_d`, nodes with children `c_d` (`u64` each), CRC-32 of section `d` (`u32`), reserved `u32` = 0 |
 //! | S + 32·D | 8 | the file's length in bytes (`u64`) |
 //! | S + 32·D + 8 | 4 | `D`, the number of levels (`u32`) |
-//! | S + 32·D + 12 | 4 | CRC-32 of the header (bytes 0…15, and the frame) and of everything from S up to here |
+//! | S + 32·D + 12 | 4 | CRC-32 of the header (bytes 0…15, the frame and the notes) and of everything from S up to here |
 //!
 //! Section `d` holds `W_d = ⌈n_d / 32⌉` words of 2-bit codes (node `i` in bits `2·(i mod 32)` of word
 //! `i / 32`: `00` empty, `01` full, `10` partial, `11` mixed — every voxel valued, not all alike; unused bits
@@ -44,6 +45,7 @@
 use std::io::Write;
 use std::path::Path;
 
+use super::notes::{self, Notes};
 use super::v2::layout::{
     samples_of, u32_at, u64_at, words_of, ENTRY_BYTES, HEADER_BYTES, TAIL_BYTES,
 };
@@ -104,28 +106,46 @@ pub fn write_valued_ktree<const K: usize, V: Value>(
 /// Any I/O error; [`std::io::ErrorKind::InvalidInput`] for a frame whose voxel size is not a positive
 /// number or whose origin is not finite.
 pub fn write_valued_ktree_framed<const K: usize, V: Value>(
+    out: impl Write,
+    tree: &KTree<K, V>,
+    frame: Option<&WorldFrame>,
+) -> std::io::Result<()> {
+    write_valued_ktree_noted(out, tree, frame, &Notes::new())
+}
+
+/// Writes a valued tree as a version 3 `.ktree` file with its world frame (if any) and `notes` (kept
+/// after the frame; none: no block, the file [`write_valued_ktree_framed`] writes). A tree without values
+/// is written as version 2, without frame or notes. Example: [`super::notes`].
+///
+/// # Errors
+/// As [`write_valued_ktree_framed`]; [`std::io::ErrorKind::InvalidInput`] for a note that cannot be kept
+/// (an empty name, a name holding `=`, a line break).
+pub fn write_valued_ktree_noted<const K: usize, V: Value>(
     mut out: impl Write,
     tree: &KTree<K, V>,
     frame: Option<&WorldFrame>,
+    notes: &Notes,
 ) -> std::io::Result<()> {
     let Some(dtype) = V::DTYPE else {
         return super::write_ktree(out, &tree.shape());
     };
+    let invalid = |e: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, e);
     if let Some(f) = frame {
-        if let Err(e) = check_frame(f) {
-            return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, e));
-        }
+        check_frame(f).map_err(invalid)?;
     }
-    let mut header = Vec::with_capacity(HEADER_BYTES + FRAME_BYTES);
+    let notes_block = notes::encode(notes).map_err(invalid)?;
+    let mut header = Vec::with_capacity(HEADER_BYTES + FRAME_BYTES + notes_block.len());
     header.extend_from_slice(MAGIC);
     header.extend_from_slice(&VERSION.to_le_bytes());
     header.extend_from_slice(&[K as u8, tree.level() as u8, dtype.code()]);
-    header.extend_from_slice(&[u8::from(frame.is_some()), 0, 0, 0, 0]);
+    let flags = u8::from(frame.is_some()) | u8::from(!notes_block.is_empty()) << 1;
+    header.extend_from_slice(&[flags, 0, 0, 0, 0]);
     if let Some(f) = frame {
         for x in [f.voxel_size, f.origin[0], f.origin[1], f.origin[2]] {
             header.extend_from_slice(&x.to_le_bytes());
         }
     }
+    header.extend_from_slice(&notes_block);
     out.write_all(&header)?;
     let mut length = header.len() as u64;
     let mut directory = Vec::with_capacity(tree.depth_count() * ENTRY_BYTES + TAIL_BYTES);
@@ -205,6 +225,20 @@ pub fn write_valued_ktree_file_framed<const K: usize, V: Value>(
     crate::fs::write_atomic_with(path, |w| write_valued_ktree_framed(w, tree, frame))
 }
 
+/// Writes a valued tree's `.ktree` file with its world frame and notes atomically
+/// ([`write_valued_ktree_noted`]).
+///
+/// # Errors
+/// A [`FileOpError`](crate::fs::FileOpError) naming the path, its source the I/O error.
+pub fn write_valued_ktree_file_noted<const K: usize, V: Value>(
+    path: &Path,
+    tree: &KTree<K, V>,
+    frame: Option<&WorldFrame>,
+    notes: &Notes,
+) -> Result<(), crate::fs::FileOpError> {
+    crate::fs::write_atomic_with(path, |w| write_valued_ktree_noted(w, tree, frame, notes))
+}
+
 /// Writes a valued tree's `.ktree` file atomically (a temporary file, then renamed).
 ///
 /// # Errors
@@ -277,11 +311,26 @@ pub fn read_valued_ktree_framed<const K: usize, V: Value>(
     bytes: &[u8],
     file: &str,
 ) -> Result<(KTree<K, V>, Option<WorldFrame>), KtreeFileError> {
+    read_valued_ktree_noted(bytes, file).map(|(tree, frame, _)| (tree, frame))
+}
+
+/// Reads a `.ktree` file's bytes as [`read_valued_ktree_framed`] does, with the notes the file keeps
+/// (none for a file without them, and for version 1 and 2 files). Example: [`super::notes`].
+///
+/// # Errors
+/// As [`read_valued_ktree_framed`]; notes that are not `name=text` lines of UTF-8, naming their byte.
+pub fn read_valued_ktree_noted<const K: usize, V: Value>(
+    bytes: &[u8],
+    file: &str,
+) -> Result<(KTree<K, V>, Option<WorldFrame>, Notes), KtreeFileError> {
     match check_valued::<K, V>(bytes, file, true)? {
-        Checked::Binary(tree) => Ok((tree, None)),
-        Checked::Valued { tree, frame, .. } => Ok((
+        Checked::Binary(tree) => Ok((tree, None, Notes::new())),
+        Checked::Valued {
+            tree, frame, notes, ..
+        } => Ok((
             tree.expect("the levels were kept: check_valued built the tree"),
             frame,
+            notes,
         )),
     }
 }
@@ -310,6 +359,7 @@ pub(crate) enum Checked<const K: usize, V: Value> {
         levels: Vec<ValuedLevel>,
         tree: Option<KTree<K, V>>,
         frame: Option<WorldFrame>,
+        notes: Notes,
     },
 }
 
@@ -361,10 +411,13 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
             KtreeFileErrorKind::Header(format!("L = {level} exceeds {} for K = {k}", max_level(k))),
         ));
     }
-    if bytes[11] > 1 {
+    if bytes[11] > 3 {
         return Err(fail(
             11,
-            KtreeFileErrorKind::Header(format!("flags {:#04x}: only bit 0 is known", bytes[11])),
+            KtreeFileErrorKind::Header(format!(
+                "flags {:#04x}: only bits 0 and 1 are known",
+                bytes[11]
+            )),
         ));
     }
     if bytes[12..HEADER_BYTES].iter().any(|&b| b != 0) {
@@ -373,7 +426,21 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
             KtreeFileErrorKind::Header("reserved bytes are not 0".into()),
         ));
     }
-    let sections_at = HEADER_BYTES + if bytes[11] == 1 { FRAME_BYTES } else { 0 };
+    let frame_bytes = if bytes[11] & 1 == 1 { FRAME_BYTES } else { 0 };
+    let notes_at = HEADER_BYTES + frame_bytes;
+    // The notes' block, measured from its length (room left for at least the tail).
+    let notes_bytes = if bytes[11] & 2 == 2 {
+        let room = bytes.len().saturating_sub(notes_at + TAIL_BYTES);
+        notes::block_bytes(bytes.get(notes_at..).unwrap_or_default(), room).ok_or_else(|| {
+            fail(
+                notes_at as u64,
+                KtreeFileErrorKind::Header("the notes' length runs past the file".into()),
+            )
+        })?
+    } else {
+        0
+    };
+    let sections_at = notes_at + notes_bytes;
     let len = bytes.len() as u64;
     let minimum = (sections_at + ENTRY_BYTES + TAIL_BYTES) as u64;
     if len < minimum {
@@ -421,7 +488,13 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
             KtreeFileErrorKind::Checksum { stored, computed },
         ));
     }
-    let frame = (sections_at > HEADER_BYTES).then(|| {
+    let notes = if notes_bytes > 0 {
+        notes::decode(&bytes[notes_at..sections_at])
+            .map_err(|(at, why)| fail((notes_at + at) as u64, KtreeFileErrorKind::Header(why)))?
+    } else {
+        Notes::new()
+    };
+    let frame = (frame_bytes > 0).then(|| {
         let at = |i: usize| f64::from_bits(u64_at(bytes, HEADER_BYTES + 8 * i));
         WorldFrame {
             voxel_size: at(0),
@@ -576,6 +649,7 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
             levels: found,
             tree: None,
             frame,
+            notes,
         });
     }
     let tree = KTree::from_valued_levels(universe, levels, values);
@@ -586,6 +660,7 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
         levels: found,
         tree: Some(tree),
         frame,
+        notes,
     })
 }
 
@@ -717,7 +792,7 @@ mod tests {
         let e = read_valued_ktree::<2, u16>(&damaged, "mem").unwrap_err();
         assert!(matches!(e.kind, KtreeFileErrorKind::Checksum { .. }), "{e}");
         let mut flagged = bytes.clone();
-        flagged[11] = 3;
+        flagged[11] = 5;
         let e = read_valued_ktree::<2, u16>(&flagged, "mem")
             .unwrap_err()
             .to_string();
@@ -728,5 +803,53 @@ mod tests {
             ..frame
         };
         assert!(write_valued_ktree_framed(&mut Vec::new(), &tree, Some(&bad)).is_err());
+    }
+
+    #[test]
+    fn notes_read_back_after_the_frame_and_are_checked() {
+        let tree =
+            KTree::<2, u16>::from_dense_values(1, &[Some(7), None, Some(9), Some(7)]).unwrap();
+        let frame = WorldFrame {
+            voxel_size: 0.25,
+            origin: [-3.5, 1e6, 0.0],
+        };
+        let notes = Notes::from([("steps".to_string(), "12".to_string())]);
+        for frame in [None, Some(&frame)] {
+            let mut bytes = Vec::new();
+            write_valued_ktree_noted(&mut bytes, &tree, frame, &notes).unwrap();
+            let mut without = Vec::new();
+            write_valued_ktree_framed(&mut without, &tree, frame).unwrap();
+            // The block: its length (8 bytes), "steps=12\n" (9), padded to 24.
+            assert_eq!(bytes.len(), without.len() + 24);
+            assert_eq!(
+                read_valued_ktree_noted::<2, u16>(&bytes, "mem").unwrap(),
+                (tree.clone(), frame.copied(), notes.clone())
+            );
+            assert_eq!(
+                read_valued_ktree_framed::<2, u16>(&bytes, "mem").unwrap(),
+                (tree.clone(), frame.copied())
+            );
+            // Without notes the file is the one written without them.
+            let mut empty = Vec::new();
+            write_valued_ktree_noted(&mut empty, &tree, frame, &Notes::new()).unwrap();
+            assert_eq!(empty, without);
+            // A changed note breaks the checksum; a length past the file is refused at the block.
+            let at = HEADER_BYTES + if frame.is_some() { FRAME_BYTES } else { 0 };
+            let mut damaged = bytes.clone();
+            damaged[at + 10] ^= 1;
+            let e = read_valued_ktree::<2, u16>(&damaged, "mem").unwrap_err();
+            assert!(matches!(e.kind, KtreeFileErrorKind::Checksum { .. }), "{e}");
+            let mut long = bytes.clone();
+            long[at..at + 8].copy_from_slice(&u64::MAX.to_le_bytes());
+            let e = read_valued_ktree::<2, u16>(&long, "mem")
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("notes") && e.contains(&format!("byte {at}")),
+                "{e}"
+            );
+        }
+        let bad = Notes::from([("a=b".to_string(), String::new())]);
+        assert!(write_valued_ktree_noted(&mut Vec::new(), &tree, None, &bad).is_err());
     }
 }

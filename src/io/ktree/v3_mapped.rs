@@ -19,6 +19,7 @@ use std::marker::PhantomData;
 use std::path::Path;
 use std::sync::Arc;
 
+use super::notes::Notes;
 use super::v3::{check_valued, Checked, ValuedLevel};
 use crate::io::mmap::FileMap;
 use crate::io::{KtreeFileError, KtreeFileErrorKind};
@@ -45,6 +46,7 @@ pub struct MappedValuedTree<const K: usize, V> {
     levels: Arc<[ValuedLevel]>,
     value_bytes: usize,
     frame: Option<WorldFrame>,
+    notes: Arc<Notes>,
     values: PhantomData<V>,
 }
 
@@ -87,6 +89,7 @@ impl<const K: usize, V: Value> MappedValuedTree<K, V> {
                 universe,
                 levels,
                 frame,
+                notes,
                 ..
             } => Ok(Self {
                 map: Arc::new(map),
@@ -95,6 +98,7 @@ impl<const K: usize, V: Value> MappedValuedTree<K, V> {
                 levels: levels.into(),
                 value_bytes: dtype.bytes(),
                 frame,
+                notes: Arc::new(notes),
                 values: PhantomData,
             }),
             Checked::Binary(_) => {
@@ -106,6 +110,11 @@ impl<const K: usize, V: Value> MappedValuedTree<K, V> {
     /// The world frame the file keeps, if any.
     pub fn frame(&self) -> Option<WorldFrame> {
         self.frame
+    }
+
+    /// The notes the file keeps ([`Notes`]; none for most files).
+    pub fn notes(&self) -> &Notes {
+        &self.notes
     }
 
     /// The error of a read the checked shape does not allow: the file changed after it was opened.
