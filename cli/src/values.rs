@@ -9,7 +9,11 @@
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::ktree::v3::{read_any_ktree, valued_header, write_valued_ktree_file, AnyKtree};
+use ktree::io::ktree::notes::label_note;
+use ktree::io::ktree::v3::{
+    read_any_ktree, read_any_ktree_noted, valued_header, write_valued_ktree_file, AnyKtree,
+};
+use ktree::io::ktree::Notes;
 use ktree::query::{stats, TreeStats};
 use ktree::solid::cloud::{self, CloudVoxelizer, PointCloud};
 use ktree::solid::volume::Volume;
@@ -296,11 +300,17 @@ pub struct ValuedStats {
 
 /// The statistics of a valued `.ktree` file.
 pub fn valued_stats(path: &Path) -> CliResult<ValuedStats> {
-    let tree = read_valued(path)?;
-    with_valued!(&tree, t => stats_of(t))
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| cannot_read(path, e))?;
+    let (tree, notes) = read_any_ktree_noted(&bytes, &name).map_err(CliError::caused)?;
+    let AnyKtree::Valued(tree) = tree else {
+        return Err(format!("{name}: the tree holds no values").into());
+    };
+    with_valued!(&tree, t => stats_of(t, &notes))
 }
 
-fn stats_of<const K: usize, V: Value>(tree: &KTree<K, V>) -> CliResult<ValuedStats> {
+/// The statistics of a valued tree; a value named by the file's notes (a label's name) with its name.
+fn stats_of<const K: usize, V: Value>(tree: &KTree<K, V>, notes: &Notes) -> CliResult<ValuedStats> {
     let shape = tree.shape();
     let Ok(mut s) = stats(&shape, None);
     // The file's own nodes (mixed nodes counted with the partial ones: both have children).
@@ -312,15 +322,17 @@ fn stats_of<const K: usize, V: Value>(tree: &KTree<K, V>) -> CliResult<ValuedSta
     s.per_level = per_level;
     let mut values = serde_json::Map::new();
     for v in tree.value_stats().into_values() {
-        values.insert(
-            v.value.text(),
-            serde_json::json!({
-                "voxels": v.voxels,
-                "bounding_box": [v.bounding_box.0.to_vec(), v.bounding_box.1.to_vec()],
-                "centroid": v.centroid.to_vec(),
-                "surface_area": v.surface_area,
-            }),
-        );
+        let text = v.value.text();
+        let mut entry = serde_json::json!({
+            "voxels": v.voxels,
+            "bounding_box": [v.bounding_box.0.to_vec(), v.bounding_box.1.to_vec()],
+            "centroid": v.centroid.to_vec(),
+            "surface_area": v.surface_area,
+        });
+        if let Some(name) = notes.get(&label_note(&text)) {
+            entry["name"] = serde_json::Value::from(name.as_str());
+        }
+        values.insert(text, entry);
     }
     Ok(ValuedStats {
         stats: s,
@@ -351,8 +363,11 @@ pub fn print_valued_stats(path: &Path, json: bool) -> CliResult {
         s.stats.voxels
     );
     for (value, m) in &s.values {
+        let named = m["name"]
+            .as_str()
+            .map_or_else(|| value.clone(), |name| format!("{value} ({name})"));
         outln!(
-            "  {value}: {} voxels, box {} to {}, centroid {}, surface area {}",
+            "  {named}: {} voxels, box {} to {}, centroid {}, surface area {}",
             m["voxels"],
             m["bounding_box"][0],
             m["bounding_box"][1],

@@ -15,6 +15,9 @@ use std::path::{Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
 use ktree::input::{voxel_source, voxelize, VoxelSource};
+use ktree::io::ktree::notes::label_note;
+use ktree::io::ktree::v3::write_valued_ktree_file_noted;
+use ktree::io::ktree::Notes;
 use ktree::io::{Format, ReadOptions};
 use ktree::rays::{RaySource, SlabRuns};
 use ktree::solid::mesh::MeshTransform;
@@ -223,8 +226,20 @@ fn run_mesh_labels(a: &Args) -> CliResult {
         outln!("label {}: {name} ({voxels} voxels)", i + 1);
     }
     let frame = labels.transform.world_frame();
+    // Each label's name kept in the file (`ktree stats` prints them).
+    let notes: Notes = labels
+        .names
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            (
+                label_note(&(i + 1).to_string()),
+                name.replace(['\n', '\r'], " "),
+            )
+        })
+        .collect();
     let nodes = ktree::with_valued!(&labels.tree, t => {
-        ktree::io::ktree::v3::write_valued_ktree_file_framed(&a.out.out, t, frame.as_ref())
+        write_valued_ktree_file_noted(&a.out.out, t, frame.as_ref(), &notes)
             .map_err(CliError::caused)?;
         t.node_count()
     });

@@ -211,10 +211,20 @@ fn one_obj_file_s_groups_are_one_label_each() {
         let want = alone(&d.join(format!("{name}.obj")), &transform, "5", d);
         assert!(want > 0, "{name}");
         assert_eq!(values[&(i + 1).to_string()]["voxels"], want, "{name}");
+        // The file keeps each label's name.
+        assert_eq!(values[&(i + 1).to_string()]["name"], *name, "{name}");
         let printed = format!("label {}: {name} ({want} voxels)", i + 1);
         assert!(
             stdout.lines().any(|l| l == printed),
             "{printed} in {stdout}"
+        );
+    }
+    let text = run(&["stats", out.to_str().unwrap()]);
+    for (i, (name, _, _)) in boxes.iter().enumerate() {
+        let line = format!("  {} ({name}): ", i + 1);
+        assert!(
+            text.lines().any(|l| l.starts_with(&line)),
+            "{line} in {text}"
         );
     }
     // Without groups, one label named by the file.

@@ -23,6 +23,17 @@ use std::collections::BTreeMap;
 /// line break.
 pub type Notes = BTreeMap<String, String>;
 
+/// The name of the note that names a value (a label's name: `label.3` = `liver`), the value as
+/// [`Value::text`](crate::value::Value::text) writes it. `ktree voxelize --labels` writes them for meshes'
+/// groups; `ktree stats` prints them.
+///
+/// ```
+/// assert_eq!(ktree::io::ktree::notes::label_note("3"), "label.3");
+/// ```
+pub fn label_note(value: &str) -> String {
+    format!("label.{value}")
+}
+
 /// Why a note cannot be kept, if it cannot.
 fn check_note(name: &str, text: &str) -> Result<(), String> {
     if name.is_empty() || name.contains(['=', '\n', '\r']) {

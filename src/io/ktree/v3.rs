@@ -701,15 +701,27 @@ pub enum AnyKtree {
 /// # Errors
 /// As [`read_valued_ktree`]; a dimension other than 1…4 is [`KtreeFileErrorKind::Dimension`].
 pub fn read_any_ktree(bytes: &[u8], file: &str) -> Result<AnyKtree, KtreeFileError> {
+    read_any_ktree_noted(bytes, file).map(|(tree, _)| tree)
+}
+
+/// [`read_any_ktree`] with the notes the file keeps ([`Notes`]; none for a tree without values).
+///
+/// # Errors
+/// As [`read_any_ktree`].
+pub fn read_any_ktree_noted(bytes: &[u8], file: &str) -> Result<(AnyKtree, Notes), KtreeFileError> {
+    let binary = |bytes, file| {
+        super::read_ktree_any(bytes, file).map(|tree| (AnyKtree::Binary(tree), Notes::new()))
+    };
     if bytes.get(6..8) != Some(&VERSION.to_le_bytes()[..]) {
-        return super::read_ktree_any(bytes, file).map(AnyKtree::Binary);
+        return binary(bytes, file);
     }
     let (k, _, dtype) = valued_header(bytes, file)?;
     let Some(dtype) = dtype else {
-        return super::read_ktree_any(bytes, file).map(AnyKtree::Binary);
+        return binary(bytes, file);
     };
     crate::with_valued!(k, dtype, K, V => {
-        read_valued_ktree::<K, V>(bytes, file).map(|t| AnyKtree::Valued(AnyValuedTree::from(t)))
+        read_valued_ktree_noted::<K, V>(bytes, file)
+            .map(|(t, _, notes)| (AnyKtree::Valued(AnyValuedTree::from(t)), notes))
     }, else Err(KtreeFileError::at_byte(
         file.to_string(),
         8,
@@ -851,5 +863,16 @@ mod tests {
         }
         let bad = Notes::from([("a=b".to_string(), String::new())]);
         assert!(write_valued_ktree_noted(&mut Vec::new(), &tree, None, &bad).is_err());
+        // Every byte changed, and every length cut: an answer, never a panic.
+        let mut bytes = Vec::new();
+        write_valued_ktree_noted(&mut bytes, &tree, Some(&frame), &notes).unwrap();
+        for i in 0..bytes.len() {
+            for b in [0, 0xff, bytes[i] ^ 0x80, 2] {
+                let mut changed = bytes.clone();
+                changed[i] = b;
+                let _ = read_valued_ktree_noted::<2, u16>(&changed, "mem");
+            }
+            let _ = read_valued_ktree_noted::<2, u16>(&bytes[..i], "mem");
+        }
     }
 }
