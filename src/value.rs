@@ -21,6 +21,19 @@ use std::hash::Hash;
 /// A colour: red, green, blue.
 pub type Rgb = [u8; 3];
 
+/// The mean colour, channel by channel, rounded to the nearest (halves up).
+///
+/// ```
+/// assert_eq!(ktree::value::mean_colour(&[[0, 10, 255], [1, 20, 255]]), [1, 15, 255]);
+/// ```
+pub fn mean_colour(colours: &[Rgb]) -> Rgb {
+    let n = colours.len().max(1) as u64;
+    std::array::from_fn(|c| {
+        let sum: u64 = colours.iter().map(|p| u64::from(p[c])).sum();
+        ((2 * sum + n) / (2 * n)) as u8
+    })
+}
+
 /// The run-time name of a value type, where the dimension is run-time too (files, the command line,
 /// Python).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

@@ -3,7 +3,7 @@
 
 use super::{tree_from_leaves, OccupancyMap, MAP_LEVEL};
 use crate::space::morton_encode;
-use crate::value::Rgb;
+use crate::value::{mean_colour, Rgb};
 use crate::KTree;
 
 impl<const K: usize> OccupancyMap<K> {
@@ -53,12 +53,8 @@ impl<const K: usize> OccupancyMap<K> {
         keyed.sort_unstable_by_key(|k| k.0);
         let mut leaves = Vec::new();
         for voxel in keyed.chunk_by(|a, b| a.0 == b.0) {
-            // The mean of each channel, rounded to the nearest (as the point-cloud readers reduce colours).
-            let n = voxel.len() as u64;
-            let mean = std::array::from_fn(|i| {
-                let sum: u64 = voxel.iter().map(|(_, c)| u64::from(c[i])).sum();
-                ((2 * sum + n) / (2 * n)) as u8
-            });
+            let colours: Vec<Rgb> = voxel.iter().map(|&(_, c)| c).collect();
+            let mean = mean_colour(&colours);
             leaves.push((voxel[0].0, 0, mean));
         }
         // Never fails: the leaves are distinct voxels of the map's level and colours are always values.

@@ -218,6 +218,20 @@ impl<const K: usize> Merge<'_, K> {
             }
             state
         };
+        // Closes the open cells below height `height` on the way to voxel `key`, each handed to the cell
+        // above it.
+        let close_below = |levels: &mut [Vec<ValueState<f32>>],
+                           kids: &mut [[ValueState<f32>; 16]],
+                           settled: &mut [usize],
+                           key: u64,
+                           height: usize| {
+            for r in 1..height {
+                let state = close(levels, &mut kids[r], settled[r], r);
+                let d = digit(key, r + 1);
+                kids[r + 1][d] = state;
+                settled[r + 1] = d + 1;
+            }
+        };
         let mut previous: Option<u64> = None;
         for &(key, is_hit) in update {
             let key = key - base;
@@ -227,12 +241,7 @@ impl<const K: usize> Merge<'_, K> {
                 None => top,
                 Some(p) => {
                     let shared = ((64 - (p ^ key).leading_zeros()).div_ceil(k)) as usize;
-                    for r in 1..shared {
-                        let state = close(&mut self.levels, &mut kids[r], settled[r], r);
-                        let d = digit(p, r + 1);
-                        kids[r + 1][d] = state;
-                        settled[r + 1] = d + 1;
-                    }
+                    close_below(&mut self.levels, &mut kids, &mut settled, p, shared);
                     shared
                 }
             };
@@ -248,12 +257,7 @@ impl<const K: usize> Merge<'_, K> {
             previous = Some(key);
         }
         let last = previous.expect("a leaf's update is not empty");
-        for r in 1..top {
-            let state = close(&mut self.levels, &mut kids[r], settled[r], r);
-            let d = digit(last, r + 1);
-            kids[r + 1][d] = state;
-            settled[r + 1] = d + 1;
-        }
+        close_below(&mut self.levels, &mut kids, &mut settled, last, top);
         close(&mut self.levels, &mut kids[top], settled[top], top)
     }
 }

@@ -4,20 +4,7 @@
 //!
 //! [`CloudVoxelizer::voxelize_values`]: super::CloudVoxelizer::voxelize_values
 
-use crate::value::Rgb;
-
-/// The mean colour, channel by channel, rounded to the nearest (halves up).
-///
-/// ```
-/// assert_eq!(ktree::solid::cloud::mean_colour(&[[0, 10, 255], [1, 20, 255]]), [1, 15, 255]);
-/// ```
-pub fn mean_colour(colours: &[Rgb]) -> Rgb {
-    let n = colours.len().max(1) as u64;
-    std::array::from_fn(|c| {
-        let sum: u64 = colours.iter().map(|p| u64::from(p[c])).sum();
-        ((2 * sum + n) / (2 * n)) as u8
-    })
-}
+pub use crate::value::mean_colour;
 
 /// The mean intensity (summed in `f64`).
 ///
