@@ -2,11 +2,14 @@
 //!
 //! A large batch first tabulates the tree's top levels (about 2^18 cells: each an empty or full leaf, or
 //! the node to descend from), so that a point's answer is one look-up in the table and a descent of the
-//! few levels below it; the points are answered in chunks on all threads, each chunk in Morton order.
+//! few levels below it. The descents run [`LANES`] side by side, a level of each in turn: their reads do
+//! not wait on one another, so the processor overlaps their cache misses, where a lone descent waits for
+//! each level's read before the next (sorting the points into Morton order instead, so that neighbours
+//! share reads, cost more than it saved on random points). The points are answered in chunks on all
+//! threads.
 
 use rayon::prelude::*;
 
-use crate::radix::sort_by_key;
 use crate::space::morton_encode;
 use crate::tree::cursor::Walk;
 use crate::tree::valued::{try_walk_values, ValueNode, ValueState, ValueStorage, ValueVisitor};
@@ -20,12 +23,15 @@ const TOP_FROM: usize = 1 << 16;
 /// Points a task answers.
 const CHUNK: usize = 1 << 14;
 
+/// Descents run side by side.
+const LANES: usize = 16;
+
 /// A cell of the table: a leaf's value (`Leaf(None)`: empty) or the node of the table's depth to descend
-/// from.
+/// from (below `2^(K · depth) ≤ 2^TOP_CELLS_LOG2`).
 #[derive(Clone, Copy)]
 enum Top<V> {
     Leaf(Option<V>),
-    Node(usize),
+    Node(u32),
 }
 
 /// The value of every voxel of `points` (`None` where empty or outside the universe), in order.
@@ -48,61 +54,126 @@ where
     T::Error: Send,
 {
     let level = tree.level();
-    let side = 1u64 << level;
     let depth = if points.len() >= TOP_FROM {
         (TOP_CELLS_LOG2 / K as u32).min(level)
     } else {
         0
     };
     let table = top_table(tree, depth)?;
-    let shift = K as u32 * (level - depth);
+    let below = level - depth;
     let mut out = vec![None; points.len()];
     points
         .par_chunks(CHUNK)
         .zip(out.par_chunks_mut(CHUNK))
         .try_for_each(|(points, out)| {
-            // In Morton order, so that neighbouring points read neighbouring cells of the table and
-            // parts of the levels.
-            let mut order: Vec<(u64, u32)> = Vec::with_capacity(points.len());
-            for (i, p) in points.iter().enumerate() {
-                if p.iter().all(|&c| u64::from(c) < side) {
-                    order.push((morton_encode(*p), i as u32));
+            let mut lanes = Lanes::new(tree);
+            for (i, &point) in points.iter().enumerate() {
+                // Outside the universe (a coordinate with a bit at or above the level): empty.
+                if point.iter().fold(0, |or, &c| or | c) >> level != 0 {
+                    continue;
+                }
+                match table[morton_encode(point.map(|c| c >> below)) as usize] {
+                    Top::Leaf(v) => out[i] = v,
+                    Top::Node(index) => lanes.push(
+                        Lane {
+                            point,
+                            depth: depth as usize,
+                            index: index as usize,
+                            slot: i as u32,
+                        },
+                        out,
+                    )?,
                 }
             }
-            sort_by_key(&mut order, K as u32 * level, &mut Vec::new(), |p| p.0);
-            for (key, i) in order {
-                out[i as usize] = match table[(key >> shift) as usize] {
-                    Top::Leaf(v) => v,
-                    Top::Node(index) => descend(tree, points[i as usize], depth as usize, index)?,
-                };
-            }
-            Ok(())
+            lanes.descend(out)
         })?;
     Ok(out)
 }
 
-/// The value at `point` found from node `index` of level `depth`, a node with children whose cell holds
-/// the point.
-#[inline]
-fn descend<const K: usize, T: ValueStorage<K>>(
-    tree: &T,
+/// A descent under way: the point, the node of level `depth` holding it (one with children) and where
+/// its answer goes.
+#[derive(Clone, Copy)]
+struct Lane<const K: usize> {
     point: [u32; K],
-    mut depth: usize,
-    mut index: usize,
-) -> Result<Option<T::Value>, T::Error> {
-    let level = tree.level() as usize;
-    loop {
-        let log_side = (level - depth - 1) as u32;
-        let code = (0..K).fold(0, |c, a| c | ((point[a] >> log_side & 1) as usize) << a);
-        let first = tree.children(depth, index)?;
-        depth += 1;
-        index = first + code;
-        let codes = tree.codes(depth, first)?;
-        match tree.decode(depth, index, codes >> (2 * code))? {
-            ValueState::Empty => return Ok(None),
-            ValueState::Full(v) => return Ok(Some(v)),
-            ValueState::Partial | ValueState::Mixed => {}
+    depth: usize,
+    index: usize,
+    slot: u32,
+}
+
+/// Up to [`LANES`] descents under way in `tree`.
+struct Lanes<'a, const K: usize, T> {
+    tree: &'a T,
+    lanes: [Lane<K>; LANES],
+    len: usize,
+}
+
+impl<'a, const K: usize, T: ValueStorage<K>> Lanes<'a, K, T> {
+    fn new(tree: &'a T) -> Self {
+        let idle = Lane {
+            point: [0; K],
+            depth: 0,
+            index: 0,
+            slot: 0,
+        };
+        Self {
+            tree,
+            lanes: [idle; LANES],
+            len: 0,
         }
+    }
+
+    /// Adds a descent; with [`LANES`] under way, runs them all to their leaves first.
+    #[inline]
+    fn push(&mut self, lane: Lane<K>, out: &mut [Option<T::Value>]) -> Result<(), T::Error> {
+        if self.len == LANES {
+            self.descend(out)?;
+        }
+        self.lanes[self.len] = lane;
+        self.len += 1;
+        Ok(())
+    }
+
+    /// Runs every descent to its leaf and writes the leaf's value (`None`: empty) to its slot of `out`.
+    fn descend(&mut self, out: &mut [Option<T::Value>]) -> Result<(), T::Error> {
+        let level = self.tree.level() as usize;
+        let mut codes = [0u32; LANES];
+        // The full leaves met: their values are read together at the end, side by side too.
+        let mut full = [(0usize, 0usize, 0u32); LANES];
+        let mut fulls = 0;
+        while self.len > 0 {
+            // One level of every descent, with no branch on what is read.
+            for (lane, code) in self.lanes[..self.len].iter_mut().zip(&mut codes) {
+                let log_side = (level - lane.depth - 1) as u32;
+                let child = (0..K).fold(0, |c, a| {
+                    c | ((lane.point[a] >> log_side & 1) as usize) << a
+                });
+                let first = self.tree.children(lane.depth, lane.index)?;
+                lane.depth += 1;
+                lane.index = first + child;
+                *code = (self.tree.codes(lane.depth, first)? >> (2 * child)) & 3;
+            }
+            // The descents at a leaf answer; the others go on.
+            let mut kept = 0;
+            for j in 0..self.len {
+                let lane = self.lanes[j];
+                match codes[j] {
+                    0 => out[lane.slot as usize] = None,
+                    1 => {
+                        full[fulls] = (lane.depth, lane.index, lane.slot);
+                        fulls += 1;
+                    }
+                    _ => {
+                        self.lanes[kept] = lane;
+                        kept += 1;
+                    }
+                }
+            }
+            self.len = kept;
+        }
+        for &(depth, index, slot) in &full[..fulls] {
+            out[slot as usize] = Some(self.tree.value(depth, index)?);
+        }
+        Ok(())
     }
 }
 
@@ -124,7 +195,7 @@ fn top_table<const K: usize, T: ValueStorage<K>>(
                 ValueState::Partial | ValueState::Mixed if node.cell.level < self.depth => {
                     return Walk::Descend
                 }
-                ValueState::Partial | ValueState::Mixed => Top::Node(node.index),
+                ValueState::Partial | ValueState::Mixed => Top::Node(node.index as u32),
             };
             // A node's cells are a contiguous range in Morton order.
             let first = (morton_encode(node.cell.origin) >> self.shift) as usize;
