@@ -2,7 +2,7 @@
 //!
 //! A large batch first tabulates the tree's top levels (about 2^18 cells: each an empty or full leaf, or
 //! the node to descend from), so that a point's answer is one look-up in the table and a descent of the
-//! few levels below it. The descents run [`LANES`] side by side, a level of each in turn: their reads do
+//! few levels below it. The descents run sixteen side by side, a level of each in turn: their reads do
 //! not wait on one another, so the processor overlaps their cache misses, where a lone descent waits for
 //! each level's read before the next (sorting the points into Morton order instead, so that neighbours
 //! share reads, cost more than it saved on random points). The points are answered in chunks on all
@@ -154,9 +154,9 @@ impl<'a, const K: usize, T: ValueStorage<K>> Lanes<'a, K, T> {
             }
             // The descents at a leaf answer; the others go on.
             let mut kept = 0;
-            for j in 0..self.len {
+            for (j, &code) in codes[..self.len].iter().enumerate() {
                 let lane = self.lanes[j];
-                match codes[j] {
+                match code {
                     0 => out[lane.slot as usize] = None,
                     1 => {
                         full[fulls] = (lane.depth, lane.index, lane.slot);
