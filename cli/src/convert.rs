@@ -246,6 +246,7 @@ pub fn run(a: Args) -> CliResult {
             let write_options = WriteOptions {
                 offset: out_offset,
                 meta: Some(meta),
+                ..WriteOptions::default()
             };
             write_tree(&a.output, tree, &write_options).map_err(CliError::caused)?;
         }

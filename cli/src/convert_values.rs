@@ -9,7 +9,8 @@
 use std::path::Path;
 
 use ktree::export::vtk::write_values_time_slices;
-use ktree::io::ktree::v3::{read_valued_ktree_framed, write_valued_ktree_file};
+use ktree::io::ktree::v3::{read_valued_ktree_noted, write_valued_ktree_file};
+use ktree::io::ktree::Notes;
 use ktree::io::{read_vdb_values, write_valued_tree, WriteOptions, WrittenValues};
 use ktree::solid::volume::Volume;
 use ktree::space::WorldFrame;
@@ -43,33 +44,40 @@ impl Placement {
 
 /// Converts the valued tree in `input` to `output` (`.nii`, `.nii.gz`, `.vdb`, `.vtu`, `.htg`, `.ply`,
 /// `.obj`, `.glb` or `.ktree`: see [`write_valued_tree`]), placed by `placement`, the rest as the input's
-/// world frame places it.
+/// world frame places it; a `.ktree` keeps the input's notes (its labels' names).
 pub fn convert_valued(input: &Path, output: &Path, placement: Placement) -> CliResult {
     let (k, dtype) = crate::values::file_dtype(input)?;
     let dtype = dtype.ok_or_else(|| format!("{}: the tree holds no values", input.display()))?;
-    let (tree, kept) = ktree::with_valued!(k, dtype, KK, V => {
-        let (tree, kept) = read_framed::<KK, V>(input)?;
-        (AnyValuedTree::from(tree), kept)
+    let (tree, kept, notes) = ktree::with_valued!(k, dtype, KK, V => {
+        let (tree, kept, notes) = read_noted::<KK, V>(input)?;
+        (AnyValuedTree::from(tree), kept, notes)
     }, else return Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
     // The frame is kept, or given; a tree without one stays without (in a `.ktree`).
     let given = placement.voxel_size.is_some() || placement.origin.is_some();
     let frame = (kept.is_some() || given).then(|| placement.frame(kept));
-    write_and_report(output, &tree, frame)
+    write_and_report(output, &tree, frame, notes)
 }
 
-/// The valued tree of a `.ktree` file and the world frame it keeps.
-pub fn read_framed<const K: usize, V: Value>(
+/// The valued tree of a `.ktree` file, the world frame it keeps and its notes.
+pub fn read_noted<const K: usize, V: Value>(
     input: &Path,
-) -> CliResult<(KTree<K, V>, Option<WorldFrame>)> {
+) -> CliResult<(KTree<K, V>, Option<WorldFrame>, Notes)> {
     let bytes = std::fs::read(input).map_err(|e| cannot_read(input, e))?;
-    read_valued_ktree_framed::<K, V>(&bytes, &input.display().to_string()).map_err(CliError::caused)
+    read_valued_ktree_noted::<K, V>(&bytes, &input.display().to_string()).map_err(CliError::caused)
 }
 
-/// Writes `tree` to `output` (ktree voxel 0 at `frame`'s origin) and says what was written.
-fn write_and_report(output: &Path, tree: &AnyValuedTree, frame: Option<WorldFrame>) -> CliResult {
+/// Writes `tree` to `output` (ktree voxel 0 at `frame`'s origin; a `.ktree` with `notes`) and says what
+/// was written.
+fn write_and_report(
+    output: &Path,
+    tree: &AnyValuedTree,
+    frame: Option<WorldFrame>,
+    notes: Notes,
+) -> CliResult {
     let options = WriteOptions {
         offset: [0; 3],
         meta: frame,
+        notes,
     };
     let written = write_valued_tree(output, tree, &options).map_err(CliError::caused)?;
     let dtype = tree.dtype().name();
@@ -105,7 +113,7 @@ pub fn time_series(input: &Path, output: &Path, axis: usize, placement: Placemen
         .into());
     }
     let files = ktree::with_valued!(4, dtype, KK, V => {
-        let (tree, kept) = read_framed::<4, V>(input)?;
+        let (tree, kept, _) = read_noted::<4, V>(input)?;
         write_values_time_slices(output, &tree, axis, &placement.frame(kept))
             .map_err(CliError::caused)?
     }, else return Err(format!("{}: K = {k} is not 1 to 4", input.display()).into()));
@@ -138,7 +146,7 @@ pub fn vdb_to_valued(
     );
     // The grid's world placement, counted from ktree voxel 0.
     let frame = read.meta.counted_from(read.placement.offset.map(|o| -o));
-    write_and_report(output, &read.tree, Some(frame))
+    write_and_report(output, &read.tree, Some(frame), Notes::new())
 }
 
 /// `ktree voxelize VOLUME --window LO:HI`: the samples from `lo` to `hi` kept as `float32` values.

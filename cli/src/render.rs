@@ -202,7 +202,7 @@ fn render_valued_quadtree<V: ktree::value::Value>(
     size: u32,
     colour: Option<[u8; 3]>,
 ) -> CliResult {
-    let (tree, _) = crate::convert_values::read_framed::<2, V>(&args.file)?;
+    let (tree, _, _) = crate::convert_values::read_noted::<2, V>(&args.file)?;
     let of_value = ktree::display::palette::value_colours(&tree);
     let canvas = plane::values_canvas(&tree, size, |v| colour.unwrap_or_else(|| of_value(v)))
         .map_err(CliError::caused)?;
@@ -223,7 +223,7 @@ fn render_valued_strip<V: ktree::value::Value>(
     size: u32,
     colour: Option<[u8; 3]>,
 ) -> CliResult {
-    let (tree, _) = crate::convert_values::read_framed::<4, V>(&args.file)?;
+    let (tree, _, _) = crate::convert_values::read_noted::<4, V>(&args.file)?;
     let of_value = ktree::display::palette::value_colours(&tree);
     let strip = slices::time_strip_values(&tree, args.time_axis, args.frames, size, |v| {
         colour.unwrap_or_else(|| of_value(v))
@@ -287,7 +287,7 @@ fn render_valued<V: ktree::value::Value>(
     bar: Option<&ProgressBar>,
     tick: &mut dyn FnMut(u64, u64),
 ) -> CliResult {
-    let (tree, _) = crate::convert_values::read_framed::<3, V>(&args.file)?;
+    let (tree, _, _) = crate::convert_values::read_noted::<3, V>(&args.file)?;
     let of_value = ktree::display::palette::value_colours(&tree);
     let paint = |cell: &Cell<3>| {
         colour.unwrap_or_else(|| tree.value_at(cell.origin()).map_or([0; 3], &of_value))

@@ -10,7 +10,7 @@
 use crate::common::error::{CliError, CliResult};
 use std::path::PathBuf;
 
-use ktree::io::ktree::v3::write_valued_ktree_file_framed;
+use ktree::io::ktree::v3::write_valued_ktree_file_noted;
 use ktree::ops::{Affine, AxisMap, Geometry, Projective};
 
 use crate::common::tree_file::{read, write};
@@ -222,9 +222,10 @@ fn run_valued(args: &Args) -> CliResult {
         dtype.ok_or_else(|| format!("{}: the tree holds no values", args.input.display()))?;
     let (level, voxels, nodes) = ktree::with_valued!(k, dtype, KK, V => {
         // The voxels move in the universe; the universe keeps its place in the world.
-        let (t, frame) = crate::convert_values::read_framed::<KK, V>(&args.input)?;
+        // The labels' names (the notes) go with them.
+        let (t, frame, notes) = crate::convert_values::read_noted::<KK, V>(&args.input)?;
         let moved = apply(&t, t.level(), args).map_err(|e| e.within(args.input.display()))?;
-        write_valued_ktree_file_framed(out, &moved, frame.as_ref()).map_err(CliError::caused)?;
+        write_valued_ktree_file_noted(out, &moved, frame.as_ref(), &notes).map_err(CliError::caused)?;
         (moved.level(), moved.voxel_count(), moved.node_count())
     }, else return Err(format!("{}: no transform of K = {k} {} trees", args.input.display(), dtype.name()).into()));
     outln!(

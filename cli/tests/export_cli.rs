@@ -85,6 +85,7 @@ fn a_grid_keeps_its_voxel_size_and_origin() {
         &WriteOptions {
             offset: [0; 3],
             meta: Some(meta),
+            ..WriteOptions::default()
         },
     )
     .unwrap();

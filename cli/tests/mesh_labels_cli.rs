@@ -219,6 +219,27 @@ fn one_obj_file_s_groups_are_one_label_each() {
             "{printed} in {stdout}"
         );
     }
+    // Moved, or copied to another .ktree, the labels keep their names.
+    let moved = d.join("moved.ktree");
+    let copied = d.join("copied.ktree");
+    let (o, m, c) = (
+        out.to_str().unwrap(),
+        moved.to_str().unwrap(),
+        copied.to_str().unwrap(),
+    );
+    run(&["transform", o, "--rotate", "z:90", "--out", m]);
+    run(&["convert", o, c]);
+    for file in [&moved, &copied] {
+        let again = stats(file);
+        for (i, (name, _, _)) in boxes.iter().enumerate() {
+            assert_eq!(
+                again["values"][&(i + 1).to_string()]["name"],
+                *name,
+                "{}",
+                file.display()
+            );
+        }
+    }
     let text = run(&["stats", out.to_str().unwrap()]);
     for (i, (name, _, _)) in boxes.iter().enumerate() {
         let line = format!("  {} ({name}): ", i + 1);

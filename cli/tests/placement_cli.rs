@@ -120,6 +120,7 @@ fn a_vdb_origin_goes_to_a_bt_when_it_is_whole_voxels_and_is_refused_otherwise() 
         let options = WriteOptions {
             offset: [3, -5, 0],
             meta: Some(meta),
+            ..WriteOptions::default()
         };
         write_tree(&p("o.vdb"), &AnyTree::K3(object()), &options).unwrap();
         let _ = std::fs::remove_file(p("o.bt"));

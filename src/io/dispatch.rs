@@ -114,6 +114,9 @@ pub struct WriteOptions {
     /// Grids: voxel size and world origin (binvox `translate`/`scale`, OctoMap `res`, OpenVDB's transform).
     /// Default: unit voxels at the origin.
     pub meta: Option<GridMeta>,
+    /// A `.ktree` with values: the notes kept with the tree (a label's name as `label.N`; see
+    /// [`Notes`](crate::io::ktree::Notes)). Other formats have nowhere to keep them.
+    pub notes: crate::io::ktree::Notes,
 }
 
 /// A tree read by [`read_tree_placed`] (or [`crate::input::read_tree_placed`]), with what the reader chose

@@ -21,7 +21,7 @@ use std::path::Path;
 use super::dispatch::{export_error, format_of, usage};
 use super::{Format, IoError, WriteOptions};
 use crate::export::{surface::value_boundary_mesh, write_value_surface, Written};
-use crate::io::ktree::v3::write_valued_ktree_file_framed;
+use crate::io::ktree::v3::write_valued_ktree_file_noted;
 use crate::value::Value;
 use crate::{AnyValuedTree, KTree};
 
@@ -42,7 +42,7 @@ pub enum WrittenValues {
 /// Writes a tree with values to `path` (atomically: a temporary file renamed), the format chosen by the
 /// extension. `options.meta` places grid index 0 in the world and grid index = ktree voxel −
 /// `options.offset`, as for [`super::write_tree`]; a `.ktree` keeps that world frame when `options.meta`
-/// is given.
+/// is given, and `options.notes`.
 ///
 /// # Errors
 /// [`IoError::Usage`] for a format that would drop the values or cannot hold the tree's dimension (`.vdb`,
@@ -86,9 +86,12 @@ fn write_typed<const K: usize, V: Value>(
         )
     };
     match format {
-        Format::Ktree => {
-            write_valued_ktree_file_framed(path, tree, options.meta.map(|_| frame).as_ref())?
-        }
+        Format::Ktree => write_valued_ktree_file_noted(
+            path,
+            tree,
+            options.meta.map(|_| frame).as_ref(),
+            &options.notes,
+        )?,
         Format::Vdb => {
             let t = octree()?;
             crate::fs::write_atomic_with(path, |w| {
