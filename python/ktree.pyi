@@ -193,6 +193,11 @@ class Tree:
     @property
     def dtype(self) -> Optional[str]:
         """The value type ("uint8", "uint16", "uint32", "int8", "float32", "rgb8"), None without values."""
+    @property
+    def label_names(self) -> dict[int, str]:
+        """The labels' names (kept by .ktree files, from_meshes, with_label_names); empty without names."""
+    def with_label_names(self, names: dict[int, str]) -> Tree:
+        """This tree with its integer labels named by `names` (replacing the names it had)."""
     def shape(self) -> Tree:
         """The voxels holding a value, as a tree without values."""
     def values(self, points: npt.ArrayLike, background: Optional[float] = None) -> npt.NDArray[Any]:
@@ -206,7 +211,7 @@ class Tree:
     def combine(self, tree: Tree, rule: Literal["first", "min", "max", "sum"]) -> Tree:
         """The voxels of either tree; where both hold a value, `rule` decides."""
     def relabel(self, mapping: dict[Any, Any]) -> Tree:
-        """Values replaced by `mapping` (a value mapped to None is removed)."""
+        """Values replaced by `mapping` (a value mapped to None is removed); the labels' names are dropped."""
     def value_stats(self) -> dict[Any, _ValueStats]:
         """Per value: voxels, bounding_box (lo, hi), centroid, surface_area."""
     @property

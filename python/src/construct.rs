@@ -7,6 +7,7 @@
 use std::ffi::CString;
 use std::path::PathBuf;
 
+use ktree::io::ktree::notes::label_note;
 use ktree::io::ReadOptions;
 use ktree::solid::cloud::CloudVoxelizer;
 use ktree::solid::mesh::{MeshTransform, Placement, TriangleMesh};
@@ -153,7 +154,8 @@ impl Tree {
     /// `level`: file i (in the order given) is label i + 1 (uint8 up to 255 meshes, uint16 beyond), or,
     /// for a single OBJ file, each of its groups/objects in file order; where meshes overlap, the later
     /// wins. `transform` places every mesh as in `from_mesh`; without it their union is fitted. Every mesh
-    /// must be closed. Returns the tree and the name of each label (`names[i]` is label i + 1).
+    /// must be closed. Returns the tree and the name of each label (`names[i]` is label i + 1), which the
+    /// tree keeps too (`label_names`).
     #[staticmethod]
     #[pyo3(signature = (paths, level, transform = None))]
     fn from_meshes(
@@ -181,7 +183,15 @@ impl Tree {
                 Failure::of_error(&e, &path)
             })
         })?;
-        Ok((Self::valued(labels.tree, 0.0), labels.names))
+        // The tree keeps the names too, so that a `.ktree` it is saved to has them.
+        let notes = (labels.names.iter().enumerate())
+            .map(|(i, name)| (label_note(&(i + 1).to_string()), name.clone()))
+            .collect();
+        let tree = Self {
+            notes,
+            ..Self::valued(labels.tree, 0.0)
+        };
+        Ok((tree, labels.names))
     }
 
     /// The octree of a triangle mesh given as an `(n, 3)` float array of vertices and an `(m, 3)` integer

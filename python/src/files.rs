@@ -7,7 +7,8 @@
 
 use std::path::{Path, PathBuf};
 
-use ktree::io::ktree::v3::{read_any_ktree, valued_header, write_any_valued_ktree, AnyKtree};
+use ktree::io::ktree::v3::{read_any_ktree_noted, valued_header, write_any_valued_ktree, AnyKtree};
+use ktree::io::ktree::Notes;
 use ktree::io::{ReadOptions, WriteOptions};
 use ktree::with_dim;
 use ktree::AnyTree;
@@ -39,7 +40,7 @@ impl Tree {
             let tree = py.detach(|| {
                 let name = path.display().to_string();
                 let bytes = std::fs::read(&path).map_err(|e| Failure::of_error(&e, &path))?;
-                read_any_ktree(&bytes, &name).map_err(|e| Failure::of_error(&e, &path))
+                read_any_ktree_noted(&bytes, &name).map_err(|e| Failure::of_error(&e, &path))
             })?;
             return Ok(Self::of_file(tree, 0.0));
         }
@@ -50,9 +51,13 @@ impl Tree {
     /// Writes the tree (atomically: a temporary file renamed); the format is chosen by the extension. A
     /// tree with values keeps them in `.ktree` (version 3), OpenVDB typed grids (`.vdb`), NIfTI (`.nii`,
     /// `.nii.gz`), VTK cell data (`.vtu`, `.htg`) and the coloured surfaces of its values (`.ply`, `.obj`,
-    /// `.glb`); other formats would drop the values: save `tree.shape()` for them.
+    /// `.glb`); other formats would drop the values: save `tree.shape()` for them. A `.ktree` keeps the
+    /// labels' names (`label_names`).
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        let options = WriteOptions::default();
+        let options = WriteOptions {
+            notes: self.notes.clone(),
+            ..WriteOptions::default()
+        };
         Ok(py.detach(|| {
             match &self.values {
                 Some(values) => ktree::io::write_valued_tree(&path, values, &options).map(drop),
@@ -68,7 +73,7 @@ impl Tree {
         let bytes = py.detach(|| {
             let mut out = Vec::new();
             match &self.values {
-                Some(values) => write_any_valued_ktree(&mut out, values),
+                Some(values) => write_any_valued_ktree(&mut out, values, &self.notes),
                 None => with_dim!(&self.inner, AnyTree, t => ktree::io::write_ktree(&mut out, t)),
             }
             .map(|()| out)
@@ -82,7 +87,7 @@ impl Tree {
     #[staticmethod]
     #[pyo3(signature = (data, background = 0.0))]
     fn from_bytes(py: Python<'_>, data: &[u8], background: f64) -> PyResult<Self> {
-        let tree = py.detach(|| read_any_ktree(data, "<bytes>").map_err(Failure::value))?;
+        let tree = py.detach(|| read_any_ktree_noted(data, "<bytes>").map_err(Failure::value))?;
         Ok(Self::of_file(tree, background))
     }
 
@@ -97,11 +102,14 @@ impl Tree {
 }
 
 impl Tree {
-    /// The Python object of a `.ktree` file's tree.
-    fn of_file(tree: AnyKtree, background: f64) -> Self {
+    /// The Python object of a `.ktree` file's tree and its notes.
+    fn of_file((tree, notes): (AnyKtree, Notes), background: f64) -> Self {
         match tree {
             AnyKtree::Binary(t) => Self::binary(t),
-            AnyKtree::Valued(t) => Self::valued(t, background),
+            AnyKtree::Valued(t) => Self {
+                notes,
+                ..Self::valued(t, background)
+            },
         }
     }
 }

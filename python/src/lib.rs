@@ -18,6 +18,7 @@
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
+use ktree::io::ktree::Notes;
 use ktree::{with_dim, with_valued};
 use ktree::{AnyTree, AnyValuedTree};
 use pyo3::prelude::*;
@@ -83,6 +84,8 @@ pub(crate) struct Tree {
     pub(crate) values: Option<AnyValuedTree>,
     /// What dense arrays of the values hold where the tree is empty (the background it was made with).
     pub(crate) background: f64,
+    /// The notes a `.ktree` file keeps with the values (the labels' names, `label.N`).
+    pub(crate) notes: Notes,
 }
 
 impl Tree {
@@ -97,6 +100,7 @@ impl Tree {
             inner,
             values: None,
             background: 0.0,
+            notes: Notes::new(),
         }
     }
 
@@ -106,12 +110,17 @@ impl Tree {
             inner: values.shape(),
             values: Some(values),
             background,
+            notes: Notes::new(),
         }
     }
 
-    /// A tree with other values and this tree's background.
+    /// A tree with other values of the same meaning (masked, combined, moved): this tree's background
+    /// and the names of its labels.
     pub(crate) fn with_values(&self, values: AnyValuedTree) -> Self {
-        Self::valued(values, self.background)
+        Self {
+            notes: self.notes.clone(),
+            ..Self::valued(values, self.background)
+        }
     }
 }
 

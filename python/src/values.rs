@@ -3,8 +3,10 @@
 //! `relabel`, `value_stats`), each one call of the library on the `KTree<K, V>` inside. `Scalar` is the one
 //! conversion between a value type and numpy's numbers and Python's objects.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
+use ktree::io::ktree::notes::label_note;
+use ktree::io::ktree::Notes;
 use ktree::ops::values::Rule;
 use ktree::space::{Universe, DENSE_LIMIT};
 use ktree::value::{Dtype, Rgb, Value};
@@ -301,6 +303,67 @@ impl Tree {
         self.values.as_ref().map(|t| t.dtype().name())
     }
 
+    /// The names of the labels, a dict from label to name: those a `.ktree` file keeps (`ktree voxelize
+    /// --labels` names each mesh or OBJ group), those of `from_meshes`, or those given to
+    /// `with_label_names`. Empty when the labels have no names.
+    #[getter]
+    fn label_names(&self) -> BTreeMap<i64, String> {
+        self.notes
+            .iter()
+            .filter_map(|(note, name)| {
+                let label = note.strip_prefix("label.")?.parse().ok()?;
+                Some((label, name.clone()))
+            })
+            .collect()
+    }
+
+    /// This tree with its labels named by `names` (a dict from integer label to name; the names it had are
+    /// replaced). `save` to `.ktree`, `to_bytes` and pickling keep them, as do `mask`, `overlay`,
+    /// `combine` and the transforms; `relabel` drops them. A tree of integer labels only.
+    fn with_label_names(&self, names: BTreeMap<i64, String>) -> PyResult<Self> {
+        let values = self.values_or_fail("with_label_names")?;
+        let dtype = values.dtype();
+        let (lo, hi) = match dtype {
+            Dtype::U8 => (0, i64::from(u8::MAX)),
+            Dtype::U16 => (0, i64::from(u16::MAX)),
+            Dtype::U32 => (0, i64::from(u32::MAX)),
+            Dtype::I8 => (i64::from(i8::MIN), i64::from(i8::MAX)),
+            Dtype::F32 | Dtype::Rgb => {
+                return Err(Failure::Value(format!(
+                    "with_label_names: the tree holds {} values, not integer labels",
+                    dtype.name()
+                ))
+                .into())
+            }
+        };
+        let mut notes: Notes = self
+            .notes
+            .iter()
+            .filter(|(note, _)| !note.starts_with("label."))
+            .map(|(n, t)| (n.clone(), t.clone()))
+            .collect();
+        for (label, name) in names {
+            if !(lo..=hi).contains(&label) {
+                return Err(Failure::Value(format!(
+                    "with_label_names: label {label} is not a {} value",
+                    dtype.name()
+                ))
+                .into());
+            }
+            if name.contains(['\n', '\r']) {
+                return Err(Failure::Value(format!(
+                    "with_label_names: the name of label {label} holds a line break"
+                ))
+                .into());
+            }
+            notes.insert(label_note(&label.to_string()), name);
+        }
+        Ok(Self {
+            notes,
+            ..self.with_values(values.clone())
+        })
+    }
+
     /// The voxels that hold a value, as a tree without values (a tree without values: itself).
     fn shape(&self) -> Self {
         Self::binary(self.inner.clone())
@@ -431,7 +494,7 @@ impl Tree {
     }
 
     /// The tree with values replaced by `mapping` (a dict from value to value; a value mapped to None is
-    /// removed); values not in it are kept.
+    /// removed); values not in it are kept. The labels' names are dropped.
     fn relabel(&self, py: Python<'_>, mapping: &Bound<'_, PyDict>) -> PyResult<Self> {
         let mine = self.values_or_fail("relabel")?;
         fn of<const K: usize, V: Scalar>(
@@ -455,7 +518,8 @@ impl Tree {
             })
         }
         let out = with_valued!(mine, t => of(py, t, mapping))?;
-        Ok(self.with_values(out))
+        // The labels change: their names no longer apply.
+        Ok(Self::valued(out, self.background))
     }
 
     /// For each value (a number, or an (r, g, b) tuple), a dict of its `voxels`, `bounding_box` (lo, hi:

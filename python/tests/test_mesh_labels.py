@@ -2,10 +2,14 @@
 that equals, voxel for voxel, each mesh voxelized alone by `Tree.from_mesh` in the same placement and painted
 in order (the later mesh wins); bad input is an error naming the file."""
 
+import pickle
+import subprocess
+
 import numpy as np
 import pytest
 
 import ktree
+from test_ktree import cli, run_json
 
 # A box's corners i at (i & 1, i >> 1 & 1, i >> 2 & 1) and its triangles, counter-clockwise from outside.
 CUBE = [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
@@ -83,3 +87,42 @@ def test_bad_input_names_the_file(tmp_path):
         ktree.Tree.from_meshes([scene, tmp_path / "missing.stl"], 4)
     with pytest.raises(ValueError):
         ktree.Tree.from_meshes([], 4)
+
+
+def test_labels_keep_their_names(tmp_path):
+    """The names travel with the labels: through .ktree files both ways between Python and the command line,
+    bytes and pickling, and the operations that keep the labels' meaning; relabel drops them."""
+    scene = "".join(f"g part{i}\n" + obj_box(lo, hi, base=8 * i) for i, (lo, hi) in enumerate(BOXES))
+    (tmp_path / "scene.obj").write_text(scene)
+    tree, names = ktree.Tree.from_meshes([tmp_path / "scene.obj"], 5, transform=TRANSFORM)
+    want = {1: "part0", 2: "part1", 3: "part2"}
+    assert tree.label_names == want
+    tree.save(tmp_path / "py.ktree")
+    assert ktree.Tree.load(tmp_path / "py.ktree").label_names == want
+    assert ktree.Tree.from_bytes(tree.to_bytes()).label_names == want
+    assert pickle.loads(pickle.dumps(tree)).label_names == want
+    # The command line reads Python's names, and Python the command line's.
+    stats = run_json("stats", tmp_path / "py.ktree")
+    assert {int(v): s["name"] for v, s in stats["values"].items()} == want
+    out = tmp_path / "cli.ktree"
+    subprocess.run(
+        [cli(), "voxelize", str(tmp_path / "scene.obj"), "--labels", "--level", "5", "--fit", "--out", str(out)],
+        check=True,
+        capture_output=True,
+    )
+    assert ktree.Tree.load(out).label_names == want
+    # Kept where the labels keep their meaning, dropped where they change.
+    assert tree.mask(tree.shape()).label_names == want
+    assert tree.translate((1, 0, 0)).label_names == want
+    assert tree.relabel({1: 7}).label_names == {}
+    assert tree.shape().label_names == {}
+    renamed = tree.with_label_names({2: "post"})
+    assert renamed.label_names == {2: "post"}
+    assert renamed == tree  # the same voxels and values
+    assert ktree.Tree.from_bytes(renamed.to_bytes()).label_names == {2: "post"}
+    with pytest.raises(ValueError, match="label 300"):
+        tree.with_label_names({300: "too big"})
+    with pytest.raises(ValueError, match="line break"):
+        tree.with_label_names({1: "two\nlines"})
+    with pytest.raises(ValueError, match="float32"):
+        ktree.Tree.from_dense(np.ones((2, 2), np.float32)).with_label_names({1: "x"})

@@ -729,13 +729,17 @@ pub fn read_any_ktree_noted(bytes: &[u8], file: &str) -> Result<(AnyKtree, Notes
     )))
 }
 
-/// Writes a tree with values of any dimension and value type as a version 3 `.ktree` file
-/// ([`write_valued_ktree`]).
+/// Writes a tree with values of any dimension and value type as a version 3 `.ktree` file with `notes`
+/// and no world frame ([`write_valued_ktree_noted`]).
 ///
 /// # Errors
-/// Any I/O error.
-pub fn write_any_valued_ktree(out: impl Write, tree: &AnyValuedTree) -> std::io::Result<()> {
-    crate::with_valued!(tree, t => write_valued_ktree(out, t))
+/// As [`write_valued_ktree_noted`].
+pub fn write_any_valued_ktree(
+    out: impl Write,
+    tree: &AnyValuedTree,
+    notes: &Notes,
+) -> std::io::Result<()> {
+    crate::with_valued!(tree, t => write_valued_ktree_noted(out, t, None, notes))
 }
 
 #[cfg(test)]
