@@ -690,12 +690,15 @@ pub enum AnyKtree {
 /// Reads a `.ktree` file's bytes of any version, dimension and value type.
 ///
 /// ```
-/// use ktree::io::ktree::v3::{read_any_ktree, write_any_valued_ktree, AnyKtree};
+/// use ktree::io::ktree::v3::{read_any_ktree, read_any_ktree_noted, write_any_valued_ktree, AnyKtree};
+/// use ktree::io::ktree::Notes;
 /// use ktree::{AnyValuedTree, KTree};
 /// let tree = AnyValuedTree::from(KTree::<1, i8>::from_dense_values(1, &[Some(-3), None]).unwrap());
+/// let notes = Notes::from([("label.-3".to_string(), "wall".to_string())]);
 /// let mut bytes = Vec::new();
-/// write_any_valued_ktree(&mut bytes, &tree).unwrap();
-/// assert_eq!(read_any_ktree(&bytes, "mem").unwrap(), AnyKtree::Valued(tree));
+/// write_any_valued_ktree(&mut bytes, &tree, &notes).unwrap();
+/// assert_eq!(read_any_ktree(&bytes, "mem").unwrap(), AnyKtree::Valued(tree.clone()));
+/// assert_eq!(read_any_ktree_noted(&bytes, "mem").unwrap(), (AnyKtree::Valued(tree), notes));
 /// ```
 ///
 /// # Errors
@@ -761,7 +764,7 @@ mod tests {
                 let tree =
                     crate::with_valued!(k, dtype, K, V => pattern::<K, V>(), else unreachable!());
                 let mut bytes = Vec::new();
-                write_any_valued_ktree(&mut bytes, &tree).unwrap();
+                write_any_valued_ktree(&mut bytes, &tree, &Notes::new()).unwrap();
                 assert_eq!(
                     read_any_ktree(&bytes, "mem").unwrap(),
                     AnyKtree::Valued(tree.clone())
