@@ -1,7 +1,10 @@
 //! Building a valued tree straight from a dense array of values, depth first: a cell whose voxels all
-//! hold one value (or all the background) is a leaf, found by comparing its rows of the fastest axis with
-//! its first voxel; any other cell is built from its `2^K` children. The first voxel that differs ends a
-//! cell's comparison, so a volume of regions is read about once, and the tree is minimal by construction.
+//! hold one value (or all the background) is a leaf; any other cell is built from its `2^K` children.
+//! The array is first read once in its own order (streamed, not visited cell by cell), noting which
+//! bricks — cells of about 4096 voxels — hold one value; a cell of bricks is then settled from its
+//! bricks, and a cell inside a brick of several values by comparing its rows of the fastest axis with its
+//! first voxel (the first voxel that differs ends the comparison). So a volume of regions is read about
+//! twice at most, and the tree is minimal by construction.
 //! The same tree as [`KTree::from_value_runs`] of the array's runs, without making the runs.
 //!
 //! ```
@@ -81,22 +84,7 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
     /// universe).
     fn new(universe: Universe<K>, dense: &'a [V], background: V) -> Self {
         let brick_log = (12 / K as u32).min(universe.level());
-        let grid = (universe.side() >> brick_log) as usize;
-        let side = 1usize << brick_log;
-        let count = grid.pow(K as u32);
-        let per_axis = |i: usize| -> [usize; K] {
-            let mut rest = i;
-            std::array::from_fn(|_| {
-                let c = rest % grid;
-                rest /= grid;
-                c * side
-            })
-        };
-        let stride = universe.side() as usize;
-        let bricks = (0..count)
-            .into_par_iter()
-            .map(|i| first_if_uniform(dense, stride, per_axis(i), side, |a, b| a.same(*b)))
-            .collect();
+        let bricks = uniform_bricks::<K, V>(dense, universe.side() as usize, brick_log);
         Self {
             universe,
             dense,
@@ -181,6 +169,56 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
     }
 }
 
+/// For each brick of side `2^brick_log` of a dense array of side `side` (axis 0 fastest; the bricks in the
+/// same order), its first voxel's value if every voxel of the brick holds it. The array is read once in
+/// its own order — each row's pieces compared with the first voxels of their bricks — so that memory is
+/// streamed rather than visited brick by brick; slabs of bricks along the last axis run on the rayon pool.
+fn uniform_bricks<const K: usize, V: Value>(
+    dense: &[V],
+    side: usize,
+    brick_log: u32,
+) -> Vec<Option<V>> {
+    let brick = 1usize << brick_log;
+    let grid = side >> brick_log;
+    let uniform = |piece: &[V]| piece.iter().all(|v| v.same(piece[0])).then_some(piece[0]);
+    if K == 1 {
+        return dense.par_chunks(brick).map(uniform).collect();
+    }
+    // Bricks a slab (one brick thick along the last axis) and voxels a slab.
+    let slab_bricks = grid.pow(K as u32 - 1);
+    let slab_voxels = side.pow(K as u32 - 1) * brick;
+    let mut bricks: Vec<(V, bool)> = vec![(dense[0], true); grid.pow(K as u32)];
+    bricks
+        .par_chunks_mut(slab_bricks)
+        .zip(dense.par_chunks(slab_voxels))
+        .for_each(|(bricks, voxels)| {
+            for (r, row) in voxels.chunks_exact(side).enumerate() {
+                // The row's coordinates along axes 1 … K − 1 (axis K − 1 within the slab).
+                let (mut rest, mut first_row, mut brick_row, mut stride) = (r, true, 0, 1);
+                for _ in 1..K {
+                    let c = rest % side;
+                    rest /= side;
+                    first_row &= c & (brick - 1) == 0;
+                    brick_row += (c >> brick_log) * stride;
+                    stride *= grid;
+                }
+                let row_bricks = &mut bricks[brick_row * grid..(brick_row + 1) * grid];
+                for ((first, uniform), piece) in row_bricks.iter_mut().zip(row.chunks_exact(brick))
+                {
+                    if first_row {
+                        *first = piece[0];
+                    }
+                    let f = *first;
+                    *uniform &= piece.iter().fold(true, |all, v| all & v.same(f));
+                }
+            }
+        });
+    bricks
+        .into_iter()
+        .map(|(first, uniform)| uniform.then_some(first))
+        .collect()
+}
+
 /// The first item of the box of side `side` from `origin` in a grid of `grid` items a side (axis 0
 /// fastest) if every item of the box is `same` as it; `None` at the first that is not. Rows along axis 0
 /// are compared a chunk at a time, so that the compiler can compare a chunk's items together.
@@ -253,6 +291,46 @@ mod tests {
             got.assert_well_formed();
             assert!(got == want, "K = {K}, split {split}");
         }
+    }
+
+    /// Universes of several bricks: some bricks of one value, some whose rows each hold one value but
+    /// not the same one, a few scattered voxels in the first column of bricks.
+    fn check_bricks<const K: usize>(level: u32) {
+        let universe = Universe::<K>::new(level).unwrap();
+        let bl = (12 / K as u32).min(level);
+        assert!(level > bl, "more than one brick");
+        let len = universe.side().pow(K as u32) as usize;
+        let dense: Vec<u16> = (0..len)
+            .map(|i| {
+                let p = universe.dense_point(i);
+                if p[0] >> bl == 0 && i.wrapping_mul(2_654_435_761) % 997 == 0 {
+                    7
+                } else if (p[0] >> bl).is_multiple_of(4) {
+                    1 + ((p[K - 1] >> (bl - 1)) % 2) as u16
+                } else if (p[0] >> bl) % 4 == 2 {
+                    // The brick's first row alone differs.
+                    let first = (1..K).all(|a| p[a].is_multiple_of(1 << bl));
+                    5 + u16::from(first)
+                } else {
+                    3 + ((p[1 % K] >> bl) % 2) as u16
+                }
+            })
+            .collect();
+        let runs = ValueRuns::<K, u16>::from_dense_background(level, &dense, 0).unwrap();
+        let want = KTree::from_value_runs(&runs);
+        for split in [0, 2] {
+            let got = KTree::from_dense_background_split(universe, &dense, 0, split).unwrap();
+            got.assert_well_formed();
+            assert!(got == want, "K = {K}, split {split}");
+        }
+    }
+
+    #[test]
+    fn bricks_of_one_value_are_found() {
+        check_bricks::<1>(14);
+        check_bricks::<2>(8);
+        check_bricks::<3>(6);
+        check_bricks::<4>(5);
     }
 
     #[test]
