@@ -74,7 +74,7 @@ print("ellipsoids, the table of Kak & Slaney as extended to 3-D by Schabel's `ph
 print("and the rotations about z only: `experiments/examples/values.rs`), as **labels** (the last ellipsoid holding a voxel's")
 print("centre, 1–10, 0 outside; stored as u32) and as a **density** (the sum of the intensities, float32, 0 outside). Both")
 print("programs read the same raw file (x fastest) before the clock starts, and 0 is the background of both.")
-print(f"**ktree**: `KTree::from_dense_background`, straight from the array (its bricks of 16³ voxels read once, a cell whose")
+print(f"**ktree**: `KTree::from_dense_background`, straight from the array (read once in its order for its bricks of 16³ voxels, a cell whose")
 print("bricks hold one value a leaf, the others built from their children), one thread (and two beside: the bricks read and")
 print("the subtrees of cells of 2^18 voxels built on the rayon pool). **OpenVDB**")
 print(f"(libopenvdb-dev {version}, `experiments/values/peers.cpp`): `tools::copyFromDense` (serial, tolerance 0) into an")
