@@ -358,9 +358,12 @@ impl Tree {
             }
             notes.insert(label_note(&label.to_string()), name);
         }
+        // The same voxels and values: only the names change.
         Ok(Self {
+            inner: self.inner.clone(),
+            values: self.values.clone(),
+            background: self.background,
             notes,
-            ..self.with_values(values.clone())
         })
     }
 

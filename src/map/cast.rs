@@ -69,7 +69,7 @@ impl<S: ValueStorage<3, Value = f32>> MapView<'_, 3, S> {
         };
         // The leaf the ray is in (its cell: the keys' bits above `leaf.0`) and its state: looked up again
         // only when the ray leaves it, from the deepest node the two leaves share.
-        let mut cursor = ValueCursor::new(self.log_odds())?;
+        let mut cursor = ValueCursor::new(self.log_odds());
         let mut look = |k: [u32; 3]| -> Result<_, S::Error> {
             let (log_side, v) = cursor.leaf_at(k)?.unwrap_or((0, None));
             Ok((log_side, k.map(|c| c >> log_side), self.state_of(v)))

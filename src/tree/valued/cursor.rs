@@ -8,7 +8,7 @@
 //! use ktree::KTree;
 //! let dense: Vec<Option<u8>> = (0..64u8).map(|i| (i % 3 != 0).then_some(i / 8)).collect();
 //! let tree = KTree::<2, u8>::from_dense_values(3, &dense).unwrap();
-//! let mut cursor = ValueCursor::new(&tree).unwrap();
+//! let mut cursor = ValueCursor::new(&tree);
 //! for p in [[0, 0], [1, 0], [7, 7], [6, 7], [9, 0]] {
 //!     assert_eq!(cursor.leaf_at(p), tree.try_leaf_at(p));
 //! }
@@ -33,17 +33,14 @@ pub struct ValueCursor<'a, const K: usize, T: ValueStorage<K>> {
 }
 
 impl<'a, const K: usize, T: ValueStorage<K>> ValueCursor<'a, K, T> {
-    /// A cursor over `tree` that has located nothing yet.
-    ///
-    /// # Errors
-    /// The storage's read error.
-    pub fn new(tree: &'a T) -> Result<Self, T::Error> {
-        Ok(Self {
+    /// A cursor over `tree` that has located nothing yet (it reads nothing until asked).
+    pub fn new(tree: &'a T) -> Self {
+        Self {
             tree,
             level: tree.level(),
             children: [(0, 0); PATH],
             last: None,
-        })
+        }
     }
 
     /// The leaf holding voxel `point` — the log of its side and its value (`None`: empty) — or `None`
@@ -124,7 +121,7 @@ mod tests {
     /// Walks of neighbours and jumps, checked against the descent from the root.
     fn check<const K: usize>(level: u32, dense: &[Option<u8>], moves: &[(usize, bool, u32)]) {
         let tree = KTree::<K, u8>::from_dense_values(level, dense).unwrap();
-        let mut cursor = ValueCursor::new(&tree).unwrap();
+        let mut cursor = ValueCursor::new(&tree);
         let side = 1u32 << level;
         let mut p = [0u32; K];
         for &(axis, up, jump) in moves {
@@ -172,7 +169,7 @@ mod tests {
     #[test]
     fn a_uniform_tree_is_one_leaf() {
         let tree = KTree::<3, u8>::from_dense_values(2, &[Some(7); 64]).unwrap();
-        let mut cursor = ValueCursor::new(&tree).unwrap();
+        let mut cursor = ValueCursor::new(&tree);
         assert_eq!(cursor.leaf_at([3, 3, 3]), Ok(Some((2, Some(7)))));
         assert_eq!(cursor.leaf_at([0, 1, 2]), Ok(Some((2, Some(7)))));
         assert_eq!(cursor.leaf_at([4, 0, 0]), Ok(None));
