@@ -182,7 +182,8 @@ class Tree:
     def load(path: _Path) -> Tree:
         """Reads a tree file, the format chosen by the extension."""
     def save(self, path: _Path) -> None:
-        """Writes the tree atomically, the format chosen by the extension (meshes: the tree's boundary)."""
+        """Writes the tree atomically, the format chosen by the extension (meshes: the tree's boundary; a tree
+        with values: the surface of each value, a label's part named by its name in label_names)."""
     def to_bytes(self) -> bytes:
         """The tree in the .ktree format (version 2: 2 bits a node, checksums per level; version 3 with
         values)."""

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use ktree::io::ktree::notes::label_note;
 use ktree::io::ktree::v3::{
-    read_any_ktree, read_any_ktree_noted, valued_header, write_valued_ktree_file, AnyKtree,
+    read_any_ktree_noted, valued_header, write_valued_ktree_file, AnyKtree,
 };
 use ktree::io::ktree::Notes;
 use ktree::query::{stats, TreeStats};
@@ -50,11 +50,16 @@ pub fn is_valued(path: &Path) -> bool {
 
 /// A valued `.ktree` file's tree, of the dimension and value type its header names.
 pub fn read_valued(path: &Path) -> CliResult<AnyValuedTree> {
+    read_valued_noted(path).map(|(tree, _)| tree)
+}
+
+/// [`read_valued`] with the file's notes (its labels' names).
+fn read_valued_noted(path: &Path) -> CliResult<(AnyValuedTree, Notes)> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| cannot_read(path, e))?;
-    match read_any_ktree(&bytes, &name).map_err(CliError::caused)? {
-        AnyKtree::Valued(tree) => Ok(tree),
-        AnyKtree::Binary(_) => Err(format!(
+    match read_any_ktree_noted(&bytes, &name).map_err(CliError::caused)? {
+        (AnyKtree::Valued(tree), notes) => Ok((tree, notes)),
+        (AnyKtree::Binary(_), _) => Err(format!(
             "{name}: the tree holds no values (this takes a tree made with values, e.g. voxelize --labels)"
         )
         .into()),
@@ -261,13 +266,25 @@ pub struct SelectArgs {
 
 /// `ktree select`.
 pub fn run_select(a: SelectArgs) -> CliResult {
-    let tree = read_valued(&a.input)?;
-    with_valued!(&tree, t => select(t, &a))
+    let (tree, notes) = read_valued_noted(&a.input)?;
+    with_valued!(&tree, t => select(t, &notes, &a))
 }
 
-fn select<const K: usize, V: Value>(tree: &KTree<K, V>, a: &SelectArgs) -> CliResult {
+fn select<const K: usize, V: Value>(
+    tree: &KTree<K, V>,
+    notes: &Notes,
+    a: &SelectArgs,
+) -> CliResult {
+    // The name of the label chosen, if the file names it (the binary output has no place for it).
+    let mut named = String::new();
     let chosen = match (&a.value, &a.range) {
-        (Some(v), _) => tree.select(V::parse(v).map_err(|e| format!("--value {e}"))?),
+        (Some(v), _) => {
+            let value = V::parse(v).map_err(|e| format!("--value {e}"))?;
+            if let Some(name) = notes.get(&label_note(&value.text())) {
+                named = format!(" (label {}: {name})", value.text());
+            }
+            tree.select(value)
+        }
         (None, Some(r)) => {
             let (lo, hi) = r
                 .split_once(':')
@@ -280,7 +297,7 @@ fn select<const K: usize, V: Value>(tree: &KTree<K, V>, a: &SelectArgs) -> CliRe
     };
     ktree::io::write_ktree_file(&a.out, &chosen).map_err(CliError::caused)?;
     outln!(
-        "{}: {} voxels selected, {} nodes",
+        "{}: {} voxels selected{named}, {} nodes",
         a.out.display(),
         chosen.voxel_count(),
         chosen.node_count()

@@ -240,6 +240,40 @@ fn one_obj_file_s_groups_are_one_label_each() {
             );
         }
     }
+    // Written as meshes, each label's part is named by its name.
+    let (obj, glb, ply) = (
+        d.join("parts.obj"),
+        d.join("parts.glb"),
+        d.join("parts.ply"),
+    );
+    for mesh in [&obj, &glb, &ply] {
+        run(&["convert", o, mesh.to_str().unwrap()]);
+    }
+    let obj_text = std::fs::read_to_string(&obj).unwrap();
+    let mtl_text = std::fs::read_to_string(d.join("parts.mtl")).unwrap();
+    let glb_text = String::from_utf8_lossy(&std::fs::read(&glb).unwrap()).into_owned();
+    let ply_bytes = std::fs::read(&ply).unwrap();
+    let ply_text = String::from_utf8_lossy(&ply_bytes[..ply_bytes.len().min(2000)]).into_owned();
+    for (i, (name, _, _)) in boxes.iter().enumerate() {
+        assert!(
+            obj_text.contains(&format!("\ng {name}\nusemtl {name}\n")),
+            "{name} in {obj_text:.300}"
+        );
+        assert!(mtl_text.contains(&format!("newmtl {name}\n")), "{mtl_text}");
+        assert!(
+            glb_text.matches(&format!(r#""name":"{name}""#)).count() >= 2,
+            "{name}: a mesh and a material"
+        );
+        assert!(
+            ply_text.contains(&format!("\ncomment {} {name}\n", i + 1)),
+            "{ply_text:.500}"
+        );
+    }
+    assert!(!obj_text.contains("label_"), "{obj_text:.300}");
+    // A label selected is named in what is printed (the binary file has no place for it).
+    let post = d.join("post.ktree");
+    let said = run(&["select", o, "--value", "2", "--out", post.to_str().unwrap()]);
+    assert!(said.contains("selected (label 2: post)"), "{said}");
     let text = run(&["stats", out.to_str().unwrap()]);
     for (i, (name, _, _)) in boxes.iter().enumerate() {
         let line = format!("  {} ({name}): ", i + 1);

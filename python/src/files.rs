@@ -52,7 +52,7 @@ impl Tree {
     /// tree with values keeps them in `.ktree` (version 3), OpenVDB typed grids (`.vdb`), NIfTI (`.nii`,
     /// `.nii.gz`), VTK cell data (`.vtu`, `.htg`) and the coloured surfaces of its values (`.ply`, `.obj`,
     /// `.glb`); other formats would drop the values: save `tree.shape()` for them. A `.ktree` keeps the
-    /// labels' names (`label_names`).
+    /// labels' names (`label_names`); a mesh names each label's part by them.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let options = WriteOptions {
             notes: self.notes.clone(),

@@ -7,6 +7,7 @@ import subprocess
 
 import numpy as np
 import pytest
+import trimesh
 
 import ktree
 from test_ktree import cli, run_json
@@ -120,6 +121,15 @@ def test_labels_keep_their_names(tmp_path):
     assert renamed.label_names == {2: "post"}
     assert renamed == tree  # the same voxels and values
     assert ktree.Tree.from_bytes(renamed.to_bytes()).label_names == {2: "post"}
+    # Saved as a mesh, each label's part is named by its name (OBJ groups and materials, checked with
+    # trimesh, which loads each material's part as its own geometry; glTF meshes).
+    renamed.save(tmp_path / "parts.obj")
+    scene = trimesh.load(tmp_path / "parts.obj", force="scene", group_material=True)
+    materials = {g.visual.material.name for g in scene.geometry.values()}
+    assert materials == {"label_1", "post", "label_3"}, materials
+    tree.save(tmp_path / "parts.glb")
+    glb = trimesh.load(tmp_path / "parts.glb", force="scene")
+    assert set(glb.geometry) == set(want.values()), set(glb.geometry)
     with pytest.raises(ValueError, match="label 300"):
         tree.with_label_names({300: "too big"})
     with pytest.raises(ValueError, match="line break"):

@@ -31,7 +31,7 @@ fn f32_le(w: &mut dyn Write, v: &[f64; 3]) -> io::Result<()> {
 /// # Errors
 /// The writer's.
 pub fn write_ply(w: &mut dyn Write, mesh: &SurfaceMesh) -> io::Result<()> {
-    ply_header(w, mesh.vertices.len(), mesh.triangles.len(), "")?;
+    ply_header(w, "", mesh.vertices.len(), mesh.triangles.len(), "")?;
     for v in &mesh.vertices {
         f32_le(w, v)?;
     }
@@ -45,13 +45,14 @@ pub fn write_ply(w: &mut dyn Write, mesh: &SurfaceMesh) -> io::Result<()> {
 /// properties `face_properties` (header lines).
 fn ply_header(
     w: &mut dyn Write,
+    comments: &str,
     vertices: usize,
     faces: usize,
     face_properties: &str,
 ) -> io::Result<()> {
     write!(
         w,
-        "ply\nformat binary_little_endian 1.0\ncomment written by ktree\nelement vertex {vertices}\n\
+        "ply\nformat binary_little_endian 1.0\ncomment written by ktree\n{comments}element vertex {vertices}\n\
          property float x\nproperty float y\nproperty float z\nelement face {faces}\n\
          property list uchar int vertex_indices\n{face_properties}end_header\n",
     )
@@ -84,7 +85,8 @@ fn ply_type(dtype: Option<Dtype>) -> &'static str {
 /// their own type, `value` and `value_back` as `float`; colours are `red`, `green`, `blue` themselves
 /// and `red_back`, `green_back`, `blue_back`), and `back_empty` (`uchar`, 1 where nothing is behind; the
 /// value behind is then 0). Each value's voxels are bounded by its faces with `label` that value together
-/// with its faces with `label_back` that value, turned over.
+/// with its faces with `label_back` that value, turned over. A value with a name of its own
+/// ([`ValueMesh::with_names`]) has it in a header comment: `comment 3 liver`.
 ///
 /// ```
 /// use ktree::export::{files::write_value_ply, surface::value_boundary_mesh};
@@ -121,8 +123,16 @@ pub fn write_value_ply<V: Value>(
         properties += &format!("property {ty} {name}\nproperty {ty} {name}_back\n");
     }
     properties += "property uchar back_empty\n";
+    // The values' own names, as comments (PLY has no other place for them).
+    let comments: String = mesh
+        .surfaces
+        .iter()
+        .filter(|s| s.label.is_some())
+        .map(|s| format!("comment {} {}\n", s.value.text(), s.name()))
+        .collect();
     ply_header(
         w,
+        &comments,
         mesh.vertex_count(),
         mesh.faces_once().count(),
         &properties,

@@ -21,6 +21,7 @@ use std::path::Path;
 use super::dispatch::{export_error, format_of, usage};
 use super::{Format, IoError, WriteOptions};
 use crate::export::{surface::value_boundary_mesh, write_value_surface, Written};
+use crate::io::ktree::notes::label_note;
 use crate::io::ktree::v3::write_valued_ktree_file_noted;
 use crate::value::Value;
 use crate::{AnyValuedTree, KTree};
@@ -42,7 +43,8 @@ pub enum WrittenValues {
 /// Writes a tree with values to `path` (atomically: a temporary file renamed), the format chosen by the
 /// extension. `options.meta` places grid index 0 in the world and grid index = ktree voxel −
 /// `options.offset`, as for [`super::write_tree`]; a `.ktree` keeps that world frame when `options.meta`
-/// is given, and `options.notes`.
+/// is given, and `options.notes`; a mesh names each label's group, material or mesh by its note
+/// (`label.3` = `liver`, see [`ValueMesh::with_names`](crate::export::surface::ValueMesh::with_names)).
 ///
 /// # Errors
 /// [`IoError::Usage`] for a format that would drop the values or cannot hold the tree's dimension (`.vdb`,
@@ -102,7 +104,10 @@ fn write_typed<const K: usize, V: Value>(
             .map_err(|e| export_error(path, e))?,
         Format::Mesh | Format::Glb if is_stl(path) => return Err(drops("STL files")),
         Format::Mesh | Format::Glb => {
-            let mesh = value_boundary_mesh(octree()?).placed(&frame);
+            // Each label named by the notes (`label.3` = `liver`) under its name.
+            let mesh = value_boundary_mesh(octree()?)
+                .placed(&frame)
+                .with_names(|v| options.notes.get(&label_note(&v.text())).cloned());
             let written = write_value_surface(path, &mesh).map_err(|e| export_error(path, e))?;
             return Ok(WrittenValues::Surfaces {
                 surfaces: mesh.surfaces.len(),

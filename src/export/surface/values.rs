@@ -28,12 +28,23 @@ pub struct ValueSurface<V> {
     pub behind: Vec<Option<V>>,
     /// Whether its rectangles are merged (else every unit face is its own square).
     pub merged: bool,
+    /// The value's own name, when it has one (a label's name: `liver`), as
+    /// [`ValueMesh::with_names`] gives it.
+    pub label: Option<String>,
 }
 
 impl<V: Value> ValueSurface<V> {
-    /// A name for the value's part of a file: `label_3` (integers), `value_0.25` (floats), `rgb_255_0_0`
-    /// (colours).
+    /// A name for the value's part of a file: its [`label`](Self::label) when it has one, else
+    /// `label_3` (integers), `value_0.25` (floats), `rgb_255_0_0` (colours).
     pub fn name(&self) -> String {
+        if let Some(label) = &self.label {
+            return label.clone();
+        }
+        self.default_name()
+    }
+
+    /// The name of the value's part of a file when it has no name of its own.
+    fn default_name(&self) -> String {
         match V::DTYPE {
             Some(Dtype::F32) => format!("value_{}", self.value.text()),
             Some(Dtype::Rgb) => format!("rgb_{}", self.value.text().replace(',', "_")),
@@ -62,6 +73,57 @@ impl<V: Value> ValueMesh<V> {
                 })
                 .collect(),
         }
+    }
+
+    /// The surfaces named by `name_of` (a label's name, say, from a file's notes): each name made fit
+    /// for the groups, materials and meshes of OBJ and glTF files — every character other than a letter,
+    /// a digit, `_`, `-` or `.` becomes `_` — and distinct: a name another surface already has is
+    /// followed by `_` and the value. A surface `name_of` names nothing keeps its default name.
+    ///
+    /// ```
+    /// use ktree::export::surface::value_boundary_mesh;
+    /// let mut dense = [None; 8];
+    /// (dense[0], dense[1], dense[2]) = (Some(1u8), Some(2), Some(3));
+    /// let mesh = value_boundary_mesh(&ktree::KTree::<3, u8>::from_dense_values(1, &dense).unwrap());
+    /// let named = mesh.with_names(|v| (*v < 3).then(|| "left lung".to_string()));
+    /// let names: Vec<String> = named.surfaces.iter().map(|s| s.name()).collect();
+    /// assert_eq!(names, ["left_lung", "left_lung_2", "label_3"]);
+    /// ```
+    pub fn with_names(mut self, name_of: impl Fn(&V) -> Option<String>) -> Self {
+        let mut taken = std::collections::BTreeSet::new();
+        for s in &mut self.surfaces {
+            s.label = None;
+        }
+        // The default names stay as they are; a name of a value's own gives way to them.
+        taken.extend(self.surfaces.iter().map(ValueSurface::default_name));
+        for s in &mut self.surfaces {
+            let Some(name) = name_of(&s.value) else {
+                continue;
+            };
+            let fit: String = name
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            let mut unique = if fit.is_empty() {
+                s.default_name()
+            } else {
+                fit
+            };
+            if unique != s.default_name() {
+                while taken.contains(&unique) {
+                    unique = format!("{unique}_{}", s.value.text().replace(',', "_"));
+                }
+                taken.insert(unique.clone());
+            }
+            s.label = Some(unique);
+        }
+        self
     }
 
     /// Every face once, as `(surface, triangle)` indices: a face against nothing from its value's
@@ -147,6 +209,7 @@ pub fn try_value_boundary_mesh<T: ValueStorage<3>>(
                 mesh,
                 behind,
                 merged: true,
+                label: None,
             },
             None => {
                 let mesh = infallible(sweep::sweep(&voxels, Merge::None));
@@ -157,6 +220,7 @@ pub fn try_value_boundary_mesh<T: ValueStorage<3>>(
                     mesh,
                     behind,
                     merged: false,
+                    label: None,
                 }
             }
         };
