@@ -89,79 +89,132 @@ pub fn visit_morton_ray<const K: usize>(
     end: [f32; K],
     mut visit: impl FnMut(u64),
 ) -> bool {
-    let (Some(key_origin), Some(key_end)) = (grid.keys(origin), grid.keys(end)) else {
-        return false;
-    };
-    if key_origin == key_end {
-        return true;
-    }
-    let mut code = morton_encode(key_origin);
-    let code_end = morton_encode(key_end);
-    visit(code);
-    let mut direction = difference(origin, end);
-    let length = norm(direction) as f32;
-    for d in &mut direction {
-        *d /= length;
-    }
-    let resolution = grid.resolution();
-    let mut t_max = [f64::MAX; K];
-    let mut t_delta = [f64::MAX; K];
-    // A step along axis i: the axis's bits of the Morton key (mask[i]) counted up or down by one,
-    // wrapping at 16 bits as OctoMap's 16-bit keys wrap. Counting up fills the other axes' bits with ones
-    // (carry[i] = !mask[i]) so the carry runs through them; counting down clears them (carry[i] = 0).
-    let mut mask = [0u64; K];
-    let mut carry = [0u64; K];
-    let mut add = [0u64; K];
-    for i in 0..K {
-        mask[i] = spread_bits::<K>(u32::from(u16::MAX)) << i;
-        let step = if direction[i] > 0.0 {
-            1.0
-        } else if direction[i] < 0.0 {
-            -1.0
-        } else {
-            continue;
-        };
-        (carry[i], add[i]) = if step > 0.0 {
-            (!mask[i], 1)
-        } else {
-            (0, u64::MAX)
-        };
-        // The voxel's border in the ray's direction; OctoMap rounds the half step to f32.
-        let border = grid.centre(key_origin[i]) + f64::from((step * resolution * 0.5) as f32);
-        t_max[i] = (border - f64::from(origin[i])) / f64::from(direction[i]);
-        t_delta[i] = resolution / f64::from(direction[i]).abs();
-    }
-    // The axis of the smallest t_max, ties going to the later axis (OctoMap's comparisons). Chosen and
-    // stepped without branches, the K times kept in registers: which axis comes next is what the
-    // processor cannot predict.
-    let nearest = |t_max: &[f64; K]| {
-        let (mut dim, mut best) = (0, t_max[0]);
-        for (i, &t) in t_max.iter().enumerate().skip(1) {
-            let nearer = t <= best;
-            dim = std::hint::select_unpredictable(nearer, i, dim);
-            best = std::hint::select_unpredictable(nearer, t, best);
+    match MortonWalk::start(grid, origin, end) {
+        None => false,
+        Some(None) => true,
+        Some(Some((first, mut walk))) => {
+            visit(first);
+            while let Some(code) = walk.next_voxel() {
+                visit(code);
+            }
+            true
         }
-        (dim, best)
-    };
-    let (mut dim, _) = nearest(&t_max);
-    loop {
-        let stepped = ((code & mask[dim]) | carry[dim]).wrapping_add(add[dim]) & mask[dim];
-        code = stepped | (code & !mask[dim]);
-        for (i, (t, delta)) in t_max.iter_mut().zip(t_delta).enumerate() {
+    }
+}
+
+/// A ray's traversal stepped one voxel at a time ([`next_voxel`](Self::next_voxel)): the state of
+/// [`visit_morton_ray`], so that several rays can be stepped in turn and the processor overlap their
+/// chains of dependent steps.
+#[derive(Debug, Clone, Copy)]
+struct MortonWalk<const K: usize> {
+    code: u64,
+    code_end: u64,
+    length: f64,
+    /// The axis stepped next.
+    dim: usize,
+    t_max: [f64; K],
+    t_delta: [f64; K],
+    mask: [u64; K],
+    carry: [u64; K],
+    add: [u64; K],
+}
+
+impl<const K: usize> MortonWalk<K> {
+    /// The traversal of the ray from `origin` to `end`: `None` if either point is outside the map,
+    /// `Some(None)` if both are in one voxel (nothing is crossed), else the origin's voxel and the walk
+    /// on from it.
+    #[inline]
+    fn start(grid: &MapGrid, origin: [f32; K], end: [f32; K]) -> Option<Option<(u64, Self)>> {
+        let (key_origin, key_end) = (grid.keys(origin)?, grid.keys(end)?);
+        if key_origin == key_end {
+            return Some(None);
+        }
+        let code = morton_encode(key_origin);
+        let code_end = morton_encode(key_end);
+        let mut direction = difference(origin, end);
+        let length = norm(direction) as f32;
+        for d in &mut direction {
+            *d /= length;
+        }
+        let resolution = grid.resolution();
+        let mut t_max = [f64::MAX; K];
+        let mut t_delta = [f64::MAX; K];
+        // A step along axis i: the axis's bits of the Morton key (mask[i]) counted up or down by one,
+        // wrapping at 16 bits as OctoMap's 16-bit keys wrap. Counting up fills the other axes' bits with
+        // ones (carry[i] = !mask[i]) so the carry runs through them; counting down clears them
+        // (carry[i] = 0).
+        let mut mask = [0u64; K];
+        let mut carry = [0u64; K];
+        let mut add = [0u64; K];
+        for i in 0..K {
+            mask[i] = spread_bits::<K>(u32::from(u16::MAX)) << i;
+            let step = if direction[i] > 0.0 {
+                1.0
+            } else if direction[i] < 0.0 {
+                -1.0
+            } else {
+                continue;
+            };
+            (carry[i], add[i]) = if step > 0.0 {
+                (!mask[i], 1)
+            } else {
+                (0, u64::MAX)
+            };
+            // The voxel's border in the ray's direction; OctoMap rounds the half step to f32.
+            let border = grid.centre(key_origin[i]) + f64::from((step * resolution * 0.5) as f32);
+            t_max[i] = (border - f64::from(origin[i])) / f64::from(direction[i]);
+            t_delta[i] = resolution / f64::from(direction[i]).abs();
+        }
+        let (dim, _) = nearest(&t_max);
+        let walk = Self {
+            code,
+            code_end,
+            length: f64::from(length),
+            dim,
+            t_max,
+            t_delta,
+            mask,
+            carry,
+            add,
+        };
+        Some(Some((code, walk)))
+    }
+
+    /// The next voxel the ray crosses, or `None` at its end (the end's voxel is not crossed).
+    #[inline]
+    fn next_voxel(&mut self) -> Option<u64> {
+        let dim = self.dim;
+        let stepped = ((self.code & self.mask[dim]) | self.carry[dim]).wrapping_add(self.add[dim])
+            & self.mask[dim];
+        self.code = stepped | (self.code & !self.mask[dim]);
+        for (i, (t, delta)) in self.t_max.iter_mut().zip(self.t_delta).enumerate() {
             *t += std::hint::select_unpredictable(i == dim, delta, 0.0);
         }
-        if code == code_end {
-            break;
+        if self.code == self.code_end {
+            return None;
         }
         let reached;
-        (dim, reached) = nearest(&t_max);
+        (self.dim, reached) = nearest(&self.t_max);
         // Past the end point's distance without meeting its voxel (rounding): stop.
-        if reached > f64::from(length) {
-            break;
+        if reached > self.length {
+            return None;
         }
-        visit(code);
+        Some(self.code)
     }
-    true
+}
+
+/// The axis of the smallest `t_max` and that time, ties going to the later axis (OctoMap's comparisons).
+/// Chosen without branches, the `K` times kept in registers: which axis comes next is what the processor
+/// cannot predict.
+#[inline]
+fn nearest<const K: usize>(t_max: &[f64; K]) -> (usize, f64) {
+    let (mut dim, mut best) = (0, t_max[0]);
+    for (i, &t) in t_max.iter().enumerate().skip(1) {
+        let nearer = t <= best;
+        dim = std::hint::select_unpredictable(nearer, i, dim);
+        best = std::hint::select_unpredictable(nearer, t, best);
+    }
+    (dim, best)
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ use super::voxel_set::{SortedVoxels, VoxelSet};
 use crate::radix::radix_sort;
 use crate::space::morton_encode;
 use crate::tree::storage::infallible;
-use crate::tree::top_down::{pack, InputNode};
+use crate::tree::top_down::{InputNode, Subtree};
 use crate::tree::valued::{combine, ValueState};
 use crate::KTree;
 
@@ -106,21 +106,79 @@ fn merge_sorted(hits: &[u64], misses: &SortedVoxels) -> Vec<(u64, bool)> {
 
 /// The map's log-odds after `update`: every updated voxel's log-odds (0 where it was unknown) moved by
 /// one hit or miss of `model`, the others kept; minimal, as always. Depth first: each cell's children are
-/// made before it, a block of alike children joined at once.
+/// made before it, a block of alike children joined at once; on the threads of the current rayon pool,
+/// a cell with many updates has its children made apart.
 pub fn apply<const K: usize>(
     map: &KTree<K, f32>,
     update: &[(u64, bool)],
     model: &SensorModel,
 ) -> KTree<K, f32> {
-    let level = map.level();
-    let mut merge = Merge {
-        map,
-        model,
-        levels: vec![Vec::new(); level as usize + 1],
-    };
-    let root = merge.node(infallible(InputNode::root(map)), update, 0, level, 0);
-    merge.levels[0].push(root);
-    pack(map.universe(), merge.levels)
+    let parallel = rayon::current_num_threads() > 1;
+    let root = infallible(InputNode::root(map));
+    let whole = subtree(map, model, root, update, 0, map.level(), parallel);
+    whole.into_tree(map.universe())
+}
+
+/// Updates a cell must hold for its children to be made apart.
+const UPDATES_APART: usize = 1 << 14;
+
+/// The subtree of the cell of the map's `node` whose voxels' Morton keys start at `base` (a side of
+/// `2^log_side`) after the updates `update` inside it: its children made apart on the rayon pool when
+/// `parallel` and it holds many updates, else depth first on this thread.
+fn subtree<const K: usize>(
+    map: &KTree<K, f32>,
+    model: &SensorModel,
+    node: InputNode<f32>,
+    update: &[(u64, bool)],
+    base: u64,
+    log_side: u32,
+    parallel: bool,
+) -> Subtree<f32> {
+    if !parallel || update.len() < UPDATES_APART || log_side < 2 {
+        let mut merge = Merge {
+            map,
+            model,
+            levels: vec![Vec::new(); log_side as usize + 1],
+        };
+        let root = merge.node(node, update, base, log_side, 0);
+        let mut levels = merge.levels;
+        levels.remove(0);
+        return Subtree::new(root, levels);
+    }
+    let parts = children_updates::<K>(update, base, log_side);
+    let kids = parts
+        .into_par_iter()
+        .enumerate()
+        .map(|(code, (start, part))| {
+            let child = infallible(node.child(map, code));
+            subtree(map, model, child, part, start, log_side - 1, parallel)
+        })
+        .collect();
+    Subtree::join(kids)
+}
+
+/// The updates of each child of the cell whose voxels' Morton keys start at `base` (a side of
+/// `2^log_side`, `log_side` ≥ 1), with the first key of the child, in code order.
+fn children_updates<const K: usize>(
+    update: &[(u64, bool)],
+    base: u64,
+    log_side: u32,
+) -> Vec<(u64, &[(u64, bool)])> {
+    let span = 1u64 << (K as u32 * (log_side - 1));
+    let mut rest = update;
+    (0..1u64 << K)
+        .map(|code| {
+            let start = base + code * span;
+            let here = match start.checked_add(span) {
+                Some(end) => rest.partition_point(|&(k, _)| k < end),
+                // The last cell of a 4-D root ends at 2^64.
+                None => rest.len(),
+            };
+            let (part, after) = rest.split_at(here);
+            rest = after;
+            (start, part)
+        })
+        .collect()
 }
 
 /// The state of a depth-first merge: the settled states of each level so far.

@@ -18,12 +18,11 @@
 
 use rayon::prelude::*;
 
-use super::values::{join, Subtree};
 use crate::rays::source::default_split_depth;
 use crate::rays::valued::check_dense_len;
 use crate::rays::RayError;
 use crate::space::{Cell, Universe};
-use crate::tree::top_down::pack;
+use crate::tree::top_down::Subtree;
 use crate::tree::valued::{combine, ValueState};
 use crate::value::Value;
 use crate::KTree;
@@ -57,14 +56,8 @@ impl<const K: usize, V: Value> KTree<K, V> {
         background: V,
         split: u32,
     ) -> Result<Self, RayError> {
-        let level = universe.level();
         let source = Dense::new(universe, dense, background);
-        let (root, below) = source.subtree(universe.root(), split)?;
-        let mut levels = Vec::with_capacity(level as usize + 1);
-        levels.push(vec![root]);
-        levels.extend(below);
-        levels.resize(level as usize + 1, Vec::new());
-        Ok(pack(universe, levels))
+        Ok(source.subtree(universe.root(), split)?.into_tree(universe))
     }
 }
 
@@ -130,19 +123,19 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
         V: Sync,
     {
         if let Some(leaf) = self.leaf(cell)? {
-            return Ok((leaf, Vec::new()));
+            return Ok(Subtree::leaf(leaf));
         }
         if cell.level() >= split {
             let mut levels = vec![Vec::new(); cell.log_side() as usize + 1];
             let root = self.node(cell, 0, &mut levels)?;
             levels.remove(0);
-            return Ok((root, levels));
+            return Ok(Subtree::new(root, levels));
         }
         let kids = (0..1usize << K)
             .into_par_iter()
             .map(|code| self.subtree(cell.child(code), split))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(join(kids))
+        Ok(Subtree::join(kids))
     }
 
     /// Builds the subtree of `cell` (at `depth`): returns its state, its children (if any) pushed onto

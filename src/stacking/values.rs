@@ -24,7 +24,7 @@ use rayon::prelude::*;
 use crate::rays::source::default_split_depth;
 use crate::rays::{ColumnKeys, ValueRun, ValueRuns};
 use crate::space::Cell;
-use crate::tree::top_down::pack;
+use crate::tree::top_down::Subtree;
 use crate::tree::valued::{combine, ValueState};
 use crate::value::Value;
 use crate::KTree;
@@ -59,17 +59,9 @@ impl<const K: usize, V: Value> KTree<K, V> {
     pub fn from_value_runs_split(runs: &ValueRuns<K, V>, split: u32) -> KTree<K, V> {
         let universe = runs.universe();
         let keys = ColumnKeys::<K>::new(universe.level());
-        let (root, below) = subtree(&keys, universe.root(), runs.runs(), split);
-        let mut levels = Vec::with_capacity(below.len() + 1);
-        levels.push(vec![root]);
-        levels.extend(below);
-        levels.resize(universe.level() as usize + 1, Vec::new());
-        pack(universe, levels)
+        subtree(&keys, universe.root(), runs.runs(), split).into_tree(universe)
     }
 }
-
-/// A subtree built apart: its root's state and the states of each level below it, in level order.
-pub(super) type Subtree<V> = (ValueState<V>, Vec<Vec<ValueState<V>>>);
 
 /// The subtree of `cell` from the pieces inside it: its root's state and the states of each level below
 /// it (in level order), built apart on the rayon pool down to the cells of depth `split`.
@@ -80,7 +72,7 @@ fn subtree<const K: usize, V: Value>(
     split: u32,
 ) -> Subtree<V> {
     if let Some(leaf) = leaf_of(cell, pieces) {
-        return (leaf, Vec::new());
+        return Subtree::leaf(leaf);
     }
     let depths = cell.log_side() as usize + 1;
     if cell.level() >= split {
@@ -92,7 +84,7 @@ fn subtree<const K: usize, V: Value>(
         let root = builder.node(cell, pieces, 0);
         let mut levels = builder.levels;
         levels.remove(0);
-        return (root, levels);
+        return Subtree::new(root, levels);
     }
     let mut buffer = Vec::new();
     let start = distribute(keys, cell, pieces, &mut buffer);
@@ -107,27 +99,7 @@ fn subtree<const K: usize, V: Value>(
             )
         })
         .collect();
-    join(kids)
-}
-
-/// The subtree of a cell from those of its `2^K` children, in code order: a leaf if they are alike, else
-/// the children, then each level of their subtrees one after the other.
-pub(super) fn join<V: Value>(kids: Vec<Subtree<V>>) -> Subtree<V> {
-    let states: Vec<ValueState<V>> = kids.iter().map(|k| k.0).collect();
-    let state = combine(&states);
-    if !state.has_children() {
-        return (state, Vec::new());
-    }
-    let mut levels = vec![states];
-    for (_, below) in kids {
-        for (d, level) in below.into_iter().enumerate() {
-            if levels.len() <= d + 1 {
-                levels.push(Vec::new());
-            }
-            levels[d + 1].extend(level);
-        }
-    }
-    (state, levels)
+    Subtree::join(kids)
 }
 
 /// The leaf `cell` is when no piece enters it (empty) or one piece of one value covers each of its

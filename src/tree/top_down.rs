@@ -129,35 +129,104 @@ fn settle<const K: usize, V: Value>(
 /// the level below) into a tree; trailing empty levels are dropped.
 pub(crate) fn pack<const K: usize, V: Value>(
     universe: Universe<K>,
-    mut levels: Vec<Vec<ValueState<V>>>,
+    levels: Vec<Vec<ValueState<V>>>,
 ) -> KTree<K, V> {
-    while levels.len() > 1 && levels.last().is_some_and(Vec::is_empty) {
+    pack_chunks(universe, levels.into_iter().map(|l| vec![l]).collect())
+}
+
+/// [`pack`] of levels each kept as consecutive chunks; the levels packed on the rayon pool.
+fn pack_chunks<const K: usize, V: Value>(
+    universe: Universe<K>,
+    mut levels: Vec<Vec<Vec<ValueState<V>>>>,
+) -> KTree<K, V> {
+    use rayon::prelude::*;
+    while levels.len() > 1 && levels.last().is_some_and(|l| l.iter().all(Vec::is_empty)) {
         levels.pop();
     }
-    let mut packed = Vec::with_capacity(levels.len());
-    let mut values = Vec::with_capacity(levels.len());
-    for states in &levels {
-        let mut level = PackedStates::with_capacity(states.len());
-        let mut column = Vec::new();
-        for state in states {
-            let code = match *state {
-                ValueState::Empty => 0,
-                ValueState::Full(v) => {
-                    if V::STORED {
-                        column.push(v);
+    let (packed, values): (Vec<PackedStates>, Vec<Vec<V>>) = levels
+        .into_par_iter()
+        .map(|chunks| {
+            let mut level = PackedStates::with_capacity(chunks.iter().map(Vec::len).sum());
+            let mut column = Vec::new();
+            for state in chunks.iter().flatten() {
+                let code = match *state {
+                    ValueState::Empty => 0,
+                    ValueState::Full(v) => {
+                        if V::STORED {
+                            column.push(v);
+                        }
+                        1
                     }
-                    1
-                }
-                ValueState::Partial => 2,
-                ValueState::Mixed => 3,
-            };
-            level.push_code(code);
-        }
-        level.finish();
-        packed.push(level);
-        values.push(column);
-    }
+                    ValueState::Partial => 2,
+                    ValueState::Mixed => 3,
+                };
+                level.push_code(code);
+            }
+            level.finish();
+            (level, column)
+        })
+        .unzip();
     KTree::from_valued_levels(universe, packed, values)
+}
+
+/// A subtree built apart (on a thread of its own, say): its root's state and the states of each level
+/// below it in level order, each level as the chunks it was made of — joined to its siblings' without
+/// copying, copied once when the whole tree is packed ([`Subtree::into_tree`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Subtree<V> {
+    root: ValueState<V>,
+    /// Level `d` holds the nodes `d + 1` levels below the root, in chunks.
+    below: Vec<Vec<Vec<ValueState<V>>>>,
+}
+
+impl<V: Value> Subtree<V> {
+    /// The subtree of root `root` and the levels `below` it (level order, the first one the root's
+    /// children, if it has any).
+    pub(crate) fn new(root: ValueState<V>, below: Vec<Vec<ValueState<V>>>) -> Self {
+        let below = below
+            .into_iter()
+            .take_while(|l| !l.is_empty())
+            .map(|l| vec![l])
+            .collect();
+        Self { root, below }
+    }
+
+    /// A leaf.
+    pub(crate) fn leaf(root: ValueState<V>) -> Self {
+        Self {
+            root,
+            below: Vec::new(),
+        }
+    }
+
+    /// The subtree of a cell from those of its `2^K` children, in code order: a leaf if they are alike
+    /// ([`combine`]), else the children, then each level of their subtrees one after the other.
+    pub(crate) fn join(kids: Vec<Self>) -> Self {
+        let states: Vec<ValueState<V>> = kids.iter().map(|k| k.root).collect();
+        let root = combine(&states);
+        if !root.has_children() {
+            return Self::leaf(root);
+        }
+        let mut below = vec![vec![states]];
+        for kid in kids {
+            for (d, chunks) in kid.below.into_iter().enumerate() {
+                if below.len() <= d + 1 {
+                    below.push(Vec::new());
+                }
+                below[d + 1].extend(chunks);
+            }
+        }
+        Self { root, below }
+    }
+
+    /// The tree of `universe` this subtree is the whole of (its root the universe's root).
+    pub(crate) fn into_tree<const K: usize>(self, universe: Universe<K>) -> KTree<K, V> {
+        let mut levels = Vec::with_capacity(universe.level() as usize + 1);
+        levels.push(vec![vec![self.root]]);
+        levels.extend(self.below);
+        levels.resize(universe.level() as usize + 1, Vec::new());
+        pack_chunks(universe, levels)
+    }
 }
 
 /// A node of an input tree as a cell of the output descends: the node the cell lies in (a leaf covers all

@@ -215,6 +215,43 @@ proptest! {
     }
 }
 
+/// Scans of thousands of rays, each crossing hundreds of voxels (a pseudo-random cloud of `n` points in
+/// a ball of radius 3 around the sensor, which moves a little between scans).
+fn big_scans<const K: usize>(n: usize, scans: usize) -> Vec<(Vec<[f32; K]>, [f32; K])> {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f32 / (1u64 << 53) as f32 * 2.0 - 1.0
+    };
+    (0..scans)
+        .map(|s| {
+            let origin = std::array::from_fn(|a| 0.3 * s as f32 * (a as f32 - 0.5));
+            let points = (0..n)
+                .map(|_| std::array::from_fn(|a| origin[a] + 3.0 * uniform()))
+                .collect();
+            (points, origin)
+        })
+        .collect()
+}
+
+/// Updates of hundreds of thousands of voxels, whose cells' children are merged into the map on
+/// several threads, give the naive reference's map, K = 2 and 3, with and without a maximum range.
+#[test]
+fn large_updates_merged_on_several_threads_match_the_naive_reference() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(4)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        for range in [None, Some(2.0)] {
+            check_map::<2>(0.004, big_scans::<2>(1500, 3), range).unwrap();
+            check_map::<3>(0.02, big_scans::<3>(1500, 2), range).unwrap();
+        }
+    });
+}
+
 /// Builds `octomap_insert` against the installed OctoMap into `dir`; `None` after [`tools::missing`]
 /// without `g++` or OctoMap's headers.
 fn octomap_insert(dir: &Path) -> Option<PathBuf> {
