@@ -143,30 +143,42 @@ fn pack_chunks<const K: usize, V: Value>(
     while levels.len() > 1 && levels.last().is_some_and(|l| l.iter().all(Vec::is_empty)) {
         levels.pop();
     }
-    let (packed, values): (Vec<PackedStates>, Vec<Vec<V>>) = levels
-        .into_par_iter()
-        .map(|chunks| {
-            let mut level = PackedStates::with_capacity(chunks.iter().map(Vec::len).sum());
-            let mut column = Vec::new();
-            for state in chunks.iter().flatten() {
-                let code = match *state {
-                    ValueState::Empty => 0,
-                    ValueState::Full(v) => {
-                        if V::STORED {
-                            column.push(v);
-                        }
-                        1
-                    }
-                    ValueState::Partial => 2,
-                    ValueState::Mixed => 3,
-                };
-                level.push_code(code);
-            }
-            level.finish();
-            (level, column)
-        })
-        .unzip();
+    let (packed, values): (Vec<PackedStates>, Vec<Vec<V>>) =
+        levels.into_par_iter().map(pack_level).unzip();
     KTree::from_valued_levels(universe, packed, values)
+}
+
+/// One level's states, in chunks, as its 2-bit codes (32 to a word) and the values of its full nodes.
+fn pack_level<V: Value>(chunks: Vec<Vec<ValueState<V>>>) -> (PackedStates, Vec<V>) {
+    let len: usize = chunks.iter().map(Vec::len).sum();
+    let mut words = Vec::with_capacity(len.div_ceil(32));
+    let mut column = Vec::new();
+    let (mut word, mut slot) = (0u64, 0u32);
+    for state in chunks.iter().flatten() {
+        let code = match *state {
+            ValueState::Empty => 0,
+            ValueState::Full(v) => {
+                if V::STORED {
+                    column.push(v);
+                }
+                1
+            }
+            ValueState::Partial => 2,
+            ValueState::Mixed => 3,
+        };
+        word |= code << (2 * slot);
+        slot += 1;
+        if slot == 32 {
+            words.push(word);
+            (word, slot) = (0, 0);
+        }
+    }
+    if slot > 0 {
+        words.push(word);
+    }
+    let level = PackedStates::from_valued_words(words, len)
+        .expect("one word for every 32 codes, none past the last");
+    (level, column)
 }
 
 /// A subtree built apart (on a thread of its own, say): its root's state and the states of each level
