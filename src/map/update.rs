@@ -146,8 +146,9 @@ fn subtree<const K: usize>(
         return Subtree::new(root, levels);
     }
     let parts = children_updates::<K>(update, base, log_side);
-    let kids = parts
-        .into_par_iter()
+    let kids = parts[..1 << K]
+        .par_iter()
+        .copied()
         .enumerate()
         .map(|(code, (start, part))| {
             let child = infallible(node.child(map, code));
@@ -158,27 +159,28 @@ fn subtree<const K: usize>(
 }
 
 /// The updates of each child of the cell whose voxels' Morton keys start at `base` (a side of
-/// `2^log_side`, `log_side` ≥ 1), with the first key of the child, in code order.
+/// `2^log_side`, `log_side` ≥ 1), with the first key of the child, in code order (the first `2^K`).
+#[allow(clippy::type_complexity)] // A child's first key and its part of the updates, for each child.
 fn children_updates<const K: usize>(
     update: &[(u64, bool)],
     base: u64,
     log_side: u32,
-) -> Vec<(u64, &[(u64, bool)])> {
+) -> [(u64, &[(u64, bool)]); 16] {
     let span = 1u64 << (K as u32 * (log_side - 1));
     let mut rest = update;
-    (0..1u64 << K)
-        .map(|code| {
-            let start = base + code * span;
-            let here = match start.checked_add(span) {
-                Some(end) => rest.partition_point(|&(k, _)| k < end),
-                // The last cell of a 4-D root ends at 2^64.
-                None => rest.len(),
-            };
-            let (part, after) = rest.split_at(here);
-            rest = after;
-            (start, part)
-        })
-        .collect()
+    let mut parts: [(u64, &[(u64, bool)]); 16] = [(0, &[]); 16];
+    for (code, part) in parts.iter_mut().enumerate().take(1 << K) {
+        let start = base + code as u64 * span;
+        let here = match start.checked_add(span) {
+            Some(end) => rest.partition_point(|&(k, _)| k < end),
+            // The last cell of a 4-D root ends at 2^64.
+            None => rest.len(),
+        };
+        let (mine, after) = rest.split_at(here);
+        *part = (start, mine);
+        rest = after;
+    }
+    parts
 }
 
 /// The state of a depth-first merge: the settled states of each level so far.
@@ -219,19 +221,11 @@ impl<const K: usize> Merge<'_, K> {
             return self.leaf(background, v.unwrap_or(0.0), update, base, log_side, depth);
         }
         // Not a leaf of the result: its children, each from the map's child and its part of the update.
-        let span = 1u64 << (K as u32 * (log_side - 1));
+        let parts = children_updates::<K>(update, base, log_side);
         let mut kids = [ValueState::Empty; 16];
-        let mut rest = update;
-        for (code, kid) in kids.iter_mut().enumerate().take(1 << K) {
-            let start = base + code as u64 * span;
-            let here = match start.checked_add(span) {
-                Some(end) => rest.partition_point(|&(k, _)| k < end),
-                // The last cell of a 4-D root ends at 2^64.
-                None => rest.len(),
-            };
+        for (code, (kid, (start, part))) in kids.iter_mut().zip(parts).enumerate().take(1 << K) {
             let child = infallible(node.child(self.map, code));
-            *kid = self.node(child, &rest[..here], start, log_side - 1, depth + 1);
-            rest = &rest[here..];
+            *kid = self.node(child, part, start, log_side - 1, depth + 1);
         }
         let kids = &kids[..1 << K];
         let state = combine(kids);
