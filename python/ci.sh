@@ -33,7 +33,7 @@ pip=("$venv/bin/python" -m pip)
 
 # The tests compare with the command-line tool's JSON.
 cargo build --quiet -p ktree-cli
-export KTREE_BIN="$root/target/debug/ktree"
+export KTREE_BIN="${CARGO_TARGET_DIR:-$root/target}/debug/ktree"
 
 # The installed type stubs against the installed module.
 "$venv/bin/python" -m mypy.stubtest ktree --allowlist python/stubtest-allowlist.txt
