@@ -38,6 +38,7 @@
 use super::ktree::KTree;
 use super::states::PackedStates;
 use super::valued::{combine, ValueState, ValueStorage};
+use super::words::NODES_PER_WORD;
 use super::TreeError;
 use crate::space::{Cell, Universe};
 use crate::value::Value;
@@ -148,12 +149,12 @@ fn pack_chunks<const K: usize, V: Value>(
     KTree::from_valued_levels(universe, packed, values)
 }
 
-/// One level's states, in chunks, as its 2-bit codes (32 to a word) and the values of its full nodes.
+/// One level's states, in chunks, as its 2-bit codes ([`NODES_PER_WORD`] to a word) and the values of its full nodes.
 fn pack_level<V: Value>(chunks: Vec<Vec<ValueState<V>>>) -> (PackedStates, Vec<V>) {
     let len: usize = chunks.iter().map(Vec::len).sum();
-    let mut words = Vec::with_capacity(len.div_ceil(32));
+    let mut words = Vec::with_capacity(len.div_ceil(NODES_PER_WORD));
     let mut column = Vec::new();
-    let (mut word, mut slot) = (0u64, 0u32);
+    let (mut word, mut slot) = (0u64, 0usize);
     for state in chunks.iter().flatten() {
         let code = match *state {
             ValueState::Empty => 0,
@@ -168,7 +169,7 @@ fn pack_level<V: Value>(chunks: Vec<Vec<ValueState<V>>>) -> (PackedStates, Vec<V
         };
         word |= code << (2 * slot);
         slot += 1;
-        if slot == 32 {
+        if slot == NODES_PER_WORD {
             words.push(word);
             (word, slot) = (0, 0);
         }
@@ -177,7 +178,7 @@ fn pack_level<V: Value>(chunks: Vec<Vec<ValueState<V>>>) -> (PackedStates, Vec<V
         words.push(word);
     }
     let level = PackedStates::from_valued_words(words, len)
-        .expect("one word for every 32 codes, none past the last");
+        .expect("one word for every NODES_PER_WORD codes, none past the last");
     (level, column)
 }
 
@@ -236,7 +237,6 @@ impl<V: Value> Subtree<V> {
         let mut levels = Vec::with_capacity(universe.level() as usize + 1);
         levels.push(vec![vec![self.root]]);
         levels.extend(self.below);
-        levels.resize(universe.level() as usize + 1, Vec::new());
         pack_chunks(universe, levels)
     }
 }
