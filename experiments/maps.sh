@@ -207,10 +207,12 @@ print("The walking-person scene (`ktree_verify::scenes::WalkingPerson`: a person
       "in front of a sensor, 360 × 64 rays a scan), integrated step by step and recorded "
       "(`map::HistoryRecorder`), its 4-D tree built, then the static map and what moved separated "
       "(`MapHistory::static_map`, `moved`). The history records changes only; a tree of every step's state "
-      "would repeat each wall voxel at every step.")
+      "would repeat each wall voxel at every step. The recorder builds the history 8 steps at a time and "
+      "keeps of each step only its states over cells of 8 voxels a side: *recorder MB* is the most it held "
+      "(`HistoryRecorder::heap_bytes`), beside what keeping every step's states would hold.")
 print()
-print("| steps | resolution | history nodes | history MB | final map nodes | history / map | static voxels | moved voxels | record s | build s | separate s |")
-print("|---|---|---|---|---|---|---|---|---|---|---|")
+print("| steps | resolution | history nodes | history MB | final map nodes | history / map | static voxels | moved voxels | recorder MB | every step's states MB | record s | build s | separate s |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 h = {}
 for line in open(history_path):
     for f in line.split():
@@ -219,7 +221,8 @@ for line in open(history_path):
     if line.startswith("record_seconds"):
         print(f"| {h['steps']} | {h['res']} m | {h['history_nodes']} | {int(h['history_bytes']) / 1e6:.2f} | "
               f"{h['map_nodes']} | {int(h['history_nodes']) / int(h['map_nodes']):.2f} | {h['static_voxels']} | "
-              f"{h['moved_voxels']} | {h['record_seconds']} | {h['build_seconds']} | {h['split_seconds']} |")
+              f"{h['moved_voxels']} | {int(h['recorder_bytes']) / 1e6:.2f} | {int(h['every_step_bytes']) / 1e6:.2f} | "
+              f"{h['record_seconds']} | {h['build_seconds']} | {h['split_seconds']} |")
 print()
 print(f"Load average at the end: {load_end}.")
 PY

@@ -298,12 +298,16 @@ fn main() {
             let mut map = OccupancyMap::<3>::new(res).unwrap();
             let mut recorder = HistoryRecorder::new(*map.grid());
             let mut record = 0.0;
+            // The recorder's largest hold, and what keeping every step's states would hold.
+            let (mut held, mut every_step) = (0usize, 0usize);
             for t in 0..scene.steps {
                 let scan = scene.scan(t, 360, 64);
                 map.insert(&scan.points, scan.origin, None).unwrap();
                 let start = Instant::now();
                 recorder.record(&map).unwrap();
                 record += start.elapsed().as_secs_f64();
+                held = held.max(recorder.heap_bytes());
+                every_step += ktree::map::state_labels(&map).heap_bytes();
             }
             let start = Instant::now();
             let history = recorder.finish();
@@ -315,6 +319,7 @@ fn main() {
             println!("history_nodes={}", history.tree().node_count());
             println!("history_bytes={}", history.tree().heap_bytes());
             println!("map_nodes={}", map.log_odds().node_count());
+            println!("recorder_bytes={held} every_step_bytes={every_step}");
             println!("static_voxels={}", still.voxel_count());
             println!("moved_voxels={}", moved.voxel_count());
             println!("record_seconds={record:.3} build_seconds={build:.3} split_seconds={split:.3}");

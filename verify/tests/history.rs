@@ -74,6 +74,57 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ktree_verify::config(12))]
+    /// Over more steps than the recorder builds at a time (and a number that may end in the middle of
+    /// one of its chunks), the history it builds step by step is the one built from every step's states
+    /// at once, node for node; scans that see one region again and again (a moving point in front of a
+    /// wall) leave most cells alike across steps, so whole cells of time are settled above the chunks.
+    #[test]
+    fn a_history_recorded_step_by_step_is_the_one_built_at_once(
+        scans in prop::collection::vec(
+            (prop::collection::vec(prop::array::uniform3(-3.9f32..3.9), 0..4), prop::array::uniform3(-1.9f32..1.9)),
+            1..40,
+        ),
+        wall in 1usize..4,
+    ) {
+        let scans: Vec<_> = scans
+            .into_iter()
+            .enumerate()
+            .map(|(t, (mut points, origin))| {
+                if t % wall == 0 {
+                    points.extend((0..6).map(|i| [3.5f32, i as f32 - 2.5, 0.5]));
+                }
+                (points, if t % 3 == 0 { [0.5; 3] } else { origin })
+            })
+            .collect();
+        let (_, history, steps) = integrate(1.0, &scans);
+        let at_once = MapHistory::from_steps(*history.grid(), &steps).unwrap();
+        prop_assert_eq!(&history, &at_once);
+        for (t, labels) in steps.iter().enumerate() {
+            prop_assert_eq!(&history.at(t as u32).unwrap(), labels);
+        }
+    }
+}
+
+#[test]
+fn a_history_built_at_once_refuses_other_states() {
+    let grid = ktree::map::MapGrid::new(0.1).unwrap();
+    let (_, history, mut steps) = integrate(1.0, &vec![(vec![[2.5, 0.5, 0.5]], [0.5; 3]); 3]);
+    assert_eq!(
+        MapHistory::from_steps(grid, &steps).unwrap().tree(),
+        history.tree()
+    );
+    steps[1] = steps[1].map_values(|v| Some(v + 1)).unwrap();
+    assert!(MapHistory::from_steps(grid, &steps)
+        .unwrap_err()
+        .contains("step 1"));
+    let small = KTree::<3, u8>::from_dense_values(1, &[Some(FREE); 8]).unwrap();
+    assert!(MapHistory::from_steps(grid, &[small])
+        .unwrap_err()
+        .contains("level"));
+}
+
 #[test]
 fn a_history_is_refused_with_other_values_levels_or_too_few_steps() {
     let grid = ktree::map::MapGrid::new(0.1).unwrap();
@@ -143,6 +194,11 @@ fn a_person_walking_through_a_room_is_separated_from_the_room() {
     for (t, labels) in steps.iter().enumerate() {
         assert_eq!(&history.at(t as u32).unwrap(), labels, "step {t}");
     }
+    // Recorded step by step in chunks of steps, the same tree as built from every step at once.
+    assert_eq!(
+        history,
+        MapHistory::from_steps(*history.grid(), &steps).unwrap()
+    );
     let (still, moved) = (history.static_map(), history.moved());
     // The person's voxels over the whole walk (grown by a voxel: its surface's hits fall on either side).
     let mut walked = std::collections::HashSet::new();

@@ -35,11 +35,17 @@
 //! assert_eq!(history.static_map().voxel_count(), 1);
 //! ```
 
+mod recorder;
+mod spans;
+
+pub use recorder::HistoryRecorder;
+
+use self::recorder::{forgets, FORGOTTEN};
+use self::spans::Window;
 use super::grid::{MapGrid, MAP_LEVEL};
 use super::OccupancyMap;
 use crate::ops::values::select_where;
 use crate::ops::{difference, extrude, intersection, project};
-use crate::space::Cell;
 use crate::tree::storage::infallible;
 use crate::tree::top_down::{build_top_down, Decision, InputNode};
 use crate::tree::valued::ValueState;
@@ -61,134 +67,6 @@ pub fn state_labels(map: &OccupancyMap<3>) -> KTree<3, u8> {
         .log_odds()
         .map_values(|l| Some(if model.is_occupied(l) { OCCUPIED } else { FREE }));
     labels.unwrap_or_else(|e| unreachable!("labels are valid values: {e}"))
-}
-
-/// Keeps a map's state after each step, to be made into a [`MapHistory`].
-#[derive(Debug, Clone)]
-pub struct HistoryRecorder {
-    grid: MapGrid,
-    steps: Vec<KTree<3, u8>>,
-}
-
-impl HistoryRecorder {
-    /// A recorder of maps of this grid, with no step yet.
-    pub fn new(grid: MapGrid) -> Self {
-        Self {
-            grid,
-            steps: Vec::new(),
-        }
-    }
-
-    /// Records the map's state as the next step.
-    ///
-    /// # Errors
-    /// A message if the map's grid is not the recorder's or the history is full ([`MAX_STEPS`]).
-    pub fn record(&mut self, map: &OccupancyMap<3>) -> Result<(), String> {
-        if *map.grid() != self.grid {
-            return Err(format!(
-                "a history of {} m voxels cannot record a map of {} m voxels",
-                self.grid.resolution(),
-                map.grid().resolution()
-            ));
-        }
-        if self.steps.len() == MAX_STEPS {
-            return Err(format!("a history holds at most {MAX_STEPS} steps"));
-        }
-        self.steps.push(state_labels(map));
-        Ok(())
-    }
-
-    /// The steps recorded so far.
-    pub fn steps(&self) -> usize {
-        self.steps.len()
-    }
-
-    /// The history of the steps recorded: one 4-D tree of their changes built from the top down, a cell
-    /// empty where no step in its span of time changes its 3-D part, a leaf where every step in the span
-    /// has one state all over it.
-    pub fn finish(&self) -> MapHistory {
-        MapHistory {
-            grid: self.grid,
-            steps: self.steps.len() as u32,
-            tree: time_space_tree(&self.steps),
-        }
-    }
-}
-
-/// A cell of the history being built: the first time of its span, its side, the node of the step before
-/// the span that its 3-D part lies in (none before the first step: all unknown), and the same for each
-/// step of the span that exists.
-#[derive(Clone)]
-struct Span {
-    first: u64,
-    side: u64,
-    before: Option<InputNode<u8>>,
-    nodes: Vec<InputNode<u8>>,
-}
-
-/// The state all over a node's cell, if it has one: `Some(None)` unknown, `Some(Some(v))` the label.
-fn uniform(node: Option<&InputNode<u8>>) -> Option<Option<u8>> {
-    match node.map(|n| n.state) {
-        None | Some(ValueState::Empty) => Some(None),
-        Some(ValueState::Full(v)) => Some(Some(v)),
-        Some(ValueState::Partial | ValueState::Mixed) => None,
-    }
-}
-
-fn time_space_tree(steps: &[KTree<3, u8>]) -> KTree<4, u8> {
-    let count = steps.len() as u64;
-    let root = Span {
-        first: 0,
-        side: 1 << MAP_LEVEL,
-        before: None,
-        nodes: steps
-            .iter()
-            .map(|s| infallible(InputNode::root(s)))
-            .collect(),
-    };
-    let decide = |_: &Cell<4>, span: &Span| -> Result<Decision<u8>, TreeError> {
-        // Nothing changes in the span (after the last step nothing is recorded): empty.
-        let before = uniform(span.before.as_ref());
-        if span.nodes.is_empty()
-            || before.is_some() && span.nodes.iter().all(|n| uniform(Some(n)) == before)
-        {
-            return Ok(Decision::Leaf(None));
-        }
-        // One label all over the span, every step of it recorded: a leaf of it.
-        let first = uniform(span.nodes.first());
-        let whole = span.first + span.side <= count;
-        Ok(match first {
-            Some(Some(v)) if whole && span.nodes.iter().all(|n| uniform(Some(n)) == first) => {
-                Decision::Leaf(Some(v))
-            }
-            _ => Decision::Split,
-        })
-    };
-    let child = |span: &Span, code: usize| -> Result<Span, TreeError> {
-        let (half, space) = (span.side / 2, code & 7);
-        let upper = code >> 3 & 1 == 1;
-        let first = span.first + if upper { half } else { 0 };
-        let at = |t: u64| -> InputNode<u8> {
-            let node = &span.nodes[(t - span.first) as usize];
-            infallible(node.child(&steps[t as usize], space))
-        };
-        let before = if upper {
-            (first - 1 < count).then(|| at(first - 1))
-        } else {
-            span.before.map(|b| {
-                let t = (first - 1) as usize; // a span after the first step has one before it
-                infallible(b.child(&steps[t], space))
-            })
-        };
-        Ok(Span {
-            first,
-            side: half,
-            before,
-            nodes: (first..(first + half).min(count)).map(at).collect(),
-        })
-    };
-    let built = build_top_down::<4, u8, Span, TreeError>(MAP_LEVEL, root, decide, child);
-    built.unwrap_or_else(|e| unreachable!("a history of label trees is a valid tree: {e}"))
 }
 
 /// A map's history: a 4-D tree at the map's keys with time (steps) along the fourth axis.
@@ -249,6 +127,50 @@ impl MapHistory {
             }
         };
         Ok(Self { grid, steps, tree })
+    }
+
+    /// The history of maps of this grid whose states after each step are `steps` (as [`state_labels`]
+    /// gives them), built at once ([`HistoryRecorder`] builds the same tree step by step, holding fewer
+    /// of them).
+    ///
+    /// # Errors
+    /// A message for more than [`MAX_STEPS`] steps, a tree of another level than [`MAP_LEVEL`], a
+    /// value other than [`FREE`] and [`OCCUPIED`], or a voxel known at a step and unknown at a later one.
+    pub fn from_steps(grid: MapGrid, steps: &[KTree<3, u8>]) -> Result<Self, String> {
+        if steps.len() > MAX_STEPS {
+            return Err(format!("a history holds at most {MAX_STEPS} steps"));
+        }
+        for (t, s) in steps.iter().enumerate() {
+            if s.level() != MAP_LEVEL {
+                return Err(format!(
+                    "step {t}: a map's states have level {MAP_LEVEL}, not {}",
+                    s.level()
+                ));
+            }
+            if let Some(v) = s
+                .value_leaves()
+                .filter_map(|(_, v)| v)
+                .find(|&v| v != FREE && v != OCCUPIED)
+            {
+                return Err(format!(
+                    "step {t}: a map's states are {FREE} (free) and {OCCUPIED} (occupied), not {v}"
+                ));
+            }
+            if t > 0 && forgets(&steps[t - 1], s) {
+                return Err(format!("step {t}: {FORGOTTEN}"));
+            }
+        }
+        let window = Window {
+            first: 0,
+            before: None,
+            steps,
+            side: 1 << MAP_LEVEL,
+        };
+        Ok(Self {
+            grid,
+            steps: steps.len() as u32,
+            tree: window.tree(),
+        })
     }
 
     /// The maps' grid.
