@@ -246,6 +246,18 @@ fn a_person_walking_through_a_room_is_separated_from_the_room() {
     );
     // The history records the room once and the changes: far below a tree of every step's map.
     assert!(history.tree().node_count() < 4 * steps.last().unwrap().node_count());
+    // And the recorder never held every step: a few maps' states and each step's coarse states.
+    let mut recorder = HistoryRecorder::new(*map.grid());
+    let mut replay = OccupancyMap::<3>::new(0.1).unwrap();
+    let (mut held, every_step) = (0usize, steps.iter().map(KTree::heap_bytes).sum::<usize>());
+    for (points, origin) in &scans {
+        replay.insert(points, *origin, None).unwrap();
+        recorder.record(&replay).unwrap();
+        held = held.max(recorder.heap_bytes());
+    }
+    eprintln!("the recorder held at most {held} bytes, every step's states {every_step}");
+    // (About 11 maps' worth over these 24 steps: the 9 steps of a chunk and the coarse states.)
+    assert!(held < every_step, "{held} of {every_step} bytes");
     // The static occupancy map: what moved made free.
     let cleared = map.cleared(&moved).unwrap();
     assert_eq!(
