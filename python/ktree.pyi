@@ -414,6 +414,10 @@ class OccupancyMap:
         """Integrates a scan: (N, dim) world points (as float32) seen from `origin`, rays cut at
         `max_range` (a point beyond it is no hit), as OctoMap's insertPointCloud. Returns the number of
         voxels updated."""
+    def forget_outside(self, centre: Sequence[float], radius: float) -> None:
+        """Forgets the voxels whose centres lie farther than `radius` from `centre` (world coordinates):
+        they become unknown and lose their colours; the others keep their log-odds. Refused for a map
+        that keeps a history."""
     def set_colours(self, points: npt.ArrayLike, colours: npt.ArrayLike) -> int:
         """Colours the observed voxels holding (N, 3) world points with (N, 3) uint8 colours, each voxel
         the mean of its points' colours (points in unknown voxels colour nothing), as OctoMap's

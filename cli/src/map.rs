@@ -1,5 +1,5 @@
 //! `ktree map SCANS… --resolution R [--max-range M] [--sensor-origin X,Y,Z | --pose X,Y,Z,ROLL,PITCH,YAW]
-//! --out MAP.ot|.bt|.ktree [--history HISTORY.ktree] [--static-map MAP]`: an occupancy map from range scans,
+//! --out MAP.ot|.bt|.ktree [--history HISTORY.ktree] [--static-map MAP] [--keep-within R]`: an occupancy map from range scans,
 //! integrated as OctoMap's `insertPointCloud` integrates them, with its history as a 4-D tree and the
 //! map without what moved; and the map branch of `ktree project` (a map's plane between two
 //! heights, as a ROS map or a quadtree).
@@ -60,6 +60,10 @@ pub struct MapArgs {
     /// step and observed free at another made free — moving objects and their trails removed.
     #[arg(long, value_name = "MAP")]
     static_map: Option<PathBuf>,
+    /// After each scan, forget the voxels farther than R from its sensor origin (they become unknown): a
+    /// map of the region around the sensor on a long run, its memory bounded by the region, not the path.
+    #[arg(long, value_name = "R", allow_hyphen_values = true, conflicts_with_all = ["history", "static_map"])]
+    keep_within: Option<f64>,
     /// The probability a hit gives.
     #[arg(long, default_value_t = 0.7)]
     prob_hit: f64,
@@ -162,6 +166,10 @@ pub fn run_map(a: MapArgs) -> CliResult {
             let update = map
                 .insert(&scan.points, scan.origin, a.max_range)
                 .map_err(|e| format!("{}: {e}", argument.display()))?;
+            if let Some(radius) = a.keep_within {
+                map.forget_outside(scan.origin.map(f64::from), radius)
+                    .map_err(|e| format!("--keep-within: {e}"))?;
+            }
             seconds += start.elapsed().as_secs_f64();
             scans += 1;
             points += scan.points.len();

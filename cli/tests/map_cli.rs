@@ -99,6 +99,57 @@ fn map_files_hold_the_librarys_map() {
 }
 
 #[test]
+fn a_map_kept_within_a_distance_of_the_sensor_is_the_librarys() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let points = walls();
+    write_xyz(&dir.path().join("room.xyz"), &points);
+    // The sensor moves along the room (the walls' points in world coordinates, a line a scan with the
+    // sensor's place); after each scan only what lies within 2 m of it is kept.
+    let list: String = ["1.5 1.5 1.2", "4.5 2.5 1.2"]
+        .iter()
+        .map(|o| format!("room.xyz {o}\n"))
+        .collect();
+    std::fs::write(dir.path().join("walk.scans"), list).unwrap();
+    let mut expected = OccupancyMap::<3>::new(0.1).unwrap();
+    for origin in [[1.5f32, 1.5, 1.2], [4.5, 2.5, 1.2]] {
+        expected.insert(&points, origin, None).unwrap();
+        expected.forget_outside(origin.map(f64::from), 2.0).unwrap();
+    }
+    run(&[
+        "map",
+        &s("walk.scans"),
+        "--resolution",
+        "0.1",
+        "--keep-within",
+        "2",
+        "--out",
+        &s("near.ktree"),
+    ]);
+    let bytes = std::fs::read(dir.path().join("near.ktree")).unwrap();
+    let tree = ktree::io::ktree::v3::read_valued_ktree::<3, f32>(&bytes, "near.ktree").unwrap();
+    assert_eq!(&tree, expected.log_odds());
+    // Nothing farther than 2 m from the last origin is known, and what is near it is.
+    let far = expected.states(&[[0.5, 0.5, 1.2], [4.5, 4.0, 1.3]]);
+    assert_eq!(far[0], ktree::map::VoxelState::Unknown);
+    assert_ne!(far[1], ktree::map::VoxelState::Unknown);
+    // A map kept near the sensor has no history (its steps would forget what they saw).
+    let (ok, _, err) = ktree(&[
+        "map",
+        &s("walk.scans"),
+        "--resolution",
+        "0.1",
+        "--keep-within",
+        "2",
+        "--history",
+        &s("h.ktree"),
+        "--out",
+        &s("m.ktree"),
+    ]);
+    assert!(!ok && err.contains("--history"), "{err}");
+}
+
+#[test]
 fn a_maps_plane_is_a_ros_map_of_its_three_states() {
     let dir = tempfile::tempdir().unwrap();
     let s = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
@@ -191,6 +242,17 @@ fn bad_map_arguments_are_one_line_errors() {
         (
             vec!["--resolution", "0.1", "--prob-hit", "0.3", "--out", "m.ot"],
             "hit",
+        ),
+        (
+            vec![
+                "--resolution",
+                "0.1",
+                "--keep-within",
+                "-1",
+                "--out",
+                "m.ot",
+            ],
+            "--keep-within",
         ),
     ] {
         let mut all = vec!["map".to_string(), s("p.xyz")];

@@ -298,6 +298,29 @@ impl OccupancyMapPy {
         Ok(updated)
     }
 
+    /// Forgets the voxels whose centres lie farther than `radius` from `centre` (dim numbers, world
+    /// coordinates): they become unknown and lose their colours; the others keep their log-odds. A map
+    /// kept within a distance of the sensor on a long run holds the region around it, not the whole path.
+    fn forget_outside(&mut self, py: Python<'_>, centre: Vec<f64>, radius: f64) -> PyResult<()> {
+        if self.recorder.is_some() {
+            return Err(Failure::Value(
+                "forget_outside: a map that keeps a history forgets nothing (its steps record what was seen)"
+                    .into(),
+            )
+            .into());
+        }
+        with_map!(&mut self.map, m, K => {
+            coordinates::<K>(&centre, "forget_outside: centre")?;
+            let centre: [f64; K] = std::array::from_fn(|i| centre[i]);
+            py.detach(|| m.forget_outside(centre, radius))
+                .map_err(|e| Failure::Value(format!("forget_outside: {e}")))?;
+        });
+        if let (Some(colours), AnyMap::D3(m)) = (&self.colours, &self.map) {
+            self.colours = Some(py.detach(|| colours.mask(&m.log_odds().shape())));
+        }
+        Ok(())
+    }
+
     /// The map's history (a map made with `history=True`): one step for each `insert` so far.
     fn history(&self, py: Python<'_>) -> PyResult<MapHistoryPy> {
         let recorder = self.recorder.as_ref().ok_or_else(|| {

@@ -496,6 +496,42 @@ def test_save_and_load_through_octomaps_files(tmp_path):
         ktree.OccupancyMap.load(tmp_path / "missing.ot")
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("seed", range(6))
+def test_a_map_forgets_what_lies_outside_a_ball(dim, seed):
+    rng = np.random.default_rng(500 + 10 * dim + seed)
+    resolution = float(rng.choice([0.1, 0.25, 0.5]))
+    m = ktree.OccupancyMap(resolution, dim=dim)
+    ref = Reference(resolution, dim)
+    for _ in range(2):
+        points, origin = random_scan(rng, dim, resolution, 40)
+        m.insert(points, origin.tolist())
+        ref.insert(points, origin, None)
+    centre, radius = rng.uniform(-2, 2, size=dim), float(rng.uniform(0.3, 3.0))
+    m.forget_outside(centre.tolist(), radius)
+    # The reference keeps the voxels whose centres are within the radius.
+    ref.voxels = {
+        k: l
+        for k, l in ref.voxels.items()
+        if sum((ref.centre(c) - centre[a]) ** 2 for a, c in enumerate(k)) <= radius * radius
+    }
+    check_against(m, ref, rng.uniform(-4, 4, size=(60, dim)))
+
+
+def test_forgetting_refuses_bad_balls_and_maps_with_a_history():
+    m = ktree.OccupancyMap(0.2)
+    m.insert(np.array([[1.0, 0.0, 0.0]]), [0.0, 0.0, 0.0])
+    m.set_colours(np.array([[1.0, 0.0, 0.0]]), np.array([[9, 9, 9]], dtype=np.uint8))
+    for centre, radius, message in [([0.0, 0.0], 1.0, "3 coordinates"), ([0.0] * 3, -1.0, "radius"), ([math.nan] * 3, 1.0, "centre")]:
+        with pytest.raises(ValueError, match=message):
+            m.forget_outside(centre, radius)
+    # The colours of the voxels forgotten go with them.
+    m.forget_outside([0.0, 0.0, 0.0], 0.5)
+    assert m.colours().voxel_count == 0 and m.occupied().voxel_count == 0
+    with pytest.raises(ValueError, match="history"):
+        ktree.OccupancyMap(0.2, history=True).forget_outside([0.0] * 3, 1.0)
+
+
 def test_colours_are_means_of_points_and_kept_by_colour_octree_files(tmp_path):
     rng = np.random.default_rng(9)
     points = rng.uniform(-1.5, 1.5, size=(400, 3)).astype(np.float32)

@@ -46,7 +46,8 @@ pub use update::{apply, ScanUpdate};
 pub use view::MapView;
 
 use crate::tree::storage::infallible;
-use crate::tree::top_down::{build_top_down, Decision};
+use crate::tree::top_down::{build_top_down, Decision, InputNode};
+use crate::tree::valued::ValueState;
 use crate::tree::TreeError;
 use crate::KTree;
 
@@ -199,6 +200,75 @@ impl<const K: usize> OccupancyMap<K> {
     /// The free voxels (observed, not occupied).
     pub fn free(&self) -> KTree<K> {
         infallible(self.view().free())
+    }
+
+    /// Forgets the voxels whose centres lie farther than `radius` from `centre` (world coordinates): they
+    /// become unknown, the others keep their log-odds. A map kept within a distance of the sensor this way
+    /// on a long run holds the region around it, not the whole path (its memory bounded by the region).
+    ///
+    /// ```
+    /// use ktree::map::{OccupancyMap, VoxelState};
+    /// let mut map = OccupancyMap::<3>::new(0.1).unwrap();
+    /// map.insert(&[[2.05, 0.05, 0.05], [-0.55, 0.05, 0.05]], [0.05; 3], None).unwrap();
+    /// map.forget_outside([0.0; 3], 1.0).unwrap();
+    /// let states = map.states(&[[2.05, 0.05, 0.05], [0.95, 0.05, 0.05], [-0.55, 0.05, 0.05]]);
+    /// assert_eq!(states, [VoxelState::Unknown, VoxelState::Free, VoxelState::Occupied]);
+    /// ```
+    ///
+    /// # Errors
+    /// A message for a centre or radius that is not finite, or a negative radius.
+    pub fn forget_outside(&mut self, centre: [f64; K], radius: f64) -> Result<(), String> {
+        if centre.iter().any(|c| !c.is_finite()) {
+            return Err("the centre has a coordinate that is not finite".to_string());
+        }
+        if !(radius.is_finite() && radius >= 0.0) {
+            return Err(format!("the radius {radius} is not a distance (0 or more)"));
+        }
+        let (grid, tree) = (self.grid, &self.log_odds);
+        // The nearest and farthest squared distances from the centre to the voxel centres of a cell.
+        let reach = |cell: &crate::space::Cell<K>| -> (f64, f64) {
+            let (mut near, mut far) = (0.0, 0.0);
+            for (a, &c) in centre.iter().enumerate() {
+                let lo = grid.centre(cell.origin()[a]);
+                let hi = lo + (cell.side() - 1) as f64 * grid.resolution();
+                let gap = (lo - c).max(c - hi).max(0.0);
+                let span = (c - lo).abs().max((hi - c).abs());
+                near += gap * gap;
+                far += span * span;
+            }
+            (near, far)
+        };
+        let r2 = radius * radius;
+        // A cell is settled whole only clear of the sphere by more than rounding; a voxel exactly.
+        let slack = |cell: &crate::space::Cell<K>| {
+            if cell.side() == 1 {
+                0.0
+            } else {
+                1e-9 * (r2 + 1.0)
+            }
+        };
+        let kept = build_top_down::<K, f32, InputNode<f32>, TreeError>(
+            MAP_LEVEL,
+            infallible(InputNode::root(tree)),
+            |cell, node| {
+                let value = match node.state {
+                    ValueState::Empty => return Ok(Decision::Leaf(None)),
+                    ValueState::Full(v) => Some(v),
+                    ValueState::Partial | ValueState::Mixed => None,
+                };
+                let ((near, far), slack) = (reach(cell), slack(cell));
+                Ok(if near > r2 + slack {
+                    Decision::Leaf(None)
+                } else if far <= r2 - slack && value.is_some() {
+                    Decision::Leaf(value)
+                } else {
+                    Decision::Split
+                })
+            },
+            |node, code| Ok(infallible(node.child(tree, code))),
+        );
+        self.log_odds = kept.map_err(|e| e.to_string())?;
+        Ok(())
     }
 
     /// This map with its observed voxels inside `voxels` made free (their log-odds the model's lower

@@ -215,6 +215,71 @@ proptest! {
     }
 }
 
+/// A map forgets the voxels whose centres lie farther than the radius from the centre, and keeps the
+/// others' log-odds, voxel for voxel against the map before.
+fn check_forgetting<const K: usize>(
+    res: f64,
+    scans: Vec<(Vec<[f32; K]>, [f32; K])>,
+    centre: [f64; K],
+    radius: f64,
+) -> Result<(), TestCaseError> {
+    let mut map = OccupancyMap::<K>::new(res).unwrap();
+    for (points, origin) in &scans {
+        map.insert(points, *origin, None).unwrap();
+    }
+    let before = voxels(map.log_odds());
+    map.forget_outside(centre, radius).unwrap();
+    map.log_odds().assert_well_formed();
+    let g = *map.grid();
+    let expected: HashMap<[u32; K], f32> = before
+        .into_iter()
+        .filter(|(k, _)| {
+            let d2: f64 = (0..K).map(|a| (g.centre(k[a]) - centre[a]).powi(2)).sum();
+            d2 <= radius * radius
+        })
+        .collect();
+    let got = voxels(map.log_odds());
+    prop_assert_eq!(got.len(), expected.len());
+    for (k, v) in &expected {
+        prop_assert_eq!(
+            got.get(k).map(|g| g.to_bits()),
+            Some(v.to_bits()),
+            "voxel {:?}",
+            k
+        );
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(48))]
+    #[test]
+    fn a_map_forgets_what_lies_outside_a_ball_k2(scans in prop::collection::vec(scan::<2>(), 1..4), res in 0.1f64..0.7, centre in prop::array::uniform2(-3.0f64..3.0), radius in 0.0f64..4.0) {
+        check_forgetting::<2>(res, scans, centre, radius)?;
+    }
+    #[test]
+    fn a_map_forgets_what_lies_outside_a_ball_k3(scans in prop::collection::vec(scan::<3>(), 1..3), res in 0.2f64..0.7, centre in prop::array::uniform3(-3.0f64..3.0), radius in 0.0f64..4.0) {
+        check_forgetting::<3>(res, scans, centre, radius)?;
+    }
+}
+
+#[test]
+fn a_map_refuses_to_forget_around_a_centre_or_radius_that_is_not_a_number() {
+    let mut map = OccupancyMap::<3>::new(0.1).unwrap();
+    map.insert(&[[1.0, 0.0, 0.0]], [0.0; 3], None).unwrap();
+    let before = map.clone();
+    assert!(map
+        .forget_outside([f64::NAN, 0.0, 0.0], 1.0)
+        .unwrap_err()
+        .contains("centre"));
+    assert!(map
+        .forget_outside([0.0; 3], -1.0)
+        .unwrap_err()
+        .contains("radius"));
+    assert!(map.forget_outside([0.0; 3], f64::INFINITY).is_err());
+    assert_eq!(map, before);
+}
+
 /// Scans of thousands of rays, each crossing hundreds of voxels (a pseudo-random cloud of `n` points in
 /// a ball of radius 3 around the sensor, which moves a little between scans).
 fn big_scans<const K: usize>(n: usize, scans: usize) -> Vec<(Vec<[f32; K]>, [f32; K])> {
