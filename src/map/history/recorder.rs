@@ -16,9 +16,10 @@ use crate::KTree;
 const CHUNK: u64 = 8;
 
 /// Records a map's state after each step, to be made into a [`MapHistory`] — in memory bounded by a
-/// few maps, not by the number of steps: the steps are built into the history [`CHUNK`] at a time (the
-/// 4-D cells of a chunk's span of time, whose side in space is the chunk's too), and of each step only
-/// its states over cells of that side are kept, which is all the cells above the chunks are decided by.
+/// few maps, not by the number of steps: the steps are built into the history 8 at a time (the 4-D
+/// cells of a chunk's span of time, whose side in space is 8 voxels too; the recorder holds the states
+/// of the chunk's steps and of the step before it), and of each step only its states over cells of that
+/// side are kept, which is all the cells above the chunks are decided by.
 /// [`finish`](Self::finish) gives the same tree as [`MapHistory::from_steps`] of every step's states.
 #[derive(Debug, Clone)]
 pub struct HistoryRecorder {
