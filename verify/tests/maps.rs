@@ -156,6 +156,24 @@ fn voxels<const K: usize>(tree: &KTree<K, f32>) -> HashMap<[u32; K], f32> {
     out
 }
 
+/// The map's voxels are `expected`'s, with the same log-odds bit for bit.
+fn same_voxels<const K: usize>(
+    tree: &KTree<K, f32>,
+    expected: &HashMap<[u32; K], f32>,
+) -> Result<(), TestCaseError> {
+    let got = voxels(tree);
+    prop_assert_eq!(got.len(), expected.len());
+    for (k, v) in expected {
+        prop_assert_eq!(
+            got.get(k).map(|g| g.to_bits()),
+            Some(v.to_bits()),
+            "voxel {:?}",
+            k
+        );
+    }
+    Ok(())
+}
+
 fn check_map<const K: usize>(
     res: f64,
     scans: Vec<(Vec<[f32; K]>, [f32; K])>,
@@ -167,16 +185,7 @@ fn check_map<const K: usize>(
     }
     map.log_odds().assert_well_formed();
     let expected = reference(map.grid(), map.model(), &scans, max_range);
-    let got = voxels(map.log_odds());
-    prop_assert_eq!(got.len(), expected.len());
-    for (k, v) in &expected {
-        prop_assert_eq!(
-            got.get(k).map(|g| g.to_bits()),
-            Some(v.to_bits()),
-            "voxel {:?}",
-            k
-        );
-    }
+    same_voxels(map.log_odds(), &expected)?;
     // The three parts partition the map, and states agree with them.
     let (occupied, free) = (map.occupied(), map.free());
     prop_assert_eq!((&occupied & &free).unwrap().voxel_count(), 0);
@@ -238,16 +247,7 @@ fn check_forgetting<const K: usize>(
             d2 <= radius * radius
         })
         .collect();
-    let got = voxels(map.log_odds());
-    prop_assert_eq!(got.len(), expected.len());
-    for (k, v) in &expected {
-        prop_assert_eq!(
-            got.get(k).map(|g| g.to_bits()),
-            Some(v.to_bits()),
-            "voxel {:?}",
-            k
-        );
-    }
+    same_voxels(map.log_odds(), &expected)?;
     Ok(())
 }
 

@@ -69,6 +69,13 @@ pub fn state_labels(map: &OccupancyMap<3>) -> KTree<3, u8> {
     labels.unwrap_or_else(|e| unreachable!("labels are valid values: {e}"))
 }
 
+/// A value of `tree` other than [`FREE`] and [`OCCUPIED`], if it holds one.
+fn other_state<const K: usize>(tree: &KTree<K, u8>) -> Option<u8> {
+    tree.value_leaves()
+        .filter_map(|(_, v)| v)
+        .find(|&v| v != FREE && v != OCCUPIED)
+}
+
 /// A map's history: a 4-D tree at the map's keys with time (steps) along the fourth axis.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MapHistory {
@@ -96,11 +103,7 @@ impl MapHistory {
                 tree.level()
             ));
         }
-        if let Some(v) = tree
-            .value_leaves()
-            .filter_map(|(_, v)| v)
-            .find(|&v| v != FREE && v != OCCUPIED)
-        {
+        if let Some(v) = other_state(&tree) {
             return Err(format!(
                 "a map's history holds {FREE} (free) and {OCCUPIED} (occupied), not {v}"
             ));
@@ -147,11 +150,7 @@ impl MapHistory {
                     s.level()
                 ));
             }
-            if let Some(v) = s
-                .value_leaves()
-                .filter_map(|(_, v)| v)
-                .find(|&v| v != FREE && v != OCCUPIED)
-            {
+            if let Some(v) = other_state(s) {
                 return Err(format!(
                     "step {t}: a map's states are {FREE} (free) and {OCCUPIED} (occupied), not {v}"
                 ));

@@ -78,17 +78,22 @@ impl HistoryRecorder {
         self.coarse.push(coarse_states(&labels));
         self.current.push(labels);
         if self.current.len() as u64 == CHUNK {
-            let first = self.chunks.len() as u64 * CHUNK;
-            let window = Window {
-                first,
-                before: self.before.as_ref(),
-                steps: &self.current,
-                side: CHUNK,
-            };
-            self.chunks.push(window.tree());
+            let chunk = self.current_chunk();
+            self.chunks.push(chunk);
             self.before = self.current.pop();
             self.current.clear();
         }
+    }
+
+    /// The history of the current chunk's steps (its cells of time side [`CHUNK`] and below).
+    fn current_chunk(&self) -> KTree<4, u8> {
+        Window {
+            first: self.chunks.len() as u64 * CHUNK,
+            before: self.before.as_ref(),
+            steps: &self.current,
+            side: CHUNK,
+        }
+        .tree()
     }
 
     /// The steps recorded so far.
@@ -110,15 +115,7 @@ impl HistoryRecorder {
     /// [`MapHistory::from_steps`] of every step's states.
     pub fn finish(&self) -> MapHistory {
         let count = self.coarse.len() as u64;
-        let last = (!self.current.is_empty()).then(|| {
-            Window {
-                first: self.chunks.len() as u64 * CHUNK,
-                before: self.before.as_ref(),
-                steps: &self.current,
-                side: CHUNK,
-            }
-            .tree()
-        });
+        let last = (!self.current.is_empty()).then(|| self.current_chunk());
         let chunks: Vec<&KTree<4, u8>> = self.chunks.iter().chain(&last).collect();
         MapHistory {
             grid: self.grid,
