@@ -158,7 +158,7 @@ pub fn voxelize_window(
     out: &Path,
 ) -> CliResult {
     let volume = Volume::read(input).map_err(CliError::caused)?;
-    let level = level.unwrap_or_else(|| fitting_level(&volume, offset));
+    let level = level.unwrap_or_else(|| fitting_level(volume.shape(), offset));
     let runs = volume
         .to_window_runs(level, offset, window.0, window.1)
         .map_err(|e| CliError::in_file(input, e))?;
@@ -175,9 +175,9 @@ pub fn voxelize_window(
     Ok(())
 }
 
-/// The smallest level whose universe holds `volume` placed at `offset`.
-pub fn fitting_level(volume: &Volume, offset: [u32; 3]) -> u32 {
-    let fits = [0, 1, 2].map(|a| offset[a] as usize + volume.shape()[a]);
+/// The smallest level whose universe holds a volume of `shape` samples placed at `offset`.
+pub fn fitting_level(shape: [usize; 3], offset: [u32; 3]) -> u32 {
+    let fits = [0, 1, 2].map(|a| offset[a] as usize + shape[a]);
     let m = fits.into_iter().max().unwrap_or(1).max(1);
     m.next_power_of_two().trailing_zeros()
 }

@@ -16,7 +16,7 @@ use ktree::io::ktree::v3::{
 use ktree::io::ktree::Notes;
 use ktree::query::{stats, TreeStats};
 use ktree::solid::cloud::{self, CloudVoxelizer, PointCloud};
-use ktree::solid::volume::Volume;
+use ktree::solid::volume_file::{label_tree, VolumeFile};
 use ktree::value::{Dtype, Value};
 use ktree::{with_valued, AnyValuedTree, KTree};
 
@@ -66,7 +66,11 @@ fn read_valued_noted(path: &Path) -> CliResult<(AnyValuedTree, Notes)> {
     }
 }
 
-/// A label volume into a valued tree of the smallest label type that holds it (or `dtype`).
+/// The labels held at once while a label volume is read: slabs of up to 64 MiB of labels.
+const LABEL_SLAB_BYTES: usize = 64 << 20;
+
+/// A label volume into a valued tree of the smallest label type that holds it (or `dtype`), read slab by
+/// slab along z: the volume is never held whole, so one larger than memory is voxelized.
 pub fn voxelize_labels(
     input: &Path,
     level: Option<u32>,
@@ -74,12 +78,13 @@ pub fn voxelize_labels(
     dtype: Option<&str>,
     out: &Path,
 ) -> CliResult {
-    let volume = Volume::read(input).map_err(CliError::caused)?;
-    let smallest = volume
-        .label_dtype()
-        .map_err(|e| CliError::in_file(input, e))?;
+    let file = VolumeFile::open(input).map_err(CliError::caused)?;
+    let shape = file.shape();
     let dtype = match dtype {
-        None => smallest,
+        // A first pass over the file finds the smallest type that holds every label.
+        None => file
+            .label_dtype()
+            .map_err(|e| CliError::in_file(input, e))?,
         Some(name) => match Dtype::parse(name) {
             Some(d @ (Dtype::U8 | Dtype::U16 | Dtype::U32)) => d,
             _ => {
@@ -87,20 +92,21 @@ pub fn voxelize_labels(
             }
         },
     };
-    let level = level.unwrap_or_else(|| crate::convert_values::fitting_level(&volume, offset));
-    fn build<V: Value + TryFrom<u32>>(
-        volume: &Volume,
+    let level = level.unwrap_or_else(|| crate::convert_values::fitting_level(shape, offset));
+    fn build<V: Value + TryFrom<u32> + Send + Sync>(
         input: &Path,
         level: u32,
         offset: [u32; 3],
         out: &Path,
     ) -> CliResult {
-        let runs = volume
-            .to_label_runs::<V>(level, offset)
+        let tree = label_tree::<V>(input, level, offset, LABEL_SLAB_BYTES)
             .map_err(|e| CliError::in_file(input, e))?;
-        let tree = KTree::from_value_runs(&runs);
         write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
-        let labels = tree.value_stats().len();
+        let labels: std::collections::HashSet<V::Key> = tree
+            .value_leaves()
+            .filter_map(|(_, v)| v.map(V::key))
+            .collect();
+        let labels = labels.len();
         outln!(
             "{}: {} voxels labelled with {labels} labels ({}), L = {level}, {} nodes",
             out.display(),
@@ -111,9 +117,9 @@ pub fn voxelize_labels(
         Ok(())
     }
     match dtype {
-        Dtype::U8 => build::<u8>(&volume, input, level, offset, out),
-        Dtype::U16 => build::<u16>(&volume, input, level, offset, out),
-        _ => build::<u32>(&volume, input, level, offset, out),
+        Dtype::U8 => build::<u8>(input, level, offset, out),
+        Dtype::U16 => build::<u16>(input, level, offset, out),
+        _ => build::<u32>(input, level, offset, out),
     }
 }
 

@@ -103,6 +103,16 @@ pub enum RayError {
         /// End.
         z2: u32,
     },
+    /// A slab of a dense volume read slab by slab holds another number of values than its box has voxels.
+    #[error("the slab from {first} along the last axis holds {got} values, but its box has {expected} voxels")]
+    SlabLength {
+        /// The slab's first coordinate along the last axis.
+        first: u32,
+        /// The voxels of the slab's box.
+        expected: usize,
+        /// The values given.
+        got: usize,
+    },
     /// A run's value is one no voxel may hold.
     #[error("run {index}: {error}")]
     Value {

@@ -8,6 +8,7 @@
 //!
 //! Meshes and clouds are read from their files by [`crate::io`] (`read_mesh`, `read_cloud`).
 //! * [`volume`]: dense 3-D scalar volumes (raw + JSON sidecar, NIfTI) by threshold or label.
+//! * [`volume_file`]: a volume file read plane by plane, and a tree of its labels built slab by slab.
 //!
 //! Boolean operations and translation on the resulting rays are in [`crate::rays`] (`union`, …).
 //!
@@ -32,6 +33,8 @@ mod quadric;
 mod rational;
 #[cfg(feature = "volume")]
 pub mod volume;
+#[cfg(feature = "volume")]
+pub mod volume_file;
 
 pub use boxsolid::BoxSolid;
 pub use error::SolidError;

@@ -81,12 +81,12 @@ struct Sidecar {
 /// Largest number of samples accepted (checked before allocating).
 pub const MAX_SAMPLES: usize = 1 << 31;
 /// Bytes of a NIfTI-1 header.
-const NIFTI_HEADER_BYTES: u64 = 348;
+pub(super) const NIFTI_HEADER_BYTES: u64 = 348;
 /// Largest offset of the samples in a NIfTI file (room for header extensions).
 const MAX_NIFTI_OFFSET: f32 = (1u32 << 24) as f32;
 
 /// The sample layout a raw volume's JSON sidecar describes.
-struct RawLayout {
+pub(super) struct RawLayout {
     meta: Sidecar,
     samples: usize,
     size: usize,
@@ -94,7 +94,45 @@ struct RawLayout {
 }
 
 impl RawLayout {
+    /// The layout of a volume to be held in memory: at most [`MAX_SAMPLES`] samples.
     fn parse(text: &[u8], json: &Path) -> Result<Self, SolidError> {
+        Self::parse_within(text, json, MAX_SAMPLES)
+    }
+
+    /// The layout of a volume read plane by plane: any number of samples.
+    pub(super) fn parse_streamed(text: &[u8], json: &Path) -> Result<Self, SolidError> {
+        Self::parse_within(text, json, usize::MAX)
+    }
+
+    /// The raw file the sidecar `json` describes: its `file`, or the same name with `.raw`.
+    pub(super) fn raw_file(&self, json: &Path) -> std::path::PathBuf {
+        match &self.meta.file {
+            Some(f) => json.with_file_name(f),
+            None => json.with_extension("raw"),
+        }
+    }
+
+    pub(super) fn shape(&self) -> [usize; 3] {
+        self.meta.shape_xyz
+    }
+
+    pub(super) fn spacing(&self) -> [f64; 3] {
+        self.meta.spacing_xyz.unwrap_or([1.0; 3])
+    }
+
+    pub(super) fn dtype(&self) -> &str {
+        &self.meta.dtype
+    }
+
+    pub(super) fn sample_bytes(&self) -> usize {
+        self.size
+    }
+
+    pub(super) fn big_endian(&self) -> bool {
+        self.big
+    }
+
+    fn parse_within(text: &[u8], json: &Path, limit: usize) -> Result<Self, SolidError> {
         let parse = |what: String| SolidError::Parse {
             path: json.to_path_buf(),
             what,
@@ -113,7 +151,7 @@ impl RawLayout {
             Some("big") => true,
             Some(other) => return Err(parse(format!("unknown endianness '{other}'"))),
         };
-        let samples = checked_samples(meta.shape_xyz)
+        let samples = checked_samples(meta.shape_xyz, limit)
             .ok_or_else(|| parse(format!("shape {:?} is empty or too large", meta.shape_xyz)))?;
         Ok(Self {
             meta,
@@ -124,7 +162,7 @@ impl RawLayout {
     }
 
     /// Checks the raw data's length before it is read or decoded.
-    fn check_length(&self, got: u64, raw: &Path) -> Result<(), SolidError> {
+    pub(super) fn check_length(&self, got: u64, raw: &Path) -> Result<(), SolidError> {
         let want = self.samples as u64 * self.size as u64;
         if got == want {
             return Ok(());
@@ -139,10 +177,8 @@ impl RawLayout {
     }
 
     fn decode(self, bytes: &[u8]) -> Volume {
-        let values = bytes
-            .chunks_exact(self.size)
-            .map(|c| decode(&self.meta.dtype, c, self.big))
-            .collect();
+        let mut values = Vec::with_capacity(self.samples);
+        decode_into(&self.meta.dtype, self.big, bytes, &mut values);
         Volume {
             shape: self.meta.shape_xyz,
             values,
@@ -184,10 +220,7 @@ impl Volume {
             source,
         })?;
         let layout = RawLayout::parse(&text, json)?;
-        let raw = match &layout.meta.file {
-            Some(f) => json.with_file_name(f),
-            None => json.with_extension("raw"),
-        };
+        let raw = layout.raw_file(json);
         let got = std::fs::metadata(&raw)
             .map_err(|source| SolidError::Io {
                 path: raw.clone(),
@@ -265,30 +298,11 @@ impl Volume {
             .read_to_end(&mut data)
             .map_err(io_error)?;
         let header = nifti::NiftiHeader::from_reader(&data[..]).map_err(nifti_error)?;
+        let layout = nifti_layout(&header, file, true)?;
+        let (shape, n) = (layout.shape, layout.shape.iter().product::<usize>());
         let dim = header.dim().map_err(nifti_error)?.to_vec();
-        if dim.len() < 3 || dim.len() > 4 || (dim.len() == 4 && dim[3] != 1) {
-            return Err(parse(format!(
-                "NIfTI: expected a 3-D volume, found dimensions {dim:?}"
-            )));
-        }
-        let shape = [dim[0] as usize, dim[1] as usize, dim[2] as usize];
-        let n = checked_samples(shape)
-            .ok_or_else(|| parse(format!("shape {shape:?} is empty or too large")))?;
-        let datatype = header.data_type().map_err(nifti_error)?;
-        let sample = datatype.size_of() as u64;
-        if u64::from(header.bitpix.unsigned_abs()) != 8 * sample {
-            return Err(parse(format!(
-                "NIfTI: {} bits per sample do not match the data type {datatype:?}",
-                header.bitpix
-            )));
-        }
-        let offset = header.vox_offset;
-        if !(offset >= NIFTI_HEADER_BYTES as f32 + 4.0 && offset <= MAX_NIFTI_OFFSET) {
-            return Err(parse(format!(
-                "NIfTI: the samples' offset {offset} is not from 352 to {MAX_NIFTI_OFFSET}"
-            )));
-        }
-        let need = offset as u64 + n as u64 * sample;
+        let (offset, sample) = (layout.offset, layout.sample);
+        let need = offset + n as u64 * sample;
         (&mut input)
             .take(need - data.len() as u64)
             .read_to_end(&mut data)
@@ -329,7 +343,7 @@ impl Volume {
     /// [`SolidError::BadParameter`] when the shape is empty or beyond 2^20 samples an axis or 2^31 in all,
     /// or `values` does not hold exactly one sample per voxel of the shape.
     pub fn new(shape: [usize; 3], values: Vec<f64>, spacing: [f64; 3]) -> Result<Self, SolidError> {
-        let n = checked_samples(shape).ok_or_else(|| {
+        let n = checked_samples(shape, MAX_SAMPLES).ok_or_else(|| {
             SolidError::BadParameter(format!("volume shape {shape:?} is empty or too large"))
         })?;
         if values.len() != n {
@@ -392,28 +406,17 @@ impl Volume {
     /// [`SolidError::BadParameter`] naming the first sample that is not a label (a non-negative integer up
     /// to `u32::MAX`), with its `(x, y, z)`.
     pub fn label_dtype(&self) -> Result<Dtype, SolidError> {
-        let mut largest = 0f64;
+        let mut largest = 0u32;
         for (i, &v) in self.values.iter().enumerate() {
-            if !(v >= 0.0 && v <= f64::from(u32::MAX) && v.fract() == 0.0) {
-                return Err(self.not_a_label(i, v));
-            }
-            largest = largest.max(v);
+            largest = largest.max(label_of::<u32>(self.position(i), v)?);
         }
-        Ok(if largest <= f64::from(u8::MAX) {
-            Dtype::U8
-        } else if largest <= f64::from(u16::MAX) {
-            Dtype::U16
-        } else {
-            Dtype::U32
-        })
+        Ok(smallest_label_type(largest))
     }
 
-    fn not_a_label(&self, i: usize, v: f64) -> SolidError {
+    /// The `(x, y, z)` of sample `i`.
+    fn position(&self, i: usize) -> [usize; 3] {
         let [nx, ny, _] = self.shape;
-        let (x, y, z) = (i % nx, i / nx % ny, i / (nx * ny));
-        SolidError::BadParameter(format!(
-            "sample ({x}, {y}, {z}) is {v}: labels are whole numbers from 0 (the background) up"
-        ))
+        [i % nx, i / nx % ny, i / (nx * ny)]
     }
 
     /// The samples as labels of type `V`, placed at `offset` in a universe of level `level`: each run of
@@ -437,16 +440,10 @@ impl Volume {
         offset: [u32; 3],
     ) -> Result<ValueRuns<3, V>, SolidError> {
         self.to_value_runs(level, offset, |i, v| {
-            if !(v >= 0.0 && v <= f64::from(u32::MAX) && v.fract() == 0.0) {
-                return Err(self.not_a_label(i, v));
-            }
-            let label = v as u32;
-            if label == 0 {
+            if v == 0.0 {
                 return Ok(None);
             }
-            V::try_from(label)
-                .map(Some)
-                .map_err(|_| self.not_a_label(i, v))
+            label_of::<V>(self.position(i), v).map(Some)
         })
     }
 
@@ -660,37 +657,120 @@ impl RaySource<3> for VolumeSource {
     }
 }
 
-fn checked_samples(shape: [usize; 3]) -> Option<usize> {
-    let n = shape.iter().try_fold(1usize, |p, &s| p.checked_mul(s))?;
-    (n > 0 && n <= MAX_SAMPLES && shape.iter().all(|&s| s <= 1 << 20)).then_some(n)
+/// A sample at `at` (`x, y, z`) as a label of type `V`: a whole number from 0 (the background) that `V`
+/// holds.
+pub(super) fn label_of<V: TryFrom<u32>>(at: [usize; 3], v: f64) -> Result<V, SolidError> {
+    let [x, y, z] = at;
+    if !(v >= 0.0 && v <= f64::from(u32::MAX) && v.fract() == 0.0) {
+        return Err(SolidError::BadParameter(format!(
+            "sample ({x}, {y}, {z}) is {v}: labels are whole numbers from 0 (the background) up"
+        )));
+    }
+    V::try_from(v as u32).map_err(|_| {
+        SolidError::BadParameter(format!(
+            "sample ({x}, {y}, {z}) is {v}: more than the largest label of the type"
+        ))
+    })
 }
 
-fn decode(dtype: &str, c: &[u8], big: bool) -> f64 {
+/// The smallest label type that holds the labels up to `largest`.
+pub(super) fn smallest_label_type(largest: u32) -> Dtype {
+    if largest <= u32::from(u8::MAX) {
+        Dtype::U8
+    } else if largest <= u32::from(u16::MAX) {
+        Dtype::U16
+    } else {
+        Dtype::U32
+    }
+}
+
+/// The number of samples of `shape` if it is not empty, at most `limit`, and at most 2^20 an axis.
+fn checked_samples(shape: [usize; 3], limit: usize) -> Option<usize> {
+    let n = shape.iter().try_fold(1usize, |p, &s| p.checked_mul(s))?;
+    (n > 0 && n <= limit && shape.iter().all(|&s| s <= 1 << 20)).then_some(n)
+}
+
+/// Where a NIfTI file's samples are and what they are.
+pub(super) struct NiftiLayout {
+    pub(super) shape: [usize; 3],
+    pub(super) datatype: nifti::NiftiType,
+    /// Bytes a sample.
+    pub(super) sample: u64,
+    /// The byte the samples start at.
+    pub(super) offset: u64,
+}
+
+/// A NIfTI header's layout, checked: a 3-D volume (or 4-D of one time point), its sample count (at most
+/// [`MAX_SAMPLES`] when `in_memory`), bits a sample matching the data type, and the samples' offset.
+pub(super) fn nifti_layout(
+    header: &nifti::NiftiHeader,
+    file: &Path,
+    in_memory: bool,
+) -> Result<NiftiLayout, SolidError> {
+    let parse = |what: String| SolidError::Parse {
+        path: file.to_path_buf(),
+        what,
+    };
+    let nifti_error = |e: nifti::NiftiError| parse(format!("NIfTI: {e}"));
+    let dim = header.dim().map_err(nifti_error)?.to_vec();
+    if dim.len() < 3 || dim.len() > 4 || (dim.len() == 4 && dim[3] != 1) {
+        return Err(parse(format!(
+            "NIfTI: expected a 3-D volume, found dimensions {dim:?}"
+        )));
+    }
+    let shape = [dim[0] as usize, dim[1] as usize, dim[2] as usize];
+    let limit = if in_memory { MAX_SAMPLES } else { usize::MAX };
+    checked_samples(shape, limit)
+        .ok_or_else(|| parse(format!("shape {shape:?} is empty or too large")))?;
+    let datatype = header.data_type().map_err(nifti_error)?;
+    let sample = datatype.size_of() as u64;
+    if u64::from(header.bitpix.unsigned_abs()) != 8 * sample {
+        return Err(parse(format!(
+            "NIfTI: {} bits per sample do not match the data type {datatype:?}",
+            header.bitpix
+        )));
+    }
+    let offset = header.vox_offset;
+    if !(offset >= NIFTI_HEADER_BYTES as f32 + 4.0 && offset <= MAX_NIFTI_OFFSET) {
+        return Err(parse(format!(
+            "NIfTI: the samples' offset {offset} is not from 352 to {MAX_NIFTI_OFFSET}"
+        )));
+    }
+    Ok(NiftiLayout {
+        shape,
+        datatype,
+        sample,
+        offset: offset as u64,
+    })
+}
+
+/// Appends the samples packed in `bytes` as `dtype` (a raw sidecar's type name), big-endian when `big`, to
+/// `out`; a trailing partial sample is ignored.
+pub(super) fn decode_into(dtype: &str, big: bool, bytes: &[u8], out: &mut Vec<f64>) {
     macro_rules! num {
         ($t:ty) => {{
-            let b = c.try_into().unwrap_or_default();
-            f64::from(if big {
-                <$t>::from_be_bytes(b)
-            } else {
-                <$t>::from_le_bytes(b)
-            })
+            const N: usize = std::mem::size_of::<$t>();
+            out.extend(bytes.chunks_exact(N).map(|c| {
+                let b: [u8; N] = c.try_into().unwrap_or_default();
+                let v = if big {
+                    <$t>::from_be_bytes(b)
+                } else {
+                    <$t>::from_le_bytes(b)
+                };
+                #[allow(clippy::cast_lossless)]
+                let v = v as f64;
+                v
+            }))
         }};
     }
     match dtype {
-        "uint8" => f64::from(c[0]),
-        "int8" => f64::from(c[0] as i8),
+        "uint8" => num!(u8),
+        "int8" => num!(i8),
         "uint16" => num!(u16),
         "int16" => num!(i16),
         "uint32" => num!(u32),
         "int32" => num!(i32),
         "float32" => num!(f32),
-        _ => {
-            let b = c.try_into().unwrap_or_default();
-            if big {
-                f64::from_be_bytes(b)
-            } else {
-                f64::from_le_bytes(b)
-            }
-        }
+        _ => num!(f64),
     }
 }

@@ -63,7 +63,7 @@ impl<const K: usize, V: Value> KTree<K, V> {
 
 /// A dense array of values, the value that means empty, and which of its bricks (cells of side
 /// `2^brick_log`) hold one value throughout.
-struct Dense<'a, const K: usize, V> {
+pub(super) struct Dense<'a, const K: usize, V> {
     universe: Universe<K>,
     dense: &'a [V],
     background: V,
@@ -75,7 +75,7 @@ struct Dense<'a, const K: usize, V> {
 impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
     /// The array's bricks read once, on the rayon pool: bricks of about 4096 voxels (no larger than the
     /// universe).
-    fn new(universe: Universe<K>, dense: &'a [V], background: V) -> Self {
+    pub(super) fn new(universe: Universe<K>, dense: &'a [V], background: V) -> Self {
         let brick_log = (12 / K as u32).min(universe.level());
         let bricks = uniform_bricks::<K, V>(dense, universe.side() as usize, brick_log);
         Self {
@@ -118,7 +118,7 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
 
     /// The subtree of `cell`: its state and the states of each level below it (in level order), built
     /// apart on the rayon pool down to the cells of depth `split`.
-    fn subtree(&self, cell: Cell<K>, split: u32) -> Result<Subtree<V>, RayError>
+    pub(super) fn subtree(&self, cell: Cell<K>, split: u32) -> Result<Subtree<V>, RayError>
     where
         V: Sync,
     {

@@ -102,6 +102,7 @@ mod out_of_core;
 pub mod paper;
 mod partition;
 mod solids;
+mod value_slabs;
 mod values;
 
 pub use builder::{Builder, CellStacking};

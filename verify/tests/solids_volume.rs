@@ -137,3 +137,154 @@ fn nifti_and_raw_read_alike() {
     std::fs::write(&nii, &nifti_bytes(shape, &values, 1.0, 0.0)[..200]).unwrap();
     assert!(Volume::read(&nii).is_err());
 }
+
+/// Labels read slab by slab from the file ([`label_tree`]) are the tree of the volume read whole, for
+/// raw samples of every integer type in both byte orders, NIfTI (scaled) and gzip-compressed NIfTI, at
+/// offsets, for slabs of every thickness; damaged files are errors naming the file, never panics.
+#[test]
+fn labels_read_slab_by_slab_are_the_labels_of_the_whole_volume() {
+    use ktree::solid::volume_file::{label_tree, VolumeFile};
+    use ktree::KTree;
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let shape = [5usize, 6, 7];
+    let n = shape.iter().product::<usize>();
+    // Blocks of labels, some scattered voxels, a background of 0.
+    let labels: Vec<u32> = (0..n)
+        .map(|i| {
+            let (x, y, z) = (i % 5, i / 5 % 6, i / 30);
+            if i * 7919 % 23 == 0 {
+                9
+            } else if z < 2 {
+                0
+            } else {
+                (1 + x / 3 + 2 * (y / 3)) as u32
+            }
+        })
+        .collect();
+    let whole = |path: &std::path::Path, level, offset| {
+        let v = Volume::read(path).unwrap();
+        KTree::from_value_runs(&v.to_label_runs::<u16>(level, offset).unwrap())
+    };
+    let check = |path: &std::path::Path| {
+        assert_eq!(VolumeFile::open(path).unwrap().shape(), shape);
+        assert_eq!(
+            VolumeFile::open(path).unwrap().label_dtype().unwrap(),
+            ktree::value::Dtype::U8
+        );
+        for (level, offset) in [(3, [0, 0, 0]), (4, [3, 9, 1]), (5, [17, 0, 20])] {
+            let want = whole(path, level, offset);
+            assert_eq!(
+                want.voxel_count(),
+                labels.iter().filter(|&&l| l > 0).count() as u128
+            );
+            for slab_bytes in [0, 60, 1 << 10, 1 << 20] {
+                let got = label_tree::<u16>(path, level, offset, slab_bytes).unwrap();
+                assert!(
+                    got == want,
+                    "{} at {offset:?}, slabs of {slab_bytes} bytes",
+                    path.display()
+                );
+            }
+        }
+        // A volume that does not fit the universe.
+        let e = label_tree::<u16>(path, 3, [4, 0, 0], 1 << 20)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("does not fit"), "{e}");
+    };
+    for (dtype, size) in [
+        ("uint8", 1),
+        ("int16", 2),
+        ("uint16", 2),
+        ("int32", 4),
+        ("uint32", 4),
+    ] {
+        for big in [false, true] {
+            let raw: Vec<u8> = labels
+                .iter()
+                .flat_map(|&l| {
+                    let le = l.to_le_bytes();
+                    let mut b = le[..size].to_vec();
+                    if big {
+                        b.reverse();
+                    }
+                    b
+                })
+                .collect();
+            let name = format!("{dtype}_{big}");
+            std::fs::write(dir.path().join(format!("{name}.raw")), &raw).unwrap();
+            let json = dir.path().join(format!("{name}.json"));
+            let endianness = if big { "big" } else { "little" };
+            std::fs::write(
+                &json,
+                format!(r#"{{"shape_xyz": [5, 6, 7], "dtype": "{dtype}", "endianness": "{endianness}"}}"#),
+            )
+            .unwrap();
+            check(&json);
+        }
+    }
+    // NIfTI with a scale (stored (label − 1) / 2 → label), and the same gzip-compressed.
+    let stored: Vec<i16> = labels.iter().map(|&l| l as i16).collect();
+    let nii_bytes = nifti_bytes(
+        [5, 6, 7],
+        &stored.iter().map(|&l| l * 2).collect::<Vec<_>>(),
+        0.5,
+        0.0,
+    );
+    let nii = dir.path().join("l.nii");
+    std::fs::write(&nii, &nii_bytes).unwrap();
+    check(&nii);
+    let gz = dir.path().join("l.nii.gz");
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    enc.write_all(&nii_bytes).unwrap();
+    std::fs::write(&gz, enc.finish().unwrap()).unwrap();
+    check(&gz);
+    // Damaged: a NIfTI file cut in the samples (plain and compressed), a raw file too short, a sample
+    // that is not a label, a label beyond the type.
+    std::fs::write(&nii, &nii_bytes[..352 + 2 * 70]).unwrap();
+    let e = label_tree::<u16>(&nii, 3, [0; 3], 1 << 20)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("l.nii") && e.contains("plane z = 2"), "{e}");
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    enc.write_all(&nii_bytes[..352 + 2 * 100]).unwrap();
+    std::fs::write(&gz, enc.finish().unwrap()).unwrap();
+    let e = label_tree::<u16>(&gz, 3, [0; 3], 1 << 20)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("l.nii.gz") && e.contains("plane z = 3"), "{e}");
+    let json = dir.path().join("uint8_false.json");
+    std::fs::write(dir.path().join("uint8_false.raw"), vec![0u8; n - 1]).unwrap();
+    let e = label_tree::<u16>(&json, 3, [0; 3], 1 << 20)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("uint8_false.raw") && e.contains(&format!("{} bytes", n - 1)),
+        "{e}"
+    );
+    let mut floats = stored.clone();
+    floats[5 + 5 * 3] = -1;
+    std::fs::write(&nii, nifti_bytes([5, 6, 7], &floats, 1.0, 0.5)).unwrap();
+    let e = label_tree::<u16>(&nii, 3, [0; 3], 1 << 20)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("(0, 0, 0)") && e.contains("whole numbers"),
+        "{e}"
+    );
+    std::fs::write(&nii, nifti_bytes([5, 6, 7], &floats, 1.0, 0.0)).unwrap();
+    let e = label_tree::<u8>(&nii, 3, [0; 3], 1 << 20)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("(0, 4, 0)") && e.contains("whole numbers"),
+        "{e}"
+    );
+    floats[5 + 5 * 3] = 300;
+    std::fs::write(&nii, nifti_bytes([5, 6, 7], &floats, 1.0, 0.0)).unwrap();
+    let e = label_tree::<u8>(&nii, 3, [0; 3], 1 << 20)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("(0, 4, 0)") && e.contains("300"), "{e}");
+}

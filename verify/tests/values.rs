@@ -288,3 +288,100 @@ fn valued_runs_that_overlap_or_hold_nan_are_errors() {
     let e = KTree::<2, f32>::from_dense_background(1, &[0.0; 5], 0.0).unwrap_err();
     assert!(!e.to_string().is_empty());
 }
+
+/// Building from a box of the dense array read slab by slab along the last axis: for a box of the painted
+/// universe (everything outside it emptied) and every slab thickness, the tree of the emptied array; a
+/// slab of the wrong length is an error, not a tree.
+fn from_slabs<const K: usize, V: Palette>(
+    o: &Painted<K>,
+    corners: ([u32; K], [u32; K]),
+) -> Result<(), TestCaseError> {
+    use ktree::rays::RayError;
+    let u = o.universe();
+    let side = u.side() as u32;
+    let region: [std::ops::Range<u32>; K] = std::array::from_fn(|a| {
+        let (p, q) = (corners.0[a] % (side + 1), corners.1[a] % (side + 1));
+        p.min(q)..p.max(q)
+    });
+    let background = V::PALETTE[0];
+    let plain: Vec<V> = o
+        .dense::<V>()
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let p = u.dense_point(i);
+            let inside = (0..K).all(|a| region[a].contains(&p[a]));
+            v.filter(|_| inside).unwrap_or(background)
+        })
+        .collect();
+    let want = KTree::<K, V>::from_dense_background(o.level, &plain, background).unwrap();
+    // The box's values with the last coordinate in `rows`, axis 0 fastest.
+    let read = |rows: std::ops::Range<u32>, out: &mut Vec<V>| {
+        for (i, &v) in plain.iter().enumerate() {
+            let p = u.dense_point(i);
+            let inside = (0..K - 1).all(|a| region[a].contains(&p[a]));
+            if inside && rows.contains(&p[K - 1]) {
+                out.push(v);
+            }
+        }
+        Ok::<_, RayError>(())
+    };
+    let row = std::mem::size_of::<V>() * region[..K - 1].iter().map(|r| r.len()).product::<usize>();
+    let mut slabs_seen = Vec::new();
+    for s in 0..=o.level {
+        let got = KTree::<K, V>::from_value_slabs(
+            o.level,
+            region.clone(),
+            background,
+            row << s,
+            |rows, out| {
+                slabs_seen.push(rows.clone());
+                read(rows, out)
+            },
+        )
+        .unwrap();
+        got.assert_well_formed();
+        prop_assert!(got == want, "slabs 2^{s} thick, box {region:?}");
+        // The slabs cover the box's rows once, in order (none of an empty box is read).
+        let covered: Vec<u32> = slabs_seen.drain(..).flatten().collect();
+        let rows = if region.iter().any(|r| r.is_empty()) {
+            0..0
+        } else {
+            region[K - 1].clone()
+        };
+        prop_assert_eq!(covered, rows.collect::<Vec<_>>());
+    }
+    if !region.iter().any(|r| r.is_empty()) {
+        let short =
+            KTree::<K, V>::from_value_slabs(o.level, region.clone(), background, 0, |rows, out| {
+                read(rows, out)?;
+                out.pop();
+                Ok::<_, RayError>(())
+            });
+        prop_assert!(
+            matches!(short, Err(RayError::SlabLength { .. })),
+            "{short:?}"
+        );
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(48))]
+    #[test]
+    fn slabs_k1(o in painted::<1>(), c in any::<([u32; 1], [u32; 1])>()) { from_slabs::<1, u8>(&o, c)?; from_slabs::<1, f32>(&o, c)?; }
+    #[test]
+    fn slabs_k2(o in painted::<2>(), c in any::<([u32; 2], [u32; 2])>()) { from_slabs::<2, Rgb>(&o, c)?; from_slabs::<2, u16>(&o, c)?; }
+    #[test]
+    fn slabs_k3(o in painted::<3>(), c in any::<([u32; 3], [u32; 3])>()) { from_slabs::<3, i8>(&o, c)?; from_slabs::<3, u32>(&o, c)?; }
+    #[test]
+    fn slabs_k4(o in painted::<4>(), c in any::<([u32; 4], [u32; 4])>()) { from_slabs::<4, f32>(&o, c)?; from_slabs::<4, u8>(&o, c)?; }
+}
+
+#[test]
+fn a_box_beyond_the_universe_is_an_error() {
+    use ktree::rays::RayError;
+    let got =
+        KTree::<2, u8>::from_value_slabs(2, [0..5, 0..4], 0, 1 << 20, |_, _| Ok::<_, RayError>(()));
+    assert!(matches!(got, Err(RayError::Space(_))), "{got:?}");
+}

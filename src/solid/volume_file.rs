@@ -1,0 +1,330 @@
+//! A volume file read plane by plane along z, front to back, without holding its samples: the input of a
+//! tree of labels built slab by slab ([`KTree::from_value_slabs`]) from a volume larger than memory.
+//!
+//! The formats and the samples' values are those of [`Volume`](super::volume::Volume): raw samples with a
+//! JSON sidecar (the raw file's length checked against the sidecar before anything is read), and NIfTI-1
+//! (`.nii`, or `.nii.gz` told by the gzip magic, inflated as it is read; the header checked as
+//! [`Volume::read_nifti`](super::volume::Volume::read_nifti) checks it, the samples rescaled by
+//! `scl_slope`/`scl_inter` by the `nifti` crate's own decoding). A volume read here may hold more than
+//! [`MAX_SAMPLES`](super::volume::MAX_SAMPLES) samples; one plane may not.
+//!
+//! ```
+//! use ktree::solid::volume::Volume;
+//! use ktree::solid::volume_file::{label_tree, VolumeFile};
+//! use std::path::Path;
+//! let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/volumes/itk_t1_brain.json");
+//! let file = VolumeFile::open(&path).unwrap();
+//! assert_eq!(file.shape(), [128, 128, 62]);
+//! // The brain's intensities up to 255 taken as labels, read 1 MiB at a time.
+//! let tree = label_tree::<u8>(&path, 7, [0, 0, 0], 1 << 20).unwrap();
+//! let volume = Volume::read(&path).unwrap();
+//! assert_eq!(tree, ktree::KTree::from_value_runs(&volume.to_label_runs::<u8>(7, [0, 0, 0]).unwrap()));
+//! ```
+
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::{Path, PathBuf};
+
+use super::volume::{label_of, nifti_layout, smallest_label_type, RawLayout};
+use super::SolidError;
+use crate::rays::RayError;
+use crate::value::{Dtype, Value};
+use crate::KTree;
+
+/// Largest number of samples in one plane (checked before a plane is allocated).
+pub const MAX_PLANE_SAMPLES: usize = 1 << 31;
+
+/// How a plane's bytes become samples.
+enum Samples {
+    /// A raw file's type name, sample size and byte order.
+    Raw {
+        dtype: String,
+        size: usize,
+        big: bool,
+    },
+    /// A NIfTI file's data type, byte order and scaling.
+    Nifti {
+        datatype: nifti::NiftiType,
+        size: usize,
+        endianness: nifti::Endianness,
+        slope: f32,
+        inter: f32,
+    },
+}
+
+/// A volume file open for reading its planes along z in order.
+pub struct VolumeFile {
+    path: PathBuf,
+    shape: [usize; 3],
+    spacing: [f64; 3],
+    samples: Samples,
+    input: Box<dyn Read>,
+    planes_read: usize,
+    bytes: Vec<u8>,
+}
+
+impl std::fmt::Debug for VolumeFile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("VolumeFile")
+            .field("path", &self.path)
+            .field("shape", &self.shape)
+            .field("planes_read", &self.planes_read)
+            .finish_non_exhaustive()
+    }
+}
+
+impl VolumeFile {
+    /// Opens a volume: a `.json` sidecar (or the `.raw` beside one) or a NIfTI file (`.nii`, `.nii.gz`),
+    /// its header read and checked.
+    ///
+    /// # Errors
+    /// [`SolidError::Io`] or [`SolidError::Parse`] naming the file and what is wrong.
+    pub fn open(path: &Path) -> Result<Self, SolidError> {
+        let name = path.to_string_lossy().to_ascii_lowercase();
+        if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+            Self::open_nifti(path)
+        } else if name.ends_with(".json") {
+            Self::open_raw(path)
+        } else if name.ends_with(".raw") {
+            Self::open_raw(&path.with_extension("json"))
+        } else {
+            Err(SolidError::Parse {
+                path: path.to_path_buf(),
+                what: "unknown volume format (known: .json sidecar with .raw, .nii, .nii.gz)"
+                    .into(),
+            })
+        }
+    }
+
+    fn open_raw(json: &Path) -> Result<Self, SolidError> {
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| SolidError::Io { path, source }
+        };
+        let text = std::fs::read(json).map_err(io(json))?;
+        let layout = RawLayout::parse_streamed(&text, json)?;
+        let raw = layout.raw_file(json);
+        let file = File::open(&raw).map_err(io(&raw))?;
+        let got = file.metadata().map_err(io(&raw))?.len();
+        layout.check_length(got, &raw)?;
+        Ok(Self::new(
+            raw,
+            layout.shape(),
+            layout.spacing(),
+            Samples::Raw {
+                dtype: layout.dtype().to_string(),
+                size: layout.sample_bytes(),
+                big: layout.big_endian(),
+            },
+            Box::new(BufReader::new(file)),
+        ))
+    }
+
+    fn open_nifti(path: &Path) -> Result<Self, SolidError> {
+        let parse = |what: String| SolidError::Parse {
+            path: path.to_path_buf(),
+            what,
+        };
+        let file = File::open(path).map_err(|source| SolidError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let mut file = BufReader::new(file);
+        let gz = std::io::BufRead::fill_buf(&mut file)
+            .map_err(|e| parse(format!("NIfTI: {e}")))?
+            .starts_with(&[0x1f, 0x8b]);
+        let mut input: Box<dyn Read> = if gz {
+            Box::new(flate2::bufread::GzDecoder::new(file))
+        } else {
+            Box::new(file)
+        };
+        let mut header_bytes = Vec::new();
+        (&mut input)
+            .take(super::volume::NIFTI_HEADER_BYTES)
+            .read_to_end(&mut header_bytes)
+            .map_err(|e| parse(format!("NIfTI: {e}")))?;
+        let header = nifti::NiftiHeader::from_reader(&header_bytes[..])
+            .map_err(|e| parse(format!("NIfTI: {e}")))?;
+        let layout = nifti_layout(&header, path, false)?;
+        // Past the header's extensions, to the first sample.
+        let skip = layout.offset - header_bytes.len() as u64;
+        let skipped = std::io::copy(&mut (&mut input).take(skip), &mut std::io::sink())
+            .map_err(|e| parse(format!("NIfTI: {e}")))?;
+        if skipped < skip {
+            return Err(parse(format!(
+                "NIfTI: {} bytes, but the samples start at byte {}: truncated",
+                header_bytes.len() as u64 + skipped,
+                layout.offset
+            )));
+        }
+        Ok(Self::new(
+            path.to_path_buf(),
+            layout.shape,
+            [
+                f64::from(header.pixdim[1]),
+                f64::from(header.pixdim[2]),
+                f64::from(header.pixdim[3]),
+            ],
+            Samples::Nifti {
+                datatype: layout.datatype,
+                size: layout.sample as usize,
+                endianness: header.endianness,
+                slope: header.scl_slope,
+                inter: header.scl_inter,
+            },
+            input,
+        ))
+    }
+
+    fn new(
+        path: PathBuf,
+        shape: [usize; 3],
+        spacing: [f64; 3],
+        samples: Samples,
+        input: Box<dyn Read>,
+    ) -> Self {
+        Self {
+            path,
+            shape,
+            spacing,
+            samples,
+            input,
+            planes_read: 0,
+            bytes: Vec::new(),
+        }
+    }
+
+    /// The samples along x, y and z.
+    pub fn shape(&self) -> [usize; 3] {
+        self.shape
+    }
+
+    /// The voxel size the file states (informative only).
+    pub fn spacing(&self) -> [f64; 3] {
+        self.spacing
+    }
+
+    /// Reads the next `count` planes along z (fewer if the volume ends first) and gives each sample to
+    /// `each` with its position `[x, y, z]` in the volume, x fastest.
+    ///
+    /// # Errors
+    /// [`SolidError::Parse`] naming the file and the plane where it ends early; the first error of `each`.
+    pub fn read_planes(
+        &mut self,
+        count: usize,
+        mut each: impl FnMut([usize; 3], f64) -> Result<(), SolidError>,
+    ) -> Result<(), SolidError> {
+        let [nx, ny, nz] = self.shape;
+        let mut plane = Vec::with_capacity(nx * ny);
+        for _ in 0..count.min(nz - self.planes_read) {
+            let z = self.planes_read;
+            plane.clear();
+            self.read_plane(&mut plane)?;
+            for (i, &v) in plane.iter().enumerate() {
+                each([i % nx, i / nx, z], v)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads the next plane's samples into `out`.
+    fn read_plane(&mut self, out: &mut Vec<f64>) -> Result<(), SolidError> {
+        let [nx, ny, nz] = self.shape;
+        let z = self.planes_read;
+        let size = match &self.samples {
+            Samples::Raw { size, .. } | Samples::Nifti { size, .. } => *size,
+        };
+        self.bytes.resize(nx * ny * size, 0);
+        self.input
+            .read_exact(&mut self.bytes)
+            .map_err(|e| SolidError::Parse {
+                path: self.path.clone(),
+                what: format!("plane z = {z} (of {nz}) cannot be read: {e}"),
+            })?;
+        match &self.samples {
+            Samples::Raw { dtype, big, .. } => {
+                super::volume::decode_into(dtype, *big, &self.bytes, out);
+            }
+            Samples::Nifti {
+                datatype,
+                endianness,
+                slope,
+                inter,
+                ..
+            } => {
+                for (i, chunk) in self.bytes.chunks_exact(size).enumerate() {
+                    let v = datatype
+                        .read_primitive_value::<_, f64>(chunk, *endianness, *slope, *inter)
+                        .map_err(|e| SolidError::Parse {
+                            path: self.path.clone(),
+                            what: format!("NIfTI: sample ({}, {}, {z}): {e}", i % nx, i / nx),
+                        })?;
+                    out.push(v);
+                }
+            }
+        }
+        self.planes_read += 1;
+        Ok(())
+    }
+
+    /// The smallest label type (`uint8`, `uint16` or `uint32`) that holds every label of the volume, reading
+    /// it to the end: every sample a whole number from 0 up.
+    ///
+    /// # Errors
+    /// As [`VolumeFile::read_planes`]; [`SolidError::BadParameter`] naming the first sample that is not a
+    /// label.
+    pub fn label_dtype(mut self) -> Result<Dtype, SolidError> {
+        let mut largest = 0u32;
+        let nz = self.shape[2];
+        self.read_planes(nz, |at, v| {
+            largest = largest.max(label_of::<u32>(at, v)?);
+            Ok(())
+        })?;
+        Ok(smallest_label_type(largest))
+    }
+}
+
+/// The tree of the labels of the volume file at `path` placed at `offset` in a universe of level `level`
+/// (each sample's label its value, 0 the background), read slab by slab along z in at most about
+/// `slab_bytes` of labels at once ([`KTree::from_value_slabs`]): the same tree as
+/// [`Volume::to_label_runs`](super::volume::Volume::to_label_runs) gives, without holding the volume.
+///
+/// # Errors
+/// As [`VolumeFile::open`] and [`VolumeFile::read_planes`]; [`SolidError::BadParameter`] naming a sample
+/// that is not a label of `V`, or a volume that does not fit the universe.
+pub fn label_tree<V: Value + TryFrom<u32> + Send + Sync>(
+    path: &Path,
+    level: u32,
+    offset: [u32; 3],
+    slab_bytes: usize,
+) -> Result<KTree<3, V>, SolidError> {
+    let mut file = VolumeFile::open(path)?;
+    let shape = file.shape;
+    if shape[0] * shape[1] > MAX_PLANE_SAMPLES {
+        return Err(SolidError::BadParameter(format!(
+            "{}: a plane of {} × {} samples is more than {MAX_PLANE_SAMPLES}",
+            path.display(),
+            shape[0],
+            shape[1]
+        )));
+    }
+    let side = crate::space::Universe::<3>::new(level)?.side();
+    if (0..3).any(|a| u64::from(offset[a]) + shape[a] as u64 > side) {
+        return Err(SolidError::BadParameter(format!(
+            "the volume ({shape:?} samples at offset {offset:?}) does not fit a level-{level} universe of side {side}"
+        )));
+    }
+    let region = std::array::from_fn(|a| offset[a]..offset[a] + shape[a] as u32);
+    let background =
+        V::try_from(0).map_err(|_| SolidError::BadParameter("0 is not a label".into()))?;
+    KTree::from_value_slabs(level, region, background, slab_bytes, |rows, out| {
+        file.read_planes(rows.len(), |at, v| {
+            out.push(label_of::<V>(at, v)?);
+            Ok(())
+        })
+    })
+    .map_err(|e: SolidError| match e {
+        SolidError::Rays(RayError::Space(s)) => SolidError::Space(s),
+        other => other,
+    })
+}
