@@ -12,7 +12,7 @@ use ktree::export::vtk::write_values_time_slices;
 use ktree::io::ktree::v3::{read_valued_ktree_noted, write_valued_ktree_file};
 use ktree::io::ktree::Notes;
 use ktree::io::{read_vdb_values, write_valued_tree, WriteOptions, WrittenValues};
-use ktree::solid::volume::Volume;
+use ktree::solid::volume_file::{window_tree, VolumeFile};
 use ktree::space::WorldFrame;
 use ktree::tree::AnyValuedTree;
 use ktree::value::Value;
@@ -149,7 +149,11 @@ pub fn vdb_to_valued(
     write_and_report(output, &read.tree, Some(frame), Notes::new())
 }
 
-/// `ktree voxelize VOLUME --window LO:HI`: the samples from `lo` to `hi` kept as `float32` values.
+/// The samples held at once while a volume's window is read: slabs of up to 64 MiB of values.
+const WINDOW_SLAB_BYTES: usize = 64 << 20;
+
+/// `ktree voxelize VOLUME --window LO:HI`: the samples from `lo` to `hi` kept as `float32` values, the
+/// volume read slab by slab along z.
 pub fn voxelize_window(
     input: &Path,
     window: (f64, f64),
@@ -157,12 +161,10 @@ pub fn voxelize_window(
     offset: [u32; 3],
     out: &Path,
 ) -> CliResult {
-    let volume = Volume::read(input).map_err(CliError::caused)?;
-    let level = level.unwrap_or_else(|| fitting_level(volume.shape(), offset));
-    let runs = volume
-        .to_window_runs(level, offset, window.0, window.1)
+    let shape = VolumeFile::open(input).map_err(CliError::caused)?.shape();
+    let level = level.unwrap_or_else(|| fitting_level(shape, offset));
+    let tree = window_tree(input, level, offset, window.0, window.1, WINDOW_SLAB_BYTES)
         .map_err(|e| CliError::in_file(input, e))?;
-    let tree = KTree::from_value_runs(&runs);
     write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
     outln!(
         "{}: {} voxels from {} to {} kept as float32, L = {level}, {} nodes",

@@ -470,11 +470,7 @@ impl Volume {
         lo: f64,
         hi: f64,
     ) -> Result<ValueRuns<3, f32>, SolidError> {
-        if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
-            return Err(SolidError::BadParameter(format!(
-                "the window {lo}:{hi} is not two finite numbers, the first no larger"
-            )));
-        }
+        check_window(lo, hi)?;
         self.to_value_runs(level, offset, |_, v| {
             Ok((lo <= v && v <= hi).then_some(v as f32))
         })
@@ -671,6 +667,16 @@ pub(super) fn label_of<V: TryFrom<u32>>(at: [usize; 3], v: f64) -> Result<V, Sol
             "sample ({x}, {y}, {z}) is {v}: more than the largest label of the type"
         ))
     })
+}
+
+/// Checks a window of samples `lo ..= hi`: two finite numbers, the first no larger.
+pub(super) fn check_window(lo: f64, hi: f64) -> Result<(), SolidError> {
+    if lo.is_finite() && hi.is_finite() && lo <= hi {
+        return Ok(());
+    }
+    Err(SolidError::BadParameter(format!(
+        "the window {lo}:{hi} is not two finite numbers, the first no larger"
+    )))
 }
 
 /// The smallest label type that holds the labels up to `largest`.

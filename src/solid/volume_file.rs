@@ -25,7 +25,7 @@ use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use super::volume::{label_of, nifti_layout, smallest_label_type, RawLayout};
+use super::volume::{check_window, label_of, nifti_layout, smallest_label_type, RawLayout};
 use super::SolidError;
 use crate::rays::RayError;
 use crate::value::{Dtype, Value};
@@ -292,11 +292,60 @@ impl VolumeFile {
 /// # Errors
 /// As [`VolumeFile::open`] and [`VolumeFile::read_planes`]; [`SolidError::BadParameter`] naming a sample
 /// that is not a label of `V`, or a volume that does not fit the universe.
-pub fn label_tree<V: Value + TryFrom<u32> + Send + Sync>(
+pub fn label_tree<V: Value + TryFrom<u32>>(
     path: &Path,
     level: u32,
     offset: [u32; 3],
     slab_bytes: usize,
+) -> Result<KTree<3, V>, SolidError> {
+    let background = label_of::<V>([0; 3], 0.0)?;
+    volume_tree(path, level, offset, slab_bytes, background, label_of::<V>)
+}
+
+/// The tree of the samples from `lo` to `hi` (both included) of the volume file at `path`, as `f32`
+/// values, every other sample (and a NaN) the background, read slab by slab as [`label_tree`] reads: the
+/// same tree as [`Volume::to_window_runs`](super::volume::Volume::to_window_runs) gives.
+///
+/// ```
+/// use ktree::solid::volume::Volume;
+/// use ktree::solid::volume_file::window_tree;
+/// use std::path::Path;
+/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/volumes/itk_t1_brain.json");
+/// let tree = window_tree(&path, 7, [0, 0, 0], 100.0, 200.0, 1 << 16).unwrap();
+/// let volume = Volume::read(&path).unwrap();
+/// assert_eq!(tree, ktree::KTree::from_value_runs(&volume.to_window_runs(7, [0, 0, 0], 100.0, 200.0).unwrap()));
+/// ```
+///
+/// # Errors
+/// As [`label_tree`]; [`SolidError::BadParameter`] for a window that is empty or not finite.
+pub fn window_tree(
+    path: &Path,
+    level: u32,
+    offset: [u32; 3],
+    lo: f64,
+    hi: f64,
+    slab_bytes: usize,
+) -> Result<KTree<3, f32>, SolidError> {
+    check_window(lo, hi)?;
+    // NaN is the background: no sample kept is one.
+    volume_tree(path, level, offset, slab_bytes, f32::NAN, |_, v| {
+        Ok(if lo <= v && v <= hi {
+            v as f32
+        } else {
+            f32::NAN
+        })
+    })
+}
+
+/// The tree of the volume file at `path` placed at `offset`, each sample's value `value_of(position,
+/// sample)` (`background`: empty), read slab by slab.
+fn volume_tree<V: Value>(
+    path: &Path,
+    level: u32,
+    offset: [u32; 3],
+    slab_bytes: usize,
+    background: V,
+    value_of: impl Fn([usize; 3], f64) -> Result<V, SolidError>,
 ) -> Result<KTree<3, V>, SolidError> {
     let mut file = VolumeFile::open(path)?;
     let shape = file.shape;
@@ -315,11 +364,9 @@ pub fn label_tree<V: Value + TryFrom<u32> + Send + Sync>(
         )));
     }
     let region = std::array::from_fn(|a| offset[a]..offset[a] + shape[a] as u32);
-    let background =
-        V::try_from(0).map_err(|_| SolidError::BadParameter("0 is not a label".into()))?;
     KTree::from_value_slabs(level, region, background, slab_bytes, |rows, out| {
         file.read_planes(rows.len(), |at, v| {
-            out.push(label_of::<V>(at, v)?);
+            out.push(value_of(at, v)?);
             Ok(())
         })
     })

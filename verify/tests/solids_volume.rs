@@ -288,3 +288,44 @@ fn labels_read_slab_by_slab_are_the_labels_of_the_whole_volume() {
         .to_string();
     assert!(e.contains("(0, 4, 0)") && e.contains("300"), "{e}");
 }
+
+/// A window of floats read slab by slab ([`window_tree`]) is the tree of the volume read whole: NaN and
+/// the samples outside the window are the background, for every slab thickness and offset.
+#[test]
+fn a_window_read_slab_by_slab_is_the_window_of_the_whole_volume() {
+    use ktree::solid::volume_file::window_tree;
+    use ktree::KTree;
+    let dir = tempfile::tempdir().unwrap();
+    let samples: Vec<f32> = (0..6 * 5 * 7)
+        .map(|i: usize| match i % 13 {
+            0 => f32::NAN,
+            1 => -2.5,
+            k if i / 30 > 3 => 4.0 + (k % 2) as f32,
+            k => k as f32 * 0.75,
+        })
+        .collect();
+    let raw: Vec<u8> = samples.iter().flat_map(|v| v.to_be_bytes()).collect();
+    std::fs::write(dir.path().join("w.raw"), raw).unwrap();
+    let json = dir.path().join("w.json");
+    std::fs::write(
+        &json,
+        r#"{"shape_xyz": [6, 5, 7], "dtype": "float32", "endianness": "big"}"#,
+    )
+    .unwrap();
+    let volume = Volume::read(&json).unwrap();
+    for (lo, hi) in [(-3.0, 100.0), (1.0, 4.0), (4.0, 4.0)] {
+        for offset in [[0, 0, 0], [2, 3, 9]] {
+            let want = KTree::from_value_runs(&volume.to_window_runs(4, offset, lo, hi).unwrap());
+            assert!(want.voxel_count() > 0);
+            for slab_bytes in [0, 200, 1 << 20] {
+                let got = window_tree(&json, 4, offset, lo, hi, slab_bytes).unwrap();
+                assert!(
+                    got == want,
+                    "window {lo}:{hi} at {offset:?}, slabs of {slab_bytes} bytes"
+                );
+            }
+        }
+    }
+    assert!(window_tree(&json, 4, [0; 3], 2.0, 1.0, 1 << 20).is_err());
+    assert!(window_tree(&json, 4, [0; 3], f64::NAN, 1.0, 1 << 20).is_err());
+}
