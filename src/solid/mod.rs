@@ -35,6 +35,8 @@ mod rational;
 pub mod volume;
 #[cfg(feature = "volume")]
 pub mod volume_file;
+#[cfg(feature = "volume")]
+mod volume_format;
 
 pub use boxsolid::BoxSolid;
 pub use error::SolidError;

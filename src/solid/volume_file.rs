@@ -25,7 +25,10 @@ use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use super::volume::{check_window, label_of, nifti_layout, smallest_label_type, RawLayout};
+use super::volume_format::{
+    check_window, decode_into, label_of, nifti_layout, smallest_label_type, RawLayout,
+    NIFTI_HEADER_BYTES,
+};
 use super::SolidError;
 use crate::rays::RayError;
 use crate::value::{Dtype, Value};
@@ -140,7 +143,7 @@ impl VolumeFile {
         };
         let mut header_bytes = Vec::new();
         (&mut input)
-            .take(super::volume::NIFTI_HEADER_BYTES)
+            .take(NIFTI_HEADER_BYTES)
             .read_to_end(&mut header_bytes)
             .map_err(|e| parse(format!("NIfTI: {e}")))?;
         let header = nifti::NiftiHeader::from_reader(&header_bytes[..])
@@ -243,7 +246,7 @@ impl VolumeFile {
             })?;
         match &self.samples {
             Samples::Raw { dtype, big, .. } => {
-                super::volume::decode_into(dtype, *big, &self.bytes, out);
+                decode_into(dtype, *big, &self.bytes, out);
             }
             Samples::Nifti {
                 datatype,
