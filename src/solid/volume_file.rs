@@ -6,7 +6,8 @@
 //! (`.nii`, or `.nii.gz` told by the gzip magic, inflated as it is read; the header checked as
 //! [`Volume::read_nifti`](super::volume::Volume::read_nifti) checks it, the samples rescaled by
 //! `scl_slope`/`scl_inter` by the `nifti` crate's own decoding). A volume read here may hold more than
-//! [`MAX_SAMPLES`](super::volume::MAX_SAMPLES) samples; one plane may not.
+//! [`MAX_SAMPLES`](super::volume::MAX_SAMPLES) samples; one plane may not. A plane's memory is taken as its
+//! bytes arrive, so a damaged header claiming a huge volume costs only what the file holds.
 //!
 //! ```
 //! use ktree::solid::volume::Volume;
@@ -84,19 +85,27 @@ impl VolumeFile {
     /// [`SolidError::Io`] or [`SolidError::Parse`] naming the file and what is wrong.
     pub fn open(path: &Path) -> Result<Self, SolidError> {
         let name = path.to_string_lossy().to_ascii_lowercase();
-        if name.ends_with(".nii") || name.ends_with(".nii.gz") {
-            Self::open_nifti(path)
+        let file = if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+            Self::open_nifti(path)?
         } else if name.ends_with(".json") {
-            Self::open_raw(path)
+            Self::open_raw(path)?
         } else if name.ends_with(".raw") {
-            Self::open_raw(&path.with_extension("json"))
+            Self::open_raw(&path.with_extension("json"))?
         } else {
-            Err(SolidError::Parse {
+            return Err(SolidError::Parse {
                 path: path.to_path_buf(),
                 what: "unknown volume format (known: .json sidecar with .raw, .nii, .nii.gz)"
                     .into(),
-            })
+            });
+        };
+        let [nx, ny, _] = file.shape;
+        if nx * ny > MAX_PLANE_SAMPLES {
+            return Err(SolidError::Parse {
+                path: file.path,
+                what: format!("a plane of {nx} × {ny} samples is more than {MAX_PLANE_SAMPLES}"),
+            });
         }
+        Ok(file)
     }
 
     fn open_raw(json: &Path) -> Result<Self, SolidError> {
@@ -217,8 +226,8 @@ impl VolumeFile {
         count: usize,
         mut each: impl FnMut([usize; 3], f64) -> Result<(), SolidError>,
     ) -> Result<(), SolidError> {
-        let [nx, ny, nz] = self.shape;
-        let mut plane = Vec::with_capacity(nx * ny);
+        let [nx, _, nz] = self.shape;
+        let mut plane = Vec::new();
         for _ in 0..count.min(nz - self.planes_read) {
             let z = self.planes_read;
             plane.clear();
@@ -237,13 +246,24 @@ impl VolumeFile {
         let size = match &self.samples {
             Samples::Raw { size, .. } | Samples::Nifti { size, .. } => *size,
         };
-        self.bytes.resize(nx * ny * size, 0);
-        self.input
-            .read_exact(&mut self.bytes)
-            .map_err(|e| SolidError::Parse {
-                path: self.path.clone(),
-                what: format!("plane z = {z} (of {nz}) cannot be read: {e}"),
-            })?;
+        // Read as the bytes arrive (never allocated ahead of them: a damaged header's claim of a huge
+        // plane costs only the bytes the file holds).
+        let want = (nx * ny * size) as u64;
+        self.bytes.clear();
+        let cannot = |what: String| SolidError::Parse {
+            path: self.path.clone(),
+            what: format!("plane z = {z} (of {nz}) cannot be read: {what}"),
+        };
+        (&mut self.input)
+            .take(want)
+            .read_to_end(&mut self.bytes)
+            .map_err(|e| cannot(e.to_string()))?;
+        if (self.bytes.len() as u64) < want {
+            return Err(cannot(format!(
+                "the file ends {} bytes into it, of {want}",
+                self.bytes.len()
+            )));
+        }
         match &self.samples {
             Samples::Raw { dtype, big, .. } => {
                 decode_into(dtype, *big, &self.bytes, out);
@@ -352,14 +372,6 @@ fn volume_tree<V: Value>(
 ) -> Result<KTree<3, V>, SolidError> {
     let mut file = VolumeFile::open(path)?;
     let shape = file.shape;
-    if shape[0] * shape[1] > MAX_PLANE_SAMPLES {
-        return Err(SolidError::BadParameter(format!(
-            "{}: a plane of {} × {} samples is more than {MAX_PLANE_SAMPLES}",
-            path.display(),
-            shape[0],
-            shape[1]
-        )));
-    }
     let side = crate::space::Universe::<3>::new(level)?.side();
     if (0..3).any(|a| u64::from(offset[a]) + shape[a] as u64 > side) {
         return Err(SolidError::BadParameter(format!(

@@ -281,6 +281,30 @@ fn labels_read_slab_by_slab_are_the_labels_of_the_whole_volume() {
         e.contains("(0, 4, 0)") && e.contains("whole numbers"),
         "{e}"
     );
+    // A header claiming planes far larger than the file: an error at the first plane, nothing allocated
+    // ahead of the bytes; a raw sidecar claiming more than its file holds: an error before reading.
+    std::fs::write(&nii, nifti_bytes([30000, 30000, 2], &[], 1.0, 0.0)).unwrap();
+    let e = label_tree::<u16>(&nii, 15, [0; 3], 1 << 20)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("l.nii") && e.contains("plane z = 0") && e.contains("ends 0 bytes"),
+        "{e}"
+    );
+    let e = VolumeFile::open(&nii)
+        .unwrap()
+        .label_dtype()
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("plane z = 0"), "{e}");
+    let huge = dir.path().join("huge.json");
+    std::fs::write(
+        &huge,
+        r#"{"shape_xyz": [1048576, 1048576, 1], "dtype": "uint8", "file": "uint8_false.raw"}"#,
+    )
+    .unwrap();
+    let e = VolumeFile::open(&huge).unwrap_err().to_string();
+    assert!(e.contains("uint8_false.raw") && e.contains("bytes"), "{e}");
     floats[5 + 5 * 3] = 300;
     std::fs::write(&nii, nifti_bytes([5, 6, 7], &floats, 1.0, 0.0)).unwrap();
     let e = label_tree::<u8>(&nii, 3, [0; 3], 1 << 20)
