@@ -1,10 +1,10 @@
-//! Building a valued tree straight from a dense array of values, depth first: a cell whose voxels all
-//! hold one value (or all the background) is a leaf; any other cell is built from its `2^K` children.
-//! The array is first read once in its own order (streamed, not visited cell by cell), noting which
-//! bricks — cells of about 4096 voxels — hold one value; a cell of bricks is then settled from its
-//! bricks, and a cell inside a brick of several values by comparing its rows of the fastest axis with its
-//! first voxel (the first voxel that differs ends the comparison). So a volume of regions is read about
-//! twice at most, and the tree is minimal by construction.
+//! Building a valued tree straight from a dense array of values: a cell whose voxels all hold one value
+//! (or all the background) is a leaf; any other cell is built from its `2^K` children.
+//! The array is read once in its own order (streamed, not visited cell by cell), a row of bricks —
+//! cells of about 4096 voxels — at a time: which bricks hold one value is noted, and the subtree of
+//! each other brick is built bottom up while the row is in the cache (its voxels gathered in Morton
+//! order, each level settled from the one below). The cells of bricks are then settled from their
+//! bricks, depth first, the bricks' subtrees moved in. The tree is minimal by construction.
 //! The same tree as [`KTree::from_value_runs`] of the array's runs, without making the runs.
 //!
 //! ```
@@ -16,12 +16,14 @@
 //! assert_eq!(tree, KTree::from_value_runs(&runs));
 //! ```
 
+use std::sync::Mutex;
+
 use rayon::prelude::*;
 
 use crate::rays::source::default_split_depth;
 use crate::rays::valued::check_dense_len;
 use crate::rays::RayError;
-use crate::space::{Cell, Universe};
+use crate::space::{spread_bits, Cell, Universe};
 use crate::tree::top_down::Subtree;
 use crate::tree::valued::{combine, ValueState};
 use crate::value::Value;
@@ -61,8 +63,8 @@ impl<const K: usize, V: Value> KTree<K, V> {
     }
 }
 
-/// A dense array of values, the value that means empty, and which of its bricks (cells of side
-/// `2^brick_log`) hold one value throughout.
+/// A dense array of values, the value that means empty, which of its bricks (cells of side
+/// `2^brick_log`) hold one value throughout, and the subtrees of the others.
 pub(super) struct Dense<'a, const K: usize, V> {
     universe: Universe<K>,
     dense: &'a [V],
@@ -70,6 +72,9 @@ pub(super) struct Dense<'a, const K: usize, V> {
     brick_log: u32,
     /// Each brick's value if all its voxels hold it, axis 0 fastest over the grid of bricks.
     bricks: Vec<Option<V>>,
+    /// The subtree of each brick of several values, in the same order (`None` for a brick of one
+    /// value, and for one holding a value [`Value::check`] refuses: that one is built cell by cell).
+    trees: Vec<Mutex<Option<BrickTree<V>>>>,
 }
 
 impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
@@ -77,13 +82,14 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
     /// universe).
     pub(super) fn new(universe: Universe<K>, dense: &'a [V], background: V) -> Self {
         let brick_log = (12 / K as u32).min(universe.level());
-        let bricks = uniform_bricks::<K, V>(dense, universe.side() as usize, brick_log);
+        let (bricks, trees) = read_bricks::<K, V>(dense, universe.level(), brick_log, background);
         Self {
             universe,
             dense,
             background,
             brick_log,
             bricks,
+            trees: trees.into_iter().map(Mutex::new).collect(),
         }
     }
 
@@ -129,7 +135,7 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
             let mut levels = vec![Vec::new(); cell.log_side() as usize + 1];
             let root = self.node(cell, 0, &mut levels)?;
             levels.remove(0);
-            return Ok(Subtree::new(root, levels));
+            return Ok(Subtree::from_chunks(root, levels));
         }
         let kids = (0..1usize << K)
             .into_par_iter()
@@ -139,15 +145,34 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
     }
 
     /// Builds the subtree of `cell` (at `depth`): returns its state, its children (if any) pushed onto
-    /// the level below in `levels`.
+    /// the level below in `levels` (each level a list of chunks, the last one open); a brick of several
+    /// values as it was built when it was read, its levels' chunks moved in.
     fn node(
         &self,
         cell: Cell<K>,
         depth: usize,
-        levels: &mut [Vec<ValueState<V>>],
+        levels: &mut [Vec<Vec<ValueState<V>>>],
     ) -> Result<ValueState<V>, RayError> {
         if let Some(leaf) = self.leaf(cell)? {
             return Ok(leaf);
+        }
+        if cell.log_side() == self.brick_log {
+            let grid = (self.universe.side() >> self.brick_log) as usize;
+            let index = cell
+                .origin()
+                .iter()
+                .rev()
+                .fold(0, |i, &c| i * grid + (c >> self.brick_log) as usize);
+            let tree = self.trees[index]
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner())
+                .take();
+            if let Some(tree) = tree {
+                for (level, below) in levels[depth + 1..].iter_mut().zip(tree.levels) {
+                    level.push(below);
+                }
+                return Ok(tree.root);
+            }
         }
         let n = 1usize << K;
         let mut kids = [ValueState::Empty; 16];
@@ -156,60 +181,239 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
         }
         let state = combine(&kids[..n]);
         if state.has_children() {
-            levels[depth + 1].extend_from_slice(&kids[..n]);
+            let level = &mut levels[depth + 1];
+            match level.last_mut() {
+                Some(chunk) => chunk.extend_from_slice(&kids[..n]),
+                None => level.push(kids[..n].to_vec()),
+            }
         }
         Ok(state)
     }
 }
 
-/// For each brick of side `2^brick_log` of a dense array of side `side` (axis 0 fastest; the bricks in the
-/// same order), its first voxel's value if every voxel of the brick holds it. The array is read once in
-/// its own order — each row's pieces compared with the first voxels of their bricks — so that memory is
-/// streamed rather than visited brick by brick; slabs of bricks along the last axis run on the rayon pool.
-fn uniform_bricks<const K: usize, V: Value>(
+/// The subtree of a brick of several values: its root's state and each level below it in level
+/// order, the root's children first.
+struct BrickTree<V> {
+    root: ValueState<V>,
+    levels: Vec<Vec<ValueState<V>>>,
+}
+
+/// The subtree of the brick of side `2^log` whose first voxel is `dense[origin]` in an array of rows
+/// `stride` long (axis 0 fastest), built bottom up: its voxels gathered in Morton order (so that a
+/// cell's `2^K` children are consecutive; `spread` holds each coordinate's bits spread `K` apart), each
+/// level's cells settled from their children, then the nodes of the tree taken top down. `scratch`
+/// holds the voxels and the states of the cells above them. `None` when a value is refused
+/// ([`Value::check`]).
+fn brick_tree<const K: usize, V: Value>(
     dense: &[V],
-    side: usize,
+    stride: usize,
+    origin: usize,
+    log: usize,
+    background: V,
+    spread: &[usize],
+    scratch: &mut BrickScratch<V>,
+) -> Option<BrickTree<V>> {
+    let side = 1usize << log;
+    let voxels = &mut scratch.voxels;
+    voxels.resize(1usize << (log * K), background);
+    // Each row along axis 0: its place in the array and its first voxel's Morton index, the other axes'
+    // offsets counted like an odometer.
+    let mut offset = [0usize; K];
+    loop {
+        let (mut start, mut morton, mut step) = (origin, 0usize, 1usize);
+        for (a, &o) in offset.iter().enumerate().skip(1) {
+            step *= stride;
+            start += o * step;
+            morton |= spread[o] << a;
+        }
+        for (&v, &x) in dense[start..start + side].iter().zip(spread) {
+            voxels[morton | x] = v;
+        }
+        let Some(axis) = (1..K).find(|&a| offset[a] + 1 < side) else {
+            break;
+        };
+        offset[axis] += 1;
+        offset[1..axis].fill(0);
+    }
+    // The voxels' state.
+    let voxel = |v: V| {
+        if v.same(background) {
+            ValueState::Empty
+        } else {
+            ValueState::Full(v)
+        }
+    };
+    // The cells of side 2, then each level above appended after the one below it; `starts[j]` where
+    // level j begins in `cells` (level 0, the voxels, is `voxels`).
+    let n = 1usize << K;
+    let cells = &mut scratch.cells;
+    cells.clear();
+    cells.extend(voxels.chunks_exact(n).map(|kids| {
+        let first = kids[0];
+        if kids.iter().fold(true, |all, v| all & v.same(first)) {
+            voxel(first)
+        } else if kids.iter().fold(false, |any, v| any | v.same(background)) {
+            ValueState::Partial
+        } else {
+            ValueState::Mixed
+        }
+    }));
+    let mut starts = vec![0usize; log + 1];
+    for j in 2..=log {
+        let below = starts[j - 1];
+        starts[j] = cells.len();
+        for i in (below..starts[j]).step_by(n) {
+            let state = combine(&cells[i..i + n]);
+            cells.push(state);
+        }
+    }
+    // Top down: the children of the nodes with children, level by level.
+    let root = cells[starts[log]];
+    let mut levels = Vec::with_capacity(log);
+    let (mut parents, mut next) = (vec![0usize], Vec::new());
+    for j in (0..log).rev() {
+        next.clear();
+        let mut states = Vec::with_capacity(parents.len() * n);
+        for &p in &parents {
+            let first = p * n;
+            if j == 0 {
+                states.extend(voxels[first..first + n].iter().map(|&v| voxel(v)));
+                continue;
+            }
+            let kids = &cells[starts[j] + first..starts[j] + first + n];
+            states.extend_from_slice(kids);
+            next.extend(
+                (0..n)
+                    .filter(|&c| kids[c].has_children())
+                    .map(|c| first + c),
+            );
+        }
+        levels.push(states);
+        std::mem::swap(&mut parents, &mut next);
+        if parents.is_empty() {
+            break;
+        }
+    }
+    for state in levels.iter().flatten() {
+        if let ValueState::Full(v) = state {
+            v.check().ok()?;
+        }
+    }
+    Some(BrickTree { root, levels })
+}
+
+/// The memory [`brick_tree`] works in, kept from one brick to the next.
+struct BrickScratch<V> {
+    voxels: Vec<V>,
+    cells: Vec<ValueState<V>>,
+}
+
+impl<V> BrickScratch<V> {
+    fn new() -> Self {
+        Self {
+            voxels: Vec::new(),
+            cells: Vec::new(),
+        }
+    }
+}
+
+/// The bricks of side `2^brick_log` of a dense array of `2^level` voxels a side (axis 0 fastest; the
+/// bricks in the same order): each brick's first voxel's value if every voxel of the brick holds it,
+/// else its subtree ([`brick_tree`]). The array is read once in its own order, a row of bricks at a
+/// time — each row's pieces compared with the first voxels of their bricks, so that memory is streamed
+/// rather than visited brick by brick — and the row's bricks of several values built while it is in
+/// the cache; slabs of bricks along the last axis run on the rayon pool.
+#[allow(clippy::type_complexity)]
+fn read_bricks<const K: usize, V: Value>(
+    dense: &[V],
+    level: u32,
     brick_log: u32,
-) -> Vec<Option<V>> {
+    background: V,
+) -> (Vec<Option<V>>, Vec<Option<BrickTree<V>>>) {
+    let side = 1usize << level;
     let brick = 1usize << brick_log;
     let grid = side >> brick_log;
+    let spread: Vec<usize> = (0..brick as u32)
+        .map(|c| spread_bits::<K>(c) as usize)
+        .collect();
+    let log = brick_log as usize;
     let uniform = |piece: &[V]| piece.iter().all(|v| v.same(piece[0])).then_some(piece[0]);
     if K == 1 {
-        return dense.par_chunks(brick).map(uniform).collect();
+        return dense
+            .par_chunks(brick)
+            .map_init(BrickScratch::new, |scratch, piece| match uniform(piece) {
+                Some(v) => (Some(v), None),
+                None => (
+                    None,
+                    brick_tree::<K, V>(piece, side, 0, log, background, &spread, scratch),
+                ),
+            })
+            .unzip();
     }
-    // Bricks a slab (one brick thick along the last axis) and voxels a slab.
+    // Bricks a slab (one brick thick along the last axis) and voxels a slab; a row of bricks (along
+    // axis 0) within a slab has rows of voxels at `brick^(K - 1)` offsets.
     let slab_bricks = grid.pow(K as u32 - 1);
     let slab_voxels = side.pow(K as u32 - 1) * brick;
     let mut bricks: Vec<(V, bool)> = vec![(dense[0], true); grid.pow(K as u32)];
+    let mut trees: Vec<Option<BrickTree<V>>> = Vec::new();
+    trees.resize_with(bricks.len(), || None);
     bricks
         .par_chunks_mut(slab_bricks)
+        .zip(trees.par_chunks_mut(slab_bricks))
         .zip(dense.par_chunks(slab_voxels))
-        .for_each(|(bricks, voxels)| {
-            for (r, row) in voxels.chunks_exact(side).enumerate() {
-                // The row's coordinates along axes 1 … K − 1 (axis K − 1 within the slab).
-                let (mut rest, mut first_row, mut brick_row, mut stride) = (r, true, 0, 1);
-                for _ in 1..K {
-                    let c = rest % side;
-                    rest /= side;
-                    first_row &= c & (brick - 1) == 0;
-                    brick_row += (c >> brick_log) * stride;
-                    stride *= grid;
+        .for_each_init(BrickScratch::new, |scratch, ((bricks, trees), voxels)| {
+            for (row_of_bricks, (bricks, trees)) in bricks
+                .chunks_exact_mut(grid)
+                .zip(trees.chunks_exact_mut(grid))
+                .enumerate()
+            {
+                // The first voxel of the row of bricks: its coordinates along axes 1 … K − 2 are those
+                // of the row of bricks times the brick's side.
+                let (mut first, mut rest, mut step) = (0, row_of_bricks, side);
+                for _ in 1..K - 1 {
+                    first += (rest % grid) * brick * step;
+                    rest /= grid;
+                    step *= side;
                 }
-                let row_bricks = &mut bricks[brick_row * grid..(brick_row + 1) * grid];
-                for ((first, uniform), piece) in row_bricks.iter_mut().zip(row.chunks_exact(brick))
-                {
-                    if first_row {
-                        *first = piece[0];
+                // Its rows, axis 1 fastest (memory in order), the offsets counted like an odometer.
+                let mut offset = [0usize; K];
+                loop {
+                    let (mut start, mut step) = (first, 1);
+                    for &o in &offset[1..] {
+                        step *= side;
+                        start += o * step;
                     }
-                    let f = *first;
-                    *uniform &= piece.iter().fold(true, |all, v| all & v.same(f));
+                    let first_row = offset[1..].iter().all(|&o| o == 0);
+                    let row = &voxels[start..start + side];
+                    for ((first, uniform), piece) in bricks.iter_mut().zip(row.chunks_exact(brick))
+                    {
+                        if first_row {
+                            *first = piece[0];
+                        }
+                        let f = *first;
+                        *uniform &= piece.iter().fold(true, |all, v| all & v.same(f));
+                    }
+                    let Some(axis) = (1..K).find(|&a| offset[a] + 1 < brick) else {
+                        break;
+                    };
+                    offset[axis] += 1;
+                    offset[1..axis].fill(0);
+                }
+                for (b, (&(_, uniform), tree)) in bricks.iter().zip(trees.iter_mut()).enumerate() {
+                    if !uniform {
+                        let origin = first + b * brick;
+                        *tree = brick_tree::<K, V>(
+                            voxels, side, origin, log, background, &spread, scratch,
+                        );
+                    }
                 }
             }
         });
-    bricks
+    let bricks = bricks
         .into_iter()
         .map(|(first, uniform)| uniform.then_some(first))
-        .collect()
+        .collect();
+    (bricks, trees)
 }
 
 /// The first item of the box of side `side` from `origin` in a grid of `grid` items a side (axis 0
@@ -316,6 +520,95 @@ mod tests {
             got.assert_well_formed();
             assert!(got == want, "K = {K}, split {split}");
         }
+    }
+
+    /// Boxes of labels at random places over a universe of several bricks (splitmix64 from `seed`),
+    /// some a single voxel, some a cube aligned to a brick: the tree of the runs, on every split.
+    fn check_boxes<const K: usize>(level: u32, seed: u64) {
+        let universe = Universe::<K>::new(level).unwrap();
+        let side = universe.side() as u32;
+        let mut state = seed;
+        let mut next = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        };
+        let len = universe.side().pow(K as u32) as usize;
+        let mut dense = vec![0u16; len];
+        for b in 0..40 {
+            let label = (next() % 4) as u16;
+            let (lo, hi): ([u32; K], [u32; K]) = match b % 3 {
+                0 => {
+                    let p = [(); K].map(|_| (next() % u64::from(side)) as u32);
+                    (p, p.map(|c| c + 1))
+                }
+                1 => {
+                    let brick = 1 << (12 / K as u32).min(level);
+                    let p = [(); K].map(|_| (next() % u64::from(side / brick)) as u32 * brick);
+                    (p, p.map(|c| c + brick))
+                }
+                _ => {
+                    let a = [(); K].map(|_| (next() % u64::from(side)) as u32);
+                    let b = [(); K].map(|_| (next() % u64::from(side)) as u32);
+                    (
+                        std::array::from_fn(|i| a[i].min(b[i])),
+                        std::array::from_fn(|i| a[i].max(b[i]) + 1),
+                    )
+                }
+            };
+            for (i, v) in dense.iter_mut().enumerate() {
+                let p = universe.dense_point(i);
+                if (0..K).all(|a| lo[a] <= p[a] && p[a] < hi[a]) {
+                    *v = label;
+                }
+            }
+        }
+        let runs = ValueRuns::<K, u16>::from_dense_background(level, &dense, 0).unwrap();
+        let want = KTree::from_value_runs(&runs);
+        for split in [0, 1, 3] {
+            let got = KTree::from_dense_background_split(universe, &dense, 0, split).unwrap();
+            got.assert_well_formed();
+            assert!(got == want, "K = {K}, seed {seed}, split {split}");
+        }
+    }
+
+    #[test]
+    fn boxes_over_several_bricks_are_the_tree_of_the_runs() {
+        for seed in 0..6 {
+            check_boxes::<1>(14, seed);
+            check_boxes::<2>(7 + (seed % 2) as u32, seed);
+            check_boxes::<3>(5 + (seed % 2) as u32, seed);
+            check_boxes::<4>(4, seed);
+        }
+    }
+
+    /// A NaN in a brick of several values is refused at the first voxel of its leaf: one voxel alone,
+    /// or an aligned cube of NaNs with equal bits, whichever comes first depth first.
+    #[test]
+    fn nan_in_a_brick_of_several_values_is_refused_at_its_leaf() {
+        let universe = Universe::<3>::new(6).unwrap();
+        let len = universe.side().pow(3) as usize;
+        let mut dense: Vec<f32> = (0..len).map(|i| (i % 3) as f32).collect();
+        let lone = universe.dense_index([37, 21, 50]);
+        dense[lone] = f32::NAN;
+        let error = |dense: &[f32]| match KTree::<3, f32>::from_dense_background(6, dense, 0.0) {
+            Err(RayError::Value { index, .. }) => index,
+            other => panic!("a NaN accepted: {other:?}"),
+        };
+        assert_eq!(error(&dense), lone);
+        // A cube of side 2 of NaNs ahead of it (depth first) is found first, at its origin.
+        for p in [[2u32, 2, 2], [2, 2, 3], [2, 3, 2], [3, 3, 3]] {
+            dense[universe.dense_index(p.map(|c| c + 16))] = f32::NAN;
+        }
+        for p in [[2u32, 3, 3], [3, 2, 2], [3, 2, 3], [3, 3, 2]] {
+            dense[universe.dense_index(p.map(|c| c + 16))] = f32::NAN;
+        }
+        assert_eq!(error(&dense), universe.dense_index([18, 18, 18]));
+        // As the background, NaN is no value.
+        let tree = KTree::<3, f32>::from_dense_background(6, &dense, f32::NAN).unwrap();
+        assert_eq!(tree.voxel_count(), len as u128 - 9);
     }
 
     #[test]

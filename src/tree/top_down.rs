@@ -204,6 +204,15 @@ impl<V: Value> Subtree<V> {
         Self { root, below }
     }
 
+    /// [`Subtree::new`] of levels each made of chunks (the level their concatenation).
+    pub(crate) fn from_chunks(root: ValueState<V>, below: Vec<Vec<Vec<ValueState<V>>>>) -> Self {
+        let below = below
+            .into_iter()
+            .take_while(|l| l.iter().any(|chunk| !chunk.is_empty()))
+            .collect();
+        Self { root, below }
+    }
+
     /// A leaf.
     pub(crate) fn leaf(root: ValueState<V>) -> Self {
         Self {
