@@ -25,8 +25,8 @@ use std::ops::Range;
 use std::path::Path;
 
 use super::volume_format::{
-    check_window, checked_samples, label_of, nifti_layout, smallest_label_type, RawLayout,
-    NIFTI_HEADER_BYTES,
+    check_window, checked_samples, label_of, open_nifti_stream, placed_universe,
+    smallest_label_type, NiftiStream, RawLayout,
 };
 use super::SolidError;
 use crate::rays::{ColumnKeys, Ray, RaySet, RaySource, SlabRuns, ValueRuns};
@@ -179,18 +179,12 @@ impl Volume {
         let io_error = |e: std::io::Error| parse(format!("NIfTI: {e}"));
         // The header, then exactly the bytes it describes (never more: a compressed file is inflated only as
         // far as the header's own claim, which is bounded by MAX_SAMPLES).
-        let mut input: Box<dyn Read + '_> = if bytes.starts_with(&[0x1f, 0x8b]) {
-            Box::new(flate2::bufread::GzDecoder::new(bytes))
-        } else {
-            Box::new(bytes)
-        };
-        let mut data = Vec::new();
-        (&mut input)
-            .take(NIFTI_HEADER_BYTES)
-            .read_to_end(&mut data)
-            .map_err(io_error)?;
-        let header = nifti::NiftiHeader::from_reader(&data[..]).map_err(nifti_error)?;
-        let layout = nifti_layout(&header, file, true)?;
+        let NiftiStream {
+            mut input,
+            header_bytes: mut data,
+            header,
+            layout,
+        } = open_nifti_stream(bytes, file, true)?;
         let (shape, n) = (layout.shape, layout.shape.iter().product::<usize>());
         let dim = header.dim().map_err(nifti_error)?.to_vec();
         let (offset, sample) = (layout.offset, layout.sample);
@@ -410,17 +404,7 @@ impl Volume {
 
     /// The universe of level `level`, checked to hold the volume at `offset`.
     fn placed(&self, level: u32, offset: [u32; 3]) -> Result<Universe<3>, SolidError> {
-        let universe = Universe::<3>::new(level)?;
-        let side = universe.side();
-        for a in 0..3 {
-            if u64::from(offset[a]) + self.shape[a] as u64 > side {
-                return Err(SolidError::BadParameter(format!(
-                    "the volume ({:?} samples at offset {offset:?}) does not fit a level-{level} universe of side {side}",
-                    self.shape
-                )));
-            }
-        }
-        Ok(universe)
+        placed_universe(self.shape, level, offset)
     }
 
     /// The column keys and runs of the universe columns whose axis-0 coordinate lies in `x`, in

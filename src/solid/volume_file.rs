@@ -27,8 +27,8 @@ use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use super::volume_format::{
-    check_window, decode_into, label_of, nifti_layout, smallest_label_type, RawLayout,
-    NIFTI_HEADER_BYTES,
+    check_window, decode_into, label_of, open_nifti_stream, placed_universe, smallest_label_type,
+    NiftiStream, RawLayout,
 };
 use super::SolidError;
 use crate::rays::RayError;
@@ -141,23 +141,12 @@ impl VolumeFile {
             path: path.to_path_buf(),
             source,
         })?;
-        let mut file = BufReader::new(file);
-        let gz = std::io::BufRead::fill_buf(&mut file)
-            .map_err(|e| parse(format!("NIfTI: {e}")))?
-            .starts_with(&[0x1f, 0x8b]);
-        let mut input: Box<dyn Read> = if gz {
-            Box::new(flate2::bufread::GzDecoder::new(file))
-        } else {
-            Box::new(file)
-        };
-        let mut header_bytes = Vec::new();
-        (&mut input)
-            .take(NIFTI_HEADER_BYTES)
-            .read_to_end(&mut header_bytes)
-            .map_err(|e| parse(format!("NIfTI: {e}")))?;
-        let header = nifti::NiftiHeader::from_reader(&header_bytes[..])
-            .map_err(|e| parse(format!("NIfTI: {e}")))?;
-        let layout = nifti_layout(&header, path, false)?;
+        let NiftiStream {
+            mut input,
+            header_bytes,
+            header,
+            layout,
+        } = open_nifti_stream(BufReader::new(file), path, false)?;
         // Past the header's extensions, to the first sample.
         let skip = layout.offset - header_bytes.len() as u64;
         let skipped = std::io::copy(&mut (&mut input).take(skip), &mut std::io::sink())
@@ -372,12 +361,7 @@ fn volume_tree<V: Value>(
 ) -> Result<KTree<3, V>, SolidError> {
     let mut file = VolumeFile::open(path)?;
     let shape = file.shape;
-    let side = crate::space::Universe::<3>::new(level)?.side();
-    if (0..3).any(|a| u64::from(offset[a]) + shape[a] as u64 > side) {
-        return Err(SolidError::BadParameter(format!(
-            "the volume ({shape:?} samples at offset {offset:?}) does not fit a level-{level} universe of side {side}"
-        )));
-    }
+    placed_universe(shape, level, offset)?;
     let region = std::array::from_fn(|a| offset[a]..offset[a] + shape[a] as u32);
     KTree::from_value_slabs(level, region, background, slab_bytes, |rows, out| {
         file.read_planes(rows.len(), |at, v| {

@@ -3,12 +3,14 @@
 //! volume held in memory ([`Volume`](super::volume::Volume)) and the file read plane by plane
 //! ([`VolumeFile`](super::volume_file::VolumeFile)).
 
+use std::io::{BufRead, Read};
 use std::path::Path;
 
 use serde::Deserialize;
 
 use super::volume::MAX_SAMPLES;
 use super::SolidError;
+use crate::space::Universe;
 use crate::value::Dtype;
 
 #[derive(Deserialize)]
@@ -24,7 +26,7 @@ struct Sidecar {
 }
 
 /// Bytes of a NIfTI-1 header.
-pub(super) const NIFTI_HEADER_BYTES: u64 = 348;
+const NIFTI_HEADER_BYTES: u64 = 348;
 /// Largest offset of the samples in a NIfTI file (room for header extensions).
 const MAX_NIFTI_OFFSET: f32 = (1u32 << 24) as f32;
 
@@ -182,7 +184,7 @@ pub(super) struct NiftiLayout {
 
 /// A NIfTI header's layout, checked: a 3-D volume (or 4-D of one time point), its sample count (at most
 /// [`MAX_SAMPLES`] when `in_memory`), bits a sample matching the data type, and the samples' offset.
-pub(super) fn nifti_layout(
+fn nifti_layout(
     header: &nifti::NiftiHeader,
     file: &Path,
     in_memory: bool,
@@ -221,6 +223,68 @@ pub(super) fn nifti_layout(
         datatype,
         sample,
         offset: offset as u64,
+    })
+}
+
+/// The universe of `level`, checked to hold a volume of `shape` samples placed at `offset`.
+pub(super) fn placed_universe(
+    shape: [usize; 3],
+    level: u32,
+    offset: [u32; 3],
+) -> Result<Universe<3>, SolidError> {
+    let universe = Universe::<3>::new(level)?;
+    let side = universe.side();
+    if (0..3).any(|a| u64::from(offset[a]) + shape[a] as u64 > side) {
+        return Err(SolidError::BadParameter(format!(
+            "the volume ({shape:?} samples at offset {offset:?}) does not fit a level-{level} universe of side {side}"
+        )));
+    }
+    Ok(universe)
+}
+
+/// A NIfTI stream opened: gzip-compressed or not (told by its magic), its header read and checked
+/// ([`nifti_layout`]), the stream left just past the header's 348 bytes.
+pub(super) struct NiftiStream<'a> {
+    /// The rest of the (inflated) stream.
+    pub(super) input: Box<dyn Read + 'a>,
+    /// The header's bytes as read.
+    pub(super) header_bytes: Vec<u8>,
+    pub(super) header: nifti::NiftiHeader,
+    pub(super) layout: NiftiLayout,
+}
+
+/// Opens the NIfTI stream `input` of `file` ([`NiftiStream`]); `in_memory` as for [`nifti_layout`].
+pub(super) fn open_nifti_stream<'a>(
+    mut input: impl BufRead + 'a,
+    file: &Path,
+    in_memory: bool,
+) -> Result<NiftiStream<'a>, SolidError> {
+    let parse = |what: String| SolidError::Parse {
+        path: file.to_path_buf(),
+        what,
+    };
+    let gz = input
+        .fill_buf()
+        .map_err(|e| parse(format!("NIfTI: {e}")))?
+        .starts_with(&[0x1f, 0x8b]);
+    let mut input: Box<dyn Read + 'a> = if gz {
+        Box::new(flate2::bufread::GzDecoder::new(input))
+    } else {
+        Box::new(input)
+    };
+    let mut header_bytes = Vec::new();
+    (&mut input)
+        .take(NIFTI_HEADER_BYTES)
+        .read_to_end(&mut header_bytes)
+        .map_err(|e| parse(format!("NIfTI: {e}")))?;
+    let header = nifti::NiftiHeader::from_reader(&header_bytes[..])
+        .map_err(|e| parse(format!("NIfTI: {e}")))?;
+    let layout = nifti_layout(&header, file, in_memory)?;
+    Ok(NiftiStream {
+        input,
+        header_bytes,
+        header,
+        layout,
     })
 }
 

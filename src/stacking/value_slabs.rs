@@ -89,10 +89,11 @@ impl<const K: usize, V: Value> KTree<K, V> {
         let m = level - s;
         let mut pending: Vec<Layer<V>> = Vec::new();
         let mut slab = Vec::new();
+        let empty_box = region.iter().any(|r| r.is_empty());
+        let area: usize = region[..K - 1].iter().map(|r| r.len()).product();
         for b in 0..1u32 << m {
             let z = (b << s)..((b + 1) << s);
             let rows = z.start.max(region[K - 1].start)..z.end.min(region[K - 1].end);
-            let empty_box = region.iter().any(|r| r.is_empty());
             let mut layer = Layer {
                 depth: m,
                 cells: None,
@@ -101,7 +102,6 @@ impl<const K: usize, V: Value> KTree<K, V> {
                 slab.clear();
                 let first = rows.start;
                 read(rows.clone(), &mut slab)?;
-                let area: usize = region[..K - 1].iter().map(|r| r.len()).product();
                 if slab.len() != area * rows.len() {
                     return Err(RayError::SlabLength {
                         first,

@@ -236,9 +236,12 @@ fn labels_read_slab_by_slab_are_the_labels_of_the_whole_volume() {
     std::fs::write(&nii, &nii_bytes).unwrap();
     check(&nii);
     let gz = dir.path().join("l.nii.gz");
-    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-    enc.write_all(&nii_bytes).unwrap();
-    std::fs::write(&gz, enc.finish().unwrap()).unwrap();
+    let write_gz = |bytes: &[u8]| {
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+        enc.write_all(bytes).unwrap();
+        std::fs::write(&gz, enc.finish().unwrap()).unwrap();
+    };
+    write_gz(&nii_bytes);
     check(&gz);
     // Damaged: a NIfTI file cut in the samples (plain and compressed), a raw file too short, a sample
     // that is not a label, a label beyond the type.
@@ -247,9 +250,7 @@ fn labels_read_slab_by_slab_are_the_labels_of_the_whole_volume() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("l.nii") && e.contains("plane z = 2"), "{e}");
-    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-    enc.write_all(&nii_bytes[..352 + 2 * 100]).unwrap();
-    std::fs::write(&gz, enc.finish().unwrap()).unwrap();
+    write_gz(&nii_bytes[..352 + 2 * 100]);
     let e = label_tree::<u16>(&gz, 3, [0; 3], 1 << 20)
         .unwrap_err()
         .to_string();
