@@ -10,15 +10,20 @@ use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
+use super::ktree::v3::ValuedKtreeWriter;
+use super::ktree::Notes;
 use super::spill::{LevelFile, PieceRelease, BUFFER_BYTES};
 use super::KtreeWriter;
 use crate::fs::{AtomicFile, SpillError};
-use crate::rays::RaySource;
+use crate::rays::{RayError, RaySource};
+use crate::space::WorldFrame;
 use crate::stacking::{
     BuildError, Builder, LevelOrderSink, LevelPieces, OutOfCoreReport, PieceStore, Progress,
     SpilledPart, StoredPieces,
 };
+use crate::stacking::{ValueSlabs, ValueSlabsReport, ValuedLevelSink};
 use crate::tree::LevelCounts;
+use crate::value::Value;
 
 // The builder accounts for the buffers of the spill files and of the output at this size.
 const _: () = assert!(BUFFER_BYTES as u64 == crate::stacking::BUFFER_BYTES);
@@ -98,13 +103,20 @@ impl SpilledPart<SpilledFiles> {
         let receive = |owner: usize, words: &mut [u64]| {
             receive(owner, words).map_err(|e| output_error(out, e))
         };
-        let output = KtreeFile { writer, path: out };
+        let output = OutputFile { writer, path: out };
         let (file_bytes, report) = self.write_into(output, receive, progress)?;
         Ok(OutOfCoreReport {
             file_bytes,
             ..report
         })
     }
+}
+
+/// Renames the finished temporary file over `path`; returns the file's size.
+fn commit(file: AtomicFile, path: &Path) -> Result<u64, SpillError> {
+    file.commit().map_err(|e| output_error(path, e))?;
+    let metadata = std::fs::metadata(path).map_err(|e| output_error(path, e))?;
+    Ok(metadata.len())
 }
 
 /// The error of the output `path`.
@@ -259,27 +271,33 @@ impl LevelPieces for SpilledLevel<'_> {
     }
 }
 
-/// A `.ktree` version 2 file being written by a build: the [`KtreeWriter`] over the temporary file of
-/// `path`, renamed over it when finished. Its output is the file's size.
-struct KtreeFile<'a> {
-    writer: KtreeWriter<AtomicFile>,
+/// A `.ktree` file being written by a build: its writer (version 2 or 3) over the temporary file of `path`,
+/// renamed over it when finished. Its output is the file's size.
+struct OutputFile<'a, W> {
+    writer: W,
     path: &'a Path,
 }
 
-impl LevelOrderSink for KtreeFile<'_> {
+impl<W> OutputFile<'_, W> {
+    /// `write` of the writer, its error one of the output.
+    fn with<T>(
+        &mut self,
+        write: impl FnOnce(&mut W) -> std::io::Result<T>,
+    ) -> Result<T, SpillError> {
+        write(&mut self.writer).map_err(|e| output_error(self.path, e))
+    }
+}
+
+impl LevelOrderSink for OutputFile<'_, KtreeWriter<AtomicFile>> {
     type Error = SpillError;
     type Output = u64;
 
     fn append_words(&mut self, words: &[u64], nodes: u64) -> Result<(), SpillError> {
-        let path = self.path;
-        self.writer
-            .append_words(words, nodes)
-            .map_err(|e| output_error(path, e))
+        self.with(|w| w.append_words(words, nodes))
     }
 
     fn end_level(&mut self) -> Result<(), SpillError> {
-        let path = self.path;
-        self.writer.end_level().map_err(|e| output_error(path, e))
+        self.with(KtreeWriter::end_level)
     }
 
     fn counts_per_level(&self) -> Vec<LevelCounts> {
@@ -287,10 +305,105 @@ impl LevelOrderSink for KtreeFile<'_> {
     }
 
     fn finish(self) -> Result<u64, SpillError> {
-        let path = self.path;
-        let file = self.writer.finish().map_err(|e| output_error(path, e))?;
-        file.commit().map_err(|e| output_error(path, e))?;
-        let metadata = std::fs::metadata(path).map_err(|e| output_error(path, e))?;
-        Ok(metadata.len())
+        let file = self
+            .writer
+            .finish()
+            .map_err(|e| output_error(self.path, e))?;
+        commit(file, self.path)
+    }
+}
+
+impl ValuedLevelSink for OutputFile<'_, ValuedKtreeWriter<AtomicFile>> {
+    type Error = SpillError;
+    type Output = u64;
+
+    fn append_words(&mut self, words: &[u64], nodes: u64) -> Result<(), SpillError> {
+        self.with(|w| w.append_words(words, nodes))
+    }
+
+    fn end_codes(&mut self) -> Result<(), SpillError> {
+        self.with(ValuedKtreeWriter::end_codes)
+    }
+
+    fn append_values(&mut self, bytes: &[u8]) -> Result<(), SpillError> {
+        self.with(|w| w.append_values(bytes))
+    }
+
+    fn end_level(&mut self) -> Result<(), SpillError> {
+        self.with(ValuedKtreeWriter::end_level)
+    }
+
+    fn counts_per_level(&self) -> Vec<LevelCounts> {
+        self.writer.counts_per_level()
+    }
+
+    fn finish(self) -> Result<u64, SpillError> {
+        let file = self
+            .writer
+            .finish()
+            .map_err(|e| output_error(self.path, e))?;
+        commit(file, self.path)
+    }
+}
+
+impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
+    /// Builds the tree of the box `read` gives straight into `out` as a `.ktree` version 3 file with its
+    /// world frame (if any) and `notes`, atomically (a temporary file renamed over it), the subtrees of its
+    /// cells spilled to temporary files next to `out` (or in `temp_dir`) as they are built: the tree is
+    /// never held whole ([`build_into`](Self::build_into) with spill files and the version 3 writer). The
+    /// file is byte for byte what [`write_valued_ktree_noted`](crate::io::ktree::v3::write_valued_ktree_noted)
+    /// writes for the tree [`KTree::from_value_slabs`](crate::KTree::from_value_slabs) makes.
+    ///
+    /// ```
+    /// use ktree::io::ktree::v3::read_valued_ktree_file;
+    /// use ktree::io::ktree::Notes;
+    /// use ktree::stacking::ValueSlabs;
+    /// use ktree::KTree;
+    /// // An 8 × 8 × 8 cube of labels (a label a plane of 2, 1 the background) in a universe of side 16.
+    /// let read = |planes: std::ops::Range<u32>, out: &mut Vec<u16>| {
+    ///     out.extend(planes.flat_map(|z| std::iter::repeat_n(z as u16 / 2, 64)));
+    ///     Ok::<_, ktree::rays::RayError>(())
+    /// };
+    /// let slabs = ValueSlabs { level: 4, region: [4..12, 4..12, 4..12], background: 1, slab_bytes: 256 };
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let out = dir.path().join("labels.ktree");
+    /// let report = slabs.write_file(&out, None, None, &Notes::new(), read).unwrap();
+    /// let tree = KTree::<3, u16>::from_value_slabs(4, [4..12, 4..12, 4..12], 1, 256, read).unwrap();
+    /// assert_eq!(read_valued_ktree_file::<3, u16>(&out).unwrap(), tree);
+    /// assert_eq!(report.counts_per_level, tree.counts_per_level());
+    /// ```
+    ///
+    /// # Errors
+    /// As [`build_into`](Self::build_into): the source's errors; a temporary folder or output that cannot
+    /// be written (a full disk included), a frame or notes that cannot be kept, a value type without
+    /// values (`()`). The target is then untouched and no temporary file remains.
+    pub fn write_file<E: From<RayError>>(
+        &self,
+        out: &Path,
+        temp_dir: Option<&Path>,
+        frame: Option<&WorldFrame>,
+        notes: &Notes,
+        read: impl FnMut(std::ops::Range<u32>, &mut Vec<V>) -> Result<(), E>,
+    ) -> Result<ValueSlabsReport, BuildError<E>> {
+        let dtype = V::DTYPE.ok_or_else(|| {
+            output_error(
+                out,
+                std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "a tree without values is not written as a valued file",
+                ),
+            )
+        })?;
+        let t = (self.level - self.cell_depth()) as usize;
+        let store = SpillFiles::create(out, temp_dir, t)?;
+        let file = AtomicFile::create(out).map_err(|e| output_error(out, e))?;
+        let writer = ValuedKtreeWriter::new(file, K, self.level, dtype, frame, notes)
+            .map_err(|e| output_error(out, e))?;
+        let sink = OutputFile { writer, path: out };
+        let (file_bytes, report) = self.build_into(read, store, sink)?;
+        Ok(ValueSlabsReport {
+            file_bytes,
+            ..report
+        })
     }
 }

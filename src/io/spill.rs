@@ -77,10 +77,11 @@ impl LevelFile {
         }
     }
 
-    /// Appends `nodes` states packed in `words` as whole words, starting at a word boundary (the states
-    /// appended before are padded to a whole word first).
+    /// Appends `nodes` states packed in the first words of `words` as whole words, starting at a word
+    /// boundary (the states appended before are padded to a whole word first); the words after the
+    /// states' (a valued piece's values) follow them.
     pub(crate) fn append_words(&mut self, words: &[u64], nodes: u64) -> Result<(), SpillError> {
-        debug_assert_eq!(words.len() as u64, nodes.div_ceil(NODES_PER_WORD as u64));
+        debug_assert!(words.len() as u64 >= nodes.div_ceil(NODES_PER_WORD as u64));
         if let Some(last) = self.packer.flush() {
             self.write_word(last)?;
         }

@@ -103,6 +103,7 @@ pub mod paper;
 mod partition;
 mod solids;
 mod value_slabs;
+mod value_spill;
 mod values;
 
 pub use builder::{Builder, CellStacking};
@@ -112,3 +113,5 @@ pub use out_of_core::{
     SpilledPart, Stage, StoredPieces, MAX_PARTS,
 };
 pub use partition::default_split_depth;
+pub use value_slabs::ValueSlabs;
+pub use value_spill::{ValueSlabsReport, ValuedLevelSink};

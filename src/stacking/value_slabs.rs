@@ -68,11 +68,56 @@ impl<const K: usize, V: Value> KTree<K, V> {
         region: [Range<u32>; K],
         background: V,
         slab_bytes: usize,
-        mut read: impl FnMut(Range<u32>, &mut Vec<V>) -> Result<(), E>,
+        read: impl FnMut(Range<u32>, &mut Vec<V>) -> Result<(), E>,
     ) -> Result<Self, E>
     where
         V: Send + Sync,
     {
+        let slabs = ValueSlabs {
+            level,
+            region,
+            background,
+            slab_bytes,
+        };
+        let root = slabs.stack(read, |_, _| Ok(()))?;
+        let universe = Universe::<K>::new(level).map_err(RayError::from)?;
+        Ok(root.into_tree(universe))
+    }
+}
+
+/// A box of values in a universe, read slab by slab along the last axis, front to back: what
+/// [`KTree::from_value_slabs`] builds a tree of in memory, and what [`ValueSlabs::build_into`] (and `io`'s
+/// `ValueSlabs::write_file`) writes level by level with the cells' subtrees spilled, for trees larger
+/// than memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValueSlabs<const K: usize, V> {
+    /// The universe's level.
+    pub level: u32,
+    /// The box read (one range a coordinate, axis 0 first); the voxels outside it are empty.
+    pub region: [Range<u32>; K],
+    /// The value meaning empty.
+    pub background: V,
+    /// The most bytes of values read at once (a slab is as thick as fits, a power of two; at least one
+    /// voxel, and thick enough that at most about 16 million cells are built apart).
+    pub slab_bytes: usize,
+}
+
+impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
+    /// The depth `m` of the cells built apart (each of side `2^(L − m)`, one slab thick).
+    pub(crate) fn cell_depth(&self) -> u32 {
+        self.level - slab_log::<K, V>(self.level, &self.region, self.slab_bytes)
+    }
+
+    /// Reads the box slab by slab and joins the slabs' cells into the root's subtree, handing each
+    /// slab's cells to `keep(b, cells)` first (`b` the slab's number, the cells in the Morton order of
+    /// their coordinates along the other axes), which may replace them (by their roots alone, say, once
+    /// spilled).
+    pub(crate) fn stack<X: From<RayError>>(
+        &self,
+        mut read: impl FnMut(Range<u32>, &mut Vec<V>) -> Result<(), X>,
+        mut keep: impl FnMut(u32, &mut Vec<Subtree<V>>) -> Result<(), X>,
+    ) -> Result<Subtree<V>, X> {
+        let (level, region, background) = (self.level, &self.region, self.background);
         let universe = Universe::<K>::new(level).map_err(RayError::from)?;
         let side = universe.side();
         if let Some(axis) =
@@ -85,8 +130,8 @@ impl<const K: usize, V: Value> KTree<K, V> {
             })
             .into());
         }
-        let s = slab_log::<K, V>(level, &region, slab_bytes);
-        let m = level - s;
+        let m = self.cell_depth();
+        let s = level - m;
         let mut pending: Vec<Layer<V>> = Vec::new();
         let mut slab = Vec::new();
         let empty_box = region.iter().any(|r| r.is_empty());
@@ -112,12 +157,14 @@ impl<const K: usize, V: Value> KTree<K, V> {
                 }
                 let view = SlabView {
                     universe,
-                    region: &region,
+                    region,
                     rows,
                     values: &slab,
                     background,
                 };
-                layer.cells = Some(view.cells(s, b)?);
+                let mut cells = view.cells(s, b)?;
+                keep(b, &mut cells)?;
+                layer.cells = Some(cells);
             }
             pending.push(layer);
             while pending.len() >= 2
@@ -130,11 +177,10 @@ impl<const K: usize, V: Value> KTree<K, V> {
         }
         let root = pending.pop().expect("the layers join into the root");
         debug_assert!(pending.is_empty() && root.depth == 0);
-        let tree = match root.cells {
+        Ok(match root.cells {
             None => Subtree::leaf(ValueState::Empty),
             Some(mut cells) => cells.pop().expect("the root layer holds one cell"),
-        };
-        Ok(tree.into_tree(universe))
+        })
     }
 }
 
@@ -258,7 +304,7 @@ impl<const K: usize, V: Value + Send + Sync> SlabView<'_, K, V> {
 
 /// The Morton key, among cells of `K` dimensions, of the cell whose coordinates along axes `0 … K − 2`
 /// have the `K − 1`-dimensional Morton key `key` and whose last coordinate is 0.
-fn spread_across<const K: usize>(key: u64) -> u64 {
+pub(crate) fn spread_across<const K: usize>(key: u64) -> u64 {
     let d = K as u64 - 1;
     let mut out = 0u64;
     let mut bit = 0;

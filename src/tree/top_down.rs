@@ -182,6 +182,9 @@ fn pack_level<V: Value>(chunks: Vec<Vec<ValueState<V>>>) -> (PackedStates, Vec<V
     (level, column)
 }
 
+/// A level packed: its 2-bit codes and the values of its full nodes.
+pub(crate) type PackedLevel<V> = (PackedStates, Vec<V>);
+
 /// A subtree built apart (on a thread of its own, say): its root's state and the states of each level
 /// below it in level order, each level as the chunks it was made of — joined to its siblings' without
 /// copying, copied once when the whole tree is packed ([`Subtree::into_tree`]).
@@ -239,6 +242,28 @@ impl<V: Value> Subtree<V> {
             }
         }
         Self { root, below }
+    }
+
+    /// The root's state.
+    pub(crate) fn root(&self) -> ValueState<V> {
+        self.root
+    }
+
+    /// The levels below the root, each packed as its codes and its full nodes' values, taken out: the
+    /// subtree is left its root alone.
+    pub(crate) fn take_levels_below(&mut self) -> Vec<PackedLevel<V>> {
+        std::mem::take(&mut self.below)
+            .into_iter()
+            .map(pack_level)
+            .collect()
+    }
+
+    /// The levels from the root down, each packed as its codes and its full nodes' values.
+    pub(crate) fn into_packed_levels(self) -> Vec<PackedLevel<V>> {
+        std::iter::once(vec![vec![self.root]])
+            .chain(self.below)
+            .map(pack_level)
+            .collect()
     }
 
     /// The tree of `universe` this subtree is the whole of (its root the universe's root).

@@ -342,6 +342,27 @@ fn from_slabs<const K: usize, V: Palette>(
         .unwrap();
         got.assert_well_formed();
         prop_assert!(got == want, "slabs 2^{s} thick, box {region:?}");
+        // Written level by level with the cells' subtrees spilled: the file of the tree, and nothing else
+        // left in the folder.
+        let slabs = ktree::stacking::ValueSlabs {
+            level: o.level,
+            region: region.clone(),
+            background,
+            slab_bytes: row << s,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("slabs.ktree");
+        let notes = ktree::io::ktree::Notes::from([("s".to_string(), s.to_string())]);
+        let report = slabs.write_file(&out, None, None, &notes, read).unwrap();
+        let mut bytes = Vec::new();
+        ktree::io::ktree::v3::write_valued_ktree_noted(&mut bytes, &want, None, &notes).unwrap();
+        prop_assert!(
+            std::fs::read(&out).unwrap() == bytes,
+            "file of slabs 2^{s} thick"
+        );
+        prop_assert_eq!(report.file_bytes, bytes.len() as u64);
+        prop_assert_eq!(&report.counts_per_level, &want.counts_per_level());
+        prop_assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
         // The slabs cover the box's rows once, in order (none of an empty box is read).
         let covered: Vec<u32> = slabs_seen.drain(..).flatten().collect();
         let rows = if region.iter().any(|r| r.is_empty()) {
@@ -362,6 +383,30 @@ fn from_slabs<const K: usize, V: Palette>(
             matches!(short, Err(RayError::SlabLength { .. })),
             "{short:?}"
         );
+        let slabs = ktree::stacking::ValueSlabs {
+            level: o.level,
+            region: region.clone(),
+            background,
+            slab_bytes: 0,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("short.ktree");
+        let notes = ktree::io::ktree::Notes::new();
+        let short = slabs.write_file(&out, None, None, &notes, |rows, out| {
+            read(rows, out)?;
+            out.pop();
+            Ok::<_, RayError>(())
+        });
+        prop_assert!(
+            matches!(
+                short,
+                Err(ktree::stacking::BuildError::Source(
+                    RayError::SlabLength { .. }
+                ))
+            ),
+            "{short:?}"
+        );
+        prop_assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
     Ok(())
 }

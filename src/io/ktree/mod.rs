@@ -27,6 +27,7 @@ use thiserror::Error;
 use crate::tree::{AnyTree, KTree};
 
 mod history_file;
+mod level_stream;
 mod map_file;
 pub mod notes;
 pub mod streamed;
@@ -34,6 +35,7 @@ pub mod v1;
 pub mod v2;
 pub mod v3;
 mod v3_mapped;
+mod v3_writer;
 
 pub use history_file::{read_history_ktree, write_history_ktree_file, STEPS_NOTE};
 pub use map_file::{read_map_ktree, write_map_ktree_file, MappedMap};

@@ -56,12 +56,11 @@ use crate::tree::words::{children_mask, full_mask};
 use crate::tree::{AnyTree, AnyValuedTree, Dtype, KTree, PackedStates, Value};
 
 pub use super::v3_mapped::MappedValuedTree;
+pub use super::v3_writer::ValuedKtreeWriter;
+use super::v3_writer::{check_frame, FRAME_BYTES};
 
 /// The format version of valued files.
 pub const VERSION: u16 = 3;
-
-/// The bytes of a world frame after the header: the voxel size and three origin coordinates.
-const FRAME_BYTES: usize = 32;
 
 /// Words between two rank samples.
 const WORDS_PER_SAMPLE: usize = 64;
@@ -121,7 +120,7 @@ pub fn write_valued_ktree_framed<const K: usize, V: Value>(
 /// As [`write_valued_ktree_framed`]; [`std::io::ErrorKind::InvalidInput`] for a note that cannot be kept
 /// (an empty name, a name holding `=`, a line break).
 pub fn write_valued_ktree_noted<const K: usize, V: Value>(
-    mut out: impl Write,
+    out: impl Write,
     tree: &KTree<K, V>,
     frame: Option<&WorldFrame>,
     notes: &Notes,
@@ -129,88 +128,26 @@ pub fn write_valued_ktree_noted<const K: usize, V: Value>(
     let Some(dtype) = V::DTYPE else {
         return super::write_ktree(out, &tree.shape());
     };
-    let invalid = |e: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, e);
-    if let Some(f) = frame {
-        check_frame(f).map_err(invalid)?;
-    }
-    let notes_block = notes::encode(notes).map_err(invalid)?;
-    let mut header = Vec::with_capacity(HEADER_BYTES + FRAME_BYTES + notes_block.len());
-    header.extend_from_slice(MAGIC);
-    header.extend_from_slice(&VERSION.to_le_bytes());
-    header.extend_from_slice(&[K as u8, tree.level() as u8, dtype.code()]);
-    let flags = u8::from(frame.is_some()) | u8::from(!notes_block.is_empty()) << 1;
-    header.extend_from_slice(&[flags, 0, 0, 0, 0]);
-    if let Some(f) = frame {
-        for x in [f.voxel_size, f.origin[0], f.origin[1], f.origin[2]] {
-            header.extend_from_slice(&x.to_le_bytes());
-        }
-    }
-    header.extend_from_slice(&notes_block);
-    out.write_all(&header)?;
-    let mut length = header.len() as u64;
-    let mut directory = Vec::with_capacity(tree.depth_count() * ENTRY_BYTES + TAIL_BYTES);
-    let mut section = Vec::new();
+    let mut writer = ValuedKtreeWriter::new(out, K, tree.level(), dtype, frame, notes)?;
+    let mut values = Vec::new();
     for depth in 0..tree.depth_count() {
         let states = tree.level_states(depth);
-        let words = states.words();
-        section.clear();
-        for w in words {
-            section.extend_from_slice(&w.to_le_bytes());
-        }
-        let (mut children, mut full) = (0u64, 0u64);
-        let mut children_samples = Vec::new();
-        let mut full_samples = Vec::new();
-        for (i, &w) in words.iter().enumerate() {
-            if i % WORDS_PER_SAMPLE == 0 {
-                children_samples.push(children);
-                full_samples.push(full);
-            }
-            children += u64::from(children_mask(w).count_ones());
-            full += u64::from(full_mask(w).count_ones());
-        }
-        for s in children_samples.iter().chain(&full_samples) {
-            section.extend_from_slice(&s.to_le_bytes());
-        }
+        writer.append_words(states.words(), states.len() as u64)?;
+        writer.end_codes()?;
+        values.clear();
         for index in 0..states.len() {
             if states.get(index) == crate::tree::NodeState::Full {
                 let value = match tree.value(depth, index) {
                     Ok(v) => v,
                     Err(never) => match never {},
                 };
-                value.write_le(&mut section);
+                value.write_le(&mut values);
             }
         }
-        section.resize(section.len().div_ceil(8) * 8, 0);
-        out.write_all(&section)?;
-        length += section.len() as u64;
-        directory.extend_from_slice(&(states.len() as u64).to_le_bytes());
-        directory.extend_from_slice(&full.to_le_bytes());
-        directory.extend_from_slice(&children.to_le_bytes());
-        directory.extend_from_slice(&crc32fast::hash(&section).to_le_bytes());
-        directory.extend_from_slice(&0u32.to_le_bytes());
+        writer.append_values(&values)?;
+        writer.end_level()?;
     }
-    length += (directory.len() + TAIL_BYTES) as u64;
-    directory.extend_from_slice(&length.to_le_bytes());
-    directory.extend_from_slice(&(tree.depth_count() as u32).to_le_bytes());
-    let mut hasher = crc32fast::Hasher::new();
-    hasher.update(&header);
-    hasher.update(&directory);
-    directory.extend_from_slice(&hasher.finalize().to_le_bytes());
-    out.write_all(&directory)
-}
-
-/// Why a world frame cannot be kept: a voxel size that is not a positive number, an origin not finite.
-fn check_frame(f: &WorldFrame) -> Result<(), String> {
-    if !(f.voxel_size.is_finite() && f.voxel_size > 0.0) {
-        return Err(format!(
-            "a frame's voxel size {} is not a positive number",
-            f.voxel_size
-        ));
-    }
-    if f.origin.iter().any(|c| !c.is_finite()) {
-        return Err(format!("a frame's origin {:?} is not finite", f.origin));
-    }
-    Ok(())
+    writer.finish().map(drop)
 }
 
 /// Writes a valued tree's `.ktree` file with its world frame atomically ([`write_valued_ktree_framed`]).

@@ -25,11 +25,8 @@ use crate::io::mmap::FileMap;
 use crate::io::{KtreeFileError, KtreeFileErrorKind};
 use crate::space::{Universe, WorldFrame};
 use crate::tree::valued::ValueStorage;
-use crate::tree::words::{children_mask, full_mask};
+use crate::tree::words::{children_mask, full_mask, NODES_PER_WORD};
 use crate::value::Value;
-
-/// Nodes a word of codes holds.
-const NODES_PER_WORD: usize = 32;
 
 /// Words between two rank samples.
 const WORDS_PER_SAMPLE: usize = 64;

@@ -99,8 +99,10 @@ pub trait PieceStore: Send {
     /// The pieces stored, to be read back.
     type Stored: StoredPieces<Error = Self::Error> + Send;
 
-    /// Appends a piece of `nodes` nodes, packed in `words` (`⌈nodes / 32⌉` words), to level `depth ≥ 1`
-    /// of the subtrees (after the pieces appended to it before).
+    /// Appends a piece of `nodes` nodes, packed in `words` (`⌈nodes / 32⌉` words; a valued build's pieces
+    /// hold their full nodes' values in the words after them, see
+    /// [`ValueSlabs::build_into`](crate::stacking::ValueSlabs::build_into)), to level `depth ≥ 1` of the
+    /// subtrees (after the pieces appended to it before).
     ///
     /// # Errors
     /// The store's error.
@@ -128,8 +130,9 @@ pub trait StoredPieces {
     fn level<'a>(&'a mut self, depth: usize, offsets: &'a [u64], words: u64) -> Self::Level<'a>;
 }
 
-/// One level of a [`StoredPieces`] being read back: each piece once, its words in order, the pieces in
-/// any order (the builder takes them in the Morton order of their cells).
+/// One level of a [`StoredPieces`] being read back: each piece's words once, in order (in one read or
+/// several), the pieces in any order (the builder takes them in the Morton order of their cells; a valued
+/// build reads every piece's codes, then every piece's values).
 pub trait LevelPieces {
     /// Why a piece could not be read back.
     type Error;

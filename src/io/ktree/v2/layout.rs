@@ -107,6 +107,46 @@ impl Section {
     }
 }
 
+/// The end of a file whose level sections (`sections`, `partial` counting the nodes with children) end at
+/// byte `written`: the directory, the file's length, the number of levels and the CRC of `header` and of
+/// all of it — the same in versions 2 and 3.
+///
+/// # Errors
+/// `InvalidInput` if there is no level or the last one has nodes with children.
+pub(crate) fn directory_tail(
+    sections: &[Section],
+    written: u64,
+    header: &[u8],
+) -> std::io::Result<Vec<u8>> {
+    match sections.last() {
+        None => return Err(invalid("no level was written".into())),
+        Some(last) if last.partial > 0 => {
+            return Err(invalid(format!(
+                "the last level ({}) has {} nodes with children, but no level below",
+                sections.len() - 1,
+                last.partial
+            )))
+        }
+        Some(_) => {}
+    }
+    let mut tail = Vec::with_capacity(sections.len() * ENTRY_BYTES + TAIL_BYTES);
+    for s in sections {
+        for v in [s.nodes, s.full, s.partial] {
+            tail.extend_from_slice(&v.to_le_bytes());
+        }
+        tail.extend_from_slice(&s.crc.to_le_bytes());
+        tail.extend_from_slice(&0u32.to_le_bytes());
+    }
+    let len = written + tail.len() as u64 + TAIL_BYTES as u64;
+    tail.extend_from_slice(&len.to_le_bytes());
+    tail.extend_from_slice(&(sections.len() as u32).to_le_bytes());
+    let mut hasher = crc32fast::Hasher::new();
+    hasher.update(header);
+    hasher.update(&tail);
+    tail.extend_from_slice(&hasher.finalize().to_le_bytes());
+    Ok(tail)
+}
+
 /// The shape of a version 2 file: its header and directory, checked.
 #[derive(Debug, Clone)]
 pub(crate) struct Layout {

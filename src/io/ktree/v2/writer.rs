@@ -3,8 +3,8 @@
 use std::io::Write;
 
 use super::layout::*;
+use crate::io::ktree::level_stream::LevelStream;
 use crate::space::{max_level, MAX_K};
-use crate::tree::words::WordPacker;
 use crate::tree::{KTree, LevelCounts, NodeState, PackedStates};
 
 /// Writes a `.ktree` version 2 file level by level, from the root down, without holding the tree.
@@ -37,26 +37,7 @@ use crate::tree::{KTree, LevelCounts, NodeState, PackedStates};
 /// ```
 #[derive(Debug)]
 pub struct KtreeWriter<W: Write> {
-    out: W,
-    k: usize,
-    level: u32,
-    /// Bytes written so far.
-    written: u64,
-    finished: Vec<Section>,
-    current: LevelWriter,
-    buffer: Vec<u8>,
-}
-
-/// The level being written.
-#[derive(Debug, Default)]
-struct LevelWriter {
-    nodes: u64,
-    full: u64,
-    partial: u64,
-    packer: WordPacker,
-    words: u64,
-    samples: Vec<u64>,
-    hasher: crc32fast::Hasher,
+    stream: LevelStream<W>,
 }
 
 impl<W: Write> KtreeWriter<W> {
@@ -64,21 +45,14 @@ impl<W: Write> KtreeWriter<W> {
     ///
     /// # Errors
     /// `InvalidInput` for `k` or `level` out of range; any I/O error.
-    pub fn new(mut out: W, k: usize, level: u32) -> std::io::Result<Self> {
-        if !(1..=MAX_K).contains(&k) || level > max_level(k) {
-            return Err(invalid(format!(
-                "K = {k}, L = {level} is not a valid universe"
-            )));
-        }
-        out.write_all(&header_bytes(k, level))?;
+    pub fn new(out: W, k: usize, level: u32) -> std::io::Result<Self> {
+        let header = if (1..=MAX_K).contains(&k) && level <= max_level(k) {
+            header_bytes(k, level).to_vec()
+        } else {
+            Vec::new()
+        };
         Ok(Self {
-            out,
-            k,
-            level,
-            written: HEADER_BYTES as u64,
-            finished: Vec::new(),
-            current: LevelWriter::default(),
-            buffer: Vec::with_capacity(1 << 16),
+            stream: LevelStream::new(out, k, level, header, false)?,
         })
     }
 
@@ -106,54 +80,19 @@ impl<W: Write> KtreeWriter<W> {
     /// `InvalidInput` if `words` holds fewer than `nodes` nodes or a node has the unused code `11`; any I/O
     /// error.
     pub fn append_words(&mut self, words: &[u64], nodes: u64) -> std::io::Result<()> {
-        let needed = words_of(nodes);
-        if (words.len() as u64) < needed {
-            return Err(invalid(format!(
-                "{} words cannot hold {nodes} nodes",
-                words.len()
-            )));
-        }
         let mut remaining = nodes;
-        for &word in &words[..needed as usize] {
+        for &word in words.iter().take(words_of(nodes) as usize) {
             let take = remaining.min(NODES_PER_WORD);
             let word = word & slots_mask(take);
             if (word >> 1) & word & LOW_BITS != 0 {
                 return Err(invalid(format!(
                     "a node of level {} has the unused code 11",
-                    self.finished.len()
+                    self.stream.depth()
                 )));
-            }
-            if let Some(whole) = self.current.packer.push(word, take as usize) {
-                self.emit(whole)?;
             }
             remaining -= take;
         }
-        self.current.nodes += nodes;
-        Ok(())
-    }
-
-    /// Writes one complete word of the current level.
-    fn emit(&mut self, word: u64) -> std::io::Result<()> {
-        let level = &mut self.current;
-        if level.words.is_multiple_of(WORDS_PER_SAMPLE) {
-            level.samples.push(level.partial);
-        }
-        level.words += 1;
-        level.full += u64::from(full_mask(word).count_ones());
-        level.partial += u64::from(partial_mask(word).count_ones());
-        self.buffer.extend_from_slice(&word.to_le_bytes());
-        if self.buffer.len() >= 1 << 16 {
-            self.flush_buffer()?;
-        }
-        Ok(())
-    }
-
-    fn flush_buffer(&mut self) -> std::io::Result<()> {
-        self.current.hasher.update(&self.buffer);
-        self.out.write_all(&self.buffer)?;
-        self.written += self.buffer.len() as u64;
-        self.buffer.clear();
-        Ok(())
+        self.stream.append_codes(words, nodes)
     }
 
     /// Closes the current level: the next append starts the level below.
@@ -163,41 +102,13 @@ impl<W: Write> KtreeWriter<W> {
     /// times the partial nodes of the level above, or the tree would be deeper than the universe; any I/O
     /// error.
     pub fn end_level(&mut self) -> std::io::Result<()> {
-        let depth = self.finished.len();
-        let nodes = self.current.nodes;
-        let expected = match self.finished.last() {
-            None => 1,
-            Some(above) => above.partial << self.k,
-        };
-        if nodes != expected || depth > self.level as usize {
-            return Err(invalid(format!(
-                "level {depth} has {nodes} nodes, but the levels above call for {expected} (universe level {})",
-                self.level
-            )));
-        }
-        if let Some(word) = self.current.packer.flush() {
-            self.emit(word)?;
-        }
-        let samples = std::mem::take(&mut self.current.samples);
-        for s in samples {
-            self.buffer.extend_from_slice(&s.to_le_bytes());
-        }
-        self.flush_buffer()?;
-        let level = std::mem::take(&mut self.current);
-        let section_bytes = 8 * (level.words + samples_of(level.words));
-        self.finished.push(Section {
-            offset: self.written - section_bytes,
-            nodes,
-            full: level.full,
-            partial: level.partial,
-            crc: level.hasher.finalize(),
-        });
-        Ok(())
+        self.stream.end_codes()?;
+        self.stream.end_level()
     }
 
     /// The node counts of the levels closed so far (`level` = depth), as the file's directory will hold them.
     pub fn counts_per_level(&self) -> Vec<LevelCounts> {
-        counts_of(&self.finished)
+        self.stream.counts_per_level()
     }
 
     /// Closes the last level if nodes were appended to it, writes the directory, and returns the output.
@@ -205,39 +116,10 @@ impl<W: Write> KtreeWriter<W> {
     /// # Errors
     /// `InvalidInput` if no level was written or the last level has partial nodes; any I/O error.
     pub fn finish(mut self) -> std::io::Result<W> {
-        if self.current.nodes > 0 {
+        if !self.stream.level_is_empty() {
             self.end_level()?;
         }
-        match self.finished.last() {
-            None => return Err(invalid("no level was written".into())),
-            Some(last) if last.partial > 0 => {
-                return Err(invalid(format!(
-                    "the last level ({}) has {} partial nodes without children",
-                    self.finished.len() - 1,
-                    last.partial
-                )))
-            }
-            Some(_) => {}
-        }
-        let depth = self.finished.len();
-        let mut tail = Vec::with_capacity(depth * ENTRY_BYTES + TAIL_BYTES);
-        for s in &self.finished {
-            for v in [s.nodes, s.full, s.partial] {
-                tail.extend_from_slice(&v.to_le_bytes());
-            }
-            tail.extend_from_slice(&s.crc.to_le_bytes());
-            tail.extend_from_slice(&0u32.to_le_bytes());
-        }
-        let len = self.written + tail.len() as u64 + TAIL_BYTES as u64;
-        tail.extend_from_slice(&len.to_le_bytes());
-        tail.extend_from_slice(&(depth as u32).to_le_bytes());
-        let mut hasher = crc32fast::Hasher::new();
-        hasher.update(&header_bytes(self.k, self.level));
-        hasher.update(&tail);
-        tail.extend_from_slice(&hasher.finalize().to_le_bytes());
-        self.out.write_all(&tail)?;
-        self.out.flush()?;
-        Ok(self.out)
+        self.stream.finish()
     }
 }
 
