@@ -164,8 +164,10 @@ print("## A label volume read slab by slab")
 print()
 print("`ktree voxelize labels-9.json --labels --dtype uint32 --out labels-9.ktree` (one thread) on the L = 9 phantom's labels")
 print("as a raw file (512³ uint32, x fastest): the file is read slab by slab along z, at most 64 MiB of labels at once")
-print("(`KTree::from_value_slabs`), each slab's cells of 2^s voxels a side built apart and joined as slabs arrive, so the")
-print("process holds one slab and the tree, never the volume. Best of 3 (the whole command: reading, building, writing).")
+print("(`stacking::ValueSlabs::write_file`), each slab's cells of 2^s voxels a side built apart, their levels below the")
+print("cells spilled to temporary files at once, and the file written level by level from the cells' roots and the spilled")
+print("pieces, so the process holds one slab and the top levels, never the volume nor the whole tree. Best of 3 (the whole")
+print("command: reading, building, writing).")
 print()
 streamed = {"secs": [], "rss_kb": []}
 for line in open(streamed_path):

@@ -9,10 +9,10 @@
 use std::path::Path;
 
 use ktree::export::vtk::write_values_time_slices;
-use ktree::io::ktree::v3::{read_valued_ktree_noted, write_valued_ktree_file};
+use ktree::io::ktree::v3::read_valued_ktree_noted;
 use ktree::io::ktree::Notes;
 use ktree::io::{read_vdb_values, write_valued_tree, WriteOptions, WrittenValues};
-use ktree::solid::volume_file::{window_tree, VolumeFile};
+use ktree::solid::volume_file::{window_slabs, VolumeFile};
 use ktree::space::WorldFrame;
 use ktree::tree::AnyValuedTree;
 use ktree::value::Value;
@@ -153,7 +153,7 @@ pub fn vdb_to_valued(
 const WINDOW_SLAB_BYTES: usize = 64 << 20;
 
 /// `ktree voxelize VOLUME --window LO:HI`: the samples from `lo` to `hi` kept as `float32` values, the
-/// volume read slab by slab along z.
+/// volume read slab by slab along z and the tree written out of core.
 pub fn voxelize_window(
     input: &Path,
     window: (f64, f64),
@@ -163,16 +163,16 @@ pub fn voxelize_window(
 ) -> CliResult {
     let shape = VolumeFile::open(input).map_err(CliError::caused)?.shape();
     let level = level.unwrap_or_else(|| fitting_level(shape, offset));
-    let tree = window_tree(input, level, offset, window.0, window.1, WINDOW_SLAB_BYTES)
+    let slabs = window_slabs(input, level, offset, window.0, window.1)
         .map_err(|e| CliError::in_file(input, e))?;
-    write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
+    let written = crate::values::write_volume_slabs(input, level, slabs, WINDOW_SLAB_BYTES, out)?;
     outln!(
         "{}: {} voxels from {} to {} kept as float32, L = {level}, {} nodes",
         out.display(),
-        tree.voxel_count(),
+        written.voxels,
         window.0,
         window.1,
-        tree.node_count()
+        written.nodes
     );
     Ok(())
 }

@@ -11,12 +11,14 @@ use std::path::{Path, PathBuf};
 
 use ktree::io::ktree::notes::label_note;
 use ktree::io::ktree::v3::{
-    read_any_ktree_noted, valued_header, write_valued_ktree_file, AnyKtree,
+    read_any_ktree_noted, valued_header, write_valued_ktree_file, AnyKtree, MappedValuedTree,
 };
 use ktree::io::ktree::Notes;
 use ktree::query::{stats, TreeStats};
 use ktree::solid::cloud::{self, CloudVoxelizer, PointCloud};
-use ktree::solid::volume_file::{label_tree, VolumeFile};
+use ktree::solid::volume_file::{label_slabs, SampleRule, VolumeFile, VolumeSlabs};
+use ktree::stacking::{BuildError, ValueSlabs};
+use ktree::tree::valued::ValueLeaves;
 use ktree::value::{Dtype, Value};
 use ktree::{with_valued, AnyValuedTree, KTree};
 
@@ -69,8 +71,52 @@ fn read_valued_noted(path: &Path) -> CliResult<(AnyValuedTree, Notes)> {
 /// The labels held at once while a label volume is read: slabs of up to 64 MiB of labels.
 const LABEL_SLAB_BYTES: usize = 64 << 20;
 
+/// What [`write_volume_slabs`] wrote: the tree's voxels and nodes.
+pub struct WrittenTree {
+    pub voxels: u128,
+    pub nodes: u64,
+}
+
+/// Writes the tree of a volume read slab by slab (at most about `slab_bytes` of values at once) to the
+/// `.ktree` file `out`, its cells' subtrees spilled next to it as they are built: the tree is never held
+/// whole. Errors of the volume name `input`; those of the files, the file.
+pub fn write_volume_slabs<V, R>(
+    input: &Path,
+    level: u32,
+    mut slabs: VolumeSlabs<V, R>,
+    slab_bytes: usize,
+    out: &Path,
+) -> CliResult<WrittenTree>
+where
+    V: Value + Send + Sync,
+    R: SampleRule<V>,
+{
+    let report = ValueSlabs {
+        level,
+        region: slabs.region.clone(),
+        background: slabs.background,
+        slab_bytes,
+    }
+    .write_file(out, None, None, &Notes::new(), |planes, values| {
+        slabs.read(planes, values)
+    })
+    .map_err(|e| match e {
+        BuildError::Source(e) => CliError::in_file(input, e),
+        other => crate::common::output::describe(out, other, 0),
+    })?;
+    let counts = &report.counts_per_level;
+    Ok(WrittenTree {
+        voxels: counts
+            .iter()
+            .map(|c| u128::from(c.full) << (3 * (level - c.level)))
+            .sum(),
+        nodes: counts.iter().map(|c| c.full + c.empty + c.partial).sum(),
+    })
+}
+
 /// A label volume into a valued tree of the smallest label type that holds it (or `dtype`), read slab by
-/// slab along z: the volume is never held whole, so one larger than memory is voxelized.
+/// slab along z and written out of core: neither the volume nor the tree is held whole, so one larger
+/// than memory is voxelized.
 pub fn voxelize_labels(
     input: &Path,
     level: Option<u32>,
@@ -99,20 +145,24 @@ pub fn voxelize_labels(
         offset: [u32; 3],
         out: &Path,
     ) -> CliResult {
-        let tree = label_tree::<V>(input, level, offset, LABEL_SLAB_BYTES)
-            .map_err(|e| CliError::in_file(input, e))?;
-        write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
-        let labels: std::collections::HashSet<V::Key> = tree
-            .value_leaves()
-            .filter_map(|(_, v)| v.map(V::key))
-            .collect();
-        let labels = labels.len();
+        let slabs =
+            label_slabs::<V>(input, level, offset).map_err(|e| CliError::in_file(input, e))?;
+        let written = write_volume_slabs(input, level, slabs, LABEL_SLAB_BYTES, out)?;
+        // The labels counted from the file, read in place.
+        let mapped = MappedValuedTree::<3, V>::open(out).map_err(CliError::caused)?;
+        let mut labels = std::collections::HashSet::new();
+        for leaf in ValueLeaves::new(&mapped) {
+            if let (_, Some(v)) = leaf.map_err(CliError::caused)? {
+                labels.insert(v.key());
+            }
+        }
         outln!(
-            "{}: {} voxels labelled with {labels} labels ({}), L = {level}, {} nodes",
+            "{}: {} voxels labelled with {} labels ({}), L = {level}, {} nodes",
             out.display(),
-            tree.voxel_count(),
+            written.voxels,
+            labels.len(),
             V::DTYPE.map_or("", Dtype::name),
-            tree.node_count()
+            written.nodes
         );
         Ok(())
     }

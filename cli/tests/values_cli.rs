@@ -173,13 +173,22 @@ fn values_on_the_command_line_fail_clearly() {
     let p = |name: &str| dir.path().join(name).display().to_string();
     let (shape, values) = labels();
     let json = write_volume(dir.path(), shape, &values);
-    run(&[
+    let said = run(&[
         "voxelize",
         json.to_str().unwrap(),
         "--labels",
         "--out",
         &p("l.ktree"),
     ]);
+    // The summary counts the samples' labels and labelled voxels.
+    let distinct: std::collections::BTreeSet<u16> =
+        values.iter().copied().filter(|&v| v > 0).collect();
+    let labelled = values.iter().filter(|&&v| v > 0).count();
+    let summary = format!(
+        "{labelled} voxels labelled with {} labels (uint16)",
+        distinct.len()
+    );
+    assert!(said.contains(&summary), "{said} lacks {summary}");
     // A value of another type, a range without a colon, a tree without values.
     let (ok, _, err) = ktree(&[
         "select",
@@ -227,6 +236,13 @@ fn values_on_the_command_line_fail_clearly() {
         &p("u8.ktree"),
     ]);
     assert!(!ok && err.contains("300"), "{err}");
+    // Nothing is left of the failed write: neither the file nor its temporary or spill files.
+    let hidden: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.starts_with('.') || name == "u8.ktree")
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
     // A volume of floats is not labels.
     let dir2 = tempfile::tempdir().unwrap();
     let raw: Vec<u8> = [0.5f32, 1.0].iter().flat_map(|v| v.to_le_bytes()).collect();

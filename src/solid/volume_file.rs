@@ -298,7 +298,7 @@ impl VolumeFile {
 
 /// The tree of the labels of the volume file at `path` placed at `offset` in a universe of level `level`
 /// (each sample's label its value, 0 the background), read slab by slab along z in at most about
-/// `slab_bytes` of labels at once ([`KTree::from_value_slabs`]): the same tree as
+/// `slab_bytes` of labels at once ([`KTree::from_value_slabs`] of [`label_slabs`]): the same tree as
 /// [`Volume::to_label_runs`](super::volume::Volume::to_label_runs) gives, without holding the volume.
 ///
 /// # Errors
@@ -310,8 +310,7 @@ pub fn label_tree<V: Value + TryFrom<u32>>(
     offset: [u32; 3],
     slab_bytes: usize,
 ) -> Result<KTree<3, V>, SolidError> {
-    let background = label_of::<V>([0; 3], 0.0)?;
-    volume_tree(path, level, offset, slab_bytes, background, label_of::<V>)
+    label_slabs::<V>(path, level, offset)?.tree(level, slab_bytes)
 }
 
 /// The tree of the samples from `lo` to `hi` (both included) of the volume file at `path`, as `f32`
@@ -338,39 +337,142 @@ pub fn window_tree(
     hi: f64,
     slab_bytes: usize,
 ) -> Result<KTree<3, f32>, SolidError> {
-    check_window(lo, hi)?;
-    // NaN is the background: no sample kept is one.
-    volume_tree(path, level, offset, slab_bytes, f32::NAN, |_, v| {
-        Ok(if lo <= v && v <= hi {
-            v as f32
+    window_slabs(path, level, offset, lo, hi)?.tree(level, slab_bytes)
+}
+
+/// A volume file as a box of values read slab by slab along z: where it lies in the universe, the value
+/// meaning empty, and its planes read in order as values by the rule `R` ([`Labels`], [`Window`]) — what
+/// [`KTree::from_value_slabs`] (or `stacking::ValueSlabs`, which writes the tree to a file without
+/// holding it) takes.
+pub struct VolumeSlabs<V, R> {
+    /// The box the volume fills (one range a coordinate, x first).
+    pub region: [std::ops::Range<u32>; 3],
+    /// The value meaning empty.
+    pub background: V,
+    file: VolumeFile,
+    rule: R,
+}
+
+/// How a volume's samples become values: `value(position, sample)`, the background meaning empty.
+pub trait SampleRule<V> {
+    /// The value of the sample `sample` at `position`.
+    ///
+    /// # Errors
+    /// [`SolidError::BadParameter`] naming a sample the rule refuses.
+    fn value(&self, position: [usize; 3], sample: f64) -> Result<V, SolidError>;
+}
+
+/// Each sample's label is its value (a whole number from 0 up that `V` holds; 0 the background).
+pub struct Labels;
+
+impl<V: Value + TryFrom<u32>> SampleRule<V> for Labels {
+    #[inline]
+    fn value(&self, position: [usize; 3], sample: f64) -> Result<V, SolidError> {
+        label_of::<V>(position, sample)
+    }
+}
+
+/// The samples from `lo` to `hi` (both included) kept as `f32` values, every other sample (and a NaN)
+/// the background (NaN).
+pub struct Window {
+    lo: f64,
+    hi: f64,
+}
+
+impl SampleRule<f32> for Window {
+    #[inline]
+    fn value(&self, _: [usize; 3], sample: f64) -> Result<f32, SolidError> {
+        Ok(if self.lo <= sample && sample <= self.hi {
+            sample as f32
         } else {
             f32::NAN
         })
-    })
+    }
 }
 
-/// The tree of the volume file at `path` placed at `offset`, each sample's value `value_of(position,
-/// sample)` (`background`: empty), read slab by slab.
-fn volume_tree<V: Value>(
+impl<V: Value, R: SampleRule<V>> VolumeSlabs<V, R> {
+    /// Appends the values of the next planes of the file — those whose z is in `planes`, in order — to
+    /// `out`, x fastest.
+    ///
+    /// # Errors
+    /// As [`VolumeFile::read_planes`]; the rule's error.
+    pub fn read(
+        &mut self,
+        planes: std::ops::Range<u32>,
+        out: &mut Vec<V>,
+    ) -> Result<(), SolidError> {
+        let rule = &self.rule;
+        self.file.read_planes(planes.len(), |at, v| {
+            out.push(rule.value(at, v)?);
+            Ok(())
+        })
+    }
+
+    /// The tree of the volume in a universe of level `level`, read in at most about `slab_bytes` of
+    /// values at once.
+    fn tree(mut self, level: u32, slab_bytes: usize) -> Result<KTree<3, V>, SolidError>
+    where
+        V: Send + Sync,
+    {
+        let (region, background) = (self.region.clone(), self.background);
+        KTree::from_value_slabs(level, region, background, slab_bytes, |planes, out| {
+            self.read(planes, out)
+        })
+        .map_err(|e: SolidError| match e {
+            SolidError::Rays(RayError::Space(s)) => SolidError::Space(s),
+            other => other,
+        })
+    }
+}
+
+/// The labels of the volume file at `path` placed at `offset` in a universe of level `level` as a box
+/// read slab by slab (each sample's label its value, 0 the background): what [`label_tree`] builds.
+///
+/// # Errors
+/// As [`VolumeFile::open`]; a volume that does not fit the universe. Its reader's: as
+/// [`VolumeFile::read_planes`], and [`SolidError::BadParameter`] naming a sample that is not a label of `V`.
+pub fn label_slabs<V: Value + TryFrom<u32>>(
     path: &Path,
     level: u32,
     offset: [u32; 3],
-    slab_bytes: usize,
+) -> Result<VolumeSlabs<V, Labels>, SolidError> {
+    let background = label_of::<V>([0; 3], 0.0)?;
+    volume_slabs(path, level, offset, background, Labels)
+}
+
+/// The samples from `lo` to `hi` (both included) of the volume file at `path` placed at `offset` as a box
+/// of `f32` values read slab by slab, every other sample (and a NaN) the background: what [`window_tree`]
+/// builds.
+///
+/// # Errors
+/// As [`label_slabs`]; [`SolidError::BadParameter`] for a window that is empty or not finite.
+pub fn window_slabs(
+    path: &Path,
+    level: u32,
+    offset: [u32; 3],
+    lo: f64,
+    hi: f64,
+) -> Result<VolumeSlabs<f32, Window>, SolidError> {
+    check_window(lo, hi)?;
+    // NaN is the background: no sample kept is one.
+    volume_slabs(path, level, offset, f32::NAN, Window { lo, hi })
+}
+
+/// The volume file at `path` placed at `offset` as a box read slab by slab by `rule`.
+fn volume_slabs<V, R>(
+    path: &Path,
+    level: u32,
+    offset: [u32; 3],
     background: V,
-    value_of: impl Fn([usize; 3], f64) -> Result<V, SolidError>,
-) -> Result<KTree<3, V>, SolidError> {
-    let mut file = VolumeFile::open(path)?;
+    rule: R,
+) -> Result<VolumeSlabs<V, R>, SolidError> {
+    let file = VolumeFile::open(path)?;
     let shape = file.shape;
     placed_universe(shape, level, offset)?;
-    let region = std::array::from_fn(|a| offset[a]..offset[a] + shape[a] as u32);
-    KTree::from_value_slabs(level, region, background, slab_bytes, |rows, out| {
-        file.read_planes(rows.len(), |at, v| {
-            out.push(value_of(at, v)?);
-            Ok(())
-        })
-    })
-    .map_err(|e: SolidError| match e {
-        SolidError::Rays(RayError::Space(s)) => SolidError::Space(s),
-        other => other,
+    Ok(VolumeSlabs {
+        region: std::array::from_fn(|a| offset[a]..offset[a] + shape[a] as u32),
+        background,
+        file,
+        rule,
     })
 }
