@@ -127,7 +127,7 @@ fn voxels_of<const K: usize>(pts: &[[i64; K]]) -> Vec<[u32; K]> {
 }
 
 /// Answers the point queries of a `.ktree` file with values read in place (its memory map): each point's
-/// value, and inside where it has one.
+/// value, inside where it has one, and its distance and nearest voxel with a value when asked.
 fn answer_mapped_values(args: &QueryArgs, k: usize, dtype: Dtype) -> CliResult {
     with_valued!(k, dtype, KK, V => {
         let tree = MappedValuedTree::<KK, V>::open(&args.tree).map_err(CliError::caused)?;
@@ -138,7 +138,12 @@ fn answer_mapped_values(args: &QueryArgs, k: usize, dtype: Dtype) -> CliResult {
             .into_iter()
             .map(|v| v.map_or(serde_json::Value::Null, value_json))
             .collect();
-        print_points(&pts, &inside, Some(&values), &[], args)
+        let near = if args.distance || args.nearest {
+            query::nearest_many_signed(&tree.leaves(), &pts).map_err(read_error)?
+        } else {
+            Vec::new()
+        };
+        print_points(&pts, &inside, Some(&values), &near, args)
     }, else Err(format!("{}: K = {k} is not 1 to 4", args.tree.display()).into()))
 }
 
@@ -244,8 +249,8 @@ pub fn run_query(args: QueryArgs) -> CliResult {
     }
     if crate::values::is_valued(&args.tree) {
         let (k, dtype) = crate::values::file_dtype(&args.tree)?;
-        // Values alone are read in place; distances need the shape's tree in memory.
-        if let (Some(dtype), false) = (dtype, args.distance || args.nearest) {
+        // Values, distances and nearest voxels are read in place.
+        if let Some(dtype) = dtype {
             return answer_mapped_values(&args, k, dtype);
         }
         let valued = crate::values::read_valued(&args.tree)?;

@@ -272,7 +272,7 @@ fn values_on_the_command_line_fail_clearly() {
 
 #[test]
 fn queries_of_a_tree_with_values_give_each_points_value() {
-    // Values alone are read from the file in place; with distances, the tree is loaded.
+    // Values, distances and nearest voxels are read from the file in place.
     use ktree::io::ktree::v3::write_valued_ktree_file;
     use ktree::KTree;
     let dir = tempfile::tempdir().unwrap();
@@ -316,19 +316,32 @@ fn queries_of_a_tree_with_values_give_each_points_value() {
             None => assert!(line.ends_with("outside"), "{line}"),
         }
     }
-    // With distances the shape is read too: the same values, 0 inside.
+    // Distances and nearest voxels, read in place too: those of the shape in memory, 0 inside.
     let out = run(&[
         "query",
         &p("labels.ktree"),
         "--points",
         &p("points.csv"),
         "--distance",
+        "--nearest",
         "--json",
     ]);
     let rows: Vec<serde_json::Value> = serde_json::from_str(&out).unwrap();
-    for (row, q) in rows.iter().zip(&points) {
+    let signed: Vec<[i64; 3]> = points.iter().map(|q| q.map(i64::from)).collect();
+    let near = ktree::query::nearest_many_signed(&labels.shape(), &signed).unwrap();
+    for ((row, q), n) in rows.iter().zip(&points).zip(&near) {
         let want = labels.value_at(*q);
         assert_eq!(row["value"], serde_json::json!(want), "{q:?}");
+        assert_eq!(
+            row["distance"],
+            serde_json::json!(n.map(|n| n.distance())),
+            "{q:?}"
+        );
+        assert_eq!(
+            row["nearest"],
+            serde_json::json!(n.map(|n| n.voxel.to_vec())),
+            "{q:?}"
+        );
         if want.is_some() {
             assert_eq!(row["distance"], serde_json::json!(0.0), "{q:?}");
         }

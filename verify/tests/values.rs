@@ -430,3 +430,63 @@ fn a_box_beyond_the_universe_is_an_error() {
         KTree::<2, u8>::from_value_slabs(2, [0..5, 0..4], 0, 1 << 20, |_, _| Ok::<_, RayError>(()));
     assert!(matches!(got, Err(RayError::Space(_))), "{got:?}");
 }
+
+/// A valued file read in place as a tree without values ([`MappedLeaves`]): the nodes, ranks and blocks
+/// of the tree in memory read the same way ([`LeavesOfValues`]), and the same nearest voxels.
+fn mapped_leaves<const K: usize>(o: &Painted<K>, points: &[[i64; K]]) -> Result<(), TestCaseError> {
+    use ktree::io::ktree::v3::{write_valued_ktree_file, MappedValuedTree};
+    use ktree::query::nearest_many_signed;
+    use ktree::tree::storage::TreeStorage;
+    use ktree::tree::valued::LeavesOfValues;
+    let tree = KTree::<K, u8>::from_dense_values(o.level, &o.dense::<u8>()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("values.ktree");
+    write_valued_ktree_file(&path, &tree).unwrap();
+    let mapped = MappedValuedTree::<K, u8>::open(&path).unwrap();
+    let (file, memory) = (mapped.leaves(), LeavesOfValues(&tree));
+    prop_assert_eq!(file.counts_per_level(), memory.counts_per_level());
+    prop_assert_eq!(file.depth_count(), memory.depth_count());
+    prop_assert_eq!(file.root_state().unwrap(), memory.root_state().unwrap());
+    for d in 0..memory.depth_count() {
+        let len = memory.level_len(d);
+        prop_assert_eq!(file.level_len(d), len);
+        for i in 0..=len {
+            prop_assert_eq!(
+                file.partial_rank(d, i).unwrap(),
+                memory.partial_rank(d, i).unwrap(),
+                "level {}, node {}",
+                d,
+                i
+            );
+        }
+        for first in (0..len).step_by(1 << K).filter(|_| d > 0) {
+            prop_assert_eq!(
+                file.block_codes(d, first).unwrap(),
+                memory.block_codes(d, first).unwrap()
+            );
+        }
+    }
+    prop_assert!(file.partial_rank(0, 2).is_err());
+    let side = 1i64 << o.level;
+    let points: Vec<[i64; K]> = points
+        .iter()
+        .map(|p| p.map(|c| c % (side + 2) - 1))
+        .collect();
+    prop_assert_eq!(
+        nearest_many_signed(&file, &points).unwrap(),
+        nearest_many_signed(&memory, &points).unwrap()
+    );
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ktree_verify::config(48))]
+    #[test]
+    fn mapped_leaves_k1(o in painted::<1>(), p in proptest::collection::vec(any::<[u16; 1]>(), 8)) { mapped_leaves::<1>(&o, &p.iter().map(|q| q.map(i64::from)).collect::<Vec<_>>())?; }
+    #[test]
+    fn mapped_leaves_k2(o in painted::<2>(), p in proptest::collection::vec(any::<[u16; 2]>(), 8)) { mapped_leaves::<2>(&o, &p.iter().map(|q| q.map(i64::from)).collect::<Vec<_>>())?; }
+    #[test]
+    fn mapped_leaves_k3(o in painted::<3>(), p in proptest::collection::vec(any::<[u16; 3]>(), 8)) { mapped_leaves::<3>(&o, &p.iter().map(|q| q.map(i64::from)).collect::<Vec<_>>())?; }
+    #[test]
+    fn mapped_leaves_k4(o in painted::<4>(), p in proptest::collection::vec(any::<[u16; 4]>(), 8)) { mapped_leaves::<4>(&o, &p.iter().map(|q| q.map(i64::from)).collect::<Vec<_>>())?; }
+}

@@ -55,7 +55,7 @@ use crate::tree::valued::ValueStorage;
 use crate::tree::words::{children_mask, full_mask};
 use crate::tree::{AnyTree, AnyValuedTree, Dtype, KTree, PackedStates, Value};
 
-pub use super::v3_mapped::MappedValuedTree;
+pub use super::v3_mapped::{MappedLeaves, MappedValuedTree};
 pub use super::v3_writer::ValuedKtreeWriter;
 use super::v3_writer::{check_frame, FRAME_BYTES};
 

@@ -24,8 +24,10 @@ use super::v3::{check_valued, Checked, ValuedLevel};
 use crate::io::mmap::FileMap;
 use crate::io::{KtreeFileError, KtreeFileErrorKind};
 use crate::space::{Universe, WorldFrame};
-use crate::tree::valued::ValueStorage;
+use crate::tree::storage::TreeStorage;
+use crate::tree::valued::{mixed_as_partial, ValueStorage};
 use crate::tree::words::{children_mask, full_mask, NODES_PER_WORD};
+use crate::tree::{LevelCounts, NodeState};
 use crate::value::Value;
 
 /// Words between two rank samples.
@@ -112,6 +114,13 @@ impl<const K: usize, V: Value> MappedValuedTree<K, V> {
     /// The notes the file keeps ([`Notes`]; none for most files).
     pub fn notes(&self) -> &Notes {
         &self.notes
+    }
+
+    /// The file read as a tree without values of the same nodes (a mixed node read as a node with
+    /// children): every query of a [`TreeStorage`] — distances, nearest voxels, ray casts — runs on the
+    /// file in place, each full leaf a leaf where one value holds ([`MappedLeaves`]).
+    pub fn leaves(&self) -> MappedLeaves<'_, K, V> {
+        MappedLeaves(self)
     }
 
     /// The error of a read the checked shape does not allow: the file changed after it was opened.
@@ -218,5 +227,95 @@ impl<const K: usize, V: Value> ValueStorage<K> for MappedValuedTree<K, V> {
             .check()
             .map_err(|e| self.changed(depth, &format!("a value no voxel may hold ({e})")))?;
         Ok(value)
+    }
+}
+
+/// A [`MappedValuedTree`] read as a tree without values of the same nodes — a mixed node (`11`) reads as a
+/// node with children (`10`), as [`LeavesOfValues`](crate::tree::valued::LeavesOfValues) reads a tree in
+/// memory — so its voxels with values are the full voxels of a [`TreeStorage`] (not reduced where a mixed
+/// node stands), read in place.
+///
+/// ```
+/// use ktree::io::ktree::v3::{write_valued_ktree_file, MappedValuedTree};
+/// use ktree::query::Query;
+/// use ktree::KTree;
+/// let tree = KTree::<2, u16>::from_dense_values(1, &[Some(7), None, Some(9), Some(7)]).unwrap();
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("labels.ktree");
+/// write_valued_ktree_file(&path, &tree).unwrap();
+/// let mapped = MappedValuedTree::<2, u16>::open(&path).unwrap();
+/// assert_eq!(mapped.leaves().contains_many(&[[0, 0], [1, 0]]).unwrap(), [true, false]);
+/// ```
+#[derive(Debug, Clone, Copy)]
+pub struct MappedLeaves<'a, const K: usize, V>(&'a MappedValuedTree<K, V>);
+
+impl<const K: usize, V: Value> MappedLeaves<'_, K, V> {
+    fn level(&self, depth: usize, index: usize) -> Result<&ValuedLevel, KtreeFileError> {
+        self.0
+            .levels
+            .get(depth)
+            .filter(|l| index as u64 <= l.nodes)
+            .ok_or_else(|| {
+                self.0
+                    .changed(depth, &format!("node {index} is not in the level"))
+            })
+    }
+}
+
+impl<const K: usize, V: Value> TreeStorage<K> for MappedLeaves<'_, K, V> {
+    type Error = KtreeFileError;
+
+    fn universe(&self) -> Universe<K> {
+        self.0.universe
+    }
+
+    fn depth_count(&self) -> usize {
+        self.0.levels.len()
+    }
+
+    fn level_len(&self, depth: usize) -> usize {
+        self.0.levels.get(depth).map_or(0, |l| l.nodes as usize)
+    }
+
+    fn counts_per_level(&self) -> Vec<LevelCounts> {
+        (self.0.levels.iter().enumerate())
+            .map(|(d, l)| LevelCounts {
+                level: d as u32,
+                full: l.full,
+                partial: l.children,
+                empty: l.nodes - l.full - l.children,
+            })
+            .collect()
+    }
+
+    fn root_state(&self) -> Result<NodeState, KtreeFileError> {
+        Ok(NodeState::from_bits(mixed_as_partial(self.0.root_code()?)))
+    }
+
+    fn partial_rank(&self, depth: usize, index: usize) -> Result<usize, KtreeFileError> {
+        let nodes = self.level(depth, index)?.nodes;
+        if index as u64 == nodes {
+            // The rank of the level's end: that of its last node plus the last node's own.
+            let Some(last) = index.checked_sub(1) else {
+                return Ok(0);
+            };
+            let code = if depth == 0 {
+                self.0.root_code()?
+            } else {
+                let sibling = last % (1 << K);
+                self.0.codes(depth, last - sibling)? >> (2 * sibling) & 3
+            };
+            let own = u64::from(code >= 2);
+            return Ok((self.0.rank(depth, last, 0, children_mask)? + own) as usize);
+        }
+        Ok(self.0.rank(depth, index, 0, children_mask)? as usize)
+    }
+
+    fn first_child(&self, depth: usize, index: usize) -> Result<usize, KtreeFileError> {
+        self.0.children(depth, index)
+    }
+
+    fn block_codes(&self, depth: usize, first: usize) -> Result<u32, KtreeFileError> {
+        Ok(mixed_as_partial(self.0.codes(depth, first)?))
     }
 }

@@ -46,6 +46,7 @@ pub mod walk;
 pub use assemble::ValueAssembler;
 pub use cursor::ValueCursor;
 pub(crate) use dense::for_each_voxel;
+pub(crate) use walk::mixed_as_partial;
 pub use walk::{
     try_walk_values, BinaryValues, LeafValue, LeavesOfValues, ValueLeaves, ValueStorage,
     ValueVisitor,

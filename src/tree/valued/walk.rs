@@ -339,7 +339,7 @@ pub struct LeavesOfValues<'a, const K: usize, V: Value>(pub &'a KTree<K, V>);
 
 /// Each mixed code (`11`) of `codes` turned into `10`.
 #[inline]
-fn mixed_as_partial(codes: u32) -> u32 {
+pub(crate) fn mixed_as_partial(codes: u32) -> u32 {
     let mixed = codes & (codes >> 1) & 0x5555_5555;
     codes & !mixed
 }
