@@ -218,22 +218,12 @@ fn brick_tree<const K: usize, V: Value>(
     voxels.resize(1usize << (log * K), background);
     // Each row along axis 0: its place in the array and its first voxel's Morton index, the other axes'
     // offsets counted like an odometer.
-    let mut offset = [0usize; K];
-    loop {
-        let (mut start, mut morton, mut step) = (origin, 0usize, 1usize);
-        for (a, &o) in offset.iter().enumerate().skip(1) {
-            step *= stride;
-            start += o * step;
-            morton |= spread[o] << a;
-        }
+    for offset in BoxRows::<K>::new(side) {
+        let start = origin + row_offset(offset, stride);
+        let morton = (1..K).fold(0, |m, a| m | spread[offset[a]] << a);
         for (&v, &x) in dense[start..start + side].iter().zip(spread) {
             voxels[morton | x] = v;
         }
-        let Some(axis) = (1..K).find(|&a| offset[a] + 1 < side) else {
-            break;
-        };
-        offset[axis] += 1;
-        offset[1..axis].fill(0);
     }
     // The voxels' state.
     let voxel = |v: V| {
@@ -375,29 +365,18 @@ fn read_bricks<const K: usize, V: Value>(
                     rest /= grid;
                     step *= side;
                 }
-                // Its rows, axis 1 fastest (memory in order), the offsets counted like an odometer.
-                let mut offset = [0usize; K];
-                loop {
-                    let (mut start, mut step) = (first, 1);
-                    for &o in &offset[1..] {
-                        step *= side;
-                        start += o * step;
-                    }
-                    let first_row = offset[1..].iter().all(|&o| o == 0);
+                // Its rows, axis 1 fastest (memory in order).
+                for (r, offset) in BoxRows::<K>::new(brick).enumerate() {
+                    let start = first + row_offset(offset, side);
                     let row = &voxels[start..start + side];
                     for ((first, uniform), piece) in bricks.iter_mut().zip(row.chunks_exact(brick))
                     {
-                        if first_row {
+                        if r == 0 {
                             *first = piece[0];
                         }
                         let f = *first;
                         *uniform &= piece.iter().fold(true, |all, v| all & v.same(f));
                     }
-                    let Some(axis) = (1..K).find(|&a| offset[a] + 1 < brick) else {
-                        break;
-                    };
-                    offset[axis] += 1;
-                    offset[1..axis].fill(0);
                 }
                 for (b, (&(_, uniform), tree)) in bricks.iter().zip(trees.iter_mut()).enumerate() {
                     if !uniform {
@@ -439,30 +418,69 @@ fn first_if_uniform<const K: usize, T: Copy>(
             .all(|c| c.iter().fold(true, |all, v| all & same(v, &first)));
         whole && chunks.remainder().iter().all(|v| same(v, &first))
     };
-    // Each row along axis 0: the other axes' offsets counted like an odometer.
-    let mut offset = [0usize; K];
-    loop {
-        let mut start = first_index;
-        let mut step = 1;
-        for &o in &offset[1..] {
-            step *= grid;
-            start += o * step;
+    BoxRows::<K>::new(side)
+        .all(|offset| {
+            let start = first_index + row_offset(offset, grid);
+            uniform(&data[start..start + side])
+        })
+        .then_some(first)
+}
+
+/// The rows along axis 0 of a cube of side `side` in `K` dimensions, in memory order (axis 1 fastest):
+/// each row's offsets from the cube's corner along axes `1 … K − 1` (`[0]` is 0), counted like an
+/// odometer.
+pub(super) struct BoxRows<const K: usize> {
+    next: Option<[usize; K]>,
+    side: usize,
+}
+
+impl<const K: usize> BoxRows<K> {
+    pub(super) fn new(side: usize) -> Self {
+        Self {
+            next: (side > 0).then_some([0; K]),
+            side,
         }
-        if !uniform(&data[start..start + side]) {
-            return None;
-        }
-        let Some(axis) = (1..K).find(|&a| offset[a] + 1 < side) else {
-            return Some(first);
-        };
-        offset[axis] += 1;
-        offset[1..axis].fill(0);
     }
+}
+
+impl<const K: usize> Iterator for BoxRows<K> {
+    type Item = [usize; K];
+
+    #[inline]
+    fn next(&mut self) -> Option<[usize; K]> {
+        let row = self.next?;
+        let mut offset = row;
+        self.next = (1..K).find(|&a| offset[a] + 1 < self.side).map(|axis| {
+            offset[axis] += 1;
+            offset[1..axis].fill(0);
+            offset
+        });
+        Some(row)
+    }
+}
+
+/// The index, in an array of rows `stride` long (axis 0 fastest, every axis `stride` long), of the row at
+/// `offset` along axes `1 … K − 1` from the array's start.
+#[inline]
+pub(super) fn row_offset<const K: usize>(offset: [usize; K], stride: usize) -> usize {
+    (1..K).rev().fold(0, |at, a| (at + offset[a]) * stride)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::rays::ValueRuns;
+
+    #[test]
+    fn the_rows_of_a_cube_come_in_memory_order() {
+        let rows: Vec<[usize; 3]> = BoxRows::<3>::new(2).collect();
+        assert_eq!(rows, [[0, 0, 0], [0, 1, 0], [0, 0, 1], [0, 1, 1]]);
+        assert_eq!(BoxRows::<1>::new(8).count(), 1);
+        assert_eq!(BoxRows::<4>::new(3).count(), 27);
+        assert_eq!(BoxRows::<2>::new(0).count(), 0);
+        assert_eq!(row_offset([0, 1, 1], 4), 4 + 16);
+        assert_eq!(row_offset([0, 2, 0, 3], 5), 2 * 5 + 3 * 125);
+    }
 
     /// Regions of a few labels with scattered voxels, on every split depth: the tree of the runs.
     fn check<const K: usize>(level: u32) {

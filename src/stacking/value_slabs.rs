@@ -16,7 +16,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::dense_values::Dense;
+use super::dense_values::{row_offset, BoxRows, Dense};
 use crate::rays::RayError;
 use crate::space::{morton_decode, Universe};
 use crate::tree::top_down::Subtree;
@@ -279,26 +279,20 @@ impl<const K: usize, V: Value + Send + Sync> SlabView<'_, K, V> {
             stride[a] = stride[a - 1] * ranges[a - 1].len();
         }
         let x = origin[0].max(ranges[0].start)..(origin[0] + side as u32).min(ranges[0].end);
-        // Each row of the cube along axis 0, its coordinates along the other axes counted like an odometer.
-        let mut offset = [0usize; K];
-        loop {
+        // Each row of the cube along axis 0.
+        for offset in BoxRows::<K>::new(side) {
             let inside = (1..K).all(|a| ranges[a].contains(&(origin[a] + offset[a] as u32)));
             if inside {
                 let mut from = (x.start - ranges[0].start) as usize;
-                let mut to = (x.start - origin[0]) as usize;
                 for a in 1..K {
                     from += (origin[a] + offset[a] as u32 - ranges[a].start) as usize * stride[a];
-                    to += offset[a] * side.pow(a as u32);
                 }
+                let to = (x.start - origin[0]) as usize + row_offset(offset, side);
                 let n = x.len();
                 cube[to..to + n].copy_from_slice(&self.values[from..from + n]);
             }
-            let Some(axis) = (1..K).find(|&a| offset[a] + 1 < side) else {
-                return cube;
-            };
-            offset[axis] += 1;
-            offset[1..axis].fill(0);
         }
+        cube
     }
 }
 
