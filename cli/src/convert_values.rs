@@ -149,9 +149,6 @@ pub fn vdb_to_valued(
     write_and_report(output, &read.tree, Some(frame), Notes::new())
 }
 
-/// The samples held at once while a volume's window is read: slabs of up to 64 MiB of values.
-const WINDOW_SLAB_BYTES: usize = 64 << 20;
-
 /// `ktree voxelize VOLUME --window LO:HI`: the samples from `lo` to `hi` kept as `float32` values, the
 /// volume read slab by slab along z and the tree written out of core.
 pub fn voxelize_window(
@@ -160,12 +157,15 @@ pub fn voxelize_window(
     level: Option<u32>,
     offset: [u32; 3],
     out: &Path,
+    build: &crate::common::memory::BuildArgs,
 ) -> CliResult {
     let shape = VolumeFile::open(input).map_err(CliError::caused)?.shape();
     let level = level.unwrap_or_else(|| fitting_level(shape, offset));
     let slabs = window_slabs(input, level, offset, window.0, window.1)
         .map_err(|e| CliError::in_file(input, e))?;
-    let written = crate::values::write_volume_slabs(input, level, slabs, WINDOW_SLAB_BYTES, out)?;
+    let Some(written) = crate::values::write_volume_slabs(input, level, slabs, build, out)? else {
+        return Ok(());
+    };
     outln!(
         "{}: {} voxels from {} to {} kept as float32, L = {level}, {} nodes",
         out.display(),

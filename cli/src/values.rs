@@ -17,12 +17,14 @@ use ktree::io::ktree::Notes;
 use ktree::query::{stats, TreeStats};
 use ktree::solid::cloud::{self, CloudVoxelizer, PointCloud};
 use ktree::solid::volume_file::{label_slabs, SampleRule, VolumeFile, VolumeSlabs};
-use ktree::stacking::{BuildError, ValueSlabs};
+use ktree::solid::SolidError;
+use ktree::stacking::{BuildError, ValueSlabs, ValueSlabsReport};
 use ktree::tree::valued::ValueLeaves;
 use ktree::value::{Dtype, Value};
 use ktree::{with_valued, AnyValuedTree, KTree};
 
 use crate::common::error::{cannot_read, CliError, CliResult};
+use crate::common::memory::BuildArgs;
 use crate::outln;
 
 /// The dimension and value type of a `.ktree` file (`None`: no values).
@@ -68,8 +70,9 @@ fn read_valued_noted(path: &Path) -> CliResult<(AnyValuedTree, Notes)> {
     }
 }
 
-/// The labels held at once while a label volume is read: slabs of up to 64 MiB of labels.
-const LABEL_SLAB_BYTES: usize = 64 << 20;
+/// The values held at once while a volume is read: slabs of up to 64 MiB of values, and at most a
+/// quarter of `--max-memory`.
+const SLAB_BYTES: u64 = 64 << 20;
 
 /// What [`write_volume_slabs`] wrote: the tree's voxels and nodes.
 pub struct WrittenTree {
@@ -77,41 +80,66 @@ pub struct WrittenTree {
     pub nodes: u64,
 }
 
-/// Writes the tree of a volume read slab by slab (at most about `slab_bytes` of values at once) to the
-/// `.ktree` file `out`, its cells' subtrees spilled next to it as they are built: the tree is never held
-/// whole. Errors of the volume name `input`; those of the files, the file.
+/// Writes the tree of a volume read slab by slab (at most 64 MiB of values at once, and a quarter of
+/// `--max-memory`) to the `.ktree` file `out`, its cells' subtrees spilled next to it (or in
+/// `--temp-dir`) as they are built: the tree is never held whole. Started over MPI ranks, each rank reads its own share of the planes and rank 0 writes the file
+/// (the same bytes). Errors of the volume name `input`; those of the files, the file. `None` on the ranks
+/// other than 0, which neither write nor print.
 pub fn write_volume_slabs<V, R>(
     input: &Path,
     level: u32,
     mut slabs: VolumeSlabs<V, R>,
-    slab_bytes: usize,
+    build: &BuildArgs,
     out: &Path,
-) -> CliResult<WrittenTree>
+) -> CliResult<Option<WrittenTree>>
 where
     V: Value + Send + Sync,
     R: SampleRule<V>,
 {
-    let report = ValueSlabs {
+    let box_slabs = ValueSlabs {
         level,
         region: slabs.region.clone(),
         background: slabs.background,
-        slab_bytes,
-    }
-    .write_file(out, None, None, &Notes::new(), |planes, values| {
-        slabs.read(planes, values)
-    })
-    .map_err(|e| match e {
-        BuildError::Source(e) => CliError::in_file(input, e),
-        other => crate::common::output::describe(out, other, 0),
-    })?;
-    let counts = &report.counts_per_level;
-    Ok(WrittenTree {
-        voxels: counts
-            .iter()
-            .map(|c| u128::from(c.full) << (3 * (level - c.level)))
-            .sum(),
-        nodes: counts.iter().map(|c| c.full + c.empty + c.partial).sum(),
-    })
+        slab_bytes: (build.budget.budget() / 4).min(SLAB_BYTES) as usize,
+    };
+    let temp_dir = build.temp_dir.as_deref();
+    let read = |planes, values: &mut Vec<V>| slabs.read(planes, values);
+    #[cfg(feature = "mpi")]
+    let report = if crate::distributed::ranks().size > 1 {
+        crate::distributed::build_values_across_ranks(&box_slabs, out, temp_dir, read, |e| {
+            CliError::in_file(input, e)
+        })?
+    } else {
+        Some(write_file(&box_slabs, input, out, temp_dir, read)?)
+    };
+    #[cfg(not(feature = "mpi"))]
+    let report = Some(write_file(&box_slabs, input, out, temp_dir, read)?);
+    Ok(report.map(|report| {
+        let counts = &report.counts_per_level;
+        WrittenTree {
+            voxels: counts
+                .iter()
+                .map(|c| u128::from(c.full) << (3 * (level - c.level)))
+                .sum(),
+            nodes: counts.iter().map(|c| c.full + c.empty + c.partial).sum(),
+        }
+    }))
+}
+
+/// [`ValueSlabs::write_file`] of `slabs` read by `read` (from `input`) into `out`, in this process.
+fn write_file<V: Value + Send + Sync>(
+    slabs: &ValueSlabs<3, V>,
+    input: &Path,
+    out: &Path,
+    temp_dir: Option<&Path>,
+    read: impl FnMut(std::ops::Range<u32>, &mut Vec<V>) -> Result<(), SolidError>,
+) -> CliResult<ValueSlabsReport> {
+    slabs
+        .write_file(out, temp_dir, None, &Notes::new(), read)
+        .map_err(|e| match e {
+            BuildError::Source(e) => CliError::in_file(input, e),
+            other => crate::common::output::describe(out, other, 0),
+        })
 }
 
 /// A label volume into a valued tree of the smallest label type that holds it (or `dtype`), read slab by
@@ -123,6 +151,7 @@ pub fn voxelize_labels(
     offset: [u32; 3],
     dtype: Option<&str>,
     out: &Path,
+    options: &BuildArgs,
 ) -> CliResult {
     let file = VolumeFile::open(input).map_err(CliError::caused)?;
     let shape = file.shape();
@@ -144,10 +173,13 @@ pub fn voxelize_labels(
         level: u32,
         offset: [u32; 3],
         out: &Path,
+        build: &BuildArgs,
     ) -> CliResult {
         let slabs =
             label_slabs::<V>(input, level, offset).map_err(|e| CliError::in_file(input, e))?;
-        let written = write_volume_slabs(input, level, slabs, LABEL_SLAB_BYTES, out)?;
+        let Some(written) = write_volume_slabs(input, level, slabs, build, out)? else {
+            return Ok(());
+        };
         // The labels counted from the file, read in place.
         let mapped = MappedValuedTree::<3, V>::open(out).map_err(CliError::caused)?;
         let mut labels = std::collections::HashSet::new();
@@ -167,9 +199,9 @@ pub fn voxelize_labels(
         Ok(())
     }
     match dtype {
-        Dtype::U8 => build::<u8>(input, level, offset, out),
-        Dtype::U16 => build::<u16>(input, level, offset, out),
-        _ => build::<u32>(input, level, offset, out),
+        Dtype::U8 => build::<u8>(input, level, offset, out, options),
+        Dtype::U16 => build::<u16>(input, level, offset, out, options),
+        _ => build::<u32>(input, level, offset, out, options),
     }
 }
 

@@ -131,7 +131,7 @@ pub fn run(a: Args) -> CliResult {
         }
         if let Some(window) = a.window {
             return crate::convert_values::voxelize_window(
-                &a.input, window, a.level, a.offset, &a.out.out,
+                &a.input, window, a.level, a.offset, &a.out.out, &a.build,
             );
         }
         if a.labels {
@@ -141,6 +141,7 @@ pub fn run(a: Args) -> CliResult {
                 a.offset,
                 a.dtype.as_deref(),
                 &a.out.out,
+                &a.build,
             );
         }
         options.select = Some(

@@ -1,5 +1,6 @@
 //! Builds over MPI ranks write the very file a single process writes (`mpirun -n 2`, and 3 ranks
-//! oversubscribed on this machine), in K = 2, 3 and 4, for `rays`, `build` and `voxelize`, also in the
+//! oversubscribed on this machine), in K = 2, 3 and 4, for `rays`, `build` and `voxelize` (volumes with
+//! values too: `--labels`, `--window`), also in the
 //! smallest `--max-memory` per rank the build names; a failed run (before the build, or while rank 0
 //! writes) leaves no output and no spill folder. Compiled with the cargo feature `mpi` only; needs
 //! `mpirun` (OpenMPI) on the PATH (every test fails without it). The failure while rank 0 writes fills a
@@ -219,6 +220,82 @@ fn ray_files_and_meshes_over_ranks_write_the_single_process_file() {
         "bunny",
         &["voxelize", bunny.to_str().unwrap(), "--level", "6", "--fit"],
     );
+}
+
+#[test]
+fn volumes_with_values_over_ranks_write_the_single_process_file() {
+    // Each rank reads only its share of the planes (thin slabs: a quarter of --max-memory a slab), in a
+    // volume placed off the universe's corner.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let classes = data_dir().join("volumes/skull_classes.json");
+    let classes = classes.to_str().unwrap();
+    same_bytes(
+        d,
+        "classes",
+        &["voxelize", classes, "--labels", "--max-memory", "64K"],
+    );
+    same_bytes(
+        d,
+        "classes-placed",
+        &[
+            "voxelize",
+            classes,
+            "--labels",
+            "--offset",
+            "3,0,37",
+            "--max-memory",
+            "32K",
+        ],
+    );
+    let brain = data_dir().join("volumes/itk_t1_brain.json");
+    same_bytes(
+        d,
+        "window",
+        &[
+            "voxelize",
+            brain.to_str().unwrap(),
+            "--window",
+            "60:140",
+            "--max-memory",
+            "1M",
+        ],
+    );
+    // A label too large for the type in the last plane: only the last rank reads it, and every rank
+    // stops with nothing written and no spill folder left.
+    let inputs = tempfile::tempdir().unwrap();
+    let mut labels: Vec<u16> = (0..16 * 16 * 16u16).map(|i| i % 3).collect();
+    labels[16 * 16 * 16 - 1] = 300;
+    let raw: Vec<u8> = labels.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(inputs.path().join("u.raw"), raw).unwrap();
+    let json = inputs.path().join("u.json");
+    std::fs::write(
+        &json,
+        r#"{"file": "u.raw", "dtype": "uint16", "endianness": "little", "shape_xyz": [16, 16, 16]}"#,
+    )
+    .unwrap();
+    let bad = d.join("bad.ktree");
+    let out = mpirun(
+        3,
+        &[
+            "voxelize",
+            json.to_str().unwrap(),
+            "--labels",
+            "--dtype",
+            "uint8",
+            "--max-memory",
+            "4K",
+            "--out",
+            bad.to_str().unwrap(),
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("rank 2 of 3") && stderr.contains("is 300"),
+        "{stderr}"
+    );
+    assert!(entries(d).is_empty(), "{:?}", entries(d));
 }
 
 #[test]

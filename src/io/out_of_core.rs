@@ -21,7 +21,7 @@ use crate::stacking::{
     BuildError, Builder, LevelOrderSink, LevelPieces, OutOfCoreReport, PieceStore, Progress,
     SpilledPart, StoredPieces,
 };
-use crate::stacking::{ValueSlabs, ValueSlabsReport, ValuedLevelSink};
+use crate::stacking::{ValuePart, ValueSlabs, ValueSlabsReport, ValuedLevelSink};
 use crate::tree::LevelCounts;
 use crate::value::Value;
 
@@ -401,6 +401,68 @@ impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
             .map_err(|e| output_error(out, e))?;
         let sink = OutputFile { writer, path: out };
         let (file_bytes, report) = self.build_into(read, store, sink)?;
+        Ok(ValueSlabsReport {
+            file_bytes,
+            ..report
+        })
+    }
+
+    /// Builds the part of the tree in the slabs `slabs` ([`stack_part`](Self::stack_part)), its cells'
+    /// subtrees spilled to temporary files next to `out` (or in `temp_dir`) — one part of a build across
+    /// processes, each reading its own slabs; the part that writes `out` adds the others' indexes and
+    /// writes it ([`ValuePart::write`]).
+    ///
+    /// # Errors
+    /// As [`stack_part`](Self::stack_part); a spill folder or file that cannot be written.
+    pub fn stack_part_files<E: From<RayError>>(
+        &self,
+        slabs: std::ops::Range<u32>,
+        out: &Path,
+        temp_dir: Option<&Path>,
+        read: impl FnMut(std::ops::Range<u32>, &mut Vec<V>) -> Result<(), E>,
+    ) -> Result<ValuePart<K, V, SpilledFiles>, BuildError<E>> {
+        let t = (self.level - self.cell_depth()) as usize;
+        let store = SpillFiles::create(out, temp_dir, t)?;
+        self.stack_part(slabs, read, store)
+    }
+}
+
+impl<const K: usize, V: Value + Send + Sync> ValuePart<K, V, SpilledFiles> {
+    /// The writing phase into a file: writes the tree to `out` as a `.ktree` version 3 file with its world
+    /// frame (if any) and `notes`, atomically — [`write_into`](Self::write_into) the version 3 writer over
+    /// a temporary file renamed over `out` at the end, `receive(owner, words)` filling `words` with the
+    /// next words of that owner's [`stream_levels`](Self::stream_levels). The file is byte for byte
+    /// [`ValueSlabs::write_file`]'s.
+    ///
+    /// # Errors
+    /// [`BuildError::PartsOverlap`]; the output or a spill file that cannot be written or read (an error
+    /// of `receive` included, as an error of the output); a value type without values. The target is
+    /// then untouched; the spill folder is removed in any case.
+    pub fn write<E>(
+        self,
+        out: &Path,
+        frame: Option<&WorldFrame>,
+        notes: &Notes,
+        receive: &mut dyn FnMut(usize, &mut [u64]) -> std::io::Result<()>,
+    ) -> Result<ValueSlabsReport, BuildError<E>> {
+        let dtype = V::DTYPE.ok_or_else(|| {
+            output_error(
+                out,
+                std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "a tree without values is not written as a valued file",
+                ),
+            )
+        })?;
+        let level = self.level();
+        let file = AtomicFile::create(out).map_err(|e| output_error(out, e))?;
+        let writer = ValuedKtreeWriter::new(file, K, level, dtype, frame, notes)
+            .map_err(|e| output_error(out, e))?;
+        let sink = OutputFile { writer, path: out };
+        let mut receive = |owner: usize, words: &mut [u64]| {
+            receive(owner, words).map_err(|e| output_error(out, e))
+        };
+        let (file_bytes, report) = self.write_into(sink, &mut receive)?;
         Ok(ValueSlabsReport {
             file_bytes,
             ..report

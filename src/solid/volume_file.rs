@@ -228,6 +228,37 @@ impl VolumeFile {
         Ok(())
     }
 
+    /// Skips the next `count` planes along z (fewer if the volume ends first): their bytes are read and
+    /// dropped.
+    ///
+    /// # Errors
+    /// [`SolidError::Parse`] naming the file and the plane where it ends early.
+    pub fn skip_planes(&mut self, count: usize) -> Result<(), SolidError> {
+        let [nx, ny, nz] = self.shape;
+        let size = match &self.samples {
+            Samples::Raw { size, .. } | Samples::Nifti { size, .. } => *size,
+        };
+        let count = count.min(nz - self.planes_read);
+        let want = (nx * ny * size) as u64 * count as u64;
+        let z = self.planes_read;
+        let skipped = std::io::copy(&mut (&mut self.input).take(want), &mut std::io::sink())
+            .map_err(|e| SolidError::Parse {
+                path: self.path.clone(),
+                what: format!("planes z = {z} … {} cannot be read: {e}", z + count),
+            })?;
+        if skipped < want {
+            return Err(SolidError::Parse {
+                path: self.path.clone(),
+                what: format!(
+                    "plane z = {} (of {nz}) cannot be read: the file ends",
+                    z + (skipped / (nx * ny * size).max(1) as u64) as usize
+                ),
+            });
+        }
+        self.planes_read += count;
+        Ok(())
+    }
+
     /// Reads the next plane's samples into `out`.
     fn read_plane(&mut self, out: &mut Vec<f64>) -> Result<(), SolidError> {
         let [nx, ny, nz] = self.shape;
@@ -391,16 +422,26 @@ impl SampleRule<f32> for Window {
 }
 
 impl<V: Value, R: SampleRule<V>> VolumeSlabs<V, R> {
-    /// Appends the values of the next planes of the file — those whose z is in `planes`, in order — to
-    /// `out`, x fastest.
+    /// Appends the values of the planes whose z (in the universe) is in `planes` to `out`, x fastest.
+    /// Planes are read front to back: those before `planes` not read yet are skipped (read and dropped —
+    /// a compressed file cannot seek), and a plane already read is not read again.
     ///
     /// # Errors
-    /// As [`VolumeFile::read_planes`]; the rule's error.
+    /// As [`VolumeFile::read_planes`]; the rule's error; [`SolidError::BadParameter`] for planes before
+    /// those already read.
     pub fn read(
         &mut self,
         planes: std::ops::Range<u32>,
         out: &mut Vec<V>,
     ) -> Result<(), SolidError> {
+        let first = planes.start.saturating_sub(self.region[2].start) as usize;
+        if first < self.file.planes_read {
+            return Err(SolidError::BadParameter(format!(
+                "{}: plane z = {first} was already read (planes are read front to back)",
+                self.file.path.display()
+            )));
+        }
+        self.file.skip_planes(first - self.file.planes_read)?;
         let rule = &self.rule;
         self.file.read_planes(planes.len(), |at, v| {
             out.push(rule.value(at, v)?);

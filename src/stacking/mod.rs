@@ -102,6 +102,7 @@ mod out_of_core;
 pub mod paper;
 mod partition;
 mod solids;
+mod value_parts;
 mod value_slabs;
 mod value_spill;
 mod values;
@@ -113,5 +114,6 @@ pub use out_of_core::{
     SpilledPart, Stage, StoredPieces, MAX_PARTS,
 };
 pub use partition::default_split_depth;
+pub use value_parts::ValuePart;
 pub use value_slabs::ValueSlabs;
 pub use value_spill::{ValueSlabsReport, ValuedLevelSink};

@@ -79,8 +79,9 @@ impl<const K: usize, V: Value> KTree<K, V> {
             background,
             slab_bytes,
         };
-        let root = slabs.stack(read, |_, _| Ok(()))?;
-        let universe = Universe::<K>::new(level).map_err(RayError::from)?;
+        let universe = slabs.check_box()?;
+        let (mut read, mut slab) = (read, Vec::new());
+        let root = slabs.join_slabs(|b| slabs.read_slab(universe, b, &mut read, &mut slab))?;
         Ok(root.into_tree(universe))
     }
 }
@@ -108,65 +109,91 @@ impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
         self.level - slab_log::<K, V>(self.level, &self.region, self.slab_bytes)
     }
 
-    /// Reads the box slab by slab and joins the slabs' cells into the root's subtree, handing each
-    /// slab's cells to `keep(b, cells)` first (`b` the slab's number, the cells in the Morton order of
-    /// their coordinates along the other axes), which may replace them (by their roots alone, say, once
-    /// spilled).
-    pub(crate) fn stack<X: From<RayError>>(
-        &self,
-        mut read: impl FnMut(Range<u32>, &mut Vec<V>) -> Result<(), X>,
-        mut keep: impl FnMut(u32, &mut Vec<Subtree<V>>) -> Result<(), X>,
-    ) -> Result<Subtree<V>, X> {
-        let (level, region, background) = (self.level, &self.region, self.background);
-        let universe = Universe::<K>::new(level).map_err(RayError::from)?;
+    /// The number of slabs the universe is cut into along the last axis (`2^m`); slab `b` holds the
+    /// voxels whose last coordinate is in `b · 2^(L − m) … (b + 1) · 2^(L − m) − 1`.
+    pub fn slab_count(&self) -> u32 {
+        1 << self.cell_depth()
+    }
+
+    /// The slabs that meet the box (the others are empty and never read).
+    pub fn slabs_in_box(&self) -> Range<u32> {
+        let s = self.level - self.cell_depth();
+        let r = &self.region[K - 1];
+        if self.region.iter().any(|r| r.is_empty()) {
+            return 0..0;
+        }
+        (r.start >> s)..((r.end - 1) >> s) + 1
+    }
+
+    /// Refuses a box reaching outside the universe (or a level beyond the largest).
+    pub(crate) fn check_box(&self) -> Result<Universe<K>, RayError> {
+        let universe = Universe::<K>::new(self.level)?;
         let side = universe.side();
+        let region = &self.region;
         if let Some(axis) =
             (0..K).find(|&a| region[a].start > region[a].end || u64::from(region[a].end) > side)
         {
-            return Err(RayError::from(crate::space::SpaceError::OutOfUniverse {
+            return Err(crate::space::SpaceError::OutOfUniverse {
                 axis,
                 value: u64::from(region[axis].end),
                 side,
-            })
+            }
             .into());
         }
-        let m = self.cell_depth();
-        let s = level - m;
-        let mut pending: Vec<Layer<V>> = Vec::new();
-        let mut slab = Vec::new();
-        let empty_box = region.iter().any(|r| r.is_empty());
+        Ok(universe)
+    }
+
+    /// The cells of slab `b` (in the Morton order of their coordinates along the other axes), its rows of
+    /// the box read into `slab` by `read`; `None` if the slab does not meet the box.
+    pub(crate) fn read_slab<X: From<RayError>>(
+        &self,
+        universe: Universe<K>,
+        b: u32,
+        read: &mut impl FnMut(Range<u32>, &mut Vec<V>) -> Result<(), X>,
+        slab: &mut Vec<V>,
+    ) -> Result<Option<Vec<Subtree<V>>>, X> {
+        let region = &self.region;
+        let s = self.level - self.cell_depth();
+        let z = (b << s)..((b + 1) << s);
+        let rows = z.start.max(region[K - 1].start)..z.end.min(region[K - 1].end);
+        if rows.is_empty() || region.iter().any(|r| r.is_empty()) {
+            return Ok(None);
+        }
         let area: usize = region[..K - 1].iter().map(|r| r.len()).product();
-        for b in 0..1u32 << m {
-            let z = (b << s)..((b + 1) << s);
-            let rows = z.start.max(region[K - 1].start)..z.end.min(region[K - 1].end);
-            let mut layer = Layer {
-                depth: m,
-                cells: None,
-            };
-            if !rows.is_empty() && !empty_box {
-                slab.clear();
-                let first = rows.start;
-                read(rows.clone(), &mut slab)?;
-                if slab.len() != area * rows.len() {
-                    return Err(RayError::SlabLength {
-                        first,
-                        expected: area * rows.len(),
-                        got: slab.len(),
-                    }
-                    .into());
-                }
-                let view = SlabView {
-                    universe,
-                    region,
-                    rows,
-                    values: &slab,
-                    background,
-                };
-                let mut cells = view.cells(s, b)?;
-                keep(b, &mut cells)?;
-                layer.cells = Some(cells);
+        slab.clear();
+        let first = rows.start;
+        read(rows.clone(), slab)?;
+        if slab.len() != area * rows.len() {
+            return Err(RayError::SlabLength {
+                first,
+                expected: area * rows.len(),
+                got: slab.len(),
             }
-            pending.push(layer);
+            .into());
+        }
+        let view = SlabView {
+            universe,
+            region,
+            rows,
+            values: slab,
+            background: self.background,
+        };
+        Ok(Some(view.cells(s, b)?))
+    }
+
+    /// Joins the layers of the slabs `0, 1, …` (`layer(b)`: slab `b`'s cells, `None` if all are empty)
+    /// into the root's subtree, like the digits of a binary counter.
+    pub(crate) fn join_slabs<X>(
+        &self,
+        mut layer: impl FnMut(u32) -> Result<Option<Vec<Subtree<V>>>, X>,
+    ) -> Result<Subtree<V>, X> {
+        let m = self.cell_depth();
+        let mut pending: Vec<Layer<V>> = Vec::new();
+        for b in 0..1u32 << m {
+            pending.push(Layer {
+                depth: m,
+                cells: layer(b)?,
+            });
             while pending.len() >= 2
                 && pending[pending.len() - 2].depth == pending[pending.len() - 1].depth
             {

@@ -9,22 +9,16 @@
 //!
 //! A piece of level `j` of a cell is its `⌈n / 32⌉` words of codes (as
 //! [`PackedStates::words`](crate::tree::PackedStates::words)) followed by the `f` values of its full nodes,
-//! little-endian ([`Value::write_le`]), zero-padded to whole words.
+//! little-endian ([`Value::write_le`]), zero-padded to whole words. The build is that of one part of
+//! [`ValueSlabs::stack_part`]: every slab in it.
 
 use std::ops::Range;
 
-use rayon::prelude::*;
-
-use super::out_of_core::{BuildError, LevelPieces, PieceStore, StoredPieces};
-use super::value_slabs::{spread_across, ValueSlabs};
+use super::out_of_core::{BuildError, PieceStore};
+use super::value_slabs::ValueSlabs;
 use crate::rays::RayError;
-use crate::tree::top_down::PackedLevel;
 use crate::tree::LevelCounts;
 use crate::value::Value;
-
-/// Words read back at once: a multiple of 3, so that as many bytes of values are whole values of 1, 2, 3
-/// or 4 bytes.
-const CHUNK_WORDS: usize = 3 << 13;
 
 /// The output of a valued build written level by level, from the root down, each level as its section of
 /// a `.ktree` version 3 file lies: its codes (in one or more runs of consecutive nodes, packed as in
@@ -86,43 +80,6 @@ pub struct ValueSlabsReport {
     pub subtrees: u64,
     /// Bytes written to the [`PieceStore`].
     pub spilled_bytes: u64,
-}
-
-/// Why reading the slabs stopped: the source's error or the store's.
-enum Stop<E, F> {
-    Source(E),
-    Store(F),
-}
-
-impl<E: From<RayError>, F> From<RayError> for Stop<E, F> {
-    fn from(e: RayError) -> Self {
-        Stop::Source(E::from(e))
-    }
-}
-
-impl<E, F> From<Stop<E, F>> for BuildError<E, F> {
-    fn from(stop: Stop<E, F>) -> Self {
-        match stop {
-            Stop::Source(e) => BuildError::Source(e),
-            Stop::Store(f) => BuildError::Files(f),
-        }
-    }
-}
-
-/// The spilled cells, in the order they were spilled: each one's Morton index among the cells of depth
-/// `m`, and per level `1 … t` below it its node count and full node count (0 beyond its depth).
-struct SpillIndex {
-    t: usize,
-    mortons: Vec<u64>,
-    counts: Vec<[u64; 2]>,
-}
-
-impl SpillIndex {
-    /// The words of cell `s`'s piece of level `j`: codes, then values of `value_bytes` bytes each.
-    fn piece_words(&self, s: usize, j: usize, value_bytes: u64) -> (u64, u64) {
-        let [nodes, full] = self.counts[s * self.t + j - 1];
-        (nodes.div_ceil(32), (full * value_bytes).div_ceil(8))
-    }
 }
 
 impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
@@ -190,168 +147,19 @@ impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
     /// [`BuildError::Files`]: the store's or the output's error.
     pub fn build_into<E, P, O>(
         &self,
-        mut read: impl FnMut(Range<u32>, &mut Vec<V>) -> Result<(), E>,
-        mut store: P,
-        mut sink: O,
+        read: impl FnMut(Range<u32>, &mut Vec<V>) -> Result<(), E>,
+        store: P,
+        sink: O,
     ) -> Result<(O::Output, ValueSlabsReport), BuildError<E, P::Error>>
     where
         E: From<RayError>,
         P: PieceStore,
         O: ValuedLevelSink<Error = P::Error>,
     {
-        let m = self.cell_depth();
-        let t = (self.level - m) as usize;
-        let value_bytes = V::DTYPE.map_or(0, |d| d.bytes()) as u64;
-        let mut index = SpillIndex {
-            t,
-            mortons: Vec::new(),
-            counts: Vec::new(),
-        };
-        let mut spilled_words = 0u64;
-        let mut piece = Vec::new();
-        let top = self.stack::<Stop<E, P::Error>>(
-            |rows, out| read(rows, out).map_err(Stop::Source),
-            |b, cells| {
-                let levels: Vec<Option<Vec<PackedLevel<V>>>> = cells
-                    .par_iter_mut()
-                    .map(|cell| cell.root().has_children().then(|| cell.take_levels_below()))
-                    .collect();
-                for (i, levels) in levels.into_iter().enumerate() {
-                    let Some(levels) = levels else { continue };
-                    index
-                        .mortons
-                        .push(spread_across::<K>(i as u64) | spread_last::<K>(b));
-                    for j in 1..=t {
-                        let Some((codes, values)) = levels.get(j - 1) else {
-                            index.counts.push([0, 0]);
-                            continue;
-                        };
-                        piece.clear();
-                        piece.extend_from_slice(codes.words());
-                        piece.extend(value_words(values));
-                        store
-                            .append(j, &piece, codes.len() as u64)
-                            .map_err(Stop::Store)?;
-                        spilled_words += piece.len() as u64;
-                        index.counts.push([codes.len() as u64, values.len() as u64]);
-                    }
-                }
-                Ok(())
-            },
-        )?;
-        let mut stored = store.finish()?;
-        for (codes, values) in top.into_packed_levels() {
-            sink.append_words(codes.words(), codes.len() as u64)?;
-            sink.end_codes()?;
-            sink.append_values(&value_bytes_of(&values))?;
-            sink.end_level()?;
-        }
-        let mut order: Vec<usize> = (0..index.mortons.len()).collect();
-        order.sort_unstable_by_key(|&s| index.mortons[s]);
-        let mut offsets = vec![0u64; order.len()];
-        let mut words = vec![0u64; CHUNK_WORDS];
-        let mut bytes = Vec::with_capacity(8 * CHUNK_WORDS);
-        for j in 1..=t {
-            if order.iter().all(|&s| index.counts[s * t + j - 1][0] == 0) {
-                break;
-            }
-            let mut at = 0;
-            for (s, offset) in offsets.iter_mut().enumerate() {
-                *offset = at;
-                let (codes, values) = index.piece_words(s, j, value_bytes);
-                at += codes + values;
-            }
-            let mut level = stored.level(j, &offsets, at);
-            for &s in &order {
-                let mut nodes = index.counts[s * t + j - 1][0];
-                let mut from = 0;
-                while nodes > 0 {
-                    let take = nodes.min(32 * CHUNK_WORDS as u64);
-                    let chunk = &mut words[..take.div_ceil(32) as usize];
-                    level.read(s, from, chunk)?;
-                    sink.append_words(chunk, take)?;
-                    from += chunk.len() as u64;
-                    nodes -= take;
-                }
-            }
-            sink.end_codes()?;
-            for &s in &order {
-                let (mut from, mut left) = index.piece_words(s, j, value_bytes);
-                let mut value_left = index.counts[s * t + j - 1][1] * value_bytes;
-                while left > 0 {
-                    let chunk = &mut words[..left.min(CHUNK_WORDS as u64) as usize];
-                    level.read(s, from, chunk)?;
-                    bytes.clear();
-                    bytes.extend(chunk.iter().flat_map(|w| w.to_le_bytes()));
-                    bytes.truncate(value_left.min(bytes.len() as u64) as usize);
-                    sink.append_values(&bytes)?;
-                    value_left -= bytes.len() as u64;
-                    from += chunk.len() as u64;
-                    left -= chunk.len() as u64;
-                }
-            }
-            sink.end_level()?;
-            level.finish();
-        }
-        let counts_per_level = sink.counts_per_level();
-        let output = sink.finish()?;
-        Ok((
-            output,
-            ValueSlabsReport {
-                counts_per_level,
-                file_bytes: 0,
-                cell_depth: m,
-                subtrees: index.mortons.len() as u64,
-                spilled_bytes: 8 * spilled_words,
-            },
-        ))
-    }
-}
-
-/// The Morton key, among cells of `K` dimensions, of the cell whose last coordinate is `b` and whose other
-/// coordinates are 0.
-fn spread_last<const K: usize>(b: u32) -> u64 {
-    (0..32)
-        .filter(|bit| b >> bit & 1 == 1)
-        .map(|bit| 1u64 << (bit * K + K - 1))
-        .sum()
-}
-
-/// Values as their little-endian bytes, one after the other.
-fn value_bytes_of<V: Value>(values: &[V]) -> Vec<u8> {
-    let mut bytes = Vec::with_capacity(std::mem::size_of_val(values));
-    for &v in values {
-        v.write_le(&mut bytes);
-    }
-    bytes
-}
-
-/// Values as their little-endian bytes, zero-padded to whole words.
-fn value_words<V: Value>(values: &[V]) -> impl Iterator<Item = u64> {
-    let bytes = value_bytes_of(values);
-    let words: Vec<u64> = bytes
-        .chunks(8)
-        .map(|c| {
-            let mut word = [0u8; 8];
-            word[..c.len()].copy_from_slice(c);
-            u64::from_le_bytes(word)
-        })
-        .collect();
-    words.into_iter()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::space::morton_encode;
-
-    #[test]
-    fn the_last_coordinate_spreads_to_the_last_axis() {
-        assert_eq!(spread_last::<3>(0b101), morton_encode::<3>([0, 0, 0b101]));
-        assert_eq!(spread_last::<1>(0b1101), 0b1101);
-        assert_eq!(
-            spread_across::<4>(0b1011) | spread_last::<4>(0b10),
-            morton_encode::<4>([0b11, 0b1, 0, 0b10])
-        );
+        let slabs = 0..self.slab_count();
+        self.stack_part(slabs, read, store)?
+            .write_into(sink, |_, _: &mut [u64]| {
+                unreachable!("a build in one part receives nothing")
+            })
     }
 }

@@ -289,6 +289,55 @@ fn valued_runs_that_overlap_or_hold_nan_are_errors() {
     assert!(!e.to_string().is_empty());
 }
 
+/// The file of `slabs` built in the parts `cuts` (ranges of slabs), part `writer` writing `out` and the
+/// others streaming their levels to it, as ranks do; the slabs' rows are read by `read`.
+fn write_in_parts<const K: usize, V: Palette>(
+    slabs: &ktree::stacking::ValueSlabs<K, V>,
+    cuts: &[std::ops::Range<u32>],
+    writer: usize,
+    out: &std::path::Path,
+    notes: &ktree::io::ktree::Notes,
+    read: impl Fn(std::ops::Range<u32>, &mut Vec<V>) -> Result<(), ktree::rays::RayError> + Copy,
+) -> ktree::stacking::ValueSlabsReport {
+    let mut built: Vec<_> = cuts
+        .iter()
+        .map(|c| {
+            slabs
+                .stack_part_files(c.clone(), out, None, |rows, values: &mut Vec<V>| {
+                    // Only the part's own slabs are read.
+                    let thickness = slabs.level - slabs.slab_count().trailing_zeros();
+                    assert!(c.start << thickness <= rows.start && rows.end <= c.end << thickness);
+                    read(rows, values)
+                })
+                .unwrap()
+        })
+        .collect();
+    let mut part = built.remove(writer);
+    // The others' streams, in the order their indexes are added (owner 1, 2, …).
+    let mut streams = Vec::new();
+    for mut other in built {
+        let expected = part.add_part(&other.index_words()).unwrap();
+        let mut words = Vec::new();
+        let sent = other
+            .stream_levels(5, &mut |chunk| {
+                words.extend_from_slice(chunk);
+                Ok(())
+            })
+            .unwrap();
+        assert_eq!((sent, words.len() as u64), (expected, expected));
+        streams.push(words.into_iter());
+    }
+    part.write::<ktree::rays::RayError>(out, None, notes, &mut |owner, words| {
+        for w in words.iter_mut() {
+            *w = streams[owner - 1]
+                .next()
+                .expect("the stream holds the words taken");
+        }
+        Ok(())
+    })
+    .unwrap()
+}
+
 /// Building from a box of the dense array read slab by slab along the last axis: for a box of the painted
 /// universe (everything outside it emptied) and every slab thickness, the tree of the emptied array; a
 /// slab of the wrong length is an error, not a tree.
@@ -363,6 +412,24 @@ fn from_slabs<const K: usize, V: Palette>(
         prop_assert_eq!(report.file_bytes, bytes.len() as u64);
         prop_assert_eq!(&report.counts_per_level, &want.counts_per_level());
         prop_assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        // Built in parts, as ranks build it: each part reads its own slabs, and any one of them writes.
+        let count = slabs.slab_count();
+        for parts in 2..=3u32 {
+            let cuts: Vec<std::ops::Range<u32>> = (0..parts)
+                .map(|p| count * p / parts..count * (p + 1) / parts)
+                .collect();
+            for writer in 0..parts as usize {
+                let out = dir.path().join("parts.ktree");
+                let report = write_in_parts(&slabs, &cuts, writer, &out, &notes, read);
+                prop_assert!(
+                    std::fs::read(&out).unwrap() == bytes,
+                    "{parts} parts, part {writer} writing, slabs 2^{s} thick"
+                );
+                prop_assert_eq!(&report.counts_per_level, &want.counts_per_level());
+                prop_assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+                std::fs::remove_file(&out).unwrap();
+            }
+        }
         // The slabs cover the box's rows once, in order (none of an empty box is read).
         let covered: Vec<u32> = slabs_seen.drain(..).flatten().collect();
         let rows = if region.iter().any(|r| r.is_empty()) {
@@ -489,4 +556,86 @@ proptest! {
     fn mapped_leaves_k3(o in painted::<3>(), p in proptest::collection::vec(any::<[u16; 3]>(), 8)) { mapped_leaves::<3>(&o, &p.iter().map(|q| q.map(i64::from)).collect::<Vec<_>>())?; }
     #[test]
     fn mapped_leaves_k4(o in painted::<4>(), p in proptest::collection::vec(any::<[u16; 4]>(), 8)) { mapped_leaves::<4>(&o, &p.iter().map(|q| q.map(i64::from)).collect::<Vec<_>>())?; }
+}
+
+/// A part's index that is not of another part of the same build is refused, naming why; nothing of it is
+/// kept.
+#[test]
+fn part_indexes_of_other_builds_are_refused() {
+    let slabs = ktree::stacking::ValueSlabs {
+        level: 4,
+        region: [1..15, 2..16, 0..13],
+        background: 0u16,
+        slab_bytes: 2 * 14 * 14 * 2,
+    };
+    let read = |rows: std::ops::Range<u32>, out: &mut Vec<u16>| {
+        for z in rows {
+            out.extend(
+                (2..16u32).flat_map(|y| (1..15u32).map(move |x| ((x / 3 + y / 5 + z) % 4) as u16)),
+            );
+        }
+        Ok::<_, ktree::rays::RayError>(())
+    };
+    assert_eq!(slabs.slab_count(), 8);
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.ktree");
+    let mut first = slabs.stack_part_files(0..4, &out, None, read).unwrap();
+    let second = slabs.stack_part_files(4..8, &out, None, read).unwrap();
+    let index = second.index_words();
+    let refused = |part: &mut ktree::stacking::ValuePart<3, u16, _>, words: &[u64], why: &str| {
+        let e = part.add_part(words).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::InvalidData);
+        assert!(e.to_string().contains(why), "{e}");
+    };
+    // Its own slabs again, a truncated index, a state that is none, another level.
+    let own = first.index_words();
+    refused(&mut first, &own, "slabs another part read");
+    refused(&mut first, &index[..index.len() - 1], "length");
+    let mut bad = index.clone();
+    bad[11] = 7;
+    refused(&mut first, &bad, "state");
+    let mut bad = index.clone();
+    bad[2] = 5;
+    refused(&mut first, &bad, "another K, level");
+    let mut bad = index.clone();
+    bad[0] = 0;
+    refused(&mut first, &bad, "not a part index");
+    // A cell with children whose subtree it did not spill.
+    let mut bad = index.clone();
+    let at = 10
+        + bad[10..]
+            .iter()
+            .position(|&w| w == 2 || w == 3)
+            .expect("a cell with children");
+    bad[at] = 0;
+    refused(&mut first, &bad, "spilled cells");
+    // The right index is still taken after the wrong ones.
+    first.add_part(&index).unwrap();
+}
+
+/// A volume read slab by slab from a later plane on skips the planes before it (as a rank reading its own
+/// slabs does), and refuses planes already read.
+#[test]
+fn volume_slabs_skip_to_the_planes_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let samples: Vec<u8> = (0..4 * 3 * 10u32).map(|i| (i * 7 % 5) as u8).collect();
+    std::fs::write(dir.path().join("v.raw"), &samples).unwrap();
+    let json = dir.path().join("v.json");
+    std::fs::write(
+        &json,
+        r#"{"file": "v.raw", "dtype": "uint8", "shape_xyz": [4, 3, 10]}"#,
+    )
+    .unwrap();
+    // Placed at z = 2: universe planes 5 and 6 are the file's planes 3 and 4.
+    let mut slabs = ktree::solid::volume_file::label_slabs::<u8>(&json, 4, [0, 0, 2]).unwrap();
+    assert_eq!(slabs.region, [0..4, 0..3, 2..12]);
+    let plane = |z: usize| samples[12 * z..12 * (z + 1)].to_vec();
+    let mut got = Vec::new();
+    slabs.read(5..7, &mut got).unwrap();
+    assert_eq!(got, [plane(3), plane(4)].concat());
+    got.clear();
+    slabs.read(7..8, &mut got).unwrap();
+    assert_eq!(got, plane(5));
+    let e = slabs.read(4..5, &mut got).unwrap_err();
+    assert!(e.to_string().contains("already read"), "{e}");
 }

@@ -24,6 +24,11 @@
 //!    rank one chunk, and these buffers come out of the budget. The file is byte for byte the
 //!    single-process file.
 //!
+//! A volume with values (`voxelize --labels`, `--window`) is built by [`build_values_across_ranks`]: each
+//! rank reads only the planes of its own range of slabs ([`ktree::stacking::ValueSlabs::stack_part`]), and
+//! phases 3 and 4 are the same with the roots of the slabs' cells as the index and each level's codes,
+//! then values, as the streams ([`ktree::stacking::ValuePart`]).
+//!
 //! **Failure.** The ranks agree after each phase whether one failed (an all-reduce); then every rank drops
 //! its spill folder, waits for the others to have dropped theirs, and fails: the failed rank prints its
 //! error with its rank, nothing is written. A rank that fails while sending its levels ends its stream with
@@ -85,4 +90,4 @@ mod imp;
 mod imp;
 
 #[cfg(feature = "mpi")]
-pub use imp::build_across_ranks;
+pub use imp::{build_across_ranks, build_values_across_ranks};

@@ -11,8 +11,14 @@ use rayon::prelude::*;
 use super::{Ranks, STOPPED};
 use crate::common::error::{CliError, CliResult};
 use crate::common::output::{describe, TreeOutput};
+use ktree::io::ktree::Notes;
+use ktree::io::SpilledFiles;
 use ktree::rays::RaySource;
-use ktree::stacking::{balanced_parts, OutOfCoreReport};
+use ktree::stacking::{
+    balanced_parts, BuildError, OutOfCoreReport, SpilledPart, ValuePart, ValueSlabs,
+    ValueSlabsReport,
+};
+use ktree::value::Value;
 
 /// Keeps MPI initialised; finalises it when dropped.
 pub struct Guard {
@@ -150,9 +156,74 @@ where
     let part = pool
         .install(|| builder.stack_part(&slabs[mine], out, part_budget))
         .map_err(|e| describe(out, e, held));
-    let mut part = agree(w, part)?;
+    let part = agree(w, part)?;
 
     // 3. Index, and 4. levels: the other ranks send, rank 0 writes.
+    let written = gather_and_write(w, part, chunk, |part, receive| {
+        let written = part.write::<std::convert::Infallible>(out, receive, &progress);
+        if let Some(bar) = &bar {
+            bar.finish_and_clear();
+        }
+        written.map_err(|e| describe(out, e, held))
+    })?;
+    Ok(written)
+}
+
+/// The part of a build a rank stacked, as the ranks exchange it ([`SpilledPart`] without values,
+/// [`ValuePart`] with).
+trait RankPart {
+    fn index_words(&self) -> Vec<u64>;
+    fn add_part(&mut self, words: &[u64]) -> std::io::Result<u64>;
+    fn stream_levels(
+        &mut self,
+        chunk_words: usize,
+        send: &mut dyn FnMut(&[u64]) -> std::io::Result<()>,
+    ) -> std::io::Result<u64>;
+}
+
+impl RankPart for SpilledPart<SpilledFiles> {
+    fn index_words(&self) -> Vec<u64> {
+        SpilledPart::index_words(self)
+    }
+    fn add_part(&mut self, words: &[u64]) -> std::io::Result<u64> {
+        SpilledPart::add_part(self, words)
+    }
+    fn stream_levels(
+        &mut self,
+        chunk_words: usize,
+        send: &mut dyn FnMut(&[u64]) -> std::io::Result<()>,
+    ) -> std::io::Result<u64> {
+        SpilledPart::stream_levels(self, chunk_words, send)
+    }
+}
+
+impl<const K: usize, V: Value + Send + Sync> RankPart for ValuePart<K, V, SpilledFiles> {
+    fn index_words(&self) -> Vec<u64> {
+        ValuePart::index_words(self)
+    }
+    fn add_part(&mut self, words: &[u64]) -> std::io::Result<u64> {
+        ValuePart::add_part(self, words)
+    }
+    fn stream_levels(
+        &mut self,
+        chunk_words: usize,
+        send: &mut dyn FnMut(&[u64]) -> std::io::Result<()>,
+    ) -> std::io::Result<u64> {
+        ValuePart::stream_levels(self, chunk_words, send)
+    }
+}
+
+/// Phases 3 and 4 of a build across ranks, once every rank stacked its `part`: the other ranks send rank 0
+/// their indexes, then their levels in chunks of `chunk` words; rank 0 adds the indexes and writes the
+/// tree with `write(part, receive)`, `receive(owner, words)` taking the next words of that rank's stream.
+/// `Some(report)` on rank 0, `None` on the others.
+fn gather_and_write<P: RankPart, R>(
+    w: &SimpleCommunicator,
+    mut part: P,
+    chunk: usize,
+    write: impl FnOnce(P, &mut dyn FnMut(usize, &mut [u64]) -> std::io::Result<()>) -> CliResult<R>,
+) -> CliResult<Option<R>> {
+    let Ranks { rank, size } = ranks();
     let root = w.process_at_rank(0);
     if rank != 0 {
         send_words(&root, &part.index_words(), chunk);
@@ -171,8 +242,7 @@ where
         drop(part);
         agree(
             w,
-            streamed
-                .map_err(|e| CliError::about(format!("{}: sending the levels", out.display()), e)),
+            streamed.map_err(|e| CliError::about("sending the levels to rank 0".to_string(), e)),
         )?;
         root.gather_into(&crate::common::memory::peak_rss_bytes().unwrap_or(0));
         return Ok(None);
@@ -191,20 +261,15 @@ where
         }
     }
     agree(w, added)?;
-    let written = part.write::<std::convert::Infallible>(
-        out,
-        &mut |owner, words| streams[owner - 1].fill(owner, words),
-        &progress,
-    );
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+    let written = write(part, &mut |owner, words| {
+        streams[owner - 1].fill(owner, words)
+    });
     // Take what is left of the streams, so that no rank waits on a send.
     for stream in &mut streams {
         stream.drain();
         moved += stream.received;
     }
-    let report = agree(w, written.map_err(|e| describe(out, e, held)))?;
+    let report = agree(w, written)?;
     let mut peaks = vec![0u64; size];
     let own = crate::common::memory::peak_rss_bytes().unwrap_or(0);
     root.gather_into_root(&own, &mut peaks[..]);
@@ -217,6 +282,54 @@ where
             .join(" ")
     );
     Ok(Some(report))
+}
+
+/// Builds the valued tree of the box `slabs` into the `.ktree` (version 3) file `out` across the ranks of
+/// the run: the slabs that meet the box are cut into one contiguous range a rank, each rank reads only
+/// its own (`read` is called with ranges of the last coordinate from its first slab on, in order),
+/// builds their cells and spills them ([`ValueSlabs::stack_part_files`]); rank 0 writes the file as
+/// [`build_across_ranks`] does, byte for byte the single process's. `Some(report)` on rank 0, `None` on
+/// the other ranks.
+///
+/// # Errors
+/// The error of `read` (through `source`), or of the files, on this rank; [`STOPPED`] if another failed.
+pub fn build_values_across_ranks<const K: usize, V, E>(
+    slabs: &ValueSlabs<K, V>,
+    out: &Path,
+    temp_dir: Option<&Path>,
+    read: impl FnMut(std::ops::Range<u32>, &mut Vec<V>) -> Result<(), E>,
+    source: impl Fn(E) -> CliError,
+) -> CliResult<Option<ValueSlabsReport>>
+where
+    V: Value + Send + Sync,
+    E: From<ktree::rays::RayError> + std::error::Error + Send + Sync + 'static,
+{
+    let w = world();
+    let outcome = (|| {
+        let Ranks { rank, size } = ranks();
+        let chunk = (CHUNK_BYTES / 8) as usize;
+        let inside = slabs.slabs_in_box();
+        let n = u64::from(inside.len() as u32);
+        let cut = |r: usize| inside.start + (n * r as u64 / size as u64) as u32;
+        let mine = cut(rank)..cut(rank + 1);
+        let part = slabs
+            .stack_part_files(mine, out, temp_dir, read)
+            .map_err(|e| match e {
+                BuildError::Source(e) => source(e),
+                other => describe(out, other, 0),
+            });
+        let part = agree(&w, part)?;
+        gather_and_write(&w, part, chunk, |part, receive| {
+            part.write::<std::convert::Infallible>(out, None, &Notes::new(), receive)
+                .map_err(|e| describe(out, e, 0))
+        })
+    })();
+    if outcome.is_err() {
+        // Every rank has dropped its spill folder: none is stopped before it could.
+        w.barrier();
+        SETTLED.store(true, Ordering::SeqCst);
+    }
+    outcome
 }
 
 /// Sends `words` to `to`: their number, then chunks of at most `chunk` words.
