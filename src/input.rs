@@ -360,9 +360,10 @@ fn mesh_placement(
 /// Meshes voxelized together as labels ([`voxelize_mesh_labels`]), with the name of each label.
 #[cfg(feature = "mesh")]
 #[derive(Debug, Clone)]
-pub struct MeshLabels {
-    /// An octree of labels: `u8` for up to 255 meshes, `u16` up to 65535, `u32` beyond.
-    pub tree: crate::AnyValuedTree,
+pub struct MeshLabels<T = crate::AnyValuedTree> {
+    /// An octree of labels ([`LabelRuns`] for [`mesh_label_runs`]): `u8` for up to 255 meshes, `u16` up
+    /// to 65535, `u32` beyond.
+    pub tree: T,
     /// Label `i + 1` is `names[i]`: the file, or the group of a single OBJ file.
     pub names: Vec<String>,
     /// Label `i + 1` is held by `voxels[i]` voxels (0 for a mesh the later ones hide).
@@ -419,6 +420,32 @@ pub fn voxelize_mesh_labels(
     paths: &[impl AsRef<Path>],
     options: &ReadOptions,
 ) -> Result<MeshLabels, IoError> {
+    let labels = mesh_label_runs(paths, options)?;
+    let tree = match &labels.tree {
+        LabelRuns::U8(runs) => crate::AnyValuedTree::from(KTree::from_value_runs(runs)),
+        LabelRuns::U16(runs) => crate::AnyValuedTree::from(KTree::from_value_runs(runs)),
+        LabelRuns::U32(runs) => crate::AnyValuedTree::from(KTree::from_value_runs(runs)),
+    };
+    Ok(MeshLabels {
+        tree,
+        names: labels.names,
+        voxels: labels.voxels,
+        transform: labels.transform,
+        fitted: labels.fitted,
+    })
+}
+
+/// [`voxelize_mesh_labels`] as the runs of labels the tree is built from (the meshes ray cast, the
+/// tree not built): what a build out of core or across processes takes
+/// ([`ValueRuns::write_file`](crate::rays::ValueRuns::write_file)).
+///
+/// # Errors
+/// As [`voxelize_mesh_labels`].
+#[cfg(feature = "mesh")]
+pub fn mesh_label_runs(
+    paths: &[impl AsRef<Path>],
+    options: &ReadOptions,
+) -> Result<MeshLabels<LabelRuns>, IoError> {
     use crate::solid::mesh::TriangleMesh;
     let Some(first) = paths.first().map(AsRef::as_ref) else {
         return Err(usage(Path::new(""), "no mesh to voxelize as labels"));
@@ -466,20 +493,14 @@ pub fn voxelize_mesh_labels(
     let meshes: Vec<TriangleMesh> = meshes.into_iter().map(|(m, _, _)| m).collect();
     let (transform, fitted) =
         mesh_placement(options, &meshes, level).map_err(solid_error(first))?;
-    // As `KTree::from_label_meshes` builds them, with the voxels of each label counted on the runs.
-    fn build<V: crate::value::Value + TryFrom<u32>>(
-        meshes: &[TriangleMesh],
-        level: u32,
-        transform: &crate::solid::mesh::MeshTransform,
-    ) -> Result<(crate::AnyValuedTree, Vec<u64>), SolidError> {
-        let labels = crate::solid::mesh::label_runs::<V>(meshes, level, transform)?;
-        let tree = KTree::from_value_runs(&labels.runs);
-        Ok((crate::AnyValuedTree::from(tree), labels.voxels))
-    }
+    // The voxels of each label counted on the runs.
     let (tree, voxels) = match meshes.len() {
-        0..=255 => build::<u8>(&meshes, level, &transform),
-        256..=65535 => build::<u16>(&meshes, level, &transform),
-        _ => build::<u32>(&meshes, level, &transform),
+        0..=255 => crate::solid::mesh::label_runs::<u8>(&meshes, level, &transform)
+            .map(|l| (LabelRuns::U8(l.runs), l.voxels)),
+        256..=65535 => crate::solid::mesh::label_runs::<u16>(&meshes, level, &transform)
+            .map(|l| (LabelRuns::U16(l.runs), l.voxels)),
+        _ => crate::solid::mesh::label_runs::<u32>(&meshes, level, &transform)
+            .map(|l| (LabelRuns::U32(l.runs), l.voxels)),
     }
     .map_err(solid_error(first))?;
     Ok(MeshLabels {
@@ -489,6 +510,17 @@ pub fn voxelize_mesh_labels(
         transform,
         fitted,
     })
+}
+
+/// The runs of labels of [`mesh_label_runs`], of the smallest label type that holds the meshes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LabelRuns {
+    /// Up to 255 meshes.
+    U8(crate::rays::ValueRuns<3, u8>),
+    /// Up to 65535 meshes.
+    U16(crate::rays::ValueRuns<3, u16>),
+    /// More.
+    U32(crate::rays::ValueRuns<3, u32>),
 }
 
 #[cfg(feature = "mesh")]

@@ -10,14 +10,14 @@
 use std::path::{Path, PathBuf};
 
 use ktree::io::ktree::notes::label_note;
-use ktree::io::ktree::v3::{
-    read_any_ktree_noted, valued_header, write_valued_ktree_file, AnyKtree, MappedValuedTree,
-};
+use ktree::io::ktree::v3::{read_any_ktree_noted, valued_header, AnyKtree, MappedValuedTree};
 use ktree::io::ktree::Notes;
 use ktree::query::{stats, TreeStats};
+use ktree::rays::ValueRuns;
 use ktree::solid::cloud::{self, CloudVoxelizer, PointCloud};
 use ktree::solid::volume_file::{label_slabs, SampleRule, VolumeFile, VolumeSlabs};
 use ktree::solid::SolidError;
+use ktree::space::WorldFrame;
 use ktree::stacking::{BuildError, ValueSlabs, ValueSlabsReport};
 use ktree::tree::valued::ValueLeaves;
 use ktree::value::{Dtype, Value};
@@ -106,9 +106,17 @@ where
     let read = |planes, values: &mut Vec<V>| slabs.read(planes, values);
     #[cfg(feature = "mpi")]
     let report = if crate::distributed::ranks().size > 1 {
-        crate::distributed::build_values_across_ranks(&box_slabs, out, temp_dir, read, |e| {
-            CliError::in_file(input, e)
-        })?
+        crate::distributed::build_values_across_ranks(
+            box_slabs.slabs_in_box(),
+            out,
+            None,
+            &Notes::new(),
+            |mine| {
+                box_slabs
+                    .stack_part_files(mine, out, temp_dir, read)
+                    .map_err(|e| build_error(input, out, e))
+            },
+        )?
     } else {
         Some(write_file(&box_slabs, input, out, temp_dir, read)?)
     };
@@ -136,10 +144,51 @@ fn write_file<V: Value + Send + Sync>(
 ) -> CliResult<ValueSlabsReport> {
     slabs
         .write_file(out, temp_dir, None, &Notes::new(), read)
-        .map_err(|e| match e {
-            BuildError::Source(e) => CliError::in_file(input, e),
-            other => crate::common::output::describe(out, other, 0),
-        })
+        .map_err(|e| build_error(input, out, e))
+}
+
+/// The error of a build from `input` into `out`: the source's names `input`; the files', the file.
+fn build_error<E: std::error::Error + Send + Sync + 'static>(
+    input: &Path,
+    out: &Path,
+    e: BuildError<E>,
+) -> CliError {
+    match e {
+        BuildError::Source(e) => CliError::in_file(input, e),
+        other => crate::common::output::describe(out, other, 0),
+    }
+}
+
+/// Writes the tree of `runs` to the `.ktree` file `out` (with `frame` and `notes`) out of core: its
+/// cells built slab by slab and spilled next to it (or in `--temp-dir`), the tree never held whole.
+/// Started over MPI ranks (each holding the runs), each rank builds its own slabs and rank 0 writes the
+/// file (the same bytes). The report on rank 0; `None` on the others, which neither write nor print.
+pub fn write_runs<V: Value + Send + Sync>(
+    runs: &ValueRuns<3, V>,
+    build: &BuildArgs,
+    out: &Path,
+    frame: Option<&WorldFrame>,
+    notes: &Notes,
+) -> CliResult<Option<ValueSlabsReport>> {
+    let temp_dir = build.temp_dir.as_deref();
+    let depth = runs.default_cell_depth();
+    #[cfg(feature = "mpi")]
+    if crate::distributed::ranks().size > 1 {
+        return crate::distributed::build_values_across_ranks(
+            0..1 << depth,
+            out,
+            frame,
+            notes,
+            |mine| {
+                runs.stack_part_files(depth, mine, out, temp_dir)
+                    .map_err(|e| crate::common::output::describe(out, e, 0))
+            },
+        );
+    }
+    let report = runs
+        .write_file(out, temp_dir, frame, notes, depth)
+        .map_err(|e| crate::common::output::describe(out, e, 0))?;
+    Ok(Some(report))
 }
 
 /// A label volume into a valued tree of the smallest label type that holds it (or `dtype`), read slab by
@@ -235,6 +284,7 @@ pub fn voxelize_cloud_values(
     voxelizer: &CloudVoxelizer,
     (value, reduce): (CloudValue, Option<Reduce>),
     out: &Path,
+    options: &BuildArgs,
 ) -> CliResult {
     if reduce.is_some() && value != CloudValue::Intensity {
         return Err("--reduce is for --value intensity".into());
@@ -262,7 +312,14 @@ pub fn voxelize_cloud_values(
     match value {
         CloudValue::Rgb => {
             let colours = cloud.colours().ok_or_else(|| missing("colour"))?;
-            build(input, voxelizer, points, colours, cloud::mean_colour, out)
+            build(
+                input,
+                voxelizer,
+                points,
+                colours,
+                cloud::mean_colour,
+                (out, options),
+            )
         }
         CloudValue::Intensity => {
             let intensities = cloud.intensities().ok_or_else(|| missing("intensity"))?;
@@ -270,7 +327,14 @@ pub fn voxelize_cloud_values(
                 Reduce::Mean => cloud::mean_intensity,
                 Reduce::Max => cloud::max_intensity,
             };
-            build(input, voxelizer, points, intensities, reduce, out)
+            build(
+                input,
+                voxelizer,
+                points,
+                intensities,
+                reduce,
+                (out, options),
+            )
         }
         CloudValue::Class => {
             let classes = cloud.classes().ok_or_else(|| missing("class"))?;
@@ -280,7 +344,7 @@ pub fn voxelize_cloud_values(
                 points,
                 classes,
                 cloud::most_frequent_class,
-                out,
+                (out, options),
             )
         }
         CloudValue::Count => {
@@ -291,7 +355,7 @@ pub fn voxelize_cloud_values(
                 points,
                 &ones,
                 |g: &[()]| g.len() as u32,
-                out,
+                (out, options),
             )
         }
     }
@@ -299,19 +363,28 @@ pub fn voxelize_cloud_values(
 
 /// Voxelizes `points` with their values `per_point` reduced by `reduce`, writes the tree to `out` and
 /// says what it holds.
-fn build<T: Copy, V: Value>(
+fn build<T: Copy, V: Value + Send + Sync>(
     input: &Path,
     voxelizer: &CloudVoxelizer,
     points: &[[f64; 3]],
     per_point: &[T],
     reduce: impl FnMut(&[T]) -> V,
-    out: &Path,
+    (out, options): (&Path, &BuildArgs),
 ) -> CliResult {
     let voxels = voxelizer
         .voxelize_values(points, per_point, reduce)
         .map_err(|e| crate::voxelize::cloud_error(input, e))?;
-    let tree = KTree::from_value_runs(&voxels.runs);
-    write_valued_ktree_file(out, &tree).map_err(CliError::caused)?;
+    // Written out of core (over MPI ranks, each rank builds its own slabs of the runs).
+    let Some(report) = write_runs(&voxels.runs, options, out, None, &Notes::new())? else {
+        return Ok(());
+    };
+    let distinct: std::collections::HashSet<_> =
+        voxels.runs.runs().iter().map(|r| r.value.key()).collect();
+    let nodes: u64 = report
+        .counts_per_level
+        .iter()
+        .map(|c| c.empty + c.full + c.partial)
+        .sum();
     let o = voxels.origin;
     outln!(
         "{}: {} points, origin {},{},{}, level {}, {} voxels of {} ({} distinct values){}; {}: {} nodes",
@@ -320,17 +393,17 @@ fn build<T: Copy, V: Value>(
         o[0],
         o[1],
         o[2],
-        tree.level(),
-        tree.voxel_count(),
+        voxels.runs.universe().level(),
+        voxels.runs.voxel_count(),
         V::DTYPE.map_or("", Dtype::name),
-        tree.value_stats().len(),
+        distinct.len(),
         if voxels.cropped > 0 {
             format!(", {} points outside the universe dropped", voxels.cropped)
         } else {
             String::new()
         },
         out.display(),
-        tree.node_count()
+        nodes
     );
     Ok(())
 }

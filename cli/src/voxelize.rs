@@ -14,9 +14,9 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
+use crate::values::write_runs;
 use ktree::input::{voxel_source, voxelize, VoxelSource};
 use ktree::io::ktree::notes::label_note;
-use ktree::io::ktree::v3::write_valued_ktree_file_noted;
 use ktree::io::ktree::Notes;
 use ktree::io::{Format, ReadOptions};
 use ktree::rays::{RaySource, SlabRuns};
@@ -219,12 +219,17 @@ fn run_mesh_labels(a: &Args) -> CliResult {
         mesh_placement,
         ..ReadOptions::default()
     };
-    let labels = ktree::input::voxelize_mesh_labels(&inputs, &options).map_err(CliError::caused)?;
-    if let Some(t) = &labels.fitted {
+    // The meshes ray cast into runs of labels, their tree written out of core (over MPI ranks, every
+    // rank casts them and builds its own slabs; rank 0 alone writes and reports).
+    let labels = ktree::input::mesh_label_runs(&inputs, &options).map_err(CliError::caused)?;
+    let root = crate::distributed::ranks().is_root();
+    if let Some(t) = labels.fitted.as_ref().filter(|_| root) {
         outln!("--fit chose --transform {t}");
     }
     for (i, (name, voxels)) in labels.names.iter().zip(&labels.voxels).enumerate() {
-        outln!("label {}: {name} ({voxels} voxels)", i + 1);
+        if root {
+            outln!("label {}: {name} ({voxels} voxels)", i + 1);
+        }
     }
     let frame = labels.transform.world_frame();
     // Each label's name kept in the file (`ktree stats` prints them).
@@ -239,18 +244,27 @@ fn run_mesh_labels(a: &Args) -> CliResult {
             )
         })
         .collect();
-    let nodes = ktree::with_valued!(&labels.tree, t => {
-        write_valued_ktree_file_noted(&a.out.out, t, frame.as_ref(), &notes)
-            .map_err(CliError::caused)?;
-        t.node_count()
-    });
+    use ktree::input::LabelRuns;
+    let (out, frame) = (&a.out.out, frame.as_ref());
+    let (report, dtype) = match &labels.tree {
+        LabelRuns::U8(runs) => (write_runs(runs, &a.build, out, frame, &notes)?, "uint8"),
+        LabelRuns::U16(runs) => (write_runs(runs, &a.build, out, frame, &notes)?, "uint16"),
+        LabelRuns::U32(runs) => (write_runs(runs, &a.build, out, frame, &notes)?, "uint32"),
+    };
+    let Some(report) = report else {
+        return Ok(());
+    };
+    let nodes: u64 = report
+        .counts_per_level
+        .iter()
+        .map(|c| c.empty + c.full + c.partial)
+        .sum();
     let voxels: u64 = labels.voxels.iter().sum();
     let used = labels.voxels.iter().filter(|&&v| v > 0).count();
     outln!(
-        "{}: {voxels} voxels labelled with {used} of {} labels ({}), L = {level}, {nodes} nodes",
-        a.out.out.display(),
+        "{}: {voxels} voxels labelled with {used} of {} labels ({dtype}), L = {level}, {nodes} nodes",
+        out.display(),
         labels.names.len(),
-        labels.tree.dtype().name(),
     );
     Ok(())
 }
@@ -289,6 +303,7 @@ fn run_cloud(a: &Args) -> CliResult {
             &v,
             (value, a.reduce),
             &a.out.out,
+            &a.build,
         );
     }
     let voxels = v

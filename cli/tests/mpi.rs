@@ -1,6 +1,6 @@
 //! Builds over MPI ranks write the very file a single process writes (`mpirun -n 2`, and 3 ranks
 //! oversubscribed on this machine), in K = 2, 3 and 4, for `rays`, `build` and `voxelize` (volumes with
-//! values too: `--labels`, `--window`), also in the
+//! values too: `--labels`, `--window`, meshes as labels, a cloud's colours), also in the
 //! smallest `--max-memory` per rank the build names; a failed run (before the build, or while rank 0
 //! writes) leaves no output and no spill folder. Compiled with the cargo feature `mpi` only; needs
 //! `mpirun` (OpenMPI) on the PATH (every test fails without it). The failure while rank 0 writes fills a
@@ -223,7 +223,7 @@ fn ray_files_and_meshes_over_ranks_write_the_single_process_file() {
 }
 
 #[test]
-fn volumes_with_values_over_ranks_write_the_single_process_file() {
+fn trees_with_values_over_ranks_write_the_single_process_file() {
     // Each rank reads only its share of the planes (thin slabs: a quarter of --max-memory a slab), in a
     // volume placed off the universe's corner.
     let dir = tempfile::tempdir().unwrap();
@@ -259,6 +259,34 @@ fn volumes_with_values_over_ranks_write_the_single_process_file() {
             "60:140",
             "--max-memory",
             "1M",
+        ],
+    );
+    // Meshes as labels and a point cloud's colours: runs cut at each rank's slabs.
+    let mesh = |name: &str| data_dir().join("meshes").join(name);
+    same_bytes(
+        d,
+        "meshes",
+        &[
+            "voxelize",
+            mesh("bunny_npm.obj").to_str().unwrap(),
+            mesh("fandisk.obj").to_str().unwrap(),
+            "--labels",
+            "--level",
+            "8",
+            "--fit",
+        ],
+    );
+    let cloud = data_dir().join("clouds/pcl_colored_cloud.pcd");
+    same_bytes(
+        d,
+        "colours",
+        &[
+            "voxelize",
+            cloud.to_str().unwrap(),
+            "--voxel-size",
+            "0.005",
+            "--value",
+            "rgb",
         ],
     );
     // A label too large for the type in the last plane: only the last rank reads it, and every rank

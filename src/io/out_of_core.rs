@@ -15,7 +15,7 @@ use super::ktree::Notes;
 use super::spill::{LevelFile, PieceRelease, BUFFER_BYTES};
 use super::KtreeWriter;
 use crate::fs::{AtomicFile, SpillError};
-use crate::rays::{RayError, RaySource};
+use crate::rays::{RayError, RaySource, ValueRuns};
 use crate::space::WorldFrame;
 use crate::stacking::{
     BuildError, Builder, LevelOrderSink, LevelPieces, OutOfCoreReport, PieceStore, Progress,
@@ -24,6 +24,7 @@ use crate::stacking::{
 use crate::stacking::{ValuePart, ValueSlabs, ValueSlabsReport, ValuedLevelSink};
 use crate::tree::LevelCounts;
 use crate::value::Value;
+use std::convert::Infallible;
 
 // The builder accounts for the buffers of the spill files and of the output at this size.
 const _: () = assert!(BUFFER_BYTES as u64 == crate::stacking::BUFFER_BYTES);
@@ -424,6 +425,64 @@ impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
         let t = (self.level - self.cell_depth()) as usize;
         let store = SpillFiles::create(out, temp_dir, t)?;
         self.stack_part(slabs, read, store)
+    }
+}
+
+impl<const K: usize, V: Value + Send + Sync> ValueRuns<K, V> {
+    /// Builds the tree of the runs straight into `out` as a `.ktree` version 3 file with its world frame
+    /// (if any) and `notes`, atomically, its cells of depth `cell_depth` built slab by slab and their
+    /// subtrees spilled to temporary files next to `out` (or in `temp_dir`): the tree is never held whole
+    /// ([`build_into`](Self::build_into) with spill files and the version 3 writer). The file is byte for
+    /// byte what [`write_valued_ktree_noted`](crate::io::ktree::v3::write_valued_ktree_noted) writes for
+    /// [`KTree::from_value_runs`](crate::KTree::from_value_runs).
+    ///
+    /// ```
+    /// use ktree::io::ktree::v3::read_valued_ktree_file;
+    /// use ktree::io::ktree::Notes;
+    /// use ktree::rays::ValueRuns;
+    /// use ktree::{KTree, Ray};
+    /// let runs = ValueRuns::<2, u8>::from_runs(3, [(Ray::new([1, 0], 7), 4), (Ray::new([2, 3], 8), 9)]).unwrap();
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let out = dir.path().join("runs.ktree");
+    /// let report = runs.write_file(&out, None, None, &Notes::new(), 2).unwrap();
+    /// assert_eq!(read_valued_ktree_file::<2, u8>(&out).unwrap(), KTree::from_value_runs(&runs));
+    /// assert_eq!(report.cell_depth, 2);
+    /// ```
+    ///
+    /// # Errors
+    /// A temporary folder or output that cannot be written (a full disk included), a frame or notes
+    /// that cannot be kept, a value type without values (`()`). The target is then untouched and no
+    /// temporary file remains.
+    pub fn write_file(
+        &self,
+        out: &Path,
+        temp_dir: Option<&Path>,
+        frame: Option<&WorldFrame>,
+        notes: &Notes,
+        cell_depth: u32,
+    ) -> Result<ValueSlabsReport, BuildError<Infallible>> {
+        self.stack_part_files(cell_depth, 0..u32::MAX, out, temp_dir)?
+            .write(out, frame, notes, &mut |_, _| {
+                unreachable!("a build in one part receives nothing")
+            })
+    }
+
+    /// [`stack_part`](Self::stack_part) with the cells' subtrees spilled to temporary files next to `out`
+    /// (or in `temp_dir`): one part of a build across processes ([`ValuePart::write`]).
+    ///
+    /// # Errors
+    /// A spill folder or file that cannot be written.
+    pub fn stack_part_files(
+        &self,
+        cell_depth: u32,
+        slabs: std::ops::Range<u32>,
+        out: &Path,
+        temp_dir: Option<&Path>,
+    ) -> Result<ValuePart<K, V, SpilledFiles>, BuildError<Infallible>> {
+        let level = self.universe().level();
+        let m = self.clamped_cell_depth(cell_depth);
+        let store = SpillFiles::create(out, temp_dir, (level - m) as usize)?;
+        self.stack_part(m, slabs, store)
     }
 }
 

@@ -103,6 +103,7 @@ pub mod paper;
 mod partition;
 mod solids;
 mod value_parts;
+mod value_run_slabs;
 mod value_slabs;
 mod value_spill;
 mod values;

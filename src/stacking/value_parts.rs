@@ -13,7 +13,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use super::out_of_core::{BuildError, LevelPieces, PieceStore, StoredPieces};
-use super::value_slabs::{spread_across, ValueSlabs};
+use super::value_slabs::{join_slabs, spread_across, ValueSlabs};
 use super::value_spill::{ValueSlabsReport, ValuedLevelSink};
 use crate::rays::RayError;
 use crate::tree::top_down::{PackedLevel, Subtree};
@@ -77,7 +77,7 @@ impl SpillIndex {
 /// ([`write_into`](Self::write_into) any [`ValuedLevelSink`]; `io`'s `ValuePart::write` a `.ktree` file),
 /// the levels of the other parts received as streams ([`stream_levels`](Self::stream_levels)).
 pub struct ValuePart<const K: usize, V, P> {
-    slabs: ValueSlabs<K, V>,
+    level: u32,
     m: u32,
     /// The slabs read by this part and by the parts added (to refuse overlapping parts).
     read: Vec<Range<u32>>,
@@ -143,7 +143,7 @@ impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
         &self,
         slabs: Range<u32>,
         mut read: impl FnMut(Range<u32>, &mut Vec<V>) -> Result<(), E>,
-        mut store: P,
+        store: P,
     ) -> Result<ValuePart<K, V, P::Stored>, BuildError<E, P::Error>>
     where
         E: From<RayError>,
@@ -152,71 +152,86 @@ impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
         let universe = self
             .check_box()
             .map_err(|e| BuildError::Source(E::from(e)))?;
-        let m = self.cell_depth();
-        let t = (self.level - m) as usize;
-        let value_bytes = V::DTYPE.map_or(0, |d| d.bytes()) as u64;
-        let slabs = slabs.start.min(self.slab_count())..slabs.end.min(self.slab_count());
-        let mut own = SpillIndex::default();
-        let mut layers = Vec::new();
-        let mut spilled_words = 0u64;
         let mut slab = Vec::new();
-        let mut piece = Vec::new();
-        for b in slabs.clone() {
-            let Some(mut cells) = self
-                .read_slab(universe, b, &mut read, &mut slab)
-                .map_err(BuildError::Source)?
-            else {
-                continue;
-            };
-            let levels: Vec<Option<Vec<PackedLevel<V>>>> = cells
-                .par_iter_mut()
-                .map(|cell| cell.root().has_children().then(|| cell.take_levels_below()))
-                .collect();
-            for (i, levels) in levels.into_iter().enumerate() {
-                let Some(levels) = levels else { continue };
-                own.mortons
-                    .push(spread_across::<K>(i as u64) | spread_last::<K>(b));
-                for j in 1..=t {
-                    let Some((codes, values)) = levels.get(j - 1) else {
-                        own.counts.push([0, 0]);
-                        continue;
-                    };
-                    piece.clear();
-                    piece.extend_from_slice(codes.words());
-                    push_value_words(values, &mut piece);
-                    store.append(j, &piece, codes.len() as u64)?;
-                    spilled_words += piece.len() as u64;
-                    own.counts.push([codes.len() as u64, values.len() as u64]);
-                }
-            }
-            let roots: Vec<ValueState<V>> = cells.iter().map(Subtree::root).collect();
-            if roots.iter().any(|r| !matches!(r, ValueState::Empty)) {
-                layers.push((b, roots));
-            }
-        }
-        debug_assert_eq!(value_bytes == 0, V::DTYPE.is_none());
-        Ok(ValuePart {
-            slabs: self.clone(),
-            m,
-            read: vec![slabs],
-            layers,
-            own,
-            others: Vec::new(),
-            pieces: store.finish()?,
-            spilled_bytes: 8 * spilled_words,
+        stack_cells(self.level, self.cell_depth(), slabs, store, |b| {
+            self.read_slab(universe, b, &mut read, &mut slab)
         })
     }
+}
+
+/// The part of a valued tree of level `level` in the slabs `slabs` of its cells of depth `m` (clamped to
+/// the `2^m` slabs along the last axis), `cells_of(b)` giving slab `b`'s cells (in the Morton order of
+/// their coordinates along the other axes; `None` if all are empty), the levels below each cell with
+/// children spilled to `store`.
+pub(crate) fn stack_cells<const K: usize, V, E, P>(
+    level: u32,
+    m: u32,
+    slabs: Range<u32>,
+    mut store: P,
+    mut cells_of: impl FnMut(u32) -> Result<Option<Vec<Subtree<V>>>, E>,
+) -> Result<ValuePart<K, V, P::Stored>, BuildError<E, P::Error>>
+where
+    V: Value + Send + Sync,
+    P: PieceStore,
+{
+    let t = (level - m) as usize;
+    let count = 1u32 << m;
+    let slabs = slabs.start.min(count)..slabs.end.min(count);
+    let mut own = SpillIndex::default();
+    let mut layers = Vec::new();
+    let mut spilled_words = 0u64;
+    let mut piece = Vec::new();
+    for b in slabs.clone() {
+        let Some(mut cells) = cells_of(b).map_err(BuildError::Source)? else {
+            continue;
+        };
+        let levels: Vec<Option<Vec<PackedLevel<V>>>> = cells
+            .par_iter_mut()
+            .map(|cell| cell.root().has_children().then(|| cell.take_levels_below()))
+            .collect();
+        for (i, levels) in levels.into_iter().enumerate() {
+            let Some(levels) = levels else { continue };
+            own.mortons
+                .push(spread_across::<K>(i as u64) | spread_last::<K>(b));
+            for j in 1..=t {
+                let Some((codes, values)) = levels.get(j - 1) else {
+                    own.counts.push([0, 0]);
+                    continue;
+                };
+                piece.clear();
+                piece.extend_from_slice(codes.words());
+                push_value_words(values, &mut piece);
+                store.append(j, &piece, codes.len() as u64)?;
+                spilled_words += piece.len() as u64;
+                own.counts.push([codes.len() as u64, values.len() as u64]);
+            }
+        }
+        let roots: Vec<ValueState<V>> = cells.iter().map(Subtree::root).collect();
+        if roots.iter().any(|r| !matches!(r, ValueState::Empty)) {
+            layers.push((b, roots));
+        }
+    }
+    Ok(ValuePart {
+        level,
+        m,
+        read: vec![slabs],
+        layers,
+        own,
+        others: Vec::new(),
+        pieces: store.finish()?,
+        spilled_bytes: 8 * spilled_words,
+    })
 }
 
 impl<const K: usize, V: Value + Send + Sync, P: StoredPieces> ValuePart<K, V, P> {
     /// The level `L` of the tree's universe.
     pub fn level(&self) -> u32 {
-        self.slabs.level
+        self.level
     }
 
     /// Levels of a cell's subtree below its root.
     fn t(&self) -> usize {
-        (self.slabs.level - self.m) as usize
+        (self.level - self.m) as usize
     }
 
     /// Bytes of a value.
@@ -237,7 +252,7 @@ impl<const K: usize, V: Value + Send + Sync, P: StoredPieces> ValuePart<K, V, P>
         let mut words = vec![
             INDEX_MAGIC,
             K as u64,
-            u64::from(self.slabs.level),
+            u64::from(self.level),
             u64::from(self.m),
             V::DTYPE.map_or(0, |d| u64::from(d.code())),
             u64::from(slabs.start),
@@ -275,16 +290,11 @@ impl<const K: usize, V: Value + Send + Sync, P: StoredPieces> ValuePart<K, V, P>
             return Err(bad("not a part index"));
         }
         let dtype = V::DTYPE.map_or(0, |d| u64::from(d.code()));
-        let expected = [
-            K as u64,
-            u64::from(self.slabs.level),
-            u64::from(self.m),
-            dtype,
-        ];
+        let expected = [K as u64, u64::from(self.level), u64::from(self.m), dtype];
         if words[1..5] != expected {
             return Err(bad("another K, level, cell depth or value type"));
         }
-        let count = u64::from(self.slabs.slab_count());
+        let count = 1u64 << self.m;
         let (start, end) = (words[5], words[6]);
         if start > end || end > count {
             return Err(bad("slabs outside the universe"));
@@ -442,7 +452,7 @@ impl<const K: usize, V: Value + Send + Sync, P: StoredPieces> ValuePart<K, V, P>
         let t = self.t();
         let value_bytes = Self::value_bytes();
         let ValuePart {
-            slabs,
+            level: _,
             m,
             read: _,
             mut layers,
@@ -453,7 +463,7 @@ impl<const K: usize, V: Value + Send + Sync, P: StoredPieces> ValuePart<K, V, P>
         } = self;
         // The top levels, joined from the slabs' cells in order.
         layers.sort_unstable_by_key(|(b, _)| std::cmp::Reverse(*b));
-        let top = slabs.join_slabs::<BuildError<E, P::Error>>(|b| {
+        let top = join_slabs::<K, V, BuildError<E, P::Error>>(m, |b| {
             if layers.last().is_some_and(|(next, _)| *next == b) {
                 let (_, roots) = layers.pop().expect("a layer");
                 return Ok(Some(roots.into_iter().map(Subtree::leaf).collect()));

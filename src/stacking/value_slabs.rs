@@ -25,7 +25,7 @@ use crate::value::Value;
 use crate::KTree;
 
 /// At most `2^(K · m)` cells are built apart: `m ≤ MAX_CELL_BITS / K` (about 16 million cells).
-const MAX_CELL_BITS: u32 = 24;
+pub(crate) const MAX_CELL_BITS: u32 = 24;
 
 /// The cells of one slab (or of the joined slabs of a cell of the depth above): `None` when all are empty.
 struct Layer<V> {
@@ -182,33 +182,42 @@ impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
     }
 
     /// Joins the layers of the slabs `0, 1, …` (`layer(b)`: slab `b`'s cells, `None` if all are empty)
-    /// into the root's subtree, like the digits of a binary counter.
+    /// into the root's subtree ([`join_slabs`] at the cell depth).
     pub(crate) fn join_slabs<X>(
         &self,
-        mut layer: impl FnMut(u32) -> Result<Option<Vec<Subtree<V>>>, X>,
+        layer: impl FnMut(u32) -> Result<Option<Vec<Subtree<V>>>, X>,
     ) -> Result<Subtree<V>, X> {
-        let m = self.cell_depth();
-        let mut pending: Vec<Layer<V>> = Vec::new();
-        for b in 0..1u32 << m {
-            pending.push(Layer {
-                depth: m,
-                cells: layer(b)?,
-            });
-            while pending.len() >= 2
-                && pending[pending.len() - 2].depth == pending[pending.len() - 1].depth
-            {
-                let upper = pending.pop().expect("two layers");
-                let lower = pending.pop().expect("two layers");
-                pending.push(join_layers::<K, V>(lower, upper));
-            }
-        }
-        let root = pending.pop().expect("the layers join into the root");
-        debug_assert!(pending.is_empty() && root.depth == 0);
-        Ok(match root.cells {
-            None => Subtree::leaf(ValueState::Empty),
-            Some(mut cells) => cells.pop().expect("the root layer holds one cell"),
-        })
+        join_slabs::<K, V, X>(self.cell_depth(), layer)
     }
+}
+
+/// Joins the layers of the `2^m` slabs `0, 1, …` of cells of depth `m` (`layer(b)`: slab `b`'s cells in
+/// the Morton order of their coordinates along the other axes, `None` if all are empty) into the root's
+/// subtree, like the digits of a binary counter.
+pub(crate) fn join_slabs<const K: usize, V: Value + Send, X>(
+    m: u32,
+    mut layer: impl FnMut(u32) -> Result<Option<Vec<Subtree<V>>>, X>,
+) -> Result<Subtree<V>, X> {
+    let mut pending: Vec<Layer<V>> = Vec::new();
+    for b in 0..1u32 << m {
+        pending.push(Layer {
+            depth: m,
+            cells: layer(b)?,
+        });
+        while pending.len() >= 2
+            && pending[pending.len() - 2].depth == pending[pending.len() - 1].depth
+        {
+            let upper = pending.pop().expect("two layers");
+            let lower = pending.pop().expect("two layers");
+            pending.push(join_layers::<K, V>(lower, upper));
+        }
+    }
+    let root = pending.pop().expect("the layers join into the root");
+    debug_assert!(pending.is_empty() && root.depth == 0);
+    Ok(match root.cells {
+        None => Subtree::leaf(ValueState::Empty),
+        Some(mut cells) => cells.pop().expect("the root layer holds one cell"),
+    })
 }
 
 /// The thickness `2^s` of a slab: the largest that fits in `slab_bytes`, but no thinner than keeps the

@@ -65,7 +65,7 @@ impl<const K: usize, V: Value> KTree<K, V> {
 
 /// The subtree of `cell` from the pieces inside it: its root's state and the states of each level below
 /// it (in level order), built apart on the rayon pool down to the cells of depth `split`.
-fn subtree<const K: usize, V: Value>(
+pub(super) fn subtree<const K: usize, V: Value>(
     keys: &ColumnKeys<K>,
     cell: Cell<K>,
     pieces: &[ValueRun<V>],

@@ -216,6 +216,37 @@ fn from_runs<const K: usize, V: Palette>(o: &Painted<K>) -> Result<(), TestCaseE
     let got = KTree::from_value_runs(&single);
     got.assert_well_formed();
     prop_assert!(got == want);
+    // Built out of core at every cell depth, whole and in parts (the runs cut at the slabs): the file of
+    // the tree.
+    let dir = tempfile::tempdir().unwrap();
+    let notes = ktree::io::ktree::Notes::new();
+    let mut bytes = Vec::new();
+    ktree::io::ktree::v3::write_valued_ktree_noted(&mut bytes, &want, None, &notes).unwrap();
+    for depth in 0..=o.level {
+        let out = dir.path().join("runs.ktree");
+        let report = runs.write_file(&out, None, None, &notes, depth).unwrap();
+        prop_assert!(std::fs::read(&out).unwrap() == bytes, "cell depth {depth}");
+        prop_assert_eq!(&report.counts_per_level, &want.counts_per_level());
+        prop_assert_eq!(report.cell_depth, depth);
+        let count = 1u32 << depth;
+        for parts in [2u32, 3] {
+            let cuts: Vec<std::ops::Range<u32>> = (0..parts)
+                .map(|p| count * p / parts..count * (p + 1) / parts)
+                .collect();
+            let writer = (depth % parts) as usize;
+            let built: Vec<_> = cuts
+                .iter()
+                .map(|c| runs.stack_part_files(depth, c.clone(), &out, None).unwrap())
+                .collect();
+            write_parts(built, writer, &out, &notes);
+            prop_assert!(
+                std::fs::read(&out).unwrap() == bytes,
+                "cell depth {depth}, {parts} parts"
+            );
+        }
+        std::fs::remove_file(&out).unwrap();
+        prop_assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
     // Built apart below every split depth, on one thread and on two: the same tree.
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -289,31 +320,15 @@ fn valued_runs_that_overlap_or_hold_nan_are_errors() {
     assert!(!e.to_string().is_empty());
 }
 
-/// The file of `slabs` built in the parts `cuts` (ranges of slabs), part `writer` writing `out` and the
-/// others streaming their levels to it, as ranks do; the slabs' rows are read by `read`.
-fn write_in_parts<const K: usize, V: Palette>(
-    slabs: &ktree::stacking::ValueSlabs<K, V>,
-    cuts: &[std::ops::Range<u32>],
+/// The file `out` written by part `writer` of `built`, the others streaming their levels to it in the
+/// order their indexes are added (owner 1, 2, …), as ranks do.
+fn write_parts<const K: usize, V: ktree::value::Value + Send + Sync>(
+    mut built: Vec<ktree::stacking::ValuePart<K, V, ktree::io::SpilledFiles>>,
     writer: usize,
     out: &std::path::Path,
     notes: &ktree::io::ktree::Notes,
-    read: impl Fn(std::ops::Range<u32>, &mut Vec<V>) -> Result<(), ktree::rays::RayError> + Copy,
 ) -> ktree::stacking::ValueSlabsReport {
-    let mut built: Vec<_> = cuts
-        .iter()
-        .map(|c| {
-            slabs
-                .stack_part_files(c.clone(), out, None, |rows, values: &mut Vec<V>| {
-                    // Only the part's own slabs are read.
-                    let thickness = slabs.level - slabs.slab_count().trailing_zeros();
-                    assert!(c.start << thickness <= rows.start && rows.end <= c.end << thickness);
-                    read(rows, values)
-                })
-                .unwrap()
-        })
-        .collect();
     let mut part = built.remove(writer);
-    // The others' streams, in the order their indexes are added (owner 1, 2, …).
     let mut streams = Vec::new();
     for mut other in built {
         let expected = part.add_part(&other.index_words()).unwrap();
@@ -336,6 +351,32 @@ fn write_in_parts<const K: usize, V: Palette>(
         Ok(())
     })
     .unwrap()
+}
+
+/// The file of `slabs` built in the parts `cuts` (ranges of slabs), part `writer` writing `out` and the
+/// others streaming their levels to it, as ranks do; the slabs' rows are read by `read`.
+fn write_in_parts<const K: usize, V: Palette>(
+    slabs: &ktree::stacking::ValueSlabs<K, V>,
+    cuts: &[std::ops::Range<u32>],
+    writer: usize,
+    out: &std::path::Path,
+    notes: &ktree::io::ktree::Notes,
+    read: impl Fn(std::ops::Range<u32>, &mut Vec<V>) -> Result<(), ktree::rays::RayError> + Copy,
+) -> ktree::stacking::ValueSlabsReport {
+    let built: Vec<_> = cuts
+        .iter()
+        .map(|c| {
+            slabs
+                .stack_part_files(c.clone(), out, None, |rows, values: &mut Vec<V>| {
+                    // Only the part's own slabs are read.
+                    let thickness = slabs.level - slabs.slab_count().trailing_zeros();
+                    assert!(c.start << thickness <= rows.start && rows.end <= c.end << thickness);
+                    read(rows, values)
+                })
+                .unwrap()
+        })
+        .collect();
+    write_parts(built, writer, out, notes)
 }
 
 /// Building from a box of the dense array read slab by slab along the last axis: for a box of the painted

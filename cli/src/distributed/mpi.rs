@@ -14,10 +14,8 @@ use crate::common::output::{describe, TreeOutput};
 use ktree::io::ktree::Notes;
 use ktree::io::SpilledFiles;
 use ktree::rays::RaySource;
-use ktree::stacking::{
-    balanced_parts, BuildError, OutOfCoreReport, SpilledPart, ValuePart, ValueSlabs,
-    ValueSlabsReport,
-};
+use ktree::space::WorldFrame;
+use ktree::stacking::{balanced_parts, OutOfCoreReport, SpilledPart, ValuePart, ValueSlabsReport};
 use ktree::value::Value;
 
 /// Keeps MPI initialised; finalises it when dropped.
@@ -284,43 +282,32 @@ fn gather_and_write<P: RankPart, R>(
     Ok(Some(report))
 }
 
-/// Builds the valued tree of the box `slabs` into the `.ktree` (version 3) file `out` across the ranks of
-/// the run: the slabs that meet the box are cut into one contiguous range a rank, each rank reads only
-/// its own (`read` is called with ranges of the last coordinate from its first slab on, in order),
-/// builds their cells and spills them ([`ValueSlabs::stack_part_files`]); rank 0 writes the file as
+/// Builds a valued tree into the `.ktree` (version 3) file `out` (with `frame` and `notes`) across the
+/// ranks of the run: the slabs `slabs` (those worth building: the others are empty) are cut into one
+/// contiguous range a rank, and each rank builds and spills its own with `stack(range)` — a volume read
+/// slab by slab reads only its own planes ([`ktree::stacking::ValueSlabs::stack_part_files`]), runs are
+/// cut at its slabs ([`ktree::rays::ValueRuns::stack_part_files`]); rank 0 writes the file as
 /// [`build_across_ranks`] does, byte for byte the single process's. `Some(report)` on rank 0, `None` on
 /// the other ranks.
 ///
 /// # Errors
-/// The error of `read` (through `source`), or of the files, on this rank; [`STOPPED`] if another failed.
-pub fn build_values_across_ranks<const K: usize, V, E>(
-    slabs: &ValueSlabs<K, V>,
+/// The error of `stack` or of the files on this rank; [`STOPPED`] if another failed.
+pub fn build_values_across_ranks<const K: usize, V: Value + Send + Sync>(
+    slabs: std::ops::Range<u32>,
     out: &Path,
-    temp_dir: Option<&Path>,
-    read: impl FnMut(std::ops::Range<u32>, &mut Vec<V>) -> Result<(), E>,
-    source: impl Fn(E) -> CliError,
-) -> CliResult<Option<ValueSlabsReport>>
-where
-    V: Value + Send + Sync,
-    E: From<ktree::rays::RayError> + std::error::Error + Send + Sync + 'static,
-{
+    frame: Option<&WorldFrame>,
+    notes: &Notes,
+    stack: impl FnOnce(std::ops::Range<u32>) -> CliResult<ValuePart<K, V, SpilledFiles>>,
+) -> CliResult<Option<ValueSlabsReport>> {
     let w = world();
     let outcome = (|| {
         let Ranks { rank, size } = ranks();
         let chunk = (CHUNK_BYTES / 8) as usize;
-        let inside = slabs.slabs_in_box();
-        let n = u64::from(inside.len() as u32);
-        let cut = |r: usize| inside.start + (n * r as u64 / size as u64) as u32;
-        let mine = cut(rank)..cut(rank + 1);
-        let part = slabs
-            .stack_part_files(mine, out, temp_dir, read)
-            .map_err(|e| match e {
-                BuildError::Source(e) => source(e),
-                other => describe(out, other, 0),
-            });
-        let part = agree(&w, part)?;
+        let n = u64::from(slabs.end - slabs.start);
+        let cut = |r: usize| slabs.start + (n * r as u64 / size as u64) as u32;
+        let part = agree(&w, stack(cut(rank)..cut(rank + 1)))?;
         gather_and_write(&w, part, chunk, |part, receive| {
-            part.write::<std::convert::Infallible>(out, None, &Notes::new(), receive)
+            part.write::<std::convert::Infallible>(out, frame, notes, receive)
                 .map_err(|e| describe(out, e, 0))
         })
     })();
