@@ -120,6 +120,17 @@ fn commit(file: AtomicFile, path: &Path) -> Result<u64, SpillError> {
     Ok(metadata.len())
 }
 
+/// The error of a valued file `path` asked of a tree without values.
+fn no_values(path: &Path) -> SpillError {
+    output_error(
+        path,
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "a tree without values is not written as a valued file",
+        ),
+    )
+}
+
 /// The error of the output `path`.
 fn output_error(path: &Path, source: std::io::Error) -> SpillError {
     SpillError::Output {
@@ -386,26 +397,13 @@ impl<const K: usize, V: Value + Send + Sync> ValueSlabs<K, V> {
         notes: &Notes,
         read: impl FnMut(std::ops::Range<u32>, &mut Vec<V>) -> Result<(), E>,
     ) -> Result<ValueSlabsReport, BuildError<E>> {
-        let dtype = V::DTYPE.ok_or_else(|| {
-            output_error(
-                out,
-                std::io::Error::new(
-                    std::io::ErrorKind::InvalidInput,
-                    "a tree without values is not written as a valued file",
-                ),
-            )
-        })?;
-        let t = (self.level - self.cell_depth()) as usize;
-        let store = SpillFiles::create(out, temp_dir, t)?;
-        let file = AtomicFile::create(out).map_err(|e| output_error(out, e))?;
-        let writer = ValuedKtreeWriter::new(file, K, self.level, dtype, frame, notes)
-            .map_err(|e| output_error(out, e))?;
-        let sink = OutputFile { writer, path: out };
-        let (file_bytes, report) = self.build_into(read, store, sink)?;
-        Ok(ValueSlabsReport {
-            file_bytes,
-            ..report
-        })
+        if V::DTYPE.is_none() {
+            return Err(no_values(out).into());
+        }
+        self.stack_part_files(0..self.slab_count(), out, temp_dir, read)?
+            .write(out, frame, notes, &mut |_, _| {
+                unreachable!("a build in one part receives nothing")
+            })
     }
 
     /// Builds the part of the tree in the slabs `slabs` ([`stack_part`](Self::stack_part)), its cells'
@@ -461,6 +459,9 @@ impl<const K: usize, V: Value + Send + Sync> ValueRuns<K, V> {
         notes: &Notes,
         cell_depth: u32,
     ) -> Result<ValueSlabsReport, BuildError<Infallible>> {
+        if V::DTYPE.is_none() {
+            return Err(no_values(out).into());
+        }
         self.stack_part_files(cell_depth, 0..u32::MAX, out, temp_dir)?
             .write(out, frame, notes, &mut |_, _| {
                 unreachable!("a build in one part receives nothing")
@@ -504,15 +505,7 @@ impl<const K: usize, V: Value + Send + Sync> ValuePart<K, V, SpilledFiles> {
         notes: &Notes,
         receive: &mut dyn FnMut(usize, &mut [u64]) -> std::io::Result<()>,
     ) -> Result<ValueSlabsReport, BuildError<E>> {
-        let dtype = V::DTYPE.ok_or_else(|| {
-            output_error(
-                out,
-                std::io::Error::new(
-                    std::io::ErrorKind::InvalidInput,
-                    "a tree without values is not written as a valued file",
-                ),
-            )
-        })?;
+        let dtype = V::DTYPE.ok_or_else(|| no_values(out))?;
         let level = self.level();
         let file = AtomicFile::create(out).map_err(|e| output_error(out, e))?;
         let writer = ValuedKtreeWriter::new(file, K, level, dtype, frame, notes)

@@ -12,7 +12,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::out_of_core::{BuildError, LevelPieces, PieceStore, StoredPieces};
+use super::out_of_core::{BuildError, ChunkedSend, LevelPieces, PieceStore, StoredPieces};
 use super::value_slabs::{join_slabs, spread_across, ValueSlabs};
 use super::value_spill::{ValueSlabsReport, ValuedLevelSink};
 use crate::rays::RayError;
@@ -388,47 +388,30 @@ impl<const K: usize, V: Value + Send + Sync, P: StoredPieces> ValuePart<K, V, P>
     where
         P::Error: Into<std::io::Error>,
     {
-        let chunk_words = chunk_words.max(1);
         let t = self.t();
         let value_bytes = Self::value_bytes();
         let order = self.own.morton_order();
         let mut offsets = vec![0u64; order.len()];
-        let mut chunk: Vec<u64> = Vec::with_capacity(chunk_words);
-        let mut sent = 0u64;
+        let mut stream = ChunkedSend::new(chunk_words, send);
         for j in 1..=t {
             let at = self.own.offsets(t, j, value_bytes, &mut offsets);
             let mut level = self.pieces.level(j, &offsets, at);
             for values in [false, true] {
                 for &s in &order {
                     let (codes, value_words) = self.own.piece_words(t, s, j, value_bytes);
-                    let (mut from, end) = if values {
-                        (codes, codes + value_words)
+                    let (from, count) = if values {
+                        (codes, value_words)
                     } else {
                         (0, codes)
                     };
-                    while from < end {
-                        let take = (end - from).min((chunk_words - chunk.len()) as u64);
-                        let filled = chunk.len();
-                        chunk.resize(filled + take as usize, 0);
-                        level
-                            .read(s, from, &mut chunk[filled..])
-                            .map_err(Into::into)?;
-                        from += take;
-                        if chunk.len() == chunk_words {
-                            send(&chunk)?;
-                            sent += chunk.len() as u64;
-                            chunk.clear();
-                        }
-                    }
+                    stream.push_from(count, |at, out| {
+                        level.read(s, from + at, out).map_err(Into::into)
+                    })?;
                 }
             }
             level.finish();
         }
-        if !chunk.is_empty() {
-            send(&chunk)?;
-            sent += chunk.len() as u64;
-        }
-        Ok(sent)
+        stream.finish()
     }
 
     /// The writing phase: writes the tree to `sink` level by level — the top levels joined from every

@@ -17,6 +17,7 @@ pub use error::BuildError;
 pub use parts::{balanced_parts, SpilledPart, MAX_PARTS};
 pub(crate) use parts::{build_slabs, slab_cost, stack_part};
 
+pub(crate) use pieces::ChunkedSend;
 pub use pieces::{LevelPieces, PieceStore, StoredPieces};
 pub use progress::{Progress, Stage};
 pub use sink::LevelOrderSink;

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use super::budget::{Budget, RUN_BYTES};
 use super::error::BuildError;
-use super::pieces::{LevelPieces, PieceStore, StoredPieces};
+use super::pieces::{ChunkedSend, LevelPieces, PieceStore, StoredPieces};
 use super::progress::{Progress, Stage};
 use super::sink::LevelOrderSink;
 use super::spill::{level_offsets, spill_piece, SubtreeIndex};
@@ -407,42 +407,22 @@ impl<P: StoredPieces> SpilledPart<P> {
     where
         P::Error: Into<std::io::Error>,
     {
-        let chunk_words = chunk_words.max(1);
         let t = self.t();
         let n = self.own.mortons.len();
         let mut order: Vec<usize> = (0..n).collect();
         order.sort_unstable_by_key(|&s| self.own.mortons[s]);
-        let mut chunk: Vec<u64> = Vec::with_capacity(chunk_words);
-        let mut sent = 0u64;
+        let mut stream = ChunkedSend::new(chunk_words, send);
         let mut offsets = vec![0u64; n];
         for j in 0..t {
             let at = level_offsets(&self.own, t, j, &mut offsets);
             let mut level = self.pieces.level(j + 1, &offsets, at);
             for &s in &order {
                 let count = self.own.counts[s * t + j].div_ceil(32);
-                let mut read = 0;
-                while read < count {
-                    let take = (count - read).min((chunk_words - chunk.len()) as u64);
-                    let filled = chunk.len();
-                    chunk.resize(filled + take as usize, 0);
-                    level
-                        .read(s, read, &mut chunk[filled..])
-                        .map_err(Into::into)?;
-                    read += take;
-                    if chunk.len() == chunk_words {
-                        send(&chunk)?;
-                        sent += chunk.len() as u64;
-                        chunk.clear();
-                    }
-                }
+                stream.push_from(count, |at, out| level.read(s, at, out).map_err(Into::into))?;
             }
             level.finish();
         }
-        if !chunk.is_empty() {
-            send(&chunk)?;
-            sent += chunk.len() as u64;
-        }
-        Ok(sent)
+        stream.finish()
     }
 
     /// The writing phase: writes the tree to `output`, level after level — the top levels from the cells'

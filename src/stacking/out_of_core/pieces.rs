@@ -147,3 +147,65 @@ pub trait LevelPieces {
     /// Ends reading the level (no piece of it is read again): the store may give back what it holds.
     fn finish(self);
 }
+
+/// A stream of words cut into chunks of at most a given length, each handed to `send` once full (the
+/// last when [`finish`](Self::finish)ed): how a part streams its pieces to the part that writes the tree.
+pub(crate) struct ChunkedSend<'a> {
+    chunk: Vec<u64>,
+    chunk_words: usize,
+    send: &'a mut dyn FnMut(&[u64]) -> std::io::Result<()>,
+    sent: u64,
+}
+
+impl<'a> ChunkedSend<'a> {
+    /// Chunks of at most `chunk_words` words (at least one).
+    pub(crate) fn new(
+        chunk_words: usize,
+        send: &'a mut dyn FnMut(&[u64]) -> std::io::Result<()>,
+    ) -> Self {
+        let chunk_words = chunk_words.max(1);
+        Self {
+            chunk: Vec::with_capacity(chunk_words),
+            chunk_words,
+            send,
+            sent: 0,
+        }
+    }
+
+    /// Appends `count` words, `read(at, out)` filling `out` with the words from `at` on.
+    ///
+    /// # Errors
+    /// The error of `read` or of `send`.
+    pub(crate) fn push_from(
+        &mut self,
+        count: u64,
+        mut read: impl FnMut(u64, &mut [u64]) -> std::io::Result<()>,
+    ) -> std::io::Result<()> {
+        let mut at = 0;
+        while at < count {
+            let take = (count - at).min((self.chunk_words - self.chunk.len()) as u64);
+            let filled = self.chunk.len();
+            self.chunk.resize(filled + take as usize, 0);
+            read(at, &mut self.chunk[filled..])?;
+            at += take;
+            if self.chunk.len() == self.chunk_words {
+                (self.send)(&self.chunk)?;
+                self.sent += self.chunk.len() as u64;
+                self.chunk.clear();
+            }
+        }
+        Ok(())
+    }
+
+    /// Sends what is left; returns the words sent.
+    ///
+    /// # Errors
+    /// The error of `send`.
+    pub(crate) fn finish(mut self) -> std::io::Result<u64> {
+        if !self.chunk.is_empty() {
+            (self.send)(&self.chunk)?;
+            self.sent += self.chunk.len() as u64;
+        }
+        Ok(self.sent)
+    }
+}
