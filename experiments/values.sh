@@ -7,7 +7,8 @@
 # `KTree::values_at`. OpenVDB: experiments/values/peers.cpp (`tools::copyFromDense` serial + `prune`, one
 # ValueAccessor), given the array in its own default layout (ZYX) and as the file holds it (XYZ). Best of 3
 # inside each process, the programs alternating over 3 rounds, best kept; ktree also on two threads. Answers
-# checked equal (voxel counts, checksums of the values read).
+# checked equal (voxel counts, checksums of the values read). Then each label's closed surface of the L = 8 and 9
+# labels (export::surface::value_boundary_mesh), timed from their trees written by `ktree voxelize --labels`.
 #
 # Needs Debian's libopenvdb-dev, libboost-dev and libtbb-dev and a C++ compiler; about 2 GB of scratch.
 set -euo pipefail
@@ -58,9 +59,21 @@ for round in 1 2 3; do
 done
 echo "file_bytes=$(stat -c %s "$scratch/labels-9.raw")" >>"$streamed"
 echo "tree_bytes=$(stat -c %s "$scratch/labels-9.ktree")" >>"$streamed"
-python3 - "$rows" "$scratch/bits.txt" "$streamed" "$openvdb_version" "$load" "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')" "$(nproc)" >"$out.tmp" <<'PY'
+# Each label's closed surface (export::surface::value_boundary_mesh) of the L = 8 and 9 labels' trees.
+surfaces=$scratch/surfaces.txt
+: >"$surfaces"
+for level in 8 9; do
+  side=$((1 << level))
+  echo "{\"shape_xyz\": [$side, $side, $side], \"dtype\": \"uint32\", \"endianness\": \"little\", \"file\": \"labels-$level.raw\"}" >"$scratch/surface-$level.json"
+  "$ktree_cli" voxelize "$scratch/surface-$level.json" --labels --dtype uint32 --out "$scratch/surface-$level.ktree" >/dev/null
+  for round in 1 2 3; do
+    echo "level=$level" >>"$surfaces"
+    RAYON_NUM_THREADS=1 /usr/bin/time -f "rss_kb=%M" "$ktree_bin" surfaces "$scratch/surface-$level.ktree" 3 >>"$surfaces" 2>&1
+  done
+done
+python3 - "$rows" "$scratch/bits.txt" "$streamed" "$surfaces" "$openvdb_version" "$load" "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')" "$(nproc)" >"$out.tmp" <<'PY'
 import sys
-rows_path, bits_path, streamed_path, version, load, cpu, cores = sys.argv[1:]
+rows_path, bits_path, streamed_path, surfaces_path, version, load, cpu, cores = sys.argv[1:]
 runs = {}
 current = None
 for line in open(rows_path):
@@ -177,6 +190,34 @@ print("| file MB | peak MB | peak / file | seconds | tree file MB |")
 print("|---:|---:|---:|---:|---:|")
 fb, rss = streamed["file_bytes"][0], min(streamed["rss_kb"]) * 1024
 print(f"| {fb / 1e6:.0f} | {rss / 1e6:.0f} | {rss / fb:.2f} | {min(streamed['secs']):.2f} | {streamed['tree_bytes'][0] / 1e6:.1f} |")
+print()
+print("## Surfaces of the labels")
+print()
+print("`export::surface::value_boundary_mesh` of the phantom's labels (its tree read from the file `ktree voxelize --labels`")
+print("wrote): each label's closed, outward surface, the label behind each triangle, its rectangles merged as far as one")
+print("label (or nothing) stays behind each — the faces between two labels are in both labels' surfaces. One thread; best")
+print("of 3 inside a process over 3 rounds; peak: the whole process (the tree, the surfaces). Unit faces: the labels' surface")
+print("areas summed (`value_stats`), what a mesh of one square a voxel face would have, at two triangles a square.")
+print()
+print("| L | labels | merged | unit faces | triangles | triangles a unit face | vertices | faces once | seconds | peak MB |")
+print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+surface_runs = {}
+for line in open(surfaces_path):
+    k, v = line.strip().split("=", 1)
+    if k == "level":
+        current = {}
+        surface_runs.setdefault(v, []).append(current)
+    else:
+        current[k] = float(v)
+for level, rounds in sorted(surface_runs.items()):
+    def same(key):
+        values = {r[key] for r in rounds}
+        assert len(values) == 1, (level, key, values)
+        return int(values.pop())
+    secs = min(r["seconds"] for r in rounds)
+    peak = min(r["rss_kb"] for r in rounds) * 1024
+    unit, triangles = same("unit_faces"), same("triangles")
+    print(f"| {level} | {same('labels')} | {same('merged')} | {unit} | {triangles} | {triangles / unit:.2f} | {same('vertices')} | {same('faces_once')} | {secs:.3f} | {peak / 1e6:.0f} |")
 PY
 mv "$out.tmp" "$out"
 echo "wrote $out"

@@ -6,18 +6,23 @@
 //! values phantom L DIR                 write DIR/labels-L.raw (u32) and DIR/density-L.raw (f32), x fastest
 //! values build labels|density L DIR R  build from the raw file (best of R), then 10^7 values (best of R)
 //! values bits L DIR                    bits a node of the phantom's tree for every value type
+//! values surfaces FILE R               each label's closed surface of a uint32 `.ktree` (best of R)
 //! ```
 //!
 //! The volume is the 3-D Shepp–Logan head phantom (ten ellipsoids, Kak & Slaney's table as extended to 3-D
 //! by Schabel's `phantom3d`, the "modified" intensities; the rotations about z only): its density is the sum
 //! of the intensities of the ellipsoids holding a voxel's centre, its label the last such ellipsoid (1–10),
 //! 0 outside. `build` prints `key=value` lines: `seconds`, `nodes`, `voxels`, `heap_bytes`,
-//! `query_seconds`, `checksum` (the sum of the values at the points, 0 where empty).
+//! `query_seconds`, `checksum` (the sum of the values at the points, 0 where empty); `surfaces` prints
+//! `seconds`, `labels`, `merged` (surfaces with merged rectangles), `triangles`, `vertices`,
+//! `faces_once` (each face between two labels counted once) and `unit_faces` (the labels' surface
+//! areas, from `value_stats`).
 
 use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
+use ktree::export::surface::value_boundary_mesh;
 use ktree::rays::ValueRuns;
 use ktree::value::{Rgb, Value};
 use ktree::KTree;
@@ -213,6 +218,41 @@ fn bits(level: u32, dir: &Path) {
     );
 }
 
+/// Each label's closed surface (`value_boundary_mesh`) of the uint32 labels in `file`, timed from the
+/// tree read.
+fn surfaces(file: &Path, repeats: usize) {
+    let tree = ktree::io::ktree::v3::read_valued_ktree_file::<3, u32>(file).unwrap();
+    let mut best = f64::INFINITY;
+    let mut mesh = None;
+    for _ in 0..repeats {
+        let start = Instant::now();
+        let made = value_boundary_mesh(&tree);
+        best = best.min(start.elapsed().as_secs_f64());
+        mesh = Some(made);
+    }
+    let mesh = mesh.expect("at least one run");
+    let stats = tree.value_stats();
+    println!("seconds={best}");
+    println!("labels={}", mesh.surfaces.len());
+    println!(
+        "merged={}",
+        mesh.surfaces.iter().filter(|s| s.merged).count()
+    );
+    println!(
+        "triangles={}",
+        mesh.surfaces
+            .iter()
+            .map(|s| s.mesh.triangles.len())
+            .sum::<usize>()
+    );
+    println!("vertices={}", mesh.vertex_count());
+    println!("faces_once={}", mesh.faces_once().count());
+    println!(
+        "unit_faces={}",
+        stats.values().map(|s| s.surface_area).sum::<u128>()
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let arg = |i: usize| args.get(i).map(String::as_str).unwrap_or_default();
@@ -220,6 +260,7 @@ fn main() {
     match arg(0) {
         "phantom" => write_phantom(level(1), Path::new(arg(2))),
         "bits" => bits(level(1), Path::new(arg(2))),
+        "surfaces" => surfaces(Path::new(arg(1)), arg(2).parse().unwrap_or(3)),
         "build" => {
             let (l, dir) = (level(2), Path::new(arg(3)));
             let repeats = arg(4).parse().unwrap_or(3);
@@ -231,7 +272,9 @@ fn main() {
             }
         }
         _ => {
-            eprintln!("usage: values phantom L DIR | build labels|density L DIR R | bits L DIR");
+            eprintln!(
+                "usage: values phantom L DIR | build labels|density L DIR R | bits L DIR | surfaces FILE R"
+            );
             std::process::exit(2);
         }
     }

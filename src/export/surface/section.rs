@@ -9,6 +9,7 @@
 
 use crate::tree::cursor::{try_walk, ChildOrder, Visitor, Walk};
 use crate::tree::storage::TreeStorage;
+use crate::tree::valued::{ValueNode, ValueState, ValueStorage};
 use crate::tree::{NodeRef, NodeState};
 
 /// Stretches `[y0, y1)` of a slab, each with its runs along `z` (a range of [`Slab::runs`]), in order
@@ -17,6 +18,9 @@ use crate::tree::{NodeRef, NodeState};
 pub(super) struct Slab {
     pub(super) bands: Vec<Band>,
     pub(super) runs: Vec<(u32, u32)>,
+    /// Each run's colour: its value's number, in a section of a tree with values (none in a binary
+    /// tree's).
+    pub(super) colours: Vec<u32>,
 }
 
 /// A stretch `[y0, y1)` of a slab and its runs.
@@ -24,7 +28,7 @@ pub(super) struct Slab {
 pub(super) struct Band {
     pub(super) y0: u32,
     pub(super) y1: u32,
-    /// Its runs' range in [`Slab::runs`], sorted, disjoint, not touching.
+    /// Its runs' range in [`Slab::runs`], sorted, disjoint, not touching unless their colours differ.
     pub(super) runs: (u32, u32),
 }
 
@@ -34,10 +38,58 @@ impl Slab {
         &self.runs[band.runs.0 as usize..band.runs.1 as usize]
     }
 
+    /// The colours of the runs of band `band`.
+    pub(super) fn colours_of(&self, band: &Band) -> &[u32] {
+        &self.colours[band.runs.0 as usize..band.runs.1 as usize]
+    }
+
+    /// The band holding column `y`, if any.
+    pub(super) fn band_at(&self, y: u32) -> Option<&Band> {
+        let i = self.bands.partition_point(|b| b.y1 <= y);
+        self.bands.get(i).filter(|b| b.y0 <= y)
+    }
+
     /// Empties the slab, keeping its memory.
     pub(super) fn clear(&mut self) {
         self.bands.clear();
         self.runs.clear();
+        self.colours.clear();
+    }
+
+    /// Appends a band `[y0, y1)` with runs `runs`, of colour `colour` in a coloured section.
+    fn push_band(&mut self, y0: u32, y1: u32, runs: &[(u32, u32)], colour: Option<u32>) {
+        let start = self.runs.len() as u32;
+        self.runs.extend_from_slice(runs);
+        if let Some(colour) = colour {
+            self.colours.extend(std::iter::repeat_n(colour, runs.len()));
+        }
+        self.bands.push(Band {
+            y0,
+            y1,
+            runs: (start, self.runs.len() as u32),
+        });
+    }
+
+    /// Each colour's own slab from this one (colour `c` into `out[c]`): the bands holding runs of that
+    /// colour, over the same stretches of `y`.
+    pub(super) fn split_by_colour(&self, out: &mut [Slab]) {
+        for slab in out.iter_mut() {
+            slab.clear();
+        }
+        for band in &self.bands {
+            let (runs, colours) = (self.runs_of(band), self.colours_of(band));
+            for (&run, &colour) in runs.iter().zip(colours) {
+                let slab = &mut out[colour as usize];
+                match slab.bands.last_mut() {
+                    Some(last) if last.y0 == band.y0 => {
+                        slab.runs.push(run);
+                        slab.colours.push(colour);
+                        last.runs.1 += 1;
+                    }
+                    _ => slab.push_band(band.y0, band.y1, &[run], Some(colour)),
+                }
+            }
+        }
     }
 }
 
@@ -63,6 +115,15 @@ impl<'s> Iterator for Pieces<'s> {
     type Item = (u32, u32, &'s [(u32, u32)], &'s [(u32, u32)]);
 
     fn next(&mut self) -> Option<Self::Item> {
+        let (y, end, bands) = self.next_bands()?;
+        let runs = |s: usize| bands[s].map_or(&[][..], |band| self.slabs[s].runs_of(band));
+        Some((y, end, runs(0), runs(1)))
+    }
+}
+
+impl<'s> Pieces<'s> {
+    /// The next stretch as `(y0, y1, the band of each slab there)`.
+    pub(super) fn next_bands(&mut self) -> Option<(u32, u32, [Option<&'s Band>; 2])> {
         loop {
             let y = self.y;
             // Each slab's band at or after y, and whether y is inside it.
@@ -84,12 +145,9 @@ impl<'s> Iterator for Pieces<'s> {
                 .min()
                 .expect("a band");
             self.y = end;
-            let runs = |s: usize| match bands[s] {
-                Some((band, true)) => self.slabs[s].runs_of(band),
-                _ => &[],
-            };
+            let inside = |s: usize| bands[s].filter(|b| b.1).map(|b| b.0);
             if bands.iter().flatten().any(|&(_, inside)| inside) {
-                return Some((y, end, runs(0), runs(1)));
+                return Some((y, end, [inside(0), inside(1)]));
             }
         }
     }
@@ -102,25 +160,31 @@ pub(super) fn section<T: TreeStorage<3>>(
     x: u32,
     slab: &mut Slab,
 ) -> Result<u32, T::Error> {
-    slab.clear();
-    let mut visitor = Section {
-        x,
-        next: u32::MAX,
-        slab: std::mem::take(slab),
-        results: Vec::new(),
-        orders: [order(0), order(1)],
-    };
-    let read = try_walk(tree, &mut visitor);
-    *slab = visitor.slab;
-    read?;
-    debug_assert!(visitor.results.len() <= 1);
-    Ok(visitor.next)
+    Section::read(x, false, slab, |section| {
+        try_walk(tree, section).map(|_| ())
+    })
+}
+
+/// The cross-section at `x` of a tree with values into `slab`, each run coloured by `colour_of` its
+/// value (touching runs of different colours kept apart); returns the next `x` at which the section may
+/// differ.
+pub(super) fn value_section<T: ValueStorage<3>>(
+    tree: &T,
+    x: u32,
+    slab: &mut Slab,
+    colour_of: &impl Fn(T::Value) -> u32,
+) -> Result<u32, T::Error> {
+    Section::read(x, true, slab, |section| {
+        section.descend_values(tree, tree.root()?, colour_of)
+    })
 }
 
 /// The walk's state: the results of the nodes done whose parent is not, each where its bands start in the
 /// slab (the results lie one after another, the last at the end).
 struct Section {
     x: u32,
+    /// Whether the runs have colours (the section of a tree with values).
+    coloured: bool,
     next: u32,
     slab: Slab,
     /// For each result: its first band and first run.
@@ -165,9 +229,15 @@ impl Section {
             for band in [in_a, in_b].into_iter().flatten() {
                 for k in band.runs.0..band.runs.1 {
                     let run = slab.runs[k as usize];
+                    let colour = self.coloured.then(|| slab.colours[k as usize]);
                     match slab.runs[start..].last_mut() {
-                        Some(last) if last.1 == run.0 => last.1 = run.1,
-                        _ => slab.runs.push(run),
+                        Some(last) if last.1 == run.0 && slab.colours.last() == colour.as_ref() => {
+                            last.1 = run.1;
+                        }
+                        _ => {
+                            slab.runs.push(run);
+                            slab.colours.extend(colour);
+                        }
                     }
                 }
             }
@@ -187,6 +257,9 @@ impl Section {
         let slab = &mut self.slab;
         let shift = (slab.runs.len() - from.1) as u32;
         slab.runs.extend_from_within(from.1..until.1);
+        if self.coloured {
+            slab.colours.extend_from_within(from.1..until.1);
+        }
         for k in from.0..until.0 {
             let band = slab.bands[k];
             slab.bands.push(Band {
@@ -205,6 +278,9 @@ impl Section {
         let slab = &mut self.slab;
         slab.bands.copy_within(from.0..until.0, to.0);
         slab.runs.copy_within(from.1..until.1, to.1);
+        if self.coloured {
+            slab.colours.copy_within(from.1..until.1, to.1);
+        }
         let shift = (from.1 - to.1) as u32;
         for band in &mut slab.bands[to.0..to.0 + until.0 - from.0] {
             band.runs = (band.runs.0 - shift, band.runs.1 - shift);
@@ -216,26 +292,98 @@ impl Visitor<3> for Section {
     fn visit(&mut self, node: &NodeRef<3>) -> Walk {
         let cell = node.cell();
         let side = 1u32 << cell.log_side;
-        let here = (self.slab.bands.len(), self.slab.runs.len());
         match node.state() {
             NodeState::Partial => return Walk::Descend,
-            NodeState::Full => {
-                let [_, y, z] = cell.origin;
-                self.slab.runs.push((z, z + side));
-                self.slab.bands.push(Band {
-                    y0: y,
-                    y1: y + side,
-                    runs: (here.1 as u32, here.1 as u32 + 1),
-                });
-            }
-            NodeState::Empty => {}
+            NodeState::Full => self.leaf(cell.origin, side, Some(0)),
+            NodeState::Empty => self.leaf(cell.origin, side, None),
         }
-        self.next = self.next.min(cell.origin[0] + side);
-        self.results.push(here);
         Walk::Skip
     }
 
     fn leave(&mut self, _node: &NodeRef<3>) {
+        self.join_quarters();
+    }
+
+    fn child_order(&self, node: &NodeRef<3>) -> ChildOrder {
+        let cell = node.cell();
+        let half = cell.log_side - 1;
+        let x_bit = (self.x >> half & 1) as usize;
+        self.orders[x_bit]
+    }
+}
+
+impl Section {
+    /// The section at `x` into `slab` (its memory reused), as the walk `walk` reads it; returns the next
+    /// `x` at which the section may differ.
+    fn read<E>(
+        x: u32,
+        coloured: bool,
+        slab: &mut Slab,
+        walk: impl FnOnce(&mut Section) -> Result<(), E>,
+    ) -> Result<u32, E> {
+        slab.clear();
+        let mut section = Section {
+            x,
+            coloured,
+            next: u32::MAX,
+            slab: std::mem::take(slab),
+            results: Vec::new(),
+            orders: [order(0), order(1)],
+        };
+        let read = walk(&mut section);
+        *slab = section.slab;
+        read?;
+        debug_assert!(section.results.len() <= 1);
+        Ok(section.next)
+    }
+
+    /// Walks the node `node` of a tree with values and its children the plane crosses (by `y` then `z`).
+    fn descend_values<T: ValueStorage<3>>(
+        &mut self,
+        tree: &T,
+        node: ValueNode<3, T::Value>,
+        colour_of: &impl Fn(T::Value) -> u32,
+    ) -> Result<(), T::Error> {
+        let cell = node.cell;
+        let side = 1u32 << cell.log_side;
+        match node.state {
+            ValueState::Full(v) => self.leaf(cell.origin, side, Some(colour_of(v))),
+            ValueState::Empty => self.leaf(cell.origin, side, None),
+            ValueState::Partial | ValueState::Mixed => {
+                let depth = cell.level as usize;
+                let first = tree.children(depth, node.index)?;
+                let codes = tree.codes(depth + 1, first)?;
+                let x_bit = (self.x >> (cell.log_side - 1) & 1) as usize;
+                for code in [x_bit, x_bit | 4, x_bit | 2, x_bit | 6] {
+                    let index = first + code;
+                    let child = ValueNode {
+                        index,
+                        cell: cell.child(code),
+                        state: tree.decode(depth + 1, index, codes >> (2 * code))?,
+                    };
+                    self.descend_values(tree, child, colour_of)?;
+                }
+                self.join_quarters();
+            }
+        }
+        Ok(())
+    }
+
+    /// A leaf the plane crosses, at `origin` with side `side`: its band and run when it is full (`full`:
+    /// its colour), and where the section next changes.
+    fn leaf(&mut self, origin: [u32; 3], side: u32, full: Option<u32>) {
+        let here = (self.slab.bands.len(), self.slab.runs.len());
+        if let Some(colour) = full {
+            let [_, y, z] = origin;
+            let colour = self.coloured.then_some(colour);
+            self.slab.push_band(y, y + side, &[(z, z + side)], colour);
+        }
+        self.next = self.next.min(origin[0] + side);
+        self.results.push(here);
+    }
+
+    /// The bands of a node whose four children the plane crosses are done: joins them into the node's.
+    fn join_quarters(&mut self) {
         // The four children's results, by (y, z): (0, 0), (0, 1), (1, 0), (1, 1), one after another.
         let n = self.results.len();
         let mut starts = [(0, 0); 5];
@@ -262,16 +410,12 @@ impl Visitor<3> for Section {
             self.move_down(out, end, starts[0]);
             self.slab.bands.truncate(starts[0].0 + end.0 - out.0);
             self.slab.runs.truncate(starts[0].1 + end.1 - out.1);
+            if self.coloured {
+                self.slab.colours.truncate(starts[0].1 + end.1 - out.1);
+            }
         }
         self.results.truncate(n - 4);
         self.results.push(starts[0]);
-    }
-
-    fn child_order(&self, node: &NodeRef<3>) -> ChildOrder {
-        let cell = node.cell();
-        let half = cell.log_side - 1;
-        let x_bit = (self.x >> half & 1) as usize;
-        self.orders[x_bit]
     }
 }
 
@@ -306,6 +450,68 @@ mod tests {
                                 slab.runs_of(b).iter().any(|r| r.0 <= z && z < r.1)
                             });
                             assert_eq!(full, tree.contains([at, y, z]), "{at} {y} {z}");
+                        }
+                    }
+                }
+                x = next;
+            }
+        }
+    }
+
+    #[test]
+    fn value_sections_hold_each_voxels_colour_until_the_next() {
+        let side = 16usize;
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut random = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..40 {
+            // Aligned blocks of every size, each of a value 1 to 4 or emptied.
+            let mut dense = vec![None; side * side * side];
+            for _ in 0..8 {
+                let log = (random() % 4) as usize;
+                let value = (random() % 5) as u8;
+                let at: [usize; 3] =
+                    std::array::from_fn(|_| ((random() as usize % side) >> log) << log);
+                for z in at[2]..at[2] + (1 << log) {
+                    for y in at[1]..at[1] + (1 << log) {
+                        for x in at[0]..at[0] + (1 << log) {
+                            dense[x + side * (y + side * z)] = (value > 0).then_some(value);
+                        }
+                    }
+                }
+            }
+            let tree = crate::KTree::<3, u8>::from_dense_values(4, &dense).unwrap();
+            // Colour c for value c + 1.
+            let colour_of = |v: u8| u32::from(v) - 1;
+            let mut slab = Slab::default();
+            let mut x = 0;
+            while x < side as u32 {
+                let next = crate::tree::storage::infallible(value_section(
+                    &tree, x, &mut slab, &colour_of,
+                ));
+                assert!(next > x);
+                for band in &slab.bands {
+                    let runs = slab.runs_of(band);
+                    assert!(runs.windows(2).all(|w| w[0].1 <= w[1].0));
+                    // Touching runs have different colours.
+                    let colours = slab.colours_of(band);
+                    assert!((1..runs.len())
+                        .all(|i| runs[i - 1].1 < runs[i].0 || colours[i - 1] != colours[i]));
+                }
+                for at in x..next.min(side as u32) {
+                    for y in 0..side as u32 {
+                        for z in 0..side as u32 {
+                            let colour = slab.band_at(y).and_then(|b| {
+                                let runs = slab.runs_of(b);
+                                let i = runs.iter().position(|r| r.0 <= z && z < r.1)?;
+                                Some(slab.colours_of(b)[i])
+                            });
+                            let voxel = (at as usize) + side * (y as usize + side * z as usize);
+                            assert_eq!(colour, dense[voxel].map(colour_of), "{at} {y} {z}");
                         }
                     }
                 }

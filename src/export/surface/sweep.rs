@@ -24,27 +24,58 @@ use std::collections::HashMap;
 use crate::radix;
 use crate::rays::stretches;
 use crate::tree::storage::TreeStorage;
+use crate::tree::valued::ValueStorage;
 
-use super::section::{section, Pieces, Slab};
+use super::section::{section, value_section, Pieces, Slab};
 use super::{Merge, Rect, SurfaceMesh};
 use junctions::{Birth, Stop, NONE};
 use points::Point;
 
 /// The boundary of `tree` as a closed, outward-oriented triangle mesh, its planes merged as `merge` says.
 pub(super) fn sweep<T: TreeStorage<3>>(tree: &T, merge: Merge) -> Result<SurfaceMesh, T::Error> {
-    let mut sweep = Sweep::new(tree.level(), merge);
+    let mut sweep = Sweep::new(tree.level(), merge, 0);
     // Unit faces: a step at every x, so that rectangles across the sweep are one voxel long.
-    for_each_section(tree, merge == Merge::None, |x, _, below, slab| {
-        if !(below.bands.is_empty() && slab.bands.is_empty()) {
-            sweep.step(x, below, slab);
-        }
-    })?;
-    debug_assert!(sweep.open[0].is_empty() && sweep.open[1].is_empty());
-    assert!(
-        u32::try_from(sweep.mesh.vertices.len()).is_ok(),
-        "fewer than 2^32 vertices (indices are 32-bit)"
+    let read = |x: u32, slab: &mut Slab| section(tree, x, slab);
+    for_each_section(
+        tree.level(),
+        merge == Merge::None,
+        read,
+        |x, _, below, slab| {
+            if !(below.bands.is_empty() && slab.bands.is_empty()) {
+                sweep.step(x, below, slab, None);
+            }
+        },
+    )?;
+    Ok(sweep.finish())
+}
+
+/// The boundary of the voxels of each colour of a tree with values (`colour_of` numbers its values
+/// `0 .. colours`), each a closed, outward-oriented triangle mesh whose rectangles are merged as far
+/// as one colour (or nothing) lies behind each: one sweep of the tree's sections, split by colour.
+pub(super) fn sweep_colours<T: ValueStorage<3>>(
+    tree: &T,
+    colour_of: impl Fn(T::Value) -> u32,
+    colours: usize,
+) -> Result<Vec<SurfaceMesh>, T::Error> {
+    let level = tree.level();
+    let mut sweeps: Vec<Sweep> = (0..colours as u32)
+        .map(|c| Sweep::new(level, Merge::Rectangles, c))
+        .collect();
+    let (mut below, mut slab) = (
+        vec![Slab::default(); colours],
+        vec![Slab::default(); colours],
     );
-    Ok(sweep.mesh)
+    let read = |x: u32, out: &mut Slab| value_section(tree, x, out, &colour_of);
+    for_each_section(level, false, read, |x, _, coloured_below, coloured| {
+        coloured.split_by_colour(&mut slab);
+        for (c, sweep) in sweeps.iter_mut().enumerate() {
+            if !(below[c].bands.is_empty() && slab[c].bands.is_empty()) {
+                sweep.step(x, &below[c], &slab[c], Some([coloured_below, coloured]));
+            }
+        }
+        std::mem::swap(&mut below, &mut slab);
+    })?;
+    Ok(sweeps.into_iter().map(Sweep::finish).collect())
 }
 
 /// The number of unit faces on the boundary of `tree`, counted on its cross-sections as [`sweep`] meets
@@ -53,7 +84,8 @@ pub(super) fn unit_faces<T: TreeStorage<3>>(tree: &T) -> Result<u128, T::Error> 
     let mut xor = Vec::new();
     let mut faces = 0u128;
     let length = |runs: &[(u32, u32)]| runs.iter().map(|r| u128::from(r.1 - r.0)).sum::<u128>();
-    for_each_section(tree, false, |x, next, below, slab| {
+    let read = |x: u32, slab: &mut Slab| section(tree, x, slab);
+    for_each_section(tree.level(), false, read, |x, next, below, slab| {
         // The plane x = X.
         for (y, end, lower, upper) in Pieces::new(below, slab) {
             xor_runs(lower, upper, &mut xor);
@@ -80,20 +112,22 @@ pub(super) fn unit_faces<T: TreeStorage<3>>(tree: &T) -> Result<u128, T::Error> 
     Ok(faces)
 }
 
-/// Calls `step(x, next, below, slab)` at each `x` where the cross-section of `tree` changes, in order, and
-/// at the universe's side (`slab` empty there): `slab` is the section from `x` up to `next`, `below` the
-/// one before `x`. At every `x` when `unit`.
-fn for_each_section<T: TreeStorage<3>>(
-    tree: &T,
+/// Calls `step(x, next, below, slab)` at each `x` where the cross-section of a tree at `level` changes,
+/// in order, and at the universe's side (`slab` empty there): `slab` is the section from `x` up to
+/// `next`, as `read(x, slab)` reads it (returning where it may next change), `below` the one before `x`.
+/// At every `x` when `unit`.
+fn for_each_section<E>(
+    level: u32,
     unit: bool,
+    mut read: impl FnMut(u32, &mut Slab) -> Result<u32, E>,
     mut step: impl FnMut(u32, u32, &Slab, &Slab),
-) -> Result<(), T::Error> {
-    let side = 1u32 << tree.level();
+) -> Result<(), E> {
+    let side = 1u32 << level;
     let (mut below, mut slab) = (Slab::default(), Slab::default());
     let mut x = 0;
     loop {
         let next = if x < side {
-            let next = section(tree, x, &mut slab)?.min(side);
+            let next = read(x, &mut slab)?.min(side);
             if unit {
                 next.min(x + 1)
             } else {
@@ -112,14 +146,23 @@ fn for_each_section<T: TreeStorage<3>>(
     }
 }
 
+/// An interval of a row of a plane's boundary: `(plane, lo, hi, colour)` — its plane (`2 · coordinate +
+/// upper`: `upper` when the solid is on the lower side), its stretch `[lo, hi)` and the colour behind it
+/// (0 for a binary tree; [`NOTHING`] where no voxel of a colour is).
+type Interval = (u32, u32, u32, u32);
+
+/// The colour behind a face with no voxel of a colour behind it.
+const NOTHING: u32 = u32::MAX;
+
 /// A rectangle of a plane `y = Y` or `z = Z` while the sweep carries it: its plane (`2 · coordinate +
-/// upper`), its interval `[lo, hi)` across the sweep, where it started, and its entry in the stores of
-/// [`Sweep::births`].
+/// upper`), its interval `[lo, hi)` across the sweep and the colour behind it, where it started, and its
+/// entry in the stores of [`Sweep::births`].
 #[derive(Debug, Clone, Copy)]
 struct Open {
     plane: u32,
     lo: u32,
     hi: u32,
+    colour: u32,
     start: u32,
     id: u32,
 }
@@ -172,6 +215,8 @@ impl StepRect {
 struct Sweep {
     level: u32,
     merge: Merge,
+    /// The colour of the solid, when the sweep reads coloured sections.
+    colour: u32,
     mesh: SurfaceMesh,
     /// The open rectangles of the planes `y = Y` (0) and `z = Z` (1), by `(plane, lo)`.
     open: [Vec<Open>; 2],
@@ -184,10 +229,12 @@ struct Sweep {
     // Buffers, kept between steps.
     rects: Vec<StepRect>,
     xor: Vec<(u32, u32, bool)>,
-    row: Vec<(u32, u32, u32)>,
-    intervals: [Vec<(u32, u32, u32)>; 2],
-    ends: Vec<(u32, u32, u32)>,
-    ends_scratch: Vec<(u32, u32, u32)>,
+    row: Vec<Interval>,
+    intervals: [Vec<Interval>; 2],
+    ends: Vec<Interval>,
+    ends_scratch: Vec<Interval>,
+    /// The solid's runs of the two slabs' bands, read from coloured sections.
+    solid: [Vec<(u32, u32)>; 2],
     next: Vec<Open>,
     closed: Vec<Open>,
     opened: Vec<usize>,
@@ -205,10 +252,11 @@ struct Sweep {
 }
 
 impl Sweep {
-    fn new(level: u32, merge: Merge) -> Self {
+    fn new(level: u32, merge: Merge, colour: u32) -> Self {
         Self {
             level,
             merge,
+            colour,
             mesh: SurfaceMesh::default(),
             open: [Vec::new(), Vec::new()],
             births: Vec::new(),
@@ -222,6 +270,7 @@ impl Sweep {
             intervals: [Vec::new(), Vec::new()],
             ends: Vec::new(),
             ends_scratch: Vec::new(),
+            solid: [Vec::new(), Vec::new()],
             next: Vec::new(),
             closed: Vec::new(),
             opened: Vec::new(),
@@ -237,12 +286,27 @@ impl Sweep {
         }
     }
 
-    /// One step: the slabs `x − 1` (`below`) and `x` (`slab`).
-    fn step(&mut self, x: u32, below: &Slab, slab: &Slab) {
+    /// The mesh made, when the sweep is done.
+    fn finish(self) -> SurfaceMesh {
+        debug_assert!(self.open[0].is_empty() && self.open[1].is_empty());
+        assert!(
+            u32::try_from(self.mesh.vertices.len()).is_ok(),
+            "fewer than 2^32 vertices (indices are 32-bit)"
+        );
+        self.mesh
+    }
+
+    /// One step: the slabs `x − 1` (`below`) and `x` (`slab`) of the solid; with `coloured`, the same
+    /// slabs' coloured sections, whose colours split the rectangles by what lies behind them.
+    fn step(&mut self, x: u32, below: &Slab, slab: &Slab, coloured: Option<[&Slab; 2]>) {
         self.rects.clear();
-        self.plane_x(x, below, slab);
-        self.intervals_y(slab);
-        self.intervals_z(slab);
+        match coloured {
+            Some(coloured) => self.plane_x_coloured(x, coloured),
+            None => self.plane_x(x, below, slab),
+        }
+        let coloured_slab = coloured.map(|c| c[1]);
+        self.intervals_y(slab, coloured_slab);
+        self.intervals_z(slab, coloured_slab);
         for axis in 0..2 {
             self.carry_open(axis, x);
         }
@@ -280,6 +344,55 @@ impl Sweep {
         }
     }
 
+    /// [`plane_x`](Self::plane_x) from coloured sections: the stretches where exactly one slab holds the
+    /// solid's colour, split where the colour behind changes (the other slab's), merged along `y`.
+    fn plane_x_coloured(&mut self, x: u32, [below, slab]: [&Slab; 2]) {
+        self.open_x.clear();
+        let mut carried: Option<u32> = None;
+        let mut pieces = Pieces::new(below, slab);
+        while let Some((y, end, bands)) = pieces.next_bands() {
+            if let Some(at) = carried.filter(|&at| at != y) {
+                self.row.clear();
+                self.carry_x(x, at);
+            }
+            let column = |s: usize| {
+                let slab = [below, slab][s];
+                bands[s].map_or((&[][..], &[][..]), |b| {
+                    (slab.runs_of(b), slab.colours_of(b))
+                })
+            };
+            let columns = [column(0), column(1)];
+            for (s, solid) in self.solid.iter_mut().enumerate() {
+                let (runs, colours) = columns[s];
+                solid.clear();
+                solid.extend(
+                    runs.iter()
+                        .zip(colours)
+                        .filter(|(_, &c)| c == self.colour)
+                        .map(|(r, _)| *r),
+                );
+            }
+            xor_runs(&self.solid[0], &self.solid[1], &mut self.xor);
+            self.row.clear();
+            for upper in [false, true] {
+                for &(lo, hi, first) in self.xor.iter().filter(|s| s.2 == upper) {
+                    // The solid below (`first`) faces slab x; else slab x − 1 is behind.
+                    let (runs, colours) = columns[usize::from(first)];
+                    let row = &mut self.row;
+                    colour_stretches(runs, colours, lo, hi, |a, b, c| {
+                        row.push((u32::from(first), a, b, c));
+                    });
+                }
+            }
+            self.carry_x(x, y);
+            carried = Some(end);
+        }
+        if let Some(at) = carried {
+            self.row.clear();
+            self.carry_x(x, at);
+        }
+    }
+
     /// Carries the plane `x = X`'s open rectangles across the row at `y` (`self.row`), making the closed
     /// ones whole.
     fn carry_x(&mut self, x: u32, y: u32) {
@@ -307,8 +420,9 @@ impl Sweep {
         }
     }
 
-    /// The intervals (along `z`) of the slab's boundary in the planes `y = Y`, by `(plane, lo)`.
-    fn intervals_y(&mut self, slab: &Slab) {
+    /// The intervals (along `z`) of the slab's boundary in the planes `y = Y`, by `(plane, lo)`; split by
+    /// the colour behind them when the slab's `coloured` section is given.
+    fn intervals_y(&mut self, slab: &Slab, coloured: Option<&Slab>) {
         let mut out = std::mem::take(&mut self.intervals[0]);
         out.clear();
         for (k, band) in slab.bands.iter().enumerate() {
@@ -316,39 +430,65 @@ impl Sweep {
                 Some(p) if p.y1 == band.y0 => slab.runs_of(p),
                 _ => &[],
             };
-            self.plane_y_row(band.y0, below, slab.runs_of(band), &mut out);
+            self.plane_y_row(band.y0, below, slab.runs_of(band), coloured, &mut out);
             if slab.bands.get(k + 1).is_none_or(|n| n.y0 != band.y1) {
-                self.plane_y_row(band.y1, slab.runs_of(band), &[], &mut out);
+                self.plane_y_row(band.y1, slab.runs_of(band), &[], coloured, &mut out);
             }
         }
         self.intervals[0] = out;
     }
 
-    /// The intervals of the plane `y = Y` between the columns `below` (at `Y − 1`) and `above`.
+    /// The intervals of the plane `y = Y` between the columns `below` (at `Y − 1`) and `above`, split
+    /// by the colours of the column behind each when `coloured` is given.
     fn plane_y_row(
         &mut self,
         y: u32,
         below: &[(u32, u32)],
         above: &[(u32, u32)],
-        out: &mut Vec<(u32, u32, u32)>,
+        coloured: Option<&Slab>,
+        out: &mut Vec<Interval>,
     ) {
         xor_runs(below, above, &mut self.xor);
-        fill_row(&self.xor, self.merge, &mut self.row);
-        out.extend(
-            self.row
-                .iter()
-                .map(|&(upper, lo, hi)| (2 * y + upper, lo, hi)),
-        );
+        let Some(coloured) = coloured else {
+            fill_row(&self.xor, self.merge, &mut self.row);
+            out.extend(
+                self.row
+                    .iter()
+                    .map(|&(upper, lo, hi, colour)| (2 * y + upper, lo, hi, colour)),
+            );
+            return;
+        };
+        for upper in [false, true] {
+            for &(lo, hi, first) in self.xor.iter().filter(|s| s.2 == upper) {
+                // The solid below faces column y; the solid above, column y − 1.
+                let behind = if first { Some(y) } else { y.checked_sub(1) };
+                let (runs, colours) = column(coloured, behind);
+                colour_stretches(runs, colours, lo, hi, |a, b, c| {
+                    out.push((2 * y + u32::from(first), a, b, c));
+                });
+            }
+        }
     }
 
     /// The intervals (along `y`) of the slab's boundary in the planes `z = Z`, by `(plane, lo)`: the runs'
-    /// ends, sorted by plane (stably: the bands come by `y`) and joined where `y` goes on.
-    fn intervals_z(&mut self, slab: &Slab) {
+    /// ends, sorted by plane (stably: the bands come by `y`) and joined where `y` goes on with the same
+    /// colour behind (read from the slab's `coloured` section, whose bands are the slab's).
+    fn intervals_z(&mut self, slab: &Slab, coloured: Option<&Slab>) {
         self.ends.clear();
         for band in &slab.bands {
+            let (runs, colours) = match coloured {
+                Some(coloured) => column(coloured, Some(band.y0)),
+                None => (&[][..], &[][..]),
+            };
+            let behind = |z: Option<u32>| match coloured {
+                Some(_) => colour_at(runs, colours, z),
+                None => 0,
+            };
             for &(z0, z1) in slab.runs_of(band) {
-                self.ends.push((2 * z0, band.y0, band.y1));
-                self.ends.push((2 * z1 + 1, band.y0, band.y1));
+                self.ends
+                    .push((2 * z0, band.y0, band.y1, behind(z0.checked_sub(1))));
+                self.ends
+                    .push((2 * z1 + 1, band.y0, band.y1, behind(Some(z1))));
             }
         }
         radix::sort_by_key(
@@ -359,13 +499,15 @@ impl Sweep {
         );
         let out = &mut self.intervals[1];
         out.clear();
-        for &(plane, y0, y1) in &self.ends {
+        for &(plane, y0, y1, colour) in &self.ends {
             match self.merge {
                 Merge::Rectangles => match out.last_mut() {
-                    Some(last) if last.0 == plane && last.2 == y0 => last.2 = y1,
-                    _ => out.push((plane, y0, y1)),
+                    Some(last) if last.0 == plane && last.2 == y0 && last.3 == colour => {
+                        last.2 = y1
+                    }
+                    _ => out.push((plane, y0, y1, colour)),
                 },
-                Merge::None => out.extend((y0..y1).map(|y| (plane, y, y + 1))),
+                Merge::None => out.extend((y0..y1).map(|y| (plane, y, y + 1, colour))),
             }
         }
     }
@@ -434,18 +576,66 @@ fn xor_runs(first: &[(u32, u32)], second: &[(u32, u32)], out: &mut Vec<(u32, u32
     );
 }
 
-/// A row's intervals `(upper, lo, hi)` by `(upper, lo)` from the stretches of [`xor_runs`] (`upper`: the
-/// first set, the one below, is full), split into unit intervals unless merging.
-fn fill_row(xor: &[(u32, u32, bool)], merge: Merge, row: &mut Vec<(u32, u32, u32)>) {
+/// A row's intervals `(upper, lo, hi, 0)` by `(upper, lo)` from the stretches of [`xor_runs`] (`upper`:
+/// the first set, the one below, is full), split into unit intervals unless merging.
+fn fill_row(xor: &[(u32, u32, bool)], merge: Merge, row: &mut Vec<Interval>) {
     row.clear();
     for upper in [false, true] {
         for &(lo, hi, first) in xor.iter().filter(|s| s.2 == upper) {
             let upper = u32::from(first);
             match merge {
-                Merge::Rectangles => row.push((upper, lo, hi)),
-                Merge::None => row.extend((lo..hi).map(|z| (upper, z, z + 1))),
+                Merge::Rectangles => row.push((upper, lo, hi, 0)),
+                Merge::None => row.extend((lo..hi).map(|z| (upper, z, z + 1, 0))),
             }
         }
+    }
+}
+
+/// The runs and their colours of column `y` of a coloured section (none for no column).
+fn column(coloured: &Slab, y: Option<u32>) -> (&[(u32, u32)], &[u32]) {
+    match y.and_then(|y| coloured.band_at(y)) {
+        Some(band) => (coloured.runs_of(band), coloured.colours_of(band)),
+        None => (&[], &[]),
+    }
+}
+
+/// The colour at `z` of a column of coloured runs ([`NOTHING`] for no voxel).
+fn colour_at(runs: &[(u32, u32)], colours: &[u32], z: Option<u32>) -> u32 {
+    let Some(z) = z else {
+        return NOTHING;
+    };
+    let i = runs.partition_point(|r| r.1 <= z);
+    match runs.get(i) {
+        Some(r) if r.0 <= z => colours[i],
+        _ => NOTHING,
+    }
+}
+
+/// Calls `emit(lo, hi, colour)` for the stretches of `[lo, hi)` in a column of coloured runs over which
+/// the colour stays the same ([`NOTHING`] between runs), in order.
+fn colour_stretches(
+    runs: &[(u32, u32)],
+    colours: &[u32],
+    lo: u32,
+    hi: u32,
+    mut emit: impl FnMut(u32, u32, u32),
+) {
+    let mut at = lo;
+    let first = runs.partition_point(|r| r.1 <= lo);
+    for (r, &colour) in runs[first..].iter().zip(&colours[first..]) {
+        if r.0 >= hi {
+            break;
+        }
+        if r.0 > at {
+            emit(at, r.0, NOTHING);
+            at = r.0;
+        }
+        let end = r.1.min(hi);
+        emit(at, end, colour);
+        at = end;
+    }
+    if at < hi {
+        emit(at, hi, NOTHING);
     }
 }
 
@@ -455,7 +645,7 @@ fn fill_row(xor: &[(u32, u32, bool)], merge: Merge, row: &mut Vec<(u32, u32, u32
 /// the new `open` appended to `opened`).
 fn carry(
     open: &mut Vec<Open>,
-    now: &[(u32, u32, u32)],
+    now: &[Interval],
     at: u32,
     merge: Merge,
     next: &mut Vec<Open>,
@@ -464,14 +654,14 @@ fn carry(
 ) {
     next.clear();
     let mut i = 0;
-    for &(plane, lo, hi) in now {
+    for &(plane, lo, hi, colour) in now {
         while i < open.len() && (open[i].plane, open[i].lo) < (plane, lo) {
             closed.push(open[i]);
             i += 1;
         }
         let same = open
             .get(i)
-            .is_some_and(|o| (o.plane, o.lo, o.hi) == (plane, lo, hi));
+            .is_some_and(|o| (o.plane, o.lo, o.hi, o.colour) == (plane, lo, hi, colour));
         if same && merge == Merge::Rectangles {
             next.push(open[i]);
             i += 1;
@@ -481,6 +671,7 @@ fn carry(
                 plane,
                 lo,
                 hi,
+                colour,
                 start: at,
                 id: NONE,
             });
@@ -522,7 +713,11 @@ mod tests {
     fn rectangles_carry_on_while_their_interval_stays() {
         let (mut open, mut next, mut closed, mut opened) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        let rows: [&[(u32, u32, u32)]; 3] = [&[(0, 0, 4), (1, 5, 6)], &[(0, 0, 4)], &[(0, 0, 3)]];
+        let rows: [&[Interval]; 3] = [
+            &[(0, 0, 4, 0), (1, 5, 6, 0)],
+            &[(0, 0, 4, 0)],
+            &[(0, 0, 3, 0)],
+        ];
         for (y, row) in rows.into_iter().enumerate() {
             carry(
                 &mut open,

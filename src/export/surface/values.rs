@@ -3,11 +3,13 @@
 //!
 //! A value's surface is the boundary mesh of the voxels holding it, made by the sweep of
 //! [`boundary_mesh`](super::boundary_mesh), so it is closed, crack-free and 2-manifold as that one is. Its
-//! rectangles stay merged when each triangle then has one value (or nothing) behind it; otherwise the
-//! value's surface is made of unit faces, each with its own value behind. A face between two values is
-//! in both values' surfaces, oriented outward from each; [`ValueMesh::faces_once`] gives it once.
+//! rectangles are merged as far as one value (or nothing) stays behind each: each plane's boundary is
+//! split where the value behind it changes, and the pieces merged into rectangles as the binary sweep
+//! merges its planes. One sweep of the tree's cross-sections serves every value. A face between two
+//! values is in both values' surfaces, oriented outward from each; [`ValueMesh::faces_once`] gives it
+//! once.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 use crate::ops::values::select_where;
 use crate::tree::storage::infallible;
@@ -26,7 +28,8 @@ pub struct ValueSurface<V> {
     pub mesh: SurfaceMesh,
     /// For each triangle, the value on its outer side (`None`: nothing).
     pub behind: Vec<Option<V>>,
-    /// Whether its rectangles are merged (else every unit face is its own square).
+    /// Whether its rectangles are merged (always, unless a triangle were found with several values
+    /// behind it: then every unit face is its own square).
     pub merged: bool,
     /// The value's own name, when it has one (a label's name: `liver`), as
     /// [`ValueMesh::with_names`] gives it.
@@ -164,9 +167,9 @@ impl<V: Value> ValueMesh<V> {
 /// ```
 ///
 /// # Performance
-/// One sweep of [`boundary_mesh`](super::boundary_mesh) per value over the voxels holding it, and a
-/// look-up of the leaves behind each triangle; a value whose merged triangles have several values
-/// behind one of them is swept again face by face.
+/// One sweep of the tree's cross-sections, each split into the voxels of each value (the work of
+/// [`boundary_mesh`](super::boundary_mesh) for every value at once), and a look-up of the leaves
+/// behind each triangle.
 ///
 /// # Panics
 /// As [`boundary_mesh`](super::boundary_mesh).
@@ -199,10 +202,10 @@ pub fn try_value_boundary_mesh<T: ValueStorage<3>>(
             values.entry(v.key()).or_insert(v);
         }
     }
+    let colour: HashMap<_, u32> = values.keys().zip(0..).map(|(k, c)| (*k, c)).collect();
+    let meshes = sweep::sweep_colours(tree, |v| colour[&v.key()], values.len())?;
     let mut surfaces = Vec::with_capacity(values.len());
-    for value in values.into_values() {
-        let voxels = select_where(tree, |v| v.same(value))?;
-        let mesh = infallible(sweep::sweep(&voxels, Merge::Rectangles));
+    for (value, mesh) in values.into_values().zip(meshes) {
         let surface = match behind_each(tree, &mesh)? {
             Some(behind) => ValueSurface {
                 value,
@@ -212,6 +215,8 @@ pub fn try_value_boundary_mesh<T: ValueStorage<3>>(
                 label: None,
             },
             None => {
+                // Not met: each rectangle has one colour behind it. Kept as a safe way out.
+                let voxels = select_where(tree, |v| v.same(value))?;
                 let mesh = infallible(sweep::sweep(&voxels, Merge::None));
                 let behind =
                     behind_each(tree, &mesh)?.expect("a unit face has one voxel behind it");
@@ -376,6 +381,7 @@ mod tests {
         let mut areas: HashMap<(u8, Option<u8>), f64> = HashMap::new();
         let mut once: HashMap<(u8, Option<u8>), f64> = HashMap::new();
         for s in &mesh.surfaces {
+            assert!(s.merged, "{} has one value behind each rectangle", s.value);
             assert_eq!(s.behind.len(), s.mesh.triangles.len());
             let voxels = dense.iter().filter(|v| **v == Some(s.value)).count();
             assert_eq!(s.mesh.volume(), voxels as f64, "the volume of {}", s.value);
@@ -432,6 +438,11 @@ mod tests {
         fn each_value_is_closed_and_its_faces_are_those_of_the_voxels(dense in labels(3)) {
             check(3, &dense);
         }
+
+        #[test]
+        fn each_value_is_closed_at_level_4(dense in labels(4)) {
+            check(4, &dense);
+        }
     }
 
     #[test]
@@ -453,5 +464,57 @@ mod tests {
             .surfaces
             .iter()
             .all(|s| s.merged && s.mesh.triangles.len() == 12));
+    }
+
+    #[test]
+    fn touching_values_keep_their_rectangles() {
+        // Blocks of 2 × 2 × 2 side by side along each axis in turn: six squares each, the one between
+        // them with the other value behind.
+        for axis in 0..3 {
+            let side = 4;
+            let mut dense = vec![None; side * side * side];
+            for z in 0..2 {
+                for y in 0..2 {
+                    for x in 0..2 {
+                        let mut p = [x, y, z];
+                        dense[p[0] + side * (p[1] + side * p[2])] = Some(1u8);
+                        p[axis] += 2;
+                        dense[p[0] + side * (p[1] + side * p[2])] = Some(2);
+                    }
+                }
+            }
+            check(2, &dense);
+            let mesh = value_boundary_mesh(&KTree::<3, u8>::from_dense_values(2, &dense).unwrap());
+            for s in &mesh.surfaces {
+                assert_eq!(s.mesh.triangles.len(), 12, "axis {axis}, value {}", s.value);
+                let other = 3 - s.value;
+                assert_eq!(s.behind.iter().filter(|b| **b == Some(other)).count(), 2);
+            }
+        }
+        // A slab of 4 × 4 × 1 under two values side by side (split along x, then along y): its top is
+        // split in two rectangles, its five other sides whole.
+        for split in 0..2 {
+            let side = 4;
+            let mut dense = vec![None; side * side * side];
+            for y in 0..4 {
+                for x in 0..4 {
+                    dense[x + side * y] = Some(1u8);
+                    dense[x + side * (y + side)] = Some(if [x, y][split] < 2 { 2 } else { 3 });
+                }
+            }
+            check(2, &dense);
+            let mesh = value_boundary_mesh(&KTree::<3, u8>::from_dense_values(2, &dense).unwrap());
+            let one = &mesh.surfaces[0];
+            assert_eq!(one.value, 1);
+            let behind = |v: u8| one.behind.iter().filter(|b| **b == Some(v)).count();
+            assert_eq!((behind(2), behind(3)), (2, 2), "split along {split}");
+            // The bottom and two sides: two triangles each; the two sides where the top's rectangles
+            // meet on their edge: a fan of five around the centre.
+            assert_eq!(
+                one.mesh.triangles.len(),
+                4 + 3 * 2 + 2 * 5,
+                "split along {split}"
+            );
+        }
     }
 }
