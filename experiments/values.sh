@@ -199,8 +199,8 @@ print("label (or nothing) stays behind each — the faces between two labels are
 print("of 3 inside a process over 3 rounds; peak: the whole process (the tree, the surfaces). Unit faces: the labels' surface")
 print("areas summed (`value_stats`), what a mesh of one square a voxel face would have, at two triangles a square.")
 print()
-print("| L | labels | merged | unit faces | triangles | triangles a unit face | vertices | faces once | seconds | peak MB |")
-print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+print("| L | labels | unit faces | triangles | triangles a unit face | vertices | faces once | seconds | peak MB |")
+print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
 surface_runs = {}
 for line in open(surfaces_path):
     k, v = line.strip().split("=", 1)
@@ -217,7 +217,7 @@ for level, rounds in sorted(surface_runs.items()):
     secs = min(r["seconds"] for r in rounds)
     peak = min(r["rss_kb"] for r in rounds) * 1024
     unit, triangles = same("unit_faces"), same("triangles")
-    print(f"| {level} | {same('labels')} | {same('merged')} | {unit} | {triangles} | {triangles / unit:.2f} | {same('vertices')} | {same('faces_once')} | {secs:.3f} | {peak / 1e6:.0f} |")
+    print(f"| {level} | {same('labels')} | {unit} | {triangles} | {triangles / unit:.2f} | {same('vertices')} | {same('faces_once')} | {secs:.3f} | {peak / 1e6:.0f} |")
 PY
 mv "$out.tmp" "$out"
 echo "wrote $out"

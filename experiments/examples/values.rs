@@ -14,7 +14,7 @@
 //! of the intensities of the ellipsoids holding a voxel's centre, its label the last such ellipsoid (1–10),
 //! 0 outside. `build` prints `key=value` lines: `seconds`, `nodes`, `voxels`, `heap_bytes`,
 //! `query_seconds`, `checksum` (the sum of the values at the points, 0 where empty); `surfaces` prints
-//! `seconds`, `labels`, `merged` (surfaces with merged rectangles), `triangles`, `vertices`,
+//! `seconds`, `labels`, `triangles`, `vertices`,
 //! `faces_once` (each face between two labels counted once) and `unit_faces` (the labels' surface
 //! areas, from `value_stats`).
 
@@ -234,10 +234,6 @@ fn surfaces(file: &Path, repeats: usize) {
     let stats = tree.value_stats();
     println!("seconds={best}");
     println!("labels={}", mesh.surfaces.len());
-    println!(
-        "merged={}",
-        mesh.surfaces.iter().filter(|s| s.merged).count()
-    );
     println!(
         "triangles={}",
         mesh.surfaces

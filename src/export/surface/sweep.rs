@@ -33,7 +33,7 @@ use points::Point;
 
 /// The boundary of `tree` as a closed, outward-oriented triangle mesh, its planes merged as `merge` says.
 pub(super) fn sweep<T: TreeStorage<3>>(tree: &T, merge: Merge) -> Result<SurfaceMesh, T::Error> {
-    let mut sweep = Sweep::new(tree.level(), merge, 0);
+    let mut sweep = Sweep::new(tree.level(), merge, None);
     // Unit faces: a step at every x, so that rectangles across the sweep are one voxel long.
     let read = |x: u32, slab: &mut Slab| section(tree, x, slab);
     for_each_section(
@@ -46,20 +46,21 @@ pub(super) fn sweep<T: TreeStorage<3>>(tree: &T, merge: Merge) -> Result<Surface
             }
         },
     )?;
-    Ok(sweep.finish())
+    Ok(sweep.finish().0)
 }
 
 /// The boundary of the voxels of each colour of a tree with values (`colour_of` numbers its values
 /// `0 .. colours`), each a closed, outward-oriented triangle mesh whose rectangles are merged as far
-/// as one colour (or nothing) lies behind each: one sweep of the tree's sections, split by colour.
+/// as one colour (or nothing) lies behind each, with the colour behind each triangle ([`NOTHING`]: no
+/// voxel of a colour): one sweep of the tree's sections, split by colour.
 pub(super) fn sweep_colours<T: ValueStorage<3>>(
     tree: &T,
     colour_of: impl Fn(T::Value) -> u32,
     colours: usize,
-) -> Result<Vec<SurfaceMesh>, T::Error> {
+) -> Result<Vec<(SurfaceMesh, Vec<u32>)>, T::Error> {
     let level = tree.level();
     let mut sweeps: Vec<Sweep> = (0..colours as u32)
-        .map(|c| Sweep::new(level, Merge::Rectangles, c))
+        .map(|c| Sweep::new(level, Merge::Rectangles, Some(c)))
         .collect();
     let (mut below, mut slab) = (
         vec![Slab::default(); colours],
@@ -152,7 +153,7 @@ fn for_each_section<E>(
 type Interval = (u32, u32, u32, u32);
 
 /// The colour behind a face with no voxel of a colour behind it.
-const NOTHING: u32 = u32::MAX;
+pub(super) const NOTHING: u32 = u32::MAX;
 
 /// A rectangle of a plane `y = Y` or `z = Z` while the sweep carries it: its plane (`2 · coordinate +
 /// upper`), its interval `[lo, hi)` across the sweep and the colour behind it, where it started, and its
@@ -174,14 +175,17 @@ struct StepRect {
     /// Its corners ([`Rect::corners`]).
     points: [[u32; 3]; 4],
     kind: Kind,
+    /// The colour behind it.
+    colour: u32,
 }
 
 impl StepRect {
-    fn new(rect: Rect, kind: Kind) -> Self {
+    fn new(rect: Rect, kind: Kind, colour: u32) -> Self {
         StepRect {
             rect,
             points: rect.corners(),
             kind,
+            colour,
         }
     }
 }
@@ -218,6 +222,8 @@ struct Sweep {
     /// The colour of the solid, when the sweep reads coloured sections.
     colour: u32,
     mesh: SurfaceMesh,
+    /// The colour behind each triangle made, when the sweep reads coloured sections.
+    behind: Option<Vec<u32>>,
     /// The open rectangles of the planes `y = Y` (0) and `z = Z` (1), by `(plane, lo)`.
     open: [Vec<Open>; 2],
     births: Vec<Birth>,
@@ -252,12 +258,15 @@ struct Sweep {
 }
 
 impl Sweep {
-    fn new(level: u32, merge: Merge, colour: u32) -> Self {
+    /// A sweep of a binary tree's sections (`colour` none) or of the voxels of colour `colour` in a
+    /// tree's coloured sections.
+    fn new(level: u32, merge: Merge, colour: Option<u32>) -> Self {
         Self {
             level,
             merge,
-            colour,
+            colour: colour.unwrap_or(0),
             mesh: SurfaceMesh::default(),
+            behind: colour.map(|_| Vec::new()),
             open: [Vec::new(), Vec::new()],
             births: Vec::new(),
             free_births: Vec::new(),
@@ -286,14 +295,15 @@ impl Sweep {
         }
     }
 
-    /// The mesh made, when the sweep is done.
-    fn finish(self) -> SurfaceMesh {
+    /// The mesh made and the colour behind each triangle (none for a binary tree), when the sweep is
+    /// done.
+    fn finish(self) -> (SurfaceMesh, Vec<u32>) {
         debug_assert!(self.open[0].is_empty() && self.open[1].is_empty());
         assert!(
             u32::try_from(self.mesh.vertices.len()).is_ok(),
             "fewer than 2^32 vertices (indices are 32-bit)"
         );
-        self.mesh
+        (self.mesh, self.behind.unwrap_or_default())
     }
 
     /// One step: the slabs `x − 1` (`below`) and `x` (`slab`) of the solid; with `coloured`, the same
@@ -416,6 +426,7 @@ impl Sweep {
                     r: [r.start, y, r.lo, r.hi],
                 },
                 Kind::Whole,
+                r.colour,
             ));
         }
     }
@@ -539,7 +550,7 @@ impl Sweep {
         };
         for o in &self.closed {
             self.rects
-                .push(StepRect::new(rect(o, x), Kind::Closed(o.id)));
+                .push(StepRect::new(rect(o, x), Kind::Closed(o.id), o.colour));
         }
         for &at in &self.opened {
             let fresh = Birth {
@@ -560,7 +571,7 @@ impl Sweep {
             o.id = id;
             // Its end is not known yet: x + 1 stands in (only its corners at x are read).
             self.rects
-                .push(StepRect::new(rect(o, x + 1), Kind::Opened(id)));
+                .push(StepRect::new(rect(o, x + 1), Kind::Opened(id), o.colour));
         }
     }
 }

@@ -11,13 +11,12 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use crate::ops::values::select_where;
 use crate::tree::storage::infallible;
 use crate::tree::valued::{ValueLeaves, ValueStorage};
 use crate::value::{Dtype, Value};
 use crate::KTree;
 
-use super::{others, sweep, Frame, Merge, SurfaceMesh};
+use super::{sweep, Frame, SurfaceMesh};
 
 /// The surface of one value: closed and outward-oriented around the voxels holding it.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,9 +27,6 @@ pub struct ValueSurface<V> {
     pub mesh: SurfaceMesh,
     /// For each triangle, the value on its outer side (`None`: nothing).
     pub behind: Vec<Option<V>>,
-    /// Whether its rectangles are merged (always, unless a triangle were found with several values
-    /// behind it: then every unit face is its own square).
-    pub merged: bool,
     /// The value's own name, when it has one (a label's name: `liver`), as
     /// [`ValueMesh::with_names`] gives it.
     pub label: Option<String>,
@@ -168,8 +164,8 @@ impl<V: Value> ValueMesh<V> {
 ///
 /// # Performance
 /// One sweep of the tree's cross-sections, each split into the voxels of each value (the work of
-/// [`boundary_mesh`](super::boundary_mesh) for every value at once), and a look-up of the leaves
-/// behind each triangle.
+/// [`boundary_mesh`](super::boundary_mesh) for every value at once); the value behind each triangle
+/// is the one its rectangle was split by.
 ///
 /// # Panics
 /// As [`boundary_mesh`](super::boundary_mesh).
@@ -185,7 +181,7 @@ pub fn value_boundary_mesh<V: Value>(tree: &KTree<3, V>) -> ValueMesh<V> {
 /// let mesh = try_value_boundary_mesh(&tree).unwrap();
 /// assert_eq!(mesh, value_boundary_mesh(&tree));
 /// assert_eq!(mesh.surfaces[0].name(), "value_0.5");
-/// assert!(mesh.surfaces[0].merged); // the cube's six squares, nothing behind them
+/// assert_eq!(mesh.surfaces[0].mesh.triangles.len(), 12); // the cube's six squares
 /// ```
 ///
 /// # Errors
@@ -204,101 +200,21 @@ pub fn try_value_boundary_mesh<T: ValueStorage<3>>(
     }
     let colour: HashMap<_, u32> = values.keys().zip(0..).map(|(k, c)| (*k, c)).collect();
     let meshes = sweep::sweep_colours(tree, |v| colour[&v.key()], values.len())?;
-    let mut surfaces = Vec::with_capacity(values.len());
-    for (value, mesh) in values.into_values().zip(meshes) {
-        let surface = match behind_each(tree, &mesh)? {
-            Some(behind) => ValueSurface {
-                value,
-                mesh,
-                behind,
-                merged: true,
-                label: None,
-            },
-            None => {
-                // Not met: each rectangle has one colour behind it. Kept as a safe way out.
-                let voxels = select_where(tree, |v| v.same(value))?;
-                let mesh = infallible(sweep::sweep(&voxels, Merge::None));
-                let behind =
-                    behind_each(tree, &mesh)?.expect("a unit face has one voxel behind it");
-                ValueSurface {
-                    value,
-                    mesh,
-                    behind,
-                    merged: false,
-                    label: None,
-                }
-            }
-        };
-        surfaces.push(surface);
-    }
+    let values: Vec<T::Value> = values.into_values().collect();
+    let surfaces = values
+        .iter()
+        .zip(meshes)
+        .map(|(&value, (mesh, behind))| ValueSurface {
+            value,
+            mesh,
+            behind: behind
+                .into_iter()
+                .map(|c| (c != sweep::NOTHING).then(|| values[c as usize]))
+                .collect(),
+            label: None,
+        })
+        .collect();
     Ok(ValueMesh { surfaces })
-}
-
-/// The value behind each triangle of `mesh`, or `None` if some triangle has several.
-#[allow(clippy::type_complexity)] // A read that may fail of a list that may not exist.
-fn behind_each<T: ValueStorage<3>>(
-    tree: &T,
-    mesh: &SurfaceMesh,
-) -> Result<Option<Vec<Option<T::Value>>>, T::Error> {
-    let mut out = Vec::with_capacity(mesh.triangles.len());
-    for t in &mesh.triangles {
-        match behind(tree, t.map(|i| mesh.vertices[i as usize]))? {
-            Some(b) => out.push(b),
-            None => return Ok(None),
-        }
-    }
-    Ok(Some(out))
-}
-
-/// The value behind the triangle `p` (in a plane of the lattice, counter-clockwise seen from outside):
-/// `Some(None)` when nothing is, `None` when the voxels behind its bounding box do not all hold one value.
-fn behind<T: ValueStorage<3>>(
-    tree: &T,
-    p: [[f64; 3]; 3],
-) -> Result<Option<Option<T::Value>>, T::Error> {
-    let a = (0..3)
-        .find(|&a| p[0][a] == p[1][a] && p[1][a] == p[2][a])
-        .expect("a boundary triangle lies in a plane of the lattice");
-    let (b, c) = others(a);
-    let (u, w) = (
-        [p[1][b] - p[0][b], p[1][c] - p[0][c]],
-        [p[2][b] - p[0][b], p[2][c] - p[0][c]],
-    );
-    // The normal's component along a: (u × w)_a, as (b, c, a) is cyclic.
-    let outward = u[0] * w[1] - u[1] * w[0] > 0.0;
-    let coord = p[0][a] as i64;
-    let layer = if outward { coord } else { coord - 1 };
-    if layer < 0 || layer >= 1i64 << tree.level() {
-        return Ok(Some(None));
-    }
-    let span = |d: usize| {
-        let (lo, hi) = p
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
-                (lo.min(q[d]), hi.max(q[d]))
-            });
-        (lo.floor() as u32, hi.ceil() as u32)
-    };
-    let ((b0, b1), (c0, c1)) = (span(b), span(c));
-    let mut found: Option<Option<T::Value>> = None;
-    for cv in c0..c1 {
-        let mut bv = b0;
-        while bv < b1 {
-            let mut point = [0u32; 3];
-            (point[a], point[b], point[c]) = (layer as u32, bv, cv);
-            let (log_side, v) = tree
-                .try_leaf_at(point)?
-                .expect("the voxels behind a boundary face are in the universe");
-            match found {
-                None => found = Some(v),
-                Some(f) if f.map(Value::key) != v.map(Value::key) => return Ok(None),
-                Some(_) => {}
-            }
-            // The leaf's cell ends where bit log_side of b next turns over.
-            bv = ((bv >> log_side) + 1) << log_side;
-        }
-    }
-    Ok(found)
 }
 
 #[cfg(test)]
@@ -381,7 +297,6 @@ mod tests {
         let mut areas: HashMap<(u8, Option<u8>), f64> = HashMap::new();
         let mut once: HashMap<(u8, Option<u8>), f64> = HashMap::new();
         for s in &mesh.surfaces {
-            assert!(s.merged, "{} has one value behind each rectangle", s.value);
             assert_eq!(s.behind.len(), s.mesh.triangles.len());
             let voxels = dense.iter().filter(|v| **v == Some(s.value)).count();
             assert_eq!(s.mesh.volume(), voxels as f64, "the volume of {}", s.value);
@@ -460,10 +375,7 @@ mod tests {
         }
         check(3, &dense);
         let mesh = value_boundary_mesh(&KTree::<3, u8>::from_dense_values(3, &dense).unwrap());
-        assert!(mesh
-            .surfaces
-            .iter()
-            .all(|s| s.merged && s.mesh.triangles.len() == 12));
+        assert!(mesh.surfaces.iter().all(|s| s.mesh.triangles.len() == 12));
     }
 
     #[test]

@@ -148,6 +148,9 @@ impl Sweep {
                 triangles.push([centre, ring[j], ring[(j + 1) % ring.len()]]);
             }
         }
+        if let Some(behind) = &mut self.behind {
+            behind.resize(self.mesh.triangles.len(), step_rect.colour);
+        }
         self.ring = ring;
     }
 }
