@@ -26,7 +26,7 @@ use crate::rays::stretches;
 use crate::tree::storage::TreeStorage;
 use crate::tree::valued::ValueStorage;
 
-use super::section::{section, value_section, Pieces, Slab};
+use super::section::{section, value_section, Band, Pieces, Slab};
 use super::{Merge, Rect, SurfaceMesh};
 use junctions::{Birth, Stop, NONE};
 use points::Point;
@@ -310,10 +310,7 @@ impl Sweep {
     /// slabs' coloured sections, whose colours split the rectangles by what lies behind them.
     fn step(&mut self, x: u32, below: &Slab, slab: &Slab, coloured: Option<[&Slab; 2]>) {
         self.rects.clear();
-        match coloured {
-            Some(coloured) => self.plane_x_coloured(x, coloured),
-            None => self.plane_x(x, below, slab),
-        }
+        self.plane_x(x, coloured.unwrap_or([below, slab]), coloured.is_some());
         let coloured_slab = coloured.map(|c| c[1]);
         self.intervals_y(slab, coloured_slab);
         self.intervals_z(slab, coloured_slab);
@@ -326,18 +323,19 @@ impl Sweep {
     }
 
     /// The rectangles of the plane `x = X`: the stretches where exactly one of the two slabs is full,
-    /// merged along `y`.
-    fn plane_x(&mut self, x: u32, below: &Slab, slab: &Slab) {
+    /// merged along `y`. With `coloured`, `slabs` are the coloured sections and the solid is the sweep's
+    /// colour: the stretches are split where the colour behind (the other slab's) changes.
+    fn plane_x(&mut self, x: u32, slabs: [&Slab; 2], coloured: bool) {
         self.open_x.clear();
         // Where the rows carried so far end.
         let mut carried: Option<u32> = None;
-        for (y, end, lower, upper) in Pieces::new(below, slab) {
+        let mut pieces = Pieces::new(slabs[0], slabs[1]);
+        while let Some((y, end, bands)) = pieces.next_bands() {
             if let Some(at) = carried.filter(|&at| at != y) {
                 self.row.clear();
                 self.carry_x(x, at);
             }
-            xor_runs(lower, upper, &mut self.xor);
-            fill_row(&self.xor, self.merge, &mut self.row);
+            self.plane_x_row(slabs, bands, coloured);
             match self.merge {
                 Merge::Rectangles => self.carry_x(x, y),
                 Merge::None => {
@@ -354,52 +352,37 @@ impl Sweep {
         }
     }
 
-    /// [`plane_x`](Self::plane_x) from coloured sections: the stretches where exactly one slab holds the
-    /// solid's colour, split where the colour behind changes (the other slab's), merged along `y`.
-    fn plane_x_coloured(&mut self, x: u32, [below, slab]: [&Slab; 2]) {
-        self.open_x.clear();
-        let mut carried: Option<u32> = None;
-        let mut pieces = Pieces::new(below, slab);
-        while let Some((y, end, bands)) = pieces.next_bands() {
-            if let Some(at) = carried.filter(|&at| at != y) {
-                self.row.clear();
-                self.carry_x(x, at);
-            }
-            let column = |s: usize| {
-                let slab = [below, slab][s];
-                bands[s].map_or((&[][..], &[][..]), |b| {
-                    (slab.runs_of(b), slab.colours_of(b))
-                })
-            };
-            let columns = [column(0), column(1)];
-            for (s, solid) in self.solid.iter_mut().enumerate() {
-                let (runs, colours) = columns[s];
-                solid.clear();
-                solid.extend(
-                    runs.iter()
-                        .zip(colours)
-                        .filter(|(_, &c)| c == self.colour)
-                        .map(|(r, _)| *r),
-                );
-            }
-            xor_runs(&self.solid[0], &self.solid[1], &mut self.xor);
-            self.row.clear();
-            for upper in [false, true] {
-                for &(lo, hi, first) in self.xor.iter().filter(|s| s.2 == upper) {
-                    // The solid below (`first`) faces slab x; else slab x − 1 is behind.
-                    let (runs, colours) = columns[usize::from(first)];
-                    let row = &mut self.row;
-                    colour_stretches(runs, colours, lo, hi, |a, b, c| {
-                        row.push((u32::from(first), a, b, c));
-                    });
-                }
-            }
-            self.carry_x(x, y);
-            carried = Some(end);
+    /// The row of the plane `x = X` over a stretch where the slabs' bands are `bands` (see
+    /// [`plane_x`](Self::plane_x)), into `self.row`.
+    fn plane_x_row(&mut self, slabs: [&Slab; 2], bands: [Option<&Band>; 2], coloured: bool) {
+        let runs = |s: usize| bands[s].map_or(&[][..], |b| slabs[s].runs_of(b));
+        if !coloured {
+            xor_runs(runs(0), runs(1), &mut self.xor);
+            fill_row(&self.xor, self.merge, &mut self.row);
+            return;
         }
-        if let Some(at) = carried {
-            self.row.clear();
-            self.carry_x(x, at);
+        let colours = |s: usize| bands[s].map_or(&[][..], |b| slabs[s].colours_of(b));
+        for (s, solid) in self.solid.iter_mut().enumerate() {
+            solid.clear();
+            solid.extend(
+                runs(s)
+                    .iter()
+                    .zip(colours(s))
+                    .filter(|(_, &c)| c == self.colour)
+                    .map(|(r, _)| *r),
+            );
+        }
+        xor_runs(&self.solid[0], &self.solid[1], &mut self.xor);
+        self.row.clear();
+        for upper in [false, true] {
+            for &(lo, hi, first) in self.xor.iter().filter(|s| s.2 == upper) {
+                // The solid below (`first`) faces slab x; else slab x − 1 is behind.
+                let behind = usize::from(first);
+                let row = &mut self.row;
+                colour_stretches(runs(behind), colours(behind), lo, hi, |a, b, c| {
+                    row.push((u32::from(first), a, b, c));
+                });
+            }
         }
     }
 
@@ -491,10 +474,7 @@ impl Sweep {
                 Some(coloured) => column(coloured, Some(band.y0)),
                 None => (&[][..], &[][..]),
             };
-            let behind = |z: Option<u32>| match coloured {
-                Some(_) => colour_at(runs, colours, z),
-                None => 0,
-            };
+            let behind = |z: Option<u32>| coloured.map_or(0, |_| colour_at(runs, colours, z));
             for &(z0, z1) in slab.runs_of(band) {
                 self.ends
                     .push((2 * z0, band.y0, band.y1, behind(z0.checked_sub(1))));
