@@ -70,25 +70,17 @@ impl Slab {
         });
     }
 
-    /// Each colour's own slab from this one (colour `c` into `out[c]`): the bands holding runs of that
-    /// colour, over the same stretches of `y`.
-    pub(super) fn split_by_colour(&self, out: &mut [Slab]) {
-        for slab in out.iter_mut() {
-            slab.clear();
-        }
-        for band in &self.bands {
-            let (runs, colours) = (self.runs_of(band), self.colours_of(band));
-            for (&run, &colour) in runs.iter().zip(colours) {
-                let slab = &mut out[colour as usize];
-                match slab.bands.last_mut() {
-                    Some(last) if last.y0 == band.y0 => {
-                        slab.runs.push(run);
-                        slab.colours.push(colour);
-                        last.runs.1 += 1;
-                    }
-                    _ => slab.push_band(band.y0, band.y1, &[run], Some(colour)),
-                }
+    /// Appends run `run` of colour `colour` over the stretch of band `band` of another slab (a coloured
+    /// section being split into each colour's own slab, its bands in order): to this slab's last band
+    /// when that one covers the same stretch, else as a band of its own.
+    pub(super) fn push_run(&mut self, band: &Band, run: (u32, u32), colour: u32) {
+        match self.bands.last_mut() {
+            Some(last) if last.y0 == band.y0 => {
+                self.runs.push(run);
+                self.colours.push(colour);
+                last.runs.1 += 1;
             }
+            _ => self.push_band(band.y0, band.y1, &[run], Some(colour)),
         }
     }
 }
@@ -103,10 +95,16 @@ pub(super) struct Pieces<'s> {
 
 impl<'s> Pieces<'s> {
     pub(super) fn new(first: &'s Slab, second: &'s Slab) -> Self {
+        Self::from_y(first, second, 0)
+    }
+
+    /// The stretches from `y` on (the first one cut at `y`).
+    pub(super) fn from_y(first: &'s Slab, second: &'s Slab, y: u32) -> Self {
+        let slabs = [first, second];
         Pieces {
-            slabs: [first, second],
-            at: [0, 0],
-            y: 0,
+            slabs,
+            at: slabs.map(|s| s.bands.partition_point(|b| b.y1 <= y)),
+            y,
         }
     }
 }

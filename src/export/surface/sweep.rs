@@ -53,30 +53,114 @@ pub(super) fn sweep<T: TreeStorage<3>>(tree: &T, merge: Merge) -> Result<Surface
 /// `0 .. colours`), each a closed, outward-oriented triangle mesh whose rectangles are merged as far
 /// as one colour (or nothing) lies behind each, with the colour behind each triangle ([`NOTHING`]: no
 /// voxel of a colour): one sweep of the tree's sections, split by colour.
+///
+/// A colour is swept only while it is in one of the two sections of a step: its sweep starts when the
+/// colour appears and ends with the first section without it, its mesh kept (a later appearance, after
+/// a gap of at least one section, shares no vertex with it and is appended). So the memory is that of
+/// the colours of two sections, not of all colours, and a step visits only the colours it meets.
 pub(super) fn sweep_colours<T: ValueStorage<3>>(
     tree: &T,
     colour_of: impl Fn(T::Value) -> u32,
     colours: usize,
 ) -> Result<Vec<(SurfaceMesh, Vec<u32>)>, T::Error> {
     let level = tree.level();
-    let mut sweeps: Vec<Sweep> = (0..colours as u32)
-        .map(|c| Sweep::new(level, Merge::Rectangles, Some(c)))
-        .collect();
-    let (mut below, mut slab) = (
-        vec![Slab::default(); colours],
-        vec![Slab::default(); colours],
-    );
+    let mut meshes: Vec<(SurfaceMesh, Vec<u32>)> = vec![Default::default(); colours];
+    let mut sweeping: Vec<Option<Box<ColourSweep>>> = (0..colours).map(|_| None).collect();
+    // Sweeps done with, their buffers kept for the next colour to appear.
+    let mut spare: Vec<Box<ColourSweep>> = Vec::new();
+    // The colours of the section below the step, and of the step's section.
+    let (mut below, mut here): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
     let read = |x: u32, out: &mut Slab| value_section(tree, x, out, &colour_of);
     for_each_section(level, false, read, |x, _, coloured_below, coloured| {
-        coloured.split_by_colour(&mut slab);
-        for (c, sweep) in sweeps.iter_mut().enumerate() {
-            if !(below[c].bands.is_empty() && slab[c].bands.is_empty()) {
-                sweep.step(x, &below[c], &slab[c], Some([coloured_below, coloured]));
+        here.clear();
+        for band in &coloured.bands {
+            for (&run, &c) in coloured.runs_of(band).iter().zip(coloured.colours_of(band)) {
+                let state = sweeping[c as usize].get_or_insert_with(|| match spare.pop() {
+                    Some(mut reused) => {
+                        reused.sweep.colour = c;
+                        reused
+                    }
+                    None => ColourSweep::new(level, c),
+                });
+                if state.slab.bands.is_empty() {
+                    here.push(c);
+                }
+                state.slab.push_run(band, run, c);
             }
         }
-        std::mem::swap(&mut below, &mut slab);
+        let sections = Some([coloured_below, coloured]);
+        // The colours below step once each; those only here have nothing below.
+        for &c in &below {
+            let state = sweeping[c as usize]
+                .as_mut()
+                .expect("a colour below is swept");
+            state.sweep.step(x, &state.below, &state.slab, sections);
+        }
+        for &c in &here {
+            let state = sweeping[c as usize]
+                .as_mut()
+                .expect("a colour here is swept");
+            if state.below.bands.is_empty() {
+                state.sweep.step(x, &state.below, &state.slab, sections);
+            }
+        }
+        // A colour below and not here is done until it appears again.
+        for &c in &below {
+            let state = &mut sweeping[c as usize];
+            if state.as_ref().is_some_and(|s| s.slab.bands.is_empty()) {
+                let mut done = state.take().expect("a colour below is swept");
+                append(&mut meshes[c as usize], done.sweep.take_mesh());
+                done.below.clear();
+                spare.push(done);
+            }
+        }
+        for &c in &here {
+            let state = sweeping[c as usize]
+                .as_mut()
+                .expect("a colour here is swept");
+            std::mem::swap(&mut state.below, &mut state.slab);
+            state.slab.clear();
+        }
+        std::mem::swap(&mut below, &mut here);
     })?;
-    Ok(sweeps.into_iter().map(Sweep::finish).collect())
+    debug_assert!(sweeping.iter().all(Option::is_none));
+    Ok(meshes)
+}
+
+/// The sweep of one colour's voxels and its slabs below and at the step.
+struct ColourSweep {
+    sweep: Sweep,
+    below: Slab,
+    slab: Slab,
+}
+
+impl ColourSweep {
+    fn new(level: u32, colour: u32) -> Box<Self> {
+        Box::new(ColourSweep {
+            sweep: Sweep::new(level, Merge::Rectangles, Some(colour)),
+            below: Slab::default(),
+            slab: Slab::default(),
+        })
+    }
+}
+
+/// Appends the mesh `more` (and the colours behind its triangles) to `mesh`; no vertex is shared.
+fn append(mesh: &mut (SurfaceMesh, Vec<u32>), more: (SurfaceMesh, Vec<u32>)) {
+    if mesh.0.vertices.is_empty() {
+        *mesh = more;
+        return;
+    }
+    let offset = mesh.0.vertices.len() as u32;
+    let (m, behind) = more;
+    mesh.0.vertices.extend(m.vertices);
+    assert!(
+        u32::try_from(mesh.0.vertices.len()).is_ok(),
+        "fewer than 2^32 vertices (indices are 32-bit)"
+    );
+    mesh.0
+        .triangles
+        .extend(m.triangles.into_iter().map(|t| t.map(|v| v + offset)));
+    mesh.1.extend(behind);
 }
 
 /// The number of unit faces on the boundary of `tree`, counted on its cross-sections as [`sweep`] meets
@@ -306,11 +390,42 @@ impl Sweep {
         (self.mesh, self.behind.unwrap_or_default())
     }
 
+    /// The mesh made and the colour behind each triangle, taken out when every rectangle is closed: the
+    /// sweep starts again with an empty mesh (for a solid that shares no vertex with the one so far),
+    /// keeping its buffers.
+    fn take_mesh(&mut self) -> (SurfaceMesh, Vec<u32>) {
+        debug_assert!(self.open[0].is_empty() && self.open[1].is_empty());
+        self.births.clear();
+        self.free_births.clear();
+        self.stops.clear();
+        self.free_stops = NONE;
+        self.midpoints.clear();
+        let behind = self.behind.as_mut().map(std::mem::take);
+        (std::mem::take(&mut self.mesh), behind.unwrap_or_default())
+    }
+
     /// One step: the slabs `x − 1` (`below`) and `x` (`slab`) of the solid; with `coloured`, the same
     /// slabs' coloured sections, whose colours split the rectangles by what lies behind them.
     fn step(&mut self, x: u32, below: &Slab, slab: &Slab, coloured: Option<[&Slab; 2]>) {
         self.rects.clear();
-        self.plane_x(x, coloured.unwrap_or([below, slab]), coloured.is_some());
+        match coloured {
+            // Only the stretch of y where the colour's voxels are: the rest of the plane has none.
+            Some(sections) => {
+                let ends = |s: &Slab| {
+                    s.bands
+                        .first()
+                        .map(|b| b.y0)
+                        .zip(s.bands.last().map(|b| b.y1))
+                };
+                let (lo, hi) = [ends(below), ends(slab)]
+                    .into_iter()
+                    .flatten()
+                    .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+                    .expect("a step has voxels of its colour");
+                self.plane_x(x, sections, Some((lo, hi)));
+            }
+            None => self.plane_x(x, [below, slab], None),
+        }
         let coloured_slab = coloured.map(|c| c[1]);
         self.intervals_y(slab, coloured_slab);
         self.intervals_z(slab, coloured_slab);
@@ -323,14 +438,17 @@ impl Sweep {
     }
 
     /// The rectangles of the plane `x = X`: the stretches where exactly one of the two slabs is full,
-    /// merged along `y`. With `coloured`, `slabs` are the coloured sections and the solid is the sweep's
-    /// colour: the stretches are split where the colour behind (the other slab's) changes.
-    fn plane_x(&mut self, x: u32, slabs: [&Slab; 2], coloured: bool) {
+    /// merged along `y`. With `coloured`, the stretch `[lo, hi)` of `y` holding the sweep's colour,
+    /// `slabs` are the coloured sections and the solid is that colour: the stretches are split where the
+    /// colour behind (the other slab's) changes.
+    fn plane_x(&mut self, x: u32, slabs: [&Slab; 2], coloured: Option<(u32, u32)>) {
         self.open_x.clear();
+        let (from, until) = coloured.unwrap_or((0, u32::MAX));
+        let coloured = coloured.is_some();
         // Where the rows carried so far end.
         let mut carried: Option<u32> = None;
-        let mut pieces = Pieces::new(slabs[0], slabs[1]);
-        while let Some((y, end, bands)) = pieces.next_bands() {
+        let mut pieces = Pieces::from_y(slabs[0], slabs[1], from);
+        while let Some((y, end, bands)) = pieces.next_bands().filter(|p| p.0 < until) {
             if let Some(at) = carried.filter(|&at| at != y) {
                 self.row.clear();
                 self.carry_x(x, at);

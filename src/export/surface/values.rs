@@ -165,7 +165,9 @@ impl<V: Value> ValueMesh<V> {
 /// # Performance
 /// One sweep of the tree's cross-sections, each split into the voxels of each value (the work of
 /// [`boundary_mesh`](super::boundary_mesh) for every value at once); the value behind each triangle
-/// is the one its rectangle was split by.
+/// is the one its rectangle was split by. A value is swept only while it is in the sections of a step,
+/// over the rows it is in: the work and the memory besides the surfaces follow the values a section
+/// meets, not all the values, so a segmentation of many small labels costs about what one of few does.
 ///
 /// # Panics
 /// As [`boundary_mesh`](super::boundary_mesh).
