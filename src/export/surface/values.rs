@@ -227,9 +227,20 @@ mod tests {
 
     /// Random labels 1 to 3 (or nothing) in aligned blocks of every size, at `level`.
     fn labels(level: u32) -> impl Strategy<Value = Vec<Option<u8>>> {
+        blocks(level, level, 4, 12)
+    }
+
+    /// Random labels below `values` (or nothing) in up to `count` aligned blocks of sides below
+    /// `2^max_log`, at `level`.
+    fn blocks(
+        level: u32,
+        max_log: u32,
+        values: u8,
+        count: usize,
+    ) -> impl Strategy<Value = Vec<Option<u8>>> {
         let side = 1usize << level;
-        let block = (0..level, any::<[u16; 3]>(), prop::option::of(1u8..4));
-        prop::collection::vec(block, 1..12).prop_map(move |blocks| {
+        let block = (0..max_log, any::<[u16; 3]>(), prop::option::of(1u8..values));
+        prop::collection::vec(block, 1..count).prop_map(move |blocks| {
             let mut dense = vec![None; side * side * side];
             for (log, at, value) in blocks {
                 let at = at.map(|c| ((c as usize % side) >> log) << log);
@@ -358,6 +369,13 @@ mod tests {
 
         #[test]
         fn each_value_is_closed_at_level_4(dense in labels(4)) {
+            check(4, &dense);
+        }
+
+        /// Many small values, most of them appearing, leaving and appearing again along the sweep: each
+        /// swept only while it is met, in sweeps handed from one value to the next.
+        #[test]
+        fn many_small_values_are_each_closed(dense in blocks(4, 2, 200, 120)) {
             check(4, &dense);
         }
     }
