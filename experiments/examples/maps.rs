@@ -219,11 +219,11 @@ fn main() {
                 let update = ktree::map::ScanUpdate::compute(map.grid(), &points, [0.0; 3], None);
                 let gather = t.elapsed().as_secs_f64();
                 let t = Instant::now();
-                let tree = ktree::map::apply(map.log_odds(), &update.voxels, map.model());
+                let tree = ktree::map::apply(map.log_odds(), &update, map.model());
                 let merge = t.elapsed().as_secs_f64();
                 println!(
                     "voxels={} gather={gather:.3} merge={merge:.3} nodes={}",
-                    update.voxels.len(),
+                    update.len(),
                     tree.node_count()
                 );
             }

@@ -178,7 +178,7 @@ impl<const K: usize> OccupancyMap<K> {
             "the sensor origin",
         )?;
         let update = ScanUpdate::compute(&self.grid, points, origin, max_range);
-        self.log_odds = apply(&self.log_odds, &update.voxels, &self.model);
+        self.log_odds = apply(&self.log_odds, &update, &self.model);
         Ok(update)
     }
 

@@ -2,7 +2,7 @@
 //! way (misses), each once, hits winning — OctoMap's `computeUpdate` and `insertPointCloud` with
 //! `discretize = false` — gathered on all threads: each ray's misses set as bits of the blocks of voxels
 //! it crosses (repeats cost nothing; the blocks, not the voxels, are sorted), the hits sorted, and the
-//! whole merged into the map's tree in one depth-first pass.
+//! two lists merged into the map's tree in one depth-first pass.
 
 use rayon::prelude::*;
 
@@ -20,12 +20,14 @@ use crate::KTree;
 /// The points of a scan handed to one thread at a time.
 const POINTS_A_TASK: usize = 2048;
 
-/// The voxels one scan updates, as Morton keys of the map's universe in increasing order, each once, with
-/// whether it is a hit (`true`) or a miss.
+/// The voxels one scan updates, as Morton keys of the map's universe in increasing order, each once: the
+/// hits, and the misses (no hit among them).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ScanUpdate {
-    /// The updated voxels and whether each is a hit.
-    pub voxels: Vec<(u64, bool)>,
+    /// The voxels holding a point of the scan.
+    pub hits: Vec<u64>,
+    /// The other voxels the scan's rays cross.
+    pub misses: Vec<u64>,
     /// Rays whose origin or end fell outside the map (OctoMap skips them and warns).
     pub rays_outside: usize,
 }
@@ -75,9 +77,34 @@ impl ScanUpdate {
         let (misses, ()) =
             rayon::join(|| SortedVoxels::union(sets), || sort_dedup(&mut hits, bits));
         Self {
-            voxels: merge_sorted(&hits, &misses),
+            misses: without(&misses, &hits),
+            hits,
             rays_outside,
         }
+    }
+
+    /// The number of voxels updated.
+    pub fn len(&self) -> usize {
+        self.hits.len() + self.misses.len()
+    }
+
+    /// Whether no voxel is updated.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The updated voxels in increasing order, each with whether it is a hit.
+    ///
+    /// ```
+    /// use ktree::map::{MapGrid, ScanUpdate};
+    /// let grid = MapGrid::new(1.0).unwrap();
+    /// // A ray along x from the voxel of the origin to the third voxel after it.
+    /// let update = ScanUpdate::compute(&grid, &[[3.5f32]], [0.5], None);
+    /// let hits: Vec<bool> = update.voxels().map(|(_, hit)| hit).collect();
+    /// assert_eq!(hits, [false, false, false, true]);
+    /// ```
+    pub fn voxels(&self) -> impl Iterator<Item = (u64, bool)> + '_ {
+        Part::whole(self).iter()
     }
 }
 
@@ -87,21 +114,102 @@ fn sort_dedup(keys: &mut Vec<u64>, bits: u32) {
     keys.dedup();
 }
 
-/// The union of the increasing keys `hits` and the set `misses`, each key marked whether it is a hit
-/// (hits win).
-fn merge_sorted(hits: &[u64], misses: &SortedVoxels) -> Vec<(u64, bool)> {
-    let mut out = Vec::with_capacity(hits.len() + misses.len());
+/// The keys of `misses` that are not among the increasing keys `hits` (hits win), in increasing order.
+fn without(misses: &SortedVoxels, hits: &[u64]) -> Vec<u64> {
+    let mut out = Vec::with_capacity(misses.len());
     let mut hits = hits.iter().copied().peekable();
     misses.for_each(|m| {
-        while let Some(h) = hits.next_if(|&h| h <= m) {
-            out.push((h, true));
-        }
-        if out.last() != Some(&(m, true)) {
-            out.push((m, false));
+        while hits.next_if(|&h| h < m).is_some() {}
+        if hits.peek() != Some(&m) {
+            out.push(m);
         }
     });
-    out.extend(hits.map(|h| (h, true)));
     out
+}
+
+/// The part of a scan's update inside a cell: its hits and its misses, each increasing.
+#[derive(Debug, Clone, Copy, Default)]
+struct Part<'a> {
+    hits: &'a [u64],
+    misses: &'a [u64],
+}
+
+impl<'a> Part<'a> {
+    fn whole(update: &'a ScanUpdate) -> Self {
+        Part {
+            hits: &update.hits,
+            misses: &update.misses,
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.hits.len() + self.misses.len()
+    }
+
+    /// Whether every voxel is a hit (`Some(true)`) or every one a miss (`Some(false)`); `None` when
+    /// there are both or none.
+    fn all_alike(&self) -> Option<bool> {
+        match (self.hits.is_empty(), self.misses.is_empty()) {
+            (false, true) => Some(true),
+            (true, false) => Some(false),
+            _ => None,
+        }
+    }
+
+    /// The part below key `end` and the rest.
+    fn split_at_key(self, end: u64) -> (Self, Self) {
+        let (h, m) = (
+            self.hits.partition_point(|&k| k < end),
+            self.misses.partition_point(|&k| k < end),
+        );
+        (
+            Part {
+                hits: &self.hits[..h],
+                misses: &self.misses[..m],
+            },
+            Part {
+                hits: &self.hits[h..],
+                misses: &self.misses[m..],
+            },
+        )
+    }
+
+    /// The voxels in increasing order, each with whether it is a hit.
+    fn iter(self) -> Merged<'a> {
+        Merged {
+            hits: self.hits,
+            misses: self.misses,
+        }
+    }
+}
+
+/// The voxels of a [`Part`] in increasing order.
+struct Merged<'a> {
+    hits: &'a [u64],
+    misses: &'a [u64],
+}
+
+impl Iterator for Merged<'_> {
+    type Item = (u64, bool);
+
+    #[inline]
+    fn next(&mut self) -> Option<(u64, bool)> {
+        match (self.hits.split_first(), self.misses.split_first()) {
+            (Some((&h, rest)), Some((&m, _))) if h < m => {
+                self.hits = rest;
+                Some((h, true))
+            }
+            (_, Some((&m, rest))) => {
+                self.misses = rest;
+                Some((m, false))
+            }
+            (Some((&h, rest)), None) => {
+                self.hits = rest;
+                Some((h, true))
+            }
+            (None, None) => None,
+        }
+    }
 }
 
 /// The map's log-odds after `update`: every updated voxel's log-odds (0 where it was unknown) moved by
@@ -110,12 +218,20 @@ fn merge_sorted(hits: &[u64], misses: &SortedVoxels) -> Vec<(u64, bool)> {
 /// a cell with many updates has its children made apart.
 pub fn apply<const K: usize>(
     map: &KTree<K, f32>,
-    update: &[(u64, bool)],
+    update: &ScanUpdate,
     model: &SensorModel,
 ) -> KTree<K, f32> {
     let parallel = rayon::current_num_threads() > 1;
     let root = infallible(InputNode::root(map));
-    let whole = subtree(map, model, root, update, 0, map.level(), parallel);
+    let whole = subtree(
+        map,
+        model,
+        root,
+        Part::whole(update),
+        0,
+        map.level(),
+        parallel,
+    );
     whole.into_tree(map.universe())
 }
 
@@ -129,7 +245,7 @@ fn subtree<const K: usize>(
     map: &KTree<K, f32>,
     model: &SensorModel,
     node: InputNode<f32>,
-    update: &[(u64, bool)],
+    update: Part,
     base: u64,
     log_side: u32,
     parallel: bool,
@@ -160,23 +276,17 @@ fn subtree<const K: usize>(
 
 /// The updates of each child of the cell whose voxels' Morton keys start at `base` (a side of
 /// `2^log_side`, `log_side` ≥ 1), with the first key of the child, in code order (the first `2^K`).
-#[allow(clippy::type_complexity)] // A child's first key and its part of the updates, for each child.
-fn children_updates<const K: usize>(
-    update: &[(u64, bool)],
-    base: u64,
-    log_side: u32,
-) -> [(u64, &[(u64, bool)]); 16] {
+fn children_updates<const K: usize>(update: Part, base: u64, log_side: u32) -> [(u64, Part); 16] {
     let span = 1u64 << (K as u32 * (log_side - 1));
     let mut rest = update;
-    let mut parts: [(u64, &[(u64, bool)]); 16] = [(0, &[]); 16];
+    let mut parts = [(0, Part::default()); 16];
     for (code, part) in parts.iter_mut().enumerate().take(1 << K) {
         let start = base + code as u64 * span;
-        let here = match start.checked_add(span) {
-            Some(end) => rest.partition_point(|&(k, _)| k < end),
+        let (mine, after) = match start.checked_add(span) {
+            Some(end) => rest.split_at_key(end),
             // The last cell of a 4-D root ends at 2^64.
-            None => rest.len(),
+            None => (rest, Part::default()),
         };
-        let (mine, after) = rest.split_at(here);
         *part = (start, mine);
         rest = after;
     }
@@ -197,7 +307,7 @@ impl<const K: usize> Merge<'_, K> {
     fn node(
         &mut self,
         node: InputNode<f32>,
-        update: &[(u64, bool)],
+        update: Part,
         base: u64,
         log_side: u32,
         depth: usize,
@@ -207,15 +317,15 @@ impl<const K: usize> Merge<'_, K> {
             ValueState::Full(v) => Some(Some(v)),
             _ => None,
         };
-        if let (Some(v), Some(&(_, first))) = (leaf, update.first()) {
+        if let (Some(v), Some(hit)) = (leaf, update.all_alike()) {
             let volume = 1u128 << (K as u32 * log_side);
-            if update.len() as u128 == volume && update.iter().all(|&(_, h)| h == first) {
-                return ValueState::Full(self.model.update(v.unwrap_or(0.0), first));
+            if update.len() as u128 == volume {
+                return ValueState::Full(self.model.update(v.unwrap_or(0.0), hit));
             }
         }
         if let Some(v) = leaf {
             let background = v.map_or(ValueState::Empty, ValueState::Full);
-            if update.is_empty() {
+            if update.len() == 0 {
                 return background;
             }
             return self.leaf(background, v.unwrap_or(0.0), update, base, log_side, depth);
@@ -243,7 +353,7 @@ impl<const K: usize> Merge<'_, K> {
         &mut self,
         background: ValueState<f32>,
         before: f32,
-        update: &[(u64, bool)],
+        update: Part,
         base: u64,
         log_side: u32,
         depth: usize,
@@ -285,7 +395,7 @@ impl<const K: usize> Merge<'_, K> {
             }
         };
         let mut previous: Option<u64> = None;
-        for &(key, is_hit) in update {
+        for (key, is_hit) in update.iter() {
             let key = key - base;
             // The lowest height whose cell holds both this voxel and the one before: the cells below it
             // on the previous voxel's way are finished.
