@@ -288,7 +288,6 @@ impl OccupancyMapPy {
             let origin = coordinates::<K>(&origin, "insert: origin")?;
             py.detach(|| m.insert(rows::<K, f32>(flat), origin, max_range))
                 .map_err(|e| Failure::Value(format!("insert: {e}")))?
-                .voxels
                 .len()
         });
         if let (Some(recorder), AnyMap::D3(m)) = (self.recorder.as_mut(), &self.map) {
