@@ -104,7 +104,7 @@ impl ScanUpdate {
     /// assert_eq!(hits, [false, false, false, true]);
     /// ```
     pub fn voxels(&self) -> impl Iterator<Item = (u64, bool)> + '_ {
-        Part::whole(self).iter()
+        Part::whole(self)
     }
 }
 
@@ -173,23 +173,10 @@ impl<'a> Part<'a> {
             },
         )
     }
-
-    /// The voxels in increasing order, each with whether it is a hit.
-    fn iter(self) -> Merged<'a> {
-        Merged {
-            hits: self.hits,
-            misses: self.misses,
-        }
-    }
 }
 
-/// The voxels of a [`Part`] in increasing order.
-struct Merged<'a> {
-    hits: &'a [u64],
-    misses: &'a [u64],
-}
-
-impl Iterator for Merged<'_> {
+/// A part read as its voxels in increasing order, each with whether it is a hit.
+impl Iterator for Part<'_> {
     type Item = (u64, bool);
 
     #[inline]
@@ -395,7 +382,7 @@ impl<const K: usize> Merge<'_, K> {
             }
         };
         let mut previous: Option<u64> = None;
-        for (key, is_hit) in update.iter() {
+        for (key, is_hit) in update {
             let key = key - base;
             // The lowest height whose cell holds both this voxel and the one before: the cells below it
             // on the previous voxel's way are finished.

@@ -89,13 +89,19 @@ pub(super) fn sweep_colours<T: ValueStorage<3>>(
             }
         }
         let sections = Some([coloured_below, coloured]);
-        // The colours below step once each; those only here have nothing below.
+        // The colours below step once each; one not here is then done until it appears again.
         for &c in &below {
-            let state = sweeping[c as usize]
-                .as_mut()
-                .expect("a colour below is swept");
+            let slot = &mut sweeping[c as usize];
+            let state = slot.as_mut().expect("a colour below is swept");
             state.sweep.step(x, &state.below, &state.slab, sections);
+            if state.slab.bands.is_empty() {
+                let mut done = slot.take().expect("a colour below is swept");
+                append(&mut meshes[c as usize], done.sweep.take_mesh());
+                done.below.clear();
+                spare.push(done);
+            }
         }
+        // The colours here step too when they were not below; each section then moves down.
         for &c in &here {
             let state = sweeping[c as usize]
                 .as_mut()
@@ -103,21 +109,6 @@ pub(super) fn sweep_colours<T: ValueStorage<3>>(
             if state.below.bands.is_empty() {
                 state.sweep.step(x, &state.below, &state.slab, sections);
             }
-        }
-        // A colour below and not here is done until it appears again.
-        for &c in &below {
-            let state = &mut sweeping[c as usize];
-            if state.as_ref().is_some_and(|s| s.slab.bands.is_empty()) {
-                let mut done = state.take().expect("a colour below is swept");
-                append(&mut meshes[c as usize], done.sweep.take_mesh());
-                done.below.clear();
-                spare.push(done);
-            }
-        }
-        for &c in &here {
-            let state = sweeping[c as usize]
-                .as_mut()
-                .expect("a colour here is swept");
             std::mem::swap(&mut state.below, &mut state.slab);
             state.slab.clear();
         }
@@ -381,13 +372,12 @@ impl Sweep {
 
     /// The mesh made and the colour behind each triangle (none for a binary tree), when the sweep is
     /// done.
-    fn finish(self) -> (SurfaceMesh, Vec<u32>) {
-        debug_assert!(self.open[0].is_empty() && self.open[1].is_empty());
+    fn finish(mut self) -> (SurfaceMesh, Vec<u32>) {
         assert!(
             u32::try_from(self.mesh.vertices.len()).is_ok(),
             "fewer than 2^32 vertices (indices are 32-bit)"
         );
-        (self.mesh, self.behind.unwrap_or_default())
+        self.take_mesh()
     }
 
     /// The mesh made and the colour behind each triangle, taken out when every rectangle is closed: the
