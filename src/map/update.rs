@@ -14,7 +14,7 @@ use crate::radix::radix_sort;
 use crate::space::morton_encode;
 use crate::tree::storage::infallible;
 use crate::tree::top_down::{InputNode, Subtree};
-use crate::tree::valued::{combine, ValueState};
+use crate::tree::valued::{combine, ValueState, ValuedLevel};
 use crate::KTree;
 
 /// The points of a scan handed to one thread at a time.
@@ -241,7 +241,7 @@ fn subtree<const K: usize>(
         let mut merge = Merge {
             map,
             model,
-            levels: vec![Vec::new(); log_side as usize + 1],
+            levels: vec![ValuedLevel::new(); log_side as usize + 1],
         };
         let root = merge.node(node, update, base, log_side, 0);
         let mut levels = merge.levels;
@@ -280,11 +280,11 @@ fn children_updates<const K: usize>(update: Part, base: u64, log_side: u32) -> [
     parts
 }
 
-/// The state of a depth-first merge: the settled states of each level so far.
+/// The state of a depth-first merge: the settled nodes of each level so far.
 struct Merge<'a, const K: usize> {
     map: &'a KTree<K, f32>,
     model: &'a SensorModel,
-    levels: Vec<Vec<ValueState<f32>>>,
+    levels: Vec<ValuedLevel<f32>>,
 }
 
 impl<const K: usize> Merge<'_, K> {
@@ -356,7 +356,7 @@ impl<const K: usize> Merge<'_, K> {
         let mut settled = vec![0usize; top + 1];
         let digit = |key: u64, r: usize| (key >> (k * (r as u32 - 1))) as usize & (fanout - 1);
         // Settles the rest of the open cell at height r with the background; its state.
-        let close = |levels: &mut [Vec<ValueState<f32>>],
+        let close = |levels: &mut [ValuedLevel<f32>],
                      kids: &mut [ValueState<f32>; 16],
                      from: usize,
                      r: usize| {
@@ -369,7 +369,7 @@ impl<const K: usize> Merge<'_, K> {
         };
         // Closes the open cells below height `height` on the way to voxel `key`, each handed to the cell
         // above it.
-        let close_below = |levels: &mut [Vec<ValueState<f32>>],
+        let close_below = |levels: &mut [ValuedLevel<f32>],
                            kids: &mut [[ValueState<f32>; 16]],
                            settled: &mut [usize],
                            key: u64,

@@ -25,7 +25,7 @@ use crate::rays::valued::check_dense_len;
 use crate::rays::RayError;
 use crate::space::{spread_bits, Cell, Universe};
 use crate::tree::top_down::Subtree;
-use crate::tree::valued::{combine, ValueState};
+use crate::tree::valued::{combine, ValueState, ValuedLevel};
 use crate::value::Value;
 use crate::KTree;
 
@@ -151,7 +151,7 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
         &self,
         cell: Cell<K>,
         depth: usize,
-        levels: &mut [Vec<Vec<ValueState<V>>>],
+        levels: &mut [Vec<ValuedLevel<V>>],
     ) -> Result<ValueState<V>, RayError> {
         if let Some(leaf) = self.leaf(cell)? {
             return Ok(leaf);
@@ -184,7 +184,7 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
             let level = &mut levels[depth + 1];
             match level.last_mut() {
                 Some(chunk) => chunk.extend_from_slice(&kids[..n]),
-                None => level.push(kids[..n].to_vec()),
+                None => level.push(ValuedLevel::from_states(&kids[..n])),
             }
         }
         Ok(state)
@@ -195,7 +195,7 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
 /// order, the root's children first.
 struct BrickTree<V> {
     root: ValueState<V>,
-    levels: Vec<Vec<ValueState<V>>>,
+    levels: Vec<ValuedLevel<V>>,
 }
 
 /// The subtree of the brick of side `2^log` whose first voxel is `dense[origin]` in an array of rows
@@ -263,11 +263,15 @@ fn brick_tree<const K: usize, V: Value>(
     let (mut parents, mut next) = (vec![0usize], Vec::new());
     for j in (0..log).rev() {
         next.clear();
-        let mut states = Vec::with_capacity(parents.len() * n);
+        let mut states = ValuedLevel::new();
         for &p in &parents {
             let first = p * n;
             if j == 0 {
-                states.extend(voxels[first..first + n].iter().map(|&v| voxel(v)));
+                let mut kids = [ValueState::Empty; 16];
+                for (kid, &v) in kids.iter_mut().zip(&voxels[first..first + n]) {
+                    *kid = voxel(v);
+                }
+                states.extend_from_slice(&kids[..n]);
                 continue;
             }
             let kids = &cells[starts[j] + first..starts[j] + first + n];
@@ -284,10 +288,8 @@ fn brick_tree<const K: usize, V: Value>(
             break;
         }
     }
-    for state in levels.iter().flatten() {
-        if let ValueState::Full(v) = state {
-            v.check().ok()?;
-        }
+    for v in levels.iter().flat_map(ValuedLevel::values) {
+        v.check().ok()?;
     }
     Some(BrickTree { root, levels })
 }

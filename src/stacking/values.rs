@@ -25,7 +25,7 @@ use crate::rays::source::default_split_depth;
 use crate::rays::{ColumnKeys, ValueRun, ValueRuns};
 use crate::space::Cell;
 use crate::tree::top_down::Subtree;
-use crate::tree::valued::{combine, ValueState};
+use crate::tree::valued::{combine, ValueState, ValuedLevel};
 use crate::value::Value;
 use crate::KTree;
 
@@ -78,7 +78,7 @@ pub(super) fn subtree<const K: usize, V: Value>(
     if cell.level() >= split {
         let mut builder = DepthFirst {
             keys,
-            levels: vec![Vec::new(); depths],
+            levels: vec![ValuedLevel::new(); depths],
             scratch: vec![Vec::new(); depths + 1],
         };
         let root = builder.node(cell, pieces, 0);
@@ -177,11 +177,11 @@ fn distribute<const K: usize, V: Value>(
     start
 }
 
-/// The state of a depth-first build: the settled states of each level so far, and one buffer a level for
+/// The state of a depth-first build: the settled nodes of each level so far, and one buffer a level for
 /// the pieces of the children of the cell being built there.
 struct DepthFirst<'a, const K: usize, V> {
     keys: &'a ColumnKeys<K>,
-    levels: Vec<Vec<ValueState<V>>>,
+    levels: Vec<ValuedLevel<V>>,
     scratch: Vec<Vec<ValueRun<V>>>,
 }
 

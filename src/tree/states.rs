@@ -141,19 +141,6 @@ impl PackedStates {
         self.len += 1;
     }
 
-    /// Appends a node by its 2-bit code (`11` only in a valued tree). Call [`PackedStates::finish`] after the
-    /// last push.
-    #[inline]
-    pub(crate) fn push_code(&mut self, code: u64) {
-        let slot = self.len % NODES_PER_WORD;
-        if slot == 0 {
-            self.words.push(0);
-        }
-        let last = self.words.len() - 1;
-        self.words[last] |= (code & 3) << (2 * slot);
-        self.len += 1;
-    }
-
     /// Builds the rank index; must be called once all nodes are pushed.
     pub(crate) fn finish(&mut self) {
         self.words.shrink_to_fit();

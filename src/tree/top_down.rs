@@ -37,8 +37,7 @@
 
 use super::ktree::KTree;
 use super::states::PackedStates;
-use super::valued::{combine, ValueState, ValueStorage};
-use super::words::NODES_PER_WORD;
+use super::valued::{combine, ValueState, ValueStorage, ValuedLevel};
 use super::TreeError;
 use crate::space::{Cell, Universe};
 use crate::value::Value;
@@ -132,16 +131,26 @@ pub(crate) fn pack<const K: usize, V: Value>(
     universe: Universe<K>,
     levels: Vec<Vec<ValueState<V>>>,
 ) -> KTree<K, V> {
-    pack_chunks(universe, levels.into_iter().map(|l| vec![l]).collect())
+    pack_chunks(
+        universe,
+        levels
+            .into_iter()
+            .map(|l| vec![ValuedLevel::from_states(&l)])
+            .collect(),
+    )
 }
 
 /// [`pack`] of levels each kept as consecutive chunks; the levels packed on the rayon pool.
 fn pack_chunks<const K: usize, V: Value>(
     universe: Universe<K>,
-    mut levels: Vec<Vec<Vec<ValueState<V>>>>,
+    mut levels: Vec<Vec<ValuedLevel<V>>>,
 ) -> KTree<K, V> {
     use rayon::prelude::*;
-    while levels.len() > 1 && levels.last().is_some_and(|l| l.iter().all(Vec::is_empty)) {
+    while levels.len() > 1
+        && levels
+            .last()
+            .is_some_and(|l| l.iter().all(ValuedLevel::is_empty))
+    {
         levels.pop();
     }
     let (packed, values): (Vec<PackedStates>, Vec<Vec<V>>) =
@@ -149,56 +158,35 @@ fn pack_chunks<const K: usize, V: Value>(
     KTree::from_valued_levels(universe, packed, values)
 }
 
-/// One level's states, in chunks, as its 2-bit codes ([`NODES_PER_WORD`] to a word) and the values of its full nodes.
-fn pack_level<V: Value>(chunks: Vec<Vec<ValueState<V>>>) -> (PackedStates, Vec<V>) {
-    let len: usize = chunks.iter().map(Vec::len).sum();
-    let mut words = Vec::with_capacity(len.div_ceil(NODES_PER_WORD));
-    let mut column = Vec::new();
-    let (mut word, mut slot) = (0u64, 0usize);
-    for state in chunks.iter().flatten() {
-        let code = match *state {
-            ValueState::Empty => 0,
-            ValueState::Full(v) => {
-                if V::STORED {
-                    column.push(v);
-                }
-                1
-            }
-            ValueState::Partial => 2,
-            ValueState::Mixed => 3,
-        };
-        word |= code << (2 * slot);
-        slot += 1;
-        if slot == NODES_PER_WORD {
-            words.push(word);
-            (word, slot) = (0, 0);
-        }
+/// One level, kept as chunks, packed: its 2-bit codes with their rank index and the values of its full
+/// nodes (the chunks' codes joined by shifted word copies; one chunk is moved, not copied).
+fn pack_level<V: Value>(chunks: Vec<ValuedLevel<V>>) -> PackedLevel<V> {
+    let mut chunks = chunks.into_iter();
+    let mut level = chunks.next().unwrap_or_default();
+    for chunk in chunks {
+        level.append(chunk);
     }
-    if slot > 0 {
-        words.push(word);
-    }
-    let level = PackedStates::from_valued_words(words, len)
-        .expect("one word for every NODES_PER_WORD codes, none past the last");
-    (level, column)
+    level.into_packed()
 }
 
 /// A level packed: its 2-bit codes and the values of its full nodes.
 pub(crate) type PackedLevel<V> = (PackedStates, Vec<V>);
 
-/// A subtree built apart (on a thread of its own, say): its root's state and the states of each level
-/// below it in level order, each level as the chunks it was made of — joined to its siblings' without
-/// copying, copied once when the whole tree is packed ([`Subtree::into_tree`]).
+/// A subtree built apart (on a thread of its own, say): its root's state and each level below it in
+/// level order (2-bit codes and the full nodes' values, [`ValuedLevel`]), each level as the chunks it
+/// was made of — joined to its siblings' without copying, copied once when the whole tree is packed
+/// ([`Subtree::into_tree`]).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Subtree<V> {
     root: ValueState<V>,
     /// Level `d` holds the nodes `d + 1` levels below the root, in chunks.
-    below: Vec<Vec<Vec<ValueState<V>>>>,
+    below: Vec<Vec<ValuedLevel<V>>>,
 }
 
 impl<V: Value> Subtree<V> {
     /// The subtree of root `root` and the levels `below` it (level order, the first one the root's
     /// children, if it has any).
-    pub(crate) fn new(root: ValueState<V>, below: Vec<Vec<ValueState<V>>>) -> Self {
+    pub(crate) fn new(root: ValueState<V>, below: Vec<ValuedLevel<V>>) -> Self {
         let below = below
             .into_iter()
             .take_while(|l| !l.is_empty())
@@ -208,7 +196,7 @@ impl<V: Value> Subtree<V> {
     }
 
     /// [`Subtree::new`] of levels each made of chunks (the level their concatenation).
-    pub(crate) fn from_chunks(root: ValueState<V>, below: Vec<Vec<Vec<ValueState<V>>>>) -> Self {
+    pub(crate) fn from_chunks(root: ValueState<V>, below: Vec<Vec<ValuedLevel<V>>>) -> Self {
         let below = below
             .into_iter()
             .take_while(|l| l.iter().any(|chunk| !chunk.is_empty()))
@@ -232,7 +220,7 @@ impl<V: Value> Subtree<V> {
         if !root.has_children() {
             return Self::leaf(root);
         }
-        let mut below = vec![vec![states]];
+        let mut below = vec![vec![ValuedLevel::from_states(&states)]];
         for kid in kids {
             for (d, chunks) in kid.below.into_iter().enumerate() {
                 if below.len() <= d + 1 {
@@ -260,7 +248,7 @@ impl<V: Value> Subtree<V> {
 
     /// The levels from the root down, each packed as its codes and its full nodes' values.
     pub(crate) fn into_packed_levels(self) -> Vec<PackedLevel<V>> {
-        std::iter::once(vec![vec![self.root]])
+        std::iter::once(vec![ValuedLevel::from_states(&[self.root])])
             .chain(self.below)
             .map(pack_level)
             .collect()
@@ -269,7 +257,7 @@ impl<V: Value> Subtree<V> {
     /// The tree of `universe` this subtree is the whole of (its root the universe's root).
     pub(crate) fn into_tree<const K: usize>(self, universe: Universe<K>) -> KTree<K, V> {
         let mut levels = Vec::with_capacity(universe.level() as usize + 1);
-        levels.push(vec![vec![self.root]]);
+        levels.push(vec![ValuedLevel::from_states(&[self.root])]);
         levels.extend(self.below);
         pack_chunks(universe, levels)
     }

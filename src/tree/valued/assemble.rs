@@ -2,10 +2,9 @@
 
 use crate::space::{DimCheck, SpaceError, Universe};
 use crate::tree::ktree::KTree;
-use crate::tree::states::PackedStates;
 use crate::value::Value;
 
-use super::ValueState;
+use super::{ValueState, ValuedLevel};
 
 /// Collects a valued tree from its nodes in depth-first order (children in code order): each node is
 /// appended to its level, each full node's value to its level's column. The caller guarantees a complete
@@ -13,8 +12,7 @@ use super::ValueState;
 #[derive(Debug, Clone)]
 pub struct ValueAssembler<const K: usize, V> {
     universe: Universe<K>,
-    levels: Vec<PackedStates>,
-    values: Vec<Vec<V>>,
+    levels: Vec<ValuedLevel<V>>,
 }
 
 impl<const K: usize, V: Value> ValueAssembler<K, V> {
@@ -27,34 +25,24 @@ impl<const K: usize, V: Value> ValueAssembler<K, V> {
         Ok(Self {
             universe: Universe::new(level)?,
             levels: Vec::new(),
-            values: Vec::new(),
         })
     }
 
     /// Appends the next node of the traversal, at `depth`.
     pub fn push(&mut self, depth: usize, state: ValueState<V>) {
-        while self.levels.len() <= depth {
-            self.levels.push(PackedStates::new());
-            self.values.push(Vec::new());
+        if self.levels.len() <= depth {
+            self.levels.resize_with(depth + 1, ValuedLevel::new);
         }
-        let code = match state {
-            ValueState::Empty => 0,
-            ValueState::Full(v) => {
-                self.values[depth].push(v);
-                1
-            }
-            ValueState::Partial => 2,
-            ValueState::Mixed => 3,
-        };
-        self.levels[depth].push_code(code);
+        self.levels[depth].push(state);
     }
 
     /// The tree (the caller guarantees the traversal was complete and minimal).
     pub fn finish(self) -> KTree<K, V> {
-        let mut levels = self.levels;
-        for level in &mut levels {
-            level.finish();
-        }
-        KTree::from_valued_levels(self.universe, levels, self.values)
+        let (levels, values) = self
+            .levels
+            .into_iter()
+            .map(ValuedLevel::into_packed)
+            .unzip();
+        KTree::from_valued_levels(self.universe, levels, values)
     }
 }

@@ -36,16 +36,19 @@
 //! [`walk`]: reading a valued tree — the storage trait over trees in memory and files read in place, its
 //! depth-first walk and its leaves, and the tree read as its shape's leaves ([`LeavesOfValues`]);
 //! [`ValueAssembler`]: a valued tree collected from a depth-first traversal; [`ValueCursor`]: point
-//! location that remembers its last path; the dense reference builder.
+//! location that remembers its last path; the dense reference builder; a level as it is written
+//! (`ValuedLevel`).
 
 mod assemble;
 mod cursor;
 mod dense;
+mod level;
 pub mod walk;
 
 pub use assemble::ValueAssembler;
 pub use cursor::ValueCursor;
 pub(crate) use dense::for_each_voxel;
+pub(crate) use level::ValuedLevel;
 pub(crate) use walk::mixed_as_partial;
 pub use walk::{
     try_walk_values, BinaryValues, LeafValue, LeavesOfValues, ValueLeaves, ValueStorage,
