@@ -1,9 +1,10 @@
 //! Builds a minimal valued tree from the top down: a function says, for each cell, its value (or that it
 //! is empty) or that it splits, and carries a context of its own (the input nodes the cell lies in) from
-//! each cell to its children. The cells are decided level by level, so the nodes come in level order;
-//! then, from the deepest level up, each block of `2^K` children that [`combine`] makes a leaf (all
-//! empty, or all full of one value) is removed and its parent becomes that leaf. The result is minimal
-//! whatever the function decides, as long as a cell it splits has children (it is not a voxel).
+//! each cell to its children. The cells are decided depth first; a split cell's `2^K` children, once
+//! built, become a leaf if [`combine`] makes one of them (all empty, or all full of one value), else are
+//! appended to their level — so each level comes in level order, written as 2-bit codes and values as it
+//! comes, and the memory held besides the tree is one context a level. The result is minimal whatever the
+//! function decides, as long as a cell it splits has children (it is not a voxel).
 //!
 //! Every operation on valued trees that makes a tree (selecting, masking, overlaying, combining, mapping)
 //! is this builder with a deciding function over its inputs' nodes ([`InputNode`]).
@@ -57,90 +58,78 @@ pub enum Decision<V> {
 /// # Errors
 /// The first error of `decide` or `child` ([`TreeError`] through `From`); [`TreeError::Value`] for a NaN
 /// decided as a value; [`TreeError::PartialVoxel`] if a voxel is split; a level beyond the largest.
-pub fn build_top_down<const K: usize, V: Value, C: Clone, E: From<TreeError>>(
+pub fn build_top_down<const K: usize, V: Value, C, E: From<TreeError>>(
     level: u32,
     root: C,
     mut decide: impl FnMut(&Cell<K>, &C) -> Result<Decision<V>, E>,
     mut child: impl FnMut(&C, usize) -> Result<C, E>,
 ) -> Result<KTree<K, V>, E> {
     let universe = Universe::<K>::new(level).map_err(TreeError::from)?;
-    // Level by level: each level's states (Partial stands for "split, to be settled") in level order.
-    let mut levels: Vec<Vec<ValueState<V>>> = Vec::new();
-    let mut frontier = vec![(universe.root(), root)];
-    while !frontier.is_empty() {
-        let depth = levels.len();
-        let mut states = Vec::with_capacity(frontier.len());
-        let mut next = Vec::new();
-        for (cell, context) in &frontier {
-            match decide(cell, context)? {
-                Decision::Leaf(None) => states.push(ValueState::Empty),
-                Decision::Leaf(Some(v)) => {
-                    v.check().map_err(TreeError::from)?;
-                    states.push(ValueState::Full(v));
-                }
-                Decision::Split => {
-                    if cell.side() == 1 {
-                        return Err(TreeError::PartialVoxel { depth }.into());
-                    }
-                    states.push(ValueState::Partial);
-                    for code in 0..1usize << K {
-                        next.push((cell.child(code), child(context, code)?));
-                    }
-                }
-            }
-        }
-        levels.push(states);
-        frontier = next;
-    }
-    Ok(settle(universe, levels))
-}
-
-/// Settles the split nodes from the deepest level up (a block of children that combines into a leaf
-/// replaces its parent and leaves its level) and packs the levels.
-fn settle<const K: usize, V: Value>(
-    universe: Universe<K>,
-    mut levels: Vec<Vec<ValueState<V>>>,
-) -> KTree<K, V> {
-    let n = 1usize << K;
-    for depth in (0..levels.len().saturating_sub(1)).rev() {
-        let (upper, lower) = levels.split_at_mut(depth + 1);
-        let (parents, children) = (&mut upper[depth], &mut lower[0]);
-        let mut kept = 0usize;
-        let mut block = 0usize;
-        for parent in parents.iter_mut() {
-            if !parent.has_children() {
-                continue;
-            }
-            let kids = &children[block * n..(block + 1) * n];
-            let combined = combine(kids);
-            block += 1;
-            *parent = combined;
-            if combined.has_children() {
-                children.copy_within((block - 1) * n..block * n, kept * n);
-                kept += 1;
-            }
-        }
-        children.truncate(kept * n);
-    }
-    pack(universe, levels)
-}
-
-/// Packs settled levels of states (level order, a node with children followed by its `2^K` children in
-/// the level below) into a tree; trailing empty levels are dropped.
-pub(crate) fn pack<const K: usize, V: Value>(
-    universe: Universe<K>,
-    levels: Vec<Vec<ValueState<V>>>,
-) -> KTree<K, V> {
-    pack_chunks(
+    let mut build = TopDown {
+        levels: vec![ValuedLevel::new(); level as usize + 1],
+        decide: &mut decide,
+        child: &mut child,
+    };
+    let state = build.node(universe.root(), &root, 0)?;
+    let mut levels = build.levels;
+    levels[0].push(state);
+    Ok(pack_chunks(
         universe,
-        levels
-            .into_iter()
-            .map(|l| vec![ValuedLevel::from_states(&l)])
-            .collect(),
-    )
+        levels.into_iter().map(|level| vec![level]).collect(),
+    ))
 }
 
-/// [`pack`] of levels each kept as consecutive chunks; the levels packed on the rayon pool.
+/// A build from the top down under way: the settled nodes of each level so far (a node's children are
+/// appended to their level when the node is settled, so each level comes in level order), and the
+/// functions that decide a cell and make a child's context.
+struct TopDown<V, D, H> {
+    levels: Vec<ValuedLevel<V>>,
+    decide: D,
+    child: H,
+}
+
+impl<V: Value, D, H> TopDown<V, D, H> {
+    /// The state of `cell` (at `depth`, of context `context`) once its children, if it splits, are built
+    /// and settled: a leaf if they combine into one, else their states appended to the level below.
+    fn node<const K: usize, C, E>(
+        &mut self,
+        cell: Cell<K>,
+        context: &C,
+        depth: usize,
+    ) -> Result<ValueState<V>, E>
+    where
+        D: FnMut(&Cell<K>, &C) -> Result<Decision<V>, E>,
+        H: FnMut(&C, usize) -> Result<C, E>,
+        E: From<TreeError>,
+    {
+        match (self.decide)(&cell, context)? {
+            Decision::Leaf(None) => Ok(ValueState::Empty),
+            Decision::Leaf(Some(v)) => {
+                v.check().map_err(TreeError::from)?;
+                Ok(ValueState::Full(v))
+            }
+            Decision::Split => {
+                if cell.side() == 1 {
+                    return Err(TreeError::PartialVoxel { depth }.into());
+                }
+                let n = 1usize << K;
+                let mut kids = [ValueState::Empty; 16];
+                for (code, kid) in kids.iter_mut().enumerate().take(n) {
+                    let context = (self.child)(context, code)?;
+                    *kid = self.node(cell.child(code), &context, depth + 1)?;
+                }
+                let state = combine(&kids[..n]);
+                if state.has_children() {
+                    self.levels[depth + 1].extend_from_slice(&kids[..n]);
+                }
+                Ok(state)
+            }
+        }
+    }
+}
+
+/// Packs levels, each kept as consecutive chunks, into a tree (trailing empty levels dropped); the levels
+/// packed on the rayon pool.
 fn pack_chunks<const K: usize, V: Value>(
     universe: Universe<K>,
     mut levels: Vec<Vec<ValuedLevel<V>>>,
