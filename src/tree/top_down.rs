@@ -253,26 +253,43 @@ impl<V: Value> Subtree<V> {
 }
 
 /// A node of an input tree as a cell of the output descends: the node the cell lies in (a leaf covers all
-/// the cells below it) and its state.
+/// the cells below it), its state, and where its children start (found once, when the node is reached,
+/// not once for each child).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InputNode<V> {
     depth: usize,
-    index: usize,
+    /// The node's first child's index at `depth + 1`, when it has children.
+    first: usize,
     /// The node's state (a leaf's for every cell inside it).
     pub state: ValueState<V>,
 }
 
 impl<V: Value> InputNode<V> {
+    /// The node at `depth`, `index` of `tree`, of state `state`.
+    fn at<const K: usize, T: ValueStorage<K, Value = V>>(
+        tree: &T,
+        depth: usize,
+        index: usize,
+        state: ValueState<V>,
+    ) -> Result<Self, T::Error> {
+        let first = if state.has_children() {
+            tree.children(depth, index)?
+        } else {
+            0
+        };
+        Ok(Self {
+            depth,
+            first,
+            state,
+        })
+    }
+
     /// The root of a valued tree.
     ///
     /// # Errors
     /// The storage's read error.
     pub fn root<const K: usize, T: ValueStorage<K, Value = V>>(tree: &T) -> Result<Self, T::Error> {
-        Ok(Self {
-            depth: 0,
-            index: 0,
-            state: tree.root()?.state,
-        })
+        Self::at(tree, 0, 0, tree.root()?.state)
     }
 
     /// The node of child `code` of the cell this node stands for.
@@ -287,13 +304,10 @@ impl<V: Value> InputNode<V> {
         if !self.state.has_children() {
             return Ok(*self);
         }
-        let first = tree.children(self.depth, self.index)?;
-        let codes = tree.codes(self.depth + 1, first)?;
-        let index = first + code;
-        Ok(Self {
-            depth: self.depth + 1,
-            index,
-            state: tree.decode(self.depth + 1, index, codes >> (2 * code))?,
-        })
+        let depth = self.depth + 1;
+        let codes = tree.codes(depth, self.first)?;
+        let index = self.first + code;
+        let state = tree.decode(depth, index, codes >> (2 * code))?;
+        Self::at(tree, depth, index, state)
     }
 }
