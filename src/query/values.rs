@@ -1,9 +1,14 @@
 //! Values at points, in a batch, on any valued storage (a tree in memory or a valued file read in place).
 //!
-//! A large batch first tabulates the tree's top levels (about 2^15 cells: each an empty or full leaf, or
-//! the node to descend from), so that a point's answer is one look-up in the table and a descent of the
-//! few levels below it. The table is kept small enough to stay in the processor's cache: with 2^18 cells
-//! (2 MB for K = 3) its random look-ups missed, and 10^7 points took 1.2 times as long. The descents run sixteen side by side, a level of each in turn: their reads do
+//! A large batch first tabulates the tree over the box its points span (about 2^15 cells: each an empty
+//! or full leaf, or the node to descend from), so that a point's answer is one look-up in the table and a
+//! descent of the few levels below it. The table's cells are the smallest aligned cells of which the box
+//! needs no more than that: points gathered in a small part of a large universe (a map's scan in
+//! OctoMap's universe of 2^16 voxels a side) descend from a few levels above the voxels, not from the
+//! universe's top levels (10^6 points spread over OctoMap's real scan at 0.1 m answered in 0.037 s,
+//! against 0.114 s from a table of the universe's top levels). The table is kept small enough to stay in
+//! the processor's cache: with 2^18 cells (2 MB for K = 3) its random look-ups missed, and 10^7 points
+//! took 1.2 times as long. The descents run sixteen side by side, a level of each in turn: their reads do
 //! not wait on one another, so the processor overlaps their cache misses, where a lone descent waits for
 //! each level's read before the next (sorting the points into Morton order instead, so that neighbours
 //! share reads, cost more than it saved on random points). The points are answered in chunks on all
@@ -11,7 +16,6 @@
 
 use rayon::prelude::*;
 
-use crate::space::morton_encode;
 use crate::tree::cursor::Walk;
 use crate::tree::valued::{try_walk_values, ValueNode, ValueState, ValueStorage, ValueVisitor};
 
@@ -28,7 +32,7 @@ const CHUNK: usize = 1 << 14;
 const LANES: usize = 16;
 
 /// A cell of the table: a leaf's value (`Leaf(None)`: empty) or the node of the table's depth to descend
-/// from (below `2^(K · depth) ≤ 2^TOP_CELLS_LOG2`).
+/// from (its index in its level).
 #[derive(Clone, Copy)]
 enum Top<V> {
     Leaf(Option<V>),
@@ -55,13 +59,8 @@ where
     T::Error: Send,
 {
     let level = tree.level();
-    let depth = if points.len() >= TOP_FROM {
-        (TOP_CELLS_LOG2 / K as u32).min(level)
-    } else {
-        0
-    };
-    let table = top_table(tree, depth)?;
-    let below = level - depth;
+    let table = TopTable::new(tree, points)?;
+    let depth = table.depth;
     let mut out = vec![None; points.len()];
     points
         .par_chunks(CHUNK)
@@ -73,7 +72,7 @@ where
                 if point.iter().fold(0, |or, &c| or | c) >> level != 0 {
                     continue;
                 }
-                match table[morton_encode(point.map(|c| c >> below)) as usize] {
+                match table.cell(point) {
                     Top::Leaf(v) => out[i] = v,
                     Top::Node(index) => lanes.push(
                         Lane {
@@ -178,40 +177,146 @@ impl<'a, const K: usize, T: ValueStorage<K>> Lanes<'a, K, T> {
     }
 }
 
-/// The table of the cells of level `depth`, in Morton order.
-fn top_table<const K: usize, T: ValueStorage<K>>(
-    tree: &T,
+/// The cells of level `depth` that a batch's box of points overlaps, each an entry of `cells`, axis 0
+/// varying fastest.
+struct TopTable<const K: usize, V> {
     depth: u32,
-) -> Result<Vec<Top<T::Value>>, T::Error> {
-    struct Fill<V> {
-        depth: u32,
-        shift: u32,
-        cells: Vec<Top<V>>,
-    }
-    impl<const K: usize, V: Copy> ValueVisitor<K, V> for Fill<V> {
-        fn visit(&mut self, node: &ValueNode<K, V>) -> Walk {
-            let entry = match node.state {
-                ValueState::Empty => Top::Leaf(None),
-                ValueState::Full(v) => Top::Leaf(Some(v)),
-                ValueState::Partial | ValueState::Mixed if node.cell.level < self.depth => {
-                    return Walk::Descend
+    /// log2 of a cell's side: `level − depth`.
+    log_side: u32,
+    /// The box's first cell along each axis (in cells).
+    first: [u32; K],
+    /// The entries between neighbouring cells along each axis.
+    strides: [usize; K],
+    cells: Vec<Top<V>>,
+}
+
+impl<const K: usize, V: Copy> TopTable<K, V> {
+    /// The table for `points` (those outside the universe ignored): a single cell, the root, for a batch
+    /// smaller than [`TOP_FROM`] points.
+    fn new<T: ValueStorage<K, Value = V>>(tree: &T, points: &[[u32; K]]) -> Result<Self, T::Error> {
+        let level = tree.level();
+        let (mut lo, mut hi) = ([u32::MAX; K], [0u32; K]);
+        for point in points {
+            if point.iter().fold(0, |or, &c| or | c) >> level == 0 {
+                for a in 0..K {
+                    lo[a] = lo[a].min(point[a]);
+                    hi[a] = hi[a].max(point[a]);
                 }
-                ValueState::Partial | ValueState::Mixed => Top::Node(node.index as u32),
-            };
-            // A node's cells are a contiguous range in Morton order.
-            let first = (morton_encode(node.cell.origin) >> self.shift) as usize;
-            let count = 1usize << (K as u32 * (self.depth - node.cell.level));
-            self.cells[first..first + count].fill(entry);
-            Walk::Skip
+            }
+        }
+        let small = lo[0] > hi[0] || points.len() < TOP_FROM;
+        if small {
+            (lo, hi) = ([0; K], [0; K]);
+        }
+        // The smallest cells of which the box needs at most 2^TOP_CELLS_LOG2.
+        let cells_for = |log_side: u32| -> u64 {
+            (0..K)
+                .map(|a| u64::from((hi[a] >> log_side) - (lo[a] >> log_side)) + 1)
+                .product()
+        };
+        let log_side = if small {
+            level
+        } else {
+            (0..=level)
+                .find(|&s| cells_for(s) <= 1 << TOP_CELLS_LOG2)
+                .unwrap_or(level)
+        };
+        let first = lo.map(|c| c >> log_side);
+        let mut strides = [0; K];
+        let mut count = 1;
+        for a in 0..K {
+            strides[a] = count;
+            count *= ((hi[a] >> log_side) - first[a]) as usize + 1;
+        }
+        let mut table = Self {
+            depth: level - log_side,
+            log_side,
+            first,
+            strides,
+            cells: vec![Top::Leaf(None); count],
+        };
+        let last = hi.map(|c| c >> log_side);
+        table.fill(tree, last)?;
+        Ok(table)
+    }
+
+    /// Writes every cell's entry, walking the nodes that overlap the box (cells `first ..= last`).
+    fn fill<T: ValueStorage<K, Value = V>>(
+        &mut self,
+        tree: &T,
+        last: [u32; K],
+    ) -> Result<(), T::Error> {
+        struct Fill<'a, const K: usize, V> {
+            table: &'a mut TopTable<K, V>,
+            last: [u32; K],
+        }
+        impl<const K: usize, V: Copy> ValueVisitor<K, V> for Fill<'_, K, V> {
+            fn visit(&mut self, node: &ValueNode<K, V>) -> Walk {
+                let table = &mut *self.table;
+                // The node's cells of the table's level (it is no deeper), clipped to the box.
+                let cells = 1u64 << (node.cell.log_side - table.log_side);
+                let (mut from, mut to) = ([0u32; K], [0u32; K]);
+                for a in 0..K {
+                    let start = u64::from(node.cell.origin[a] >> table.log_side);
+                    let end = start + cells - 1;
+                    if end < u64::from(table.first[a]) || start > u64::from(self.last[a]) {
+                        return Walk::Skip;
+                    }
+                    from[a] = (start as u32).max(table.first[a]);
+                    to[a] = (end.min(u64::from(self.last[a]))) as u32;
+                }
+                let entry = match node.state {
+                    ValueState::Empty => Top::Leaf(None),
+                    ValueState::Full(v) => Top::Leaf(Some(v)),
+                    ValueState::Partial | ValueState::Mixed if node.cell.level < table.depth => {
+                        return Walk::Descend
+                    }
+                    ValueState::Partial | ValueState::Mixed => Top::Node(node.index as u32),
+                };
+                table.fill_range(from, to, entry);
+                Walk::Skip
+            }
+        }
+        try_walk_values(tree, &mut Fill { table: self, last })?;
+        Ok(())
+    }
+
+    /// Sets the cells `from ..= to` (in cells, inside the box) to `entry`.
+    fn fill_range(&mut self, from: [u32; K], to: [u32; K], entry: Top<V>) {
+        let mut at = from;
+        loop {
+            let start = self.index_of(at);
+            let run = (to[0] - from[0]) as usize + 1;
+            self.cells[start..start + run].fill(entry);
+            // The next row: axes 1.. counted like an odometer.
+            let mut a = 1;
+            loop {
+                if a == K {
+                    return;
+                }
+                if at[a] < to[a] {
+                    at[a] += 1;
+                    break;
+                }
+                at[a] = from[a];
+                a += 1;
+            }
         }
     }
-    let mut fill = Fill {
-        depth,
-        shift: K as u32 * (tree.level() - depth),
-        cells: vec![Top::Leaf(None); 1 << (K as u32 * depth)],
-    };
-    try_walk_values(tree, &mut fill)?;
-    Ok(fill.cells)
+
+    /// The entry of the cell `at` (in cells, inside the box).
+    #[inline]
+    fn index_of(&self, at: [u32; K]) -> usize {
+        (0..K)
+            .map(|a| (at[a] - self.first[a]) as usize * self.strides[a])
+            .sum()
+    }
+
+    /// The entry of the cell holding `point` (a voxel of the box).
+    #[inline]
+    fn cell(&self, point: [u32; K]) -> Top<V> {
+        self.cells[self.index_of(point.map(|c| c >> self.log_side))]
+    }
 }
 
 /// The first voxel holding a value that each ray meets, with its value (`None`: the ray meets none), on
@@ -244,4 +349,89 @@ pub fn first_values<const K: usize, V: crate::value::Value>(
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::space::Universe;
+    use crate::KTree;
+    use proptest::prelude::*;
+
+    /// A step of a linear congruential generator.
+    fn next(x: &mut u64) -> u64 {
+        *x = x
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        *x >> 33
+    }
+
+    /// A large batch of points inside the box `lo ..= hi` (and a few outside the universe) is answered as
+    /// the tree answers each point, whatever the box's size and place (the table's cells are then of any
+    /// size, from a voxel to the root).
+    fn batch_in_a_box_is_point_by_point<const K: usize>(
+        level: u32,
+        corners: [[u32; K]; 2],
+        seed: u64,
+    ) -> Result<(), TestCaseError> {
+        let u = Universe::<K>::new(level).unwrap();
+        let mut x = seed;
+        // Values in blocks of 2 and 4 voxels a side, some empty, so that the tree has leaves of all sizes.
+        let dense: Vec<Option<u8>> = (0..u.voxels() as usize)
+            .map(|i| {
+                let p = u.dense_point(i);
+                let block = p
+                    .iter()
+                    .fold(seed, |h, &c| h.wrapping_mul(31) ^ u64::from(c >> 2));
+                let fine = p
+                    .iter()
+                    .fold(seed, |h, &c| h.wrapping_mul(17) ^ u64::from(c >> 1));
+                (block % 3 != 0).then_some((fine.wrapping_mul(0x9E37_79B9) >> 7) as u8 % 3)
+            })
+            .collect();
+        let tree = KTree::<K, u8>::from_dense_values(level, &dense).unwrap();
+        let side = u.side() as u32;
+        let [c, d] = corners.map(|corner| corner.map(|v| v % side));
+        let lo: [u32; K] = std::array::from_fn(|a| c[a].min(d[a]));
+        let hi: [u32; K] = std::array::from_fn(|a| c[a].max(d[a]));
+        let points: Vec<[u32; K]> = (0..TOP_FROM + 1000)
+            .map(|i| {
+                if i % 1000 == 7 {
+                    return [side + (i as u32 % 3); K];
+                }
+                std::array::from_fn(|a: usize| {
+                    lo[a] + (next(&mut x) % u64::from(hi[a] - lo[a] + 1)) as u32
+                })
+            })
+            .collect();
+        let got = values_at(&tree, &points).unwrap();
+        for (g, p) in got.iter().zip(&points) {
+            prop_assert_eq!(*g, tree.value_at(*p), "at {:?}", p);
+        }
+        Ok(())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+
+        #[test]
+        fn batch_in_a_box_is_point_by_point_k1(a in any::<[u32; 1]>(), b in any::<[u32; 1]>(), seed in any::<u64>()) {
+            batch_in_a_box_is_point_by_point::<1>(20, [a, b], seed)?;
+        }
+
+        #[test]
+        fn batch_in_a_box_is_point_by_point_k2(a in any::<[u32; 2]>(), b in any::<[u32; 2]>(), seed in any::<u64>()) {
+            batch_in_a_box_is_point_by_point::<2>(9, [a, b], seed)?;
+        }
+
+        #[test]
+        fn batch_in_a_box_is_point_by_point_k3(a in any::<[u32; 3]>(), b in any::<[u32; 3]>(), seed in any::<u64>()) {
+            batch_in_a_box_is_point_by_point::<3>(6, [a, b], seed)?;
+        }
+
+        #[test]
+        fn batch_in_a_box_is_point_by_point_k4(a in any::<[u32; 4]>(), b in any::<[u32; 4]>(), seed in any::<u64>()) {
+            batch_in_a_box_is_point_by_point::<4>(4, [a, b], seed)?;
+        }
+    }
 }
