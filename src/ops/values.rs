@@ -305,6 +305,22 @@ impl<const K: usize, V: Value> KTree<K, V> {
         crate::tree::storage::infallible(crate::query::values_at(self, points))
     }
 
+    /// [`KTree::values_at`] written into `out`, one entry a point (a buffer kept from batch to batch).
+    ///
+    /// ```
+    /// use ktree::KTree;
+    /// let t = KTree::<1, u8>::from_dense_values(1, &[Some(5), None]).unwrap();
+    /// let mut out = vec![None; 2];
+    /// t.values_at_into(&[[0], [1]], &mut out);
+    /// assert_eq!(out, [Some(5), None]);
+    /// ```
+    ///
+    /// # Panics
+    /// If `out` and `points` differ in length.
+    pub fn values_at_into(&self, points: &[[u32; K]], out: &mut [Option<V>]) {
+        crate::tree::storage::infallible(crate::query::values_at_into(self, points, out));
+    }
+
     /// The tree as valued runs along the last axis: each full leaf's columns, one run each (touching runs
     /// of one value are not joined; [`KTree::from_value_runs`] gives this tree back).
     pub fn to_value_runs(&self) -> ValueRuns<K, V> {

@@ -38,7 +38,7 @@ pub use nearest::{distance, nearest, nearest_many, nearest_many_signed, nearest_
 pub use points::{contains, contains_many, contains_many_signed, PointCursor};
 pub use ray::{cast_ray, cast_rays, CastError, Face, RayCast, RayHit};
 pub use stats::{stats, TreeStats};
-pub use values::{first_values, values_at};
+pub use values::{first_values, values_at, values_at_into};
 
 use crate::tree::storage::{infallible, TreeStorage};
 use crate::KTree;
