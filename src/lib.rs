@@ -113,6 +113,8 @@ pub mod shape;
 pub mod solid;
 pub mod space;
 pub mod stacking;
+#[cfg(test)]
+mod testing;
 pub mod tree;
 pub mod value;
 

@@ -485,14 +485,11 @@ mod tests {
 
     fn check_morton<const K: usize>() {
         let bits = max_level(K);
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut lcg = crate::testing::Lcg(0x9E37_79B9_7F4A_7C15);
         for _ in 0..2000 {
             let mut p = [0u32; K];
             for c in p.iter_mut() {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                *c = ((state >> 33) as u32) & ((1u64 << bits) - 1) as u32;
+                *c = ((lcg.next_u64() >> 33) as u32) & ((1u64 << bits) - 1) as u32;
             }
             let key = morton_encode(p);
             assert_eq!(key, naive_morton(p, bits), "K={K} p={p:?}");

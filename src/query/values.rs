@@ -419,14 +419,6 @@ mod tests {
     use crate::KTree;
     use proptest::prelude::*;
 
-    /// A step of a linear congruential generator.
-    fn next(x: &mut u64) -> u64 {
-        *x = x
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        *x >> 33
-    }
-
     /// A large batch of points inside the box `lo ..= hi` (and a few outside the universe) is answered as
     /// the tree answers each point, whatever the box's size and place (the table's cells are then of any
     /// size, from a voxel to the root).
@@ -436,7 +428,7 @@ mod tests {
         seed: u64,
     ) -> Result<(), TestCaseError> {
         let u = Universe::<K>::new(level).unwrap();
-        let mut x = seed;
+        let mut lcg = crate::testing::Lcg(seed);
         // Values in blocks of 2 and 4 voxels a side, some empty, so that the tree has leaves of all sizes.
         let dense: Vec<Option<u8>> = (0..u.voxels() as usize)
             .map(|i| {
@@ -463,10 +455,10 @@ mod tests {
                     return [side + (i as u32 % 3); K];
                 }
                 if i % 1000 == 501 {
-                    return std::array::from_fn(|_| (next(&mut x) % u64::from(side)) as u32);
+                    return std::array::from_fn(|_| lcg.below(u64::from(side)) as u32);
                 }
                 std::array::from_fn(|a: usize| {
-                    lo[a] + (next(&mut x) % u64::from(hi[a] - lo[a] + 1)) as u32
+                    lo[a] + lcg.below(u64::from(hi[a] - lo[a] + 1)) as u32
                 })
             })
             .collect();

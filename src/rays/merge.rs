@@ -492,15 +492,11 @@ impl<Z: Copy + Ord> Iterator for Stretches<'_, Z> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testing::Lcg;
 
     /// Random sorted, disjoint, non-touching runs in `0..60`.
-    fn runs(state: &mut u64) -> Vec<(u32, u32)> {
-        let mut next = |n: u64| {
-            *state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (*state >> 33) % n
-        };
+    fn runs(lcg: &mut Lcg) -> Vec<(u32, u32)> {
+        let mut next = |n: u64| lcg.below(n);
         let mut out = Vec::new();
         let mut z = next(4) as u32;
         while z < 56 && next(8) != 0 {
@@ -514,9 +510,9 @@ mod tests {
     /// The fast unions and intersections give what the sweep gives, ends' causes included.
     #[test]
     fn fast_tables_are_the_sweep() {
-        let mut state = 5;
+        let mut lcg = Lcg(5);
         for _ in 0..2000 {
-            let (a, b) = (runs(&mut state), runs(&mut state));
+            let (a, b) = (runs(&mut lcg), runs(&mut lcg));
             for table in [TruthTable::UNION, TruthTable::INTERSECTION] {
                 let (mut fast, mut swept) = (Vec::new(), Vec::new());
                 merge_runs(
@@ -540,9 +536,9 @@ mod tests {
 
     #[test]
     fn stretches_cover_both_inputs() {
-        let mut state = 9;
+        let mut lcg = Lcg(9);
         for _ in 0..500 {
-            let (a, b) = (runs(&mut state), runs(&mut state));
+            let (a, b) = (runs(&mut lcg), runs(&mut lcg));
             let inside = |runs: &[(u32, u32)], z: u32| runs.iter().any(|r| r.0 <= z && z < r.1);
             let mut at = None;
             for s in stretches(&a, &b) {

@@ -818,13 +818,8 @@ mod tests {
     /// The envelope against the minimum over all samples, with random-ish samples and query ranges.
     #[test]
     fn envelope_is_the_lower_envelope() {
-        let mut seed = 7u64;
-        let mut next = |n: u64| {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 33) % n
-        };
+        let mut lcg = crate::testing::Lcg(7);
+        let mut next = |n: u64| lcg.below(n);
         let mut hull = Vec::new();
         for _ in 0..500 {
             let mut samples: Vec<(i64, u64)> = (0..next(12))

@@ -292,14 +292,12 @@ mod tests {
     #[test]
     fn reduced_blocks_make_the_same_top_levels() {
         let (k, m) = (2u32, 4u32);
-        let mut x = 11u64;
+        let mut lcg = crate::testing::Lcg(11);
         for round in 0..50u64 {
             let mut single = Vec::new();
             let mut partial = Vec::new();
             for i in 0..1u64 << (k * m) {
-                x = x
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
+                let x = lcg.next_u64();
                 // One full quadrant; elsewhere mostly full cells, some partial and empty ones.
                 let state = match (i >> 6 == round % 4, (x >> 33) % 16) {
                     (true, _) | (false, 1..=9) => NodeState::Full,

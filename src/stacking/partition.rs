@@ -402,16 +402,13 @@ mod tests {
 
     #[test]
     fn level_words_concatenate_like_pushes() {
-        let mut x = 7u64;
+        let mut lcg = crate::testing::Lcg(7);
         let mut expected = PackedStates::new();
         let mut joined = LevelWords::default();
         for n in [0usize, 1, 31, 32, 33, 5, 64, 100, 3] {
             let mut part = PackedStates::new();
             for _ in 0..n {
-                x = x
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let s = NodeState::from_code((x >> 33) as u8 % 3).unwrap();
+                let s = NodeState::from_code(lcg.below(3) as u8).unwrap();
                 part.push(s);
                 expected.push(s);
             }

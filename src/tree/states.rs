@@ -457,13 +457,10 @@ mod tests {
         // Codes 00, 01, 10 and 11 (a mixed node of a valued tree: it has children, it is not full).
         let mut words = Vec::new();
         let mut codes = Vec::new();
-        let mut x = 99u64;
+        let mut lcg = crate::testing::Lcg(99);
         let n = 2 * 65_536 + 4_321;
         for i in 0..n {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let code = (x >> 61) & 3;
+            let code = (lcg.next_u64() >> 61) & 3;
             if i % 32 == 0 {
                 words.push(0u64);
             }

@@ -218,18 +218,12 @@ impl LevelWords {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testing::Lcg;
 
     /// Random 2-bit codes 0…2 from a fixed seed.
     fn codes(n: usize, seed: u64) -> Vec<u64> {
-        let mut x = seed;
-        (0..n)
-            .map(|_| {
-                x = x
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (x >> 33) % 3
-            })
-            .collect()
+        let mut lcg = Lcg(seed);
+        (0..n).map(|_| lcg.below(3)).collect()
     }
 
     /// The naive packing: one code at a time.
@@ -258,11 +252,9 @@ mod tests {
 
     #[test]
     fn masks_and_counts_agree_with_decoding_each_slot() {
-        let mut x = 99u64;
+        let mut lcg = Lcg(99);
         for _ in 0..2000 {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            let x = lcg.next_u64();
             for word in [
                 x,
                 x & 0x5555_5555_5555_5555,

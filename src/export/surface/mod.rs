@@ -385,18 +385,16 @@ fn pinched(m: u8, d: usize) -> bool {
     f == [true, false, false, true] || f == [false, true, true, false]
 }
 
-/// A tree of `blocks` aligned blocks of every size at random places (from `state`), at `level` (at most
+/// A tree of `blocks` aligned blocks of every size at random places (from `lcg`), at `level` (at most
 /// 7), each third one cut out when `cut`.
 #[cfg(test)]
-fn random_blocks(level: u32, state: &mut u64, blocks: usize, cut: bool) -> KTree<3> {
+fn random_blocks(level: u32, lcg: &mut crate::testing::Lcg, blocks: usize, cut: bool) -> KTree<3> {
     let side = 1usize << level;
     let mut dense = vec![false; side * side * side];
     for block in 0..blocks {
-        *state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        let log_side = (*state >> 60) as usize % level as usize;
-        let at = [*state >> 8, *state >> 20, *state >> 32]
+        let state = lcg.next_u64();
+        let log_side = (state >> 60) as usize % level as usize;
+        let at = [state >> 8, state >> 20, state >> 32]
             .map(|c| ((c as usize % side) >> log_side) << log_side);
         for z in at[2]..at[2] + (1 << log_side) {
             for y in at[1]..at[1] + (1 << log_side) {

@@ -430,9 +430,9 @@ mod tests {
     #[test]
     fn sections_hold_the_voxels_of_their_plane_until_the_next() {
         let side = 16;
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut lcg = crate::testing::Lcg(0x2545_F491_4F6C_DD1D);
         for _ in 0..40 {
-            let tree = super::super::random_blocks(4, &mut state, 6, false);
+            let tree = super::super::random_blocks(4, &mut lcg, 6, false);
             let mut slab = Slab::default();
             let mut x = 0;
             while x < side {

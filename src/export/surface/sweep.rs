@@ -786,10 +786,10 @@ mod tests {
 
     #[test]
     fn unit_faces_are_the_surface_area() {
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut lcg = crate::testing::Lcg(0x9E37_79B9_7F4A_7C15);
         for round in 0..30 {
             // Aligned blocks of every size, added and cut out.
-            let tree = super::super::random_blocks(4, &mut state, 8, true);
+            let tree = super::super::random_blocks(4, &mut lcg, 8, true);
             assert_eq!(unit_faces(&tree), Ok(tree.surface_area()), "round {round}");
         }
         // The full universe at the largest level, counted without a run per column.

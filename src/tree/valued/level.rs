@@ -112,12 +112,10 @@ mod tests {
 
     /// States of every kind, values 0…4, from a fixed seed.
     fn states(n: usize, seed: u64) -> Vec<ValueState<u8>> {
-        let mut x = seed;
+        let mut lcg = crate::testing::Lcg(seed);
         (0..n)
             .map(|_| {
-                x = x
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
+                let x = lcg.next_u64();
                 match (x >> 33) % 4 {
                     0 => ValueState::Empty,
                     1 => ValueState::Full((x >> 40) as u8 % 5),
