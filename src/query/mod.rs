@@ -24,6 +24,7 @@
 //! assert_eq!(tree.nearest([3, 3]).unwrap().voxel, [2, 1]);
 //! ```
 
+mod box_table;
 pub mod boxes;
 pub mod dense;
 pub mod nearest;

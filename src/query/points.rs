@@ -1,11 +1,12 @@
 //! Point queries: one voxel ([`contains`]), many at once ([`contains_many`], from anywhere:
-//! [`contains_many_signed`]; most answered from a table of the tree's top levels, the rest ordered by
+//! [`contains_many_signed`]; most answered from a table of the cells of the points' box, the rest ordered by
 //! Morton key and answered on all threads, each thread walking its share of the tree once), and a cursor
 //! that remembers its last path for coherent queries ([`PointCursor`], the one point descent of
 //! [`locate`](crate::tree::locate)).
 
 use rayon::prelude::*;
 
+use super::box_table::BoxTable;
 use crate::radix::sort_by_key;
 use crate::space::morton_encode;
 use crate::tree::cursor::{try_walk, Visitor, Walk};
@@ -27,72 +28,50 @@ pub fn contains<const K: usize, T: TreeStorage<K>>(
 /// The points of one run of a batch, ordered by Morton key and answered by one [`PointCursor`].
 const RUN: usize = 1 << 14;
 
-/// log₂ of the most cells of [`TopStates`]: a byte each, 256 KiB, held in the second-level cache.
+/// log₂ of the most cells of a batch's table: a byte each, 256 KiB, held in the second-level cache.
 const TOP_CELLS_LOG2: u32 = 18;
 
-/// Batches of at least this many points first build a [`TopStates`] table (its cost, a walk of the top
-/// levels and a fill of its cells, is then a small share of the batch).
+/// Batches of at least this many points first build a table of their box (its cost, a walk of the nodes
+/// above its cells and a fill of its cells, is then a small share of the batch).
 const TOP_FROM: usize = 1 << 16;
 
-/// The state of every cell of one depth `d` of the tree (`d` levels of `K` bits: at most
-/// 2^[`TOP_CELLS_LOG2`] cells), indexed by Morton key, as OpenVDB keeps its top levels in a root table: a
-/// point in an empty or full cell of depth ≤ `d` is answered by one read, and only a point in a partial
-/// cell of depth `d` walks the tree below.
-struct TopStates {
-    /// A point's Morton key shifted right by this gives its cell.
-    shift: u32,
-    states: Vec<u8>,
-}
-
-impl TopStates {
-    fn new<const K: usize, T: TreeStorage<K>>(tree: &T) -> Result<Self, T::Error> {
-        let level = tree.level();
-        let depth = (TOP_CELLS_LOG2 / K as u32).min(level);
-        let shift = K as u32 * (level - depth);
-        let mut fill = Fill {
-            depth,
-            shift,
-            states: vec![NodeState::Empty as u8; 1 << (K as u32 * depth)],
-        };
-        try_walk(tree, &mut fill)?;
-        Ok(Self {
-            shift,
-            states: fill.states,
-        })
-    }
-
-    /// The state of the cell holding the point of Morton key `key`: [`NodeState::Partial`] where the
-    /// tree must be walked below.
-    #[inline]
-    fn state(&self, key: u64) -> NodeState {
-        NodeState::from_bits(u32::from(self.states[(key >> self.shift) as usize]))
-    }
-}
-
-/// Writes each node of a [`TopStates`] walk that is a leaf above its depth, or at its depth, over its cells.
-struct Fill {
-    depth: u32,
-    shift: u32,
-    states: Vec<u8>,
-}
-
-impl<const K: usize> Visitor<K> for Fill {
-    const LEAVES: bool = false;
-    fn visit(&mut self, node: &NodeRef<K>) -> Walk {
-        if node.state == NodeState::Partial && node.cell.level < self.depth {
-            return Walk::Descend;
+/// The state of every cell of a batch's box ([`BoxTable`]), as OpenVDB keeps its top levels in a root
+/// table: a point in an empty or full cell is answered by one read, and only a point in a partial cell (or
+/// outside the box) walks the tree.
+fn top_states<const K: usize, T: TreeStorage<K>, P>(
+    tree: &T,
+    points: &[P],
+    voxel: impl Fn(&P) -> Option<[u32; K]>,
+) -> Result<BoxTable<K, NodeState>, T::Error> {
+    struct Fill<'a, const K: usize>(&'a mut BoxTable<K, NodeState>);
+    impl<const K: usize> Visitor<K> for Fill<'_, K> {
+        const LEAVES: bool = false;
+        fn visit(&mut self, node: &NodeRef<K>) -> Walk {
+            if node.state == NodeState::Partial && node.cell.level < self.0.depth {
+                return if self.0.overlaps(&node.cell) {
+                    Walk::Descend
+                } else {
+                    Walk::Skip
+                };
+            }
+            self.0.set(&node.cell, node.state);
+            Walk::Skip
         }
-        // A node's cells are a contiguous range in Morton order.
-        let first = (morton_encode(node.cell.origin) >> self.shift) as usize;
-        let count = 1usize << (K as u32 * (self.depth - node.cell.level));
-        self.states[first..first + count].fill(node.state as u8);
-        Walk::Skip
     }
+    let mut table = BoxTable::spanning(
+        tree.level(),
+        points,
+        voxel,
+        TOP_CELLS_LOG2,
+        NodeState::Empty,
+    );
+    try_walk(tree, &mut Fill(&mut table))?;
+    Ok(table)
 }
 
 /// Whether each voxel of `points` is inside the object, in the order given. A batch of 65 536 points or
-/// more first reads the tree's top levels into a table of at most 2^18 cells, which answers every point
-/// in an empty or full cell down to that depth by one read. The other points are cut into runs of 16 384
+/// more first reads the tree's nodes over the box of its points into a table of at most 2^18 cells,
+/// which answers every point in an empty or full cell by one read. The other points are cut into runs of 16 384
 /// answered on all threads; within a run they are ordered by Morton key and answered by one
 /// [`PointCursor`], so that each run walks the tree once, in order, in cache. Points outside the universe
 /// are `false`.
@@ -156,7 +135,7 @@ where
     P: Sync,
 {
     let top = if points.len() >= TOP_FROM {
-        Some(TopStates::new(tree)?)
+        Some(top_states(tree, points, &voxel)?)
     } else {
         None
     };
@@ -169,10 +148,11 @@ where
             let Some(v) = inside(p) else {
                 continue;
             };
-            let key = morton_encode(v);
-            match top.as_ref().map_or(NodeState::Partial, |t| t.state(key)) {
-                NodeState::Partial => order.push((key, i as u32)),
-                state => out[i] = state == NodeState::Full,
+            match top.as_ref().and_then(|t| t.get(v)) {
+                Some(NodeState::Full) => out[i] = true,
+                Some(NodeState::Empty) => {}
+                // In a partial cell or outside the box: walked.
+                _ => order.push((morton_encode(v), i as u32)),
             }
         }
         sort_by_key(&mut order, K as u32 * tree.level(), &mut Vec::new(), |p| {
