@@ -71,7 +71,7 @@
 //!  solid/             quadrics, meshes, volumes → rays, slab by slab
 //!  tree/              KTree (binary, or with a value per voxel: tree::value, tree::valued), AnyTree, the
 //!                     storage trait, the walks, the level sink, the top-down builder, packed 2-bit words
-//!  rays/   space   fs (atomic writes, spill folders)
+//!  rays/   space   fs (atomic writes, spill folders)   testing (the unit tests' seeded numbers)
 //! ```
 //! `verify/tests/layers.rs` fails on any upward import. The operators `|`, `&`, `-`,
 //! `^`, `!` on trees are defined in `ops/`, beside the Booleans they call. The streamed Booleans of files

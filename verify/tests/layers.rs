@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// The layers, lowest first; a module may import the modules of the layers before its own.
 const LAYERS: &[&[&str]] = &[
-    &["space", "fs", "radix", "dim", "value"],
+    &["space", "fs", "radix", "dim", "value", "testing"],
     &["rays"],
     &["tree"],
     &["solid"],
