@@ -148,11 +148,15 @@ where
             let Some(v) = inside(p) else {
                 continue;
             };
-            match top.as_ref().and_then(|t| t.get(v)) {
-                Some(NodeState::Full) => out[i] = true,
-                Some(NodeState::Empty) => {}
-                // In a partial cell or outside the box: walked.
-                _ => order.push((morton_encode(v), i as u32)),
+            // In a partial cell or outside the box: walked. (A leaf's answer is written without a
+            // branch on which leaf: inside and outside alternate at random.)
+            match top
+                .as_ref()
+                .and_then(|t| t.get(v))
+                .unwrap_or(NodeState::Partial)
+            {
+                NodeState::Partial => order.push((morton_encode(v), i as u32)),
+                state => out[i] = state == NodeState::Full,
             }
         }
         sort_by_key(&mut order, K as u32 * tree.level(), &mut Vec::new(), |p| {
