@@ -1,6 +1,6 @@
 //! Values at points, in a batch, on any valued storage (a tree in memory or a valued file read in place).
 //!
-//! A large batch first tabulates the tree over the box its points span ([`BoxTable`], 2^15 cells: each an
+//! A large batch first tabulates the tree over the box its points span (`box_table`, 2^15 cells: each an
 //! empty or full leaf, or the node to descend from), so that a point's answer is one look-up in the table
 //! and a descent of the few levels below it (10^6 points spread over OctoMap's real scan at 0.1 m answered
 //! in 0.037 s, against 0.114 s from a table of the universe's top levels). The table is kept small enough
