@@ -18,6 +18,10 @@
 
 use crate::space::Cell;
 
+/// Batches of at least this many points first build a table of their box (its cost, a walk of the nodes
+/// above its cells and a fill of its cells, is then a small share of the batch).
+pub(crate) const TABLE_FROM: usize = 1 << 16;
+
 /// The points sampled to find a batch's box, at most.
 const SAMPLE_LOG2: u32 = 16;
 

@@ -6,7 +6,7 @@
 
 use rayon::prelude::*;
 
-use super::box_table::BoxTable;
+use super::box_table::{BoxTable, TABLE_FROM};
 use crate::radix::sort_by_key;
 use crate::space::morton_encode;
 use crate::tree::cursor::{try_walk, Visitor, Walk};
@@ -30,10 +30,6 @@ const RUN: usize = 1 << 14;
 
 /// log₂ of the most cells of a batch's table: a byte each, 256 KiB, held in the second-level cache.
 const TOP_CELLS_LOG2: u32 = 18;
-
-/// Batches of at least this many points first build a table of their box (its cost, a walk of the nodes
-/// above its cells and a fill of its cells, is then a small share of the batch).
-const TOP_FROM: usize = 1 << 16;
 
 /// The state of every cell of a batch's box ([`BoxTable`]), as OpenVDB keeps its top levels in a root
 /// table: a point in an empty or full cell is answered by one read, and only a point in a partial cell (or
@@ -134,7 +130,7 @@ where
     T: TreeStorage<K> + Sync,
     P: Sync,
 {
-    let top = if points.len() >= TOP_FROM {
+    let top = if points.len() >= TABLE_FROM {
         Some(top_states(tree, points, &voxel)?)
     } else {
         None

@@ -13,15 +13,12 @@
 
 use rayon::prelude::*;
 
-use super::box_table::BoxTable;
+use super::box_table::{BoxTable, TABLE_FROM};
 use crate::tree::cursor::Walk;
 use crate::tree::valued::{try_walk_values, ValueNode, ValueState, ValueStorage, ValueVisitor};
 
 /// Cells of the table of a batch's box, as a power of two.
 const TOP_CELLS_LOG2: u32 = 15;
-
-/// Batches from this many points are answered through the table.
-const TOP_FROM: usize = 1 << 16;
 
 /// Points a task answers.
 const CHUNK: usize = 1 << 14;
@@ -35,6 +32,17 @@ const LANES: usize = 16;
 enum Top<V> {
     Leaf(Option<V>),
     Node(u32),
+}
+
+impl<V> Top<V> {
+    /// The entry of node `index` in state `state`.
+    fn of(state: ValueState<V>, index: usize) -> Self {
+        match state {
+            ValueState::Empty => Top::Leaf(None),
+            ValueState::Full(v) => Top::Leaf(Some(v)),
+            ValueState::Partial | ValueState::Mixed => Top::Node(index as u32),
+        }
+    }
 }
 
 /// The value of every voxel of `points` (`None` where empty or outside the universe), in order.
@@ -217,11 +225,11 @@ struct TopTable<const K: usize, V> {
 }
 
 impl<const K: usize, V: Copy> TopTable<K, V> {
-    /// The table for `points`: the root alone for a batch smaller than [`TOP_FROM`] points.
+    /// The table for `points`: the root alone for a batch smaller than [`TABLE_FROM`] points.
     fn new<T: ValueStorage<K, Value = V>>(tree: &T, points: &[[u32; K]]) -> Result<Self, T::Error> {
         let level = tree.level();
         let empty = Top::Leaf(None);
-        let mut cells = if points.len() < TOP_FROM {
+        let mut cells = if points.len() < TABLE_FROM {
             BoxTable::root(level, empty)
         } else {
             BoxTable::spanning(level, points, |p| Some(*p), TOP_CELLS_LOG2, empty)
@@ -229,28 +237,20 @@ impl<const K: usize, V: Copy> TopTable<K, V> {
         struct Fill<'a, const K: usize, V>(&'a mut BoxTable<K, Top<V>>);
         impl<const K: usize, V: Copy> ValueVisitor<K, V> for Fill<'_, K, V> {
             fn visit(&mut self, node: &ValueNode<K, V>) -> Walk {
-                let entry = match node.state {
-                    ValueState::Empty => Top::Leaf(None),
-                    ValueState::Full(v) => Top::Leaf(Some(v)),
-                    ValueState::Partial | ValueState::Mixed if node.cell.level < self.0.depth => {
-                        return if self.0.overlaps(&node.cell) {
-                            Walk::Descend
-                        } else {
-                            Walk::Skip
-                        };
-                    }
-                    ValueState::Partial | ValueState::Mixed => Top::Node(node.index as u32),
-                };
+                let entry = Top::of(node.state, node.index);
+                if matches!(entry, Top::Node(_)) && node.cell.level < self.0.depth {
+                    return if self.0.overlaps(&node.cell) {
+                        Walk::Descend
+                    } else {
+                        Walk::Skip
+                    };
+                }
                 self.0.set(&node.cell, entry);
                 Walk::Skip
             }
         }
         try_walk_values(tree, &mut Fill(&mut cells))?;
-        let root = match tree.root()?.state {
-            ValueState::Empty => Top::Leaf(None),
-            ValueState::Full(v) => Top::Leaf(Some(v)),
-            ValueState::Partial | ValueState::Mixed => Top::Node(0),
-        };
+        let root = Top::of(tree.root()?.state, 0);
         Ok(Self { cells, root })
     }
 
