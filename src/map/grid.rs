@@ -52,10 +52,17 @@ impl MapGrid {
     /// or `None` outside the map's `2^16` voxels.
     #[inline]
     pub fn key(&self, c: f64) -> Option<u32> {
-        let scaled = (self.factor * c).floor();
+        let scaled = self.factor * c;
         let centre = f64::from(CENTRE_KEY);
-        (scaled >= -centre && scaled < centre)
-            .then(|| (scaled as i64 + i64::from(CENTRE_KEY)) as u32)
+        // The floor of `scaled` is in [−centre, centre) exactly when `scaled` is (the bounds are whole).
+        if !(scaled >= -centre && scaled < centre) {
+            return None;
+        }
+        // The floor by truncation, one less below zero unless whole (`f64::floor` is a library call on
+        // processors without SSE4.1).
+        let truncated = scaled as i64;
+        let floor = truncated - i64::from(truncated as f64 > scaled);
+        Some((floor + i64::from(CENTRE_KEY)) as u32)
     }
 
     /// The keys of a point, or `None` if any coordinate is outside the map.
@@ -100,5 +107,45 @@ impl MapGrid {
     pub fn from_world_frame(frame: &crate::space::WorldFrame) -> Option<Self> {
         let grid = Self::new(frame.voxel_size).ok()?;
         (grid.world_frame() == *frame).then_some(grid)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// OctoMap's `coordToKeyChecked`: the floor of the scaled coordinate, checked against the map.
+    fn key_by_floor(grid: &MapGrid, c: f64) -> Option<u32> {
+        let scaled = (grid.factor * c).floor();
+        let centre = f64::from(CENTRE_KEY);
+        (scaled >= -centre && scaled < centre)
+            .then(|| (scaled as i64 + i64::from(CENTRE_KEY)) as u32)
+    }
+
+    proptest! {
+        /// Keys of coordinates anywhere, on voxel borders (whole multiples of the resolution, negative
+        /// ones included) and near the map's edges.
+        #[test]
+        fn key_is_the_floor_of_the_scaled_coordinate(
+            res in prop_oneof![Just(0.1f64), Just(0.05), Just(1.0), 0.01f64..2.0],
+            c in prop_oneof![-5000.0f64..5000.0, (-70_000i32..70_000).prop_map(f64::from), -1e-9f64..1e-9],
+            whole in any::<bool>(),
+        ) {
+            let grid = MapGrid::new(res).unwrap();
+            let c = if whole { (c / res).round() * res } else { c };
+            prop_assert_eq!(grid.key(c), key_by_floor(&grid, c));
+            prop_assert_eq!(grid.key(-c), key_by_floor(&grid, -c));
+        }
+    }
+
+    #[test]
+    fn coordinates_that_are_not_numbers_have_no_key() {
+        let grid = MapGrid::new(0.1).unwrap();
+        for c in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300] {
+            assert_eq!(grid.key(c), None);
+        }
+        assert_eq!(grid.key(-0.0), Some(CENTRE_KEY));
+        assert_eq!(grid.key(-1e-12), Some(CENTRE_KEY - 1));
     }
 }
