@@ -93,7 +93,8 @@
 //! assert_eq!(tree.counts().full, 76); // a one-voxel-thick ray is all voxels in an octree
 //! ```
 #![deny(missing_docs)]
-// The one exception, a read-only memory map, is `io::mmap` (allowed there, with its soundness argument).
+// Two exceptions, each allowed in its own module with its soundness argument: a read-only memory map
+// (`io::mmap`), and the vector instructions that step eight rays of a scan at once (`map::ray_lanes`).
 #![deny(unsafe_code)]
 
 #[macro_use]

@@ -1,4 +1,5 @@
-//! Read-only memory maps of files: the crate's one `unsafe` block.
+//! Read-only memory maps of files: one of the crate's two modules with `unsafe` code (the other steps rays
+//! in the lanes of vectors, `map::ray_lanes`).
 //!
 //! A `.ktree` (version 2) is read by mapping it, so that queries touch only the pages they need and a tree
 //! larger than memory can be inspected. Everything else in the crate sees a map as a plain `&[u8]`.

@@ -29,6 +29,9 @@ mod history;
 mod leaves;
 mod model;
 mod plane;
+// The vector instructions that step eight rays at a time are `unsafe` to call and to load and store.
+#[allow(unsafe_code)]
+mod ray_lanes;
 mod rays;
 mod traverse;
 mod update;

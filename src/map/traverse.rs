@@ -104,19 +104,21 @@ pub fn visit_morton_ray<const K: usize>(
 
 /// A ray's traversal stepped one voxel at a time ([`next_voxel`](Self::next_voxel)): the state of
 /// [`visit_morton_ray`]. (Stepping two or four rays in turn, so that the processor might overlap their
-/// steps, was measured slower: the walks' states no longer stay in registers.)
+/// steps, was measured slower: the walks' states no longer stay in registers. Eight rays stepped in the
+/// lanes of vectors are faster: [`super::ray_lanes`].)
+/// Its fields are read by [`super::ray_lanes`], which steps eight such walks side by side.
 #[derive(Debug, Clone, Copy)]
-struct MortonWalk<const K: usize> {
-    code: u64,
-    code_end: u64,
-    length: f64,
+pub(super) struct MortonWalk<const K: usize> {
+    pub(super) code: u64,
+    pub(super) code_end: u64,
+    pub(super) length: f64,
     /// The axis stepped next.
     dim: usize,
-    t_max: [f64; K],
-    t_delta: [f64; K],
-    mask: [u64; K],
-    carry: [u64; K],
-    add: [u64; K],
+    pub(super) t_max: [f64; K],
+    pub(super) t_delta: [f64; K],
+    pub(super) mask: [u64; K],
+    pub(super) carry: [u64; K],
+    pub(super) add: [u64; K],
 }
 
 impl<const K: usize> MortonWalk<K> {
@@ -124,7 +126,11 @@ impl<const K: usize> MortonWalk<K> {
     /// `Some(None)` if both are in one voxel (nothing is crossed), else the origin's voxel and the walk
     /// on from it.
     #[inline]
-    fn start(grid: &MapGrid, origin: [f32; K], end: [f32; K]) -> Option<Option<(u64, Self)>> {
+    pub(super) fn start(
+        grid: &MapGrid,
+        origin: [f32; K],
+        end: [f32; K],
+    ) -> Option<Option<(u64, Self)>> {
         let (key_origin, key_end) = (grid.keys(origin)?, grid.keys(end)?);
         if key_origin == key_end {
             return Some(None);

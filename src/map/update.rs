@@ -8,7 +8,8 @@ use rayon::prelude::*;
 
 use super::grid::MapGrid;
 use super::model::SensorModel;
-use super::traverse::{clipped_end, difference, norm, visit_morton_ray};
+use super::ray_lanes::add_rays;
+use super::traverse::{clipped_end, difference, norm};
 use super::voxel_set::{SortedVoxels, VoxelSet};
 use crate::radix::radix_sort;
 use crate::space::morton_encode;
@@ -49,20 +50,21 @@ impl ScanUpdate {
             .fold(
                 || (VoxelSet::new(), Vec::new(), 0usize),
                 |(mut misses, mut hits, mut outside), chunk| {
+                    // Each ray's end: the point, or where the maximum range cuts the ray.
+                    let mut stops = Vec::with_capacity(chunk.len());
                     for &p in chunk {
                         let within = max_range.is_none_or(|m| norm(difference(origin, p)) <= m);
-                        let end = match max_range {
+                        stops.push(match max_range {
                             Some(m) if !within => clipped_end(origin, p, m),
                             _ => p,
-                        };
-                        let inside = visit_morton_ray(grid, origin, end, |key| misses.insert(key));
-                        outside += usize::from(!inside);
+                        });
                         if within {
                             if let Some(k) = grid.keys(p) {
                                 hits.push(morton_encode(k));
                             }
                         }
                     }
+                    outside += add_rays(&mut misses, grid, origin, &stops);
                     (misses, hits, outside)
                 },
             )
