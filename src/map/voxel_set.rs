@@ -1,14 +1,15 @@
-//! A set of a map's voxels held as bitmaps of blocks: a block is the aligned cube of 2^12 voxels (a side of
-//! 2^(12/K)) whose Morton keys share all but their last 12 bits, kept as 4 096 bits found through a small
-//! open-addressed table. A ray's voxels mostly follow one another inside a block, so adding one is a bit
-//! set, and the table is asked only when the ray enters another block; repeats cost nothing and the set is
-//! read back in Morton order without sorting its voxels (only its blocks).
+//! A set of a map's voxels held as bitmaps of blocks: a block is the 2^15 voxels whose Morton keys share
+//! all but their last 15 bits (for K = 3 an aligned cube of 32 voxels a side), kept as 32 768 bits found
+//! through a small open-addressed table. A ray's voxels mostly follow one another inside a block, so adding
+//! one is a bit set, and the table is asked only when the ray enters another block; repeats cost nothing
+//! and the set is read back in Morton order without sorting its voxels (only its blocks). (Blocks of 2^12
+//! and 2^18 voxels were measured slower, for OctoMap's scan and for LiDAR scans alike.)
 
 /// The bits of a Morton key that place a voxel inside its block.
-pub(crate) const BLOCK_BITS: u32 = 12;
+pub(crate) const BLOCK_BITS: u32 = 15;
 /// The 64-bit words of a block's bitmap.
 pub(crate) const WORDS: usize = 1 << (BLOCK_BITS - 6);
-/// A table slot no block holds (block codes are below 2^52).
+/// A table slot no block holds (block codes are below 2^49).
 const NO_BLOCK: u64 = u64::MAX;
 
 /// A block's bitmap: bit `i` of word `w` is the voxel at `64 · w + i` in the block's Morton order.
