@@ -48,7 +48,7 @@ mod avx512 {
     use std::arch::x86_64::*;
 
     use super::super::grid::MapGrid;
-    use super::super::traverse::MortonWalk;
+    use super::super::traverse::{MortonWalk, RayOrigin};
     use super::super::voxel_set::{VoxelSet, BLOCK_BITS, WORDS};
     use super::LANES;
 
@@ -91,6 +91,9 @@ mod avx512 {
         origin: [f32; K],
         ends: &[[f32; K]],
     ) -> usize {
+        let Some(from) = RayOrigin::new(grid, origin) else {
+            return ends.len();
+        };
         let mut lanes = Lanes::<K> {
             code: [0; LANES],
             code_end: [0; LANES],
@@ -116,7 +119,7 @@ mod avx512 {
                 }
                 while let Some(&end) = ends.get(next_ray) {
                     next_ray += 1;
-                    match MortonWalk::start(grid, origin, end) {
+                    match MortonWalk::start_from(grid, &from, end) {
                         None => outside += 1,
                         Some(None) => {}
                         Some(Some((first, walk))) => {

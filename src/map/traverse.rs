@@ -121,21 +121,58 @@ pub(super) struct MortonWalk<const K: usize> {
     pub(super) add: [u64; K],
 }
 
+/// What the traversals of rays from one origin share: the origin, its voxel and the borders of that
+/// voxel (OctoMap rounds the half step to `f32`), computed once for a scan's rays.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RayOrigin<const K: usize> {
+    origin: [f32; K],
+    key: [u32; K],
+    code: u64,
+    /// The origin's voxel's border along each axis, below (`[0]`) and above (`[1]`).
+    borders: [[f64; 2]; K],
+}
+
+impl<const K: usize> RayOrigin<K> {
+    /// The rays' common start, or `None` if `origin` is outside the map (every ray then leaves it).
+    #[inline]
+    pub(super) fn new(grid: &MapGrid, origin: [f32; K]) -> Option<Self> {
+        let key = grid.keys(origin)?;
+        let half = f64::from((grid.resolution() * 0.5) as f32);
+        let borders = std::array::from_fn(|i| {
+            let centre = grid.centre(key[i]);
+            [centre - half, centre + half]
+        });
+        Some(Self {
+            origin,
+            key,
+            code: morton_encode(key),
+            borders,
+        })
+    }
+}
+
 impl<const K: usize> MortonWalk<K> {
     /// The traversal of the ray from `origin` to `end`: `None` if either point is outside the map,
     /// `Some(None)` if both are in one voxel (nothing is crossed), else the origin's voxel and the walk
     /// on from it.
     #[inline]
-    pub(super) fn start(
+    fn start(grid: &MapGrid, origin: [f32; K], end: [f32; K]) -> Option<Option<(u64, Self)>> {
+        Self::start_from(grid, &RayOrigin::new(grid, origin)?, end)
+    }
+
+    /// [`start`](Self::start) from an origin's shared parts.
+    #[inline]
+    pub(super) fn start_from(
         grid: &MapGrid,
-        origin: [f32; K],
+        from: &RayOrigin<K>,
         end: [f32; K],
     ) -> Option<Option<(u64, Self)>> {
-        let (key_origin, key_end) = (grid.keys(origin)?, grid.keys(end)?);
+        let (origin, key_origin) = (from.origin, from.key);
+        let key_end = grid.keys(end)?;
         if key_origin == key_end {
             return Some(None);
         }
-        let code = morton_encode(key_origin);
+        let code = from.code;
         let code_end = morton_encode(key_end);
         let mut direction = difference(origin, end);
         let length = norm(direction) as f32;
@@ -154,20 +191,16 @@ impl<const K: usize> MortonWalk<K> {
         let mut add = [0u64; K];
         for i in 0..K {
             mask[i] = spread_bits::<K>(u32::from(u16::MAX)) << i;
-            let step = if direction[i] > 0.0 {
-                1.0
+            let up = if direction[i] > 0.0 {
+                true
             } else if direction[i] < 0.0 {
-                -1.0
+                false
             } else {
                 continue;
             };
-            (carry[i], add[i]) = if step > 0.0 {
-                (!mask[i], 1)
-            } else {
-                (0, u64::MAX)
-            };
-            // The voxel's border in the ray's direction; OctoMap rounds the half step to f32.
-            let border = grid.centre(key_origin[i]) + f64::from((step * resolution * 0.5) as f32);
+            (carry[i], add[i]) = if up { (!mask[i], 1) } else { (0, u64::MAX) };
+            // The voxel's border in the ray's direction.
+            let border = from.borders[i][usize::from(up)];
             t_max[i] = (border - f64::from(origin[i])) / f64::from(direction[i]);
             t_delta[i] = resolution / f64::from(direction[i]).abs();
         }
