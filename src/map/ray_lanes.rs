@@ -48,7 +48,7 @@ mod avx512 {
     use std::arch::x86_64::*;
 
     use super::super::grid::MapGrid;
-    use super::super::traverse::{MortonWalk, RayOrigin};
+    use super::super::traverse::{self, MortonWalk, RayOrigin};
     use super::super::voxel_set::{VoxelSet, BLOCK_BITS, WORDS};
     use super::LANES;
 
@@ -102,12 +102,13 @@ mod avx512 {
             t_delta: [[0.0; LANES]; K],
             carry: [[0; LANES]; K],
             add: [[0; LANES]; K],
-            // No block: a Morton key shifted by the block's bits is below 2^52.
+            // No block: a Morton key shifted by the block's bits is below 2^49.
             block: [u64::MAX; LANES],
             first_word: [0; LANES],
         };
         // The bits of each axis in a Morton key: the same for every ray.
-        let mut axis_bits = [_mm512_setzero_si512(); K];
+        let axis_bits: [__m512i; K] =
+            std::array::from_fn(|i| _mm512_set1_epi64(traverse::axis_bits::<K>(i) as i64));
         let (mut next_ray, mut outside) = (0, 0);
         // The lanes holding a ray.
         let mut live: __mmask8 = 0;
@@ -124,9 +125,6 @@ mod avx512 {
                         Some(None) => {}
                         Some(Some((first, walk))) => {
                             set.insert(first);
-                            for (bits, &mask) in axis_bits.iter_mut().zip(&walk.mask) {
-                                *bits = _mm512_set1_epi64(mask as i64);
-                            }
                             lanes.set(lane, &walk);
                             live |= 1 << lane;
                             break;

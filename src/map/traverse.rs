@@ -116,9 +116,15 @@ pub(super) struct MortonWalk<const K: usize> {
     dim: usize,
     pub(super) t_max: [f64; K],
     pub(super) t_delta: [f64; K],
-    pub(super) mask: [u64; K],
+    mask: [u64; K],
     pub(super) carry: [u64; K],
     pub(super) add: [u64; K],
+}
+
+/// The bits of axis `i`'s key in a Morton key of the map's universe: the same for every ray.
+#[inline]
+pub(super) fn axis_bits<const K: usize>(i: usize) -> u64 {
+    spread_bits::<K>(u32::from(u16::MAX)) << i
 }
 
 /// What the traversals of rays from one origin share: the origin, its voxel and the borders of that
@@ -190,7 +196,7 @@ impl<const K: usize> MortonWalk<K> {
         let mut carry = [0u64; K];
         let mut add = [0u64; K];
         for i in 0..K {
-            mask[i] = spread_bits::<K>(u32::from(u16::MAX)) << i;
+            mask[i] = axis_bits::<K>(i);
             let up = if direction[i] > 0.0 {
                 true
             } else if direction[i] < 0.0 {
