@@ -335,9 +335,9 @@ impl<const K: usize> Merge<'_, K> {
     }
 
     /// [`node`](Self::node) for a leaf of the map (every voxel `background`, of log-odds `before`), in one
-    /// pass over its updates: the cells on the way from one updated voxel to the next are opened and
-    /// closed as the voxels come (their Morton keys are in order), each cell's children settled once, with
-    /// no search. `log_side` ≥ 1.
+    /// pass over its updates: the updated voxels sharing a cell of side 2 are settled together, and the
+    /// cells on the way from one such cell to the next are opened and closed as they come (their Morton
+    /// keys are in order), each cell's children settled once, with no search. `log_side` ≥ 1.
     fn leaf(
         &mut self,
         background: ValueState<f32>,
@@ -349,11 +349,12 @@ impl<const K: usize> Merge<'_, K> {
     ) -> ValueState<f32> {
         let k = K as u32;
         let fanout = 1usize << K;
+        let voxel_digit = fanout as u64 - 1;
         let hit = ValueState::Full(self.model.update(before, true));
         let miss = ValueState::Full(self.model.update(before, false));
         let top = log_side as usize;
-        // The open cell at each height r (a side of 2^r; r = top is this leaf's cell): its children and
-        // how many of them are settled.
+        // The open cell at each height r ≥ 2 (a side of 2^r; r = top is this leaf's cell): its children
+        // and how many of them are settled.
         let mut kids = vec![[background; 16]; top + 1];
         let mut settled = vec![0usize; top + 1];
         let digit = |key: u64, r: usize| (key >> (k * (r as u32 - 1))) as usize & (fanout - 1);
@@ -369,43 +370,60 @@ impl<const K: usize> Merge<'_, K> {
             }
             state
         };
-        // Closes the open cells below height `height` on the way to voxel `key`, each handed to the cell
-        // above it.
+        // Closes the open cells from height 2 to below `height` on the way to key `key`, each handed to
+        // the cell above it.
         let close_below = |levels: &mut [ValuedLevel<f32>],
                            kids: &mut [[ValueState<f32>; 16]],
                            settled: &mut [usize],
                            key: u64,
                            height: usize| {
-            for r in 1..height {
+            for r in 2..height {
                 let state = close(levels, &mut kids[r], settled[r], r);
                 let d = digit(key, r + 1);
                 kids[r + 1][d] = state;
                 settled[r + 1] = d + 1;
             }
         };
+        let mut voxels = update.peekable();
         let mut previous: Option<u64> = None;
-        for (key, is_hit) in update {
-            let key = key - base;
-            // The lowest height whose cell holds both this voxel and the one before: the cells below it
-            // on the previous voxel's way are finished.
+        while let Some((first, is_hit)) = voxels.next() {
+            // The cell of side 2 holding this voxel, with every updated voxel in it.
+            let first = first - base;
+            let cell_key = first & !voxel_digit;
+            let mut cell = [background; 16];
+            cell[(first & voxel_digit) as usize] = if is_hit { hit } else { miss };
+            while let Some((key, is_hit)) =
+                voxels.next_if(|&(key, _)| (key - base) & !voxel_digit == cell_key)
+            {
+                cell[((key - base) & voxel_digit) as usize] = if is_hit { hit } else { miss };
+            }
+            let state = combine(&cell[..fanout]);
+            if state.has_children() {
+                self.levels[depth + top].extend_from_slice(&cell[..fanout]);
+            }
+            if top == 1 {
+                return state;
+            }
+            // The lowest height whose cell holds both this cell and the one before: the cells below it
+            // on the previous cell's way are finished.
             let shared = match previous {
                 None => top,
                 Some(p) => {
-                    let shared = ((64 - (p ^ key).leading_zeros()).div_ceil(k)) as usize;
+                    let shared = ((64 - (p ^ cell_key).leading_zeros()).div_ceil(k)) as usize;
                     close_below(&mut self.levels, &mut kids, &mut settled, p, shared);
                     shared
                 }
             };
-            for r in (1..=shared).rev() {
+            for r in (2..=shared).rev() {
                 let from = if r == shared { settled[r] } else { 0 };
-                let d = digit(key, r);
+                let d = digit(cell_key, r);
                 kids[r][from..d].fill(background);
                 settled[r] = d;
             }
-            let d = digit(key, 1);
-            kids[1][d] = if is_hit { hit } else { miss };
-            settled[1] = d + 1;
-            previous = Some(key);
+            let d = digit(cell_key, 2);
+            kids[2][d] = state;
+            settled[2] = d + 1;
+            previous = Some(cell_key);
         }
         let last = previous.expect("a leaf's update is not empty");
         close_below(&mut self.levels, &mut kids, &mut settled, last, top);
