@@ -1,8 +1,8 @@
 //! One scan's update of a map: the voxels its points end in (hits) and the voxels its rays cross on the
 //! way (misses), each once, hits winning — OctoMap's `computeUpdate` and `insertPointCloud` with
-//! `discretize = false` — gathered on all threads: each ray's misses set as bits of the blocks of voxels
-//! it crosses (repeats cost nothing; the blocks, not the voxels, are sorted), the hits sorted, and the
-//! two lists merged into the map's tree in one depth-first pass.
+//! `discretize = false` — gathered on all threads: each ray's misses and each point's hit set as bits of
+//! the blocks of voxels (repeats cost nothing; the blocks, not the voxels, are sorted), the hits taken
+//! out of the misses, and the two lists merged into the map's tree in one depth-first pass.
 
 use rayon::prelude::*;
 
@@ -10,8 +10,7 @@ use super::grid::MapGrid;
 use super::model::SensorModel;
 use super::ray_lanes::add_rays;
 use super::traverse::{clipped_end, difference, norm};
-use super::voxel_set::{SortedVoxels, VoxelSet};
-use crate::radix::radix_sort;
+use super::voxel_set::{Union, VoxelSet};
 use crate::space::morton_encode;
 use crate::tree::storage::infallible;
 use crate::tree::top_down::{InputNode, Subtree};
@@ -43,12 +42,11 @@ impl ScanUpdate {
         origin: [f32; K],
         max_range: Option<f64>,
     ) -> Self {
-        let bits = K as u32 * super::MAP_LEVEL;
-        // Each task's misses in a set of its own (repeats cost nothing), its hits in a list.
-        let parts: Vec<(VoxelSet, Vec<u64>, usize)> = points
+        // Each task's misses and hits in sets of its own (repeats cost nothing).
+        let parts: Vec<(VoxelSet, VoxelSet, usize)> = points
             .par_chunks(POINTS_A_TASK)
             .fold(
-                || (VoxelSet::new(), Vec::new(), 0usize),
+                || (VoxelSet::new(), VoxelSet::new(), 0usize),
                 |(mut misses, mut hits, mut outside), chunk| {
                     // Each ray's end: the point, or where the maximum range cuts the ray.
                     let mut stops = Vec::with_capacity(chunk.len());
@@ -60,7 +58,7 @@ impl ScanUpdate {
                         });
                         if within {
                             if let Some(k) = grid.keys(p) {
-                                hits.push(morton_encode(k));
+                                hits.insert(morton_encode(k));
                             }
                         }
                     }
@@ -70,16 +68,14 @@ impl ScanUpdate {
             )
             .collect();
         let rays_outside = parts.iter().map(|p| p.2).sum();
-        let mut hits = Vec::new();
-        let mut sets = Vec::with_capacity(parts.len());
-        for (set, h, _) in parts {
-            hits.extend(h);
-            sets.push(set);
-        }
-        let (misses, ()) =
-            rayon::join(|| SortedVoxels::union(sets), || sort_dedup(&mut hits, bits));
+        let (miss_sets, hit_sets): (Vec<_>, Vec<_>) =
+            parts.into_iter().map(|(m, h, _)| (m, h)).unzip();
+        let (hits, misses) = rayon::join(
+            || Union::of(hit_sets).into_keys_without(&[]),
+            || Union::of(miss_sets),
+        );
         Self {
-            misses: without(&misses, &hits),
+            misses: misses.into_keys_without(&hits),
             hits,
             rays_outside,
         }
@@ -108,25 +104,6 @@ impl ScanUpdate {
     pub fn voxels(&self) -> impl Iterator<Item = (u64, bool)> + '_ {
         Part::whole(self)
     }
-}
-
-/// Sorts keys below `2^bits` and removes repeats.
-fn sort_dedup(keys: &mut Vec<u64>, bits: u32) {
-    radix_sort(keys, bits, &mut Vec::new());
-    keys.dedup();
-}
-
-/// The keys of `misses` that are not among the increasing keys `hits` (hits win), in increasing order.
-fn without(misses: &SortedVoxels, hits: &[u64]) -> Vec<u64> {
-    let mut out = Vec::with_capacity(misses.len());
-    let mut hits = hits.iter().copied().peekable();
-    misses.for_each(|m| {
-        while hits.next_if(|&h| h < m).is_some() {}
-        if hits.peek() != Some(&m) {
-            out.push(m);
-        }
-    });
-    out
 }
 
 /// The part of a scan's update inside a cell: its hits and its misses, each increasing.
