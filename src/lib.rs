@@ -94,7 +94,7 @@
 //! ```
 #![deny(missing_docs)]
 // Two exceptions, each allowed in its own module with its soundness argument: a read-only memory map
-// (`io::mmap`), and the vector instructions that step eight rays of a scan at once (`map::ray_lanes`).
+// (`io::mmap`), and the vector instructions that step eight or four rays of a scan at once (`map::ray_lanes`).
 #![deny(unsafe_code)]
 
 #[macro_use]

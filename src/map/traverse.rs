@@ -106,7 +106,7 @@ pub fn visit_morton_ray<const K: usize>(
 /// [`visit_morton_ray`]. (Stepping two or four rays in turn, so that the processor might overlap their
 /// steps, was measured slower: the walks' states no longer stay in registers. Eight rays stepped in the
 /// lanes of vectors are faster: [`super::ray_lanes`].)
-/// Its fields are read by [`super::ray_lanes`], which steps eight such walks side by side.
+/// Its fields are read by [`super::ray_lanes`], which steps eight (or four) such walks side by side.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct MortonWalk<const K: usize> {
     pub(super) code: u64,
