@@ -10,7 +10,9 @@
 use std::path::{Path, PathBuf};
 
 use ktree::io::ktree::notes::label_note;
-use ktree::io::ktree::v3::{read_any_ktree_noted, valued_header, AnyKtree, MappedValuedTree};
+use ktree::io::ktree::v3::{
+    read_any_ktree_framed, read_any_ktree_noted, valued_header, AnyKtree, MappedValuedTree,
+};
 use ktree::io::ktree::Notes;
 use ktree::query::{stats, TreeStats};
 use ktree::rays::ValueRuns;
@@ -59,11 +61,16 @@ pub fn read_valued(path: &Path) -> CliResult<AnyValuedTree> {
 
 /// [`read_valued`] with the file's notes (its labels' names).
 fn read_valued_noted(path: &Path) -> CliResult<(AnyValuedTree, Notes)> {
+    read_valued_framed(path).map(|(tree, _, notes)| (tree, notes))
+}
+
+/// [`read_valued`] with where its voxels are in the world, if the file says, and its notes.
+fn read_valued_framed(path: &Path) -> CliResult<(AnyValuedTree, Option<WorldFrame>, Notes)> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| cannot_read(path, e))?;
-    match read_any_ktree_noted(&bytes, &name).map_err(CliError::caused)? {
-        (AnyKtree::Valued(tree), notes) => Ok((tree, notes)),
-        (AnyKtree::Binary(_), _) => Err(format!(
+    match read_any_ktree_framed(&bytes, &name).map_err(CliError::caused)? {
+        (AnyKtree::Valued(tree), frame, notes) => Ok((tree, frame, notes)),
+        (AnyKtree::Binary(..), ..) => Err(format!(
             "{name}: the tree holds no values (this takes a tree made with values, e.g. voxelize --labels)"
         )
         .into()),
@@ -420,23 +427,26 @@ pub struct SelectArgs {
     /// The values kept, LO:HI, both included (on every channel for colours).
     #[arg(long, allow_hyphen_values = true)]
     range: Option<String>,
-    /// The output `.ktree`: the selected voxels, without values.
+    /// The output `.ktree`: the selected voxels, without values, with the input's world frame and notes.
     #[arg(long)]
     out: PathBuf,
 }
 
 /// `ktree select`.
 pub fn run_select(a: SelectArgs) -> CliResult {
-    let (tree, notes) = read_valued_noted(&a.input)?;
-    with_valued!(&tree, t => select(t, &notes, &a))
+    let (tree, frame, notes) = read_valued_framed(&a.input)?;
+    with_valued!(&tree, t => select(t, frame.as_ref(), &notes, &a))
 }
 
+/// The voxels chosen of `tree` written as a tree without values, with the input's world frame and
+/// notes (its labels' names among them).
 fn select<const K: usize, V: Value>(
     tree: &KTree<K, V>,
+    frame: Option<&WorldFrame>,
     notes: &Notes,
     a: &SelectArgs,
 ) -> CliResult {
-    // The name of the label chosen, if the file names it (the binary output has no place for it).
+    // The name of the label chosen, if the file names it.
     let mut named = String::new();
     let chosen = match (&a.value, &a.range) {
         (Some(v), _) => {
@@ -456,7 +466,7 @@ fn select<const K: usize, V: Value>(
         }
         (None, None) => unreachable!("clap requires --value or --range"),
     };
-    ktree::io::write_ktree_file(&a.out, &chosen).map_err(CliError::caused)?;
+    ktree::io::write_ktree_file_framed(&a.out, &chosen, frame, notes).map_err(CliError::caused)?;
     outln!(
         "{}: {} voxels selected{named}, {} nodes",
         a.out.display(),

@@ -727,3 +727,45 @@ fn a_tree_with_values_keeps_its_world_frame_through_every_conversion() {
     run(&["convert", &p("a.ktree"), &p("d.ktree"), "--voxel-size", "2"]);
     assert_eq!(framed("d.ktree").1.unwrap().voxel_size, 2.0);
 }
+
+/// `select` keeps the input's world frame and notes (the labels' names) in the tree it writes, which
+/// every reader of trees without values reads, through a map too.
+#[test]
+fn select_keeps_the_world_frame_and_the_notes() {
+    use ::ktree::io::ktree::v3::write_valued_ktree_file_noted;
+    use ::ktree::io::{read_ktree_framed, KtreeView, Notes};
+    use ::ktree::space::WorldFrame;
+    use ::ktree::{AnyTree, KTree};
+    let dir = tempfile::tempdir().unwrap();
+    let labels: Vec<Option<u8>> = (0..64)
+        .map(|i| (i % 3 != 0).then_some((i % 4) as u8))
+        .collect();
+    let tree = KTree::<3, u8>::from_dense_values(2, &labels).unwrap();
+    let frame = WorldFrame {
+        voxel_size: 0.25,
+        origin: [1.0, -3.5, 0.75],
+    };
+    let notes = Notes::from([("label.2".to_string(), "kidney".to_string())]);
+    let input = dir.path().join("labels.ktree");
+    write_valued_ktree_file_noted(&input, &tree, Some(&frame), &notes).unwrap();
+    let out = dir.path().join("two.ktree");
+    let printed = run(&[
+        "select",
+        input.to_str().unwrap(),
+        "--value",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(printed.contains("kidney"), "{printed}");
+    let (selected, kept, kept_notes) =
+        read_ktree_framed(&std::fs::read(&out).unwrap(), "two").unwrap();
+    assert_eq!(selected, AnyTree::K3(tree.select(2)));
+    assert_eq!((kept, kept_notes), (Some(frame), notes.clone()));
+    let view = KtreeView::open(&out).unwrap();
+    assert_eq!((view.frame(), view.notes()), (Some(frame), &notes));
+    // The commands on trees without values read it as any other.
+    let stats: serde_json::Value =
+        serde_json::from_str(&run(&["stats", out.to_str().unwrap(), "--json"])).unwrap();
+    assert_eq!(stats["voxels"], tree.select(2).voxel_count() as u64);
+}

@@ -24,6 +24,7 @@ use std::path::Path;
 
 use thiserror::Error;
 
+use crate::space::WorldFrame;
 use crate::tree::{AnyTree, KTree};
 
 mod history_file;
@@ -140,7 +141,49 @@ impl crate::io::ProblemKind for KtreeFileErrorKind {
 /// # Errors
 /// Any I/O error.
 pub fn write_ktree<const K: usize>(out: impl Write, tree: &KTree<K>) -> std::io::Result<()> {
-    v2::write_levels(out, tree)
+    v2::write_levels(out, tree, None, &Notes::new())
+}
+
+/// [`write_ktree`] of a file that keeps where the tree's voxels are in the world (`frame`) and `notes`;
+/// read back by [`read_ktree_framed`] and [`KtreeView::frame`] and [`KtreeView::notes`]. Without
+/// either, the file is the one [`write_ktree`] writes.
+///
+/// ```
+/// use ktree::io::{read_ktree_framed, write_ktree_framed, Notes};
+/// use ktree::space::WorldFrame;
+/// use ktree::{AnyTree, KTree};
+/// let tree = KTree::<2>::from_dense(1, &[true, false, false, true]).unwrap();
+/// let frame = WorldFrame { voxel_size: 0.05, origin: [1.0, -2.0, 0.0] };
+/// let notes = Notes::from([("source".to_string(), "select 3".to_string())]);
+/// let mut bytes = Vec::new();
+/// write_ktree_framed(&mut bytes, &tree, Some(&frame), &notes).unwrap();
+/// let (back, kept, kept_notes) = read_ktree_framed(&bytes, "mem").unwrap();
+/// assert_eq!((back, kept, kept_notes), (AnyTree::K2(tree), Some(frame), notes));
+/// ```
+///
+/// # Errors
+/// Any I/O error; `InvalidInput` for a frame whose voxel size is not a positive number or whose origin
+/// is not finite, or a note that cannot be kept.
+pub fn write_ktree_framed<const K: usize>(
+    out: impl Write,
+    tree: &KTree<K>,
+    frame: Option<&WorldFrame>,
+    notes: &Notes,
+) -> std::io::Result<()> {
+    v2::write_levels(out, tree, frame, notes)
+}
+
+/// [`write_ktree_framed`] to a file, atomically (temporary file, then rename).
+///
+/// # Errors
+/// A [`FileOpError`](crate::fs::FileOpError) naming the path, its source the I/O error.
+pub fn write_ktree_file_framed<const K: usize>(
+    path: &Path,
+    tree: &KTree<K>,
+    frame: Option<&WorldFrame>,
+    notes: &Notes,
+) -> Result<(), crate::fs::FileOpError> {
+    crate::fs::write_atomic_with(path, |w| write_ktree_framed(w, tree, frame, notes))
 }
 
 /// Writes a `.ktree` file of the current version atomically (temporary file, then rename).
@@ -186,6 +229,18 @@ pub fn read_ktree_file(path: &Path) -> Result<AnyTree, KtreeFileError> {
 /// # Errors
 /// [`KtreeFileError`] naming the byte offset of the first inconsistency.
 pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileError> {
+    read_ktree_framed(bytes, file).map(|(tree, _, _)| tree)
+}
+
+/// [`read_ktree_any`] with where the voxels are in the world and the notes, if the file keeps them
+/// ([`write_ktree_framed`]; a version 1 file keeps neither).
+///
+/// # Errors
+/// As [`read_ktree_any`].
+pub fn read_ktree_framed(
+    bytes: &[u8],
+    file: &str,
+) -> Result<(AnyTree, Option<WorldFrame>, Notes), KtreeFileError> {
     let fail = |offset: u64, kind| KtreeFileError::at_byte(file.to_string(), offset, kind);
     if bytes.len() < 6 || &bytes[..6] != MAGIC {
         return Err(fail(0, KtreeFileErrorKind::BadMagic));
@@ -200,8 +255,8 @@ pub fn read_ktree_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileErro
         ));
     }
     match u16::from_le_bytes([bytes[6], bytes[7]]) {
-        v1::VERSION => v1::read_v1_any(bytes, file),
-        v2::VERSION => v2::read_v2_any(bytes, file),
+        v1::VERSION => v1::read_v1_any(bytes, file).map(|tree| (tree, None, Notes::new())),
+        v2::VERSION => v2::read_v2_framed(bytes, file),
         v3::VERSION => Err(fail(
             10,
             KtreeFileErrorKind::Dtype {

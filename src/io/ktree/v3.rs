@@ -644,13 +644,25 @@ pub fn read_any_ktree(bytes: &[u8], file: &str) -> Result<AnyKtree, KtreeFileErr
     read_any_ktree_noted(bytes, file).map(|(tree, _)| tree)
 }
 
-/// [`read_any_ktree`] with the notes the file keeps ([`Notes`]; none for a tree without values).
+/// [`read_any_ktree`] with the notes the file keeps ([`Notes`]).
 ///
 /// # Errors
 /// As [`read_any_ktree`].
 pub fn read_any_ktree_noted(bytes: &[u8], file: &str) -> Result<(AnyKtree, Notes), KtreeFileError> {
+    read_any_ktree_framed(bytes, file).map(|(tree, _, notes)| (tree, notes))
+}
+
+/// [`read_any_ktree`] with where the voxels are in the world, if the file says, and its notes.
+///
+/// # Errors
+/// As [`read_any_ktree`].
+pub fn read_any_ktree_framed(
+    bytes: &[u8],
+    file: &str,
+) -> Result<(AnyKtree, Option<WorldFrame>, Notes), KtreeFileError> {
     let binary = |bytes, file| {
-        super::read_ktree_any(bytes, file).map(|tree| (AnyKtree::Binary(tree), Notes::new()))
+        super::read_ktree_framed(bytes, file)
+            .map(|(tree, frame, notes)| (AnyKtree::Binary(tree), frame, notes))
     };
     if bytes.get(6..8) != Some(&VERSION.to_le_bytes()[..]) {
         return binary(bytes, file);
@@ -661,7 +673,7 @@ pub fn read_any_ktree_noted(bytes: &[u8], file: &str) -> Result<(AnyKtree, Notes
     };
     crate::with_valued!(k, dtype, K, V => {
         read_valued_ktree_noted::<K, V>(bytes, file)
-            .map(|(t, _, notes)| (AnyKtree::Valued(AnyValuedTree::from(t)), notes))
+            .map(|(t, frame, notes)| (AnyKtree::Valued(AnyValuedTree::from(t)), frame, notes))
     }, else Err(KtreeFileError::at_byte(
         file.to_string(),
         8,

@@ -3,8 +3,8 @@
 use std::io::Write;
 
 use super::level_stream::LevelStream;
-use super::notes::{self, Notes};
-use super::v2::layout::{invalid, HEADER_BYTES};
+use super::notes::Notes;
+use super::v2::layout::{header_block, invalid, HEADER_BYTES};
 use super::MAGIC;
 use crate::space::WorldFrame;
 use crate::stacking::ValuedLevelSink;
@@ -74,22 +74,11 @@ impl<W: Write> ValuedKtreeWriter<W> {
         frame: Option<&WorldFrame>,
         notes: &Notes,
     ) -> std::io::Result<Self> {
-        if let Some(f) = frame {
-            check_frame(f).map_err(invalid)?;
-        }
-        let notes_block = notes::encode(notes).map_err(invalid)?;
-        let mut header = Vec::with_capacity(HEADER_BYTES + FRAME_BYTES + notes_block.len());
-        header.extend_from_slice(MAGIC);
-        header.extend_from_slice(&super::v3::VERSION.to_le_bytes());
-        header.extend_from_slice(&[k as u8, level as u8, dtype.code()]);
-        let flags = u8::from(frame.is_some()) | u8::from(!notes_block.is_empty()) << 1;
-        header.extend_from_slice(&[flags, 0, 0, 0, 0]);
-        if let Some(f) = frame {
-            for x in [f.voxel_size, f.origin[0], f.origin[1], f.origin[2]] {
-                header.extend_from_slice(&x.to_le_bytes());
-            }
-        }
-        header.extend_from_slice(&notes_block);
+        let mut first = [0u8; HEADER_BYTES];
+        first[..6].copy_from_slice(MAGIC);
+        first[6..8].copy_from_slice(&super::v3::VERSION.to_le_bytes());
+        first[8..11].copy_from_slice(&[k as u8, level as u8, dtype.code()]);
+        let header = header_block(first, frame, notes)?;
         Ok(Self {
             stream: LevelStream::new(out, k, level, header, true)?,
             value_bytes: dtype.bytes() as u64,

@@ -1,9 +1,10 @@
 //! The checks of a version 2 file's sections (listed in [`layout`](super::layout)), run in bounded windows
 //! when a file is opened or read, and reading a checked file's bytes into a tree.
 
+use super::super::notes::Notes;
 use super::super::{KtreeFileError, KtreeFileErrorKind};
 use super::layout::*;
-use crate::space::Universe;
+use crate::space::{Universe, WorldFrame};
 use crate::tree::{AnyTree, KTree, PackedStates};
 
 impl Layout {
@@ -189,8 +190,12 @@ pub(super) fn check_bytes(layout: &Layout, bytes: &[u8], file: &str) -> Result<(
     })
 }
 
-/// Reads a version 2 file's bytes into a tree in memory (called by [`read_ktree_any`](crate::io::read_ktree_any)).
-pub(crate) fn read_v2_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFileError> {
+/// Reads a version 2 file's bytes into a tree in memory, with its frame and notes (called by
+/// [`read_ktree_framed`](crate::io::read_ktree_framed)).
+pub(crate) fn read_v2_framed(
+    bytes: &[u8],
+    file: &str,
+) -> Result<(AnyTree, Option<WorldFrame>, Notes), KtreeFileError> {
     let layout = layout_of_bytes(bytes, file)?;
     check_bytes(&layout, bytes, file)?;
     let levels: Vec<PackedStates> = layout
@@ -222,5 +227,5 @@ pub(crate) fn read_v2_any(bytes: &[u8], file: &str) -> Result<AnyTree, KtreeFile
             KtreeFileErrorKind::Tree(e.to_string()),
         )
     })?;
-    Ok(tree)
+    Ok((tree, layout.frame, layout.notes))
 }

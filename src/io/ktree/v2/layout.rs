@@ -9,13 +9,17 @@
 //! | 6 | 2 | format version, `u16` (= 2) |
 //! | 8 | 1 | `K` (1…4) |
 //! | 9 | 1 | `L` (0…[`crate::max_level`]`(K)`) |
-//! | 10 | 6 | reserved, 0 |
-//! | 16 | 8·(W₀ + R₀) | section 0 (the root level) |
+//! | 10 | 1 | reserved, 0 (version 3's value type) |
+//! | 11 | 1 | flags: bit 0 set when a world frame follows the header, bit 1 when notes follow it; the other bits 0 |
+//! | 12 | 4 | reserved, 0 |
+//! | 16 | 32 | only with flag bit 0: the world frame ([`WorldFrame`]): the voxel size, then the origin's x, y and z (`f64` each) |
+//! | 16 or 48 | 8 + N, padded to 8 | only with flag bit 1: the notes ([`Notes`]): their length `N` (`u64`), then `N` bytes of `name=text` lines |
+//! | H (16 without either) | 8·(W₀ + R₀) | section 0 (the root level) |
 //! | … | 8·(W_d + R_d) | section `d`, right after section `d − 1` |
 //! | S | 32·D | directory: per level `d`, nodes `n_d`, full nodes, partial nodes (`u64` each), CRC-32 of section `d` (`u32`), reserved `u32` = 0 |
 //! | S + 32·D | 8 | the file's length in bytes (`u64`) |
 //! | S + 32·D + 8 | 4 | `D`, the number of levels (`u32`) |
-//! | S + 32·D + 12 | 4 | CRC-32 of the header (bytes 0…15) and of everything from S up to here |
+//! | S + 32·D + 12 | 4 | CRC-32 of the header (bytes 0…H − 1: with the frame and the notes) and of everything from S up to here |
 //!
 //! Section `d` holds `W_d = ⌈n_d / 32⌉` words of node states — node `i` of the level in bits `2·(i mod 32)`
 //! of word `i / 32`, `00` empty, `01` full, `10` partial, unused bits 0 (the in-memory layout of
@@ -23,6 +27,9 @@
 //! nodes in words `0 … 64·b − 1`. With them the first child of a node (`2^K` × the partial nodes before
 //! it) is found from the map by at most 64 word pop-counts, without an index in memory. The section's CRC
 //! covers its words and samples.
+//!
+//! A file without frame or notes (flags 0) is byte for byte what the format wrote before they existed;
+//! a reader older than them refuses a file with either (its byte 11 is not 0).
 //!
 //! The directory is at the end so that the file can be written in one pass, level after level, by a
 //! builder that never holds the whole tree ([`KtreeWriter`]). A reader finds it from the last 16 bytes.
@@ -37,8 +44,10 @@
 //! the section's byte offset), the unused code `11`, zero padding, the rank samples, the full and partial
 //! counts of the directory, and that the tree is reduced (no `2^K` siblings all full or all empty).
 
+use super::super::notes::{self, Notes};
+use super::super::v3_writer::{check_frame, FRAME_BYTES};
 use super::super::{KtreeFileError, KtreeFileErrorKind, MAGIC};
-use crate::space::{max_level, MAX_K};
+use crate::space::{max_level, WorldFrame, MAX_K};
 use crate::tree::LevelCounts;
 
 /// The format version of this layout.
@@ -80,6 +89,34 @@ pub(crate) fn header_bytes(k: usize, level: u32) -> [u8; HEADER_BYTES] {
     h[8] = k as u8;
     h[9] = level as u8;
     h
+}
+
+/// The header of a file with where its voxels are in the world (`frame`) and `notes`: the 16 bytes of
+/// [`header_bytes`] with the flags set, then the frame and the notes' block, if any — the same in
+/// versions 2 and 3.
+///
+/// # Errors
+/// `InvalidInput` for a frame whose voxel size is not a positive number or whose origin is not finite,
+/// or a note that cannot be kept.
+pub(crate) fn header_block(
+    mut header: [u8; HEADER_BYTES],
+    frame: Option<&WorldFrame>,
+    notes: &Notes,
+) -> std::io::Result<Vec<u8>> {
+    if let Some(f) = frame {
+        check_frame(f).map_err(invalid)?;
+    }
+    let notes_block = notes::encode(notes).map_err(invalid)?;
+    header[11] = u8::from(frame.is_some()) | u8::from(!notes_block.is_empty()) << 1;
+    let mut block = Vec::with_capacity(HEADER_BYTES + FRAME_BYTES + notes_block.len());
+    block.extend_from_slice(&header);
+    if let Some(f) = frame {
+        for x in [f.voxel_size, f.origin[0], f.origin[1], f.origin[2]] {
+            block.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    block.extend_from_slice(&notes_block);
+    Ok(block)
 }
 
 /// One level's directory entry.
@@ -153,6 +190,9 @@ pub(crate) struct Layout {
     pub(crate) k: usize,
     pub(crate) level: u32,
     pub(crate) sections: Vec<Section>,
+    /// Where the voxels are in the world, if the file says.
+    pub(crate) frame: Option<WorldFrame>,
+    pub(crate) notes: Notes,
 }
 
 pub(crate) fn u64_at(bytes: &[u8], at: usize) -> u64 {
@@ -164,21 +204,21 @@ pub(crate) fn u32_at(bytes: &[u8], at: usize) -> u32 {
 }
 
 impl Layout {
-    /// Reads and checks the header and directory. `head` is the file's first 16 bytes, `len` its length,
-    /// and `tail(n)` returns its last `n` bytes (`n ≤ len`).
+    /// Reads and checks the header (with the frame and the notes) and the directory. `len` is the
+    /// file's length and `read(offset, n)` returns its `n` bytes from `offset` (`offset + n ≤ len`).
     pub(crate) fn parse(
         file: &str,
-        head: &[u8],
         len: u64,
-        mut tail: impl FnMut(usize) -> Result<Vec<u8>, KtreeFileError>,
+        mut read: impl FnMut(u64, usize) -> Result<Vec<u8>, KtreeFileError>,
     ) -> Result<Self, KtreeFileError> {
         let fail = |offset: u64, kind| KtreeFileError::at_byte(file.to_string(), offset, kind);
         let header_error =
             |offset: u64, message: String| fail(offset, KtreeFileErrorKind::Header(message));
+        let head = read(0, len.min(HEADER_BYTES as u64) as usize)?;
         if head.len() < 6 || &head[..6] != MAGIC {
             return Err(fail(0, KtreeFileErrorKind::BadMagic));
         }
-        let minimum = (HEADER_BYTES + ENTRY_BYTES + TAIL_BYTES) as u64;
+        let mut minimum = (HEADER_BYTES + ENTRY_BYTES + TAIL_BYTES) as u64;
         if len < minimum || head.len() < HEADER_BYTES {
             return Err(fail(
                 len,
@@ -203,11 +243,59 @@ impl Layout {
                 format!("L = {level} exceeds {} for K = {k}", max_level(k)),
             ));
         }
-        if head[10..16].iter().any(|&b| b != 0) {
+        if head[11] > 3 {
+            return Err(header_error(
+                11,
+                format!("flags {:#04x}: only bits 0 and 1 are known", head[11]),
+            ));
+        }
+        if head[10] != 0 || head[12..HEADER_BYTES].iter().any(|&b| b != 0) {
             return Err(header_error(10, "reserved bytes are not 0".into()));
         }
-        let end = tail(TAIL_BYTES)?;
+        // The frame and the notes, each measured before it is read.
+        let mut header = head;
+        let mut frame = None;
+        if header[11] & 1 == 1 {
+            minimum += FRAME_BYTES as u64;
+            if len < minimum {
+                return Err(fail(
+                    len,
+                    KtreeFileErrorKind::Length {
+                        expected: minimum,
+                        found: len,
+                    },
+                ));
+            }
+            let bytes = read(HEADER_BYTES as u64, FRAME_BYTES)?;
+            let at = |i: usize| f64::from_bits(u64_at(&bytes, 8 * i));
+            let f = WorldFrame {
+                voxel_size: at(0),
+                origin: [at(1), at(2), at(3)],
+            };
+            check_frame(&f).map_err(|e| header_error(HEADER_BYTES as u64, e))?;
+            frame = Some(f);
+            header.extend_from_slice(&bytes);
+        }
+        let mut notes = Notes::new();
+        if header[11] & 2 == 2 {
+            let notes_at = header.len() as u64;
+            let room = (len - notes_at - (ENTRY_BYTES + TAIL_BYTES) as u64) as usize;
+            let runs_past =
+                || header_error(notes_at, "the notes' length runs past the file".into());
+            if room < 8 {
+                return Err(runs_past());
+            }
+            let length = read(notes_at, 8)?;
+            let bytes = notes::block_bytes(&length, room).ok_or_else(runs_past)?;
+            let block = read(notes_at, bytes)?;
+            notes = notes::decode(&block)
+                .map_err(|(at, why)| header_error(notes_at + at as u64, why))?;
+            minimum += bytes as u64;
+            header.extend_from_slice(&block);
+        }
+        let sections_at = header.len() as u64;
         let tail_at = len - TAIL_BYTES as u64;
+        let end = read(tail_at, TAIL_BYTES)?;
         let recorded = u64_at(&end, 0);
         if recorded != len {
             return Err(fail(
@@ -232,10 +320,10 @@ impl Layout {
             ));
         }
         let directory_at = tail_at - directory_bytes;
-        let directory = tail(directory_bytes as usize + TAIL_BYTES)?;
+        let directory = read(directory_at, directory_bytes as usize + TAIL_BYTES)?;
         let stored = u32_at(&directory, directory.len() - 4);
         let mut hasher = crc32fast::Hasher::new();
-        hasher.update(&head[..HEADER_BYTES]);
+        hasher.update(&header);
         hasher.update(&directory[..directory.len() - 4]);
         let computed = hasher.finalize();
         if stored != computed {
@@ -245,7 +333,7 @@ impl Layout {
             ));
         }
         let mut sections = Vec::with_capacity(depth as usize);
-        let mut offset = HEADER_BYTES as u64;
+        let mut offset = sections_at;
         for d in 0..depth as usize {
             let e = &directory[d * ENTRY_BYTES..(d + 1) * ENTRY_BYTES];
             let entry_at = directory_at + (d * ENTRY_BYTES) as u64;
@@ -308,7 +396,13 @@ impl Layout {
                 )),
             ));
         }
-        Ok(Self { k, level, sections })
+        Ok(Self {
+            k,
+            level,
+            sections,
+            frame,
+            notes,
+        })
     }
 
     pub(crate) fn counts_per_level(&self) -> Vec<LevelCounts> {
@@ -318,8 +412,8 @@ impl Layout {
 
 pub(crate) fn layout_of_bytes(bytes: &[u8], file: &str) -> Result<Layout, KtreeFileError> {
     let len = bytes.len() as u64;
-    Layout::parse(file, &bytes[..bytes.len().min(HEADER_BYTES)], len, |n| {
-        Ok(bytes[bytes.len() - n..].to_vec())
+    Layout::parse(file, len, |offset, n| {
+        Ok(bytes[offset as usize..offset as usize + n].to_vec())
     })
 }
 

@@ -8,7 +8,7 @@ mod mapped;
 mod view;
 mod writer;
 
-pub(crate) use check::read_v2_any;
+pub(crate) use check::read_v2_framed;
 pub use layout::VERSION;
 pub use mapped::{AnyMappedTree, MappedTree};
 pub(crate) use view::read_at;
@@ -28,7 +28,7 @@ mod tests {
     fn sample() -> (KTree<3>, Vec<u8>) {
         let tree = stack(&ball_rays::<3>(4, [10, 12, 14], 9).unwrap());
         let mut bytes = Vec::new();
-        write_levels(&mut bytes, &tree).unwrap();
+        write_levels(&mut bytes, &tree, None, &crate::io::Notes::new()).unwrap();
         (tree, bytes)
     }
 
@@ -36,7 +36,11 @@ mod tests {
     fn round_trip_view_and_pieces_agree() {
         let (tree, bytes) = sample();
         assert_eq!(bytes.len() % 8, 0);
-        let back = read_v2_any(&bytes, "s").unwrap().into_dim::<3>().unwrap();
+        let back = read_v2_framed(&bytes, "s")
+            .unwrap()
+            .0
+            .into_dim::<3>()
+            .unwrap();
         assert_eq!(back, tree);
         let view = KtreeView::from_bytes(bytes.clone(), "s").unwrap();
         assert_eq!(view.counts_per_level(), tree.counts_per_level());
@@ -73,6 +77,99 @@ mod tests {
         assert_eq!(pieces, bytes);
     }
 
+    fn framed(frame: Option<&crate::space::WorldFrame>, notes: &crate::io::Notes) -> Vec<u8> {
+        let (tree, _) = sample();
+        let mut bytes = Vec::new();
+        write_levels(&mut bytes, &tree, frame, notes).unwrap();
+        bytes
+    }
+
+    fn frame_and_notes() -> (crate::space::WorldFrame, crate::io::Notes) {
+        let frame = crate::space::WorldFrame {
+            voxel_size: 0.1,
+            origin: [-1.5, 2.0, 0.25],
+        };
+        let notes = crate::io::Notes::from([
+            ("label.3".to_string(), "liver".to_string()),
+            ("source".to_string(), "ct.nii".to_string()),
+        ]);
+        (frame, notes)
+    }
+
+    #[test]
+    fn frame_and_notes_read_back_from_bytes_and_through_a_map() {
+        let (tree, plain) = sample();
+        // Without frame or notes: the file of before, flags 0.
+        assert_eq!(framed(None, &crate::io::Notes::new()), plain);
+        assert_eq!(plain[11], 0);
+        let (frame, notes) = frame_and_notes();
+        for (f, n, flags) in [
+            (Some(&frame), crate::io::Notes::new(), 1),
+            (None, notes.clone(), 2),
+            (Some(&frame), notes.clone(), 3),
+        ] {
+            let bytes = framed(f, &n);
+            assert_eq!(bytes[11], flags);
+            assert_eq!(bytes.len() % 8, 0);
+            let (back, kept, kept_notes) = read_v2_framed(&bytes, "s").unwrap();
+            assert_eq!(back.into_dim::<3>().unwrap(), tree);
+            assert_eq!((kept, &kept_notes), (f.copied(), &n));
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("t.ktree");
+            std::fs::write(&path, &bytes).unwrap();
+            let view = KtreeView::open(&path).unwrap();
+            assert_eq!(view.to_tree::<3>().unwrap(), tree);
+            assert_eq!((view.frame(), view.notes()), (f.copied(), &n));
+            assert_eq!(
+                view.contains([10u32, 12, 14]),
+                Ok(tree.contains([10, 12, 14]))
+            );
+        }
+    }
+
+    #[test]
+    fn a_damaged_frame_or_notes_block_is_an_error_naming_its_byte() {
+        let (frame, notes) = frame_and_notes();
+        let bytes = framed(Some(&frame), &notes);
+        let error_at = |bytes: &[u8]| {
+            let e = read_v2_framed(bytes, "s").unwrap_err();
+            let from_view = KtreeView::from_bytes(bytes.to_vec(), "s").unwrap_err();
+            assert_eq!(e.offset(), from_view.offset());
+            (e.offset(), e.to_string())
+        };
+        // An unknown flag.
+        let mut b = bytes.clone();
+        b[11] |= 4;
+        assert_eq!(error_at(&b).0, Some(11));
+        // A voxel size that is not a number.
+        let mut b = bytes.clone();
+        b[16..24].copy_from_slice(&f64::NAN.to_le_bytes());
+        let (at, message) = error_at(&b);
+        assert_eq!(at, Some(16));
+        assert!(message.contains("voxel size"), "{message}");
+        // An origin changed: the header's checksum.
+        let mut b = bytes.clone();
+        b[24] ^= 1;
+        assert!(matches!(
+            read_v2_framed(&b, "s").unwrap_err().kind,
+            KtreeFileErrorKind::Checksum { .. }
+        ));
+        // The notes' length past the end of the file.
+        let mut b = bytes.clone();
+        let len = b.len() as u64;
+        b[48..56].copy_from_slice(&len.to_le_bytes());
+        let (at, message) = error_at(&b);
+        assert_eq!(at, Some(48));
+        assert!(message.contains("runs past"), "{message}");
+        // Notes that are not name=text.
+        let mut b = bytes.clone();
+        let eq = 56 + b[56..].iter().position(|&c| c == b'=').unwrap();
+        b[eq] = b'-';
+        assert!(error_at(&b).1.contains("not name=text"));
+        // Cut inside the frame.
+        assert!(read_v2_framed(&bytes[..40], "s").is_err());
+    }
+
     #[test]
     fn bad_section_checksum_names_level_and_offset() {
         let (tree, mut bytes) = sample();
@@ -90,7 +187,7 @@ mod tests {
             })
             .unwrap();
         bytes[at..at + 8].copy_from_slice(&swapped.to_le_bytes());
-        let e = read_v2_any(&bytes, "s").unwrap_err();
+        let e = read_v2_framed(&bytes, "s").unwrap_err();
         assert_eq!(e.offset(), Some(offset));
         assert!(
             matches!(e.kind, KtreeFileErrorKind::SectionChecksum { level, .. } if level == last),

@@ -4,12 +4,13 @@ use std::fs::File;
 use std::path::Path;
 use std::sync::Arc;
 
+use super::super::notes::Notes;
 use super::super::{KtreeFileError, KtreeFileErrorKind};
 use super::check::check_bytes;
 use super::layout::*;
 use super::mapped::MappedTree;
 use crate::io::mmap::FileMap;
-use crate::space::{Cell, Universe};
+use crate::space::{Cell, Universe, WorldFrame};
 use crate::tree::{KTree, LevelCounts, NodeState, PackedStates};
 
 /// Where a view's bytes are (shared by the view's clones).
@@ -65,10 +66,8 @@ impl KtreeView {
                 std::io::Error::other("the file is larger than the address space"),
             )
         })?;
-        let head =
-            read_at(&file, 0, (len as usize).min(HEADER_BYTES)).map_err(|e| io_error(0, e))?;
-        let layout = Layout::parse(&name, &head, len, |n| {
-            read_at(&file, len - n as u64, n).map_err(|e| io_error(len - n as u64, e))
+        let layout = Layout::parse(&name, len, |offset, n| {
+            read_at(&file, offset, n).map_err(|e| io_error(offset, e))
         })?;
         layout.check_sections(&name, |offset, n, f| {
             let window = FileMap::map(&file, offset, n).map_err(|e| io_error(offset, e))?;
@@ -116,6 +115,16 @@ impl KtreeView {
     /// The universe level `L`.
     pub fn level(&self) -> u32 {
         self.layout.level
+    }
+
+    /// Where the voxels are in the world, if the file says ([`write_ktree_framed`](crate::io::write_ktree_framed)).
+    pub fn frame(&self) -> Option<WorldFrame> {
+        self.layout.frame
+    }
+
+    /// The file's notes (none if it keeps none).
+    pub fn notes(&self) -> &Notes {
+        &self.layout.notes
     }
 
     /// The number of stored levels.

@@ -4,7 +4,8 @@ use std::io::Write;
 
 use super::layout::*;
 use crate::io::ktree::level_stream::LevelStream;
-use crate::space::{max_level, MAX_K};
+use crate::io::ktree::notes::Notes;
+use crate::space::{max_level, WorldFrame, MAX_K};
 use crate::tree::{KTree, LevelCounts, NodeState, PackedStates};
 
 /// Writes a `.ktree` version 2 file level by level, from the root down, without holding the tree.
@@ -48,6 +49,29 @@ impl<W: Write> KtreeWriter<W> {
     pub fn new(out: W, k: usize, level: u32) -> std::io::Result<Self> {
         let header = if (1..=MAX_K).contains(&k) && level <= max_level(k) {
             header_bytes(k, level).to_vec()
+        } else {
+            Vec::new()
+        };
+        Ok(Self {
+            stream: LevelStream::new(out, k, level, header, false)?,
+        })
+    }
+
+    /// [`new`](Self::new) for a file that keeps where its voxels are in the world (`frame`) and `notes`
+    /// (without either, the file is the one [`new`](Self::new) writes).
+    ///
+    /// # Errors
+    /// As [`new`](Self::new), and `InvalidInput` for a frame whose voxel size is not a positive number
+    /// or whose origin is not finite, or a note that cannot be kept.
+    pub fn with_frame(
+        out: W,
+        k: usize,
+        level: u32,
+        frame: Option<&WorldFrame>,
+        notes: &Notes,
+    ) -> std::io::Result<Self> {
+        let header = if (1..=MAX_K).contains(&k) && level <= max_level(k) {
+            header_block(header_bytes(k, level), frame, notes)?
         } else {
             Vec::new()
         };
@@ -123,12 +147,15 @@ impl<W: Write> KtreeWriter<W> {
     }
 }
 
-/// Writes a tree as a version 2 file, level by level ([`write_ktree`](crate::io::write_ktree) calls it).
+/// Writes a tree as a version 2 file, level by level, with `frame` and `notes`
+/// ([`write_ktree`](crate::io::write_ktree) and [`write_ktree_framed`](crate::io::write_ktree_framed) call it).
 pub(crate) fn write_levels<const K: usize>(
     out: impl Write,
     tree: &KTree<K>,
+    frame: Option<&WorldFrame>,
+    notes: &Notes,
 ) -> std::io::Result<()> {
-    let mut w = KtreeWriter::new(out, K, tree.level())?;
+    let mut w = KtreeWriter::with_frame(out, K, tree.level(), frame, notes)?;
     for d in 0..tree.depth_count() {
         w.append_states(tree.level_states(d))?;
         w.end_level()?;
