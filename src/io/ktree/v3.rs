@@ -45,9 +45,10 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::notes::{self, Notes};
+use super::notes::Notes;
 use super::v2::layout::{
-    samples_of, u32_at, u64_at, words_of, ENTRY_BYTES, HEADER_BYTES, TAIL_BYTES,
+    header_extras, samples_of, u32_at, u64_at, words_of, HeaderExtras, ENTRY_BYTES, HEADER_BYTES,
+    TAIL_BYTES,
 };
 use super::{KtreeFileError, KtreeFileErrorKind, MAGIC};
 use crate::space::{max_level, Universe, WorldFrame, MAX_K};
@@ -57,7 +58,6 @@ use crate::tree::{AnyTree, AnyValuedTree, Dtype, KTree, PackedStates, Value};
 
 pub use super::v3_mapped::{MappedLeaves, MappedValuedTree};
 pub use super::v3_writer::ValuedKtreeWriter;
-use super::v3_writer::{check_frame, FRAME_BYTES};
 
 /// The format version of valued files.
 pub const VERSION: u16 = 3;
@@ -348,47 +348,33 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
             KtreeFileErrorKind::Header(format!("L = {level} exceeds {} for K = {k}", max_level(k))),
         ));
     }
-    if bytes[11] > 3 {
-        return Err(fail(
-            11,
-            KtreeFileErrorKind::Header(format!(
-                "flags {:#04x}: only bits 0 and 1 are known",
-                bytes[11]
-            )),
-        ));
-    }
     if bytes[12..HEADER_BYTES].iter().any(|&b| b != 0) {
         return Err(fail(
             12,
             KtreeFileErrorKind::Header("reserved bytes are not 0".into()),
         ));
     }
-    let frame_bytes = if bytes[11] & 1 == 1 { FRAME_BYTES } else { 0 };
-    let notes_at = HEADER_BYTES + frame_bytes;
-    // The notes' block, measured from its length (room left for at least the tail).
-    let notes_bytes = if bytes[11] & 2 == 2 {
-        let room = bytes.len().saturating_sub(notes_at + TAIL_BYTES);
-        notes::block_bytes(bytes.get(notes_at..).unwrap_or_default(), room).ok_or_else(|| {
-            fail(
-                notes_at as u64,
-                KtreeFileErrorKind::Header("the notes' length runs past the file".into()),
-            )
-        })?
-    } else {
-        0
-    };
-    let sections_at = notes_at + notes_bytes;
     let len = bytes.len() as u64;
-    let minimum = (sections_at + ENTRY_BYTES + TAIL_BYTES) as u64;
-    if len < minimum {
-        return Err(fail(
+    let too_short = |minimum: usize| {
+        fail(
             len,
             KtreeFileErrorKind::Length {
-                expected: minimum,
+                expected: minimum as u64,
                 found: len,
             },
-        ));
+        )
+    };
+    if bytes.len() < HEADER_BYTES + ENTRY_BYTES + TAIL_BYTES {
+        return Err(too_short(HEADER_BYTES + ENTRY_BYTES + TAIL_BYTES));
     }
+    let extras = header_extras(file, bytes[..HEADER_BYTES].to_vec(), len, &mut |at, n| {
+        Ok(bytes[at as usize..at as usize + n].to_vec())
+    })?;
+    let sections_at = extras.bytes.len();
+    if bytes.len() < sections_at + ENTRY_BYTES + TAIL_BYTES {
+        return Err(too_short(sections_at + ENTRY_BYTES + TAIL_BYTES));
+    }
+    let minimum = (sections_at + ENTRY_BYTES + TAIL_BYTES) as u64;
     let tail_at = bytes.len() - TAIL_BYTES;
     let recorded = u64_at(bytes, tail_at);
     if recorded != len {
@@ -425,22 +411,7 @@ pub(crate) fn check_valued<const K: usize, V: Value>(
             KtreeFileErrorKind::Checksum { stored, computed },
         ));
     }
-    let notes = if notes_bytes > 0 {
-        notes::decode(&bytes[notes_at..sections_at])
-            .map_err(|(at, why)| fail((notes_at + at) as u64, KtreeFileErrorKind::Header(why)))?
-    } else {
-        Notes::new()
-    };
-    let frame = (frame_bytes > 0).then(|| {
-        let at = |i: usize| f64::from_bits(u64_at(bytes, HEADER_BYTES + 8 * i));
-        WorldFrame {
-            voxel_size: at(0),
-            origin: [at(1), at(2), at(3)],
-        }
-    });
-    if let Some(Err(e)) = frame.as_ref().map(check_frame) {
-        return Err(fail(16, KtreeFileErrorKind::Header(e)));
-    }
+    let HeaderExtras { frame, notes, .. } = extras;
     let value_bytes = dtype.bytes();
     let mut levels = Vec::with_capacity(if keep { depth as usize } else { 0 });
     let mut values: Vec<Vec<V>> = Vec::with_capacity(if keep { depth as usize } else { 0 });
@@ -697,6 +668,7 @@ pub fn write_any_valued_ktree(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::ktree::v3_writer::FRAME_BYTES;
 
     fn pattern<const K: usize, V: Value>() -> AnyValuedTree {
         let bytes = V::DTYPE.unwrap().bytes();

@@ -203,6 +203,81 @@ pub(crate) fn u32_at(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"))
 }
 
+/// What follows a version 2 or 3 header when its flags (byte 11) say so.
+pub(crate) struct HeaderExtras {
+    pub(crate) frame: Option<WorldFrame>,
+    pub(crate) notes: Notes,
+    /// The header's 16 bytes, then the frame's and the notes' block, as in the file: what its checksum
+    /// covers before the directory. The level sections start right after them.
+    pub(crate) bytes: Vec<u8>,
+}
+
+/// Reads and checks the world frame and the notes that follow `head` (a header's 16 bytes) in a file of
+/// `len` bytes (at least a header, a directory entry and the tail), as the header's flags say, each
+/// measured before it is read; `read(offset, n)` returns the file's `n` bytes from `offset`.
+pub(crate) fn header_extras(
+    file: &str,
+    head: Vec<u8>,
+    len: u64,
+    read: &mut impl FnMut(u64, usize) -> Result<Vec<u8>, KtreeFileError>,
+) -> Result<HeaderExtras, KtreeFileError> {
+    let fail = |offset: u64, kind| KtreeFileError::at_byte(file.to_string(), offset, kind);
+    let header_error =
+        |offset: u64, message: String| fail(offset, KtreeFileErrorKind::Header(message));
+    let flags = head[11];
+    if flags > 3 {
+        return Err(header_error(
+            11,
+            format!("flags {flags:#04x}: only bits 0 and 1 are known"),
+        ));
+    }
+    // Room for at least one directory entry and the tail after what follows the header.
+    let after = (ENTRY_BYTES + TAIL_BYTES) as u64;
+    let mut bytes = head;
+    let mut frame = None;
+    if flags & 1 == 1 {
+        let minimum = (HEADER_BYTES + FRAME_BYTES) as u64 + after;
+        if len < minimum {
+            return Err(fail(
+                len,
+                KtreeFileErrorKind::Length {
+                    expected: minimum,
+                    found: len,
+                },
+            ));
+        }
+        let block = read(HEADER_BYTES as u64, FRAME_BYTES)?;
+        let at = |i: usize| f64::from_bits(u64_at(&block, 8 * i));
+        let f = WorldFrame {
+            voxel_size: at(0),
+            origin: [at(1), at(2), at(3)],
+        };
+        check_frame(&f).map_err(|e| header_error(HEADER_BYTES as u64, e))?;
+        frame = Some(f);
+        bytes.extend_from_slice(&block);
+    }
+    let mut notes = Notes::new();
+    if flags & 2 == 2 {
+        let notes_at = bytes.len() as u64;
+        let room = (len - notes_at).saturating_sub(after) as usize;
+        let runs_past = || header_error(notes_at, "the notes' length runs past the file".into());
+        if room < 8 {
+            return Err(runs_past());
+        }
+        let length = read(notes_at, 8)?;
+        let size = notes::block_bytes(&length, room).ok_or_else(runs_past)?;
+        let block = read(notes_at, size)?;
+        notes =
+            notes::decode(&block).map_err(|(at, why)| header_error(notes_at + at as u64, why))?;
+        bytes.extend_from_slice(&block);
+    }
+    Ok(HeaderExtras {
+        frame,
+        notes,
+        bytes,
+    })
+}
+
 impl Layout {
     /// Reads and checks the header (with the frame and the notes) and the directory. `len` is the
     /// file's length and `read(offset, n)` returns its `n` bytes from `offset` (`offset + n ≤ len`).
@@ -218,7 +293,7 @@ impl Layout {
         if head.len() < 6 || &head[..6] != MAGIC {
             return Err(fail(0, KtreeFileErrorKind::BadMagic));
         }
-        let mut minimum = (HEADER_BYTES + ENTRY_BYTES + TAIL_BYTES) as u64;
+        let minimum = (HEADER_BYTES + ENTRY_BYTES + TAIL_BYTES) as u64;
         if len < minimum || head.len() < HEADER_BYTES {
             return Err(fail(
                 len,
@@ -243,57 +318,12 @@ impl Layout {
                 format!("L = {level} exceeds {} for K = {k}", max_level(k)),
             ));
         }
-        if head[11] > 3 {
-            return Err(header_error(
-                11,
-                format!("flags {:#04x}: only bits 0 and 1 are known", head[11]),
-            ));
-        }
         if head[10] != 0 || head[12..HEADER_BYTES].iter().any(|&b| b != 0) {
             return Err(header_error(10, "reserved bytes are not 0".into()));
         }
-        // The frame and the notes, each measured before it is read.
-        let mut header = head;
-        let mut frame = None;
-        if header[11] & 1 == 1 {
-            minimum += FRAME_BYTES as u64;
-            if len < minimum {
-                return Err(fail(
-                    len,
-                    KtreeFileErrorKind::Length {
-                        expected: minimum,
-                        found: len,
-                    },
-                ));
-            }
-            let bytes = read(HEADER_BYTES as u64, FRAME_BYTES)?;
-            let at = |i: usize| f64::from_bits(u64_at(&bytes, 8 * i));
-            let f = WorldFrame {
-                voxel_size: at(0),
-                origin: [at(1), at(2), at(3)],
-            };
-            check_frame(&f).map_err(|e| header_error(HEADER_BYTES as u64, e))?;
-            frame = Some(f);
-            header.extend_from_slice(&bytes);
-        }
-        let mut notes = Notes::new();
-        if header[11] & 2 == 2 {
-            let notes_at = header.len() as u64;
-            let room = (len - notes_at - (ENTRY_BYTES + TAIL_BYTES) as u64) as usize;
-            let runs_past =
-                || header_error(notes_at, "the notes' length runs past the file".into());
-            if room < 8 {
-                return Err(runs_past());
-            }
-            let length = read(notes_at, 8)?;
-            let bytes = notes::block_bytes(&length, room).ok_or_else(runs_past)?;
-            let block = read(notes_at, bytes)?;
-            notes = notes::decode(&block)
-                .map_err(|(at, why)| header_error(notes_at + at as u64, why))?;
-            minimum += bytes as u64;
-            header.extend_from_slice(&block);
-        }
-        let sections_at = header.len() as u64;
+        let extras = header_extras(file, head, len, &mut read)?;
+        let sections_at = extras.bytes.len() as u64;
+        let minimum = sections_at + (ENTRY_BYTES + TAIL_BYTES) as u64;
         let tail_at = len - TAIL_BYTES as u64;
         let end = read(tail_at, TAIL_BYTES)?;
         let recorded = u64_at(&end, 0);
@@ -323,7 +353,7 @@ impl Layout {
         let directory = read(directory_at, directory_bytes as usize + TAIL_BYTES)?;
         let stored = u32_at(&directory, directory.len() - 4);
         let mut hasher = crc32fast::Hasher::new();
-        hasher.update(&header);
+        hasher.update(&extras.bytes);
         hasher.update(&directory[..directory.len() - 4]);
         let computed = hasher.finalize();
         if stored != computed {
@@ -400,8 +430,8 @@ impl Layout {
             k,
             level,
             sections,
-            frame,
-            notes,
+            frame: extras.frame,
+            notes: extras.notes,
         })
     }
 

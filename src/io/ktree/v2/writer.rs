@@ -47,14 +47,7 @@ impl<W: Write> KtreeWriter<W> {
     /// # Errors
     /// `InvalidInput` for `k` or `level` out of range; any I/O error.
     pub fn new(out: W, k: usize, level: u32) -> std::io::Result<Self> {
-        let header = if (1..=MAX_K).contains(&k) && level <= max_level(k) {
-            header_bytes(k, level).to_vec()
-        } else {
-            Vec::new()
-        };
-        Ok(Self {
-            stream: LevelStream::new(out, k, level, header, false)?,
-        })
+        Self::with_frame(out, k, level, None, &Notes::new())
     }
 
     /// [`new`](Self::new) for a file that keeps where its voxels are in the world (`frame`) and `notes`
