@@ -87,6 +87,28 @@ impl WorldFrame {
         std::array::from_fn(|a| self.origin[a] + c[a] as f64 * self.voxel_size)
     }
 
+    /// The world frame of a tree made from the voxels of two (a Boolean of them): the frame they both
+    /// keep, or the one of the tree that keeps one; `Err` with both when they differ (the same voxel
+    /// coordinates would be different places).
+    ///
+    /// ```
+    /// use ktree::space::WorldFrame;
+    /// let f = WorldFrame { voxel_size: 0.5, origin: [1.0, 0.0, -2.0] };
+    /// assert_eq!(WorldFrame::shared(Some(f), None), Ok(Some(f)));
+    /// assert_eq!(WorldFrame::shared(None, None), Ok(None));
+    /// let g = WorldFrame { voxel_size: 0.25, ..f };
+    /// assert_eq!(WorldFrame::shared(Some(f), Some(g)), Err([f, g]));
+    /// ```
+    ///
+    /// # Errors
+    /// Both frames, when both are given and differ.
+    pub fn shared(a: Option<Self>, b: Option<Self>) -> Result<Option<Self>, [Self; 2]> {
+        match (a, b) {
+            (Some(a), Some(b)) if a != b => Err([a, b]),
+            (a, b) => Ok(a.or(b)),
+        }
+    }
+
     /// The same placement with coordinates counted from `offset` (coordinate `c` here is `c − offset` in
     /// the frame returned): the world does not move.
     pub fn counted_from(&self, offset: [i64; 3]) -> Self {

@@ -18,8 +18,9 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
-use super::KtreeWriter;
+use super::{KtreeWriter, Notes};
 use crate::fs::SpillError;
+use crate::space::WorldFrame;
 use crate::tree::sink::LevelSink;
 use crate::tree::words::{WordPacker, NODES_PER_WORD};
 use crate::tree::{LevelCounts, NodeState};
@@ -310,6 +311,8 @@ pub(crate) struct SpillLevels {
     k: usize,
     level: u32,
     out: PathBuf,
+    frame: Option<WorldFrame>,
+    notes: Notes,
 }
 
 impl SpillLevels {
@@ -330,7 +333,18 @@ impl SpillLevels {
             k,
             level,
             out: out.to_path_buf(),
+            frame: None,
+            notes: Notes::new(),
         })
+    }
+
+    /// The output written with a world frame and notes.
+    pub(crate) fn framed(self, frame: Option<WorldFrame>, notes: Notes) -> Self {
+        Self {
+            frame,
+            notes,
+            ..self
+        }
     }
 
     /// Writes the tree (root `root`) to the output: the root level, then each spilled level.
@@ -353,7 +367,9 @@ impl SpillLevels {
         }
         let mut counts = Vec::new();
         crate::fs::write_atomic_with(&self.out, |w| {
-            let mut writer = KtreeWriter::new(BufWriter::with_capacity(BUFFER_BYTES, w), k, level)?;
+            let buffered = BufWriter::with_capacity(BUFFER_BYTES, w);
+            let mut writer =
+                KtreeWriter::with_frame(buffered, k, level, self.frame.as_ref(), &self.notes)?;
             writer.push(root)?;
             writer.end_level()?;
             let mut words = vec![0u64; BUFFER_BYTES / 8];

@@ -150,3 +150,54 @@ fn mismatched_inputs_are_an_error_and_leave_the_target() {
     assert!(e.to_string().contains("a.ktree"), "{e}");
     assert_eq!(std::fs::read(&out).unwrap(), b"keep");
 }
+
+/// A streamed Boolean writes the bytes of the in-memory result written with the world frame its inputs
+/// share (or the one that keeps one) and the first one's notes (else the second's); inputs kept in
+/// different frames are refused, the target untouched.
+#[test]
+fn streamed_booleans_keep_the_world_frame_and_refuse_two_frames() {
+    use io::{read_ktree_file_framed, write_ktree_file_framed, write_ktree_framed, Notes};
+    use ktree::space::WorldFrame;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    let a = KTree::<2>::from_dense(2, &[true, true, false, true].repeat(4)).unwrap();
+    let b = KTree::<2>::from_dense(2, &[false, true, true, false].repeat(4)).unwrap();
+    let frame = WorldFrame {
+        voxel_size: 0.1,
+        origin: [-2.0, 3.0, 0.0],
+    };
+    let noted = Notes::from([("source".to_string(), "b".to_string())]);
+    write_ktree_file_framed(&p("a.ktree"), &a, None, &Notes::new()).unwrap();
+    write_ktree_file_framed(&p("b.ktree"), &b, Some(&frame), &noted).unwrap();
+    for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
+        io::boolean_files(&p("a.ktree"), &p("b.ktree"), op, &p("c.ktree"), None).unwrap();
+        let mut want = Vec::new();
+        let result = ops::boolean(&a, &b, op).unwrap();
+        write_ktree_framed(&mut want, &result, Some(&frame), &noted).unwrap();
+        assert_eq!(std::fs::read(p("c.ktree")).unwrap(), want, "{op:?}");
+    }
+    io::complement_file(&p("b.ktree"), &p("n.ktree"), None).unwrap();
+    let (_, kept, notes) = read_ktree_file_framed(&p("n.ktree")).unwrap();
+    assert_eq!((kept, notes), (Some(frame), noted.clone()));
+    // Another frame on the first input.
+    let moved = WorldFrame {
+        origin: [-2.0, 3.0, 0.5],
+        ..frame
+    };
+    write_ktree_file_framed(&p("a.ktree"), &a, Some(&moved), &Notes::new()).unwrap();
+    std::fs::write(p("c.ktree"), b"keep").unwrap();
+    let e = io::boolean_files(
+        &p("a.ktree"),
+        &p("b.ktree"),
+        BoolOp::Union,
+        &p("c.ktree"),
+        None,
+    )
+    .unwrap_err();
+    assert!(matches!(e, BooleanFileError::Frames { .. }), "{e}");
+    assert!(
+        e.to_string().contains("a.ktree") && e.to_string().contains("b.ktree"),
+        "{e}"
+    );
+    assert_eq!(std::fs::read(p("c.ktree")).unwrap(), b"keep");
+}

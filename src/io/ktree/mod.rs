@@ -218,10 +218,21 @@ pub fn read_ktree<const K: usize>(bytes: &[u8], file: &str) -> Result<KTree<K>, 
 /// # Errors
 /// As [`read_ktree_any`]; an unreadable file is [`KtreeFileErrorKind::Io`].
 pub fn read_ktree_file(path: &Path) -> Result<AnyTree, KtreeFileError> {
+    read_ktree_file_framed(path).map(|(tree, _, _)| tree)
+}
+
+/// [`read_ktree_file`] with where the voxels are in the world and the notes, if the file keeps them
+/// ([`read_ktree_framed`]).
+///
+/// # Errors
+/// As [`read_ktree_file`].
+pub fn read_ktree_file_framed(
+    path: &Path,
+) -> Result<(AnyTree, Option<WorldFrame>, Notes), KtreeFileError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path)
         .map_err(|e| KtreeFileError::at_byte(name.clone(), 0, KtreeFileErrorKind::Io(e.into())))?;
-    read_ktree_any(&bytes, &name)
+    read_ktree_framed(&bytes, &name)
 }
 
 /// Reads a `.ktree` file's bytes (version 1 or 2), of whatever dimension they hold.

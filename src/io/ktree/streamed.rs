@@ -36,10 +36,11 @@
 
 use std::path::Path;
 
-use super::{KtreeFileError, KtreeView, MappedTree};
+use super::{KtreeFileError, KtreeView, MappedTree, Notes};
 use crate::fs::SpillError;
 use crate::io::spill::{SpillLevels, SpilledTree};
 use crate::ops::{boolean_into, complement_into, BoolOp};
+use crate::space::WorldFrame;
 use crate::tree::LevelCounts;
 
 /// Why a streamed Boolean failed. The target file is untouched and the spill files are removed.
@@ -63,6 +64,20 @@ pub enum BooleanFileError {
         kb: usize,
         /// Its `L`.
         lb: u32,
+    },
+    /// The inputs keep different world frames: their voxels are not the same places.
+    #[error(
+        "{a} keeps the world frame {fa:?} but {b} keeps {fb:?}: a Boolean needs trees on one grid"
+    )]
+    Frames {
+        /// The first input.
+        a: String,
+        /// Its frame.
+        fa: WorldFrame,
+        /// The second input.
+        b: String,
+        /// Its frame.
+        fb: WorldFrame,
     },
     /// A temporary file or the output could not be written.
     #[error(transparent)]
@@ -95,7 +110,9 @@ pub enum ViewOperation<'a> {
 /// Writes `a op b` to the `.ktree` version 2 file `out`, reading the version 2 files `a` and `b` through
 /// their memory maps, in bounded memory (see the module's notes). Spill files go to a hidden folder in
 /// `temp_dir` (default: the output's folder), removed at the end. The bytes are those of
-/// [`write_ktree`](crate::io::write_ktree) of [`ops::boolean`](crate::ops::boolean) of the trees.
+/// [`write_ktree_framed`](crate::io::write_ktree_framed) of [`ops::boolean`](crate::ops::boolean) of
+/// the trees, with the world frame they keep ([`WorldFrame::shared`]) and the first one's notes (else
+/// the second's).
 ///
 /// # Errors
 /// [`BooleanFileError`]; the target is then untouched.
@@ -146,6 +163,7 @@ pub fn boolean_views(
     out: &Path,
     temp_dir: Option<&Path>,
 ) -> Result<BooleanFileReport, BooleanFileError> {
+    let mut frame = a.frame();
     if let ViewOperation::Binary(_, b) = operation {
         if (a.k(), a.level()) != (b.k(), b.level()) {
             return Err(BooleanFileError::Mismatch {
@@ -157,23 +175,55 @@ pub fn boolean_views(
                 lb: b.level(),
             });
         }
+        frame = WorldFrame::shared(a.frame(), b.frame()).map_err(|[fa, fb]| {
+            BooleanFileError::Frames {
+                a: a.name().to_string(),
+                fa,
+                b: b.name().to_string(),
+                fb,
+            }
+        })?;
     }
+    // The first input's notes, else the second's.
+    let notes = match operation {
+        ViewOperation::Binary(_, b) if a.notes().is_empty() => b.notes(),
+        _ => a.notes(),
+    };
+    let output = Output {
+        path: out,
+        frame,
+        notes,
+        temp_dir,
+    };
     match a.k() {
-        1 => boolean_views_k::<1>(a, operation, out, temp_dir),
-        2 => boolean_views_k::<2>(a, operation, out, temp_dir),
-        3 => boolean_views_k::<3>(a, operation, out, temp_dir),
+        1 => boolean_views_k::<1>(a, operation, output),
+        2 => boolean_views_k::<2>(a, operation, output),
+        3 => boolean_views_k::<3>(a, operation, output),
         // Any other `K` is refused by `MappedTree::new`.
-        _ => boolean_views_k::<4>(a, operation, out, temp_dir),
+        _ => boolean_views_k::<4>(a, operation, output),
     }
+}
+
+/// Where a streamed Boolean writes, and the world frame and notes its file keeps.
+struct Output<'a> {
+    path: &'a Path,
+    frame: Option<WorldFrame>,
+    notes: &'a Notes,
+    temp_dir: Option<&'a Path>,
 }
 
 /// [`boolean_views`] for files of dimension `K`.
 fn boolean_views_k<const K: usize>(
     a: &KtreeView,
     operation: ViewOperation<'_>,
-    out: &Path,
-    temp_dir: Option<&Path>,
+    output: Output<'_>,
 ) -> Result<BooleanFileReport, BooleanFileError> {
+    let Output {
+        path: out,
+        frame,
+        notes,
+        temp_dir,
+    } = output;
     let sa = MappedTree::<K>::new(a)?;
     let sb = match operation {
         ViewOperation::Binary(_, b) => Some(MappedTree::<K>::new(b)?),
@@ -184,7 +234,8 @@ fn boolean_views_k<const K: usize>(
         .max(sb.as_ref().map_or(0, |b| b.view().depth_count()));
     let folder = crate::fs::spill_folder(out, temp_dir)
         .map_err(|(path, source)| BooleanFileError::Files(SpillError::TempDir { path, source }))?;
-    let sink = SpillLevels::create(folder.path(), depths, K, a.level(), out)?;
+    let sink =
+        SpillLevels::create(folder.path(), depths, K, a.level(), out)?.framed(frame, notes.clone());
     let written: Result<SpilledTree, BooleanFileError> = match (operation, sb) {
         (ViewOperation::Binary(op, _), Some(sb)) => boolean_into(&sa, &sb, op, sink),
         _ => complement_into(&sa, sink),
