@@ -14,13 +14,14 @@ use ktree::export::vtk::{write_time_slices, write_vtk_file};
 use ktree::export::{write_mesh_of, write_surface, ExportError, Frame};
 use ktree::input::read_tree_placed;
 use ktree::io::{
-    ktree_file_version, write_tree, AnyMappedTree, FileTree, Format, ReadOptions, WriteOptions,
-    VERSION,
+    ktree_file_version, write_tree, AnyMappedTree, FileTree, Format, KtreeView, Notes, ReadOptions,
+    WriteOptions, VERSION,
 };
 use ktree::solid::mesh::MeshTransform;
 use ktree::tree::storage::TreeStorage;
 use ktree::{with_tree, AnyTree};
 
+use crate::common::tree_file::write_tree_framed;
 use crate::common::vector::vector;
 
 /// Arguments of `ktree convert`.
@@ -109,19 +110,25 @@ pub fn run(a: Args) -> CliResult {
     );
     // Meshes and VTK files of a version 2 .ktree are made from its memory map, whatever its size; every
     // other input is read into memory, with the placement and metadata of its format.
-    let (file, placement, read_meta) = if (exported || a.time_axis.is_some() || a.smooth)
-        && Format::of(&a.input) == Some(Format::Ktree)
-        && ktree_file_version(&a.input).is_ok_and(|v| v == VERSION)
-    {
-        let mapped = AnyMappedTree::open(&a.input).map_err(CliError::caused)?;
-        (FileTree::Mapped(mapped), None, None)
-    } else {
-        let read = read_tree_placed(&a.input, &options).map_err(CliError::caused)?;
-        for r in &read.remarks {
-            eprintln!("note: {}: {r}", a.input.display());
-        }
-        (FileTree::Memory(read.tree), read.placement, read.meta)
+    // A version 2 .ktree may keep where its voxels are in the world, and notes.
+    let input_v2 = Format::of(&a.input) == Some(Format::Ktree)
+        && ktree_file_version(&a.input).is_ok_and(|v| v == VERSION);
+    let (kept_frame, notes) = match input_v2.then(|| KtreeView::open(&a.input)) {
+        Some(Ok(view)) => (view.frame(), view.notes().clone()),
+        _ => (None, Notes::new()),
     };
+    let (file, placement, read_meta) =
+        if (exported || a.time_axis.is_some() || a.smooth) && input_v2 {
+            let mapped = AnyMappedTree::open(&a.input).map_err(CliError::caused)?;
+            (FileTree::Mapped(mapped), None, None)
+        } else {
+            let read = read_tree_placed(&a.input, &options).map_err(CliError::caused)?;
+            for r in &read.remarks {
+                eprintln!("note: {}: {r}", a.input.display());
+            }
+            (FileTree::Memory(read.tree), read.placement, read.meta)
+        };
+    let read_meta = read_meta.or(kept_frame);
     // The input grid's index 0 is ktree voxel `read_offset`; the output grid's, `out_offset`: by default
     // the input's grid indices are kept where the output has indices of its own (.vdb, .bt; binvox starts
     // at 0).
@@ -159,19 +166,18 @@ pub fn run(a: Args) -> CliResult {
         origin: corner,
     }
     .counted_from(out_offset);
-    if matches!(format, Some(Format::Ktree | Format::Rays))
-        && (read_meta.is_some_and(|m| m != Frame::default())
-            || read_offset != [0; 3]
-            || a.origin.is_some()
-            || a.voxel_size.is_some()
-            || a.out_offset.is_some())
-    {
+    // Whether the voxels have a place in the world to keep.
+    let placed = read_meta.is_some_and(|m| m != Frame::default())
+        || read_offset != [0; 3]
+        || a.origin.is_some()
+        || a.voxel_size.is_some()
+        || a.out_offset.is_some();
+    if format == Some(Format::Rays) && placed {
         // Say what is lost: these files hold voxels only.
         eprintln!(
-            "note: {}: a {} file holds no world placement: voxel size {}, ktree voxel 0 at {:?} are not \
+            "note: {}: a ray file holds no world placement: voxel size {}, ktree voxel 0 at {:?} are not \
              kept (give --voxel-size and --origin when converting it back to a grid or a mesh)",
             a.output.display(),
-            if format == Some(Format::Ktree) { ".ktree" } else { "ray" },
             meta.voxel_size,
             corner
         );
@@ -239,9 +245,16 @@ pub fn run(a: Args) -> CliResult {
             unreachable!("only meshes and VTK files are made from a file read in place")
         };
         if format == Some(Format::Ktree) {
-            // The version --format-version asks for, as every command that writes trees.
-            ktree::with_dim!(tree, AnyTree, t => crate::common::tree_file::write_tree(&a.output, t))
-                .map_err(CliError::caused)?;
+            // The version --format-version asks for, as every command that writes trees, with the world
+            // frame of ktree voxel 0 if the voxels have a place.
+            let frame = placed.then_some(Frame {
+                voxel_size: meta.voxel_size,
+                origin: corner,
+            });
+            ktree::with_dim!(tree, AnyTree, t => {
+                write_tree_framed(&a.output, t, frame.as_ref(), &notes)
+            })
+            .map_err(CliError::caused)?;
         } else {
             let write_options = WriteOptions {
                 offset: out_offset,

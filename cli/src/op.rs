@@ -9,10 +9,11 @@
 use crate::common::error::{CliError, CliResult};
 use std::path::PathBuf;
 
-use ktree::io::{self, ktree_file_version, BooleanFileReport};
+use ktree::io::{self, ktree_file_version, BooleanFileError, BooleanFileReport};
 use ktree::ops::BoolOp;
+use ktree::space::WorldFrame;
 
-use crate::common::tree_file::{pair_error, print_summary, read, write};
+use crate::common::tree_file::{pair_error, print_summary, read_framed, write_framed};
 
 /// Arguments of `ktree op`.
 #[derive(Debug, clap::Args)]
@@ -125,13 +126,24 @@ fn run_op(args: Args) -> CliResult {
         let [a] = args.inputs.as_slice() else {
             return Err("`ktree op not` takes exactly one input tree".into());
         };
-        let out = read(a)?.complement();
-        return ktree::with_dim!(&out, AnyTree, t => write(&args.out.out, t));
+        let (tree, frame, notes) = read_framed(a)?;
+        let out = tree.complement();
+        return ktree::with_dim!(&out, AnyTree, t => write_framed(&args.out.out, t, frame.as_ref(), &notes));
     };
     let [a, b] = args.inputs.as_slice() else {
         return Err(format!("`ktree op {}` takes exactly two input trees", op.name()).into());
     };
-    let (ta, tb) = (read(a)?, read(b)?);
+    let ((ta, fa, na), (tb, fb, nb)) = (read_framed(a)?, read_framed(b)?);
     let out = ta.boolean(&tb, op).map_err(|e| pair_error(a, b, e))?;
-    ktree::with_dim!(&out, AnyTree, t => write(&args.out.out, t))
+    // The frame both keep (or the one that keeps one), the first one's notes, as a streamed Boolean.
+    let frame = WorldFrame::shared(fa, fb).map_err(|[fa, fb]| {
+        CliError::caused(BooleanFileError::Frames {
+            a: a.display().to_string(),
+            fa,
+            b: b.display().to_string(),
+            fb,
+        })
+    })?;
+    let notes = if na.is_empty() { nb } else { na };
+    ktree::with_dim!(&out, AnyTree, t => write_framed(&args.out.out, t, frame.as_ref(), &notes))
 }

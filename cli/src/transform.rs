@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use ktree::io::ktree::v3::write_valued_ktree_file_noted;
 use ktree::ops::{Affine, AxisMap, Geometry, Projective};
 
-use crate::common::tree_file::{read, write};
+use crate::common::tree_file::{read_framed, write_framed};
 use crate::common::vector::{list, List};
 use crate::outln;
 
@@ -200,10 +200,11 @@ pub fn run(args: Args) -> CliResult {
     if crate::values::is_valued(&args.input) {
         return run_valued(&args);
     }
-    let tree = read(&args.input)?;
+    // The voxels move in the universe; the universe keeps its place in the world (and its notes).
+    let (tree, frame, notes) = read_framed(&args.input)?;
     ktree::with_dim!(&tree, AnyTree, t => {
         let out = apply(t, t.level(), &args).map_err(|e| e.within(args.input.display()))?;
-        write(&args.out.out, &out)
+        write_framed(&args.out.out, &out, frame.as_ref(), &notes)
     })
 }
 

@@ -1,6 +1,7 @@
 //! A grid's place in the world survives `ktree convert`: `.bt` → `.bt`, `.bt` ↔ `.vdb`, and `--origin` with a
 //! `.bt` output, each voxel at the same world position after as before (or a clear refusal where the
-//! output cannot hold the placement); a `.ktree`, which holds no placement, says so.
+//! output cannot hold the placement); a `.ktree` keeps it as its world frame; a ray file, which holds
+//! none, says so.
 
 mod common;
 
@@ -99,8 +100,14 @@ fn a_bt_away_from_the_origin_keeps_its_place_through_bt_and_vdb() {
         assert!(ok, "{from} -> {to}: {err}");
         assert_eq!(world_voxels(&p(to)), original, "{from} -> {to}");
     }
-    // A .ktree holds no placement: the conversion says so.
+    // A .ktree keeps the placement as its world frame: back to a .bt, each voxel where it was.
     let (ok, _, err) = ktree(&["convert", s(&p("map.bt")), s(&p("map.ktree"))]);
+    assert!(ok && err.is_empty(), "{err}");
+    let (ok, _, err) = ktree(&["convert", s(&p("map.ktree")), s(&p("again.bt"))]);
+    assert!(ok, "{err}");
+    assert_eq!(world_voxels(&p("again.bt")), original);
+    // A ray file holds none: the conversion says so.
+    let (ok, _, err) = ktree(&["convert", s(&p("map.bt")), s(&p("map.rays"))]);
     assert!(ok, "{err}");
     assert!(
         err.contains("note:") && err.contains("no world placement"),

@@ -8,9 +8,10 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use ktree::fs::write_atomic_with;
-use ktree::io::read_ktree_file;
+use ktree::io::{read_ktree_file, read_ktree_file_framed, write_ktree_file_framed, Notes};
 use ktree::io::{write_ktree_file, write_ktree_v1, write_ktree_v1_view, KtreeView};
 use ktree::ops;
+use ktree::space::WorldFrame;
 use ktree::{AnyTree, KTree, LevelCounts};
 
 static VERSION: OnceLock<u16> = OnceLock::new();
@@ -80,10 +81,54 @@ pub fn read(path: &Path) -> CliResult<AnyTree> {
     read_ktree_file(path).map_err(CliError::caused)
 }
 
+/// A tree read with the world frame and the notes its file keeps.
+pub type Framed = (AnyTree, Option<WorldFrame>, Notes);
+
+/// Reads a tree file with the world frame and notes it keeps (none in a version 1 file), with the path
+/// in any error.
+pub fn read_framed(path: &Path) -> CliResult<Framed> {
+    read_ktree_file_framed(path).map_err(CliError::caused)
+}
+
 /// Writes a tree file and prints a one-line summary.
 pub fn write<const K: usize>(path: &Path, tree: &KTree<K>) -> CliResult {
-    write_tree(path, tree).map_err(CliError::caused)?;
+    write_framed(path, tree, None, &Notes::new())
+}
+
+/// Writes a tree file keeping a world frame and notes, and prints a one-line summary.
+pub fn write_framed<const K: usize>(
+    path: &Path,
+    tree: &KTree<K>,
+    frame: Option<&WorldFrame>,
+    notes: &Notes,
+) -> CliResult {
+    write_tree_framed(path, tree, frame, notes).map_err(CliError::caused)?;
     print_summary(path, K, tree.level(), &tree.counts_per_level())
+}
+
+/// [`write_tree`] keeping a world frame and notes. A version 1 file keeps neither: a note on the standard
+/// error says so when there were some.
+///
+/// # Errors
+/// The file operation that failed, naming the path.
+pub fn write_tree_framed<const K: usize>(
+    path: &Path,
+    tree: &KTree<K>,
+    frame: Option<&WorldFrame>,
+    notes: &Notes,
+) -> Result<(), ktree::fs::FileOpError> {
+    let kept = frame.is_some() || !notes.is_empty();
+    if version() == 1 && kept {
+        eprintln!(
+            "note: {}: a version 1 file keeps no world frame and no notes (write version 2 to keep them)",
+            path.display()
+        );
+    }
+    if version() == 1 || !kept {
+        write_tree(path, tree)
+    } else {
+        write_ktree_file_framed(path, tree, frame, notes)
+    }
 }
 
 /// Prints the one-line summary of a tree written to `path`, from its counts per level.

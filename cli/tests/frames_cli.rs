@@ -1,0 +1,251 @@
+//! Where a tree's voxels are in the world (the world frame a `.ktree` keeps) survives the commands that
+//! write trees: `op` (streamed from the files' maps, or in memory), `transform` and `convert` keep it and
+//! the notes; `convert` writes a grid's placement into the `.ktree` and places meshes and grids by it; a
+//! Boolean of trees kept in different frames is refused, the output untouched.
+
+mod common;
+
+use std::path::Path;
+
+use common::{ktree, run};
+use ktree::io::{read_ktree_file_framed, write_ktree_file_framed, write_ktree_v1, Notes};
+use ktree::space::WorldFrame;
+use ktree::{AnyTree, KTree};
+
+const FRAME: WorldFrame = WorldFrame {
+    voxel_size: 0.25,
+    origin: [1.0, -3.5, 0.75],
+};
+
+/// Two overlapping octrees of level 3.
+fn pair() -> (KTree<3>, KTree<3>) {
+    let a: Vec<bool> = (0..512).map(|i| i % 7 == 0 || i < 100).collect();
+    let b: Vec<bool> = (0..512).map(|i| i % 5 == 0 || i > 400).collect();
+    (
+        KTree::from_dense(3, &a).unwrap(),
+        KTree::from_dense(3, &b).unwrap(),
+    )
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn notes(text: &str) -> Notes {
+    Notes::from([("source".to_string(), text.to_string())])
+}
+
+/// The tree, frame and notes of a `.ktree` file.
+fn framed(path: &Path) -> (AnyTree, Option<WorldFrame>, Notes) {
+    read_ktree_file_framed(path).unwrap()
+}
+
+#[test]
+fn op_keeps_the_frame_the_inputs_share_streamed_and_in_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    let (a, b) = pair();
+    write_ktree_file_framed(&p("a.ktree"), &a, Some(&FRAME), &notes("a")).unwrap();
+    write_ktree_file_framed(&p("b.ktree"), &b, None, &Notes::new()).unwrap();
+    // Streamed from the maps (both version 2): the frame of the one that keeps one, its notes.
+    for (op, want) in [
+        ("union", ktree::ops::union(&a, &b).unwrap()),
+        ("diff", ktree::ops::difference(&a, &b).unwrap()),
+    ] {
+        let out = p(&format!("{op}.ktree"));
+        run(&[
+            "op",
+            op,
+            s(&p("a.ktree")),
+            s(&p("b.ktree")),
+            "--out",
+            s(&out),
+        ]);
+        assert_eq!(
+            framed(&out),
+            (AnyTree::K3(want), Some(FRAME), notes("a")),
+            "{op}"
+        );
+    }
+    run(&["op", "not", s(&p("a.ktree")), "--out", s(&p("not.ktree"))]);
+    assert_eq!(
+        framed(&p("not.ktree")),
+        (
+            AnyTree::K3(ktree::ops::complement(&a)),
+            Some(FRAME),
+            notes("a")
+        )
+    );
+    // In memory (the second a version 1 file): the same.
+    let mut v1 = Vec::new();
+    write_ktree_v1(&mut v1, &b).unwrap();
+    std::fs::write(p("b1.ktree"), v1).unwrap();
+    run(&[
+        "op",
+        "xor",
+        s(&p("b1.ktree")),
+        s(&p("a.ktree")),
+        "--out",
+        s(&p("x.ktree")),
+    ]);
+    assert_eq!(
+        framed(&p("x.ktree")),
+        (
+            AnyTree::K3(ktree::ops::symmetric_difference(&b, &a).unwrap()),
+            Some(FRAME),
+            notes("a")
+        )
+    );
+    // Trees without frames give a tree without one, byte for byte the file of before.
+    write_ktree_file_framed(&p("a0.ktree"), &a, None, &Notes::new()).unwrap();
+    run(&[
+        "op",
+        "union",
+        s(&p("a0.ktree")),
+        s(&p("b.ktree")),
+        "--out",
+        s(&p("u0.ktree")),
+    ]);
+    let plain = p("plain.ktree");
+    ktree::io::write_ktree_file(&plain, &ktree::ops::union(&a, &b).unwrap()).unwrap();
+    assert_eq!(
+        std::fs::read(p("u0.ktree")).unwrap(),
+        std::fs::read(plain).unwrap()
+    );
+}
+
+#[test]
+fn a_boolean_of_trees_in_different_frames_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    let (a, b) = pair();
+    let other = WorldFrame {
+        voxel_size: 0.5,
+        ..FRAME
+    };
+    write_ktree_file_framed(&p("a.ktree"), &a, Some(&FRAME), &Notes::new()).unwrap();
+    write_ktree_file_framed(&p("b.ktree"), &b, Some(&other), &Notes::new()).unwrap();
+    std::fs::write(p("out.ktree"), b"before").unwrap();
+    let (pa, pb, out) = (p("a.ktree"), p("b.ktree"), p("out.ktree"));
+    // Streamed, and in memory (a version 1 output).
+    for extra in [&[][..], &["--format-version", "1"][..]] {
+        let mut args = vec!["op", "union", s(&pa), s(&pb), "--out", s(&out)];
+        args.extend_from_slice(extra);
+        let (ok, _, err) = ktree(&args);
+        assert!(!ok, "{extra:?}");
+        assert!(
+            err.contains("a.ktree") && err.contains("b.ktree") && err.contains("frame"),
+            "{err}"
+        );
+        assert_eq!(std::fs::read(p("out.ktree")).unwrap(), b"before");
+    }
+}
+
+#[test]
+fn a_version_1_output_says_it_keeps_no_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    let (a, _) = pair();
+    write_ktree_file_framed(&p("a.ktree"), &a, Some(&FRAME), &Notes::new()).unwrap();
+    let (ok, _, err) = ktree(&[
+        "op",
+        "not",
+        s(&p("a.ktree")),
+        "--out",
+        s(&p("n.ktree")),
+        "--format-version",
+        "1",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("note:") && err.contains("no world frame"),
+        "{err}"
+    );
+    assert_eq!(framed(&p("n.ktree")).1, None);
+}
+
+#[test]
+fn transform_keeps_the_frame_and_the_notes() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    let (a, _) = pair();
+    write_ktree_file_framed(&p("a.ktree"), &a, Some(&FRAME), &notes("scan")).unwrap();
+    run(&[
+        "transform",
+        s(&p("a.ktree")),
+        "--translate",
+        "1,0,2",
+        "--out",
+        s(&p("t.ktree")),
+    ]);
+    let (moved, frame, kept) = framed(&p("t.ktree"));
+    assert_eq!((frame, kept), (Some(FRAME), notes("scan")));
+    let AnyTree::K3(moved) = moved else {
+        panic!("not an octree")
+    };
+    assert_eq!(moved.voxel_count(), {
+        // The voxels that stay inside the universe.
+        let mut n = 0;
+        for z in 0..8u32 {
+            for y in 0..8u32 {
+                for x in 0..8u32 {
+                    if a.contains([x, y, z]) && x + 1 < 8 && z + 2 < 8 {
+                        n += 1;
+                    }
+                }
+            }
+        }
+        n
+    });
+}
+
+/// The smallest vertex coordinate of an `.obj` along each axis.
+fn lowest_vertex(obj: &Path) -> [f64; 3] {
+    let mut low = [f64::INFINITY; 3];
+    for line in std::fs::read_to_string(obj).unwrap().lines() {
+        if let Some(rest) = line.strip_prefix("v ") {
+            for (l, c) in low.iter_mut().zip(rest.split_whitespace()) {
+                *l = l.min(c.parse::<f64>().unwrap());
+            }
+        }
+    }
+    low
+}
+
+#[test]
+fn convert_keeps_a_grids_placement_in_the_ktree_and_places_meshes_by_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    // One voxel at (2, 1, 3) of a level-2 tree.
+    let dense: Vec<bool> = (0..64).map(|i| i == 2 + 4 + 3 * 16).collect();
+    let one = KTree::<3>::from_dense(2, &dense).unwrap();
+    write_ktree_file_framed(&p("one.ktree"), &one, Some(&FRAME), &notes("one")).unwrap();
+    // Its mesh is in the world: the voxel's lower corner at origin + size · (2, 1, 3).
+    run(&["convert", s(&p("one.ktree")), s(&p("one.obj"))]);
+    let low = lowest_vertex(&p("one.obj"));
+    let want = FRAME.corner_of([2, 1, 3]);
+    for a in 0..3 {
+        assert!((low[a] - want[a]).abs() < 1e-9, "{low:?} against {want:?}");
+    }
+    // To a grid with a placement and back: each voxel in the same world place.
+    run(&["convert", s(&p("one.ktree")), s(&p("one.vdb"))]);
+    run(&["convert", s(&p("one.vdb")), s(&p("back.ktree"))]);
+    let (tree, frame, _) = framed(&p("back.ktree"));
+    let frame = frame.expect("the grid's placement kept");
+    let AnyTree::K3(tree) = tree else {
+        panic!("not an octree")
+    };
+    let cells: Vec<[u32; 3]> = tree.full_cells().map(|c| c.origin()).collect();
+    assert_eq!(cells.len(), 1);
+    let at = frame.corner_of(cells[0].map(i64::from));
+    for a in 0..3 {
+        assert!((at[a] - want[a]).abs() < 1e-9, "{at:?} against {want:?}");
+    }
+    assert_eq!(frame.voxel_size, FRAME.voxel_size);
+    // A .ktree to a .ktree keeps the frame and the notes.
+    run(&["convert", s(&p("one.ktree")), s(&p("copy.ktree"))]);
+    assert_eq!(
+        framed(&p("copy.ktree")),
+        (AnyTree::K3(one), Some(FRAME), notes("one"))
+    );
+}
