@@ -382,7 +382,12 @@ fn build<T: Copy, V: Value + Send + Sync>(
         .voxelize_values(points, per_point, reduce)
         .map_err(|e| crate::voxelize::cloud_error(input, e))?;
     // Written out of core (over MPI ranks, each rank builds its own slabs of the runs).
-    let Some(report) = write_runs(&voxels.runs, options, out, None, &Notes::new())? else {
+    // Voxel (0, 0, 0) has its lower corner at the origin.
+    let frame = WorldFrame {
+        voxel_size: voxelizer.voxel_size(),
+        origin: voxels.origin,
+    };
+    let Some(report) = write_runs(&voxels.runs, options, out, Some(&frame), &Notes::new())? else {
         return Ok(());
     };
     let distinct: std::collections::HashSet<_> =

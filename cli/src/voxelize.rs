@@ -21,6 +21,7 @@ use ktree::io::ktree::Notes;
 use ktree::io::{Format, ReadOptions};
 use ktree::rays::{RaySource, SlabRuns};
 use ktree::solid::mesh::MeshTransform;
+use ktree::space::WorldFrame;
 use ktree::Universe;
 
 use crate::common::output::{is_tree_file, write_output, TreeOutput};
@@ -163,7 +164,8 @@ pub fn run(a: Args) -> CliResult {
     }
     let v = voxelize(&a.input, &options).map_err(CliError::caused)?;
     remarks(&a.input, v.fitted.as_deref(), v.open_edges, root)?;
-    crate::common::output::print_summary(&write_output(&v.rays, &a.out.out, &a.build)?)?;
+    let written = write_output(&v.rays, &a.out.out, &a.build, mesh_frame(&a))?;
+    crate::common::output::print_summary(&written)?;
     Ok(())
 }
 
@@ -335,7 +337,13 @@ fn run_cloud(a: &Args) -> CliResult {
             }
         );
     }
-    crate::common::output::print_summary(&write_output(&voxels.rays, &a.out.out, &a.build)?)?;
+    // Voxel (0, 0, 0) has its lower corner at the origin.
+    let frame = WorldFrame {
+        voxel_size: size,
+        origin: voxels.origin,
+    };
+    let written = write_output(&voxels.rays, &a.out.out, &a.build, Some(frame))?;
+    crate::common::output::print_summary(&written)?;
     Ok(())
 }
 
@@ -370,6 +378,13 @@ fn remarks(input: &Path, fitted: Option<&str>, open_edges: usize, root: bool) ->
     Ok(())
 }
 
+/// Where a mesh's voxels are in the world, when `--transform` places it (scale `s` > 0: voxels of
+/// `1 / s`); a mesh fitted into the universe keeps none.
+fn mesh_frame(a: &Args) -> Option<WorldFrame> {
+    let mesh = Format::of(&a.input) == Some(Format::Mesh);
+    a.transform.filter(|_| mesh).and_then(|t| t.world_frame())
+}
+
 /// Stacks the source straight into the output, out of core, in the budget less what the source holds;
 /// returns the summary (the one [`write_output`] prints for a tree).
 fn build_out_of_core(source: &VoxelSource, a: &Args) -> CliResult<String> {
@@ -379,7 +394,9 @@ fn build_out_of_core(source: &VoxelSource, a: &Args) -> CliResult<String> {
     };
     let counted = CountedRuns::new(source);
     let held = (what.as_str(), source.heap_bytes());
-    let built = TreeOutput::new(&a.out.out, &a.build).write(&counted, Some(held))?;
+    let built = TreeOutput::new(&a.out.out, &a.build)
+        .framed(mesh_frame(a))
+        .write(&counted, Some(held))?;
     Ok(built
         .map(|b| b.summary(Some(counted.runs())))
         .unwrap_or_default())

@@ -249,3 +249,78 @@ fn convert_keeps_a_grids_placement_in_the_ktree_and_places_meshes_by_it() {
         (AnyTree::K3(one), Some(FRAME), notes("one"))
     );
 }
+
+#[test]
+fn voxelize_keeps_where_a_clouds_and_a_placed_meshs_voxels_are() {
+    use ktree::io::ktree::v3::read_any_ktree_framed;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    // A cloud: voxel (0, 0, 0) has its lower corner at the points' minimum corner.
+    std::fs::write(p("c.xyz"), "1.5 -2 0.25\n2.5 -1 0.75\n1.6 -2 0.3\n").unwrap();
+    run(&[
+        "voxelize",
+        s(&p("c.xyz")),
+        "--voxel-size",
+        "0.5",
+        "--out",
+        s(&p("c.ktree")),
+    ]);
+    let cloud = WorldFrame {
+        voxel_size: 0.5,
+        origin: [1.5, -2.0, 0.25],
+    };
+    assert_eq!(framed(&p("c.ktree")).1, Some(cloud));
+    run(&[
+        "voxelize",
+        s(&p("c.xyz")),
+        "--voxel-size",
+        "0.5",
+        "--value",
+        "count",
+        "--out",
+        s(&p("n.ktree")),
+    ]);
+    let bytes = std::fs::read(p("n.ktree")).unwrap();
+    assert_eq!(read_any_ktree_framed(&bytes, "n").unwrap().1, Some(cloud));
+    // A mesh placed by --transform s,t (voxel = s·v + t): voxels of 1/s, voxel 0 at −t/s.
+    let cube = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+                f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\n\
+                f 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+    std::fs::write(p("cube.obj"), cube).unwrap();
+    run(&[
+        "voxelize",
+        s(&p("cube.obj")),
+        "--level",
+        "3",
+        "--transform",
+        "4,2,2,2",
+        "--out",
+        s(&p("cube.ktree")),
+    ]);
+    let (tree, frame, _) = framed(&p("cube.ktree"));
+    assert_eq!(
+        frame,
+        Some(WorldFrame {
+            voxel_size: 0.25,
+            origin: [-0.5; 3],
+        })
+    );
+    let AnyTree::K3(tree) = tree else {
+        panic!("not an octree")
+    };
+    assert_eq!(tree.voxel_count(), 64);
+    // Its mesh is the unit cube again, in the world.
+    run(&["convert", s(&p("cube.ktree")), s(&p("cube-out.obj"))]);
+    assert_eq!(lowest_vertex(&p("cube-out.obj")), [0.0; 3]);
+    // Fitted into the universe, a mesh keeps no frame.
+    run(&[
+        "voxelize",
+        s(&p("cube.obj")),
+        "--level",
+        "3",
+        "--fit",
+        "--out",
+        s(&p("fit.ktree")),
+    ]);
+    assert_eq!(framed(&p("fit.ktree")).1, None);
+}

@@ -34,7 +34,8 @@ impl<const K: usize, S: RaySource<K>> Builder<'_, K, S> {
     /// renamed over it), holding at most about `max_memory` bytes: the subtrees of the cells are spilled
     /// to temporary files as they are stacked (see [`stacking`](crate::stacking)'s notes on memory and
     /// temporary files). The file is byte for byte what [`write_ktree_file`](crate::io::write_ktree_file)
-    /// writes for the tree [`build`](Self::build) makes. It is [`build_into`](Self::build_into) with
+    /// writes for the tree [`build`](Self::build) makes (with a [`world_frame`](Self::world_frame),
+    /// what [`write_ktree_file_framed`](crate::io::write_ktree_file_framed) writes). It is [`build_into`](Self::build_into) with
     /// spill files and the `.ktree` writer: [`stack_part`](Self::stack_part) of every slab, then
     /// [`SpilledPart::write`].
     ///
@@ -52,8 +53,9 @@ impl<const K: usize, S: RaySource<K>> Builder<'_, K, S> {
         S::Error: Display,
     {
         let part = self.stack_part(&self.slabs(), out, max_memory)?;
-        part.write(
+        part.write_framed(
             out,
+            (self.frame(), &Notes::new()),
             &mut |_, _| Err(std::io::Error::other("no other part")),
             self.progress_callback(),
         )
@@ -98,9 +100,24 @@ impl SpilledPart<SpilledFiles> {
         receive: &mut dyn FnMut(usize, &mut [u64]) -> std::io::Result<()>,
         progress: &(dyn Fn(Progress) + Sync),
     ) -> Result<OutOfCoreReport, BuildError<E>> {
+        self.write_framed(out, (None, &Notes::new()), receive, progress)
+    }
+
+    /// [`write`](Self::write) with a world frame and notes in the file's header (see
+    /// [`io::write_ktree_framed`](crate::io::write_ktree_framed)).
+    ///
+    /// # Errors
+    /// As [`write`](Self::write).
+    pub fn write_framed<E>(
+        self,
+        out: &Path,
+        (frame, notes): (Option<&WorldFrame>, &Notes),
+        receive: &mut dyn FnMut(usize, &mut [u64]) -> std::io::Result<()>,
+        progress: &(dyn Fn(Progress) + Sync),
+    ) -> Result<OutOfCoreReport, BuildError<E>> {
         let file = AtomicFile::create(out).map_err(|e| output_error(out, e))?;
-        let writer =
-            KtreeWriter::new(file, self.k(), self.level()).map_err(|e| output_error(out, e))?;
+        let writer = KtreeWriter::with_frame(file, self.k(), self.level(), frame, notes)
+            .map_err(|e| output_error(out, e))?;
         let receive = |owner: usize, words: &mut [u64]| {
             receive(owner, words).map_err(|e| output_error(out, e))
         };

@@ -24,6 +24,7 @@ use super::out_of_core::{
 use super::partition::{default_split_depth, stack_source};
 use crate::rays::RaySet;
 use crate::rays::RaySource;
+use crate::space::WorldFrame;
 use crate::tree::KTree;
 
 /// How each cell the object's boundary passes through is stacked (the tree is the same either way).
@@ -63,6 +64,7 @@ pub struct Builder<'a, const K: usize, S: RaySource<K>> {
     cells: CellStacking,
     temp_dir: Option<PathBuf>,
     progress: Option<&'a (dyn Fn(Progress) + Sync)>,
+    frame: Option<WorldFrame>,
 }
 
 impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
@@ -76,6 +78,7 @@ impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
             cells: CellStacking::default(),
             temp_dir: None,
             progress: None,
+            frame: None,
         }
     }
 
@@ -104,6 +107,18 @@ impl<'a, const K: usize, S: RaySource<K>> Builder<'a, K, S> {
     pub fn temp_dir(mut self, dir: impl Into<PathBuf>) -> Self {
         self.temp_dir = Some(dir.into());
         self
+    }
+
+    /// Where the voxels are in the world: kept in the header of the file [`to_file`](Self::to_file)
+    /// writes (see [`io::write_ktree_framed`](crate::io::write_ktree_framed)).
+    pub fn world_frame(mut self, frame: WorldFrame) -> Self {
+        self.frame = Some(frame);
+        self
+    }
+
+    /// The world frame given to [`world_frame`](Self::world_frame), if any.
+    pub fn frame(&self) -> Option<&WorldFrame> {
+        self.frame.as_ref()
     }
 
     /// Called on the calling thread as a build out of core stacks slabs and writes levels.

@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use ktree::fs::SpillError;
 use ktree::io::write_rays_file;
 use ktree::rays::RaySource;
+use ktree::space::WorldFrame;
 use ktree::stacking::{BuildError, Builder, OutOfCoreReport};
 use ktree::{LevelCounts, RaySet};
 
@@ -32,6 +33,8 @@ pub struct TreeOutput<'a> {
     pub threads: Option<usize>,
     /// Budget, spill folder, progress bar.
     pub args: &'a BuildArgs,
+    /// Where the voxels are in the world, kept in the file.
+    pub frame: Option<WorldFrame>,
 }
 
 /// A tree built and written by [`TreeOutput::write`]: what its summary says.
@@ -50,7 +53,13 @@ impl<'a> TreeOutput<'a> {
             out,
             threads: args.threads.threads,
             args,
+            frame: None,
         }
+    }
+
+    /// The output keeping where the voxels are in the world.
+    pub fn framed(self, frame: Option<WorldFrame>) -> Self {
+        Self { frame, ..self }
     }
 
     /// Builds the tree of `source` and writes it to the output: out of core in the budget less what the
@@ -121,7 +130,10 @@ impl<'a> TreeOutput<'a> {
     /// The build of `source` out of core: cells of the default split depth, the spill folder of
     /// `--temp-dir`.
     pub fn builder<'s, const K: usize, S: RaySource<K>>(&self, source: &'s S) -> Builder<'s, K, S> {
-        let builder = Builder::new(source);
+        let mut builder = Builder::new(source);
+        if let Some(frame) = self.frame {
+            builder = builder.world_frame(frame);
+        }
         match &self.args.temp_dir {
             Some(dir) => builder.temp_dir(dir),
             None => builder,
@@ -193,10 +205,13 @@ pub fn write_output<const K: usize>(
     rays: &RaySet<K>,
     out: &Path,
     build: &BuildArgs,
+    frame: Option<WorldFrame>,
 ) -> CliResult<String> {
     if is_tree_file(out) {
         let held = ("the rays", crate::common::memory::ray_bytes(rays));
-        let built = TreeOutput::new(out, build).write(rays, Some(held))?;
+        let built = TreeOutput::new(out, build)
+            .framed(frame)
+            .write(rays, Some(held))?;
         return Ok(built
             .map(|b| b.summary(Some(rays.len() as u64)))
             .unwrap_or_default());

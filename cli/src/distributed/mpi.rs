@@ -158,7 +158,9 @@ where
 
     // 3. Index, and 4. levels: the other ranks send, rank 0 writes.
     let written = gather_and_write(w, part, chunk, |part, receive| {
-        let written = part.write::<std::convert::Infallible>(out, receive, &progress);
+        let header = (builder.frame(), &ktree::io::Notes::new());
+        let written =
+            part.write_framed::<std::convert::Infallible>(out, header, receive, &progress);
         if let Some(bar) = &bar {
             bar.finish_and_clear();
         }

@@ -74,6 +74,11 @@ impl CloudVoxelizer {
         })
     }
 
+    /// The edge of a voxel, in the points' units.
+    pub fn voxel_size(&self) -> f64 {
+        self.voxel_size
+    }
+
     /// The corner of voxel (0, 0, 0) (default: the minimum corner of the points' bounding box).
     pub fn origin(mut self, origin: [f64; 3]) -> Self {
         self.origin = Some(origin);
