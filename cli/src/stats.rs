@@ -6,18 +6,20 @@
 //! on the file as it is read (in place for a version 2 file): the surface area on the nodes alone, the
 //! Euler number on the tree's runs when they fit the memory budget. A `.ktree` with values gives the counts
 //! of its own nodes, its value type (`dtype`) and, per value (`values`), the voxels, bounding box, centroid
-//! and surface area.
+//! and surface area. A `.ktree` that keeps where its voxels are in the world gives it too (`world_frame`:
+//! `voxel_size` and `origin`, voxel 0's lower corner).
 
 use crate::common::error::{CliError, CliResult};
 use crate::outln;
 
 use std::path::PathBuf;
 
-use ktree::io::read_rays_file;
+use ktree::io::{read_rays_file, FileTree};
 use ktree::query::{stats, TreeStats};
 use ktree::with_tree;
 
 use crate::common::error::read_error;
+use crate::common::tree_file::FrameOut;
 
 /// Arguments of `ktree stats`.
 #[derive(Debug, clap::Args)]
@@ -51,10 +53,15 @@ pub fn run(args: Args) -> CliResult {
         return crate::values::print_valued_stats(path, args.json);
     }
     // The JSON keys are the fields of `TreeStats`, which users' scripts rely on.
+    let mut frame = None;
     let (stats, measures) = match (&args.tree, &args.rays) {
         (Some(path), None) => {
             let file = ktree::input::open_tree(path, &ktree::io::ReadOptions::default())
                 .map_err(CliError::caused)?;
+            // A version 2 `.ktree` may keep where its voxels are in the world.
+            if let FileTree::Mapped(mapped) = &file {
+                frame = mapped.view().frame().map(FrameOut::from);
+            }
             let stats = with_tree!(&file, t => stats(t, None).map_err(read_error))?;
             let measures = if args.measures {
                 Some(crate::shape::measures(&file)?)
@@ -83,10 +90,13 @@ pub fn run(args: Args) -> CliResult {
             stats: &'a TreeStats,
             #[serde(flatten)]
             measures: Option<crate::shape::Measures>,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            world_frame: Option<FrameOut>,
         }
         let out = Out {
             stats: &stats,
             measures,
+            world_frame: frame,
         };
         outln!(
             "{}",
@@ -108,6 +118,9 @@ pub fn run(args: Args) -> CliResult {
     match &stats.bounding_box {
         Some([lo, hi]) => outln!("box      {lo:?} to {hi:?} (upper bound excluded)"),
         None => outln!("box      - (the object is empty)"),
+    }
+    if let Some(frame) = frame {
+        outln!("world    {frame}");
     }
     outln!("bytes    {} (at 2 bits/node)", stats.bytes_at_2_bits);
     outln!(

@@ -10,9 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use ktree::io::ktree::notes::label_note;
-use ktree::io::ktree::v3::{
-    read_any_ktree_framed, read_any_ktree_noted, valued_header, AnyKtree, MappedValuedTree,
-};
+use ktree::io::ktree::v3::{read_any_ktree_framed, valued_header, AnyKtree, MappedValuedTree};
 use ktree::io::ktree::Notes;
 use ktree::query::{stats, TreeStats};
 use ktree::rays::ValueRuns;
@@ -27,6 +25,7 @@ use ktree::{with_valued, AnyValuedTree, KTree};
 
 use crate::common::error::{cannot_read, CliError, CliResult};
 use crate::common::memory::BuildArgs;
+use crate::common::tree_file::FrameOut;
 use crate::outln;
 
 /// The dimension and value type of a `.ktree` file (`None`: no values).
@@ -489,17 +488,21 @@ pub struct ValuedStats {
     stats: TreeStats,
     dtype: &'static str,
     values: serde_json::Map<String, serde_json::Value>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    world_frame: Option<FrameOut>,
 }
 
 /// The statistics of a valued `.ktree` file.
 pub fn valued_stats(path: &Path) -> CliResult<ValuedStats> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| cannot_read(path, e))?;
-    let (tree, notes) = read_any_ktree_noted(&bytes, &name).map_err(CliError::caused)?;
+    let (tree, frame, notes) = read_any_ktree_framed(&bytes, &name).map_err(CliError::caused)?;
     let AnyKtree::Valued(tree) = tree else {
         return Err(format!("{name}: the tree holds no values").into());
     };
-    with_valued!(&tree, t => stats_of(t, &notes))
+    let mut s = with_valued!(&tree, t => stats_of(t, &notes))?;
+    s.world_frame = frame.map(FrameOut::from);
+    Ok(s)
 }
 
 /// The statistics of a valued tree; a value named by the file's notes (a label's name) with its name.
@@ -531,6 +534,7 @@ fn stats_of<const K: usize, V: Value>(tree: &KTree<K, V>, notes: &Notes) -> CliR
         stats: s,
         dtype: V::DTYPE.map_or("", Dtype::name),
         values,
+        world_frame: None,
     })
 }
 
@@ -555,6 +559,9 @@ pub fn print_valued_stats(path: &Path, json: bool) -> CliResult {
         s.stats.empty,
         s.stats.voxels
     );
+    if let Some(frame) = s.world_frame {
+        outln!("world: {frame}");
+    }
     for (value, m) in &s.values {
         let named = m["name"]
             .as_str()

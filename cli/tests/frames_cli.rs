@@ -324,3 +324,34 @@ fn voxelize_keeps_where_a_clouds_and_a_placed_meshs_voxels_are() {
     ]);
     assert_eq!(framed(&p("fit.ktree")).1, None);
 }
+
+#[test]
+fn stats_gives_the_world_frame_a_file_keeps() {
+    use ktree::io::ktree::v3::write_valued_ktree_file_noted;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    let (a, _) = pair();
+    write_ktree_file_framed(&p("a.ktree"), &a, Some(&FRAME), &Notes::new()).unwrap();
+    write_ktree_file_framed(&p("plain.ktree"), &a, None, &Notes::new()).unwrap();
+    let labels: Vec<Option<u8>> = (0..64).map(|i| (i % 3 != 0).then_some(1)).collect();
+    let valued = KTree::<3, u8>::from_dense_values(2, &labels).unwrap();
+    write_valued_ktree_file_noted(&p("v.ktree"), &valued, Some(&FRAME), &Notes::new()).unwrap();
+    for file in ["a.ktree", "v.ktree"] {
+        let json: serde_json::Value =
+            serde_json::from_str(&run(&["stats", s(&p(file)), "--json"])).unwrap();
+        assert_eq!(json["world_frame"]["voxel_size"], 0.25, "{file}");
+        assert_eq!(
+            json["world_frame"]["origin"],
+            serde_json::json!([1.0, -3.5, 0.75]),
+            "{file}"
+        );
+        let text = run(&["stats", s(&p(file))]);
+        assert!(
+            text.contains("voxels of 0.25, voxel 0 at [1.0, -3.5, 0.75]"),
+            "{text}"
+        );
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&run(&["stats", s(&p("plain.ktree")), "--json"])).unwrap();
+    assert!(json.get("world_frame").is_none(), "{json}");
+}
