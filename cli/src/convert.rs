@@ -167,7 +167,8 @@ pub fn run(a: Args) -> CliResult {
     }
     .counted_from(out_offset);
     // Whether the voxels have a place in the world to keep.
-    let placed = read_meta.is_some_and(|m| m != Frame::default())
+    let placed = kept_frame.is_some()
+        || read_meta.is_some_and(|m| m != Frame::default())
         || read_offset != [0; 3]
         || a.origin.is_some()
         || a.voxel_size.is_some()

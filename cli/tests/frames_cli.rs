@@ -242,12 +242,16 @@ fn convert_keeps_a_grids_placement_in_the_ktree_and_places_meshes_by_it() {
         assert!((at[a] - want[a]).abs() < 1e-9, "{at:?} against {want:?}");
     }
     assert_eq!(frame.voxel_size, FRAME.voxel_size);
-    // A .ktree to a .ktree keeps the frame and the notes.
+    // A .ktree to a .ktree keeps the frame and the notes, a unit frame at the origin too.
     run(&["convert", s(&p("one.ktree")), s(&p("copy.ktree"))]);
     assert_eq!(
         framed(&p("copy.ktree")),
-        (AnyTree::K3(one), Some(FRAME), notes("one"))
+        (AnyTree::K3(one.clone()), Some(FRAME), notes("one"))
     );
+    let unit = WorldFrame::default();
+    write_ktree_file_framed(&p("unit.ktree"), &one, Some(&unit), &Notes::new()).unwrap();
+    run(&["convert", s(&p("unit.ktree")), s(&p("unit-copy.ktree"))]);
+    assert_eq!(framed(&p("unit-copy.ktree")).1, Some(unit));
 }
 
 #[test]
