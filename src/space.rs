@@ -64,6 +64,7 @@ pub const fn max_level(k: usize) -> u32 {
 /// assert_eq!(ktree::space::WorldFrame::default().corner_of([3, 1, 2]), [3.0, 1.0, 2.0]);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct WorldFrame {
     /// The edge of a voxel in world units.
     pub voxel_size: f64,

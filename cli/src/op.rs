@@ -9,9 +9,8 @@
 use crate::common::error::{CliError, CliResult};
 use std::path::PathBuf;
 
-use ktree::io::{self, ktree_file_version, BooleanFileError, BooleanFileReport};
+use ktree::io::{self, ktree_file_version, BooleanFileReport};
 use ktree::ops::BoolOp;
-use ktree::space::WorldFrame;
 
 use crate::common::tree_file::{pair_error, print_summary, read_framed, write_framed};
 
@@ -135,15 +134,9 @@ fn run_op(args: Args) -> CliResult {
     };
     let ((ta, fa, na), (tb, fb, nb)) = (read_framed(a)?, read_framed(b)?);
     let out = ta.boolean(&tb, op).map_err(|e| pair_error(a, b, e))?;
-    // The frame both keep (or the one that keeps one), the first one's notes, as a streamed Boolean.
-    let frame = WorldFrame::shared(fa, fb).map_err(|[fa, fb]| {
-        CliError::caused(BooleanFileError::Frames {
-            a: a.display().to_string(),
-            fa,
-            b: b.display().to_string(),
-            fb,
-        })
-    })?;
-    let notes = if na.is_empty() { nb } else { na };
+    // The frame and notes a streamed Boolean keeps.
+    let (a, b) = (a.display().to_string(), b.display().to_string());
+    let (frame, notes) =
+        io::boolean_header((&a, fa, &na), (&b, fb, &nb)).map_err(CliError::caused)?;
     ktree::with_dim!(&out, AnyTree, t => write_framed(&args.out.out, t, frame.as_ref(), &notes))
 }

@@ -19,7 +19,7 @@ use ktree::query::{stats, TreeStats};
 use ktree::with_tree;
 
 use crate::common::error::read_error;
-use crate::common::tree_file::FrameOut;
+use crate::common::tree_file::frame_text;
 
 /// Arguments of `ktree stats`.
 #[derive(Debug, clap::Args)]
@@ -60,7 +60,7 @@ pub fn run(args: Args) -> CliResult {
                 .map_err(CliError::caused)?;
             // A version 2 `.ktree` may keep where its voxels are in the world.
             if let FileTree::Mapped(mapped) = &file {
-                frame = mapped.view().frame().map(FrameOut::from);
+                frame = mapped.view().frame();
             }
             let stats = with_tree!(&file, t => stats(t, None).map_err(read_error))?;
             let measures = if args.measures {
@@ -91,7 +91,7 @@ pub fn run(args: Args) -> CliResult {
             #[serde(flatten)]
             measures: Option<crate::shape::Measures>,
             #[serde(skip_serializing_if = "Option::is_none")]
-            world_frame: Option<FrameOut>,
+            world_frame: Option<ktree::space::WorldFrame>,
         }
         let out = Out {
             stats: &stats,
@@ -119,8 +119,8 @@ pub fn run(args: Args) -> CliResult {
         Some([lo, hi]) => outln!("box      {lo:?} to {hi:?} (upper bound excluded)"),
         None => outln!("box      - (the object is empty)"),
     }
-    if let Some(frame) = frame {
-        outln!("world    {frame}");
+    if let Some(frame) = &frame {
+        outln!("world    {}", frame_text(frame));
     }
     outln!("bytes    {} (at 2 bits/node)", stats.bytes_at_2_bits);
     outln!(

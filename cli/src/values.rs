@@ -25,7 +25,7 @@ use ktree::{with_valued, AnyValuedTree, KTree};
 
 use crate::common::error::{cannot_read, CliError, CliResult};
 use crate::common::memory::BuildArgs;
-use crate::common::tree_file::FrameOut;
+use crate::common::tree_file::frame_text;
 use crate::outln;
 
 /// The dimension and value type of a `.ktree` file (`None`: no values).
@@ -489,7 +489,7 @@ pub struct ValuedStats {
     dtype: &'static str,
     values: serde_json::Map<String, serde_json::Value>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    world_frame: Option<FrameOut>,
+    world_frame: Option<WorldFrame>,
 }
 
 /// The statistics of a valued `.ktree` file.
@@ -501,7 +501,7 @@ pub fn valued_stats(path: &Path) -> CliResult<ValuedStats> {
         return Err(format!("{name}: the tree holds no values").into());
     };
     let mut s = with_valued!(&tree, t => stats_of(t, &notes))?;
-    s.world_frame = frame.map(FrameOut::from);
+    s.world_frame = frame;
     Ok(s)
 }
 
@@ -559,8 +559,8 @@ pub fn print_valued_stats(path: &Path, json: bool) -> CliResult {
         s.stats.empty,
         s.stats.voxels
     );
-    if let Some(frame) = s.world_frame {
-        outln!("world: {frame}");
+    if let Some(frame) = &s.world_frame {
+        outln!("world: {}", frame_text(frame));
     }
     for (value, m) in &s.values {
         let named = m["name"]

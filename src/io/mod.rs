@@ -81,9 +81,9 @@ pub use interop::{
 pub use interop::{write_nifti_file, NiftiWriteError};
 pub use ktree::v1::{write_ktree_v1, write_ktree_v1_view};
 pub use ktree::{
-    boolean_files, boolean_views, complement_file, ktree_file_version, read_ktree, read_ktree_any,
-    read_ktree_file, read_ktree_file_framed, read_ktree_framed, write_ktree, write_ktree_file,
-    write_ktree_file_framed, write_ktree_framed, AnyMappedTree, BooleanFileError,
+    boolean_files, boolean_header, boolean_views, complement_file, ktree_file_version, read_ktree,
+    read_ktree_any, read_ktree_file, read_ktree_file_framed, read_ktree_framed, write_ktree,
+    write_ktree_file, write_ktree_file_framed, write_ktree_framed, AnyMappedTree, BooleanFileError,
     BooleanFileReport, KtreeFileError, KtreeFileErrorKind, KtreeView, KtreeWriter, MappedTree,
     Notes, ViewOperation, MAGIC, VERSION,
 };

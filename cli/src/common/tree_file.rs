@@ -151,30 +151,10 @@ pub fn pair_error(a: &Path, b: &Path, e: ops::OpsError) -> CliError {
     CliError::about(format!("{} and {}", a.display(), b.display()), e)
 }
 
-/// Where a tree's voxels are in the world, as `ktree stats` gives it (JSON key `world_frame`).
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct FrameOut {
-    /// The edge of a voxel in world units.
-    voxel_size: f64,
-    /// The world position of voxel 0's lower corner.
-    origin: [f64; 3],
-}
-
-impl From<WorldFrame> for FrameOut {
-    fn from(f: WorldFrame) -> Self {
-        Self {
-            voxel_size: f.voxel_size,
-            origin: f.origin,
-        }
-    }
-}
-
-impl std::fmt::Display for FrameOut {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "voxels of {}, voxel 0 at {:?}",
-            self.voxel_size, self.origin
-        )
-    }
+/// Where a tree's voxels are in the world, as `ktree stats` prints it.
+pub fn frame_text(frame: &WorldFrame) -> String {
+    format!(
+        "voxels of {}, voxel 0 at {:?}",
+        frame.voxel_size, frame.origin
+    )
 }

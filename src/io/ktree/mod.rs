@@ -42,8 +42,8 @@ pub use history_file::{read_history_ktree, write_history_ktree_file, STEPS_NOTE}
 pub use map_file::{read_map_ktree, write_map_ktree_file, MappedMap};
 pub use notes::Notes;
 pub use streamed::{
-    boolean_files, boolean_views, complement_file, BooleanFileError, BooleanFileReport,
-    ViewOperation,
+    boolean_files, boolean_header, boolean_views, complement_file, BooleanFileError,
+    BooleanFileReport, ViewOperation,
 };
 pub use v2::{AnyMappedTree, KtreeView, KtreeWriter, MappedTree};
 

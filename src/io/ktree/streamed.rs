@@ -163,36 +163,29 @@ pub fn boolean_views(
     out: &Path,
     temp_dir: Option<&Path>,
 ) -> Result<BooleanFileReport, BooleanFileError> {
-    let mut frame = a.frame();
-    if let ViewOperation::Binary(_, b) = operation {
-        if (a.k(), a.level()) != (b.k(), b.level()) {
-            return Err(BooleanFileError::Mismatch {
-                a: a.name().to_string(),
-                ka: a.k(),
-                la: a.level(),
-                b: b.name().to_string(),
-                kb: b.k(),
-                lb: b.level(),
-            });
-        }
-        frame = WorldFrame::shared(a.frame(), b.frame()).map_err(|[fa, fb]| {
-            BooleanFileError::Frames {
-                a: a.name().to_string(),
-                fa,
-                b: b.name().to_string(),
-                fb,
+    let (frame, notes) = match operation {
+        ViewOperation::Binary(_, b) => {
+            if (a.k(), a.level()) != (b.k(), b.level()) {
+                return Err(BooleanFileError::Mismatch {
+                    a: a.name().to_string(),
+                    ka: a.k(),
+                    la: a.level(),
+                    b: b.name().to_string(),
+                    kb: b.k(),
+                    lb: b.level(),
+                });
             }
-        })?;
-    }
-    // The first input's notes, else the second's.
-    let notes = match operation {
-        ViewOperation::Binary(_, b) if a.notes().is_empty() => b.notes(),
-        _ => a.notes(),
+            boolean_header(
+                (a.name(), a.frame(), a.notes()),
+                (b.name(), b.frame(), b.notes()),
+            )?
+        }
+        ViewOperation::Complement => (a.frame(), a.notes().clone()),
     };
     let output = Output {
         path: out,
         frame,
-        notes,
+        notes: &notes,
         temp_dir,
     };
     match a.k() {
@@ -202,6 +195,35 @@ pub fn boolean_views(
         // Any other `K` is refused by `MappedTree::new`.
         _ => boolean_views_k::<4>(a, operation, output),
     }
+}
+
+/// The world frame and notes of a Boolean of two trees, each given as its name (for the error), frame and
+/// notes: the frame they share ([`WorldFrame::shared`]) and the first one's notes, else the second's — what
+/// [`boolean_files`] writes, and what a Boolean in memory should keep.
+///
+/// ```
+/// use ktree::io::{boolean_header, Notes};
+/// use ktree::space::WorldFrame;
+/// let f = WorldFrame { voxel_size: 0.5, origin: [0.0; 3] };
+/// let named = Notes::from([("source".to_string(), "b".to_string())]);
+/// let (frame, notes) = boolean_header(("a", None, &Notes::new()), ("b", Some(f), &named)).unwrap();
+/// assert_eq!((frame, notes), (Some(f), named));
+/// ```
+///
+/// # Errors
+/// [`BooleanFileError::Frames`] when both keep a frame and they differ.
+pub fn boolean_header(
+    (a, fa, na): (&str, Option<WorldFrame>, &Notes),
+    (b, fb, nb): (&str, Option<WorldFrame>, &Notes),
+) -> Result<(Option<WorldFrame>, Notes), BooleanFileError> {
+    let frame = WorldFrame::shared(fa, fb).map_err(|[fa, fb]| BooleanFileError::Frames {
+        a: a.to_string(),
+        fa,
+        b: b.to_string(),
+        fb,
+    })?;
+    let notes = if na.is_empty() { nb } else { na };
+    Ok((frame, notes.clone()))
 }
 
 /// Where a streamed Boolean writes, and the world frame and notes its file keeps.
