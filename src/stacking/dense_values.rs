@@ -1,11 +1,13 @@
 //! Building a valued tree straight from a dense array of values: a cell whose voxels all hold one value
 //! (or all the background) is a leaf; any other cell is built from its `2^K` children.
-//! The array is read once in its own order (streamed, not visited cell by cell), a row of bricks —
-//! cells of about 4096 voxels — at a time: which bricks hold one value is noted, and the subtree of
-//! each other brick is built bottom up while the row is in the cache (its voxels gathered in Morton
-//! order, each level settled from the one below). The cells of bricks are then settled from their
-//! bricks, depth first, the bricks' subtrees moved in. The tree is minimal by construction.
-//! The same tree as [`KTree::from_value_runs`] of the array's runs, without making the runs.
+//! The array is read once in its own order (streamed, not visited cell by cell, the next row asked of
+//! memory while one is read), a row of bricks — cells of about 4096 voxels — at a time: which bricks
+//! hold one value is noted, and the voxels of each other brick are gathered in Morton order as they are
+//! read, from the first that differs from the brick's first voxel (all before it held that value); its
+//! subtree is built bottom up once the row is read (each level settled from the one below). The cells
+//! of bricks are then settled from their bricks, depth first, the bricks' subtrees moved in. The tree is
+//! minimal by construction. The same tree as [`KTree::from_value_runs`] of the array's runs, without
+//! making the runs.
 //!
 //! ```
 //! use ktree::rays::ValueRuns;
@@ -20,12 +22,14 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
+use super::prefetch::prefetch;
 use crate::rays::source::default_split_depth;
 use crate::rays::valued::check_dense_len;
 use crate::rays::RayError;
 use crate::space::{spread_bits, Cell, Universe};
 use crate::tree::top_down::Subtree;
 use crate::tree::valued::{combine, ValueState, ValuedLevel};
+use crate::tree::words::LevelWords;
 use crate::value::Value;
 use crate::KTree;
 
@@ -198,93 +202,123 @@ struct BrickTree<V> {
     levels: Vec<ValuedLevel<V>>,
 }
 
-/// The subtree of the brick of side `2^log` whose first voxel is `dense[origin]` in an array of rows
-/// `stride` long (axis 0 fastest), built bottom up: its voxels gathered in Morton order (so that a
-/// cell's `2^K` children are consecutive; `spread` holds each coordinate's bits spread `K` apart), each
-/// level's cells settled from their children, then the nodes of the tree taken top down. `scratch`
-/// holds the voxels and the states of the cells above them. `None` when a value is refused
-/// ([`Value::check`]).
+/// The subtree of a brick of side `2^log` from its voxels in Morton order (so that a cell's `2^K`
+/// children are consecutive), built bottom up: each level's cells settled from their children, then the
+/// nodes of the tree taken top down, in `scratch` (kept from one brick to the next). Each cell is kept
+/// as its 2-bit code and a value, so that settling and writing a node take no branch on its state.
+/// `None` when a value is refused ([`Value::check`]).
 fn brick_tree<const K: usize, V: Value>(
-    dense: &[V],
-    stride: usize,
-    origin: usize,
+    voxels: &[V],
     log: usize,
     background: V,
-    spread: &[usize],
     scratch: &mut BrickScratch<V>,
 ) -> Option<BrickTree<V>> {
-    let side = 1usize << log;
-    let voxels = &mut scratch.voxels;
-    voxels.resize(1usize << (log * K), background);
-    // Each row along axis 0: its place in the array and its first voxel's Morton index, the other axes'
-    // offsets counted like an odometer.
-    for offset in BoxRows::<K>::new(side) {
-        let start = origin + row_offset(offset, stride);
-        let morton = (1..K).fold(0, |m, a| m | spread[offset[a]] << a);
-        for (&v, &x) in dense[start..start + side].iter().zip(spread) {
-            voxels[morton | x] = v;
-        }
-    }
-    // The voxels' state.
-    let voxel = |v: V| {
-        if v.same(background) {
-            ValueState::Empty
-        } else {
-            ValueState::Full(v)
-        }
-    };
-    // The cells of side 2, then each level above appended after the one below it; `starts[j]` where
-    // level j begins in `cells` (level 0, the voxels, is `voxels`).
     let n = 1usize << K;
-    let cells = &mut scratch.cells;
-    cells.clear();
-    cells.extend(voxels.chunks_exact(n).map(|kids| {
+    let BrickScratch {
+        codes,
+        values,
+        full,
+        parents,
+        next,
+    } = scratch;
+    // The cells of side 2, then each level above appended after the one below it; `starts[j]` where
+    // level j begins (level 0, the voxels, is `voxels`).
+    codes.clear();
+    values.clear();
+    for kids in voxels.chunks_exact(n) {
         let first = kids[0];
-        if kids.iter().fold(true, |all, v| all & v.same(first)) {
-            voxel(first)
-        } else if kids.iter().fold(false, |any, v| any | v.same(background)) {
-            ValueState::Partial
+        let same = kids.iter().fold(true, |all, v| all & v.same(first));
+        let any_empty = kids.iter().fold(false, |any, v| any | v.same(background));
+        codes.push(if same {
+            u8::from(!first.same(background))
         } else {
-            ValueState::Mixed
-        }
-    }));
-    let mut starts = vec![0usize; log + 1];
+            PARTIAL + u8::from(!any_empty)
+        });
+        values.push(first);
+    }
+    let mut starts = [0usize; 32];
     for j in 2..=log {
         let below = starts[j - 1];
-        starts[j] = cells.len();
+        starts[j] = codes.len();
         for i in (below..starts[j]).step_by(n) {
-            let state = combine(&cells[i..i + n]);
-            cells.push(state);
+            let (kid_codes, kid_values) = (&codes[i..i + n], &values[i..i + n]);
+            let first = kid_values[0];
+            let full = kid_codes.iter().fold(true, |all, &c| all & (c == FULL));
+            let same = kid_values.iter().fold(true, |all, v| all & v.same(first));
+            let empty = kid_codes.iter().fold(true, |all, &c| all & (c == EMPTY));
+            // Full or mixed: every voxel holds a value.
+            let valued = kid_codes.iter().fold(true, |all, &c| all & (c & 1 == 1));
+            codes.push(if full && same {
+                FULL
+            } else if empty {
+                EMPTY
+            } else if valued {
+                MIXED
+            } else {
+                PARTIAL
+            });
+            values.push(first);
         }
     }
-    // Top down: the children of the nodes with children, level by level.
-    let root = cells[starts[log]];
+    let root = match codes[starts[log]] {
+        EMPTY => ValueState::Empty,
+        FULL => ValueState::Full(values[starts[log]]),
+        PARTIAL => ValueState::Partial,
+        _ => ValueState::Mixed,
+    };
+    // Top down: the children of the nodes with children, level by level, each child's code and (if it
+    // is full) value written in place and counted in or not, rather than branched on.
     let mut levels = Vec::with_capacity(log);
-    let (mut parents, mut next) = (vec![0usize], Vec::new());
+    parents.clear();
+    parents.push(0);
     for j in (0..log).rev() {
-        next.clear();
-        let mut states = ValuedLevel::new();
-        for &p in &parents {
-            let first = p * n;
-            if j == 0 {
-                let mut kids = [ValueState::Empty; 16];
-                for (kid, &v) in kids.iter_mut().zip(&voxels[first..first + n]) {
-                    *kid = voxel(v);
-                }
-                states.extend_from_slice(&kids[..n]);
-                continue;
-            }
-            let kids = &cells[starts[j] + first..starts[j] + first + n];
-            states.extend_from_slice(kids);
-            next.extend(
-                (0..n)
-                    .filter(|&c| kids[c].has_children())
-                    .map(|c| first + c),
-            );
+        let mut level_codes = LevelWords::default();
+        level_codes.reserve(parents.len() * n);
+        if full.len() < parents.len() * n {
+            full.resize(parents.len() * n, background);
         }
-        levels.push(states);
-        std::mem::swap(&mut parents, &mut next);
-        if parents.is_empty() {
+        let mut kept = 0;
+        if j == 0 {
+            for &p in parents.iter() {
+                let mut packed = 0;
+                for (c, &v) in voxels[p * n..p * n + n].iter().enumerate() {
+                    let is_full = !v.same(background);
+                    packed |= u64::from(is_full) << (2 * c);
+                    full[kept] = v;
+                    kept += usize::from(is_full);
+                }
+                level_codes.push(packed, n);
+            }
+        } else {
+            next.clear();
+            next.resize(parents.len() * n, 0);
+            let mut with_children = 0;
+            for &p in parents.iter() {
+                let at = starts[j] + p * n;
+                let mut packed = 0;
+                for (c, (&code, &v)) in codes[at..at + n]
+                    .iter()
+                    .zip(&values[at..at + n])
+                    .enumerate()
+                {
+                    packed |= u64::from(code) << (2 * c);
+                    full[kept] = v;
+                    kept += usize::from(code == FULL);
+                    next[with_children] = p * n + c;
+                    with_children += usize::from(code >= PARTIAL);
+                }
+                level_codes.push(packed, n);
+            }
+            next.truncate(with_children);
+        }
+        let full = if V::STORED {
+            full[..kept].to_vec()
+        } else {
+            Vec::new()
+        };
+        levels.push(ValuedLevel::from_parts(level_codes, full));
+        std::mem::swap(parents, next);
+        if j == 0 || parents.is_empty() {
             break;
         }
     }
@@ -294,17 +328,53 @@ fn brick_tree<const K: usize, V: Value>(
     Some(BrickTree { root, levels })
 }
 
-/// The memory [`brick_tree`] works in, kept from one brick to the next.
-struct BrickScratch<V> {
+/// The 2-bit codes of a node's states, as the files and [`ValuedLevel`] write them.
+const EMPTY: u8 = 0;
+const FULL: u8 = 1;
+const PARTIAL: u8 = 2;
+const MIXED: u8 = 3;
+
+/// The memory a thread reads its rows of bricks in, kept from one row to the next: for each brick of
+/// the row, the voxels (in Morton order) of the bricks found to hold several values, and the states of
+/// the cells [`brick_tree`] settles.
+struct RowScratch<V> {
+    /// Each brick's place in `voxels` once one of its voxels differs from its first.
+    mixed: Vec<Option<usize>>,
+    /// The voxels of the row's bricks of several values, a brick after another.
     voxels: Vec<V>,
-    cells: Vec<ValueState<V>>,
+    brick: BrickScratch<V>,
+}
+
+impl<V> RowScratch<V> {
+    fn new() -> Self {
+        Self {
+            mixed: Vec::new(),
+            voxels: Vec::new(),
+            brick: BrickScratch::new(),
+        }
+    }
+}
+
+/// The memory [`brick_tree`] works in, kept from one brick to the next: the cells above the voxels,
+/// level after level (each one's code, and its value — the first voxel's, meaningful when it is full),
+/// the values of a level's full nodes as they are found, and the nodes with children of a level and of
+/// the next.
+struct BrickScratch<V> {
+    codes: Vec<u8>,
+    values: Vec<V>,
+    full: Vec<V>,
+    parents: Vec<usize>,
+    next: Vec<usize>,
 }
 
 impl<V> BrickScratch<V> {
     fn new() -> Self {
         Self {
-            voxels: Vec::new(),
-            cells: Vec::new(),
+            codes: Vec::new(),
+            values: Vec::new(),
+            full: Vec::new(),
+            parents: Vec::new(),
+            next: Vec::new(),
         }
     }
 }
@@ -313,8 +383,12 @@ impl<V> BrickScratch<V> {
 /// bricks in the same order): each brick's first voxel's value if every voxel of the brick holds it,
 /// else its subtree ([`brick_tree`]). The array is read once in its own order, a row of bricks at a
 /// time — each row's pieces compared with the first voxels of their bricks, so that memory is streamed
-/// rather than visited brick by brick — and the row's bricks of several values built while it is in
-/// the cache; slabs of bricks along the last axis run on the rayon pool.
+/// rather than visited brick by brick, the next row [`prefetch`]ed meanwhile (rows of a row of bricks
+/// lie a page or more apart, which the processor's own prefetching does not follow). A brick's voxels
+/// are gathered in Morton order from the piece where one first differs from its first voxel (those
+/// before it all held the first voxel's value), so that no voxel is read twice; the row's bricks of
+/// several values are built once the row is read. Slabs of bricks along the last axis run on the rayon
+/// pool.
 #[allow(clippy::type_complexity)]
 fn read_bricks<const K: usize, V: Value>(
     dense: &[V],
@@ -325,23 +399,30 @@ fn read_bricks<const K: usize, V: Value>(
     let side = 1usize << level;
     let brick = 1usize << brick_log;
     let grid = side >> brick_log;
-    let spread: Vec<usize> = (0..brick as u32)
-        .map(|c| spread_bits::<K>(c) as usize)
-        .collect();
     let log = brick_log as usize;
     let uniform = |piece: &[V]| piece.iter().all(|v| v.same(piece[0])).then_some(piece[0]);
     if K == 1 {
+        // A brick of a bintree is a piece of the array, already in Morton order.
         return dense
             .par_chunks(brick)
             .map_init(BrickScratch::new, |scratch, piece| match uniform(piece) {
                 Some(v) => (Some(v), None),
-                None => (
-                    None,
-                    brick_tree::<K, V>(piece, side, 0, log, background, &spread, scratch),
-                ),
+                None => (None, brick_tree::<K, V>(piece, log, background, scratch)),
             })
             .unzip();
     }
+    let spread: Vec<usize> = (0..brick as u32)
+        .map(|c| spread_bits::<K>(c) as usize)
+        .collect();
+    let brick_voxels = 1usize << (log * K);
+    // A brick's rows along axis 0 in memory order (axis 1 fastest): each one's offset from the brick's
+    // first voxel in the array and the Morton index of its first voxel in the brick.
+    let brick_rows: Vec<(usize, usize)> = BoxRows::<K>::new(brick)
+        .map(|o| {
+            let morton = (1..K).fold(0, |m, a| m | spread[o[a]] << a);
+            (row_offset(o, side), morton)
+        })
+        .collect();
     // Bricks a slab (one brick thick along the last axis) and voxels a slab; a row of bricks (along
     // axis 0) within a slab has rows of voxels at `brick^(K - 1)` offsets.
     let slab_bricks = grid.pow(K as u32 - 1);
@@ -353,7 +434,7 @@ fn read_bricks<const K: usize, V: Value>(
         .par_chunks_mut(slab_bricks)
         .zip(trees.par_chunks_mut(slab_bricks))
         .zip(dense.par_chunks(slab_voxels))
-        .for_each_init(BrickScratch::new, |scratch, ((bricks, trees), voxels)| {
+        .for_each_init(RowScratch::new, |scratch, ((bricks, trees), voxels)| {
             for (row_of_bricks, (bricks, trees)) in bricks
                 .chunks_exact_mut(grid)
                 .zip(trees.chunks_exact_mut(grid))
@@ -361,31 +442,55 @@ fn read_bricks<const K: usize, V: Value>(
             {
                 // The first voxel of the row of bricks: its coordinates along axes 1 … K − 2 are those
                 // of the row of bricks times the brick's side.
-                let (mut first, mut rest, mut step) = (0, row_of_bricks, side);
+                let (mut corner, mut rest, mut step) = (0, row_of_bricks, side);
                 for _ in 1..K - 1 {
-                    first += (rest % grid) * brick * step;
+                    corner += (rest % grid) * brick * step;
                     rest /= grid;
                     step *= side;
                 }
-                // Its rows, axis 1 fastest (memory in order).
-                for (r, offset) in BoxRows::<K>::new(brick).enumerate() {
-                    let start = first + row_offset(offset, side);
+                scratch.mixed.clear();
+                scratch.mixed.resize(grid, None);
+                scratch.voxels.clear();
+                for (r, &(offset, morton)) in brick_rows.iter().enumerate() {
+                    let start = corner + offset;
                     let row = &voxels[start..start + side];
-                    for ((first, uniform), piece) in bricks.iter_mut().zip(row.chunks_exact(brick))
+                    // The next row, asked for piece by piece while this one is read.
+                    let ahead = corner + brick_rows.get(r + 1).map_or(offset, |next| next.0);
+                    for (b, (((first, uniform), mixed), piece)) in bricks
+                        .iter_mut()
+                        .zip(scratch.mixed.iter_mut())
+                        .zip(row.chunks_exact(brick))
+                        .enumerate()
                     {
-                        if r == 0 {
-                            *first = piece[0];
+                        prefetch(voxels, ahead + b * brick);
+                        let at = match *mixed {
+                            Some(at) => at,
+                            None => {
+                                if r == 0 {
+                                    *first = piece[0];
+                                }
+                                let f = *first;
+                                if piece.iter().fold(true, |all, v| all & v.same(f)) {
+                                    continue;
+                                }
+                                // The brick's rows read so far all held `f`.
+                                *uniform = false;
+                                let at = scratch.voxels.len();
+                                scratch.voxels.resize(at + brick_voxels, f);
+                                *mixed = Some(at);
+                                at
+                            }
+                        };
+                        let gathered = &mut scratch.voxels[at..at + brick_voxels];
+                        for (&v, &x) in piece.iter().zip(&spread) {
+                            gathered[morton | x] = v;
                         }
-                        let f = *first;
-                        *uniform &= piece.iter().fold(true, |all, v| all & v.same(f));
                     }
                 }
-                for (b, (&(_, uniform), tree)) in bricks.iter().zip(trees.iter_mut()).enumerate() {
-                    if !uniform {
-                        let origin = first + b * brick;
-                        *tree = brick_tree::<K, V>(
-                            voxels, side, origin, log, background, &spread, scratch,
-                        );
+                for (&mixed, tree) in scratch.mixed.iter().zip(trees.iter_mut()) {
+                    if let Some(at) = mixed {
+                        let gathered = &scratch.voxels[at..at + brick_voxels];
+                        *tree = brick_tree::<K, V>(gathered, log, background, &mut scratch.brick);
                     }
                 }
             }

@@ -101,6 +101,9 @@ mod dense_values;
 mod out_of_core;
 pub mod paper;
 mod partition;
+// The one instruction that is `unsafe` to call here: a hint to the cache, see its SAFETY comment.
+#[allow(unsafe_code)]
+mod prefetch;
 mod solids;
 mod value_parts;
 mod value_run_slabs;

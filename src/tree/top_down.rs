@@ -148,10 +148,14 @@ fn pack_chunks<const K: usize, V: Value>(
 }
 
 /// One level, kept as chunks, packed: its 2-bit codes with their rank index and the values of its full
-/// nodes (the chunks' codes joined by shifted word copies; one chunk is moved, not copied).
+/// nodes (the chunks' codes joined by shifted word copies into room made once; the first chunk is moved,
+/// not copied).
 fn pack_level<V: Value>(chunks: Vec<ValuedLevel<V>>) -> PackedLevel<V> {
+    let nodes: usize = chunks.iter().map(ValuedLevel::len).sum();
+    let values: usize = chunks.iter().map(|c| c.values().len()).sum();
     let mut chunks = chunks.into_iter();
     let mut level = chunks.next().unwrap_or_default();
+    level.reserve(nodes - level.len(), values - level.values().len());
     for chunk in chunks {
         level.append(chunk);
     }

@@ -188,6 +188,20 @@ impl LevelWords {
         }
     }
 
+    /// Appends the codes of `other` (its whole words, then the codes after them).
+    pub(crate) fn append(&mut self, other: &Self) {
+        self.append_words(&other.words, other.words.len() * NODES_PER_WORD);
+        let pending = other.packer.pending_nodes();
+        if pending > 0 {
+            self.push(other.packer.pending, pending);
+        }
+    }
+
+    /// Room for `nodes` more codes without reallocating.
+    pub(crate) fn reserve(&mut self, nodes: usize) {
+        self.words.reserve(nodes / NODES_PER_WORD + 1);
+    }
+
     /// Appends the codes `start .. start + nodes` of the packed level `src`, leaves complemented if
     /// `invert`.
     pub(crate) fn append_range(&mut self, src: &[u64], start: usize, nodes: usize, invert: bool) {

@@ -35,6 +35,11 @@ impl<V: Value> ValuedLevel<V> {
         level
     }
 
+    /// The level of `codes` and the values of its full nodes, in order (one for each code `01`).
+    pub(crate) fn from_parts(codes: LevelWords, values: Vec<V>) -> Self {
+        Self { codes, values }
+    }
+
     /// The number of nodes.
     pub(crate) fn len(&self) -> usize {
         self.codes.len()
@@ -92,9 +97,14 @@ impl<V: Value> ValuedLevel<V> {
             *self = other;
             return;
         }
-        let (words, len) = other.codes.into_words();
-        self.codes.append_words(&words, len);
+        self.codes.append(&other.codes);
         self.values.extend(other.values);
+    }
+
+    /// Room for `nodes` more nodes and `values` more values without reallocating.
+    pub(crate) fn reserve(&mut self, nodes: usize, values: usize) {
+        self.codes.reserve(nodes);
+        self.values.reserve(values);
     }
 
     /// The level packed for a tree: its codes with their rank index, and its full nodes' values.
