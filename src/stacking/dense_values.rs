@@ -243,12 +243,12 @@ fn brick_tree<const K: usize, V: Value>(
         for i in (below..starts[j]).step_by(n) {
             let (kid_codes, kid_values) = (&codes[i..i + n], &values[i..i + n]);
             let first = kid_values[0];
-            let full = kid_codes.iter().fold(true, |all, &c| all & (c == FULL));
+            let all_full = kid_codes.iter().fold(true, |all, &c| all & (c == FULL));
             let same = kid_values.iter().fold(true, |all, v| all & v.same(first));
             let empty = kid_codes.iter().fold(true, |all, &c| all & (c == EMPTY));
             // Full or mixed: every voxel holds a value.
             let valued = kid_codes.iter().fold(true, |all, &c| all & (c & 1 == 1));
-            codes.push(if full && same {
+            codes.push(if all_full && same {
                 FULL
             } else if empty {
                 EMPTY
@@ -335,8 +335,8 @@ const PARTIAL: u8 = 2;
 const MIXED: u8 = 3;
 
 /// The memory a thread reads its rows of bricks in, kept from one row to the next: for each brick of
-/// the row, the voxels (in Morton order) of the bricks found to hold several values, and the states of
-/// the cells [`brick_tree`] settles.
+/// the row, where its voxels are copied (in Morton order) once it is found to hold several values, those
+/// voxels, and the memory [`brick_tree`] works in.
 struct RowScratch<V> {
     /// Each brick's place in `voxels` once one of its voxels differs from its first.
     mixed: Vec<Option<usize>>,
