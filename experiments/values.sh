@@ -105,7 +105,7 @@ print("and the rotations about z only: `experiments/examples/values.rs`), as **l
 print("centre, 1–10, 0 outside; stored as u32) and as a **density** (the sum of the intensities, float32, 0 outside). Both")
 print("programs read the same raw file (x fastest) before the clock starts, and 0 is the background of both.")
 print("**ktree**: `KTree::from_dense_background`, straight from the array (read once in its order a row of bricks of 16³")
-print("voxels at a time, the next row asked of memory ahead (a prefetch hint) while one is read: a brick of one value a")
+print("voxels at a time, the rows 4 KiB ahead asked of memory (a prefetch hint) while one is read: a brick of one value a")
 print("leaf, the voxels of each other brick copied out as they are read — from the first that differs from the brick's first")
 print("— and its subtree built bottom up once the row is read; the cells of bricks settled from their bricks), one thread")
 print("(and two beside: slabs of bricks read and the subtrees of cells of 2^18 voxels built on the rayon pool). **OpenVDB**")

@@ -164,6 +164,10 @@ pub trait Value: Copy + PartialEq + Debug + Send + Sync + 'static + sealed::Seal
         self.key() == other.key()
     }
 
+    /// Whether [`Value::check`] can refuse a value of the type (`f32` alone): a loop checking many
+    /// values is skipped when not.
+    const REFUSES: bool = false;
+
     /// Refuses a value no voxel may hold (a NaN).
     ///
     /// # Errors
@@ -293,6 +297,7 @@ integer_value!(i8, Dtype::I8);
 impl Value for f32 {
     const STORED: bool = true;
     const DTYPE: Option<Dtype> = Some(Dtype::F32);
+    const REFUSES: bool = true;
     type Key = u32;
     #[inline(always)]
     fn key(self) -> u32 {
@@ -392,6 +397,24 @@ impl Value for Rgb {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A type says it refuses values exactly when one of its samples (its extremes, and NaN for `f32`)
+    /// is refused.
+    fn refuses_when_a_sample_is_refused<V: Value>(samples: &[V]) {
+        let refused = samples.iter().any(|v| v.check().is_err());
+        assert_eq!(V::REFUSES, refused, "{:?}", V::DTYPE);
+    }
+
+    #[test]
+    fn only_f32_refuses_values() {
+        refuses_when_a_sample_is_refused(&[()]);
+        refuses_when_a_sample_is_refused(&[u8::MIN, u8::MAX]);
+        refuses_when_a_sample_is_refused(&[i8::MIN, 0, i8::MAX]);
+        refuses_when_a_sample_is_refused(&[u16::MIN, u16::MAX]);
+        refuses_when_a_sample_is_refused(&[u32::MIN, u32::MAX]);
+        refuses_when_a_sample_is_refused(&[0.0f32, f32::INFINITY, f32::NEG_INFINITY, f32::NAN]);
+        refuses_when_a_sample_is_refused::<Rgb>(&[[0; 3], [255; 3]]);
+    }
 
     fn round_trip<V: Value>(values: &[V]) {
         for &v in values {

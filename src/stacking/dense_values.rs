@@ -1,11 +1,11 @@
 //! Building a valued tree straight from a dense array of values: a cell whose voxels all hold one value
 //! (or all the background) is a leaf; any other cell is built from its `2^K` children.
-//! The array is read once in its own order (streamed, not visited cell by cell, the next row asked of
-//! memory while one is read), a row of bricks — cells of about 4096 voxels — at a time: which bricks
+//! The array is read once in its own order (streamed, not visited cell by cell, the rows 4 KiB ahead
+//! asked of memory while one is read), a row of bricks — cells of about 4096 voxels — at a time: which bricks
 //! hold one value is noted, and the voxels of each other brick are gathered in Morton order as they are
 //! read, from the first that differs from the brick's first voxel (all before it held that value); its
 //! subtree is built bottom up once the row is read (each level settled from the one below). The cells
-//! of bricks are then settled from their bricks, depth first, the bricks' subtrees moved in. The tree is
+//! of bricks are then settled from their bricks, depth first, the bricks' subtrees copied in. The tree is
 //! minimal by construction. The same tree as [`KTree::from_value_runs`] of the array's runs, without
 //! making the runs.
 //!
@@ -29,7 +29,7 @@ use crate::rays::RayError;
 use crate::space::{spread_bits, Cell, Universe};
 use crate::tree::top_down::Subtree;
 use crate::tree::valued::{combine, ValueState, ValuedLevel};
-use crate::tree::words::LevelWords;
+use crate::tree::words::{children_mask, full_count};
 use crate::value::Value;
 use crate::KTree;
 
@@ -150,7 +150,7 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
 
     /// Builds the subtree of `cell` (at `depth`): returns its state, its children (if any) pushed onto
     /// the level below in `levels` (each level a list of chunks, the last one open); a brick of several
-    /// values as it was built when it was read, its levels' chunks moved in.
+    /// values as it was built when it was read, its levels appended to the open chunks.
     fn node(
         &self,
         cell: Cell<K>,
@@ -172,10 +172,9 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
                 .unwrap_or_else(|poisoned| poisoned.into_inner())
                 .take();
             if let Some(tree) = tree {
-                for (level, below) in levels[depth + 1..].iter_mut().zip(tree.levels) {
-                    level.push(below);
-                }
-                return Ok(tree.root);
+                let root = tree.root;
+                tree.append_to::<K>(&mut levels[depth + 1..]);
+                return Ok(root);
             }
         }
         let n = 1usize << K;
@@ -195,11 +194,47 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
     }
 }
 
-/// The subtree of a brick of several values: its root's state and each level below it in level
-/// order, the root's children first.
+/// The subtree of a brick of several values: its root's state, the 2-bit codes of each level below it
+/// in level order (the root's children first), each level from a word of its own, and the values of
+/// their full nodes, level after level — two allocations however deep the brick.
 struct BrickTree<V> {
     root: ValueState<V>,
-    levels: Vec<ValuedLevel<V>>,
+    words: Vec<u64>,
+    values: Vec<V>,
+}
+
+impl<V: Value> BrickTree<V> {
+    /// Appends each level below the root to the last chunk of the matching level of `levels` (the
+    /// root's children to `levels[0]`). A level's length is found from the one above: `2^K` nodes for
+    /// each node with children.
+    fn append_to<const K: usize>(self, levels: &mut [Vec<ValuedLevel<V>>]) {
+        let (mut nodes, mut word, mut value) = (1usize << K, 0, 0);
+        for level in levels {
+            if nodes == 0 {
+                break;
+            }
+            let words = &self.words[word..word + (2 * nodes).div_ceil(64)];
+            let full: usize = words.iter().map(|&w| full_count(w) as usize).sum();
+            let values = if V::STORED {
+                &self.values[value..value + full]
+            } else {
+                &[]
+            };
+            if level.is_empty() {
+                level.push(ValuedLevel::new());
+            }
+            if let Some(chunk) = level.last_mut() {
+                chunk.append_words(words, nodes, values);
+            }
+            word += words.len();
+            value += values.len();
+            nodes = words
+                .iter()
+                .map(|&w| children_mask(w).count_ones() as usize)
+                .sum::<usize>()
+                << K;
+        }
+    }
 }
 
 /// The subtree of a brick of side `2^log` from its voxels in Morton order (so that a cell's `2^K`
@@ -217,6 +252,7 @@ fn brick_tree<const K: usize, V: Value>(
     let BrickScratch {
         codes,
         values,
+        words,
         full,
         parents,
         next,
@@ -225,17 +261,17 @@ fn brick_tree<const K: usize, V: Value>(
     // level j begins (level 0, the voxels, is `voxels`).
     codes.clear();
     values.clear();
-    for kids in voxels.chunks_exact(n) {
+    codes.extend(voxels.chunks_exact(n).map(|kids| {
         let first = kids[0];
         let same = kids.iter().fold(true, |all, v| all & v.same(first));
         let any_empty = kids.iter().fold(false, |any, v| any | v.same(background));
-        codes.push(if same {
+        if same {
             u8::from(!first.same(background))
         } else {
             PARTIAL + u8::from(!any_empty)
-        });
-        values.push(first);
-    }
+        }
+    }));
+    values.extend(voxels.chunks_exact(n).map(|kids| kids[0]));
     let mut starts = [0usize; 32];
     for j in 2..=log {
         let below = starts[j - 1];
@@ -267,19 +303,22 @@ fn brick_tree<const K: usize, V: Value>(
         _ => ValueState::Mixed,
     };
     // Top down: the children of the nodes with children, level by level, each child's code and (if it
-    // is full) value written in place and counted in or not, rather than branched on.
-    let mut levels = Vec::with_capacity(log);
+    // is full) value written in place and counted in or not, rather than branched on. A block of
+    // siblings' codes (`2n` bits, which divides 64) lies within one word.
+    let bits = 2 * n;
+    words.clear();
     parents.clear();
     parents.push(0);
+    let mut kept = 0;
     for j in (0..log).rev() {
-        let mut level_codes = LevelWords::default();
-        level_codes.reserve(parents.len() * n);
-        if full.len() < parents.len() * n {
-            full.resize(parents.len() * n, background);
+        let start = words.len();
+        words.resize(start + (parents.len() * bits).div_ceil(64), 0);
+        let level_words = &mut words[start..];
+        if full.len() < kept + parents.len() * n {
+            full.resize(kept + parents.len() * n, background);
         }
-        let mut kept = 0;
         if j == 0 {
-            for &p in parents.iter() {
+            for (i, &p) in parents.iter().enumerate() {
                 let mut packed = 0;
                 for (c, &v) in voxels[p * n..p * n + n].iter().enumerate() {
                     let is_full = !v.same(background);
@@ -287,13 +326,13 @@ fn brick_tree<const K: usize, V: Value>(
                     full[kept] = v;
                     kept += usize::from(is_full);
                 }
-                level_codes.push(packed, n);
+                level_words[i * bits / 64] |= packed << (i * bits % 64);
             }
         } else {
             next.clear();
             next.resize(parents.len() * n, 0);
             let mut with_children = 0;
-            for &p in parents.iter() {
+            for (i, &p) in parents.iter().enumerate() {
                 let at = starts[j] + p * n;
                 let mut packed = 0;
                 for (c, (&code, &v)) in codes[at..at + n]
@@ -307,25 +346,30 @@ fn brick_tree<const K: usize, V: Value>(
                     next[with_children] = p * n + c;
                     with_children += usize::from(code >= PARTIAL);
                 }
-                level_codes.push(packed, n);
+                level_words[i * bits / 64] |= packed << (i * bits % 64);
             }
             next.truncate(with_children);
         }
-        let full = if V::STORED {
-            full[..kept].to_vec()
-        } else {
-            Vec::new()
-        };
-        levels.push(ValuedLevel::from_parts(level_codes, full));
         std::mem::swap(parents, next);
         if j == 0 || parents.is_empty() {
             break;
         }
     }
-    for v in levels.iter().flat_map(ValuedLevel::values) {
-        v.check().ok()?;
+    let values = if V::STORED {
+        full[..kept].to_vec()
+    } else {
+        Vec::new()
+    };
+    if V::REFUSES {
+        for v in &values {
+            v.check().ok()?;
+        }
     }
-    Some(BrickTree { root, levels })
+    Some(BrickTree {
+        root,
+        words: words.clone(),
+        values,
+    })
 }
 
 /// The 2-bit codes of a node's states, as the files and [`ValuedLevel`] write them.
@@ -357,11 +401,12 @@ impl<V> RowScratch<V> {
 
 /// The memory [`brick_tree`] works in, kept from one brick to the next: the cells above the voxels,
 /// level after level (each one's code, and its value — the first voxel's, meaningful when it is full),
-/// the values of a level's full nodes as they are found, and the nodes with children of a level and of
-/// the next.
+/// the subtree's codes and the values of its full nodes as they are found, and the nodes with children
+/// of a level and of the next.
 struct BrickScratch<V> {
     codes: Vec<u8>,
     values: Vec<V>,
+    words: Vec<u64>,
     full: Vec<V>,
     parents: Vec<usize>,
     next: Vec<usize>,
@@ -372,6 +417,7 @@ impl<V> BrickScratch<V> {
         Self {
             codes: Vec::new(),
             values: Vec::new(),
+            words: Vec::new(),
             full: Vec::new(),
             parents: Vec::new(),
             next: Vec::new(),
@@ -383,8 +429,9 @@ impl<V> BrickScratch<V> {
 /// bricks in the same order): each brick's first voxel's value if every voxel of the brick holds it,
 /// else its subtree ([`brick_tree`]). The array is read once in its own order, a row of bricks at a
 /// time — each row's pieces compared with the first voxels of their bricks, so that memory is streamed
-/// rather than visited brick by brick, the next row [`prefetch`]ed meanwhile (rows of a row of bricks
-/// lie a page or more apart, which the processor's own prefetching does not follow). A brick's voxels
+/// rather than visited brick by brick, the row at least 4 KiB ahead [`prefetch`]ed meanwhile (rows of a
+/// row of bricks lie a page or more apart every `brick` rows, which the processor's own prefetching does
+/// not follow; one row ahead is too little time for memory to answer when rows are short). A brick's voxels
 /// are gathered in Morton order from the piece where one first differs from its first voxel (those
 /// before it all held the first voxel's value), so that no voxel is read twice; the row's bricks of
 /// several values are built once the row is read. Slabs of bricks along the last axis run on the rayon
@@ -427,6 +474,22 @@ fn read_bricks<const K: usize, V: Value>(
     // axis 0) within a slab has rows of voxels at `brick^(K - 1)` offsets.
     let slab_bricks = grid.pow(K as u32 - 1);
     let slab_voxels = side.pow(K as u32 - 1) * brick;
+    let rows_of_bricks = slab_bricks / grid;
+    // The first voxel of a row of bricks in its slab: its coordinates along axes 1 … K − 2 are those of
+    // the row of bricks times the brick's side.
+    let corner_of = |row_of_bricks: usize| {
+        let (mut corner, mut rest, mut step) = (0, row_of_bricks, side);
+        for _ in 1..K - 1 {
+            corner += (rest % grid) * brick * step;
+            rest /= grid;
+            step *= side;
+        }
+        corner
+    };
+    // Rows are asked for far enough ahead that memory has time to answer: at least 4 KiB ahead, and
+    // no further than a brick's rows.
+    let row_bytes = side * std::mem::size_of::<V>().max(1);
+    let distance = 4096usize.div_ceil(row_bytes).clamp(1, brick_rows.len());
     let mut bricks: Vec<(V, bool)> = vec![(dense[0], true); grid.pow(K as u32)];
     let mut trees: Vec<Option<BrickTree<V>>> = Vec::new();
     trees.resize_with(bricks.len(), || None);
@@ -440,22 +503,24 @@ fn read_bricks<const K: usize, V: Value>(
                 .zip(trees.chunks_exact_mut(grid))
                 .enumerate()
             {
-                // The first voxel of the row of bricks: its coordinates along axes 1 … K − 2 are those
-                // of the row of bricks times the brick's side.
-                let (mut corner, mut rest, mut step) = (0, row_of_bricks, side);
-                for _ in 1..K - 1 {
-                    corner += (rest % grid) * brick * step;
-                    rest /= grid;
-                    step *= side;
-                }
+                let corner = corner_of(row_of_bricks);
+                // Where the rows `distance` ahead begin: the rows of this row of bricks, then those
+                // of the next one in the slab, if any.
+                let next =
+                    (row_of_bricks + 1 < rows_of_bricks).then(|| corner_of(row_of_bricks + 1));
+                let ahead_of = |r: usize| match (brick_rows.get(r + distance), next) {
+                    (Some(&(offset, _)), _) => corner + offset,
+                    (None, Some(next)) => next + brick_rows[r + distance - brick_rows.len()].0,
+                    (None, None) => voxels.len(),
+                };
                 scratch.mixed.clear();
                 scratch.mixed.resize(grid, None);
                 scratch.voxels.clear();
                 for (r, &(offset, morton)) in brick_rows.iter().enumerate() {
                     let start = corner + offset;
                     let row = &voxels[start..start + side];
-                    // The next row, asked for piece by piece while this one is read.
-                    let ahead = corner + brick_rows.get(r + 1).map_or(offset, |next| next.0);
+                    // The row `distance` ahead, asked for piece by piece while this one is read.
+                    let ahead = ahead_of(r);
                     for (b, (((first, uniform), mixed), piece)) in bricks
                         .iter_mut()
                         .zip(scratch.mixed.iter_mut())

@@ -35,11 +35,6 @@ impl<V: Value> ValuedLevel<V> {
         level
     }
 
-    /// The level of `codes` and the values of its full nodes, in order (one for each code `01`).
-    pub(crate) fn from_parts(codes: LevelWords, values: Vec<V>) -> Self {
-        Self { codes, values }
-    }
-
     /// The number of nodes.
     pub(crate) fn len(&self) -> usize {
         self.codes.len()
@@ -88,6 +83,13 @@ impl<V: Value> ValuedLevel<V> {
             }
             self.codes.push(codes, chunk.len());
         }
+    }
+
+    /// Appends `nodes` codes packed in `words` (see [`LevelWords::append_words`]) and the values of
+    /// their full nodes.
+    pub(crate) fn append_words(&mut self, words: &[u64], nodes: usize, values: &[V]) {
+        self.codes.append_words(words, nodes);
+        self.values.extend_from_slice(values);
     }
 
     /// Appends the nodes of `other` after these (its codes shifted into place, or moved when this level
