@@ -78,7 +78,7 @@ pub(super) struct Dense<'a, const K: usize, V> {
     bricks: Vec<Option<V>>,
     /// The subtree of each brick of several values, in the same order (`None` for a brick of one
     /// value, and for one holding a value [`Value::check`] refuses: that one is built cell by cell).
-    trees: Vec<Mutex<Option<BrickTree<V>>>>,
+    trees: Vec<BrickSlot<V>>,
 }
 
 impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
@@ -93,7 +93,7 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
             background,
             brick_log,
             bricks,
-            trees: trees.into_iter().map(Mutex::new).collect(),
+            trees,
         }
     }
 
@@ -193,6 +193,9 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
         Ok(state)
     }
 }
+
+/// Where a brick's subtree waits until the cell it is the child of takes it (on whichever thread).
+type BrickSlot<V> = Mutex<Option<BrickTree<V>>>;
 
 /// The subtree of a brick of several values: its root's state, the 2-bit codes of each level below it
 /// in level order (the root's children first), each level from a word of its own, and the values of
@@ -442,7 +445,7 @@ fn read_bricks<const K: usize, V: Value>(
     level: u32,
     brick_log: u32,
     background: V,
-) -> (Vec<Option<V>>, Vec<Option<BrickTree<V>>>) {
+) -> (Vec<Option<V>>, Vec<BrickSlot<V>>) {
     let side = 1usize << level;
     let brick = 1usize << brick_log;
     let grid = side >> brick_log;
@@ -453,8 +456,11 @@ fn read_bricks<const K: usize, V: Value>(
         return dense
             .par_chunks(brick)
             .map_init(BrickScratch::new, |scratch, piece| match uniform(piece) {
-                Some(v) => (Some(v), None),
-                None => (None, brick_tree::<K, V>(piece, log, background, scratch)),
+                Some(v) => (Some(v), Mutex::new(None)),
+                None => (
+                    None,
+                    Mutex::new(brick_tree::<K, V>(piece, log, background, scratch)),
+                ),
             })
             .unzip();
     }
@@ -491,8 +497,8 @@ fn read_bricks<const K: usize, V: Value>(
     let row_bytes = side * std::mem::size_of::<V>().max(1);
     let distance = 4096usize.div_ceil(row_bytes).clamp(1, brick_rows.len());
     let mut bricks: Vec<(V, bool)> = vec![(dense[0], true); grid.pow(K as u32)];
-    let mut trees: Vec<Option<BrickTree<V>>> = Vec::new();
-    trees.resize_with(bricks.len(), || None);
+    let mut trees: Vec<BrickSlot<V>> = Vec::new();
+    trees.resize_with(bricks.len(), || Mutex::new(None));
     bricks
         .par_chunks_mut(slab_bricks)
         .zip(trees.par_chunks_mut(slab_bricks))
@@ -555,7 +561,12 @@ fn read_bricks<const K: usize, V: Value>(
                 for (&mixed, tree) in scratch.mixed.iter().zip(trees.iter_mut()) {
                     if let Some(at) = mixed {
                         let gathered = &scratch.voxels[at..at + brick_voxels];
-                        *tree = brick_tree::<K, V>(gathered, log, background, &mut scratch.brick);
+                        *tree = Mutex::new(brick_tree::<K, V>(
+                            gathered,
+                            log,
+                            background,
+                            &mut scratch.brick,
+                        ));
                     }
                 }
             }
