@@ -194,7 +194,8 @@ impl<'a, const K: usize, V: Value> Dense<'a, K, V> {
     }
 }
 
-/// Where a brick's subtree waits until the cell it is the child of takes it (on whichever thread).
+/// Where a brick's subtree waits, from the read of its row until the depth-first build reaches its
+/// cell (on whichever thread).
 type BrickSlot<V> = Mutex<Option<BrickTree<V>>>;
 
 /// The subtree of a brick of several values: its root's state, the 2-bit codes of each level below it
@@ -358,20 +359,21 @@ fn brick_tree<const K: usize, V: Value>(
             break;
         }
     }
-    let values = if V::STORED {
+    // Copied out of the scratch, which the next brick reuses.
+    let full_values = if V::STORED {
         full[..kept].to_vec()
     } else {
         Vec::new()
     };
     if V::REFUSES {
-        for v in &values {
+        for v in &full_values {
             v.check().ok()?;
         }
     }
     Some(BrickTree {
         root,
-        words: words.clone(),
-        values,
+        words: words.to_vec(),
+        values: full_values,
     })
 }
 
@@ -517,6 +519,7 @@ fn read_bricks<const K: usize, V: Value>(
                 let ahead_of = |r: usize| match (brick_rows.get(r + distance), next) {
                     (Some(&(offset, _)), _) => corner + offset,
                     (None, Some(next)) => next + brick_rows[r + distance - brick_rows.len()].0,
+                    // Past the end: no hint.
                     (None, None) => voxels.len(),
                 };
                 scratch.mixed.clear();
