@@ -1,6 +1,6 @@
 //! Building a valued tree straight from a dense array of values: a cell whose voxels all hold one value
 //! (or all the background) is a leaf; any other cell is built from its `2^K` children.
-//! The array is read once in its own order (streamed, not visited cell by cell, the rows 4 KiB ahead
+//! The array is read once in its own order (streamed, not visited cell by cell, the rows 16 KiB ahead
 //! asked of memory while one is read), a row of bricks — cells of about 4096 voxels — at a time: which bricks
 //! hold one value is noted, and the voxels of each other brick are gathered in Morton order as they are
 //! read, from the first that differs from the brick's first voxel (all before it held that value); its
@@ -434,7 +434,7 @@ impl<V> BrickScratch<V> {
 /// bricks in the same order): each brick's first voxel's value if every voxel of the brick holds it,
 /// else its subtree ([`brick_tree`]). The array is read once in its own order, a row of bricks at a
 /// time — each row's pieces compared with the first voxels of their bricks, so that memory is streamed
-/// rather than visited brick by brick, the row at least 4 KiB ahead [`prefetch`]ed meanwhile (rows of a
+/// rather than visited brick by brick, the row at least 16 KiB ahead [`prefetch`]ed meanwhile (rows of a
 /// row of bricks lie a page or more apart every `brick` rows, which the processor's own prefetching does
 /// not follow; one row ahead is too little time for memory to answer when rows are short). A brick's voxels
 /// are gathered in Morton order from the piece where one first differs from its first voxel (those
@@ -494,10 +494,10 @@ fn read_bricks<const K: usize, V: Value>(
         }
         corner
     };
-    // Rows are asked for far enough ahead that memory has time to answer: at least 4 KiB ahead, and
+    // Rows are asked for far enough ahead that memory has time to answer: at least 16 KiB ahead, and
     // no further than a brick's rows.
     let row_bytes = side * std::mem::size_of::<V>().max(1);
-    let distance = 4096usize.div_ceil(row_bytes).clamp(1, brick_rows.len());
+    let distance = 16384usize.div_ceil(row_bytes).clamp(1, brick_rows.len());
     let mut bricks: Vec<(V, bool)> = vec![(dense[0], true); grid.pow(K as u32)];
     let mut trees: Vec<BrickSlot<V>> = Vec::new();
     trees.resize_with(bricks.len(), || Mutex::new(None));
