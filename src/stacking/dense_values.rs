@@ -29,7 +29,9 @@ use crate::rays::RayError;
 use crate::space::{spread_bits, Cell, Universe};
 use crate::tree::top_down::Subtree;
 use crate::tree::valued::{combine, ValueState, ValuedLevel};
-use crate::tree::words::{children_mask, full_count};
+use crate::tree::words::{
+    children_mask, full_count, EMPTY_CODE, FULL_CODE, MIXED_CODE, PARTIAL_CODE,
+};
 use crate::value::Value;
 use crate::KTree;
 
@@ -262,7 +264,9 @@ fn brick_tree<const K: usize, V: Value>(
         next,
     } = scratch;
     // The cells of side 2, then each level above appended after the one below it; `starts[j]` where
-    // level j begins (level 0, the voxels, is `voxels`).
+    // level j begins (level 0, the voxels, is `voxels`). A cell is settled by [`combine`]'s rule, on the
+    // codes and values of its children rather than their states: a voxel's code is its state's,
+    // `EMPTY_CODE` (0) or `FULL_CODE` (1), and `PARTIAL_CODE + 1` is `MIXED_CODE`.
     codes.clear();
     values.clear();
     codes.extend(voxels.chunks_exact(n).map(|kids| {
@@ -272,7 +276,7 @@ fn brick_tree<const K: usize, V: Value>(
         if same {
             u8::from(!first.same(background))
         } else {
-            PARTIAL + u8::from(!any_empty)
+            PARTIAL_CODE + u8::from(!any_empty)
         }
     }));
     values.extend(voxels.chunks_exact(n).map(|kids| kids[0]));
@@ -283,27 +287,31 @@ fn brick_tree<const K: usize, V: Value>(
         for i in (below..starts[j]).step_by(n) {
             let (kid_codes, kid_values) = (&codes[i..i + n], &values[i..i + n]);
             let first = kid_values[0];
-            let all_full = kid_codes.iter().fold(true, |all, &c| all & (c == FULL));
+            let all_full = kid_codes
+                .iter()
+                .fold(true, |all, &c| all & (c == FULL_CODE));
             let same = kid_values.iter().fold(true, |all, v| all & v.same(first));
-            let empty = kid_codes.iter().fold(true, |all, &c| all & (c == EMPTY));
+            let empty = kid_codes
+                .iter()
+                .fold(true, |all, &c| all & (c == EMPTY_CODE));
             // Full or mixed: every voxel holds a value.
             let valued = kid_codes.iter().fold(true, |all, &c| all & (c & 1 == 1));
             codes.push(if all_full && same {
-                FULL
+                FULL_CODE
             } else if empty {
-                EMPTY
+                EMPTY_CODE
             } else if valued {
-                MIXED
+                MIXED_CODE
             } else {
-                PARTIAL
+                PARTIAL_CODE
             });
             values.push(first);
         }
     }
     let root = match codes[starts[log]] {
-        EMPTY => ValueState::Empty,
-        FULL => ValueState::Full(values[starts[log]]),
-        PARTIAL => ValueState::Partial,
+        EMPTY_CODE => ValueState::Empty,
+        FULL_CODE => ValueState::Full(values[starts[log]]),
+        PARTIAL_CODE => ValueState::Partial,
         _ => ValueState::Mixed,
     };
     // Top down: the children of the nodes with children, level by level, each child's code and (if it
@@ -346,9 +354,9 @@ fn brick_tree<const K: usize, V: Value>(
                 {
                     packed |= u64::from(code) << (2 * c);
                     full[kept] = v;
-                    kept += usize::from(code == FULL);
+                    kept += usize::from(code == FULL_CODE);
                     next[with_children] = p * n + c;
-                    with_children += usize::from(code >= PARTIAL);
+                    with_children += usize::from(code >= PARTIAL_CODE);
                 }
                 level_words[i * bits / 64] |= packed << (i * bits % 64);
             }
@@ -376,12 +384,6 @@ fn brick_tree<const K: usize, V: Value>(
         values: full_values,
     })
 }
-
-/// The 2-bit codes of a node's states, as the files and [`ValuedLevel`] write them.
-const EMPTY: u8 = 0;
-const FULL: u8 = 1;
-const PARTIAL: u8 = 2;
-const MIXED: u8 = 3;
 
 /// The memory a thread reads its rows of bricks in, kept from one row to the next: for each brick of
 /// the row, where its voxels are copied (in Morton order) once it is found to hold several values, those

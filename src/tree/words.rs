@@ -1,15 +1,26 @@
 //! Words of packed 2-bit node codes: the one place that knows the bit layout of a level.
 //!
 //! A level of a tree (in memory, in a `.ktree` version 2 file, in a spill file) is a sequence of 2-bit codes
-//! (`00` empty, `01` full, `10` partial, `11` unused) in `u64` words, node `i` at bits `2·(i mod 32)` of
-//! word `i / 32`. This module holds the masks that pick out full and partial nodes from a word, the
-//! complement of a word's leaves, reading codes at any node offset, and [`WordPacker`], the one shifted
-//! appender: codes appended at any offset come out as whole words.
+//! (`00` empty, `01` full, `10` partial, `11` unused in a binary tree and mixed in a valued one: the
+//! `*_CODE` constants) in `u64` words, node `i` at bits `2·(i mod 32)` of word `i / 32`. This module
+//! holds the masks that pick out full and partial nodes from a word, the complement of a word's leaves,
+//! reading codes at any node offset, and [`WordPacker`], the one shifted appender: codes appended at any
+//! offset come out as whole words.
 
 use super::states::NodeState;
 
 /// Nodes in a word.
 pub(crate) const NODES_PER_WORD: usize = 32;
+
+/// The code of an empty node.
+pub(crate) const EMPTY_CODE: u8 = 0b00;
+/// The code of a full node (in a valued tree, every voxel holding the one value it keeps).
+pub(crate) const FULL_CODE: u8 = 0b01;
+/// The code of a node with children that has empty voxels.
+pub(crate) const PARTIAL_CODE: u8 = 0b10;
+/// The code of a valued tree's node with children whose voxels all hold a value, not all equal; unused
+/// in a binary tree.
+pub(crate) const MIXED_CODE: u8 = 0b11;
 
 /// The low bit of every 2-bit slot.
 pub(crate) const LOW_BITS: u64 = 0x5555_5555_5555_5555;
@@ -233,6 +244,27 @@ impl LevelWords {
 mod tests {
     use super::*;
     use crate::testing::Lcg;
+
+    /// Each code read back by the masks, in every slot of a word.
+    #[test]
+    fn the_codes_are_what_the_masks_read() {
+        let read = |code: u8, slot: usize| {
+            let word = u64::from(code) << (2 * slot);
+            let bit = |mask: u64| mask >> (2 * slot) & 1 == 1;
+            (
+                bit(full_mask(word)),
+                bit(partial_mask(word)),
+                bit(children_mask(word)),
+                bit(unused_mask(word)),
+            )
+        };
+        for slot in 0..NODES_PER_WORD {
+            assert_eq!(read(EMPTY_CODE, slot), (false, false, false, false));
+            assert_eq!(read(FULL_CODE, slot), (true, false, false, false));
+            assert_eq!(read(PARTIAL_CODE, slot), (false, true, true, false));
+            assert_eq!(read(MIXED_CODE, slot), (false, false, true, true));
+        }
+    }
 
     /// Random 2-bit codes 0…2 from a fixed seed.
     fn codes(n: usize, seed: u64) -> Vec<u64> {

@@ -3,7 +3,9 @@
 
 use super::ValueState;
 use crate::tree::states::PackedStates;
-use crate::tree::words::{LevelWords, NODES_PER_WORD};
+use crate::tree::words::{
+    LevelWords, EMPTY_CODE, FULL_CODE, MIXED_CODE, NODES_PER_WORD, PARTIAL_CODE,
+};
 use crate::value::Value;
 
 /// A level of a valued tree being written: 2 bits a node and the values of its full nodes, nothing more.
@@ -53,17 +55,18 @@ impl<V: Value> ValuedLevel<V> {
     /// The code of `state`, its value (if it is full) kept.
     #[inline(always)]
     fn code(&mut self, state: ValueState<V>) -> u64 {
-        match state {
-            ValueState::Empty => 0,
+        let code = match state {
+            ValueState::Empty => EMPTY_CODE,
             ValueState::Full(v) => {
                 if V::STORED {
                     self.values.push(v);
                 }
-                1
+                FULL_CODE
             }
-            ValueState::Partial => 2,
-            ValueState::Mixed => 3,
-        }
+            ValueState::Partial => PARTIAL_CODE,
+            ValueState::Mixed => MIXED_CODE,
+        };
+        u64::from(code)
     }
 
     /// Appends a node.
