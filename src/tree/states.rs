@@ -1,5 +1,11 @@
 //! Node states packed two bits a node (Meagher's encoding), with a rank index over the partial nodes.
 
+use super::words::{
+    children_mask, full_count, full_mask, partial_mask, unused_mask, EMPTY_CODE, FULL_CODE,
+    NODES_PER_WORD, PARTIAL_CODE,
+};
+use super::TreeError;
+
 /// The state of a k-tree node ("obel"): wholly outside the object, wholly inside, or mixed.
 ///
 /// The discriminants are the 2-bit codes stored in trees and in `.ktree` files.
@@ -7,20 +13,20 @@
 #[repr(u8)]
 pub enum NodeState {
     /// No voxel of the node belongs to the object (code `00`).
-    Empty = 0,
+    Empty = EMPTY_CODE,
     /// Every voxel of the node belongs to the object (code `01`).
-    Full = 1,
+    Full = FULL_CODE,
     /// Some voxels do, some do not: the node has `2^K` children (code `10`).
-    Partial = 2,
+    Partial = PARTIAL_CODE,
 }
 
 impl NodeState {
     /// The state of a 2-bit code, `None` for the unused code `11`.
     pub fn from_code(code: u8) -> Option<Self> {
         match code {
-            0 => Some(Self::Empty),
-            1 => Some(Self::Full),
-            2 => Some(Self::Partial),
+            EMPTY_CODE => Some(Self::Empty),
+            FULL_CODE => Some(Self::Full),
+            PARTIAL_CODE => Some(Self::Partial),
             _ => None,
         }
     }
@@ -41,11 +47,6 @@ impl NodeState {
         self != Self::Partial
     }
 }
-
-use super::words::{
-    children_mask, full_count, full_mask, partial_mask, unused_mask, NODES_PER_WORD,
-};
-use super::TreeError;
 
 /// Words per rank block: 256 nodes share one 16-bit block rank.
 const WORDS_PER_BLOCK: usize = 8;
